@@ -1,0 +1,83 @@
+#pragma once
+// Non-owning image views and owning images with a typed pixel format.
+// Rows are `stride` elements apart; pixel (x, y) has its centre at (x + 0.5, y + 0.5).
+#include <cstddef>
+#include <cstdint>
+#include <type_traits>
+#include <vector>
+
+#include <glm/vec2.hpp>
+#include <glm/vec3.hpp>
+#include <glm/vec4.hpp>
+
+#include "reprise/core/status.hpp"
+
+namespace reprise {
+
+template <class T>
+struct ImageView {
+    T* data = nullptr;
+    int width = 0;
+    int height = 0;
+    std::ptrdiff_t stride = 0;  // in elements
+
+    T* row(int y) const { return data + y * stride; }
+    T& operator()(int x, int y) const { return data[y * stride + x]; }
+    bool empty() const { return width <= 0 || height <= 0; }
+    std::size_t pixel_count() const { return std::size_t(width) * std::size_t(height); }
+
+    operator ImageView<const T>() const
+        requires(!std::is_const_v<T>)
+    {
+        return {data, width, height, stride};
+    }
+};
+
+template <class T>
+class Image {
+public:
+    Image() = default;
+    Image(int width, int height, T fill = T{}) { resize(width, height, fill); }
+
+    void resize(int width, int height, T fill = T{}) {
+        REPRISE_ASSERT(width >= 0 && height >= 0);
+        width_ = width;
+        height_ = height;
+        pixels_.assign(std::size_t(width) * std::size_t(height), fill);
+    }
+    void clear() { resize(0, 0); }
+
+    int width() const { return width_; }
+    int height() const { return height_; }
+    bool empty() const { return pixels_.empty(); }
+    std::size_t pixel_count() const { return pixels_.size(); }
+
+    T* data() { return pixels_.data(); }
+    const T* data() const { return pixels_.data(); }
+    T& operator()(int x, int y) { return pixels_[std::size_t(y) * width_ + x]; }
+    const T& operator()(int x, int y) const { return pixels_[std::size_t(y) * width_ + x]; }
+
+    ImageView<T> view() { return {pixels_.data(), width_, height_, width_}; }
+    ImageView<const T> view() const { return {pixels_.data(), width_, height_, width_}; }
+
+    bool operator==(const Image&) const = default;
+
+private:
+    std::vector<T> pixels_;
+    int width_ = 0;
+    int height_ = 0;
+};
+
+// Largest width or height reprise accepts from files and arguments.
+inline constexpr int kMaxImageSide = 16384;
+
+// Checks a size that came from untrusted data; `what` names its origin.
+inline Status check_image_size(int width, int height, const std::string& what) {
+    if (width <= 0 || height <= 0 || width > kMaxImageSide || height > kMaxImageSide)
+        return Status::error(what + ": image size " + std::to_string(width) + "x" +
+                             std::to_string(height) + " is outside 1.." +
+                             std::to_string(kMaxImageSide));
+    return {};
+}
+
+}  // namespace reprise

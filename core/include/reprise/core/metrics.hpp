@@ -1,0 +1,33 @@
+#pragma once
+// Image error on display values (sRGB-encoded after clamping linear light to [0, 1]).
+#include <cstdint>
+
+#include "reprise/core/image.hpp"
+
+namespace reprise {
+
+// Display RGB in [0, 1] from linear RGBA (alpha ignored).
+void to_display(ImageView<const glm::vec4> linear, ImageView<glm::vec3> display);
+
+struct ImageError {
+    double psnr = 0.0;  // dB over RGB, +inf for identical images
+    double ssim = 0.0;  // mean SSIM over RGB (OpenCV quality), 1 for identical images
+    double flip = 0.0;  // mean LDR-FLIP, 0 for identical images
+};
+
+// All three metrics between two display images of the same size. A non-empty `mask`
+// (nonzero = counted) restricts the means to its pixels.
+ImageError image_error(ImageView<const glm::vec3> reference, ImageView<const glm::vec3> test,
+                       ImageView<const uint8_t> mask = {});
+
+double psnr(ImageView<const glm::vec3> reference, ImageView<const glm::vec3> test,
+            ImageView<const uint8_t> mask = {});
+double ssim(ImageView<const glm::vec3> reference, ImageView<const glm::vec3> test,
+            ImageView<const uint8_t> mask = {});
+// Per-pixel LDR-FLIP error (Andersson et al. 2020, 67 pixels per degree by default) into
+// `error_map` when it is not empty; returns the mean over the mask.
+double flip(ImageView<const glm::vec3> reference, ImageView<const glm::vec3> test,
+            ImageView<const uint8_t> mask = {}, ImageView<float> error_map = {},
+            float pixels_per_degree = 67.0f);
+
+}  // namespace reprise
