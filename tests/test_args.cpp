@@ -1,6 +1,6 @@
 #include <gtest/gtest.h>
 
-#include "../tools/args.hpp"
+#include "args.hpp"
 
 using reprise::cli::Args;
 
