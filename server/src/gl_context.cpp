@@ -1,1 +1,129 @@
-// placeholder until written
+#include "reprise/server/gl_context.hpp"
+
+#include <cstdlib>
+#include <cstring>
+#include <vector>
+
+#include <EGL/egl.h>
+#include <EGL/eglext.h>
+#include <GLES3/gl32.h>
+
+namespace reprise::server {
+
+namespace {
+
+bool has_extension(const char* list, const char* name) {
+    if (!list) return false;
+    const std::size_t n = std::strlen(name);
+    for (const char* p = list; (p = std::strstr(p, name)); p += n)
+        if ((p == list || p[-1] == ' ') && (p[n] == ' ' || p[n] == '\0')) return true;
+    return false;
+}
+
+// The first EGL device backed by real hardware (not Mesa's software device).
+EGLDisplay hardware_display() {
+    auto query_devices = reinterpret_cast<PFNEGLQUERYDEVICESEXTPROC>(eglGetProcAddress("eglQueryDevicesEXT"));
+    auto query_string = reinterpret_cast<PFNEGLQUERYDEVICESTRINGEXTPROC>(
+        eglGetProcAddress("eglQueryDeviceStringEXT"));
+    auto get_display = reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(
+        eglGetProcAddress("eglGetPlatformDisplayEXT"));
+    if (!query_devices || !query_string || !get_display) return EGL_NO_DISPLAY;
+    EGLint count = 0;
+    if (!query_devices(0, nullptr, &count) || count <= 0) return EGL_NO_DISPLAY;
+    std::vector<EGLDeviceEXT> devices(count);
+    query_devices(count, devices.data(), &count);
+    for (EGLDeviceEXT device : devices) {
+        const char* extensions = query_string(device, EGL_EXTENSIONS);
+        if (has_extension(extensions, "EGL_MESA_device_software")) continue;
+        EGLDisplay display = get_display(EGL_PLATFORM_DEVICE_EXT, device, nullptr);
+        if (display != EGL_NO_DISPLAY) return display;
+    }
+    return EGL_NO_DISPLAY;
+}
+
+EGLDisplay surfaceless_display() {
+    auto get_display = reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(
+        eglGetProcAddress("eglGetPlatformDisplayEXT"));
+    if (!get_display) return EGL_NO_DISPLAY;
+    return get_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
+}
+
+}  // namespace
+
+Status GlContext::create(std::unique_ptr<GlContext>& context) {
+    const char* forced = std::getenv("REPRISE_EGL");
+    std::string mode = forced ? forced : "";
+    if (!mode.empty() && mode != "device" && mode != "surfaceless")
+        return Status::error("REPRISE_EGL='" + mode + "': expected device or surfaceless");
+    const char* client_extensions = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
+    EGLDisplay display = EGL_NO_DISPLAY;
+    if (mode != "surfaceless" && has_extension(client_extensions, "EGL_EXT_device_enumeration"))
+        display = hardware_display();
+    if (display == EGL_NO_DISPLAY && mode == "device")
+        return Status::error("EGL: no hardware EGL device found (REPRISE_EGL=device)");
+    if (display == EGL_NO_DISPLAY) {
+        if (!has_extension(client_extensions, "EGL_MESA_platform_surfaceless"))
+            return Status::error("EGL: Mesa's surfaceless platform is not available "
+                                 "(install libegl-mesa0 and libgl1-mesa-dri)");
+        display = surfaceless_display();
+    }
+    EGLint major = 0, minor = 0;
+    if (display == EGL_NO_DISPLAY || !eglInitialize(display, &major, &minor))
+        return Status::error("EGL: cannot initialise a display (error 0x" +
+                             std::to_string(eglGetError()) + ")");
+    if (!eglBindAPI(EGL_OPENGL_ES_API)) return Status::error("EGL: OpenGL ES is not supported");
+    const EGLint config_attributes[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_ES3_BIT, EGL_NONE};
+    EGLConfig config = nullptr;
+    EGLint configs = 0;
+    if (!eglChooseConfig(display, config_attributes, &config, 1, &configs) || configs < 1) {
+        eglTerminate(display);
+        return Status::error("EGL: no OpenGL ES 3 configuration");
+    }
+    EGLContext egl_context = EGL_NO_CONTEXT;
+    for (EGLint minor_version : {2, 1, 0}) {
+        const EGLint attributes[] = {EGL_CONTEXT_MAJOR_VERSION, 3, EGL_CONTEXT_MINOR_VERSION,
+                                     minor_version, EGL_NONE};
+        egl_context = eglCreateContext(display, config, EGL_NO_CONTEXT, attributes);
+        if (egl_context != EGL_NO_CONTEXT) break;
+    }
+    if (egl_context == EGL_NO_CONTEXT) {
+        eglTerminate(display);
+        return Status::error("EGL: cannot create an OpenGL ES 3 context");
+    }
+    if (!eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, egl_context)) {
+        eglDestroyContext(display, egl_context);
+        eglTerminate(display);
+        return Status::error("EGL: cannot make the context current without a surface");
+    }
+    context.reset(new GlContext());
+    context->display_ = display;
+    context->context_ = egl_context;
+    const char* renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+    const char* version = reinterpret_cast<const char*>(glGetString(GL_VERSION));
+    context->description_ = std::string(renderer ? renderer : "?") + ", " + (version ? version : "?");
+    const char* gl_extensions = reinterpret_cast<const char*>(glGetString(GL_EXTENSIONS));
+    GLint gl_major = 0, gl_minor = 0;
+    glGetIntegerv(GL_MAJOR_VERSION, &gl_major);
+    glGetIntegerv(GL_MINOR_VERSION, &gl_minor);
+    bool float_targets = gl_major > 3 || (gl_major == 3 && gl_minor >= 2) ||
+                         has_extension(gl_extensions, "GL_EXT_color_buffer_float");
+    if (!float_targets) {
+        context.reset();
+        return Status::error("OpenGL ES: float render targets (GL_EXT_color_buffer_float) are "
+                             "not supported");
+    }
+    return {};
+}
+
+GlContext::~GlContext() {
+    if (!display_) return;
+    eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    if (context_) eglDestroyContext(display_, context_);
+    eglTerminate(display_);
+}
+
+void GlContext::make_current() const {
+    eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_);
+}
+
+}  // namespace reprise::server

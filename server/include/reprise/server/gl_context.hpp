@@ -1,0 +1,28 @@
+#pragma once
+// A headless OpenGL ES 3 context through EGL: a real GPU's EGL device when one is present,
+// else Mesa's surfaceless platform (llvmpipe). REPRISE_EGL=surfaceless|device forces one.
+#include <memory>
+#include <string>
+
+#include "reprise/core/status.hpp"
+
+namespace reprise::server {
+
+class GlContext {
+public:
+    static Status create(std::unique_ptr<GlContext>& context);
+    ~GlContext();
+    GlContext(const GlContext&) = delete;
+    GlContext& operator=(const GlContext&) = delete;
+
+    void make_current() const;
+    const std::string& description() const { return description_; }  // "llvmpipe (LLVM ...)"
+
+private:
+    GlContext() = default;
+    void* display_ = nullptr;
+    void* context_ = nullptr;
+    std::string description_;
+};
+
+}  // namespace reprise::server

@@ -1,0 +1,80 @@
+#pragma once
+// GLSL ES 3.00 shaders of the G-buffer pass. Vertices arrive posed in world space (current and
+// previous instant); the fragment shader writes colour, (depth, motion, id) and the normal.
+
+namespace reprise::server::shaders {
+
+inline constexpr const char* kVertex = R"(#version 300 es
+uniform mat4 u_view_projection;           // jittered, for rasterisation
+uniform mat4 u_view;
+uniform mat4 u_previous_view_projection;  // unjittered
+layout(location = 0) in vec3 a_position;
+layout(location = 1) in vec3 a_previous_position;
+layout(location = 2) in vec3 a_normal;
+layout(location = 3) in vec2 a_uv;
+out vec4 v_previous_clip;
+out vec3 v_world;
+out vec3 v_normal;
+out vec2 v_uv;
+out float v_depth;
+void main() {
+    vec4 world = vec4(a_position, 1.0);
+    gl_Position = u_view_projection * world;
+    v_previous_clip = u_previous_view_projection * vec4(a_previous_position, 1.0);
+    v_world = a_position;
+    v_normal = a_normal;
+    v_uv = a_uv;
+    v_depth = -(u_view * world).z;
+}
+)";
+
+inline constexpr const char* kFragment = R"(#version 300 es
+precision highp float;
+uniform vec2 u_size;
+uniform vec2 u_jitter;
+uniform vec3 u_eye;
+uniform vec3 u_light_direction;
+uniform vec3 u_light_color;
+uniform vec3 u_ambient;
+uniform vec4 u_base_color;
+uniform bool u_textured;
+uniform bool u_lit;
+uniform float u_specular;
+uniform float u_shininess;
+uniform float u_id;
+uniform sampler2D u_texture;
+in vec4 v_previous_clip;
+in vec3 v_world;
+in vec3 v_normal;
+in vec2 v_uv;
+in float v_depth;
+layout(location = 0) out vec4 o_color;
+layout(location = 1) out vec4 o_depth_motion_id;
+layout(location = 2) out vec4 o_normal;
+void main() {
+    vec3 n = normalize(gl_FrontFacing ? v_normal : -v_normal);
+    vec4 base = u_base_color;
+    if (u_textured) base *= texture(u_texture, v_uv);
+    vec3 color = base.rgb;
+    if (u_lit) {
+        vec3 l = -normalize(u_light_direction);
+        vec3 v = normalize(u_eye - v_world);
+        float diffuse = max(dot(n, l), 0.0);
+        float highlight = diffuse > 0.0 ? pow(max(dot(n, normalize(l + v)), 0.0), u_shininess) : 0.0;
+        color = base.rgb * (u_ambient + u_light_color * diffuse) + u_light_color * u_specular * highlight;
+    }
+    // Pixel p (y down) samples the unjittered image at p + jitter; motion is measured there.
+    vec2 here = vec2(gl_FragCoord.x, u_size.y - gl_FragCoord.y) + u_jitter;
+    vec2 motion = vec2(1e30);  // no previous position: behind the previous camera
+    if (v_previous_clip.w > 0.0) {
+        vec2 ndc = v_previous_clip.xy / v_previous_clip.w;
+        vec2 there = vec2((ndc.x * 0.5 + 0.5) * u_size.x, (0.5 - ndc.y * 0.5) * u_size.y);
+        motion = there - here;
+    }
+    o_color = vec4(color, 1.0);
+    o_depth_motion_id = vec4(v_depth, motion, u_id);
+    o_normal = vec4(n, 0.0);
+}
+)";
+
+}  // namespace reprise::server::shaders
