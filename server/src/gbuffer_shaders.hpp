@@ -6,12 +6,14 @@ namespace reprise::server::shaders {
 
 inline constexpr const char* kVertex = R"(#version 300 es
 uniform mat4 u_view_projection;           // jittered, for rasterisation
+uniform mat4 u_unjittered_view_projection;
 uniform mat4 u_view;
 uniform mat4 u_previous_view_projection;  // unjittered
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_previous_position;
 layout(location = 2) in vec3 a_normal;
 layout(location = 3) in vec2 a_uv;
+out vec4 v_clip;
 out vec4 v_previous_clip;
 out vec3 v_world;
 out vec3 v_normal;
@@ -20,6 +22,7 @@ out float v_depth;
 void main() {
     vec4 world = vec4(a_position, 1.0);
     gl_Position = u_view_projection * world;
+    v_clip = u_unjittered_view_projection * world;
     v_previous_clip = u_previous_view_projection * vec4(a_previous_position, 1.0);
     v_world = a_position;
     v_normal = a_normal;
@@ -31,7 +34,6 @@ void main() {
 inline constexpr const char* kFragment = R"(#version 300 es
 precision highp float;
 uniform vec2 u_size;
-uniform vec2 u_jitter;
 uniform vec3 u_eye;
 uniform vec3 u_light_direction;
 uniform vec3 u_light_color;
@@ -43,6 +45,7 @@ uniform float u_specular;
 uniform float u_shininess;
 uniform float u_id;
 uniform sampler2D u_texture;
+in vec4 v_clip;
 in vec4 v_previous_clip;
 in vec3 v_world;
 in vec3 v_normal;
@@ -51,6 +54,10 @@ in float v_depth;
 layout(location = 0) out vec4 o_color;
 layout(location = 1) out vec4 o_depth_motion_id;
 layout(location = 2) out vec4 o_normal;
+vec2 to_pixels(vec4 clip) {  // y down, origin at the top-left corner
+    vec2 ndc = clip.xy / clip.w;
+    return vec2((ndc.x * 0.5 + 0.5) * u_size.x, (0.5 - ndc.y * 0.5) * u_size.y);
+}
 void main() {
     vec3 n = normalize(gl_FrontFacing ? v_normal : -v_normal);
     vec4 base = u_base_color;
@@ -63,14 +70,10 @@ void main() {
         float highlight = diffuse > 0.0 ? pow(max(dot(n, normalize(l + v)), 0.0), u_shininess) : 0.0;
         color = base.rgb * (u_ambient + u_light_color * diffuse) + u_light_color * u_specular * highlight;
     }
-    // Pixel p (y down) samples the unjittered image at p + jitter; motion is measured there.
-    vec2 here = vec2(gl_FragCoord.x, u_size.y - gl_FragCoord.y) + u_jitter;
+    // Both ends through the same arithmetic, so that nothing moving gives exactly 0.
+    // Pixel p samples the unjittered image at p + jitter, which is where `here` lies.
     vec2 motion = vec2(1e30);  // no previous position: behind the previous camera
-    if (v_previous_clip.w > 0.0) {
-        vec2 ndc = v_previous_clip.xy / v_previous_clip.w;
-        vec2 there = vec2((ndc.x * 0.5 + 0.5) * u_size.x, (0.5 - ndc.y * 0.5) * u_size.y);
-        motion = there - here;
-    }
+    if (v_previous_clip.w > 0.0) motion = to_pixels(v_previous_clip) - to_pixels(v_clip);
     o_color = vec4(color, 1.0);
     o_depth_motion_id = vec4(v_depth, motion, u_id);
     o_normal = vec4(n, 0.0);

@@ -72,7 +72,8 @@ Status GlContext::create(std::unique_ptr<GlContext>& context) {
         return Status::error("EGL: cannot initialise a display (error 0x" +
                              std::to_string(eglGetError()) + ")");
     if (!eglBindAPI(EGL_OPENGL_ES_API)) return Status::error("EGL: OpenGL ES is not supported");
-    const EGLint config_attributes[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_ES3_BIT, EGL_NONE};
+    const EGLint config_attributes[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_ES3_BIT, EGL_SURFACE_TYPE,
+                                       EGL_PBUFFER_BIT, EGL_NONE};
     EGLConfig config = nullptr;
     EGLint configs = 0;
     if (!eglChooseConfig(display, config_attributes, &config, 1, &configs) || configs < 1) {

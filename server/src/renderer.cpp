@@ -276,11 +276,13 @@ Status Renderer::render(const Scene& scene, const Instant& current, const Instan
 
     glUseProgram(g.program);
     glUniformMatrix4fv(g.uniform("u_view_projection"), 1, GL_FALSE, glm::value_ptr(view_projection));
+    const glm::mat4 unjittered = current.projection * current.view;
+    glUniformMatrix4fv(g.uniform("u_unjittered_view_projection"), 1, GL_FALSE,
+                       glm::value_ptr(unjittered));
     glUniformMatrix4fv(g.uniform("u_view"), 1, GL_FALSE, glm::value_ptr(current.view));
     glUniformMatrix4fv(g.uniform("u_previous_view_projection"), 1, GL_FALSE,
                        glm::value_ptr(previous_view_projection));
     glUniform2f(g.uniform("u_size"), float(w), float(h));
-    glUniform2f(g.uniform("u_jitter"), current.jitter.x, current.jitter.y);
     glUniform3fv(g.uniform("u_eye"), 1, glm::value_ptr(eye));
     glUniform3fv(g.uniform("u_light_direction"), 1, glm::value_ptr(scene.light.direction));
     glUniform3fv(g.uniform("u_light_color"), 1, glm::value_ptr(scene.light.color));
@@ -334,11 +336,16 @@ Status Renderer::render(const Scene& scene, const Instant& current, const Instan
     };
     read(0, [&](int x, int y, glm::vec4 v) { frame.color(x, y) = v; });
     read(2, [&](int x, int y, glm::vec4 v) { frame.normal(x, y) = glm::vec3(v); });
-    // Background: depth +inf, motion of the point at infinity seen through this pixel.
-    const glm::dmat4 unproject = glm::inverse(glm::dmat4(shift * current.projection));
-    const glm::dmat3 to_world = glm::transpose(glm::dmat3(current.view));
-    const glm::dmat4 previous_projection(previous.projection);
-    const glm::dmat3 previous_rotation(previous.view);
+    // Background: depth +inf, motion of the point at infinity seen through this pixel, with
+    // both ends projected the same way (a still camera gives exactly 0).
+    // Orthographic cameras see the far plane instead (w = 1: a point, not a direction).
+    const double point = current.projection[3][3] == 1.0f ? 1.0 : 0.0;
+    const glm::dmat4 unproject = glm::inverse(glm::dmat4(shift * current.projection * current.view));
+    auto to_pixels = [&](const glm::mat4& matrix, glm::dvec4 world, glm::dvec2& pixel) {
+        glm::dvec4 clip = glm::dmat4(matrix) * world;
+        pixel = {(clip.x / clip.w * 0.5 + 0.5) * w, (0.5 - 0.5 * clip.y / clip.w) * h};
+        return clip.w > 0.0;
+    };
     const float nan = std::numeric_limits<float>::quiet_NaN();
     read(1, [&](int x, int y, glm::vec4 v) {
         if (v.w != 0.0f) {
@@ -351,16 +358,12 @@ Status Renderer::render(const Scene& scene, const Instant& current, const Instan
         frame.depth(x, y) = std::numeric_limits<float>::infinity();
         frame.id(x, y) = 0;
         glm::dvec2 ndc(2.0 * (x + 0.5) / w - 1.0, 1.0 - 2.0 * (y + 0.5) / h);
-        glm::dvec4 a = unproject * glm::dvec4(ndc, -1.0, 1.0), b = unproject * glm::dvec4(ndc, 0.0, 1.0);
-        glm::dvec3 direction = glm::dvec3(b) / b.w - glm::dvec3(a) / a.w;
-        glm::dvec4 clip = previous_projection * glm::dvec4(previous_rotation * (to_world * direction), 0.0);
-        if (clip.w <= 0.0) {
-            frame.motion(x, y) = glm::vec2(nan);
-            return;
-        }
-        glm::dvec2 there((clip.x / clip.w * 0.5 + 0.5) * w, (0.5 - 0.5 * clip.y / clip.w) * h);
-        frame.motion(x, y) = glm::vec2(there - glm::dvec2(x + 0.5 + current.jitter.x,
-                                                          y + 0.5 + current.jitter.y));
+        glm::dvec4 a = unproject * glm::dvec4(ndc, -1.0, 1.0), b = unproject * glm::dvec4(ndc, point, 1.0);
+        glm::dvec4 world = point == 1.0 ? b / b.w : glm::dvec4(glm::dvec3(b) / b.w - glm::dvec3(a) / a.w, 0.0);
+        glm::dvec2 here, there;
+        bool visible = to_pixels(unjittered, world, here) &&
+                       to_pixels(previous_view_projection, world, there);
+        frame.motion(x, y) = visible ? glm::vec2(there - here) : glm::vec2(nan);
     });
     GLenum error = glGetError();
     if (error != GL_NO_ERROR)
