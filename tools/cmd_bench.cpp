@@ -1,6 +1,146 @@
-// placeholder until written
-#include "commands.hpp"
+// reprise bench render|exr — throughput of the renderer and of EXR frame I/O.
+#include <chrono>
 #include <cstdio>
+#include <filesystem>
+#include <functional>
+#include <fstream>
+#include <vector>
+
+#include "args.hpp"
+#include "commands.hpp"
+#include "reprise/core/exr.hpp"
+#include "reprise/server/builtin_scenes.hpp"
+#include "reprise/server/renderer.hpp"
+
 namespace reprise::cli {
-int command_bench(int, char**) { std::fputs("reprise bench: not written yet\n", stderr); return 1; }
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+    return std::chrono::duration<double>(Clock::now() - start).count();
 }
+
+struct BenchJob {
+    std::string what;
+    std::string scene = "pan";
+    int frames = 10;
+    std::string sizes = "640x360,1920x1080";
+    std::string dir;
+};
+
+Status for_each_size(const std::string& sizes, const std::function<Status(int, int)>& run) {
+    std::size_t start = 0;
+    while (start <= sizes.size()) {
+        std::size_t end = sizes.find(',', start);
+        if (end == std::string::npos) end = sizes.size();
+        int w = 0, h = 0;
+        REPRISE_TRY(parse_size(sizes.substr(start, end - start), w, h));
+        REPRISE_TRY(run(w, h));
+        start = end + 1;
+    }
+    return {};
+}
+
+Status bench_render(const BenchJob& job) {
+    server::Scene scene;
+    server::CameraPath path;
+    REPRISE_TRY(server::load_scene(job.scene, scene, path));
+    std::unique_ptr<server::Renderer> renderer;
+    REPRISE_TRY(server::Renderer::create(renderer));
+    std::printf("renderer: %s, scene %s, %d frames per size\n", renderer->device().c_str(),
+                job.scene.c_str(), job.frames);
+    std::printf("%-11s %10s %10s\n", "size", "ms/frame", "frames/s");
+    return for_each_size(job.sizes, [&](int w, int h) {
+        Frame frame;
+        const server::RenderSettings settings{.width = w, .height = h};
+        REPRISE_TRY(renderer->render_frame(scene, path, 0, 30.0, settings, frame));  // warm-up
+        auto start = Clock::now();
+        for (int i = 1; i <= job.frames; ++i) {
+            REPRISE_TRY(renderer->render_frame(scene, path, i, 30.0, settings, frame));
+            std::fprintf(stderr, "\r[bench] %dx%d %d/%d", w, h, i, job.frames);
+        }
+        double s = seconds_since(start);
+        std::fprintf(stderr, "\r%40s\r", "");
+        std::printf("%-11s %10.1f %10.2f\n", (std::to_string(w) + "x" + std::to_string(h)).c_str(),
+                    1e3 * s / job.frames, job.frames / s);
+        return Status{};
+    });
+}
+
+// EXR write and read of full G-buffer frames, against writing and reading the same bytes raw
+// (the floor any file format pays), measured in the same run.
+Status bench_exr(const BenchJob& job) {
+    server::Scene scene;
+    server::CameraPath path;
+    REPRISE_TRY(server::load_scene(job.scene, scene, path));
+    std::unique_ptr<server::Renderer> renderer;
+    REPRISE_TRY(server::Renderer::create(renderer));
+    std::string dir = job.dir.empty() ? (std::filesystem::temp_directory_path() / "reprise-bench-exr").string()
+                                      : job.dir;
+    std::error_code ec;
+    std::filesystem::create_directories(dir, ec);
+    if (ec) return Status::error(dir + ": " + ec.message());
+    std::printf("EXR frames (R,G,B,A,Z,motion.x,motion.y,N.X,N.Y,N.Z,id; 32-bit, zip) in %s\n",
+                dir.c_str());
+    std::printf("%-11s %9s %9s %9s %9s %11s %11s\n", "size", "write ms", "read ms", "MB/frame",
+                "file MB", "write/raw", "read/raw");
+    return for_each_size(job.sizes, [&](int w, int h) {
+        Frame frame, back;
+        REPRISE_TRY(renderer->render_frame(scene, path, 0, 30.0, {.width = w, .height = h}, frame));
+        const double bytes = double(w) * h * 11 * 4;
+        std::vector<char> raw(static_cast<std::size_t>(bytes));
+        std::string raw_path = dir + "/raw.bin";
+        double write_s = 0, read_s = 0, raw_write_s = 0, raw_read_s = 0;
+        for (int i = 0; i < job.frames; ++i) {
+            std::string file = frame_path(dir, i);
+            auto t = Clock::now();
+            REPRISE_TRY(write_frame(file, frame));
+            write_s += seconds_since(t);
+            t = Clock::now();
+            REPRISE_TRY(read_frame(file, back));
+            read_s += seconds_since(t);
+            t = Clock::now();
+            std::ofstream(raw_path, std::ios::binary).write(raw.data(), std::streamsize(raw.size()));
+            raw_write_s += seconds_since(t);
+            t = Clock::now();
+            std::ifstream(raw_path, std::ios::binary).read(raw.data(), std::streamsize(raw.size()));
+            raw_read_s += seconds_since(t);
+            std::fprintf(stderr, "\r[bench] %dx%d %d/%d", w, h, i + 1, job.frames);
+        }
+        std::fprintf(stderr, "\r%40s\r", "");
+        double file_mb = double(std::filesystem::file_size(frame_path(dir, 0))) / 1e6;
+        std::printf("%-11s %9.1f %9.1f %9.1f %9.1f %10.1fx %10.1fx\n",
+                    (std::to_string(w) + "x" + std::to_string(h)).c_str(), 1e3 * write_s / job.frames,
+                    1e3 * read_s / job.frames, bytes / 1e6, file_mb, write_s / raw_write_s,
+                    read_s / raw_read_s);
+        for (int i = 0; i < job.frames; ++i) std::filesystem::remove(frame_path(dir, i), ec);
+        std::filesystem::remove(raw_path, ec);
+        return Status{};
+    });
+}
+
+}  // namespace
+
+int command_bench(int argc, char** argv) {
+    BenchJob job;
+    Args args("bench",
+              "Benchmarks. render: renderer frames per second; exr: frame write/read time against "
+              "raw file I/O\nof the same bytes, measured in the same run.");
+    args.positional("WHAT", &job.what, "render | exr");
+    args.option("--scene", &job.scene, "scene to render (default pan)");
+    args.option("--frames", &job.frames, "frames per size (default 10)");
+    args.option("--sizes", &job.sizes, "comma-separated WxH list (default 640x360,1920x1080)");
+    args.option("--dir", &job.dir, "exr: folder for the files (default: the temp folder)");
+    Status parsed = args.parse(argc, argv);
+    if (!parsed.ok() || args.help_requested()) return report(args, parsed, {});
+    Status result;
+    if (job.frames < 1 || job.frames > 100000) result = Status::error("bench: --frames must be in 1..100000");
+    else if (job.what == "render") result = bench_render(job);
+    else if (job.what == "exr") result = bench_exr(job);
+    else result = Status::error("bench: unknown benchmark '" + job.what + "' (render, exr)");
+    return report(args, parsed, result);
+}
+
+}  // namespace reprise::cli

@@ -1,0 +1,118 @@
+// The `reprise` executable on bad input: one clear message, exit status 1 or 2, never a crash
+// or a hang. Also walks every glTF file of Debian's assimp-testmodels through `reprise render`.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Run {
+    int status = -1;  // exit status; 128 + signal when killed, 124 when it timed out
+    std::string output;
+};
+
+Run run(const std::string& arguments) {
+    std::string command = "timeout 120 " REPRISE_BINARY " " + arguments + " 2>&1";
+    Run r;
+    FILE* pipe = popen(command.c_str(), "r");
+    if (!pipe) return r;
+    std::array<char, 4096> buffer;
+    std::size_t n;
+    while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) r.output.append(buffer.data(), n);
+    int raw = pclose(pipe);
+    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : 128 + WTERMSIG(raw);
+    return r;
+}
+
+fs::path scratch(const std::string& name) {
+    fs::path dir = fs::temp_directory_path() / ("reprise-cli-" + name);
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    return dir;
+}
+
+void expect_clean_failure(const Run& r, const std::string& must_mention, const std::string& what) {
+    EXPECT_TRUE(r.status == 1 || r.status == 2) << what << ": status " << r.status << "\n" << r.output;
+    EXPECT_NE(r.output.find(must_mention), std::string::npos) << what << ":\n" << r.output;
+    EXPECT_EQ(r.output.find("Sanitizer"), std::string::npos) << what << ":\n" << r.output;
+}
+
+}  // namespace
+
+TEST(CliBadInput, ArgumentsGetOneMessageAndStatusTwo) {
+    fs::path out = scratch("args");
+    expect_clean_failure(run(""), "usage", "no command");
+    expect_clean_failure(run("frobnicate"), "unknown command", "unknown command");
+    expect_clean_failure(run("render --nope 3"), "--nope", "unknown option");
+    expect_clean_failure(run("render --frames"), "--frames", "missing value");
+    expect_clean_failure(run("render --frames ten --out " + out.string()), "--frames", "bad integer");
+    expect_clean_failure(run("render --fps nan --out " + out.string()), "--fps", "NaN rate");
+    expect_clean_failure(run("render --fps -30 --out " + out.string()), "--fps", "negative rate");
+    expect_clean_failure(run("render --frames 0 --out " + out.string()), "--frames", "zero frames");
+    expect_clean_failure(run("render --size 0x0 --out " + out.string()), "0x0", "empty size");
+    expect_clean_failure(run("render --size 20000x10 --out " + out.string()), "20000x10", "huge size");
+    expect_clean_failure(run("render --size wide --out " + out.string()), "wide", "not a size");
+    expect_clean_failure(run("render --scene nowhere --out " + out.string()), "nowhere", "bad scene");
+    expect_clean_failure(run("render --camera spiral --out " + out.string()), "spiral", "bad camera");
+    expect_clean_failure(run("render --camera orbit:speed=x --out " + out.string()), "'x'", "bad param");
+    expect_clean_failure(run("render"), "--out", "no output");
+    EXPECT_EQ(run("render --help").status, 0);
+    EXPECT_EQ(run("--help").status, 0);
+}
+
+TEST(CliBadInput, BrokenFramesGetOneMessageAndStatusOne) {
+    fs::path dir = scratch("frames");
+    std::ofstream(dir / "garbage.exr") << "this is not an OpenEXR file at all";
+    std::ofstream(dir / "empty.exr");
+    for (const char* name : {"garbage.exr", "empty.exr"}) {
+        std::string file = (dir / name).string();
+        expect_clean_failure(run("info " + file), name, std::string("info ") + name);
+        expect_clean_failure(run("export " + file + " --png " + (dir / "x.png").string()), name,
+                             std::string("export ") + name);
+    }
+    expect_clean_failure(run("info " + (dir / "missing").string()), "missing", "missing path");
+    // A valid frame cut in half.
+    ASSERT_EQ(run("render --frames 1 --size 64x36 --out " + (dir / "ok").string()).status, 0);
+    fs::path good = dir / "ok" / "frame_00000.exr";
+    auto size = fs::file_size(good);
+    fs::copy_file(good, dir / "cut.exr");
+    fs::resize_file(dir / "cut.exr", size / 2);
+    expect_clean_failure(run("info " + (dir / "cut.exr").string()), "cut.exr", "truncated frame");
+    expect_clean_failure(run("metrics --ref " + (dir / "ok").string() + " --test " +
+                             (dir / "cut.exr").string()),
+                         "cut.exr", "metrics on a truncated frame");
+}
+
+// Every glTF file of the assimp test models either renders or fails with one message naming it.
+TEST(CliBadInput, EveryAssimpGltfModelRendersOrFailsCleanly) {
+    const fs::path models = REPRISE_ASSIMP_MODELS;
+    ASSERT_TRUE(fs::is_directory(models)) << "install assimp-testmodels (scripts/deps)";
+    fs::path out = scratch("models");
+    int rendered = 0, refused = 0;
+    for (const auto& entry : fs::recursive_directory_iterator(models)) {
+        std::string ext = entry.path().extension().string();
+        if (ext != ".gltf" && ext != ".glb") continue;
+        Run r = run("render --scene '" + entry.path().string() + "' --frames 2 --size 96x64 --out " +
+                    out.string());
+        if (r.status == 0) {
+            ++rendered;
+            EXPECT_TRUE(fs::exists(out / "frame_00001.exr")) << entry.path();
+            continue;
+        }
+        ++refused;
+        expect_clean_failure(r, entry.path().filename().string(), entry.path().string());
+        // One message: the error line (progress output goes before it, on its own line).
+        EXPECT_LE(std::count(r.output.begin(), r.output.end(), '\n'), 3) << r.output;
+    }
+    std::printf("[models] %d rendered, %d refused with a message\n", rendered, refused);
+    EXPECT_GE(rendered, 10);
+    EXPECT_GE(refused, 8);
+}
