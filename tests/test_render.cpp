@@ -321,8 +321,12 @@ TEST_P(GltfModels, RenderWithCoverageAndMotion) {
             lo = std::min(lo, c.g), hi = std::max(hi, c.g);
         }
     EXPECT_GT(covered, w * h / 20) << file;
-    if (GetParam().varied) EXPECT_GT(hi - lo, 0.05f) << file;
-    if (GetParam().animated) EXPECT_GT(moving, covered / 10) << file;
+    if (GetParam().varied) {
+        EXPECT_GT(hi - lo, 0.05f) << file;
+    }
+    if (GetParam().animated) {
+        EXPECT_GT(moving, covered / 10) << file;
+    }
 }
 
 INSTANTIATE_TEST_SUITE_P(
@@ -332,8 +336,8 @@ INSTANTIATE_TEST_SUITE_P(
                       ModelCase{"simple_skin/simple_skin.gltf", true, false},
                       ModelCase{"BoxTextured-glTF/BoxTextured.gltf", false},
                       ModelCase{"ClearCoat-glTF/ClearCoatTest.gltf", false}),
-    [](const auto& info) {
-        std::string name = info.param.path;
+    [](const auto& model) {
+        std::string name = model.param.path;
         name = name.substr(0, name.find_first_of("-/"));
         return name;
     });

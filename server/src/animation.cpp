@@ -18,6 +18,13 @@ double animation_duration(const Scene& scene) {
 
 namespace {
 
+// Transforms normals like transpose(inverse(m)) up to scale, and stays finite when m is
+// singular (a zero scale is legal glTF).
+glm::mat3 normal_matrix(const glm::mat3& m) {
+    glm::mat3 cofactor(glm::cross(m[1], m[2]), glm::cross(m[2], m[0]), glm::cross(m[0], m[1]));
+    return glm::determinant(m) < 0.0f ? -cofactor : cofactor;  // mirrors keep outward normals
+}
+
 struct Local {
     glm::vec3 translation;
     glm::quat rotation;
@@ -165,9 +172,9 @@ void pose_vertices(const Scene& scene, const Pose& pose, int node, const Primiti
     const bool skinned = n.skin >= 0 && !primitive.joints.empty() && !primitive.weights.empty();
     if (!skinned) {
         const glm::mat4& m = pose.world[node];
-        const glm::mat3 normal_matrix = glm::transpose(glm::inverse(glm::mat3(m)));
+        const glm::mat3 to_world = normal_matrix(glm::mat3(m));
         for (glm::vec3& p : positions) p = glm::vec3(m * glm::vec4(p, 1.0f));
-        for (glm::vec3& v : normals) v = normal_matrix * v;
+        for (glm::vec3& v : normals) v = to_world * v;
         return;
     }
     const Skin& skin = scene.skins[n.skin];
@@ -179,7 +186,7 @@ void pose_vertices(const Scene& scene, const Pose& pose, int node, const Primiti
         const glm::vec4 wi = primitive.weights[v];
         glm::mat4 m = wi.x * joint[ji.x] + wi.y * joint[ji.y] + wi.z * joint[ji.z] + wi.w * joint[ji.w];
         positions[v] = glm::vec3(m * glm::vec4(positions[v], 1.0f));
-        if (v < normals.size()) normals[v] = glm::transpose(glm::inverse(glm::mat3(m))) * normals[v];
+        if (v < normals.size()) normals[v] = normal_matrix(glm::mat3(m)) * normals[v];
     }
 }
 

@@ -59,7 +59,8 @@ vec2 to_pixels(vec4 clip) {  // y down, origin at the top-left corner
     return vec2((ndc.x * 0.5 + 0.5) * u_size.x, (0.5 - ndc.y * 0.5) * u_size.y);
 }
 void main() {
-    vec3 n = normalize(gl_FrontFacing ? v_normal : -v_normal);
+    vec3 n = dot(v_normal, v_normal) > 0.0 ? normalize(gl_FrontFacing ? v_normal : -v_normal)
+                                           : vec3(0.0, 0.0, 1.0);
     vec4 base = u_base_color;
     if (u_textured) base *= texture(u_texture, v_uv);
     vec3 color = base.rgb;
