@@ -14,14 +14,14 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct Run {
+struct Outcome {
     int status = -1;  // exit status; 128 + signal when killed, 124 when it timed out
     std::string output;
 };
 
-Run run(const std::string& arguments) {
+Outcome run(const std::string& arguments) {
     std::string command = "timeout 120 " REPRISE_BINARY " " + arguments + " 2>&1";
-    Run r;
+    Outcome r;
     FILE* pipe = popen(command.c_str(), "r");
     if (!pipe) return r;
     std::array<char, 4096> buffer;
@@ -39,7 +39,7 @@ fs::path scratch(const std::string& name) {
     return dir;
 }
 
-void expect_clean_failure(const Run& r, const std::string& must_mention, const std::string& what) {
+void expect_clean_failure(const Outcome& r, const std::string& must_mention, const std::string& what) {
     EXPECT_TRUE(r.status == 1 || r.status == 2) << what << ": status " << r.status << "\n" << r.output;
     EXPECT_NE(r.output.find(must_mention), std::string::npos) << what << ":\n" << r.output;
     EXPECT_EQ(r.output.find("Sanitizer"), std::string::npos) << what << ":\n" << r.output;
@@ -100,7 +100,7 @@ TEST(CliBadInput, EveryAssimpGltfModelRendersOrFailsCleanly) {
     for (const auto& entry : fs::recursive_directory_iterator(models)) {
         std::string ext = entry.path().extension().string();
         if (ext != ".gltf" && ext != ".glb") continue;
-        Run r = run("render --scene '" + entry.path().string() + "' --frames 2 --size 96x64 --out " +
+        Outcome r = run("render --scene '" + entry.path().string() + "' --frames 2 --size 96x64 --out " +
                     out.string());
         if (r.status == 0) {
             ++rendered;

@@ -98,7 +98,8 @@ void evaluate_pose(const Scene& scene, double time, Pose& pose) {
         else pose.weights[i].clear();
     }
     double duration = animation_duration(scene);
-    float t = float(duration > 0 ? time - duration * std::floor(time / duration) : time);
+    // Loop after the end; before the start, keys clamp (or extend, for keys at negative times).
+    float t = float(duration > 0 && time > duration ? std::fmod(time, duration) : time);
     float value[64];
     std::vector<float> many;
     for (const Animation& a : scene.animations) {

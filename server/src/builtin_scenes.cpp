@@ -202,16 +202,17 @@ struct Builder {
         scene.roots.push_back(int(scene.nodes.size()) - 1);
         return int(scene.nodes.size()) - 1;
     }
-    // Constant velocity from t = 0 for `seconds` (two linear keys: exact at every instant).
+    // Constant velocity, through the node's position at t = 0, from t = -1 s to `seconds` (two
+    // linear keys: exact at every instant, including the instant before frame 0).
     void move(int node, glm::vec3 velocity, float seconds = 60.0f) {
-        glm::vec3 a = scene.nodes[node].translation, b = a + velocity * seconds;
-        channel(node, AnimatedPath::Translation, {0.0f, seconds}, {a.x, a.y, a.z, b.x, b.y, b.z}, 3);
+        glm::vec3 a = scene.nodes[node].translation - velocity, b = a + velocity * (seconds + 1.0f);
+        channel(node, AnimatedPath::Translation, {-1.0f, seconds}, {a.x, a.y, a.z, b.x, b.y, b.z}, 3);
     }
     // Constant spin about an axis, keyed every quarter turn.
     void spin(int node, glm::vec3 axis, float radians_per_second, float seconds = 60.0f) {
         std::vector<float> times, values;
         float step = glm::half_pi<float>() / std::abs(radians_per_second);
-        for (float t = 0; t <= seconds + step; t += step) {
+        for (float t = -step; t <= seconds + step; t += step) {
             glm::quat q = glm::angleAxis(radians_per_second * t, glm::normalize(axis));
             times.push_back(t);
             values.insert(values.end(), {q.x, q.y, q.z, q.w});

@@ -8,22 +8,44 @@
 namespace reprise {
 
 // Writes R,G,B,A,Z,motion.x,motion.y,N.X,N.Y,N.Z,id (absent buffers are left out) and the camera:
-// worldToCamera, worldToNDC and the reprise:* attributes of docs/conventions.md.
+// worldToCamera, worldToNDC and the reprise:* attributes of docs/exr_format.md. Writes a
+// temporary file beside `path` and renames it, so a failed write never leaves a broken frame.
 Status write_frame(const std::string& path, const Frame& frame);
 
-// Reads a reprise frame or a Blender multilayer EXR render (Combined, Depth, Vector passes).
-// Every buffer is checked: a missing colour, a bad size or a truncated file is an error naming
-// the file; NaN/Inf are kept as they are (depth +inf is background).
+// Reads a reprise frame or a Blender multilayer EXR render (Combined, Depth, Vector, Normal,
+// IndexOB passes, converted to reprise's conventions). Every buffer is checked: a missing colour,
+// a bad size or a truncated file is an error naming the file; NaN/Inf are kept as they are
+// (depth +inf is background). On error the frame's contents are unspecified.
 Status read_frame(const std::string& path, Frame& frame);
 
+// What a frame file's header says, read without its pixels.
+struct FrameHeader {
+    int width = 0;
+    int height = 0;
+    std::vector<std::string> channels;       // as stored: "R", "ViewLayer.Combined.R", ...
+    std::vector<std::string> channel_types;  // "half", "float" or "uint", one per channel
+    bool blender = false;                    // a Blender multilayer render
+    bool has_camera = false;                 // worldToCamera or reprise:projection present
+    Camera camera;
+    double fps = 0.0;
+};
+Status read_frame_header(const std::string& path, FrameHeader& header);
+
 struct Sequence {
-    std::vector<std::string> files;  // sorted by name
+    std::vector<std::string> files;  // sorted by name (frame_9 before frame_10)
     double fps = 0.0;                // from the first frame's header; 0 when not recorded
 };
 
-// Lists a folder of EXR frames (reprise's frame_00000.exr… or a Blender render folder);
-// a single .exr file is a sequence of one.
+// Lists a folder of EXR frames (reprise's frame_00000.exr… or a Blender render folder), sorted
+// with digit runs compared as numbers; a single file is a sequence of one.
 Status open_sequence(const std::string& path, Sequence& sequence);
+
+// OpenEXR's standard camera attributes, column-vector form (the file holds their transposes):
+// worldToCamera maps to RenderMan's camera space (+x right, +y up, +z forward: the view with z
+// negated); worldToNDC maps to (0,0) at the image's top-left and (1,1) at its bottom-right corner
+// after the division by w.
+glm::mat4 exr_world_to_camera(const glm::mat4& view);
+glm::mat4 exr_world_to_ndc(const glm::mat4& projection, const glm::mat4& view);
 
 // "DIR/frame_00042.exr"
 std::string frame_path(const std::string& dir, int index);

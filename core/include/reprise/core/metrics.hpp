@@ -15,8 +15,9 @@ struct ImageError {
     double flip = 0.0;  // mean LDR-FLIP, 0 for identical images
 };
 
-// All three metrics between two display images of the same size. A non-empty `mask`
-// (nonzero = counted) restricts the means to its pixels.
+// All three metrics between two display images of the same size (a size mismatch is a broken
+// contract). A non-empty `mask` (nonzero = counted, same size) restricts the means to its
+// pixels; a mask that selects no pixel gives NaN.
 ImageError image_error(ImageView<const glm::vec3> reference, ImageView<const glm::vec3> test,
                        ImageView<const uint8_t> mask = {});
 

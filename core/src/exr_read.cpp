@@ -1,0 +1,370 @@
+// read_frame / read_frame_header: reprise frames and Blender multilayer renders.
+// Channel layouts, header attributes and the Blender mapping are in docs/exr_format.md.
+#include <OpenImageIO/half.h>
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <glm/gtc/type_ptr.hpp>
+#include <glm/mat4x4.hpp>
+#include <limits>
+#include <memory>
+#include <string_view>
+#include <vector>
+
+#include "reprise/core/exr.hpp"
+
+namespace reprise {
+namespace {
+
+namespace fs = std::filesystem;
+using OIIO::ImageSpec;
+using OIIO::TypeDesc;
+
+enum Slot { R, G, B, A, Z, MotionX, MotionY, NormalX, NormalY, NormalZ, Id, kSlots };
+using Channels = std::array<int, kSlots>;  // file channel index per slot, -1 when absent
+
+constexpr std::array<const char*, kSlots> kRepriseNames = {
+    "R", "G", "B", "A", "Z", "motion.x", "motion.y", "N.X", "N.Y", "N.Z", "id"};
+
+struct Layout {
+    Channels channel;
+    bool blender = false;
+};
+
+bool complete(const Channels& c, std::initializer_list<Slot> slots) {
+    return std::all_of(slots.begin(), slots.end(), [&](Slot s) { return c[s] >= 0; });
+}
+
+std::string type_name(TypeDesc type) {
+    if (type == TypeDesc::HALF) return "half";
+    if (type == TypeDesc::FLOAT) return "float";
+    if (type == TypeDesc::UINT) return "uint";
+    return type.c_str();
+}
+
+Status open_exr(const std::string& path, std::unique_ptr<OIIO::ImageInput>& in) {
+    std::error_code ec;
+    const fs::file_status status = fs::status(path, ec);
+    if (!fs::exists(status)) return Status::error(path + ": no such file");
+    if (fs::is_directory(status)) return Status::error(path + ": is a folder, not an EXR file");
+    // Only the OpenEXR reader: a file that is not EXR must fail, whatever else it may be.
+    in = OIIO::ImageInput::create("openexr");
+    if (!in) return Status::error(path + ": " + OIIO::geterror());
+    ImageSpec spec;
+    if (!in->open(path, spec)) {
+        std::string why = in->geterror();
+        in.reset();
+        return Status::error(path + ": not a readable OpenEXR file" +
+                             (why.empty() ? std::string() : " (" + why + ")"));
+    }
+    if (spec.deep) return Status::error(path + ": deep EXR images are not supported");
+    if (spec.depth > 1) return Status::error(path + ": volume EXR images are not supported");
+    REPRISE_TRY(check_image_size(spec.width, spec.height, path));
+    for (int c = 0; c < spec.nchannels; ++c) {
+        const TypeDesc type = spec.channelformat(c);
+        if (type != TypeDesc::HALF && type != TypeDesc::FLOAT && type != TypeDesc::UINT)
+            return Status::error(path + ": channel " + spec.channelnames[c] + " has type " +
+                                 type_name(type));
+    }
+    return {};
+}
+
+// Blender multilayer names are LAYER.PASS.CHANNEL or LAYER.PASS.VIEW.CHANNEL (OpenEXR's
+// multi-view naming); layer names may contain dots themselves.
+struct BlenderChannel {
+    std::string group;  // LAYER|VIEW
+    Slot slot;
+};
+
+bool parse_blender(std::string_view name, BlenderChannel& out) {
+    std::vector<std::string_view> tokens;
+    for (std::size_t start = 0;;) {
+        const std::size_t dot = name.find('.', start);
+        tokens.push_back(name.substr(start, dot - start));
+        if (dot == std::string_view::npos) break;
+        start = dot + 1;
+    }
+    if (tokens.size() < 2) return false;
+    const std::string_view letter = tokens.back();
+    struct Pass {
+        std::string_view pass, letter;
+        Slot slot;
+    };
+    static constexpr Pass kPasses[] = {
+        {"Combined", "R", R},     {"Combined", "G", G},     {"Combined", "B", B},
+        {"Combined", "A", A},     {"Depth", "Z", Z},        {"Vector", "X", MotionX},
+        {"Vector", "Y", MotionY}, {"Normal", "X", NormalX}, {"Normal", "Y", NormalY},
+        {"Normal", "Z", NormalZ}, {"IndexOB", "X", Id},
+    };
+    for (std::size_t k = tokens.size() - 1; k-- > 0;) {
+        for (const Pass& p : kPasses) {
+            if (tokens[k] != p.pass || letter != p.letter) continue;
+            // group = everything but the pass and the channel letter
+            std::string group;
+            for (std::size_t t = 0; t + 1 < tokens.size(); ++t) {
+                if (t == k)
+                    group += '|';
+                else
+                    group.append(tokens[t]).append(".");
+            }
+            out = {group, p.slot};
+            return true;
+        }
+    }
+    return false;
+}
+
+// Picks the layer (and view) with a complete Combined pass and the most other passes.
+bool find_blender_layout(const ImageSpec& spec, Layout& layout) {
+    std::vector<std::pair<std::string, Channels>> groups;  // in file order
+    for (int c = 0; c < spec.nchannels; ++c) {
+        BlenderChannel bc;
+        if (!parse_blender(spec.channelnames[c], bc)) continue;
+        auto it = std::find_if(groups.begin(), groups.end(),
+                               [&](const auto& g) { return g.first == bc.group; });
+        if (it == groups.end()) {
+            Channels none;
+            none.fill(-1);
+            it = groups.insert(groups.end(), {bc.group, none});
+        }
+        if (it->second[bc.slot] < 0) it->second[bc.slot] = c;
+    }
+    int best_score = -1;
+    for (auto& [group, c] : groups) {
+        if (!complete(c, {R, G, B})) continue;
+        // Incomplete optional passes are left out.
+        if (!complete(c, {MotionX, MotionY})) c[MotionX] = c[MotionY] = -1;
+        if (!complete(c, {NormalX, NormalY, NormalZ})) c[NormalX] = c[NormalY] = c[NormalZ] = -1;
+        const int score = (c[Z] >= 0) + (c[MotionX] >= 0) + (c[NormalX] >= 0) + (c[Id] >= 0);
+        if (score > best_score) {
+            best_score = score;
+            layout = {.channel = c, .blender = true};
+        }
+    }
+    return best_score >= 0;
+}
+
+Status find_layout(const ImageSpec& spec, const std::string& path, Layout& layout) {
+    Channels c;
+    for (int s = 0; s < kSlots; ++s) c[s] = spec.channelindex(kRepriseNames[s]);
+    if (c[R] < 0 && c[G] < 0 && c[B] < 0 && find_blender_layout(spec, layout)) return {};
+    for (Slot s : {R, G, B})
+        if (c[s] < 0)
+            return Status::error(path + ": no colour channel " + kRepriseNames[s] +
+                                 " (nor a Blender Combined pass)");
+    auto group = [&](std::initializer_list<Slot> slots) {
+        const bool any = std::any_of(slots.begin(), slots.end(), [&](Slot s) { return c[s] >= 0; });
+        for (Slot s : slots)
+            if (any && c[s] < 0)
+                return Status::error(path + ": channel " + kRepriseNames[s] + " is missing");
+        return ok();
+    };
+    REPRISE_TRY(group({MotionX, MotionY}));
+    REPRISE_TRY(group({NormalX, NormalY, NormalZ}));
+    layout = {.channel = c, .blender = false};
+    return {};
+}
+
+bool get_matrix(const ImageSpec& spec, const char* name, glm::mat4& m) {
+    // Imath's row-vector M44f holds the same 16 floats, in the same order, as glm's mat4.
+    return spec.getattribute(name, OIIO::TypeMatrix44, glm::value_ptr(m));
+}
+
+void read_camera(const ImageSpec& spec, Camera& camera, bool& has_camera) {
+    camera = Camera{};
+    glm::mat4 world_to_camera, world_to_ndc;
+    const bool view = get_matrix(spec, "worldToCamera", world_to_camera);
+    // Negating z again is exact: the view comes back bit for bit.
+    if (view) camera.view = exr_world_to_camera(world_to_camera);
+    bool projection = get_matrix(spec, "reprise:projection", camera.projection);
+    if (!projection && view && get_matrix(spec, "worldToNDC", world_to_ndc)) {
+        // A file from elsewhere: undo exr_world_to_ndc's clip-to-NDC step.
+        const glm::mat4 ndc_to_clip(glm::vec4(2, 0, 0, 0), glm::vec4(0, -2, 0, 0),
+                                    glm::vec4(0, 0, 1, 0), glm::vec4(-1, 1, 0, 1));
+        camera.projection = ndc_to_clip * world_to_ndc * glm::inverse(camera.view);
+        projection = true;
+    }
+    has_camera = view || projection;
+    if (!get_matrix(spec, "reprise:prevView", camera.prev_view)) camera.prev_view = camera.view;
+    if (!get_matrix(spec, "reprise:prevProjection", camera.prev_projection))
+        camera.prev_projection = camera.projection;
+    spec.getattribute("reprise:near", OIIO::TypeFloat, &camera.near);
+    spec.getattribute("reprise:far", OIIO::TypeFloat, &camera.far);
+    spec.getattribute("reprise:jitter", OIIO::TypeVector2, glm::value_ptr(camera.jitter));
+    spec.getattribute("reprise:time", TypeDesc::DOUBLE, &camera.time);
+}
+
+double read_fps(const ImageSpec& spec) {
+    double fps = 0.0;
+    if (spec.getattribute("reprise:fps", TypeDesc::DOUBLE, &fps)) return fps;
+    int rational[2] = {0, 0};  // OpenEXR's standard framesPerSecond
+    if (spec.getattribute("FramesPerSecond", OIIO::TypeRational, rational) && rational[1] != 0)
+        return double(rational[0]) / double(rational[1]);
+    return 0.0;
+}
+
+float to_float(TypeDesc type, const unsigned char* p) {
+    if (type == TypeDesc::FLOAT) {
+        float v;
+        std::memcpy(&v, p, 4);
+        return v;
+    }
+    if (type == TypeDesc::HALF) {
+        uint16_t bits;
+        std::memcpy(&bits, p, 2);
+        Imath::half h;
+        h.setBits(bits);
+        return float(h);
+    }
+    uint32_t v;
+    std::memcpy(&v, p, 4);
+    return float(v);
+}
+
+uint32_t to_uint(TypeDesc type, const unsigned char* p) {
+    if (type == TypeDesc::UINT) {
+        uint32_t v;
+        std::memcpy(&v, p, 4);
+        return v;
+    }
+    // A float id (Blender's IndexOB): rounded; NaN and negatives are background.
+    const float f = to_float(type, p);
+    if (!(f > 0.0f)) return 0;
+    return f >= 4294967295.0f ? std::numeric_limits<uint32_t>::max() : uint32_t(std::lround(f));
+}
+
+// One slot's destination: a 4-byte component of one of the Frame's buffers.
+struct Target {
+    int channel;
+    unsigned char* first;
+    std::size_t stride;
+    bool is_uint;
+};
+
+template <class T>
+void add_target(std::vector<Target>& targets, int channel, Image<T>& image, int component) {
+    if (channel < 0) return;
+    targets.push_back({channel, reinterpret_cast<unsigned char*>(image.data()) + 4 * component,
+                       sizeof(T), std::is_same_v<T, uint32_t>});
+}
+
+template <class T>
+void fit(Image<T>& image, bool present, int width, int height) {
+    if (present)
+        image.resize(width, height);
+    else
+        image.clear();
+}
+
+}  // namespace
+
+Status read_frame_header(const std::string& path, FrameHeader& header) {
+    std::unique_ptr<OIIO::ImageInput> in;
+    REPRISE_TRY(open_exr(path, in));
+    const ImageSpec& spec = in->spec();
+    Layout layout;
+    REPRISE_TRY(find_layout(spec, path, layout));
+    header = FrameHeader{.width = spec.width, .height = spec.height, .blender = layout.blender};
+    for (int c = 0; c < spec.nchannels; ++c) {
+        header.channels.push_back(spec.channelnames[c]);
+        header.channel_types.push_back(type_name(spec.channelformat(c)));
+    }
+    read_camera(spec, header.camera, header.has_camera);
+    header.fps = read_fps(spec);
+    return {};
+}
+
+Status read_frame(const std::string& path, Frame& frame) {
+    std::unique_ptr<OIIO::ImageInput> in;
+    REPRISE_TRY(open_exr(path, in));
+    const ImageSpec& spec = in->spec();
+    Layout layout;
+    REPRISE_TRY(find_layout(spec, path, layout));
+    const Channels& c = layout.channel;
+
+    const int width = spec.width;
+    const int height = spec.height;
+    frame.color.resize(width, height, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
+    fit(frame.depth, c[Z] >= 0, width, height);
+    fit(frame.motion, c[MotionX] >= 0, width, height);
+    fit(frame.normal, c[NormalX] >= 0, width, height);
+    fit(frame.id, c[Id] >= 0, width, height);
+
+    std::vector<Target> targets;
+    for (int s = R; s <= A; ++s) add_target(targets, c[s], frame.color, s - R);
+    add_target(targets, c[Z], frame.depth, 0);
+    add_target(targets, c[MotionX], frame.motion, 0);
+    add_target(targets, c[MotionY], frame.motion, 1);
+    add_target(targets, c[NormalX], frame.normal, 0);
+    add_target(targets, c[NormalY], frame.normal, 1);
+    add_target(targets, c[NormalZ], frame.normal, 2);
+    add_target(targets, c[Id], frame.id, 0);
+
+    // Read the channel range that holds every target, in the file's own types.
+    int chbegin = spec.nchannels, chend = 0;
+    for (const Target& t : targets) {
+        chbegin = std::min(chbegin, t.channel);
+        chend = std::max(chend, t.channel + 1);
+    }
+    std::vector<std::size_t> offset(chend - chbegin);
+    std::size_t pixel_bytes = 0;
+    for (int ch = chbegin; ch < chend; ++ch) {
+        offset[ch - chbegin] = pixel_bytes;
+        pixel_bytes += spec.channelformat(ch).size();
+    }
+
+    // Strips of whole rows of tiles for a tiled file.
+    const int tile = spec.tile_width > 0 ? std::max(spec.tile_height, 1) : 1;
+    const int strip_rows = std::min(height, tile * std::max(1, 64 / tile));
+    std::vector<unsigned char> strip(std::size_t(strip_rows) * width * pixel_bytes);
+    for (int y0 = 0; y0 < height; y0 += strip_rows) {
+        const int y1 = std::min(height, y0 + strip_rows);
+        const bool read =
+            spec.tile_width > 0
+                ? in->read_tiles(0, 0, spec.x, spec.x + width, spec.y + y0, spec.y + y1, spec.z,
+                                 spec.z + 1, chbegin, chend, TypeDesc::UNKNOWN, strip.data())
+                : in->read_scanlines(0, 0, spec.y + y0, spec.y + y1, spec.z, chbegin, chend,
+                                     TypeDesc::UNKNOWN, strip.data());
+        if (!read)
+            return Status::error(path + ": cannot read pixels, the file is truncated or corrupt (" +
+                                 in->geterror() + ")");
+        const std::size_t first = std::size_t(y0) * width;
+        const std::size_t count = std::size_t(y1 - y0) * width;
+        for (const Target& t : targets) {
+            const TypeDesc type = spec.channelformat(t.channel);
+            const unsigned char* from = strip.data() + offset[t.channel - chbegin];
+            unsigned char* to = t.first + first * t.stride;
+            for (std::size_t i = 0; i < count; ++i, from += pixel_bytes, to += t.stride) {
+                if (t.is_uint) {
+                    const uint32_t v = to_uint(type, from);
+                    std::memcpy(to, &v, 4);
+                } else if (type == TypeDesc::FLOAT) {
+                    std::memcpy(to, from, 4);  // bit exact, NaN payloads included
+                } else {
+                    const float v = to_float(type, from);
+                    std::memcpy(to, &v, 4);
+                }
+            }
+        }
+    }
+
+    if (layout.blender) {
+        // Cycles marks background depth with 1e10; Blender's vector pass has +y up.
+        float* depth = frame.depth.data();
+        for (std::size_t i = 0; i < frame.depth.pixel_count(); ++i)
+            if (depth[i] >= 1e10f) depth[i] = std::numeric_limits<float>::infinity();
+        for (std::size_t i = 0; i < frame.motion.pixel_count(); ++i)
+            frame.motion.data()[i].y = -frame.motion.data()[i].y;
+    }
+
+    bool has_camera = false;
+    read_camera(spec, frame.camera, has_camera);
+    frame.fps = read_fps(spec);
+    return {};
+}
+
+}  // namespace reprise
