@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "args.hpp"
+#include "bench.hpp"
 #include "commands.hpp"
 #include "reprise/core/exr.hpp"
 #include "reprise/server/builtin_scenes.hpp"
@@ -22,12 +23,8 @@ double seconds_since(Clock::time_point start) {
     return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-struct BenchJob {
+struct BenchJob : BenchOptions {
     std::string what;
-    std::string scene = "pan";
-    int frames = 10;
-    std::string sizes = "640x360,1920x1080";
-    std::string dir;
 };
 
 Status for_each_size(const std::string& sizes, const std::function<Status(int, int)>& run) {
@@ -127,19 +124,33 @@ int command_bench(int argc, char** argv) {
     BenchJob job;
     Args args("bench",
               "Benchmarks. render: renderer frames per second; exr: frame write/read time against "
-              "raw file I/O\nof the same bytes, measured in the same run.");
-    args.positional("WHAT", &job.what, "render | exr");
+              "raw file I/O\nof the same bytes, measured in the same run. fruc: frame-rate upconversion "
+              "error against run time\nfor every setting beside ffmpeg minterpolate and OpenCV DIS flow "
+              "(CSV + HTML report in --out).");
+    args.positional("WHAT", &job.what, "render | exr | reproject | grid | fill | fruc");
     args.option("--scene", &job.scene, "scene to render (default pan)");
-    args.option("--frames", &job.frames, "frames per size (default 10)");
+    args.option("--frames", &job.frames, "frames per size (default 10); fruc: input frames (default 20)");
     args.option("--sizes", &job.sizes, "comma-separated WxH list (default 640x360,1920x1080)");
     args.option("--dir", &job.dir, "exr: folder for the files (default: the temp folder)");
+    args.option("--out", &job.out, "fruc: report folder (default out/bench-fruc)");
+    args.option("--scenes", &job.scenes, "fruc: comma-separated scenes (default: every built-in scene)");
+    args.option("--factor", &job.factor, "fruc: K, output frames per input frame (default 2)");
+    args.option("--size", &job.size, "fruc: WxH (default 640x360)");
+    args.flag("--quick", &job.quick, "fruc: a few settings only (grid+pullpush, reverse+pullpush, splat+none, ...)");
+    args.flag("--exr", &job.exr, "fruc: also write the rendered input and truth as EXR under OUT/SCENE/");
     Status parsed = args.parse(argc, argv);
     if (!parsed.ok() || args.help_requested()) return report(args, parsed, {});
+    if (job.what == "fruc" && !args.given("--frames")) job.frames = 20;  // reaches the cut at 0.5 s
     Status result;
     if (job.frames < 1 || job.frames > 100000) result = Status::error("bench: --frames must be in 1..100000");
     else if (job.what == "render") result = bench_render(job);
     else if (job.what == "exr") result = bench_exr(job);
-    else result = Status::error("bench: unknown benchmark '" + job.what + "' (render, exr)");
+    else if (job.what == "reproject") result = bench_reproject(job);
+    else if (job.what == "grid") result = bench_grid(job);
+    else if (job.what == "fill") result = bench_fill(job);
+    else if (job.what == "fruc") result = bench_fruc(job);
+    else result = Status::error("bench: unknown benchmark '" + job.what +
+                                "' (render, exr, reproject, grid, fill, fruc)");
     return report(args, parsed, result);
 }
 

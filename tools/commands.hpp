@@ -9,5 +9,6 @@ int command_info(int argc, char** argv);
 int command_metrics(int argc, char** argv);
 int command_export(int argc, char** argv);
 int command_bench(int argc, char** argv);
+int command_fruc(int argc, char** argv);
 
 }  // namespace reprise::cli

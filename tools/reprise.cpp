@@ -18,7 +18,8 @@ constexpr Command kCommands[] = {
     {"info", reprise::cli::command_info, "channels, size, camera and frame rate of EXR frames"},
     {"metrics", reprise::cli::command_metrics, "PSNR, SSIM and FLIP of a sequence against another"},
     {"export", reprise::cli::command_export, "a sequence as PNG contact sheet or MP4"},
-    {"bench", reprise::cli::command_bench, "benchmarks (render, exr)"},
+    {"fruc", reprise::cli::command_fruc, "frame-rate upconversion (interpolate or extrapolate) x K"},
+    {"bench", reprise::cli::command_bench, "benchmarks (render, exr, reproject, grid, fill, fruc)"},
 };
 
 void print_usage(FILE* out) {

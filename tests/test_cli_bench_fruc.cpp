@@ -1,0 +1,129 @@
+// `reprise bench fruc` end to end on a tiny scene: the CSV rows, the summary and the HTML report.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Run {
+    int status = -1;  // exit status; 128 + signal when killed, 124 when it timed out
+    std::string output;
+};
+
+Run run(const std::string& arguments) {
+    std::string command = "timeout 300 " REPRISE_BINARY " " + arguments + " 2>&1";
+    Run r;
+    FILE* pipe = popen(command.c_str(), "r");
+    if (!pipe) return r;
+    std::array<char, 4096> buffer;
+    std::size_t n;
+    while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) r.output.append(buffer.data(), n);
+    int raw = pclose(pipe);
+    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : 128 + WTERMSIG(raw);
+    return r;
+}
+
+std::string read_text(const fs::path& path) {
+    std::ifstream file(path);
+    std::stringstream text;
+    text << file.rdbuf();
+    return text.str();
+}
+
+std::vector<std::string> fields(const std::string& line) {
+    std::vector<std::string> out;
+    std::stringstream stream(line);
+    std::string field;
+    while (std::getline(stream, field, ',')) out.push_back(field);
+    return out;
+}
+
+class CliBenchFruc : public testing::Test {
+protected:
+    static void SetUpTestSuite() {
+        dir_ = fs::temp_directory_path() / "reprise-cli-bench-fruc";
+        fs::remove_all(dir_);
+        result_ = run("bench fruc --scenes pan --factor 2 --size 96x54 --frames 3 --quick --out " +
+                      dir_.string());
+    }
+    static fs::path dir_;
+    static Run result_;
+};
+fs::path CliBenchFruc::dir_;
+Run CliBenchFruc::result_;
+
+TEST_F(CliBenchFruc, RunsAndPrintsTheSummary) {
+    ASSERT_EQ(result_.status, 0) << result_.output;
+    EXPECT_NE(result_.output.find("best interpolation"), std::string::npos) << result_.output;
+    EXPECT_NE(result_.output.find("index.html"), std::string::npos) << result_.output;
+}
+
+TEST_F(CliBenchFruc, CsvHasFiniteRowsForOursAndTheDisPeer) {
+    ASSERT_EQ(result_.status, 0) << result_.output;
+    std::ifstream csv(dir_ / "fruc.csv");
+    ASSERT_TRUE(csv) << "no fruc.csv";
+    std::string line;
+    std::getline(csv, line);
+    EXPECT_EQ(line, "scene,method,setting,frame,psnr,ssim,flip,ms");
+    std::set<std::string> methods;
+    std::set<int> frames;
+    int rows = 0;
+    while (std::getline(csv, line)) {
+        std::vector<std::string> f = fields(line);
+        ASSERT_EQ(f.size(), 8u) << line;
+        ++rows;
+        EXPECT_EQ(f[0], "pan") << line;
+        methods.insert(f[1]);
+        const int frame = std::atoi(f[3].c_str());
+        frames.insert(frame);
+        EXPECT_NE(frame % 2, 0) << "an input frame passed through was scored: " << line;
+        const double psnr = std::strtod(f[4].c_str(), nullptr), ms = std::strtod(f[7].c_str(), nullptr);
+        const double ssim = std::strtod(f[5].c_str(), nullptr), flip = std::strtod(f[6].c_str(), nullptr);
+        if (f[1] == "interpolate" || f[1] == "opencv-dis") {
+            EXPECT_TRUE(std::isfinite(psnr)) << line;
+            EXPECT_GT(psnr, 10.0) << line;  // a plausible frame, not noise or black
+        }
+        EXPECT_TRUE(ssim >= -1.0 && ssim <= 1.0) << line;
+        EXPECT_TRUE(flip >= 0.0 && flip <= 1.0) << line;
+        EXPECT_TRUE(std::isfinite(ms) && ms > 0.0) << line;
+    }
+    EXPECT_TRUE(methods.count("interpolate")) << "no row for our interpolation";
+    EXPECT_TRUE(methods.count("opencv-dis")) << "no row for the DIS peer";
+    EXPECT_EQ(frames, (std::set<int>{1, 3})) << "3 input frames at x2 have in-between frames 1 and 3";
+    EXPECT_GE(rows, 2 * 5);  // four settings and one peer at least, two frames each
+}
+
+TEST_F(CliBenchFruc, SummaryAndHtmlReport) {
+    ASSERT_EQ(result_.status, 0) << result_.output;
+    std::string summary = read_text(dir_ / "fruc_summary.csv");
+    EXPECT_EQ(summary.rfind("scene,method,setting,frames,psnr,ssim,flip,ms\n", 0), 0u) << summary;
+    EXPECT_NE(summary.find("pan,interpolate,grid+pullpush,2,"), std::string::npos) << summary;
+    std::string html = read_text(dir_ / "index.html");
+    ASSERT_FALSE(html.empty()) << "no index.html";
+    EXPECT_NE(html.find("<svg"), std::string::npos);
+    EXPECT_NE(html.find("Pareto"), std::string::npos);
+    EXPECT_EQ(html.find("<script"), std::string::npos);
+    EXPECT_NE(html.find("pan/worst_frame.png"), std::string::npos);
+    EXPECT_TRUE(fs::exists(dir_ / "pan" / "worst_frame.png"));
+}
+
+TEST(CliBenchFrucArgs, BadFactorGetsOneMessage) {
+    Run r = run("bench fruc --factor 1 --out " + (fs::temp_directory_path() / "reprise-cli-bench-fruc-bad").string());
+    EXPECT_TRUE(r.status == 1 || r.status == 2) << r.output;
+    EXPECT_NE(r.output.find("--factor"), std::string::npos) << r.output;
+}
+
+}  // namespace

@@ -1,0 +1,165 @@
+// Frame-rate upconversion end to end on rendered scenes, plus its skips, cuts and bad values.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <memory>
+
+#include "reprise/core/metrics.hpp"
+#include "reprise/server/builtin_scenes.hpp"
+#include "reprise/server/renderer.hpp"
+#include "reprise/warp/fruc.hpp"
+
+using namespace reprise;
+using namespace reprise::warp;
+
+namespace {
+
+server::Renderer& renderer() {
+    static std::unique_ptr<server::Renderer> r = [] {
+        std::unique_ptr<server::Renderer> made;
+        Status status = server::Renderer::create(made);
+        if (!status.ok()) ADD_FAILURE() << status.message();
+        return made;
+    }();
+    return *r;
+}
+
+// Frames [first, first + count) of `scene` at `fps`.
+std::vector<Frame> render(const std::string& scene_name, double fps, int first, int count,
+                          int w = 384, int h = 216) {
+    server::Scene scene;
+    server::CameraPath path;
+    EXPECT_TRUE(server::load_scene(scene_name, scene, path).ok());
+    std::vector<Frame> frames(count);
+    for (int i = 0; i < count; ++i)
+        EXPECT_TRUE(renderer().render_frame(scene, path, first + i, fps, {.width = w, .height = h}, frames[i]).ok());
+    return frames;
+}
+
+double psnr_of(const Frame& truth, const Frame& test) {
+    Image<glm::vec3> a(truth.width(), truth.height()), b(truth.width(), truth.height());
+    to_display(truth.color.view(), a.view());
+    to_display(test.color.view(), b.view());
+    return psnr(a.view(), b.view());
+}
+
+std::vector<Frame> convert(const std::vector<Frame>& inputs, int factor, const FrucOptions& options,
+                           FrucCounters* counters = nullptr) {
+    FrameRateConverter converter(factor, options);
+    std::vector<Frame> outputs;
+    for (const Frame& f : inputs) {
+        EXPECT_TRUE(converter.send(f).ok());
+        Frame out;
+        while (converter.receive(out)) outputs.push_back(out);
+    }
+    if (counters) *counters = converter.counters();
+    return outputs;
+}
+
+}  // namespace
+
+struct Setting {
+    WarpMethod warp;
+    FillMethod fill;
+    const char* name;
+};
+
+class FrucMethods : public ::testing::TestWithParam<Setting> {};
+
+// 30 -> 60 Hz on the pan scene: every synthesized frame is close to the rendered 60 Hz frame and
+// much closer than repeating the previous frame.
+TEST_P(FrucMethods, InterpolationBeatsFrameRepetition) {
+    const std::vector<Frame> input = render("pan", 30.0, 0, 4);
+    const std::vector<Frame> truth = render("pan", 60.0, 0, 7);
+    FrucOptions options{.mode = FrucMode::Interpolate, .warp = GetParam().warp, .fill = GetParam().fill};
+    std::vector<Frame> out = convert(input, 2, options);
+    ASSERT_EQ(out.size(), 7u);
+    for (int i = 1; i < 7; i += 2) {
+        double ours = psnr_of(truth[i], out[i]), repeat = psnr_of(truth[i], input[i / 2]);
+        std::printf("[fruc] %s frame %d: %.2f dB (repeating the previous frame: %.2f dB)\n",
+                    GetParam().name, i, ours, repeat);
+        EXPECT_GT(ours, repeat + 3.0) << GetParam().name << " frame " << i;
+        EXPECT_GT(ours, 32.0) << GetParam().name << " frame " << i;
+    }
+    EXPECT_EQ(out[2].color, input[1].color) << "inputs pass through unchanged";
+}
+
+TEST_P(FrucMethods, ExtrapolationBeatsFrameRepetition) {
+    const std::vector<Frame> input = render("crossing", 30.0, 10, 2);
+    const std::vector<Frame> truth = render("crossing", 60.0, 20, 4);
+    FrucOptions options{.mode = FrucMode::Extrapolate, .warp = GetParam().warp, .fill = GetParam().fill};
+    FrucCounters counters;
+    std::vector<Frame> out = convert(input, 2, options, &counters);
+    ASSERT_EQ(out.size(), 4u);
+    double ours = psnr_of(truth[3], out[3]), repeat = psnr_of(truth[3], input[1]);
+    std::printf("[fruc] extrapolate %s: %.2f dB (repeating: %.2f dB)\n", GetParam().name, ours, repeat);
+    EXPECT_GT(ours, repeat + 3.0) << GetParam().name;
+    EXPECT_GT(counters.dynamic_layers, 0u) << "crossing has moving objects";
+}
+
+INSTANTIATE_TEST_SUITE_P(AllWarps, FrucMethods,
+                         ::testing::Values(Setting{WarpMethod::Grid, FillMethod::PullPush, "grid_pullpush"},
+                                           Setting{WarpMethod::Splat, FillMethod::PullPush, "splat_pullpush"},
+                                           Setting{WarpMethod::Reverse, FillMethod::Andreev, "reverse_andreev"}),
+                         [](const auto& setting) { return std::string(setting.param.name); });
+
+TEST(Fruc, StillFramesAreCopiedNotWarped) {
+    std::vector<Frame> input = render("pan", 30.0, 0, 3, 64, 36);
+    for (Frame& f : input) {
+        f.color = input[0].color;
+        f.motion.resize(64, 36, glm::vec2(0.0f));
+    }
+    for (FrucMode mode : {FrucMode::Interpolate, FrucMode::Extrapolate}) {
+        FrucCounters counters;
+        std::vector<Frame> out = convert(input, 4, {.mode = mode}, &counters);
+        for (const Frame& f : out) EXPECT_EQ(f.color, input[0].color);
+        EXPECT_EQ(counters.copied_still, counters.outputs);
+        EXPECT_EQ(counters.fills + counters.grid_cells, 0u) << "nothing warped or filled";
+    }
+}
+
+TEST(Fruc, PanWithoutMovingObjectsSkipsTheDynamicLayer) {
+    FrucCounters counters;
+    convert(render("pan", 30.0, 3, 2, 96, 54), 3, {.mode = FrucMode::Extrapolate}, &counters);
+    EXPECT_EQ(counters.outputs, 4u);
+    EXPECT_EQ(counters.dynamic_skipped, counters.outputs);
+    EXPECT_EQ(counters.dynamic_layers, 0u);
+}
+
+TEST(Fruc, CameraCutResetsHistoryWithoutGhosts) {
+    // The cut scene switches shots at 0.5 s: between frames 14 and 15 at 30 Hz.
+    std::vector<Frame> input = render("cut", 30.0, 13, 4, 96, 54);
+    for (FrucMode mode : {FrucMode::Interpolate, FrucMode::Extrapolate}) {
+        FrucCounters counters;
+        std::vector<Frame> out = convert(input, 2, {.mode = mode}, &counters);
+        EXPECT_EQ(counters.cuts, 1u);
+        if (mode == FrucMode::Interpolate) {
+            // out: f13, (13|14), f14, (14|15) = cut, f15, ...
+            EXPECT_TRUE(out[3].color == input[1].color || out[3].color == input[2].color);
+        } else {
+            // out: f13, x, f14, x, f15, (after the cut: a copy of f15), ...
+            EXPECT_EQ(out[5].color, input[2].color);
+        }
+    }
+}
+
+TEST(Fruc, BadValuesNeverSpreadAndTinyImagesWork) {
+    const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+    for (auto [w, h] : {std::pair{1, 1}, std::pair{7, 3}, std::pair{64, 36}}) {
+        std::vector<Frame> input = render("crossing", 30.0, 5, 3, w, h);
+        input[1].motion(0, 0) = glm::vec2(nan, 1e30f);
+        input[1].depth(w / 2, h / 2) = nan;
+        input[2].motion(w - 1, h - 1) = glm::vec2(1e4f, -1e4f);
+        input[2].depth(0, h - 1) = -inf;
+        for (FrucMode mode : {FrucMode::Interpolate, FrucMode::Extrapolate})
+            for (WarpMethod warp : {WarpMethod::Grid, WarpMethod::Splat, WarpMethod::Reverse}) {
+                std::vector<Frame> out = convert(input, 3, {.mode = mode, .warp = warp});
+                for (const Frame& f : out)
+                    for (int y = 0; y < h; ++y)
+                        for (int x = 0; x < w; ++x)
+                            for (int k = 0; k < 3; ++k)
+                                ASSERT_TRUE(std::isfinite(f.color(x, y)[k])) << w << "x" << h;
+            }
+    }
+}

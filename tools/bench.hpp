@@ -1,0 +1,31 @@
+#pragma once
+// Benchmarks behind `reprise bench WHAT`. Each prints its timings and, for kernels, the ratio
+// against a peer (OpenCV, ffmpeg) measured in the same run on the same input.
+#include <string>
+
+#include "reprise/core/status.hpp"
+
+namespace reprise::cli {
+
+struct BenchOptions {
+    std::string scene = "pan";
+    int frames = 10;                        // repetitions / frames per measurement
+    std::string sizes = "640x360,1920x1080";
+    std::string dir;                        // where files go (default: the temp folder)
+    std::string out;                        // report folder (bench fruc)
+    // bench fruc
+    std::string scenes;                     // comma-separated; empty = every built-in scene
+    int factor = 2;                         // K
+    std::string size = "640x360";
+    bool quick = false;                     // a few settings only
+    bool exr = false;                       // also write the rendered input and truth as EXR
+};
+
+Status bench_reproject(const BenchOptions& options);  // reverse reprojection vs cv::remap
+Status bench_grid(const BenchOptions& options);       // splat and adaptive grid warp
+Status bench_fill(const BenchOptions& options);       // pull-push, Andreev vs cv::inpaint (Telea)
+// Upconversion error against run time, every setting and the peers (ffmpeg minterpolate,
+// OpenCV DIS flow, Telea): OUT/fruc.csv, OUT/fruc_summary.csv, OUT/index.html.
+Status bench_fruc(const BenchOptions& options);
+
+}  // namespace reprise::cli

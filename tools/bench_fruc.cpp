@@ -1,0 +1,526 @@
+// reprise bench fruc — frame-rate upconversion error against run time: every mode, warp and fill
+// beside ffmpeg's minterpolate, OpenCV DIS flow and Telea inpainting, on the same rendered frames.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <functional>
+#include <map>
+
+#include <glm/common.hpp>
+
+#include "args.hpp"
+#include "bench.hpp"
+#include "fruc_options.hpp"
+#include "peers.hpp"
+#include "report_html.hpp"
+#include "reprise/core/exr.hpp"
+#include "reprise/core/metrics.hpp"
+#include "reprise/core/parallel.hpp"
+#include "reprise/server/builtin_scenes.hpp"
+#include "reprise/server/renderer.hpp"
+#include "reprise/warp/fruc.hpp"
+
+namespace reprise::cli {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+namespace fs = std::filesystem;
+
+double ms_since(Clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+const char* const kFfmpeg = "ffmpeg-minterpolate";
+const char* const kDis = "opencv-dis";
+
+struct Setting {
+    std::string method, setting;
+    warp::FrucOptions options;
+    bool with_telea = false;  // also score Telea inpainting of this run's holes (fill none)
+};
+
+std::vector<Setting> fruc_settings(bool quick) {
+    std::vector<Setting> settings;
+    auto add = [&](const std::string& mode, const std::string& warp_name, const std::string& fill) {
+        Setting s{mode, warp_name + "+" + fill};
+        Status parsed = parse_fruc_options(mode, warp_name, fill, s.options);
+        REPRISE_ASSERT(parsed.ok());
+        s.with_telea = !quick && mode == "interpolate" && warp_name == "grid" && fill == "none";
+        settings.push_back(s);
+    };
+    if (quick) {
+        add("interpolate", "grid", "pullpush");
+        add("interpolate", "reverse", "pullpush");
+        add("interpolate", "splat", "none");
+        add("extrapolate", "grid", "pullpush");
+        return settings;
+    }
+    for (const char* mode : {"interpolate", "extrapolate"})
+        for (const char* warp_name : {"reverse", "splat", "grid"})
+            for (const char* fill : {"pullpush", "andreev", "none"}) add(mode, warp_name, fill);
+    return settings;
+}
+
+struct Score {
+    int frame = 0;
+    ImageError error;
+    double ms = 0.0;
+};
+
+// One method and setting on one scene.
+struct Run {
+    std::string method, setting;
+    std::vector<Score> scores;
+    int worst_frame = -1;
+    double worst_psnr = INFINITY;
+    Image<Rgb8> worst;                    // the lowest-PSNR frame as shown
+    std::map<int, Image<Rgb8>> frames;    // peers: every scored frame, for the comparison picture
+
+    ReportPoint mean() const {
+        ReportPoint p{method, setting};
+        for (const Score& s : scores) {
+            p.psnr += s.error.psnr, p.ssim += s.error.ssim, p.flip += s.error.flip, p.ms += s.ms;
+        }
+        const double n = scores.empty() ? NAN : double(scores.size());
+        p.psnr /= n, p.ssim /= n, p.flip /= n, p.ms /= n;
+        return p;
+    }
+    bool ours() const { return method == "interpolate" || method == "extrapolate"; }
+};
+
+struct SceneFrames {
+    std::string name;                      // folder-safe
+    std::vector<Frame> input;              // 30 Hz
+    std::vector<Image<Rgb8>> input_shown;  // their display values in 8 bits: the peers' input
+    std::vector<Image<glm::vec3>> truth;   // display values at 30 K Hz; empty at input instants
+    int factor = 2;
+    int last() const { return (int(input.size()) - 1) * factor; }
+    bool scored(int j) const { return j % factor != 0 && j > 0 && j < last(); }
+};
+
+void to_rgb8(ImageView<const glm::vec3> display, Image<Rgb8>& out) {
+    out.resize(display.width, display.height);
+    for (int y = 0; y < display.height; ++y)
+        for (int x = 0; x < display.width; ++x) {
+            glm::vec3 c = glm::clamp(display(x, y), 0.0f, 1.0f) * 255.0f + 0.5f;
+            out(x, y) = Rgb8(uint8_t(c.x), uint8_t(c.y), uint8_t(c.z));
+        }
+}
+
+void from_rgb8(ImageView<const Rgb8> shown, Image<glm::vec3>& out) {
+    out.resize(shown.width, shown.height);
+    for (int y = 0; y < shown.height; ++y)
+        for (int x = 0; x < shown.width; ++x) out(x, y) = glm::vec3(shown(x, y)) / 255.0f;
+}
+
+void record(Run& run, int frame, const Image<glm::vec3>& display, const Image<glm::vec3>& truth,
+            double ms, bool keep_frame) {
+    Score score{frame, image_error(truth.view(), display.view()), ms};
+    run.scores.push_back(score);
+    if (keep_frame) to_rgb8(display.view(), run.frames[frame]);
+    if (run.worst_frame < 0 || score.error.psnr < run.worst_psnr) {
+        run.worst_frame = frame;
+        run.worst_psnr = score.error.psnr;
+        to_rgb8(display.view(), run.worst);
+    }
+}
+
+Status render_scene(server::Renderer& renderer, const std::string& scene_name, int frames, int factor,
+                    int w, int h, const std::string& exr_dir, SceneFrames& out) {
+    server::Scene scene;
+    server::CameraPath path;
+    REPRISE_TRY(server::load_scene(scene_name, scene, path));
+    const server::RenderSettings settings{.width = w, .height = h};
+    out.factor = factor;
+    out.input.resize(frames);
+    out.input_shown.resize(frames);
+    for (int i = 0; i < frames; ++i) {
+        REPRISE_TRY(renderer.render_frame(scene, path, i, 30.0, settings, out.input[i]));
+        out.input_shown[i].resize(w, h);
+        visualize_color(out.input[i].color.view(), out.input_shown[i].view());
+        if (!exr_dir.empty()) {
+            REPRISE_TRY(write_frame(frame_path(exr_dir + "/input", i), out.input[i]));
+            REPRISE_TRY(write_frame(frame_path(exr_dir + "/truth", i * factor), out.input[i]));
+        }
+        std::fprintf(stderr, "\r[fruc] %s: rendering input %d/%d   ", out.name.c_str(), i + 1, frames);
+    }
+    out.truth.assign(out.last() + 1, {});
+    Frame truth;
+    for (int j = 1; j < out.last(); ++j) {
+        if (!out.scored(j)) continue;
+        REPRISE_TRY(renderer.render_frame(scene, path, j, 30.0 * factor, settings, truth));
+        out.truth[j].resize(w, h);
+        reprise::to_display(truth.color.view(), out.truth[j].view());
+        if (!exr_dir.empty()) REPRISE_TRY(write_frame(frame_path(exr_dir + "/truth", j), truth));
+        std::fprintf(stderr, "\r[fruc] %s: rendering truth %d/%d   ", out.name.c_str(), j, out.last());
+    }
+    std::fprintf(stderr, "\n");
+    return {};
+}
+
+// Times send() alone; each frame it made gets an equal share of that time.
+Status run_ours(const SceneFrames& scene, const Setting& setting, Run& run, Run* telea) {
+    const int w = scene.input[0].width(), h = scene.input[0].height();
+    warp::FrameRateConverter converter(scene.factor, setting.options);
+    Frame out;
+    Image<glm::vec3> display(w, h);
+    Image<uint8_t> holes(w, h);
+    int index = 0;
+    for (const Frame& input : scene.input) {
+        auto start = Clock::now();
+        REPRISE_TRY(converter.send(input));
+        const double send_ms = ms_since(start);
+        const std::size_t first = run.scores.size(), first_telea = telea ? telea->scores.size() : 0;
+        int made = 0;
+        while (converter.receive(out)) {
+            const int j = index++;
+            if (j % scene.factor == 0) continue;  // an input passed through
+            ++made;
+            if (!scene.scored(j)) continue;       // beyond the last input: no truth to compare
+            to_display(out.color.view(), display.view());
+            record(run, j, display, scene.truth[j], 0.0, false);
+            if (!telea) continue;
+            // With fill none the converter leaves holes at colour 0 and depth +inf.
+            for (int y = 0; y < h; ++y)
+                for (int x = 0; x < w; ++x)
+                    holes(x, y) = out.color(x, y) == glm::vec4(0.0f) && std::isinf(out.depth(x, y));
+            auto telea_start = Clock::now();
+            inpaint_telea(display.view(), holes.view());
+            record(*telea, j, display, scene.truth[j], ms_since(telea_start), false);
+        }
+        for (std::size_t k = first; k < run.scores.size(); ++k) run.scores[k].ms += send_ms / made;
+        if (telea)
+            for (std::size_t k = first_telea; k < telea->scores.size(); ++k)
+                telea->scores[k].ms += send_ms / made;
+    }
+    return {};
+}
+
+void run_dis(const SceneFrames& scene, Run& run) {
+    const int w = scene.input[0].width(), h = scene.input[0].height(), k_max = scene.factor;
+    DisInterpolator dis;
+    Image<Rgb8> shown(w, h);
+    Image<glm::vec3> display;
+    for (std::size_t i = 0; i + 1 < scene.input.size(); ++i) {
+        auto start = Clock::now();
+        dis.set_pair(scene.input_shown[i].view(), scene.input_shown[i + 1].view());
+        const double pair_ms = ms_since(start);
+        for (int k = 1; k < k_max; ++k) {
+            start = Clock::now();
+            dis.interpolate(float(k) / float(k_max), shown.view());
+            const double frame_ms = ms_since(start) + pair_ms / (k_max - 1);
+            const int j = int(i) * k_max + k;
+            from_rgb8(shown.view(), display);
+            record(run, j, display, scene.truth[j], frame_ms, true);
+        }
+    }
+}
+
+Status run_ffmpeg(const SceneFrames& scene, const std::string& scratch_dir, Run& run) {
+    std::vector<Image<Rgb8>> output;
+    double seconds = 0.0;
+    REPRISE_TRY(ffmpeg_minterpolate(scene.input_shown, scene.factor, scratch_dir, output, seconds));
+    const int synthesized = (int(scene.input.size()) - 1) * (scene.factor - 1);
+    Image<glm::vec3> display;
+    for (int j = 1; j < scene.last(); ++j) {
+        if (!scene.scored(j)) continue;
+        from_rgb8(output[j].view(), display);
+        record(run, j, display, scene.truth[j], 1e3 * seconds / synthesized, true);
+    }
+    return {};
+}
+
+// The window of the given size where `a` and `b` differ most (sum of absolute differences).
+void worst_window(const Image<Rgb8>& a, const Image<Rgb8>& b, int cw, int ch, int& best_x, int& best_y) {
+    const int w = a.width(), h = a.height();
+    std::vector<double> sat(std::size_t(w + 1) * (h + 1), 0.0);  // summed-area table
+    auto at = [&](int x, int y) -> double& { return sat[std::size_t(y) * (w + 1) + x]; };
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            glm::ivec3 d = glm::abs(glm::ivec3(a(x, y)) - glm::ivec3(b(x, y)));
+            at(x + 1, y + 1) = d.x + d.y + d.z + at(x, y + 1) + at(x + 1, y) - at(x, y);
+        }
+    double best = -1.0;
+    best_x = best_y = 0;
+    for (int y = 0; y + ch <= h; y += 2)
+        for (int x = 0; x + cw <= w; x += 2) {
+            double sum = at(x + cw, y + ch) - at(x, y + ch) - at(x + cw, y) + at(x, y);
+            if (sum > best) best = sum, best_x = x, best_y = y;
+        }
+}
+
+Image<Rgb8> crop(const Image<Rgb8>& image, int x0, int y0, int cw, int ch) {
+    Image<Rgb8> out(cw, ch);
+    for (int y = 0; y < ch; ++y)
+        for (int x = 0; x < cw; ++x) out(x, y) = image(x0 + x, y0 + y);
+    return out;
+}
+
+Image<Rgb8> outlined(Image<Rgb8> image, int x0, int y0, int cw, int ch) {
+    const Rgb8 yellow(255, 220, 0);
+    for (int x = x0; x < x0 + cw; ++x) image(x, y0) = image(x, y0 + ch - 1) = yellow;
+    for (int y = y0; y < y0 + ch; ++y) image(x0, y) = image(x0 + cw - 1, y) = yellow;
+    return image;
+}
+
+std::string db(double psnr) {
+    char buffer[32];
+    std::snprintf(buffer, sizeof buffer, "%.2f dB", psnr);
+    return buffer;
+}
+
+// Full frames and the crop where ours errs most: ours, truth, the better peer.
+Status comparison_picture(const SceneFrames& scene, const Run& ours, const Run* peer,
+                          const std::string& path) {
+    const int j = ours.worst_frame;
+    Image<Rgb8> truth;
+    to_rgb8(scene.truth[j].view(), truth);
+    const int w = truth.width(), h = truth.height();
+    const int cw = std::min(w, 200), ch = std::min(h, 112);
+    int x0 = 0, y0 = 0;
+    worst_window(ours.worst, truth, cw, ch, x0, y0);
+    std::vector<Image<Rgb8>> images = {outlined(ours.worst, x0, y0, cw, ch), outlined(truth, x0, y0, cw, ch)};
+    std::vector<std::string> labels = {"ours " + ours.setting + ", frame " + std::to_string(j) + ", " +
+                                           db(ours.worst_psnr),
+                                       "ground truth"};
+    const Score* peer_score = nullptr;
+    if (peer && peer->frames.count(j)) {
+        images.push_back(outlined(peer->frames.at(j), x0, y0, cw, ch));
+        for (const Score& s : peer->scores)
+            if (s.frame == j) peer_score = &s;
+        labels.push_back(peer->method + (peer_score ? ", " + db(peer_score->error.psnr) : ""));
+    }
+    const std::size_t columns = images.size();
+    for (std::size_t i = 0; i < columns; ++i) images.push_back(crop(images[i], x0, y0, cw, ch));
+    std::vector<Tile> tiles;
+    for (std::size_t i = 0; i < images.size(); ++i)
+        tiles.push_back({images[i].view(), i < columns ? labels[i] : "crop: " + labels[i - columns]});
+    Image<Rgb8> sheet = contact_sheet(tiles, {.columns = int(columns), .tile_width = 2 * cw});
+    return write_png(path, sheet.view());
+}
+
+std::vector<std::string> split(const std::string& list) {
+    std::vector<std::string> items;
+    std::size_t start = 0;
+    while (start <= list.size()) {
+        std::size_t end = std::min(list.find(',', start), list.size());
+        if (end > start) items.push_back(list.substr(start, end - start));
+        start = end + 1;
+    }
+    return items;
+}
+
+const Run* best_of(const std::vector<Run>& runs, const std::function<bool(const Run&)>& wanted) {
+    const Run* best = nullptr;
+    for (const Run& r : runs)
+        if (wanted(r) && !r.scores.empty() && (!best || r.mean().psnr > best->mean().psnr)) best = &r;
+    return best;
+}
+
+void progress(const std::string& scene, const Run& run) {
+    ReportPoint p = run.mean();
+    std::fprintf(stderr, "[fruc] %s: %-19s %-17s %6.2f dB %8.2f ms\n", scene.c_str(), run.method.c_str(),
+                 run.setting.c_str(), p.psnr, p.ms);
+}
+
+struct SceneSummary {
+    std::string scene;
+    ReportPoint interpolation, extrapolation, ffmpeg, dis;  // empty method: not run
+};
+
+std::string summary_table(const std::vector<SceneSummary>& rows) {
+    std::string text;
+    char line[512];
+    std::snprintf(line, sizeof line, "%-9s %-18s %7s %8s | %-17s %7s %8s | %7s %8s | %7s %8s | %7s  %s\n",
+                  "scene", "best interpolation", "PSNR", "ms", "best extrapolation", "PSNR", "ms",
+                  "ffmpeg", "ms", "DIS", "ms", "margin", ">=3 dB over the better peer, faster than both");
+    text += line;
+    auto value = [](const ReportPoint& p, bool ms) {
+        char b[32];
+        if (p.method.empty()) return std::string("-");
+        std::snprintf(b, sizeof b, "%.2f", ms ? p.ms : p.psnr);
+        return std::string(b);
+    };
+    for (const SceneSummary& r : rows) {
+        const bool has_ffmpeg = !r.ffmpeg.method.empty(), has_dis = !r.dis.method.empty();
+        double peer_db = -INFINITY, peer_ms = INFINITY;
+        if (has_ffmpeg) peer_db = std::max(peer_db, r.ffmpeg.psnr), peer_ms = std::min(peer_ms, r.ffmpeg.ms);
+        if (has_dis) peer_db = std::max(peer_db, r.dis.psnr), peer_ms = std::min(peer_ms, r.dis.ms);
+        std::string margin = "-", verdict = "no peer";
+        if (has_ffmpeg || has_dis) {
+            const double m = r.interpolation.psnr - peer_db;
+            char b[32];
+            std::snprintf(b, sizeof b, "%+.2f", m);
+            margin = b;
+            const bool enough = m >= 3.0, faster = r.interpolation.ms < peer_ms;
+            verdict = enough && faster ? "yes"
+                      : enough         ? "no: slower than a peer"
+                      : faster         ? "no: margin under 3 dB"
+                                       : "no: margin under 3 dB and slower";
+            if (!(has_ffmpeg && has_dis)) verdict += " (one peer only)";
+        }
+        std::snprintf(line, sizeof line, "%-9s %-18s %7s %8s | %-17s %7s %8s | %7s %8s | %7s %8s | %7s  %s\n",
+                      r.scene.c_str(), r.interpolation.setting.c_str(), value(r.interpolation, false).c_str(),
+                      value(r.interpolation, true).c_str(), r.extrapolation.setting.c_str(),
+                      value(r.extrapolation, false).c_str(), value(r.extrapolation, true).c_str(),
+                      value(r.ffmpeg, false).c_str(), value(r.ffmpeg, true).c_str(),
+                      value(r.dis, false).c_str(), value(r.dis, true).c_str(), margin.c_str(), verdict.c_str());
+        text += line;
+    }
+    return text;
+}
+
+}  // namespace
+
+Status bench_fruc(const BenchOptions& job) {
+    if (job.factor < 2 || job.factor > 16) return Status::error("bench fruc: --factor must be in 2..16");
+    if (job.frames < 2 || job.frames > 1000) return Status::error("bench fruc: --frames must be in 2..1000");
+    int w = 0, h = 0;
+    REPRISE_TRY(parse_size(job.size, w, h));
+    std::vector<std::string> scenes = split(job.scenes);
+    if (scenes.empty())
+        for (const server::SceneInfo& s : server::builtin_scenes()) scenes.push_back(s.name);
+    const std::string out_dir = job.out.empty() ? "out/bench-fruc" : job.out;
+    std::error_code ec;
+    fs::create_directories(out_dir, ec);
+    if (ec) return Status::error(out_dir + ": cannot create the folder: " + ec.message());
+
+    std::unique_ptr<server::Renderer> renderer;
+    REPRISE_TRY(server::Renderer::create(renderer));
+    const bool has_ffmpeg = ffmpeg_has_minterpolate();
+    if (!has_ffmpeg) std::printf("note: ffmpeg with the minterpolate filter not found; that peer is skipped\n");
+    const std::vector<Setting> settings = fruc_settings(job.quick);
+
+    const std::string csv_path = out_dir + "/fruc.csv", summary_path = out_dir + "/fruc_summary.csv";
+    FILE* csv = std::fopen(csv_path.c_str(), "w");
+    FILE* summary_csv = std::fopen(summary_path.c_str(), "w");
+    if (!csv || !summary_csv) {
+        if (csv) std::fclose(csv);
+        if (summary_csv) std::fclose(summary_csv);
+        return Status::error(out_dir + ": cannot write fruc.csv / fruc_summary.csv");
+    }
+    std::fprintf(csv, "scene,method,setting,frame,psnr,ssim,flip,ms\n");
+    std::fprintf(summary_csv, "scene,method,setting,frames,psnr,ssim,flip,ms\n");
+
+    Report report;
+    report.title = "reprise bench fruc: frame-rate upconversion, error against run time";
+    const int synthesized = (job.frames - 1) * (job.factor - 1);
+    char text[2048];
+    std::snprintf(text, sizeof text,
+                  "x%d upconversion of %d input frames at 30 Hz (%dx%d), renderer %s. Each method's "
+                  "%d in-between frames are compared with frames rendered at %d Hz (display values: "
+                  "PSNR, SSIM, LDR-FLIP); the input frames passed through are not scored.",
+                  job.factor, job.frames, w, h, renderer->device().c_str(), synthesized, 30 * job.factor);
+    report.paragraphs.push_back(text);
+    std::snprintf(text, sizeof text,
+                  "ms = wall-clock milliseconds per synthesized frame on this machine (%d threads for "
+                  "reprise's loops). Ours: FrameRateConverter::send() alone, from G-buffers in memory. "
+                  "opencv-dis: DIS flow (preset MEDIUM) both ways per input pair, shared by its in-between "
+                  "frames, plus remap and blend of 8-bit frames. ffmpeg-minterpolate (mi_mode=mci): the "
+                  "whole ffmpeg run divided by the frames it synthesized, including process start, raw "
+                  "video I/O and RGB/YUV conversion. grid+telea: the grid warp without fill plus "
+                  "cv::inpaint (Telea) of its holes.",
+                  thread_count());
+    report.paragraphs.push_back(text);
+    std::vector<SceneSummary> summaries;
+
+    Status failure;
+    for (const std::string& scene_name : scenes) {
+        SceneFrames scene;
+        scene.name = fs::path(scene_name).stem().string();
+        const std::string scene_dir = out_dir + "/" + scene.name;
+        fs::create_directories(scene_dir, ec);
+        if (ec) return Status::error(scene_dir + ": cannot create the folder: " + ec.message());
+        failure = render_scene(*renderer, scene_name, job.frames, job.factor, w, h,
+                               job.exr ? scene_dir : std::string(), scene);
+        if (!failure.ok()) break;
+
+        std::vector<Run> runs;
+        runs.reserve(settings.size() + 3);
+        for (const Setting& setting : settings) {
+            runs.push_back({setting.method, setting.setting});
+            Run telea{"interpolate", "grid+telea"};
+            failure = run_ours(scene, setting, runs.back(), setting.with_telea ? &telea : nullptr);
+            if (!failure.ok()) break;
+            progress(scene.name, runs.back());
+            if (setting.with_telea) {
+                runs.push_back(std::move(telea));
+                progress(scene.name, runs.back());
+            }
+        }
+        if (!failure.ok()) break;
+        runs.push_back({kDis, "medium"});
+        run_dis(scene, runs.back());
+        progress(scene.name, runs.back());
+        if (has_ffmpeg) {
+            Run ffmpeg{kFfmpeg, "mci"};
+            Status ran = run_ffmpeg(scene, scene_dir, ffmpeg);
+            if (ran.ok()) {
+                runs.push_back(std::move(ffmpeg));
+                progress(scene.name, runs.back());
+            } else {
+                std::printf("note: %s: ffmpeg peer skipped: %s\n", scene.name.c_str(), ran.message().c_str());
+            }
+        }
+
+        ReportSection section{scene.name};
+        for (const server::SceneInfo& info : server::builtin_scenes())
+            if (scene_name == info.name) section.note = info.stresses;
+        for (const Run& run : runs) {
+            for (const Score& s : run.scores)
+                std::fprintf(csv, "%s,%s,%s,%d,%.4f,%.6f,%.6f,%.4f\n", scene.name.c_str(), run.method.c_str(),
+                             run.setting.c_str(), s.frame, s.error.psnr, s.error.ssim, s.error.flip, s.ms);
+            ReportPoint p = run.mean();
+            std::fprintf(summary_csv, "%s,%s,%s,%zu,%.4f,%.6f,%.6f,%.4f\n", scene.name.c_str(),
+                         run.method.c_str(), run.setting.c_str(), run.scores.size(), p.psnr, p.ssim, p.flip, p.ms);
+            section.points.push_back(p);
+        }
+
+        SceneSummary row{scene.name};
+        const Run* interpolation = best_of(runs, [](const Run& r) {
+            return r.method == "interpolate" && r.setting != "grid+telea";
+        });
+        const Run* extrapolation = best_of(runs, [](const Run& r) { return r.method == "extrapolate"; });
+        const Run* peer = best_of(runs, [](const Run& r) { return !r.ours(); });
+        if (interpolation) row.interpolation = interpolation->mean();
+        if (extrapolation) row.extrapolation = extrapolation->mean();
+        for (const Run& r : runs) {
+            if (r.method == kFfmpeg) row.ffmpeg = r.mean();
+            if (r.method == kDis) row.dis = r.mean();
+        }
+        summaries.push_back(row);
+        if (interpolation) {
+            const std::string picture = scene.name + "/worst_frame.png";
+            failure = comparison_picture(scene, *interpolation, peer, out_dir + "/" + picture);
+            if (!failure.ok()) break;
+            section.images.push_back(
+                {picture, "The lowest-PSNR frame of the best interpolation setting (" + interpolation->setting +
+                              ", frame " + std::to_string(interpolation->worst_frame) + ") beside the ground truth" +
+                              (peer ? " and the better peer (" + peer->method + ")" : std::string()) +
+                              "; below, the window where ours differs most from the truth, enlarged."});
+        }
+        report.sections.push_back(std::move(section));
+        std::fflush(csv);
+        std::fflush(summary_csv);
+    }
+    std::fclose(csv);
+    std::fclose(summary_csv);
+    REPRISE_TRY(failure);
+
+    std::string table = summary_table(summaries);
+    std::snprintf(text, sizeof text,
+                  "fruc x%d, %dx%d, %d input frames, %d scored frames per method; PSNR in dB, ms per "
+                  "synthesized frame; margin = best interpolation - better peer\n",
+                  job.factor, w, h, job.frames, synthesized);
+    report.preformatted = std::string(text) + table;
+    const std::string html_path = out_dir + "/index.html";
+    REPRISE_TRY(write_html_report(html_path, report));
+    std::printf("%s%s", text, table.c_str());
+    std::printf("report: %s\nrows: %s\nmeans: %s\n", html_path.c_str(), csv_path.c_str(), summary_path.c_str());
+    return {};
+}
+
+}  // namespace reprise::cli

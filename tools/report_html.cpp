@@ -1,0 +1,234 @@
+#include "report_html.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+
+namespace reprise::cli {
+
+namespace {
+
+std::string escape(const std::string& text) {
+    std::string out;
+    for (char c : text) {
+        switch (c) {
+            case '&': out += "&amp;"; break;
+            case '<': out += "&lt;"; break;
+            case '>': out += "&gt;"; break;
+            case '"': out += "&quot;"; break;
+            default: out += c;
+        }
+    }
+    return out;
+}
+
+std::string format(const char* pattern, double value) {
+    char buffer[64];
+    std::snprintf(buffer, sizeof buffer, pattern, value);
+    return buffer;
+}
+
+const char* method_color(std::size_t index) {
+    static const char* palette[] = {"#1f6fb4", "#e8790c", "#2a9d3a", "#c9302c",
+                                    "#7b52ab", "#8c5a3c", "#d4429b", "#6b6b6b"};
+    return palette[index % (sizeof palette / sizeof *palette)];
+}
+
+struct Box {
+    double x0, y0, x1, y1;
+    bool overlaps(const Box& o) const { return x0 < o.x1 && o.x0 < x1 && y0 < o.y1 && o.y0 < y1; }
+};
+
+// A 1-2-5 step giving about `count` intervals over `range`.
+double nice_step(double range, int count) {
+    double raw = range / count, decade = std::pow(10.0, std::floor(std::log10(raw)));
+    for (double m : {1.0, 2.0, 5.0, 10.0})
+        if (m * decade >= raw) return m * decade;
+    return 10.0 * decade;
+}
+
+}  // namespace
+
+std::vector<std::size_t> pareto_front(const std::vector<ReportPoint>& points) {
+    std::vector<std::size_t> order;
+    for (std::size_t i = 0; i < points.size(); ++i)
+        if (points[i].ms > 0.0 && !std::isnan(points[i].psnr)) order.push_back(i);
+    std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+        if (points[a].ms != points[b].ms) return points[a].ms < points[b].ms;
+        return points[a].psnr > points[b].psnr;
+    });
+    std::vector<std::size_t> front;
+    for (std::size_t i : order)
+        if (front.empty() || points[i].psnr > points[front.back()].psnr) front.push_back(i);
+    return front;
+}
+
+std::string error_time_svg(const std::vector<ReportPoint>& points) {
+    const double width = 760, height = 460, left = 64, right = 24, top = 20, bottom = 84;
+    const double plot_w = width - left - right, plot_h = height - top - bottom;
+    std::vector<std::size_t> shown;
+    double ms_lo = INFINITY, ms_hi = -INFINITY, db_lo = INFINITY, db_hi = -INFINITY;
+    for (std::size_t i = 0; i < points.size(); ++i) {
+        const ReportPoint& p = points[i];
+        if (!(p.ms > 0.0) || !std::isfinite(p.ms) || std::isnan(p.psnr)) continue;
+        shown.push_back(i);
+        ms_lo = std::min(ms_lo, p.ms), ms_hi = std::max(ms_hi, p.ms);
+        if (std::isfinite(p.psnr)) db_lo = std::min(db_lo, p.psnr), db_hi = std::max(db_hi, p.psnr);
+    }
+    if (shown.empty()) ms_lo = 1, ms_hi = 10;
+    if (!(db_lo <= db_hi)) db_lo = 20, db_hi = 40;
+    const double x_lo = std::floor(std::log10(ms_lo)), x_hi = std::max(x_lo + 1, std::ceil(std::log10(ms_hi)));
+    const double step = nice_step(std::max(db_hi - db_lo, 1.0), 6);
+    const double y_lo = std::floor((db_lo - 0.3 * step) / step) * step;
+    const double y_hi = std::ceil((db_hi + 0.3 * step) / step) * step;
+    auto px = [&](double ms) { return left + (std::log10(ms) - x_lo) / (x_hi - x_lo) * plot_w; };
+    auto py = [&](double db) {
+        db = std::clamp(db, y_lo, y_hi);  // +inf (identical frames) sits on the top edge
+        return top + (y_hi - db) / (y_hi - y_lo) * plot_h;
+    };
+
+    std::string svg = "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + format("%.0f", width) +
+                      "\" height=\"" + format("%.0f", height) + "\" viewBox=\"0 0 " +
+                      format("%.0f", width) + " " + format("%.0f", height) +
+                      "\" font-family=\"sans-serif\" font-size=\"11\">\n";
+    svg += "<rect x=\"" + format("%.1f", left) + "\" y=\"" + format("%.1f", top) + "\" width=\"" +
+           format("%.1f", plot_w) + "\" height=\"" + format("%.1f", plot_h) +
+           "\" fill=\"#fafafa\" stroke=\"#888\"/>\n";
+    // Grid and ticks: 1, 2, 5 per decade on x; a 1-2-5 step on y.
+    for (double d = x_lo; d <= x_hi; ++d)
+        for (double m : {1.0, 2.0, 5.0}) {
+            double ms = m * std::pow(10.0, d), x = px(ms);
+            if (std::log10(ms) > x_hi + 1e-9) continue;
+            svg += "<line x1=\"" + format("%.1f", x) + "\" y1=\"" + format("%.1f", top) + "\" x2=\"" +
+                   format("%.1f", x) + "\" y2=\"" + format("%.1f", top + plot_h) + "\" stroke=\"" +
+                   (m == 1.0 ? "#ccc" : "#eee") + "\"/>\n";
+            svg += "<text x=\"" + format("%.1f", x) + "\" y=\"" + format("%.1f", top + plot_h + 14) +
+                   "\" text-anchor=\"middle\">" + format("%g", ms) + "</text>\n";
+        }
+    for (double db = y_lo; db <= y_hi + 1e-9; db += step) {
+        double y = py(db);
+        svg += "<line x1=\"" + format("%.1f", left) + "\" y1=\"" + format("%.1f", y) + "\" x2=\"" +
+               format("%.1f", left + plot_w) + "\" y2=\"" + format("%.1f", y) + "\" stroke=\"#e4e4e4\"/>\n";
+        svg += "<text x=\"" + format("%.1f", left - 6) + "\" y=\"" + format("%.1f", y + 4) +
+               "\" text-anchor=\"end\">" + format("%g", db) + "</text>\n";
+    }
+    svg += "<text x=\"" + format("%.1f", left + plot_w / 2) + "\" y=\"" + format("%.1f", top + plot_h + 32) +
+           "\" text-anchor=\"middle\">ms per synthesized frame (log scale)</text>\n";
+    svg += "<text transform=\"translate(16 " + format("%.1f", top + plot_h / 2) +
+           ") rotate(-90)\" text-anchor=\"middle\">PSNR, dB (higher is better)</text>\n";
+
+    std::vector<std::string> methods;
+    for (std::size_t i : shown)
+        if (std::find(methods.begin(), methods.end(), points[i].method) == methods.end())
+            methods.push_back(points[i].method);
+    auto color_of = [&](const std::string& method) {
+        return method_color(std::size_t(std::find(methods.begin(), methods.end(), method) - methods.begin()));
+    };
+
+    std::vector<std::size_t> front = pareto_front(points);
+    if (!front.empty()) {
+        std::string path = "M" + format("%.1f", px(points[front[0]].ms)) + " " +
+                           format("%.1f", py(points[front[0]].psnr));
+        for (std::size_t k = 1; k < front.size(); ++k)
+            path += " H" + format("%.1f", px(points[front[k]].ms)) + " V" +
+                    format("%.1f", py(points[front[k]].psnr));
+        path += " H" + format("%.1f", left + plot_w);
+        svg += "<path d=\"" + path + "\" fill=\"none\" stroke=\"#222\" stroke-width=\"1.5\" "
+               "stroke-dasharray=\"5 3\"/>\n";
+    }
+
+    std::vector<Box> taken;
+    for (std::size_t i : shown) {
+        const ReportPoint& p = points[i];
+        double x = px(p.ms), y = py(p.psnr);
+        taken.push_back({x - 5, y - 5, x + 5, y + 5});
+    }
+    for (std::size_t i : shown) {
+        const ReportPoint& p = points[i];
+        const double x = px(p.ms), y = py(p.psnr);
+        const bool on_front = std::find(front.begin(), front.end(), i) != front.end();
+        svg += "<g><title>" + escape(p.method + " " + p.setting) + ": " + format("%.2f dB", p.psnr) +
+               ", " + format("%.3g ms", p.ms) + (on_front ? " (Pareto front)" : "") + "</title>";
+        if (on_front)
+            svg += "<circle cx=\"" + format("%.1f", x) + "\" cy=\"" + format("%.1f", y) +
+                   "\" r=\"7\" fill=\"none\" stroke=\"#222\" stroke-width=\"1.5\"/>";
+        svg += "<circle cx=\"" + format("%.1f", x) + "\" cy=\"" + format("%.1f", y) + "\" r=\"4\" fill=\"" +
+               color_of(p.method) + "\"/></g>\n";
+        // The label goes to the first side where it covers no other point or label.
+        const double text_w = 6.0 * double(p.setting.size()), text_h = 11;
+        const Box candidates[] = {{x + 8, y - text_h / 2, x + 8 + text_w, y + text_h / 2},
+                                  {x - 8 - text_w, y - text_h / 2, x - 8, y + text_h / 2},
+                                  {x - text_w / 2, y - 8 - text_h, x + text_w / 2, y - 8},
+                                  {x - text_w / 2, y + 8, x + text_w / 2, y + 8 + text_h}};
+        Box chosen = candidates[0];
+        for (const Box& c : candidates) {
+            bool free = c.x0 >= 0 && c.x1 <= width && c.y0 >= 0 && c.y1 <= top + plot_h;
+            for (const Box& t : taken) free = free && !c.overlaps(t);
+            if (free) {
+                chosen = c;
+                break;
+            }
+        }
+        taken.push_back(chosen);
+        svg += "<text x=\"" + format("%.1f", chosen.x0) + "\" y=\"" + format("%.1f", chosen.y1 - 2) +
+               "\" font-size=\"10\" fill=\"" + color_of(p.method) + "\">" + escape(p.setting) + "</text>\n";
+    }
+
+    double lx = left;
+    const double ly = top + plot_h + 56;
+    for (const std::string& m : methods) {
+        svg += "<circle cx=\"" + format("%.1f", lx + 5) + "\" cy=\"" + format("%.1f", ly - 4) +
+               "\" r=\"4\" fill=\"" + color_of(m) + "\"/><text x=\"" + format("%.1f", lx + 13) +
+               "\" y=\"" + format("%.1f", ly) + "\">" + escape(m) + "</text>\n";
+        lx += 30 + 6.5 * double(m.size());
+    }
+    svg += "<path d=\"M" + format("%.1f", lx) + " " + format("%.1f", ly - 4) + " h24\" stroke=\"#222\" "
+           "stroke-width=\"1.5\" stroke-dasharray=\"5 3\"/><text x=\"" + format("%.1f", lx + 30) +
+           "\" y=\"" + format("%.1f", ly) + "\">Pareto front (best PSNR for the time)</text>\n";
+    svg += "</svg>\n";
+    return svg;
+}
+
+Status write_html_report(const std::string& path, const Report& report) {
+    std::string html =
+        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>" + escape(report.title) +
+        "</title>\n<style>body{font-family:sans-serif;margin:2em;max-width:1100px;color:#222}"
+        "table{border-collapse:collapse;font-size:13px;margin:1em 0}"
+        "td,th{border:1px solid #ccc;padding:2px 8px;text-align:right}"
+        "td:nth-child(-n+2),th:nth-child(-n+2){text-align:left}"
+        "tr.front td{font-weight:bold}pre{background:#f4f4f4;padding:1em;overflow-x:auto}"
+        "figure{margin:1em 0}img{max-width:100%;image-rendering:pixelated}"
+        "figcaption{font-size:13px;color:#555}</style></head><body>\n<h1>" +
+        escape(report.title) + "</h1>\n";
+    for (const std::string& p : report.paragraphs) html += "<p>" + escape(p) + "</p>\n";
+    if (!report.preformatted.empty()) html += "<pre>" + escape(report.preformatted) + "</pre>\n";
+    for (const ReportSection& section : report.sections) {
+        html += "<h2>" + escape(section.title) + "</h2>\n";
+        if (!section.note.empty()) html += "<p>" + escape(section.note) + "</p>\n";
+        html += error_time_svg(section.points);
+        std::vector<std::size_t> front = pareto_front(section.points);
+        html += "<table><tr><th>method</th><th>setting</th><th>PSNR dB</th><th>SSIM</th>"
+                "<th>FLIP</th><th>ms</th><th>Pareto</th></tr>\n";
+        for (std::size_t i = 0; i < section.points.size(); ++i) {
+            const ReportPoint& p = section.points[i];
+            const bool on_front = std::find(front.begin(), front.end(), i) != front.end();
+            html += std::string(on_front ? "<tr class=\"front\">" : "<tr>") + "<td>" + escape(p.method) +
+                    "</td><td>" + escape(p.setting) + "</td><td>" + format("%.2f", p.psnr) + "</td><td>" +
+                    format("%.4f", p.ssim) + "</td><td>" + format("%.4f", p.flip) + "</td><td>" +
+                    format("%.3g", p.ms) + "</td><td>" + (on_front ? "front" : "") + "</td></tr>\n";
+        }
+        html += "</table>\n";
+        for (const ReportImage& image : section.images)
+            html += "<figure><img src=\"" + escape(image.file) + "\" alt=\"" + escape(image.caption) +
+                    "\"><figcaption>" + escape(image.caption) + "</figcaption></figure>\n";
+    }
+    html += "</body></html>\n";
+    std::ofstream file(path, std::ios::binary);
+    file << html;
+    file.close();
+    if (!file) return Status::error(path + ": cannot write the report");
+    return {};
+}
+
+}  // namespace reprise::cli

@@ -1,0 +1,67 @@
+#pragma once
+// Hole filling for warped frames: pull-push (Marroquim et al. 2007), its depth-aware variant
+// and Andreev-style patch inpainting.
+//
+// Shared rules: a pixel is a hole where valid(p) == 0 or where its RGB is not finite (NaN/Inf
+// never spread). Only the RGB of holes is written; valid pixels and every alpha stay bit-exact.
+// With `depth` (same size, linear depth as in Frame), samples whose depth exceeds the nearest
+// one in the same neighbourhood by more than kBackgroundDepthRatio are preferred, so that
+// disocclusions fill from the background; NaN depth counts as +inf, negative depth as 0.
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "reprise/core/frame.hpp"
+
+namespace reprise::warp {
+
+inline constexpr float kBackgroundDepthRatio = 1.1f;
+
+struct FillStats {
+    std::size_t holes = 0;     // hole pixels found on entry (including non-finite colour)
+    std::size_t unfilled = 0;  // holes left as they were (no valid pixel to fill from)
+    int levels = 0;            // pyramid levels built (pull-push) or passes run (Andreev)
+};
+
+// Pull-push: the pull averages each 2x2 block of valid samples into a coarser level with a
+// saturating weight min(1, sum) until a level has no empty pixel (at most down to 1x1); the push
+// fills empty pixels from the bilinearly upsampled coarser level. With no valid pixel at all the
+// image is left unchanged and holes == unfilled == W*H. `fill` is threaded and reuses its scratch
+// pyramid (no allocation while the size stays the same); `fill_reference` is the plain scalar
+// version it is tested against (same arithmetic, same result).
+class PullPush {
+public:
+    FillStats fill(ImageView<glm::vec4> color, ImageView<const uint8_t> valid,
+                   ImageView<const float> depth = {});
+    FillStats fill_reference(ImageView<glm::vec4> color, ImageView<const uint8_t> valid,
+                             ImageView<const float> depth = {});
+
+private:
+    std::vector<Image<glm::vec4>> color_levels_;  // levels 1.., rgb premultiplied, a = weight
+    std::vector<Image<float>> depth_levels_;      // farthest kept depth per pixel
+    Image<uint8_t> hole_bits_;                    // per level-1 pixel: which of its 2x2 are holes
+};
+
+// Andreev-style inpainting: each hole pixel looks left, right, up and down for the nearest valid
+// pixel at distance k and copies the pixel mirrored about the hole's edge (distance k - 1 beyond
+// that pixel, clamped to the run of valid pixels there); directions are averaged with weights
+// 1/k (with depth: only the directions whose source is background). Pixels filled in one pass
+// are valid in the next; passes repeat until no hole is left, a pass fills nothing, or
+// max_passes. One pass fills every hole that has a valid pixel in its row or column, so any
+// image with a valid pixel is filled within two passes. Deterministic for any thread count.
+class AndreevInpaint {
+public:
+    FillStats fill(ImageView<glm::vec4> color, ImageView<const uint8_t> valid,
+                   ImageView<const float> depth = {}, int max_passes = 64);
+
+private:
+    Image<uint8_t> state_;     // 0 hole, 1 valid on entry, 2 filled by an earlier pass
+    Image<uint16_t> up_, down_;  // holes: distance to the nearest valid pixel; valid: run length
+    Image<float> filled_depth_;
+};
+
+// One-shot form of AndreevInpaint::fill (allocates its scratch per call).
+FillStats inpaint_andreev(ImageView<glm::vec4> color, ImageView<const uint8_t> valid,
+                          ImageView<const float> depth = {}, int max_passes = 64);
+
+}  // namespace reprise::warp

@@ -1,0 +1,128 @@
+#include <cmath>
+#include <limits>
+
+#include "fruc_stages.hpp"
+#include "reprise/core/parallel.hpp"
+#include "reprise/warp/sample.hpp"
+
+namespace reprise::warp {
+
+void WarpBuffers::resize(int w, int h) {
+    if (color.width() == w && color.height() == h) return;
+    color.resize(w, h);
+    depth.resize(w, h);
+    motion.resize(w, h);
+    covered.resize(w, h);
+}
+
+bool motion_is_zero(const Frame& f) {
+    if (f.motion.empty()) return false;
+    const glm::vec2* m = f.motion.data();
+    for (std::size_t i = 0, n = f.motion.pixel_count(); i < n; ++i)
+        if (m[i].x != 0.0f || m[i].y != 0.0f) return false;
+    return true;
+}
+
+namespace {
+
+// Reverse warp: the splat placed, at each covered pixel q, the source pixel p that lands there;
+// refine p = q - factor * motion(p) with the source's own (bilinear) motion and fetch colour
+// bilinearly there. Taps are not depth-tested: across silhouettes the blend measured closer to the
+// rendered truth than keeping either surface.
+void refetch(const Frame& source, float factor, WarpBuffers& out) {
+    const int w = out.color.width(), h = out.color.height();
+    parallel_for(0, h, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y)
+            for (int x = 0; x < w; ++x) {
+                if (!out.covered(x, y)) continue;
+                glm::vec2 q(x + 0.5f, y + 0.5f);
+                glm::vec2 p = q - factor * out.motion(x, y);
+                Bilinear b = bilinear_taps(p.x, p.y, source.width(), source.height());
+                if (!b.inside) continue;
+                glm::vec2 m = bilinear_fetch(source.motion.view(), b);
+                if (!std::isfinite(m.x) || !std::isfinite(m.y)) continue;
+                p = q - factor * m;
+                b = bilinear_taps(p.x, p.y, source.width(), source.height());
+                if (!b.inside) continue;
+                glm::vec4 c = bilinear_fetch(source.color.view(), b);
+                if (std::isfinite(c.r + c.g + c.b + c.a)) out.color(x, y) = c;
+            }
+    });
+}
+
+}  // namespace
+
+void warp_frame(const Frame& source, float factor, const FrucOptions& options, FrucScratch& scratch,
+                WarpBuffers& out, FrucCounters& counters) {
+    out.resize(source.width(), source.height());
+    switch (options.warp) {
+        case WarpMethod::Grid:
+            counters.grid_cells += scratch.grid.warp(source, factor, out.target(), options.grid).cells;
+            return;
+        case WarpMethod::Splat:
+            splat(source, factor, out.target(), options.splat);
+            return;
+        case WarpMethod::Reverse:
+            splat(source, factor, out.target(), {.footprint = 2});
+            refetch(source, factor, out);
+            return;
+    }
+}
+
+void fill_holes(ImageView<glm::vec4> color, ImageView<const uint8_t> valid,
+                ImageView<const float> depth, const FrucOptions& options, FrucScratch& scratch,
+                FrucCounters& counters) {
+    std::size_t holes = 0;
+    for (int y = 0; y < valid.height; ++y)
+        for (int x = 0; x < valid.width; ++x) holes += valid(x, y) == 0;
+    counters.hole_pixels += holes;
+    if (holes == 0 || options.fill == FillMethod::None) {
+        counters.fills_skipped += holes == 0;
+        return;
+    }
+    ++counters.fills;
+    if (options.fill == FillMethod::PullPush) scratch.pull_push.fill(color, valid, depth);
+    else inpaint_andreev(color, valid, depth);
+}
+
+void interpolate_frame(const Frame& a, const Frame& b, float s, const FrucOptions& options,
+                       FrucScratch& scratch, Frame& out, FrucCounters& counters) {
+    const int w = b.width(), h = b.height();
+    warp_frame(b, 1.0f - s, options, scratch, scratch.side_b, counters);
+    warp_frame(a, -s, options, scratch, scratch.side_a, counters);
+    out.color.resize(w, h);
+    out.depth.resize(w, h);
+    out.motion.resize(w, h);
+    scratch.valid.resize(w, h);
+    const WarpBuffers &wa = scratch.side_a, &wb = scratch.side_b;
+    const float inf = std::numeric_limits<float>::infinity();
+    parallel_for(0, h, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y)
+            for (int x = 0; x < w; ++x) {
+                bool ca = wa.covered(x, y), cb = wb.covered(x, y);
+                float za = wa.depth(x, y), zb = wb.depth(x, y);
+                glm::vec4 color(0.0f);
+                float z = inf;
+                glm::vec2 m(0.0f);
+                if (ca && cb && std::abs(za - zb) <= 0.02f * std::min(za, zb)) {
+                    color = (1.0f - s) * wa.color(x, y) + s * wb.color(x, y);
+                    z = std::min(za, zb);
+                    m = wb.motion(x, y);
+                } else if (ca && cb && std::isinf(za) && std::isinf(zb)) {
+                    color = (1.0f - s) * wa.color(x, y) + s * wb.color(x, y);
+                    m = wb.motion(x, y);
+                } else if (cb && (!ca || zb < za)) {
+                    color = wb.color(x, y), z = zb, m = wb.motion(x, y);
+                } else if (ca) {
+                    color = wa.color(x, y), z = za, m = wa.motion(x, y);
+                }
+                out.color(x, y) = color;
+                out.depth(x, y) = z;
+                out.motion(x, y) = m;
+                scratch.valid(x, y) = ca || cb;
+            }
+    });
+    fill_holes(out.color.view(), scratch.valid.view(), out.depth.view(), options, scratch, counters);
+}
+
+}  // namespace reprise::warp

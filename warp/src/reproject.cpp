@@ -1,0 +1,540 @@
+// Reverse reprojection with a depth and id cache-hit test (Nehab et al. 2007, §3.2).
+#include "reprise/warp/reproject.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <glm/mat4x4.hpp>
+#include <glm/matrix.hpp>
+#include <limits>
+
+#include "reprise/core/parallel.hpp"
+#include "reprise/warp/sample.hpp"
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+namespace reprise::warp {
+
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+enum Outcome { Hit, Offscreen, Behind, Occluded, OtherId, Invalid, OutcomeCount };
+
+// Per-frame constants. The depth the surface point seen at pixel position (px, py) with current
+// depth z has in the previous camera is affine in (px w, py w, z, 1), with w the current clip w
+// (z for perspective, 1 for orthographic): z_expected = w (kx px + ky py + kw) + kz z + k1.
+struct Setup {
+    float kx, ky, kw, kz, k1;
+    float wz, w1;    // w = wz z + w1
+    float px0, py0;  // pixel x is seen at px = x + px0 (centre + jitter)
+    float qx0, qy0;  // and looked up in the previous image at x + qx0 + motion.x
+    float tolerance, id_tolerance;
+    bool use_ids, background;
+};
+
+Setup make_setup(const Frame& current, const Frame& previous, const ReprojectOptions& options) {
+    const Camera& c = current.camera;
+    const glm::dmat4 p(c.projection);
+    // Unprojection at a known depth solves a 2x2 system for (x_view, y_view); that needs a clip w
+    // free of x_view and y_view, as perspective and orthographic projections have.
+    const double a = p[0][0], b = p[1][0], cc = p[0][1], d = p[1][1];
+    const double det = a * d - b * cc;
+    const glm::dmat4 t = glm::dmat4(c.prev_view) * glm::inverse(glm::dmat4(c.view));
+    const double m00 = d / det, m01 = -b / det, m10 = -cc / det, m11 = a / det;
+    const double u0 = t[0][2] * m00 + t[1][2] * m10, u1 = t[0][2] * m01 + t[1][2] * m11;
+    const double w = current.depth.width(), h = current.depth.height();
+    double k[7] = {-2.0 * u0 / w,
+                   2.0 * u1 / h,
+                   u0 - u1,
+                   t[2][2] - u0 * p[2][0] - u1 * p[2][1],
+                   u0 * p[3][0] + u1 * p[3][1] - t[3][2],
+                   -p[2][3],
+                   p[3][3]};
+    bool usable = p[0][3] == 0.0 && p[1][3] == 0.0 && det != 0.0;
+    for (double& v : k) {
+        usable = usable && std::isfinite(v) && std::abs(v) < 1e38;
+    }
+    if (!usable) std::fill(std::begin(k), std::end(k), std::numeric_limits<double>::quiet_NaN());
+
+    Setup s{};
+    s.kx = float(k[0]);
+    s.ky = float(k[1]);
+    s.kw = float(k[2]);
+    s.kz = float(k[3]);
+    s.k1 = float(k[4]);
+    s.wz = float(k[5]);
+    s.w1 = float(k[6]);
+    const glm::vec2 j = c.jitter, pj = previous.camera.jitter;
+    s.px0 = float(0.5 + double(j.x));
+    s.py0 = float(0.5 + double(j.y));
+    s.qx0 = float(0.5 + double(j.x) - double(pj.x));
+    s.qy0 = float(0.5 + double(j.y) - double(pj.y));
+    s.tolerance = options.depth_tolerance;
+    s.id_tolerance = options.id_depth_tolerance;
+    s.use_ids = options.match_ids && !current.id.empty() && !previous.id.empty();
+    s.background = options.background;
+    return s;
+}
+
+// Shared by both paths so that they decide alike; `row` = ky (y + py0) + kw.
+inline float expected_depth(const Setup& s, float px, float row, float z) {
+    const float w = s.wz * z + s.w1;
+    return w * (s.kx * px + row) + (s.kz * z + s.k1);
+}
+
+void check_contract(const Frame& current, const Frame& previous, const ConstPayload& in,
+                    const Payload& out, const ImageView<uint8_t>& hit) {
+    const int w = current.depth.width(), h = current.depth.height();
+    REPRISE_ASSERT(current.motion.width() == w && current.motion.height() == h);
+    REPRISE_ASSERT(current.id.empty() || (current.id.width() == w && current.id.height() == h));
+    const int pw = previous.depth.width(), ph = previous.depth.height();
+    REPRISE_ASSERT(previous.id.empty() ||
+                   (previous.id.width() == pw && previous.id.height() == ph));
+    REPRISE_ASSERT(in.width == pw && in.height == ph && in.channels >= 1);
+    REPRISE_ASSERT(out.width == w && out.height == h && out.channels == in.channels);
+    REPRISE_ASSERT(hit.empty() || (hit.width == w && hit.height == h));
+    const float* out_end = out.data + (h - 1) * out.stride + std::ptrdiff_t(w) * out.channels;
+    const float* in_end = in.data + (ph - 1) * in.stride + std::ptrdiff_t(pw) * in.channels;
+    REPRISE_ASSERT(out_end <= in.data || in_end <= out.data);  // no reprojection in place
+}
+
+ReprojectCounts to_counts(const std::size_t* n) {
+    ReprojectCounts c;
+    c.hits = n[Hit];
+    c.offscreen = n[Offscreen];
+    c.behind = n[Behind];
+    c.occluded = n[Occluded];
+    c.other_id = n[OtherId];
+    c.invalid = n[Invalid];
+    return c;
+}
+
+// The fast path: raw row pointers, everything per frame or per row hoisted out of the loop.
+struct Kernel {
+    Setup s;
+    int width, pw, ph, channels;
+    const float* depth;
+    std::ptrdiff_t depth_stride;
+    const glm::vec2* motion;
+    std::ptrdiff_t motion_stride;
+    const uint32_t* id;
+    std::ptrdiff_t id_stride;
+    const float* prev_depth;
+    std::ptrdiff_t prev_depth_stride;
+    const uint32_t* prev_id;
+    std::ptrdiff_t prev_id_stride;
+    const float* in;
+    std::ptrdiff_t in_stride;
+    float* out;
+    std::ptrdiff_t out_stride;
+    uint8_t* hit;
+    std::ptrdiff_t hit_stride;
+};
+
+inline bool finite(float v) {
+    return v - v == 0.0f;
+}
+
+#if defined(__SSE2__)
+// Lane i is all ones where bit i is set.
+alignas(16) constexpr int32_t kLaneMasks[16][4] = {
+    {0, 0, 0, 0},   {-1, 0, 0, 0},   {0, -1, 0, 0},   {-1, -1, 0, 0},
+    {0, 0, -1, 0},  {-1, 0, -1, 0},  {0, -1, -1, 0},  {-1, -1, -1, 0},
+    {0, 0, 0, -1},  {-1, 0, 0, -1},  {0, -1, 0, -1},  {-1, -1, 0, -1},
+    {0, 0, -1, -1}, {-1, 0, -1, -1}, {0, -1, -1, -1}, {-1, -1, -1, -1}};
+#endif
+
+// Bilinear over taps a, b (row 0) and c, d (row 1) of n channels; writes `dst` only when every
+// channel is finite.
+template <int C>
+inline bool fetch(const float* a, const float* b, const float* c, const float* d, int n, float fx,
+                  float fy, float* dst) {
+#if defined(__SSE2__)
+    if constexpr (C == 4) {
+        const __m128 vfx = _mm_set1_ps(fx), vfy = _mm_set1_ps(fy);
+        const __m128 va = _mm_loadu_ps(a), vb = _mm_loadu_ps(b);
+        const __m128 vc = _mm_loadu_ps(c), vd = _mm_loadu_ps(d);
+        const __m128 top = _mm_add_ps(va, _mm_mul_ps(_mm_sub_ps(vb, va), vfx));
+        const __m128 bottom = _mm_add_ps(vc, _mm_mul_ps(_mm_sub_ps(vd, vc), vfx));
+        const __m128 v = _mm_add_ps(top, _mm_mul_ps(_mm_sub_ps(bottom, top), vfy));
+        const __m128 zero = _mm_sub_ps(v, v);
+        if (_mm_movemask_ps(_mm_cmpunord_ps(zero, zero)) != 0) return false;
+        _mm_storeu_ps(dst, v);
+        return true;
+    }
+#endif
+    if constexpr (C > 0) n = C;
+    float acc = 0.0f;
+    for (int k = 0; k < n; ++k) {
+        const float top = a[k] + (b[k] - a[k]) * fx, bottom = c[k] + (d[k] - c[k]) * fx;
+        const float v = top + (bottom - top) * fy;
+        acc += v - v;
+    }
+    if (!finite(acc)) return false;
+    for (int k = 0; k < n; ++k) {
+        const float top = a[k] + (b[k] - a[k]) * fx, bottom = c[k] + (d[k] - c[k]) * fx;
+        dst[k] = top + (bottom - top) * fy;
+    }
+    return true;
+}
+
+// Rows [y_begin, y_end) with C payload channels (0: any). Everything the loop reads is copied
+// into locals first: the float stores to `out` could otherwise alias them.
+template <int C>
+void reproject_rows(const Kernel& kernel, int y_begin, int y_end, std::size_t* counts) {
+    const Setup s = kernel.s;
+    const int width = kernel.width, pw = kernel.pw, ph = kernel.ph;
+    const int n = C > 0 ? C : kernel.channels;
+    const float fpw = float(pw), fph = float(ph);
+    const float* const depth = kernel.depth;
+    const glm::vec2* const motion = kernel.motion;
+    const uint32_t* const id = kernel.id;
+    const float* const prev_depth = kernel.prev_depth;
+    const uint32_t* const prev_id = kernel.prev_id;
+    const float* const in = kernel.in;
+    float* const out = kernel.out;
+    uint8_t* const hit = kernel.hit;
+    const std::ptrdiff_t depth_stride = kernel.depth_stride, motion_stride = kernel.motion_stride,
+                         id_stride = kernel.id_stride, prev_depth_stride = kernel.prev_depth_stride,
+                         prev_id_stride = kernel.prev_id_stride, in_stride = kernel.in_stride,
+                         out_stride = kernel.out_stride, hit_stride = kernel.hit_stride;
+    const bool use_ids = s.use_ids, background_hits = s.background;
+    std::size_t hits = 0;
+
+    auto record = [&](int x, Outcome o, uint8_t* hrow) {
+        if (o == Hit)
+            ++hits;
+        else
+            ++counts[o];
+        if (hrow) hrow[x] = o == Hit;
+    };
+    for (int y = y_begin; y < y_end; ++y) {
+        const float* const zr = depth + y * depth_stride;
+        const glm::vec2* const mr = motion + y * motion_stride;
+        const uint32_t* const ir = use_ids ? id + y * id_stride : nullptr;
+        float* const orow = out + y * out_stride;
+        uint8_t* const hrow = hit ? hit + y * hit_stride : nullptr;
+        const float row = s.ky * (float(y) + s.py0) + s.kw;
+        const float qy_row = float(y) + s.qy0;
+        auto classify = [&](int x) -> Outcome {
+            const float z = zr[x], mx = mr[x].x, my = mr[x].y;
+            if (!finite(mx) || !finite(my)) return Invalid;
+            float z_expected = 0.0f;
+            const bool background = !finite(z);
+            if (!background) {
+                z_expected = expected_depth(s, float(x) + s.px0, row, z);
+                if (!finite(z_expected)) return Invalid;
+                if (z_expected <= 0.0f) return Behind;
+            } else if (!(background_hits && z == kInf)) {
+                return Invalid;
+            }
+            const float qx = (float(x) + s.qx0) + mx, qy = qy_row + my;
+            if (!(qx >= 0.0f && qy >= 0.0f && qx <= fpw && qy <= fph)) return Offscreen;
+
+            // floor() by truncation and correction: exact, and no libm call without SSE4.1.
+            const float sx = qx - 0.5f, sy = qy - 0.5f;
+            int ix = int(sx), iy = int(sy);
+            ix -= sx < float(ix);
+            iy -= sy < float(iy);
+            const float fx = sx - float(ix), fy = sy - float(iy);
+            const int x0 = std::clamp(ix, 0, pw - 1), y0 = std::clamp(iy, 0, ph - 1);
+            const int x1 = fx == 0.0f ? x0 : std::min(ix + 1, pw - 1);
+            const int y1 = fy == 0.0f ? y0 : std::min(iy + 1, ph - 1);
+
+            bool ids_agree = true;
+            if (use_ids) {
+                const uint32_t* i0 = prev_id + y0 * prev_id_stride;
+                const uint32_t* i1 = prev_id + y1 * prev_id_stride;
+                const uint32_t me = ir[x];
+                ids_agree = ((i0[x0] ^ me) | (i0[x1] ^ me) | (i1[x0] ^ me) | (i1[x1] ^ me)) == 0;
+            }
+            const float* d0 = prev_depth + y0 * prev_depth_stride;
+            const float* d1 = prev_depth + y1 * prev_depth_stride;
+            const float a = d0[x0], b = d0[x1], c = d1[x0], d = d1[x1];
+            if (background) {
+                if (!(a == kInf && b == kInf && c == kInf && d == kInf)) return Occluded;
+            } else {
+                if (!((a - a) + (b - b) + (c - c) + (d - d) == 0.0f)) return Occluded;
+                const float top = a + (b - a) * fx, bottom = c + (d - c) * fx;
+                const float z_previous = top + (bottom - top) * fy;
+                const float tolerance = use_ids && ids_agree ? s.id_tolerance : s.tolerance;
+                if (!(std::abs(z_expected - z_previous) <= tolerance * z_expected)) return Occluded;
+            }
+            if (!ids_agree) return OtherId;
+            const float* r0 = in + y0 * in_stride;
+            const float* r1 = in + y1 * in_stride;
+            const std::ptrdiff_t c0 = std::ptrdiff_t(x0) * n, c1 = std::ptrdiff_t(x1) * n;
+            if (!fetch<C>(r0 + c0, r0 + c1, r1 + c0, r1 + c1, n, fx, fy,
+                          orow + std::ptrdiff_t(x) * n))
+                return Invalid;
+            return Hit;
+        };
+
+        int x = 0;
+#if defined(__SSE2__)
+        // Four pixels at a time: the same arithmetic lane by lane (so the same bits as the scalar
+        // code), with the taps gathered per lane. Blocks with any pixel that is invalid, behind or
+        // offscreen go to the scalar code.
+        const __m128 zero = _mm_setzero_ps(), inf = _mm_set1_ps(kInf);
+        const __m128 v_kx = _mm_set1_ps(s.kx), v_kz = _mm_set1_ps(s.kz), v_k1 = _mm_set1_ps(s.k1);
+        const __m128 v_wz = _mm_set1_ps(s.wz), v_w1 = _mm_set1_ps(s.w1), v_row = _mm_set1_ps(row);
+        const __m128 v_px0 = _mm_set1_ps(s.px0), v_qx0 = _mm_set1_ps(s.qx0);
+        const __m128 v_qy = _mm_set1_ps(qy_row), v_half = _mm_set1_ps(0.5f);
+        const __m128 v_fpw = _mm_set1_ps(fpw), v_fph = _mm_set1_ps(fph);
+        const __m128 v_tol = _mm_set1_ps(s.tolerance), v_id_tol = _mm_set1_ps(s.id_tolerance);
+        const __m128 v_background = _mm_castsi128_ps(_mm_set1_epi32(background_hits ? -1 : 0));
+        const __m128 v_abs = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
+        const __m128i v_pw1 = _mm_set1_epi32(pw - 1), v_ph1 = _mm_set1_epi32(ph - 1);
+        const __m128i v_one = _mm_set1_epi32(1), izero = _mm_setzero_si128();
+        auto min_i = [](__m128i a, __m128i b) {  // SSE2 has no pminsd
+            const __m128i greater = _mm_cmpgt_epi32(a, b);
+            return _mm_or_si128(_mm_and_si128(greater, b), _mm_andnot_si128(greater, a));
+        };
+        auto max0 = [&](__m128i a) { return _mm_andnot_si128(_mm_cmpgt_epi32(izero, a), a); };
+        auto floor_split = [](__m128 v, __m128i& i, __m128& f) {
+            i = _mm_cvttps_epi32(v);
+            i = _mm_add_epi32(i, _mm_castps_si128(_mm_cmplt_ps(v, _mm_cvtepi32_ps(i))));
+            f = _mm_sub_ps(v, _mm_cvtepi32_ps(i));
+        };
+        __m128i v_x = _mm_setr_epi32(0, 1, 2, 3);
+        for (; x + 4 <= width; x += 4, v_x = _mm_add_epi32(v_x, _mm_set1_epi32(4))) {
+            const __m128 xf = _mm_cvtepi32_ps(v_x);
+            const __m128 z = _mm_loadu_ps(zr + x);
+            const __m128 m01 = _mm_loadu_ps(&mr[x].x), m23 = _mm_loadu_ps(&mr[x + 2].x);
+            const __m128 mx = _mm_shuffle_ps(m01, m23, _MM_SHUFFLE(2, 0, 2, 0));
+            const __m128 my = _mm_shuffle_ps(m01, m23, _MM_SHUFFLE(3, 1, 3, 1));
+            const __m128 w = _mm_add_ps(_mm_mul_ps(v_wz, z), v_w1);
+            const __m128 lin = _mm_add_ps(_mm_mul_ps(v_kx, _mm_add_ps(xf, v_px0)), v_row);
+            const __m128 z_expected =
+                _mm_add_ps(_mm_mul_ps(w, lin), _mm_add_ps(_mm_mul_ps(v_kz, z), v_k1));
+            const __m128 qx = _mm_add_ps(_mm_add_ps(xf, v_qx0), mx), qy = _mm_add_ps(v_qy, my);
+            const __m128 motion_ok = _mm_and_ps(_mm_cmpeq_ps(_mm_sub_ps(mx, mx), zero),
+                                                _mm_cmpeq_ps(_mm_sub_ps(my, my), zero));
+            const __m128 surface =
+                _mm_and_ps(_mm_and_ps(_mm_cmpeq_ps(_mm_sub_ps(z, z), zero),
+                                      _mm_cmpeq_ps(_mm_sub_ps(z_expected, z_expected), zero)),
+                           _mm_cmpgt_ps(z_expected, zero));
+            const __m128 background = _mm_and_ps(_mm_cmpeq_ps(z, inf), v_background);
+            const __m128 inside =
+                _mm_and_ps(_mm_and_ps(_mm_cmpge_ps(qx, zero), _mm_cmpge_ps(qy, zero)),
+                           _mm_and_ps(_mm_cmple_ps(qx, v_fpw), _mm_cmple_ps(qy, v_fph)));
+            const __m128 go =
+                _mm_and_ps(_mm_and_ps(motion_ok, inside), _mm_or_ps(surface, background));
+            if (_mm_movemask_ps(go) != 0xF) {
+                for (int i = 0; i < 4; ++i) record(x + i, classify(x + i), hrow);
+                continue;
+            }
+            __m128i ix, iy;
+            __m128 fx, fy;
+            floor_split(_mm_sub_ps(qx, v_half), ix, fx);
+            floor_split(_mm_sub_ps(qy, v_half), iy, fy);
+            const __m128i x0 = min_i(max0(ix), v_pw1), y0 = min_i(max0(iy), v_ph1);
+            const __m128i fx0 = _mm_castps_si128(_mm_cmpeq_ps(fx, zero));
+            const __m128i fy0 = _mm_castps_si128(_mm_cmpeq_ps(fy, zero));
+            const __m128i x1 =
+                _mm_or_si128(_mm_and_si128(fx0, x0),
+                             _mm_andnot_si128(fx0, min_i(_mm_add_epi32(ix, v_one), v_pw1)));
+            const __m128i y1 =
+                _mm_or_si128(_mm_and_si128(fy0, y0),
+                             _mm_andnot_si128(fy0, min_i(_mm_add_epi32(iy, v_one), v_ph1)));
+            alignas(16) int32_t X0[4], X1[4], Y0[4], Y1[4];
+            _mm_store_si128(reinterpret_cast<__m128i*>(X0), x0);
+            _mm_store_si128(reinterpret_cast<__m128i*>(X1), x1);
+            _mm_store_si128(reinterpret_cast<__m128i*>(Y0), y0);
+            _mm_store_si128(reinterpret_cast<__m128i*>(Y1), y1);
+            // Taps straight into registers (an array store + vector load would stall forwarding).
+            const float* d0[4] = {
+                prev_depth + Y0[0] * prev_depth_stride, prev_depth + Y0[1] * prev_depth_stride,
+                prev_depth + Y0[2] * prev_depth_stride, prev_depth + Y0[3] * prev_depth_stride};
+            const float* d1[4] = {
+                prev_depth + Y1[0] * prev_depth_stride, prev_depth + Y1[1] * prev_depth_stride,
+                prev_depth + Y1[2] * prev_depth_stride, prev_depth + Y1[3] * prev_depth_stride};
+            const __m128 a = _mm_setr_ps(d0[0][X0[0]], d0[1][X0[1]], d0[2][X0[2]], d0[3][X0[3]]);
+            const __m128 b = _mm_setr_ps(d0[0][X1[0]], d0[1][X1[1]], d0[2][X1[2]], d0[3][X1[3]]);
+            const __m128 c = _mm_setr_ps(d1[0][X0[0]], d1[1][X0[1]], d1[2][X0[2]], d1[3][X0[3]]);
+            const __m128 d = _mm_setr_ps(d1[0][X1[0]], d1[1][X1[1]], d1[2][X1[2]], d1[3][X1[3]]);
+            int id_bits = 0xF;
+            if (use_ids) {
+                id_bits = 0;
+                for (int i = 0; i < 4; ++i) {
+                    const uint32_t* i0 = prev_id + Y0[i] * prev_id_stride;
+                    const uint32_t* i1 = prev_id + Y1[i] * prev_id_stride;
+                    const uint32_t me = ir[x + i];
+                    id_bits |= int(((i0[X0[i]] ^ me) | (i0[X1[i]] ^ me) | (i1[X0[i]] ^ me) |
+                                    (i1[X1[i]] ^ me)) == 0)
+                               << i;
+                }
+            }
+            const __m128 ids_agree =
+                _mm_load_ps(reinterpret_cast<const float*>(kLaneMasks[id_bits]));
+            const __m128 taps_finite = _mm_cmpeq_ps(
+                _mm_add_ps(
+                    _mm_add_ps(_mm_add_ps(_mm_sub_ps(a, a), _mm_sub_ps(b, b)), _mm_sub_ps(c, c)),
+                    _mm_sub_ps(d, d)),
+                zero);
+            const __m128 top = _mm_add_ps(a, _mm_mul_ps(_mm_sub_ps(b, a), fx));
+            const __m128 bottom = _mm_add_ps(c, _mm_mul_ps(_mm_sub_ps(d, c), fx));
+            const __m128 z_previous = _mm_add_ps(top, _mm_mul_ps(_mm_sub_ps(bottom, top), fy));
+            const __m128 relaxed = use_ids ? ids_agree : zero;
+            const __m128 tolerance =
+                _mm_or_ps(_mm_and_ps(relaxed, v_id_tol), _mm_andnot_ps(relaxed, v_tol));
+            const __m128 close = _mm_cmple_ps(_mm_and_ps(_mm_sub_ps(z_expected, z_previous), v_abs),
+                                              _mm_mul_ps(tolerance, z_expected));
+            const __m128 all_background =
+                _mm_and_ps(_mm_and_ps(_mm_cmpeq_ps(a, inf), _mm_cmpeq_ps(b, inf)),
+                           _mm_and_ps(_mm_cmpeq_ps(c, inf), _mm_cmpeq_ps(d, inf)));
+            const __m128 depth_ok =
+                _mm_or_ps(_mm_and_ps(background, all_background),
+                          _mm_andnot_ps(background, _mm_and_ps(taps_finite, close)));
+            const int depth_bits = _mm_movemask_ps(depth_ok);
+            alignas(16) float FX[4], FY[4];
+            _mm_store_ps(FX, fx);
+            _mm_store_ps(FY, fy);
+            for (int i = 0; i < 4; ++i) {
+                Outcome o = Hit;
+                if (!(depth_bits >> i & 1)) {
+                    o = Occluded;
+                } else if (!(id_bits >> i & 1)) {
+                    o = OtherId;
+                } else {
+                    const float* r0 = in + Y0[i] * in_stride;
+                    const float* r1 = in + Y1[i] * in_stride;
+                    const std::ptrdiff_t c0 = std::ptrdiff_t(X0[i]) * n,
+                                         c1 = std::ptrdiff_t(X1[i]) * n;
+                    if (!fetch<C>(r0 + c0, r0 + c1, r1 + c0, r1 + c1, n, FX[i], FY[i],
+                                  orow + std::ptrdiff_t(x + i) * n))
+                        o = Invalid;
+                }
+                record(x + i, o, hrow);
+            }
+        }
+#endif
+        for (; x < width; ++x) record(x, classify(x), hrow);
+    }
+    counts[Hit] += hits;
+}
+
+}  // namespace
+
+ReprojectCounts reproject(const Frame& current, const Frame& previous,
+                          ConstPayload previous_payload, Payload out, ImageView<uint8_t> hit,
+                          const ReprojectOptions& options) {
+    check_contract(current, previous, previous_payload, out, hit);
+    const Setup s = make_setup(current, previous, options);
+    const Kernel k{s,
+                   current.depth.width(),
+                   previous.depth.width(),
+                   previous.depth.height(),
+                   previous_payload.channels,
+                   current.depth.data(),
+                   current.depth.width(),
+                   current.motion.data(),
+                   current.motion.width(),
+                   current.id.data(),
+                   current.id.width(),
+                   previous.depth.data(),
+                   previous.depth.width(),
+                   previous.id.data(),
+                   previous.id.width(),
+                   previous_payload.data,
+                   previous_payload.stride,
+                   out.data,
+                   out.stride,
+                   hit.empty() ? nullptr : hit.data,
+                   hit.stride};
+    using Rows = void (*)(const Kernel&, int, int, std::size_t*);
+    constexpr Rows kRows[5] = {reproject_rows<0>, reproject_rows<1>, reproject_rows<2>,
+                               reproject_rows<3>, reproject_rows<4>};
+    const Rows rows = kRows[k.channels <= 4 ? k.channels : 0];
+    std::atomic<std::size_t> total[OutcomeCount] = {};
+    const int grain = std::max(1, 4096 / std::max(1, k.width));
+    parallel_for(
+        0, current.depth.height(),
+        [&](int y0, int y1) {
+            std::size_t n[OutcomeCount] = {};
+            rows(k, y0, y1, n);
+            for (int i = 0; i < OutcomeCount; ++i)
+                total[i].fetch_add(n[i], std::memory_order_relaxed);
+        },
+        grain);
+    std::size_t n[OutcomeCount];
+    for (int i = 0; i < OutcomeCount; ++i) n[i] = total[i].load();
+    return to_counts(n);
+}
+
+ReprojectCounts reproject_reference(const Frame& current, const Frame& previous,
+                                    ConstPayload previous_payload, Payload out,
+                                    ImageView<uint8_t> hit, const ReprojectOptions& options) {
+    check_contract(current, previous, previous_payload, out, hit);
+    const Setup s = make_setup(current, previous, options);
+    const int w = current.depth.width(), h = current.depth.height();
+    const int pw = previous.depth.width(), ph = previous.depth.height();
+    const int channels = previous_payload.channels;
+    std::size_t n[OutcomeCount] = {};
+    for (int y = 0; y < h; ++y) {
+        for (int x = 0; x < w; ++x) {
+            auto outcome = [&]() -> Outcome {
+                const float z = current.depth(x, y);
+                const glm::vec2 m = current.motion(x, y);
+                if (!std::isfinite(m.x) || !std::isfinite(m.y)) return Invalid;
+                const bool background = s.background && z == kInf;
+                if (!std::isfinite(z) && !background) return Invalid;
+                float z_expected = 0.0f;
+                if (!background) {
+                    z_expected =
+                        expected_depth(s, float(x) + s.px0, s.ky * (float(y) + s.py0) + s.kw, z);
+                    if (!std::isfinite(z_expected)) return Invalid;
+                    if (z_expected <= 0.0f) return Behind;
+                }
+                Bilinear b =
+                    bilinear_taps((float(x) + s.qx0) + m.x, (float(y) + s.qy0) + m.y, pw, ph);
+                if (!b.inside) return Offscreen;
+                if (b.fx == 0.0f) b.x1 = b.x0;
+                if (b.fy == 0.0f) b.y1 = b.y0;
+                const int xs[4] = {b.x0, b.x1, b.x0, b.x1}, ys[4] = {b.y0, b.y0, b.y1, b.y1};
+
+                bool ids_agree = true;
+                if (s.use_ids)
+                    for (int i = 0; i < 4; ++i)
+                        ids_agree &= previous.id(xs[i], ys[i]) == current.id(x, y);
+                bool all_finite = true, all_background = true;
+                for (int i = 0; i < 4; ++i) {
+                    const float d = previous.depth(xs[i], ys[i]);
+                    all_finite &= std::isfinite(d);
+                    all_background &= d == kInf;
+                }
+                if (background) {
+                    if (!all_background) return Occluded;
+                } else {
+                    if (!all_finite) return Occluded;
+                    const float z_previous = bilinear_fetch(previous.depth.view(), b);
+                    const float tolerance = s.use_ids && ids_agree ? s.id_tolerance : s.tolerance;
+                    if (!(std::abs(z_expected - z_previous) <= tolerance * z_expected))
+                        return Occluded;
+                }
+                if (!ids_agree) return OtherId;
+
+                auto value = [&](int c) {
+                    const float* p[4];
+                    for (int i = 0; i < 4; ++i) p[i] = previous_payload.pixel(xs[i], ys[i]);
+                    const float top = p[0][c] + (p[1][c] - p[0][c]) * b.fx;
+                    const float bottom = p[2][c] + (p[3][c] - p[2][c]) * b.fx;
+                    return top + (bottom - top) * b.fy;
+                };
+                for (int c = 0; c < channels; ++c)
+                    if (!std::isfinite(value(c))) return Invalid;
+                for (int c = 0; c < channels; ++c) out.pixel(x, y)[c] = value(c);
+                return Hit;
+            };
+            const Outcome o = outcome();
+            ++n[o];
+            if (!hit.empty()) hit(x, y) = o == Hit;
+        }
+    }
+    return to_counts(n);
+}
+
+}  // namespace reprise::warp
