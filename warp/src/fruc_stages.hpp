@@ -23,6 +23,7 @@ struct FrucScratch {
     Image<glm::vec4> reprojected;
     GridWarper grid;
     PullPush pull_push;
+    AndreevInpaint andreev;
 };
 
 // Warps `source` by `factor` times its motion into `out` with the chosen method.

@@ -82,7 +82,7 @@ void fill_holes(ImageView<glm::vec4> color, ImageView<const uint8_t> valid,
     }
     ++counters.fills;
     if (options.fill == FillMethod::PullPush) scratch.pull_push.fill(color, valid, depth);
-    else inpaint_andreev(color, valid, depth);
+    else scratch.andreev.fill(color, valid, depth);
 }
 
 void interpolate_frame(const Frame& a, const Frame& b, float s, const FrucOptions& options,
