@@ -47,7 +47,10 @@ Image<float> random_depth(int w, int h, unsigned seed) {
     std::uniform_real_distribution<float> u(0.0f, 1.0f);
     for (std::size_t i = 0; i < depth.pixel_count(); ++i) {
         float r = u(rng);
-        depth.data()[i] = r < 0.05f ? kInf : r < 0.06f ? kNaN : r < 0.5f ? 1.0f + r : 10.0f + 100 * r;
+        depth.data()[i] = r < 0.05f   ? kInf
+                          : r < 0.06f ? kNaN
+                          : r < 0.5f  ? 1.0f + r
+                                      : 10.0f + 100 * r;
     }
     return depth;
 }
@@ -264,7 +267,8 @@ TEST(PullPush, NonFiniteColourIsAHoleAndDoesNotSpread) {
         Image<vec4> a = img;
         const Image<float> depth(32, 20, 3.0f);
         PullPush pp;
-        const FillStats s = pp.fill(a.view(), mask.view(), with_depth ? depth.view() : Image<float>().view());
+        const FillStats s =
+            pp.fill(a.view(), mask.view(), with_depth ? depth.view() : Image<float>().view());
         EXPECT_EQ(s.holes, 4u);
         EXPECT_EQ(s.unfilled, 0u);
         for (int y = 0; y < 20; ++y)
@@ -321,7 +325,8 @@ FillStats naive_andreev(Image<vec4>& color, const Image<uint8_t>& mask, const Im
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
             const vec4 c = color(x, y);
-            state(x, y) = mask(x, y) && std::isfinite(c.r) && std::isfinite(c.g) && std::isfinite(c.b);
+            state(x, y) =
+                mask(x, y) && std::isfinite(c.r) && std::isfinite(c.g) && std::isfinite(c.b);
             stats.holes += !state(x, y);
         }
     auto sane = [](float d) { return std::isnan(d) ? kInf : std::max(d, 0.0f); };
@@ -335,10 +340,14 @@ FillStats naive_andreev(Image<vec4>& color, const Image<uint8_t>& mask, const Im
                 if (before(x, y)) continue;
                 const int dx[4] = {-1, 1, 0, 0}, dy[4] = {0, 0, -1, 1};  // left right up down
                 int sx[4], sy[4], kk[4] = {};
-                auto inside = [&](int px, int py) { return px >= 0 && py >= 0 && px < w && py < h; };
+                auto inside = [&](int px, int py) {
+                    return px >= 0 && py >= 0 && px < w && py < h;
+                };
                 for (int d = 0; d < 4; ++d) {
                     int k = 1;
-                    while (inside(x + k * dx[d], y + k * dy[d]) && !before(x + k * dx[d], y + k * dy[d])) ++k;
+                    while (inside(x + k * dx[d], y + k * dy[d]) &&
+                           !before(x + k * dx[d], y + k * dy[d]))
+                        ++k;
                     if (!inside(x + k * dx[d], y + k * dy[d])) continue;
                     const int ex = x + k * dx[d], ey = y + k * dy[d];
                     int s = 0;
@@ -437,12 +446,14 @@ TEST(Andreev, MatchesBruteForceAndOnlyWritesHoles) {
             for (bool with_depth : {false, true}) {
                 const Image<vec4> input = random_image(w, h, seed);
                 const Image<uint8_t> mask = random_mask(w, h, fraction, seed + 1);
-                const Image<float> depth = with_depth ? random_depth(w, h, seed + 2) : Image<float>();
+                const Image<float> depth =
+                    with_depth ? random_depth(w, h, seed + 2) : Image<float>();
                 seed += 3;
                 for (int passes : {1, 64}) {
                     Image<vec4> fast = input, naive = input;
                     AndreevInpaint inpaint;
-                    const FillStats a = inpaint.fill(fast.view(), mask.view(), depth.view(), passes);
+                    const FillStats a =
+                        inpaint.fill(fast.view(), mask.view(), depth.view(), passes);
                     const FillStats b = naive_andreev(naive, mask, depth, passes);
                     SCOPED_TRACE(::testing::Message() << w << "x" << h << " holes " << fraction
                                                       << (with_depth ? " depth" : "") << " passes "

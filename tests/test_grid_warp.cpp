@@ -35,7 +35,9 @@ struct Output {
     Image<glm::vec2> motion;
     Image<uint8_t> covered;
     Output(int w, int h)
-        : color(w, h, glm::vec4(-7.0f)), depth(w, h, -3.0f), motion(w, h, glm::vec2(99.0f)),
+        : color(w, h, glm::vec4(-7.0f)),
+          depth(w, h, -3.0f),
+          motion(w, h, glm::vec2(99.0f)),
           covered(w, h, 5) {}
     WarpTarget target() { return {color.view(), depth.view(), motion.view(), covered.view()}; }
 };
@@ -125,8 +127,10 @@ TEST(GridWarp, IntegerTranslationShiftsExactly) {
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
             ASSERT_EQ(out.covered(x, y), x >= k ? 1 : 0) << x << "," << y;
-            if (x >= k) ASSERT_EQ(out.color(x, y), f.color(x - k, y)) << x << "," << y;
-            else ASSERT_EQ(out.depth(x, y), kInf);
+            if (x >= k)
+                ASSERT_EQ(out.color(x, y), f.color(x - k, y)) << x << "," << y;
+            else
+                ASSERT_EQ(out.depth(x, y), kInf);
         }
 }
 
@@ -219,8 +223,12 @@ TEST(GridWarp, SmoothMotionLeavesNoCracks) {
             const glm::vec2 q = glm::vec2(x + 0.5f, y + 0.5f) - glm::vec2(w / 2, h / 2);
             const glm::vec2 d = glm::vec2(c * q.x + s * q.y, -s * q.x + c * q.y) / 1.1f;
             const glm::vec2 p = d + glm::vec2(w / 2, h / 2);
-            auto near_step = [](float v) { return std::abs(std::fmod(v + 20.0f, 40.0f) - 20.0f) < 3.0f; };
-            if (p.x < 3 || p.y < 3 || p.x > w - 3 || p.y > h - 3 || near_step(p.x) || near_step(p.y)) continue;
+            auto near_step = [](float v) {
+                return std::abs(std::fmod(v + 20.0f, 40.0f) - 20.0f) < 3.0f;
+            };
+            if (p.x < 3 || p.y < 3 || p.x > w - 3 || p.y > h - 3 || near_step(p.x) ||
+                near_step(p.y))
+                continue;
             ++far_from_steps;
             ASSERT_EQ(out.covered(x, y), 1) << x << "," << y;
         }
@@ -255,12 +263,18 @@ TEST(GridWarp, ThreadedEqualsReferenceOnRandomFrames) {
                         f.motion(x, y) = {(u(rng) - 0.5f) * 12.0f, (u(rng) - 0.5f) * 12.0f};
                     }
                     const float s = u(rng);
-                    if (s < 0.01f) f.depth(x, y) = kNaN;
-                    else if (s < 0.015f) f.depth(x, y) = -kInf;
-                    else if (s < 0.02f) f.motion(x, y).x = kNaN;
-                    else if (s < 0.025f) f.motion(x, y).y = kInf;
-                    else if (s < 0.03f) f.motion(x, y) = {1e4f, -1e4f};
-                    else if (s < 0.035f) f.motion(x, y) = {3e38f, 0.0f};
+                    if (s < 0.01f)
+                        f.depth(x, y) = kNaN;
+                    else if (s < 0.015f)
+                        f.depth(x, y) = -kInf;
+                    else if (s < 0.02f)
+                        f.motion(x, y).x = kNaN;
+                    else if (s < 0.025f)
+                        f.motion(x, y).y = kInf;
+                    else if (s < 0.03f)
+                        f.motion(x, y) = {1e4f, -1e4f};
+                    else if (s < 0.035f)
+                        f.motion(x, y) = {3e38f, 0.0f};
                 }
             for (float factor : {-0.5f, 1.0f})
                 for (int min_cell : {1, 2})
@@ -293,6 +307,30 @@ TEST(GridWarp, WorstCasesGiveNoCoverageAndNoCrash) {
     Frame one = flat_frame(1, 1, 1.0f, {0.25f, 0.0f});
     Output single(1, 1);
     EXPECT_EQ(warp_both(one, -1.0f, single).covered, 1u);
+}
+
+TEST(GridWarp, TargetOfAnotherSizeAndScratchReuse) {
+    GridWarper warper;  // one warper through frames and targets of changing sizes
+    const int sizes[][4] = {
+        {97, 61, 97, 61}, {20, 10, 40, 30}, {300, 170, 300, 170}, {64, 64, 5, 3}, {97, 61, 97, 61}};
+    for (auto [w, h, tw, th] : sizes) {
+        Frame f = scene_frame(w, h, {1.25f, 0.5f}, uint32_t(w));
+        Output fast(tw, th), ref(tw, th);
+        const GridStats a = warper.warp(f, -0.5f, fast.target());
+        const GridStats b = GridWarper().warp_reference(f, -0.5f, ref.target());
+        EXPECT_EQ(a.cells, b.cells);
+        EXPECT_EQ(a.covered, b.covered);
+        EXPECT_TRUE(same_bits(fast.color, ref.color));
+        EXPECT_TRUE(same_bits(fast.depth, ref.depth));
+        EXPECT_TRUE(same_bits(fast.covered, ref.covered));
+        EXPECT_LE(a.covered, std::size_t(tw) * th);
+    }
+    // Without a motion target.
+    Frame f = scene_frame(50, 40, {1.0f, 0.0f}, 5);
+    Output out(50, 40);
+    WarpTarget no_motion = out.target();
+    no_motion.motion = {};
+    EXPECT_GT(warper.warp(f, -0.5f, no_motion).covered, 1900u);
 }
 
 TEST(GridWarp, LargeFrameRuns) {

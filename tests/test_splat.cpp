@@ -35,7 +35,9 @@ struct Output {
     Image<uint8_t> covered;
     // Filled with garbage: the warp must initialise everything itself.
     Output(int w, int h)
-        : color(w, h, glm::vec4(-7.0f)), depth(w, h, -3.0f), motion(w, h, glm::vec2(99.0f)),
+        : color(w, h, glm::vec4(-7.0f)),
+          depth(w, h, -3.0f),
+          motion(w, h, glm::vec2(99.0f)),
           covered(w, h, 5) {}
     WarpTarget target() { return {color.view(), depth.view(), motion.view(), covered.view()}; }
 };
@@ -143,7 +145,8 @@ TEST(Splat, SameSurfaceGoesToTheNearestLanding) {
     // pixel must take the source that lands nearest its centre, not the nearest depth.
     Frame f = flat_frame(16, 4, 1.0f, {-0.25f, 0.0f});
     for (int y = 0; y < 4; ++y)
-        for (int x = 0; x < 16; ++x) f.depth(x, y) = 1.0f + 0.005f * float(x);  // the left neighbour is nearer
+        for (int x = 0; x < 16; ++x)
+            f.depth(x, y) = 1.0f + 0.005f * float(x);  // the left neighbour is nearer
     Output out(16, 4);
     (void)splat(f, -1.0f, out.target(), {.footprint = 2});
     for (int x = 1; x < 16; ++x) EXPECT_EQ(out.color(x, 1), f.color(x, 1)) << x;
@@ -160,22 +163,29 @@ TEST(Splat, ThreadedEqualsReferenceOnRandomFrames) {
                 for (int x = 0; x < w; ++x) {
                     const float r = u(rng);
                     // Few depth levels so that ties and the tolerance rule are exercised.
-                    f.depth(x, y) = r < 0.05f ? kInf : r < 0.07f ? kNaN : r < 0.08f ? -1.0f
-                                                                   : 1.0f + float(int(r * 4.0f));
+                    f.depth(x, y) = r < 0.05f   ? kInf
+                                    : r < 0.07f ? kNaN
+                                    : r < 0.08f ? -1.0f
+                                                : 1.0f + float(int(r * 4.0f));
                     const float s = u(rng);
                     glm::vec2 m{(u(rng) - 0.5f) * 16.0f, (u(rng) - 0.5f) * 16.0f};
                     if (trial == 1) m = glm::round(m);  // integer landings: many exact ties
-                    if (s < 0.02f) m.x = kNaN;
-                    else if (s < 0.03f) m.y = kInf;
-                    else if (s < 0.04f) m = {1e4f, -1e4f};
-                    else if (s < 0.05f) m = {3e38f, 0.0f};
+                    if (s < 0.02f)
+                        m.x = kNaN;
+                    else if (s < 0.03f)
+                        m.y = kInf;
+                    else if (s < 0.04f)
+                        m = {1e4f, -1e4f};
+                    else if (s < 0.05f)
+                        m = {3e38f, 0.0f};
                     f.motion(x, y) = m;
                 }
             for (int footprint : {1, 2})
                 for (float factor : {-0.5f, 1.0f, 0.3f}) {
                     Output fast(w, h), ref(w, h);
                     const SplatOptions o{.footprint = footprint};
-                    EXPECT_EQ(splat(f, factor, fast.target(), o), splat_reference(f, factor, ref.target(), o));
+                    EXPECT_EQ(splat(f, factor, fast.target(), o),
+                              splat_reference(f, factor, ref.target(), o));
                     expect_same(fast, ref);
                 }
         }
@@ -206,6 +216,20 @@ TEST(Splat, TargetOfAnotherSize) {
     EXPECT_EQ(splat(f, 0.0f, small.target()), 12u);
     EXPECT_EQ(splat(f, 0.0f, large.target()), 100u);
     EXPECT_EQ(large.covered(15, 5), 0);
+}
+
+TEST(Splat, WithoutMotionTargetAndAcrossSizes) {
+    for (auto [w, h] : {std::pair{50, 30}, std::pair{7, 3}, std::pair{200, 90}}) {
+        Frame f = flat_frame(w, h, 2.0f, {0.4f, -0.3f});
+        Output fast(w, h), ref(w, h);
+        WarpTarget a = fast.target(), b = ref.target();
+        a.motion = {};
+        b.motion = {};
+        EXPECT_EQ(splat(f, -1.0f, a), splat_reference(f, -1.0f, b));
+        EXPECT_TRUE(same_bits(fast.color, ref.color));
+        EXPECT_TRUE(same_bits(fast.covered, ref.covered));
+        EXPECT_EQ(fast.motion, Image<glm::vec2>(w, h, glm::vec2(99.0f)));  // left alone
+    }
 }
 
 TEST(Splat, LargeFrameRuns) {

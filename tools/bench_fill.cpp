@@ -75,10 +75,11 @@ Status bench_fill(const BenchOptions& options) {
     REPRISE_TRY(server::Renderer::create(renderer));
     std::printf("hole filling on scene %s, %d frames per size, %d threads (ours), renderer %s\n",
                 options.scene.c_str(), options.frames, thread_count(), renderer->device().c_str());
-    std::printf("holes: strips right of edges whose left neighbour is >10%% nearer (forward "
-                "disocclusions, width/240 px wide)\n       + random 2-8 px discs, up to %.0f%% "
-                "of the pixels; PSNR on the hole pixels only (display values): all, strips, blobs\n",
-                100 * kHoleTarget);
+    std::printf(
+        "holes: strips right of edges whose left neighbour is >10%% nearer (forward "
+        "disocclusions, width/240 px wide)\n       + random 2-8 px discs, up to %.0f%% "
+        "of the pixels; PSNR on the hole pixels only (display values): all, strips, blobs\n",
+        100 * kHoleTarget);
     std::printf("%-11s %6s  %-22s %9s %15s %8s %8s %8s\n", "size", "holes%", "method", "ms",
                 "ours/Telea", "PSNR dB", "strips", "blobs");
 
@@ -109,7 +110,8 @@ Status bench_fill(const BenchOptions& options) {
             const int index = std::max(f, 0);
             REPRISE_TRY(renderer->render_frame(scene, path, index, 30.0, {.width = w, .height = h},
                                                frame));
-            const Image<uint8_t> kind = make_holes(frame.depth, unsigned(index), std::max(2, w / 240));
+            const Image<uint8_t> kind =
+                make_holes(frame.depth, unsigned(index), std::max(2, w / 240));
             std::size_t holes = 0;
             for (int y = 0; y < h; ++y)
                 for (int x = 0; x < w; ++x) {
@@ -131,7 +133,8 @@ Status bench_fill(const BenchOptions& options) {
                 }
 
             auto score = [&](Method& m) {
-                for (int i = 0; i < 3; ++i) m.psnr[i] += psnr(truth.view(), shown.view(), masks[i].view());
+                for (int i = 0; i < 3; ++i)
+                    m.psnr[i] += psnr(truth.view(), shown.view(), masks[i].view());
             };
             auto run = [&](Method& m, auto&& fill) {
                 work = holed;

@@ -5,11 +5,10 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <string>
-#include <vector>
-
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
+#include <string>
+#include <vector>
 
 #include "args.hpp"
 #include "bench.hpp"
@@ -79,12 +78,15 @@ Status bench_size(server::Renderer& renderer, const server::Scene& scene,
     auto run_splat1 = [&] { covered1 = warp::splat(frame, kFactor, t1.view(), {.footprint = 1}); };
     auto run_splat2 = [&] { covered2 = warp::splat(frame, kFactor, t2.view(), {.footprint = 2}); };
     auto run_grid = [&] { grid = warper.warp(frame, kFactor, tg.view()); };
-    auto run_remap = [&] { cv::remap(src, dst, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT); };
+    auto run_remap = [&] {
+        cv::remap(src, dst, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT);
+    };
     run_splat1();  // warm-up: page in the outputs, start the pools, size the scratch
     run_splat2();
     run_grid();
     run_remap();
-    for (int i = 0; i < repetitions; ++i) {  // interleaved, so that load on the machine hits all alike
+    for (int i = 0; i < repetitions;
+         ++i) {  // interleaved, so that load on the machine hits all alike
         time_once(splat1, run_splat1);
         time_once(splat2, run_splat2);
         time_once(grid_ms, run_grid);
@@ -101,8 +103,8 @@ Status bench_size(server::Renderer& renderer, const server::Scene& scene,
                 splat1.median() / remap, "", 100.0 * double(covered1) / pixels);
     std::printf("%-10s %-8s %8.2f %7.2fx %8s %8.2f%%\n", "", "splat2", splat2.median(),
                 splat2.median() / remap, "", 100.0 * double(covered2) / pixels);
-    std::printf("%-10s %-8s %8.2f %7.2fx %8zu %8.2f%%  (reference, 1 thread: %.2f ms)\n", "", "grid",
-                grid_ms.median(), grid_ms.median() / remap, grid.cells,
+    std::printf("%-10s %-8s %8.2f %7.2fx %8zu %8.2f%%  (reference, 1 thread: %.2f ms)\n", "",
+                "grid", grid_ms.median(), grid_ms.median() / remap, grid.cells,
                 100.0 * double(grid.covered) / pixels, reference_ms.median());
     std::printf("%-10s %-8s %8.2f %7.2fx\n", "", "remap", remap, 1.0);
     if (w == 1920 && h == 1080) met_budget = grid_ms.median() <= kGridBudgetMs;
@@ -118,11 +120,13 @@ Status bench_grid(const BenchOptions& options) {
     std::unique_ptr<server::Renderer> renderer;
     REPRISE_TRY(server::Renderer::create(renderer));
     cv::setNumThreads(thread_count());
-    std::printf("forward warps extrapolating by %.1f frame (RGBA float, depth, motion, coverage) vs "
-                "cv::remap (INTER_LINEAR, CV_32FC4, float maps)\n"
-                "scene %s, frame 2, %d threads (reprise) / %d (OpenCV), median of %d, ms\n",
-                -kFactor, options.scene.c_str(), thread_count(), cv::getNumThreads(), options.frames);
-    std::printf("%-10s %-8s %8s %8s %8s %9s\n", "size", "method", "ms", "/remap", "cells", "covered");
+    std::printf(
+        "forward warps extrapolating by %.1f frame (RGBA float, depth, motion, coverage) vs "
+        "cv::remap (INTER_LINEAR, CV_32FC4, float maps)\n"
+        "scene %s, frame 2, %d threads (reprise) / %d (OpenCV), median of %d, ms\n",
+        -kFactor, options.scene.c_str(), thread_count(), cv::getNumThreads(), options.frames);
+    std::printf("%-10s %-8s %8s %8s %8s %9s\n", "size", "method", "ms", "/remap", "cells",
+                "covered");
     bool measured = false, met_budget = false;
     std::size_t start = 0;
     while (start <= options.sizes.size()) {
@@ -135,8 +139,8 @@ Status bench_grid(const BenchOptions& options) {
         start = end + 1;
     }
     if (measured)
-        std::printf("grid warp at 1920x1080 %s the %.0f ms budget\n", met_budget ? "meets" : "misses",
-                    kGridBudgetMs);
+        std::printf("grid warp at 1920x1080 %s the %.0f ms budget\n",
+                    met_budget ? "meets" : "misses", kGridBudgetMs);
     return {};
 }
 

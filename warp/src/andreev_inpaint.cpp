@@ -43,10 +43,8 @@ void table_row(const uint8_t* state, const uint8_t* prev_state, const uint16_t* 
     }
 }
 
-// Per axis (left/right, up/down): where both sources were found and one is nearer than the other
-// by more than the ratio, the nearer one (the foreground side of a disocclusion) is dropped.
-// Comparing only opposite sides keeps a far-away background (the sky) seen along the other
-// axis from overriding the adjacent one.
+// Per axis: of two sources nearer/farther than each other by more than the ratio, the nearer
+// (the foreground side of a disocclusion) is dropped.
 void prefer_background(bool use[4], const float depth[4]) {
     for (int a = 0; a < 4; a += 2) {
         if (!use[a] || !use[a + 1]) continue;
@@ -107,7 +105,8 @@ FillStats AndreevInpaint::fill(ImageView<glm::vec4> color, ImageView<const uint8
     // Length of the valid run starting at x in direction step, at most `cap`.
     auto run_from = [&](const uint8_t* st, int x, int step, int cap) {
         int n = 0;
-        while (n < cap && x >= 0 && x < width && (st[x] == kValid || st[x] == kFilled)) ++n, x += step;
+        while (n < cap && x >= 0 && x < width && (st[x] == kValid || st[x] == kFilled))
+            ++n, x += step;
         return n;
     };
 

@@ -1,12 +1,13 @@
 // Forward splatting: each source pixel scattered along its motion into a z-buffered target.
-// Threads own bands of target rows and visit only the source rows that can land in them, in
-// source order, so every target pixel sees its candidates in the same order as the reference.
+// Threads draw bands of target rows (band.hpp) and visit only the source rows that can land in
+// them, in source order, so every target pixel sees its candidates in the reference's order.
 #include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <limits>
 #include <vector>
 
+#include "band.hpp"
 #include "reprise/core/parallel.hpp"
 #include "reprise/warp/splat.hpp"
 
@@ -15,13 +16,17 @@ namespace reprise::warp {
 namespace {
 
 constexpr float kInf = std::numeric_limits<float>::infinity();
+constexpr int kBandRows = 8;  // a band's scratch stays in a core's cache
 
 void check_target(const Frame& source, const WarpTarget& t) {
-    REPRISE_ASSERT(source.depth.width() == source.width() && source.depth.height() == source.height());
-    REPRISE_ASSERT(source.motion.width() == source.width() && source.motion.height() == source.height());
+    REPRISE_ASSERT(source.depth.width() == source.width() &&
+                   source.depth.height() == source.height());
+    REPRISE_ASSERT(source.motion.width() == source.width() &&
+                   source.motion.height() == source.height());
     REPRISE_ASSERT(t.depth.width == t.color.width && t.depth.height == t.color.height);
     REPRISE_ASSERT(t.covered.width == t.color.width && t.covered.height == t.color.height);
-    REPRISE_ASSERT(t.motion.empty() || (t.motion.width == t.color.width && t.motion.height == t.color.height));
+    REPRISE_ASSERT(t.motion.empty() ||
+                   (t.motion.width == t.color.width && t.motion.height == t.color.height));
 }
 
 // Where one source pixel lands: target pixels [x0, x0 + nx) x [y0, y0 + ny), and the offset of
@@ -35,20 +40,25 @@ bool valid_source(float z, glm::vec2 m) {
     return z >= 0.0f && std::isfinite(m.x) && std::isfinite(m.y);  // z = +inf: background
 }
 
+// floor() for values known to lie well inside the int range.
+int floor_small(float v) {
+    const int i = int(v);
+    return float(i) > v ? i - 1 : i;
+}
+
 bool land(int x, int y, glm::vec2 m, float factor, int footprint, int w, int h, Landing& out) {
-    float dx = (float(x) + 0.5f) + factor * m.x;
-    float dy = (float(y) + 0.5f) + factor * m.y;
-    // Pixel-centre frame: centre of pixel i is at i.
-    dx -= 0.5f;
-    dy -= 0.5f;
+    // In the pixel-centre frame (the centre of pixel i at i).
+    const float dx = (float(x) + 0.5f) + factor * m.x - 0.5f;
+    const float dy = (float(y) + 0.5f) + factor * m.y - 0.5f;
     // Compared as floats first so that huge positions never reach an int conversion.
     if (!(dx > -1.5f && dy > -1.5f && dx < float(w) + 0.5f && dy < float(h) + 0.5f)) return false;
     if (footprint == 1) {
-        float fx = std::floor(dx + 0.5f), fy = std::floor(dy + 0.5f);
-        out = {int(fx), int(fy), 1, 1, dx - fx, dy - fy};
+        const int ix = floor_small(dx + 0.5f), iy = floor_small(dy + 0.5f);
+        out = {ix, iy, 1, 1, dx - float(ix), dy - float(iy)};
     } else {
-        float fx = std::floor(dx), fy = std::floor(dy);
-        out = {int(fx), int(fy), dx > fx ? 2 : 1, dy > fy ? 2 : 1, dx - fx, dy - fy};
+        const int ix = floor_small(dx), iy = floor_small(dy);
+        const float ox = dx - float(ix), oy = dy - float(iy);
+        out = {ix, iy, ox > 0.0f ? 2 : 1, oy > 0.0f ? 2 : 1, ox, oy};
     }
     return true;
 }
@@ -61,81 +71,73 @@ uint8_t closeness(float ox, float oy) {
 }
 
 struct Scatter {
-    const Frame& source;
-    const WarpTarget& target;
+    ImageView<const glm::vec4> color;
+    ImageView<const float> depth;
+    ImageView<const glm::vec2> motion;
     float factor;
     int footprint;
     float tol_lo, tol_hi;  // 1 -/+ depth tolerance
+    int width, height;     // of the target
 
-    // Offers source pixel (x, y) to the target rows [y_begin, y_end).
-    void offer(int x, int y, int y_begin, int y_end) const {
-        const float z = source.depth(x, y);
-        const glm::vec2 m = source.motion(x, y);
-        if (!valid_source(z, m)) return;
-        Landing l;
-        if (!land(x, y, m, factor, footprint, target.color.width, target.color.height, l)) return;
-        for (int j = 0; j < l.ny; ++j) {
-            const int ty = l.y0 + j;
-            if (ty < y_begin || ty >= y_end) continue;
-            for (int i = 0; i < l.nx; ++i) {
-                const int tx = l.x0 + i;
-                if (tx < 0 || tx >= target.color.width) continue;
-                const uint8_t q = closeness(l.ox - float(i), l.oy - float(j));
-                uint8_t& stored_q = target.covered(tx, ty);
-                float& stored_z = target.depth(tx, ty);
-                const bool wins = stored_q == 0 || z < stored_z * tol_lo ||
-                                  (z <= stored_z * tol_hi && q < stored_q);
-                if (!wins) continue;
-                stored_q = q;
-                stored_z = z;
-                target.color(tx, ty) = source.color(x, y);
-                if (!target.motion.empty()) target.motion(tx, ty) = m;
+    // Offers source row y to the band's rows, pixel by pixel in order.
+    void offer_row(int y, const Band& band) const {
+        const float* z_row = depth.row(y);
+        const glm::vec2* m_row = motion.row(y);
+        const glm::vec4* c_row = color.row(y);
+        const WarpTarget& v = band.view;
+        const int rows = v.color.height;
+        for (int x = 0; x < depth.width; ++x) {
+            const float z = z_row[x];
+            const glm::vec2 m = m_row[x];
+            if (!valid_source(z, m)) continue;
+            Landing l;
+            if (!land(x, y, m, factor, footprint, width, height, l)) continue;
+            for (int j = 0; j < l.ny; ++j) {
+                const int row = l.y0 + j - band.y0;
+                if (row < 0 || row >= rows) continue;
+                uint8_t* q_row = v.covered.row(row);
+                float* d_row = v.depth.row(row);
+                for (int i = 0; i < l.nx; ++i) {
+                    const int tx = l.x0 + i;
+                    if (tx < 0 || tx >= width) continue;
+                    const uint8_t q = closeness(l.ox - float(i), l.oy - float(j));
+                    const float stored = d_row[tx];
+                    const bool wins = q_row[tx] == 0 || z < stored * tol_lo ||
+                                      (z <= stored * tol_hi && q < q_row[tx]);
+                    if (!wins) continue;
+                    q_row[tx] = q;
+                    d_row[tx] = z;
+                    v.color.row(row)[tx] = c_row[x];
+                    if (!v.motion.empty()) v.motion.row(row)[tx] = m;
+                }
             }
         }
     }
 
     // Rows of the target that source row y can touch; lo > hi when none.
     void row_range(int y, int& lo, int& hi) const {
-        lo = std::numeric_limits<int>::max();
-        hi = std::numeric_limits<int>::min();
-        for (int x = 0; x < source.width(); ++x) {
-            const float z = source.depth(x, y);
-            const glm::vec2 m = source.motion(x, y);
-            if (!valid_source(z, m)) continue;
-            Landing l;
-            if (!land(x, y, m, factor, footprint, target.color.width, target.color.height, l)) continue;
-            lo = std::min(lo, l.y0);
-            hi = std::max(hi, l.y0 + l.ny - 1);
+        const float* z_row = depth.row(y);
+        const glm::vec2* m_row = motion.row(y);
+        float dy_min = kInf, dy_max = -kInf;
+        for (int x = 0; x < depth.width; ++x) {
+            const float dy = (float(y) + 0.5f) + factor * m_row[x].y - 0.5f;  // as in land()
+            if (!valid_source(z_row[x], m_row[x]) || !(dy > -1.5f && dy < float(height) + 0.5f))
+                continue;
+            dy_min = std::min(dy_min, dy);
+            dy_max = std::max(dy_max, dy);
+        }
+        if (dy_min > dy_max) {
+            lo = 1;
+            hi = 0;
+        } else if (footprint == 1) {
+            lo = floor_small(dy_min + 0.5f);
+            hi = floor_small(dy_max + 0.5f);
+        } else {
+            lo = floor_small(dy_min);
+            hi = -floor_small(-dy_max);
         }
     }
 };
-
-void clear_rows(const WarpTarget& t, int y_begin, int y_end) {
-    for (int y = y_begin; y < y_end; ++y) {
-        std::fill_n(t.depth.row(y), t.depth.width, kInf);
-        std::fill_n(t.covered.row(y), t.covered.width, uint8_t(0));
-    }
-}
-
-// Turns the closeness bytes into coverage, clears what nothing reached, counts the covered.
-std::size_t finish_rows(const WarpTarget& t, int y_begin, int y_end) {
-    std::size_t count = 0;
-    for (int y = y_begin; y < y_end; ++y) {
-        uint8_t* covered = t.covered.row(y);
-        glm::vec4* color = t.color.row(y);
-        glm::vec2* motion = t.motion.empty() ? nullptr : t.motion.row(y);
-        for (int x = 0; x < t.color.width; ++x) {
-            if (covered[x]) {
-                covered[x] = 1;
-                ++count;
-            } else {
-                color[x] = glm::vec4(0.0f);
-                if (motion) motion[x] = glm::vec2(0.0f);
-            }
-        }
-    }
-    return count;
-}
 
 Scatter make_scatter(const Frame& source, float factor, const WarpTarget& target,
                      const SplatOptions& options) {
@@ -143,7 +145,23 @@ Scatter make_scatter(const Frame& source, float factor, const WarpTarget& target
     REPRISE_ASSERT(options.footprint == 1 || options.footprint == 2);
     REPRISE_ASSERT(std::isfinite(factor));
     const float tol = std::clamp(options.depth_tolerance, 0.0f, 0.5f);
-    return {source, target, factor, options.footprint, 1.0f - tol, 1.0f + tol};
+    return {source.color.view(), source.depth.view(), source.motion.view(), factor,
+            options.footprint,   1.0f - tol,          1.0f + tol,           target.color.width,
+            target.color.height};
+}
+
+struct Scratch {
+    std::vector<glm::vec4> color;
+    std::vector<float> depth;
+    std::vector<glm::vec2> motion;
+    std::vector<uint8_t> covered;
+    std::vector<int> ranges;
+};
+
+// Per-thread scratch: grown on first use, then reused by every call on that thread.
+Scratch& thread_scratch() {
+    thread_local Scratch scratch;
+    return scratch;
 }
 
 }  // namespace
@@ -151,37 +169,57 @@ Scatter make_scatter(const Frame& source, float factor, const WarpTarget& target
 std::size_t splat(const Frame& source, float factor, const WarpTarget& target,
                   const SplatOptions& options) {
     const Scatter scatter = make_scatter(source, factor, target, options);
-    const int sh = source.height(), sw = source.width(), th = target.color.height;
     if (target.color.empty()) return 0;
+    const int sh = source.height(), width = target.color.width, height = target.color.height;
 
-    thread_local std::vector<int> ranges;  // lo, hi per source row
+    std::vector<int>& ranges = thread_scratch().ranges;  // lo, hi per source row
     if (ranges.size() < std::size_t(2 * sh)) ranges.resize(std::size_t(2 * sh));
     int* range = ranges.data();
-    parallel_for(0, sh, [&](int a, int b) {
-        for (int y = a; y < b; ++y) scatter.row_range(y, range[2 * y], range[2 * y + 1]);
-    }, 8);
+    parallel_for(
+        0, sh,
+        [&](int a, int b) {
+            for (int y = a; y < b; ++y) scatter.row_range(y, range[2 * y], range[2 * y + 1]);
+        },
+        8);
 
+    const int bands = (height + kBandRows - 1) / kBandRows;
+    std::atomic<int> next{0};
     std::atomic<std::size_t> covered{0};
-    parallel_for(0, th, [&](int y_begin, int y_end) {
-        clear_rows(target, y_begin, y_end);
-        for (int y = 0; y < sh; ++y) {
-            if (range[2 * y] >= y_end || range[2 * y + 1] < y_begin) continue;
-            for (int x = 0; x < sw; ++x) scatter.offer(x, y, y_begin, y_end);
-        }
-        covered += finish_rows(target, y_begin, y_end);
-    }, 8);
+    parallel_for(
+        0, std::min(thread_count(), bands),
+        [&](int a, int b) {
+            Scratch& s = thread_scratch();
+            for (int k = a; k < b; ++k) {
+                std::size_t n = 0;
+                for (int i = next++; i < bands; i = next++) {
+                    const int y0 = i * kBandRows, rows = std::min(kBandRows, height - y0);
+                    const Band band{
+                        {scratch_rows(s.color, width, rows), scratch_rows(s.depth, width, rows),
+                         target.motion.empty() ? ImageView<glm::vec2>{}
+                                               : scratch_rows(s.motion, width, rows),
+                         scratch_rows(s.covered, width, rows)},
+                        y0};
+                    clear_band(band);
+                    for (int y = 0; y < sh; ++y)
+                        if (range[2 * y] < y0 + rows && range[2 * y + 1] >= y0)
+                            scatter.offer_row(y, band);
+                    n += copy_band(band, target, kInf);
+                }
+                covered += n;
+            }
+        },
+        1);
     return covered;
 }
 
 std::size_t splat_reference(const Frame& source, float factor, const WarpTarget& target,
                             const SplatOptions& options) {
     const Scatter scatter = make_scatter(source, factor, target, options);
-    const int th = target.color.height;
     if (target.color.empty()) return 0;
-    clear_rows(target, 0, th);
-    for (int y = 0; y < source.height(); ++y)
-        for (int x = 0; x < source.width(); ++x) scatter.offer(x, y, 0, th);
-    return finish_rows(target, 0, th);
+    const Band whole{target, 0};
+    clear_band(whole);
+    for (int y = 0; y < source.height(); ++y) scatter.offer_row(y, whole);
+    return finish_band(whole, kInf);
 }
 
 }  // namespace reprise::warp

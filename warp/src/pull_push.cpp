@@ -257,7 +257,8 @@ FillStats PullPush::fill(ImageView<glm::vec4> color, ImageView<const uint8_t> va
                     // Four valid children (within the depth ratio): the plain mean, in the
                     // same order and arithmetic as pull_pixel; alpha of the sum is ignored.
                     if (nx == 2 && ny == 2 && m0[x0] && m0[x0 + 1] && m1[x0] && m1[x0 + 1]) {
-                        const vec4 s = vec4(0.0f) + row0[x0] + row0[x0 + 1] + row1[x0] + row1[x0 + 1];
+                        const vec4 s =
+                            vec4(0.0f) + row0[x0] + row0[x0 + 1] + row1[x0] + row1[x0 + 1];
                         float dmax = 0.0f;
                         bool same_layer = true;
                         if (use_depth) {

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstring>
 #include <glm/mat4x4.hpp>
 #include <glm/matrix.hpp>
 #include <limits>
@@ -139,6 +140,11 @@ inline bool finite(float v) {
 }
 
 #if defined(__SSE2__)
+// Byte i is 1 where bit i is set.
+constexpr uint8_t kLaneBytes[16][4] = {{0, 0, 0, 0}, {1, 0, 0, 0}, {0, 1, 0, 0}, {1, 1, 0, 0},
+                                       {0, 0, 1, 0}, {1, 0, 1, 0}, {0, 1, 1, 0}, {1, 1, 1, 0},
+                                       {0, 0, 0, 1}, {1, 0, 0, 1}, {0, 1, 0, 1}, {1, 1, 0, 1},
+                                       {0, 0, 1, 1}, {1, 0, 1, 1}, {0, 1, 1, 1}, {1, 1, 1, 1}};
 // Lane i is all ones where bit i is set.
 alignas(16) constexpr int32_t kLaneMasks[16][4] = {
     {0, 0, 0, 0},   {-1, 0, 0, 0},   {0, -1, 0, 0},   {-1, -1, 0, 0},
@@ -393,23 +399,23 @@ void reproject_rows(const Kernel& kernel, int y_begin, int y_end, std::size_t* c
             alignas(16) float FX[4], FY[4];
             _mm_store_ps(FX, fx);
             _mm_store_ps(FY, fy);
+            int hit_bits = depth_bits & id_bits;
             for (int i = 0; i < 4; ++i) {
-                Outcome o = Hit;
-                if (!(depth_bits >> i & 1)) {
-                    o = Occluded;
-                } else if (!(id_bits >> i & 1)) {
-                    o = OtherId;
-                } else {
-                    const float* r0 = in + Y0[i] * in_stride;
-                    const float* r1 = in + Y1[i] * in_stride;
-                    const std::ptrdiff_t c0 = std::ptrdiff_t(X0[i]) * n,
-                                         c1 = std::ptrdiff_t(X1[i]) * n;
-                    if (!fetch<C>(r0 + c0, r0 + c1, r1 + c0, r1 + c1, n, FX[i], FY[i],
-                                  orow + std::ptrdiff_t(x + i) * n))
-                        o = Invalid;
+                if (!(hit_bits >> i & 1)) {
+                    ++counts[depth_bits >> i & 1 ? OtherId : Occluded];
+                    continue;
                 }
-                record(x + i, o, hrow);
+                const float* r0 = in + Y0[i] * in_stride;
+                const float* r1 = in + Y1[i] * in_stride;
+                const std::ptrdiff_t c0 = std::ptrdiff_t(X0[i]) * n, c1 = std::ptrdiff_t(X1[i]) * n;
+                if (!fetch<C>(r0 + c0, r0 + c1, r1 + c0, r1 + c1, n, FX[i], FY[i],
+                              orow + std::ptrdiff_t(x + i) * n)) {
+                    hit_bits &= ~(1 << i);
+                    ++counts[Invalid];
+                }
             }
+            hits += (hit_bits & 1) + (hit_bits >> 1 & 1) + (hit_bits >> 2 & 1) + (hit_bits >> 3);
+            if (hrow) std::memcpy(hrow + x, kLaneBytes[hit_bits], 4);
         }
 #endif
         for (; x < width; ++x) record(x, classify(x), hrow);

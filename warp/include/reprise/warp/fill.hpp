@@ -4,9 +4,9 @@
 //
 // Shared rules: a pixel is a hole where valid(p) == 0 or where its RGB is not finite (NaN/Inf
 // never spread). Only the RGB of holes is written; valid pixels and every alpha stay bit-exact.
-// With `depth` (same size, linear depth as in Frame), samples whose depth exceeds the nearest
-// one in the same neighbourhood by more than kBackgroundDepthRatio are preferred, so that
-// disocclusions fill from the background; NaN depth counts as +inf, negative depth as 0.
+// With `depth` (same size, linear depth as in Frame), where samples disagree in depth by more
+// than kBackgroundDepthRatio the nearer ones are left out, so that disocclusions fill from the
+// background rather than from the foreground edge; NaN depth counts as +inf, negative as 0.
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -25,10 +25,12 @@ struct FillStats {
 
 // Pull-push: the pull averages each 2x2 block of valid samples into a coarser level with a
 // saturating weight min(1, sum) until a level has no empty pixel (at most down to 1x1); the push
-// fills empty pixels from the bilinearly upsampled coarser level. With no valid pixel at all the
-// image is left unchanged and holes == unfilled == W*H. `fill` is threaded and reuses its scratch
-// pyramid (no allocation while the size stays the same); `fill_reference` is the plain scalar
-// version it is tested against (same arithmetic, same result).
+// fills empty pixels from the bilinearly upsampled coarser level. With depth, a block keeps only
+// the samples within the ratio of its farthest one, and the upsampling only such taps. With no
+// valid pixel at all the image is left unchanged and holes == unfilled == W*H. `fill` is
+// threaded and reuses its scratch pyramid (no allocation while the size stays the same);
+// `fill_reference` is the plain scalar version it is tested against (same arithmetic, same
+// result).
 class PullPush {
 public:
     FillStats fill(ImageView<glm::vec4> color, ImageView<const uint8_t> valid,
@@ -44,11 +46,14 @@ private:
 
 // Andreev-style inpainting: each hole pixel looks left, right, up and down for the nearest valid
 // pixel at distance k and copies the pixel mirrored about the hole's edge (distance k - 1 beyond
-// that pixel, clamped to the run of valid pixels there); directions are averaged with weights
-// 1/k (with depth: only the directions whose source is background). Pixels filled in one pass
-// are valid in the next; passes repeat until no hole is left, a pass fills nothing, or
-// max_passes. One pass fills every hole that has a valid pixel in its row or column, so any
-// image with a valid pixel is filled within two passes. Deterministic for any thread count.
+// that pixel, clamped to the run of valid pixels there); the directions found are averaged with
+// weights 1/k. With depth, of two opposite directions whose sources differ by more than the
+// ratio only the farther is used (comparing only opposite sides keeps a distant background seen
+// along the other axis from overriding the adjacent one). Pixels filled in one pass are valid in
+// the next; passes repeat until no hole is left, a pass fills nothing, or max_passes (then
+// `unfilled` says how many are left, untouched). One pass fills every hole with a valid pixel in
+// its row or column, so an image with any valid pixel is filled within two passes.
+// Deterministic for any thread count; the scratch is kept while the size stays the same.
 class AndreevInpaint {
 public:
     FillStats fill(ImageView<glm::vec4> color, ImageView<const uint8_t> valid,

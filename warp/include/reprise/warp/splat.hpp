@@ -33,7 +33,7 @@ struct SplatOptions {
 // depth) is splatted too and loses against any geometry. Pixels with NaN/Inf motion, or NaN or
 // negative depth, are dropped, and so is whatever lands off the target. Returns the number of
 // covered pixels. The target may differ in size from the source (same pixel coordinates).
-// Keeps a per-thread scratch of two ints per source row.
+// Keeps a per-thread scratch (two ints per source row, eight target rows), grown on first use.
 std::size_t splat(const Frame& source, float factor, const WarpTarget& target,
                   const SplatOptions& options = {});
 std::size_t splat_reference(const Frame& source, float factor, const WarpTarget& target,

@@ -1,0 +1,34 @@
+#pragma once
+// Target rows drawn a band at a time by the forward warps (splat, grid): each thread draws into a
+// scratch band that stays in its cache, then writes the band out with streaming stores.
+#include <cstddef>
+#include <vector>
+
+#include "reprise/warp/splat.hpp"
+
+namespace reprise::warp {
+
+// Target rows [y0, y0 + view height) as a warp sees them. While drawing, `covered` may hold any
+// non-zero value where something landed.
+struct Band {
+    WarpTarget view;
+    int y0;
+};
+
+// Scratch rows with room for vector kernels to read a few pixels past the last.
+template <class T>
+ImageView<T> scratch_rows(std::vector<T>& pixels, int width, int rows) {
+    const std::size_t n = std::size_t(width) * std::size_t(rows) + 4;
+    if (pixels.size() < n) pixels.resize(n);
+    return {pixels.data(), width, rows, width};
+}
+
+// Depth +inf, nothing covered.
+void clear_band(const Band& band);
+// In place: covered becomes 0/1, depths at or beyond `background_from` +inf, colour and motion
+// 0 where nothing landed. Returns the covered count.
+std::size_t finish_band(const Band& band, float background_from);
+// The same, written from a scratch band to its rows of `target`.
+std::size_t copy_band(const Band& scratch, const WarpTarget& target, float background_from);
+
+}  // namespace reprise::warp
