@@ -44,7 +44,7 @@ void refetch(const Frame& source, float factor, WarpBuffers& out) {
                 p = q - factor * m;
                 b = bilinear_taps(p.x, p.y, source.width(), source.height());
                 if (!b.inside) continue;
-                glm::vec4 c = bilinear_fetch(source.color.view(), b);
+                glm::vec4 c = bicubic_fetch(source.color.view(), p.x, p.y);
                 if (std::isfinite(c.r + c.g + c.b + c.a)) out.color(x, y) = c;
             }
     });

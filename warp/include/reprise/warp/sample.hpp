@@ -39,4 +39,32 @@ T bilinear_fetch(ImageView<const T> image, const Bilinear& b) {
     return top + (bottom - top) * b.fy;
 }
 
+// Catmull-Rom (bicubic) sample at a continuous position inside the image, taps clamped to the
+// edges: sharper than bilinear (resampling blurs less), may overshoot at edges.
+template <class T>
+T bicubic_fetch(ImageView<const T> image, float x, float y) {
+    float sx = x - 0.5f, sy = y - 0.5f;
+    float fx = std::floor(sx), fy = std::floor(sy);
+    float tx = sx - fx, ty = sy - fy;
+    auto weights = [](float t, float w[4]) {
+        float t2 = t * t, t3 = t2 * t;
+        w[0] = 0.5f * (-t3 + 2.0f * t2 - t);
+        w[1] = 0.5f * (3.0f * t3 - 5.0f * t2 + 2.0f);
+        w[2] = 0.5f * (-3.0f * t3 + 4.0f * t2 + t);
+        w[3] = 0.5f * (t3 - t2);
+    };
+    float wx[4], wy[4];
+    weights(tx, wx);
+    weights(ty, wy);
+    int x0 = int(fx) - 1, y0 = int(fy) - 1;
+    T sum{};
+    for (int j = 0; j < 4; ++j) {
+        const T* row = image.row(std::clamp(y0 + j, 0, image.height - 1));
+        T line{};
+        for (int i = 0; i < 4; ++i) line += wx[i] * row[std::clamp(x0 + i, 0, image.width - 1)];
+        sum += wy[j] * line;
+    }
+    return sum;
+}
+
 }  // namespace reprise::warp
