@@ -1,7 +1,7 @@
 // `reprise bench fruc` end to end on a tiny scene: the CSV rows, the summary and the HTML report.
 #include <gtest/gtest.h>
-
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <array>
 #include <cmath>
@@ -18,19 +18,20 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct Run {
+struct Outcome {
     int status = -1;  // exit status; 128 + signal when killed, 124 when it timed out
     std::string output;
 };
 
-Run run(const std::string& arguments) {
+Outcome run(const std::string& arguments) {
     std::string command = "timeout 300 " REPRISE_BINARY " " + arguments + " 2>&1";
-    Run r;
+    Outcome r;
     FILE* pipe = popen(command.c_str(), "r");
     if (!pipe) return r;
     std::array<char, 4096> buffer;
     std::size_t n;
-    while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) r.output.append(buffer.data(), n);
+    while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
+        r.output.append(buffer.data(), n);
     int raw = pclose(pipe);
     r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : 128 + WTERMSIG(raw);
     return r;
@@ -52,18 +53,20 @@ std::vector<std::string> fields(const std::string& line) {
 }
 
 class CliBenchFruc : public testing::Test {
-protected:
+  protected:
     static void SetUpTestSuite() {
-        dir_ = fs::temp_directory_path() / "reprise-cli-bench-fruc";
+        // One folder per process: ctest may run the cases of this suite side by side.
+        dir_ = fs::temp_directory_path() / ("reprise-cli-bench-fruc-" + std::to_string(getpid()));
         fs::remove_all(dir_);
         result_ = run("bench fruc --scenes pan --factor 2 --size 96x54 --frames 3 --quick --out " +
                       dir_.string());
     }
+    static void TearDownTestSuite() { fs::remove_all(dir_); }
     static fs::path dir_;
-    static Run result_;
+    static Outcome result_;
 };
 fs::path CliBenchFruc::dir_;
-Run CliBenchFruc::result_;
+Outcome CliBenchFruc::result_;
 
 TEST_F(CliBenchFruc, RunsAndPrintsTheSummary) {
     ASSERT_EQ(result_.status, 0) << result_.output;
@@ -90,8 +93,10 @@ TEST_F(CliBenchFruc, CsvHasFiniteRowsForOursAndTheDisPeer) {
         const int frame = std::atoi(f[3].c_str());
         frames.insert(frame);
         EXPECT_NE(frame % 2, 0) << "an input frame passed through was scored: " << line;
-        const double psnr = std::strtod(f[4].c_str(), nullptr), ms = std::strtod(f[7].c_str(), nullptr);
-        const double ssim = std::strtod(f[5].c_str(), nullptr), flip = std::strtod(f[6].c_str(), nullptr);
+        const double psnr = std::strtod(f[4].c_str(), nullptr),
+                     ms = std::strtod(f[7].c_str(), nullptr);
+        const double ssim = std::strtod(f[5].c_str(), nullptr),
+                     flip = std::strtod(f[6].c_str(), nullptr);
         if (f[1] == "interpolate" || f[1] == "opencv-dis") {
             EXPECT_TRUE(std::isfinite(psnr)) << line;
             EXPECT_GT(psnr, 10.0) << line;  // a plausible frame, not noise or black
@@ -102,7 +107,8 @@ TEST_F(CliBenchFruc, CsvHasFiniteRowsForOursAndTheDisPeer) {
     }
     EXPECT_TRUE(methods.count("interpolate")) << "no row for our interpolation";
     EXPECT_TRUE(methods.count("opencv-dis")) << "no row for the DIS peer";
-    EXPECT_EQ(frames, (std::set<int>{1, 3})) << "3 input frames at x2 have in-between frames 1 and 3";
+    EXPECT_EQ(frames, (std::set<int>{1, 3}))
+        << "3 input frames at x2 have in-between frames 1 and 3";
     EXPECT_GE(rows, 2 * 5);  // four settings and one peer at least, two frames each
 }
 
@@ -121,7 +127,8 @@ TEST_F(CliBenchFruc, SummaryAndHtmlReport) {
 }
 
 TEST(CliBenchFrucArgs, BadFactorGetsOneMessage) {
-    Run r = run("bench fruc --factor 1 --out " + (fs::temp_directory_path() / "reprise-cli-bench-fruc-bad").string());
+    Outcome r = run("bench fruc --factor 1 --out " +
+                    (fs::temp_directory_path() / "reprise-cli-bench-fruc-bad").string());
     EXPECT_TRUE(r.status == 1 || r.status == 2) << r.output;
     EXPECT_NE(r.output.find("--factor"), std::string::npos) << r.output;
 }

@@ -129,14 +129,19 @@ TEST(Fruc, PanWithoutMovingObjectsSkipsTheDynamicLayer) {
 
 TEST(Fruc, CameraCutResetsHistoryWithoutGhosts) {
     // The cut scene switches shots at 0.5 s: between frames 14 and 15 at 30 Hz.
-    std::vector<Frame> input = render("cut", 30.0, 13, 4, 96, 54);
+    std::vector<Frame> input = render("cut", 30.0, 13, 4, 192, 108);
+    std::vector<Frame> truth = render("cut", 60.0, 26, 8, 192, 108);
     for (FrucMode mode : {FrucMode::Interpolate, FrucMode::Extrapolate}) {
         FrucCounters counters;
         std::vector<Frame> out = convert(input, 2, {.mode = mode}, &counters);
         EXPECT_EQ(counters.cuts, 1u);
         if (mode == FrucMode::Interpolate) {
-            // out: f13, (13|14), f14, (14|15) = cut, f15, ...
-            EXPECT_TRUE(out[3].color == input[1].color || out[3].color == input[2].color);
+            // out: f13, (13|14), f14, (14|15) = cut, f15, (15|16), f16. The frame before the cut
+            // continues the old shot: close to the truth and to f14, nothing of f15 in it.
+            EXPECT_GT(psnr_of(truth[3], out[3]), 30.0);
+            EXPECT_GT(psnr_of(input[1], out[3]), psnr_of(input[2], out[3]) + 10.0);
+            // f15 starts its shot (its motion reaches into the old one): (15|16) uses f16 only.
+            EXPECT_GT(psnr_of(truth[5], out[5]), 30.0);
         } else {
             // out: f13, x, f14, x, f15, (after the cut: a copy of f15), ...
             EXPECT_EQ(out[5].color, input[2].color);

@@ -19,6 +19,7 @@ struct BenchOptions {
     std::string size = "640x360";
     bool quick = false;                     // a few settings only
     bool exr = false;                       // also write the rendered input and truth as EXR
+    int repeat = 3;                         // timed runs; each frame's fastest counts
 };
 
 Status bench_reproject(const BenchOptions& options);  // reverse reprojection vs cv::remap

@@ -6,9 +6,11 @@
 #include <cstdio>
 #include <filesystem>
 #include <functional>
-#include <map>
-
 #include <glm/common.hpp>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
 
 #include "args.hpp"
 #include "bench.hpp"
@@ -76,8 +78,8 @@ struct Run {
     std::vector<Score> scores;
     int worst_frame = -1;
     double worst_psnr = INFINITY;
-    Image<Rgb8> worst;                    // the lowest-PSNR frame as shown
-    std::map<int, Image<Rgb8>> frames;    // peers: every scored frame, for the comparison picture
+    Image<Rgb8> worst;                  // the lowest-PSNR frame as shown
+    std::map<int, Image<Rgb8>> frames;  // peers: every scored frame, for the comparison picture
 
     ReportPoint mean() const {
         ReportPoint p{method, setting};
@@ -128,113 +130,142 @@ void record(Run& run, int frame, const Image<glm::vec3>& display, const Image<gl
     }
 }
 
-Status render_scene(server::Renderer& renderer, const std::string& scene_name, int frames, int factor,
-                    int w, int h, const std::string& exr_dir, SceneFrames& out) {
+Status render_scene(server::Renderer& renderer, const std::string& scene_name, int frames,
+                    int factor, int w, int h, const std::string& exr_dir, SceneFrames& out) {
     server::Scene scene;
     server::CameraPath path;
     REPRISE_TRY(server::load_scene(scene_name, scene, path));
     const server::RenderSettings settings{.width = w, .height = h};
     out.factor = factor;
+    if (!exr_dir.empty()) {
+        std::error_code ec;
+        for (const char* sub : {"/input", "/truth"}) {
+            fs::create_directories(exr_dir + sub, ec);
+            if (ec)
+                return Status::error(exr_dir + sub + ": cannot create the folder: " + ec.message());
+        }
+    }
     out.input.resize(frames);
     out.input_shown.resize(frames);
     for (int i = 0; i < frames; ++i) {
         REPRISE_TRY(renderer.render_frame(scene, path, i, 30.0, settings, out.input[i]));
         out.input_shown[i].resize(w, h);
         visualize_color(out.input[i].color.view(), out.input_shown[i].view());
-        if (!exr_dir.empty()) {
+        if (!exr_dir.empty())
             REPRISE_TRY(write_frame(frame_path(exr_dir + "/input", i), out.input[i]));
-            REPRISE_TRY(write_frame(frame_path(exr_dir + "/truth", i * factor), out.input[i]));
-        }
-        std::fprintf(stderr, "\r[fruc] %s: rendering input %d/%d   ", out.name.c_str(), i + 1, frames);
+        std::fprintf(stderr, "\r[fruc] %s: rendering input %d/%d   ", out.name.c_str(), i + 1,
+                     frames);
     }
     out.truth.assign(out.last() + 1, {});
     Frame truth;
-    for (int j = 1; j < out.last(); ++j) {
-        if (!out.scored(j)) continue;
+    for (int j = 0; j <= out.last(); ++j) {
+        if (!out.scored(j) && exr_dir.empty()) continue;  // the inputs' instants need no truth
         REPRISE_TRY(renderer.render_frame(scene, path, j, 30.0 * factor, settings, truth));
+        if (!exr_dir.empty()) REPRISE_TRY(write_frame(frame_path(exr_dir + "/truth", j), truth));
+        if (!out.scored(j)) continue;
         out.truth[j].resize(w, h);
         reprise::to_display(truth.color.view(), out.truth[j].view());
-        if (!exr_dir.empty()) REPRISE_TRY(write_frame(frame_path(exr_dir + "/truth", j), truth));
-        std::fprintf(stderr, "\r[fruc] %s: rendering truth %d/%d   ", out.name.c_str(), j, out.last());
+        std::fprintf(stderr, "\r[fruc] %s: rendering truth %d/%d   ", out.name.c_str(), j,
+                     out.last());
     }
     std::fprintf(stderr, "\n");
     return {};
 }
 
-// Times send() alone; each frame it made gets an equal share of that time.
-Status run_ours(const SceneFrames& scene, const Setting& setting, Run& run, Run* telea) {
+void keep_fastest(std::map<int, double>& fastest, int frame, double ms) {
+    auto [it, inserted] = fastest.try_emplace(frame, ms);
+    if (!inserted) it->second = std::min(it->second, ms);
+}
+
+// Times send() alone; each frame it made gets an equal share of that time, the fastest of
+// `repeat` runs over the sequence. Frames are scored on the first run.
+Status run_ours(const SceneFrames& scene, const Setting& setting, int repeat, Run& run,
+                Run* telea) {
     const int w = scene.input[0].width(), h = scene.input[0].height();
-    warp::FrameRateConverter converter(scene.factor, setting.options);
     Frame out;
     Image<glm::vec3> display(w, h);
     Image<uint8_t> holes(w, h);
-    int index = 0;
-    for (const Frame& input : scene.input) {
-        auto start = Clock::now();
-        REPRISE_TRY(converter.send(input));
-        const double send_ms = ms_since(start);
-        const std::size_t first = run.scores.size(), first_telea = telea ? telea->scores.size() : 0;
-        int made = 0;
-        while (converter.receive(out)) {
-            const int j = index++;
-            if (j % scene.factor == 0) continue;  // an input passed through
-            ++made;
-            if (!scene.scored(j)) continue;       // beyond the last input: no truth to compare
-            to_display(out.color.view(), display.view());
-            record(run, j, display, scene.truth[j], 0.0, false);
-            if (!telea) continue;
-            // With fill none the converter leaves holes at colour 0 and depth +inf.
-            for (int y = 0; y < h; ++y)
-                for (int x = 0; x < w; ++x)
-                    holes(x, y) = out.color(x, y) == glm::vec4(0.0f) && std::isinf(out.depth(x, y));
-            auto telea_start = Clock::now();
-            inpaint_telea(display.view(), holes.view());
-            record(*telea, j, display, scene.truth[j], ms_since(telea_start), false);
+    std::map<int, double> send_ms, telea_ms;
+    for (int rep = 0; rep < repeat; ++rep) {
+        warp::FrameRateConverter converter(scene.factor, setting.options);
+        int index = 0;
+        for (const Frame& input : scene.input) {
+            auto start = Clock::now();
+            REPRISE_TRY(converter.send(input));
+            const double ms = ms_since(start);
+            std::vector<int> made;
+            while (converter.receive(out)) {
+                const int j = index++;
+                if (j % scene.factor == 0) continue;  // an input passed through
+                made.push_back(j);
+                if (!scene.scored(j)) continue;  // beyond the last input: no truth to compare
+                if (rep == 0 || telea) to_display(out.color.view(), display.view());
+                if (rep == 0) record(run, j, display, scene.truth[j], 0.0, false);
+                if (!telea) continue;
+                // With fill none the converter leaves holes at colour 0 and depth +inf.
+                for (int y = 0; y < h; ++y)
+                    for (int x = 0; x < w; ++x)
+                        holes(x, y) =
+                            out.color(x, y) == glm::vec4(0.0f) && std::isinf(out.depth(x, y));
+                auto telea_start = Clock::now();
+                inpaint_telea(display.view(), holes.view());
+                keep_fastest(telea_ms, j, ms_since(telea_start));
+                if (rep == 0) record(*telea, j, display, scene.truth[j], 0.0, false);
+            }
+            for (int j : made) keep_fastest(send_ms, j, ms / double(made.size()));
         }
-        for (std::size_t k = first; k < run.scores.size(); ++k) run.scores[k].ms += send_ms / made;
-        if (telea)
-            for (std::size_t k = first_telea; k < telea->scores.size(); ++k)
-                telea->scores[k].ms += send_ms / made;
     }
+    for (Score& s : run.scores) s.ms = send_ms[s.frame];
+    if (telea)
+        for (Score& s : telea->scores) s.ms = send_ms[s.frame] + telea_ms[s.frame];
     return {};
 }
 
-void run_dis(const SceneFrames& scene, Run& run) {
+void run_dis(const SceneFrames& scene, int repeat, Run& run) {
     const int w = scene.input[0].width(), h = scene.input[0].height(), k_max = scene.factor;
     DisInterpolator dis;
     Image<Rgb8> shown(w, h);
     Image<glm::vec3> display;
-    for (std::size_t i = 0; i + 1 < scene.input.size(); ++i) {
-        auto start = Clock::now();
-        dis.set_pair(scene.input_shown[i].view(), scene.input_shown[i + 1].view());
-        const double pair_ms = ms_since(start);
-        for (int k = 1; k < k_max; ++k) {
-            start = Clock::now();
-            dis.interpolate(float(k) / float(k_max), shown.view());
-            const double frame_ms = ms_since(start) + pair_ms / (k_max - 1);
-            const int j = int(i) * k_max + k;
-            from_rgb8(shown.view(), display);
-            record(run, j, display, scene.truth[j], frame_ms, true);
+    std::map<int, double> fastest;
+    for (int rep = 0; rep < repeat; ++rep)
+        for (std::size_t i = 0; i + 1 < scene.input.size(); ++i) {
+            auto start = Clock::now();
+            dis.set_pair(scene.input_shown[i].view(), scene.input_shown[i + 1].view());
+            const double pair_ms = ms_since(start);
+            for (int k = 1; k < k_max; ++k) {
+                start = Clock::now();
+                dis.interpolate(float(k) / float(k_max), shown.view());
+                const int j = int(i) * k_max + k;
+                keep_fastest(fastest, j, ms_since(start) + pair_ms / (k_max - 1));
+                if (rep > 0) continue;
+                from_rgb8(shown.view(), display);
+                record(run, j, display, scene.truth[j], 0.0, true);
+            }
         }
-    }
+    for (Score& s : run.scores) s.ms = fastest[s.frame];
 }
 
-Status run_ffmpeg(const SceneFrames& scene, const std::string& scratch_dir, Run& run) {
-    std::vector<Image<Rgb8>> output;
-    double seconds = 0.0;
-    REPRISE_TRY(ffmpeg_minterpolate(scene.input_shown, scene.factor, scratch_dir, output, seconds));
+Status run_ffmpeg(const SceneFrames& scene, const std::string& scratch_dir, int repeat, Run& run) {
+    std::vector<Image<Rgb8>> output, again;
+    double seconds = 0.0, fastest = INFINITY;
+    for (int rep = 0; rep < repeat; ++rep) {
+        REPRISE_TRY(ffmpeg_minterpolate(scene.input_shown, scene.factor, scratch_dir,
+                                        rep ? again : output, seconds));
+        fastest = std::min(fastest, seconds);
+    }
     const int synthesized = (int(scene.input.size()) - 1) * (scene.factor - 1);
     Image<glm::vec3> display;
     for (int j = 1; j < scene.last(); ++j) {
         if (!scene.scored(j)) continue;
         from_rgb8(output[j].view(), display);
-        record(run, j, display, scene.truth[j], 1e3 * seconds / synthesized, true);
+        record(run, j, display, scene.truth[j], 1e3 * fastest / synthesized, true);
     }
     return {};
 }
 
 // The window of the given size where `a` and `b` differ most (sum of absolute differences).
-void worst_window(const Image<Rgb8>& a, const Image<Rgb8>& b, int cw, int ch, int& best_x, int& best_y) {
+void worst_window(const Image<Rgb8>& a, const Image<Rgb8>& b, int cw, int ch, int& best_x,
+                  int& best_y) {
     const int w = a.width(), h = a.height();
     std::vector<double> sat(std::size_t(w + 1) * (h + 1), 0.0);  // summed-area table
     auto at = [&](int x, int y) -> double& { return sat[std::size_t(y) * (w + 1) + x]; };
@@ -280,25 +311,30 @@ Status comparison_picture(const SceneFrames& scene, const Run& ours, const Run* 
     to_rgb8(scene.truth[j].view(), truth);
     const int w = truth.width(), h = truth.height();
     const int cw = std::min(w, 200), ch = std::min(h, 112);
+    const bool cropped = cw < w || ch < h;
     int x0 = 0, y0 = 0;
     worst_window(ours.worst, truth, cw, ch, x0, y0);
-    std::vector<Image<Rgb8>> images = {outlined(ours.worst, x0, y0, cw, ch), outlined(truth, x0, y0, cw, ch)};
-    std::vector<std::string> labels = {"ours " + ours.setting + ", frame " + std::to_string(j) + ", " +
-                                           db(ours.worst_psnr),
-                                       "ground truth"};
-    const Score* peer_score = nullptr;
+    std::vector<Image<Rgb8>> images = {ours.worst, truth};
+    std::vector<std::string> labels = {"ours " + ours.setting + " " + db(ours.worst_psnr),
+                                       "truth, frame " + std::to_string(j)};
     if (peer && peer->frames.count(j)) {
-        images.push_back(outlined(peer->frames.at(j), x0, y0, cw, ch));
+        images.push_back(peer->frames.at(j));
+        std::string label = peer->method;
         for (const Score& s : peer->scores)
-            if (s.frame == j) peer_score = &s;
-        labels.push_back(peer->method + (peer_score ? ", " + db(peer_score->error.psnr) : ""));
+            if (s.frame == j) label += " " + db(s.error.psnr);
+        labels.push_back(label);
     }
     const std::size_t columns = images.size();
-    for (std::size_t i = 0; i < columns; ++i) images.push_back(crop(images[i], x0, y0, cw, ch));
+    if (cropped)
+        for (std::size_t i = 0; i < columns; ++i) {
+            images.push_back(crop(images[i], x0, y0, cw, ch));
+            images[i] = outlined(images[i], x0, y0, cw, ch);
+            labels.push_back(i == 0 ? "crop where ours errs most" : "same crop");
+        }
     std::vector<Tile> tiles;
-    for (std::size_t i = 0; i < images.size(); ++i)
-        tiles.push_back({images[i].view(), i < columns ? labels[i] : "crop: " + labels[i - columns]});
-    Image<Rgb8> sheet = contact_sheet(tiles, {.columns = int(columns), .tile_width = 2 * cw});
+    for (std::size_t i = 0; i < images.size(); ++i) tiles.push_back({images[i].view(), labels[i]});
+    Image<Rgb8> sheet =
+        contact_sheet(tiles, {.columns = int(columns), .tile_width = std::max(2 * cw, 320)});
     return write_png(path, sheet.view());
 }
 
@@ -316,14 +352,15 @@ std::vector<std::string> split(const std::string& list) {
 const Run* best_of(const std::vector<Run>& runs, const std::function<bool(const Run&)>& wanted) {
     const Run* best = nullptr;
     for (const Run& r : runs)
-        if (wanted(r) && !r.scores.empty() && (!best || r.mean().psnr > best->mean().psnr)) best = &r;
+        if (wanted(r) && !r.scores.empty() && (!best || r.mean().psnr > best->mean().psnr))
+            best = &r;
     return best;
 }
 
 void progress(const std::string& scene, const Run& run) {
     ReportPoint p = run.mean();
-    std::fprintf(stderr, "[fruc] %s: %-19s %-17s %6.2f dB %8.2f ms\n", scene.c_str(), run.method.c_str(),
-                 run.setting.c_str(), p.psnr, p.ms);
+    std::fprintf(stderr, "[fruc] %s: %-19s %-17s %6.2f dB %8.2f ms\n", scene.c_str(),
+                 run.method.c_str(), run.setting.c_str(), p.psnr, p.ms);
 }
 
 struct SceneSummary {
@@ -334,9 +371,10 @@ struct SceneSummary {
 std::string summary_table(const std::vector<SceneSummary>& rows) {
     std::string text;
     char line[512];
-    std::snprintf(line, sizeof line, "%-9s %-18s %7s %8s | %-17s %7s %8s | %7s %8s | %7s %8s | %7s  %s\n",
-                  "scene", "best interpolation", "PSNR", "ms", "best extrapolation", "PSNR", "ms",
-                  "ffmpeg", "ms", "DIS", "ms", "margin", ">=3 dB over the better peer, faster than both");
+    std::snprintf(line, sizeof line,
+                  "%-9s %-18s %7s %8s | %-17s %7s %8s | %7s %8s | %7s %8s | %7s  %s\n", "scene",
+                  "best interpolation", "PSNR", "ms", "best extrapolation", "PSNR", "ms", "ffmpeg",
+                  "ms", "DIS", "ms", "margin", ">=3 dB over the better peer, faster than both");
     text += line;
     auto value = [](const ReportPoint& p, bool ms) {
         char b[32];
@@ -347,7 +385,8 @@ std::string summary_table(const std::vector<SceneSummary>& rows) {
     for (const SceneSummary& r : rows) {
         const bool has_ffmpeg = !r.ffmpeg.method.empty(), has_dis = !r.dis.method.empty();
         double peer_db = -INFINITY, peer_ms = INFINITY;
-        if (has_ffmpeg) peer_db = std::max(peer_db, r.ffmpeg.psnr), peer_ms = std::min(peer_ms, r.ffmpeg.ms);
+        if (has_ffmpeg)
+            peer_db = std::max(peer_db, r.ffmpeg.psnr), peer_ms = std::min(peer_ms, r.ffmpeg.ms);
         if (has_dis) peer_db = std::max(peer_db, r.dis.psnr), peer_ms = std::min(peer_ms, r.dis.ms);
         std::string margin = "-", verdict = "no peer";
         if (has_ffmpeg || has_dis) {
@@ -362,12 +401,14 @@ std::string summary_table(const std::vector<SceneSummary>& rows) {
                                        : "no: margin under 3 dB and slower";
             if (!(has_ffmpeg && has_dis)) verdict += " (one peer only)";
         }
-        std::snprintf(line, sizeof line, "%-9s %-18s %7s %8s | %-17s %7s %8s | %7s %8s | %7s %8s | %7s  %s\n",
-                      r.scene.c_str(), r.interpolation.setting.c_str(), value(r.interpolation, false).c_str(),
-                      value(r.interpolation, true).c_str(), r.extrapolation.setting.c_str(),
-                      value(r.extrapolation, false).c_str(), value(r.extrapolation, true).c_str(),
-                      value(r.ffmpeg, false).c_str(), value(r.ffmpeg, true).c_str(),
-                      value(r.dis, false).c_str(), value(r.dis, true).c_str(), margin.c_str(), verdict.c_str());
+        std::snprintf(line, sizeof line,
+                      "%-9s %-18s %7s %8s | %-17s %7s %8s | %7s %8s | %7s %8s | %7s  %s\n",
+                      r.scene.c_str(), r.interpolation.setting.c_str(),
+                      value(r.interpolation, false).c_str(), value(r.interpolation, true).c_str(),
+                      r.extrapolation.setting.c_str(), value(r.extrapolation, false).c_str(),
+                      value(r.extrapolation, true).c_str(), value(r.ffmpeg, false).c_str(),
+                      value(r.ffmpeg, true).c_str(), value(r.dis, false).c_str(),
+                      value(r.dis, true).c_str(), margin.c_str(), verdict.c_str());
         text += line;
     }
     return text;
@@ -376,8 +417,12 @@ std::string summary_table(const std::vector<SceneSummary>& rows) {
 }  // namespace
 
 Status bench_fruc(const BenchOptions& job) {
-    if (job.factor < 2 || job.factor > 16) return Status::error("bench fruc: --factor must be in 2..16");
-    if (job.frames < 2 || job.frames > 1000) return Status::error("bench fruc: --frames must be in 2..1000");
+    if (job.factor < 2 || job.factor > 16)
+        return Status::error("bench fruc: --factor must be in 2..16");
+    if (job.frames < 2 || job.frames > 1000)
+        return Status::error("bench fruc: --frames must be in 2..1000");
+    if (job.repeat < 1 || job.repeat > 100)
+        return Status::error("bench fruc: --repeat must be in 1..100");
     int w = 0, h = 0;
     REPRISE_TRY(parse_size(job.size, w, h));
     std::vector<std::string> scenes = split(job.scenes);
@@ -391,10 +436,12 @@ Status bench_fruc(const BenchOptions& job) {
     std::unique_ptr<server::Renderer> renderer;
     REPRISE_TRY(server::Renderer::create(renderer));
     const bool has_ffmpeg = ffmpeg_has_minterpolate();
-    if (!has_ffmpeg) std::printf("note: ffmpeg with the minterpolate filter not found; that peer is skipped\n");
+    if (!has_ffmpeg)
+        std::printf("note: ffmpeg with the minterpolate filter not found; that peer is skipped\n");
     const std::vector<Setting> settings = fruc_settings(job.quick);
 
-    const std::string csv_path = out_dir + "/fruc.csv", summary_path = out_dir + "/fruc_summary.csv";
+    const std::string csv_path = out_dir + "/fruc.csv",
+                      summary_path = out_dir + "/fruc_summary.csv";
     FILE* csv = std::fopen(csv_path.c_str(), "w");
     FILE* summary_csv = std::fopen(summary_path.c_str(), "w");
     if (!csv || !summary_csv) {
@@ -409,21 +456,24 @@ Status bench_fruc(const BenchOptions& job) {
     report.title = "reprise bench fruc: frame-rate upconversion, error against run time";
     const int synthesized = (job.frames - 1) * (job.factor - 1);
     char text[2048];
-    std::snprintf(text, sizeof text,
-                  "x%d upconversion of %d input frames at 30 Hz (%dx%d), renderer %s. Each method's "
-                  "%d in-between frames are compared with frames rendered at %d Hz (display values: "
-                  "PSNR, SSIM, LDR-FLIP); the input frames passed through are not scored.",
-                  job.factor, job.frames, w, h, renderer->device().c_str(), synthesized, 30 * job.factor);
+    std::snprintf(
+        text, sizeof text,
+        "x%d upconversion of %d input frames at 30 Hz (%dx%d), renderer %s. Each method's "
+        "%d in-between frames are compared with frames rendered at %d Hz (display values: "
+        "PSNR, SSIM, LDR-FLIP); the input frames passed through are not scored.",
+        job.factor, job.frames, w, h, renderer->device().c_str(), synthesized, 30 * job.factor);
     report.paragraphs.push_back(text);
-    std::snprintf(text, sizeof text,
-                  "ms = wall-clock milliseconds per synthesized frame on this machine (%d threads for "
-                  "reprise's loops). Ours: FrameRateConverter::send() alone, from G-buffers in memory. "
-                  "opencv-dis: DIS flow (preset MEDIUM) both ways per input pair, shared by its in-between "
-                  "frames, plus remap and blend of 8-bit frames. ffmpeg-minterpolate (mi_mode=mci): the "
-                  "whole ffmpeg run divided by the frames it synthesized, including process start, raw "
-                  "video I/O and RGB/YUV conversion. grid+telea: the grid warp without fill plus "
-                  "cv::inpaint (Telea) of its holes.",
-                  thread_count());
+    std::snprintf(
+        text, sizeof text,
+        "ms = wall-clock milliseconds per synthesized frame on this machine (%d threads for "
+        "reprise's loops), the fastest of %d runs (machines are shared and noisy). Ours: "
+        "FrameRateConverter::send() alone, from G-buffers in memory. "
+        "opencv-dis: DIS flow (preset MEDIUM) both ways per input pair, shared by its in-between "
+        "frames, plus remap and blend of 8-bit frames. ffmpeg-minterpolate (mi_mode=mci): the "
+        "whole ffmpeg run divided by the frames it synthesized, including process start, raw "
+        "video I/O and RGB/YUV conversion. grid+telea: the grid warp without fill plus "
+        "cv::inpaint (Telea) of its holes.",
+        thread_count(), job.repeat);
     report.paragraphs.push_back(text);
     std::vector<SceneSummary> summaries;
 
@@ -443,7 +493,8 @@ Status bench_fruc(const BenchOptions& job) {
         for (const Setting& setting : settings) {
             runs.push_back({setting.method, setting.setting});
             Run telea{"interpolate", "grid+telea"};
-            failure = run_ours(scene, setting, runs.back(), setting.with_telea ? &telea : nullptr);
+            failure = run_ours(scene, setting, job.repeat, runs.back(),
+                               setting.with_telea ? &telea : nullptr);
             if (!failure.ok()) break;
             progress(scene.name, runs.back());
             if (setting.with_telea) {
@@ -453,16 +504,17 @@ Status bench_fruc(const BenchOptions& job) {
         }
         if (!failure.ok()) break;
         runs.push_back({kDis, "medium"});
-        run_dis(scene, runs.back());
+        run_dis(scene, job.repeat, runs.back());
         progress(scene.name, runs.back());
         if (has_ffmpeg) {
             Run ffmpeg{kFfmpeg, "mci"};
-            Status ran = run_ffmpeg(scene, scene_dir, ffmpeg);
+            Status ran = run_ffmpeg(scene, scene_dir, job.repeat, ffmpeg);
             if (ran.ok()) {
                 runs.push_back(std::move(ffmpeg));
                 progress(scene.name, runs.back());
             } else {
-                std::printf("note: %s: ffmpeg peer skipped: %s\n", scene.name.c_str(), ran.message().c_str());
+                std::printf("note: %s: ffmpeg peer skipped: %s\n", scene.name.c_str(),
+                            ran.message().c_str());
             }
         }
 
@@ -471,11 +523,13 @@ Status bench_fruc(const BenchOptions& job) {
             if (scene_name == info.name) section.note = info.stresses;
         for (const Run& run : runs) {
             for (const Score& s : run.scores)
-                std::fprintf(csv, "%s,%s,%s,%d,%.4f,%.6f,%.6f,%.4f\n", scene.name.c_str(), run.method.c_str(),
-                             run.setting.c_str(), s.frame, s.error.psnr, s.error.ssim, s.error.flip, s.ms);
+                std::fprintf(csv, "%s,%s,%s,%d,%.4f,%.6f,%.6f,%.4f\n", scene.name.c_str(),
+                             run.method.c_str(), run.setting.c_str(), s.frame, s.error.psnr,
+                             s.error.ssim, s.error.flip, s.ms);
             ReportPoint p = run.mean();
             std::fprintf(summary_csv, "%s,%s,%s,%zu,%.4f,%.6f,%.6f,%.4f\n", scene.name.c_str(),
-                         run.method.c_str(), run.setting.c_str(), run.scores.size(), p.psnr, p.ssim, p.flip, p.ms);
+                         run.method.c_str(), run.setting.c_str(), run.scores.size(), p.psnr, p.ssim,
+                         p.flip, p.ms);
             section.points.push_back(p);
         }
 
@@ -483,7 +537,8 @@ Status bench_fruc(const BenchOptions& job) {
         const Run* interpolation = best_of(runs, [](const Run& r) {
             return r.method == "interpolate" && r.setting != "grid+telea";
         });
-        const Run* extrapolation = best_of(runs, [](const Run& r) { return r.method == "extrapolate"; });
+        const Run* extrapolation =
+            best_of(runs, [](const Run& r) { return r.method == "extrapolate"; });
         const Run* peer = best_of(runs, [](const Run& r) { return !r.ours(); });
         if (interpolation) row.interpolation = interpolation->mean();
         if (extrapolation) row.extrapolation = extrapolation->mean();
@@ -497,10 +552,12 @@ Status bench_fruc(const BenchOptions& job) {
             failure = comparison_picture(scene, *interpolation, peer, out_dir + "/" + picture);
             if (!failure.ok()) break;
             section.images.push_back(
-                {picture, "The lowest-PSNR frame of the best interpolation setting (" + interpolation->setting +
-                              ", frame " + std::to_string(interpolation->worst_frame) + ") beside the ground truth" +
-                              (peer ? " and the better peer (" + peer->method + ")" : std::string()) +
-                              "; below, the window where ours differs most from the truth, enlarged."});
+                {picture,
+                 "The lowest-PSNR frame of the best interpolation setting (" +
+                     interpolation->setting + ", frame " +
+                     std::to_string(interpolation->worst_frame) + ") beside the ground truth" +
+                     (peer ? " and the better peer (" + peer->method + ")" : std::string()) +
+                     "; below, the window where ours differs most from the truth, enlarged."});
         }
         report.sections.push_back(std::move(section));
         std::fflush(csv);
@@ -511,15 +568,17 @@ Status bench_fruc(const BenchOptions& job) {
     REPRISE_TRY(failure);
 
     std::string table = summary_table(summaries);
-    std::snprintf(text, sizeof text,
-                  "fruc x%d, %dx%d, %d input frames, %d scored frames per method; PSNR in dB, ms per "
-                  "synthesized frame; margin = best interpolation - better peer\n",
-                  job.factor, w, h, job.frames, synthesized);
+    std::snprintf(
+        text, sizeof text,
+        "fruc x%d, %dx%d, %d input frames, %d scored frames per method; PSNR in dB, ms per "
+        "synthesized frame; margin = best interpolation - better peer\n",
+        job.factor, w, h, job.frames, synthesized);
     report.preformatted = std::string(text) + table;
     const std::string html_path = out_dir + "/index.html";
     REPRISE_TRY(write_html_report(html_path, report));
     std::printf("%s%s", text, table.c_str());
-    std::printf("report: %s\nrows: %s\nmeans: %s\n", html_path.c_str(), csv_path.c_str(), summary_path.c_str());
+    std::printf("report: %s\nrows: %s\nmeans: %s\n", html_path.c_str(), csv_path.c_str(),
+                summary_path.c_str());
     return {};
 }
 

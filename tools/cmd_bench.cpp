@@ -137,6 +137,7 @@ int command_bench(int argc, char** argv) {
     args.option("--factor", &job.factor, "fruc: K, output frames per input frame (default 2)");
     args.option("--size", &job.size, "fruc: WxH (default 640x360)");
     args.flag("--quick", &job.quick, "fruc: a few settings only (grid+pullpush, reverse+pullpush, splat+none, ...)");
+    args.option("--repeat", &job.repeat, "fruc: timed runs, each frame's fastest counts (default 3)");
     args.flag("--exr", &job.exr, "fruc: also write the rendered input and truth as EXR under OUT/SCENE/");
     Status parsed = args.parse(argc, argv);
     if (!parsed.ok() || args.help_requested()) return report(args, parsed, {});

@@ -6,7 +6,6 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-
 #include <glm/common.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/photo.hpp>
@@ -64,7 +63,8 @@ Status ffmpeg_minterpolate(const std::vector<Image<Rgb8>>& input, int factor,
     std::string command = shell_quote(ffmpeg) +
                           " -hide_banner -loglevel error -nostdin -f rawvideo -pix_fmt rgb24 -s " +
                           std::to_string(w) + "x" + std::to_string(h) + " -r 30 -i " +
-                          shell_quote(raw) + " -vf minterpolate=fps=" + std::to_string(30 * factor) +
+                          shell_quote(raw) +
+                          " -vf minterpolate=fps=" + std::to_string(30 * factor) +
                           ":mi_mode=mci -f rawvideo -pix_fmt rgb24 - 2>/dev/null";
     output.clear();
     auto start = std::chrono::steady_clock::now();
@@ -87,7 +87,8 @@ Status ffmpeg_minterpolate(const std::vector<Image<Rgb8>>& input, int factor,
 }
 
 struct DisInterpolator::State {
-    cv::Ptr<cv::DISOpticalFlow> flow = cv::DISOpticalFlow::create(cv::DISOpticalFlow::PRESET_MEDIUM);
+    cv::Ptr<cv::DISOpticalFlow> flow =
+        cv::DISOpticalFlow::create(cv::DISOpticalFlow::PRESET_MEDIUM);
     cv::Mat a, b, grey_a, grey_b, flow_ab, flow_ba, grid, map, warped_a, warped_b;
 };
 
@@ -105,7 +106,8 @@ void DisInterpolator::set_pair(ImageView<const Rgb8> a, ImageView<const Rgb8> b)
     if (st.grid.rows != a.height || st.grid.cols != a.width) {
         st.grid.create(a.height, a.width, CV_32FC2);
         for (int y = 0; y < a.height; ++y)
-            for (int x = 0; x < a.width; ++x) st.grid.at<cv::Vec2f>(y, x) = cv::Vec2f(float(x), float(y));
+            for (int x = 0; x < a.width; ++x)
+                st.grid.at<cv::Vec2f>(y, x) = cv::Vec2f(float(x), float(y));
     }
 }
 

@@ -23,14 +23,14 @@ Status ffmpeg_minterpolate(const std::vector<Image<Rgb8>>& input, int factor,
 // OpenCV's dense inverse search flow (preset MEDIUM) on grey levels, both ways between two
 // frames; an in-between frame warps both backwards along the scaled flow and blends them.
 class DisInterpolator {
-public:
+  public:
     DisInterpolator();
     ~DisInterpolator();
     void set_pair(ImageView<const Rgb8> a, ImageView<const Rgb8> b);
     // The frame at fraction s in (0, 1) from a to b, same size as the pair.
     void interpolate(float s, ImageView<Rgb8> out);
 
-private:
+  private:
     struct State;
     std::unique_ptr<State> state_;
 };

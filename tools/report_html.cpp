@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <utility>
 
 namespace reprise::cli {
 
@@ -13,11 +14,20 @@ std::string escape(const std::string& text) {
     std::string out;
     for (char c : text) {
         switch (c) {
-            case '&': out += "&amp;"; break;
-            case '<': out += "&lt;"; break;
-            case '>': out += "&gt;"; break;
-            case '"': out += "&quot;"; break;
-            default: out += c;
+            case '&':
+                out += "&amp;";
+                break;
+            case '<':
+                out += "&lt;";
+                break;
+            case '>':
+                out += "&gt;";
+                break;
+            case '"':
+                out += "&quot;";
+                break;
+            default:
+                out += c;
         }
     }
     return out;
@@ -45,6 +55,19 @@ double nice_step(double range, int count) {
     double raw = range / count, decade = std::pow(10.0, std::floor(std::log10(raw)));
     for (double m : {1.0, 2.0, 5.0, 10.0})
         if (m * decade >= raw) return m * decade;
+    return 10.0 * decade;
+}
+
+// The largest 1-2-5 value (..., 0.5, 1, 2, 5, 10, ...) at most `v`, or the smallest above it.
+double step_125(double v, bool up) {
+    double decade = std::pow(10.0, std::floor(std::log10(v)));
+    if (!up) {
+        for (double m : {5.0, 2.0, 1.0})
+            if (m * decade <= v) return m * decade;
+        return decade;
+    }
+    for (double m : {1.0, 2.0, 5.0, 10.0})
+        if (m * decade > v) return m * decade;
     return 10.0 * decade;
 }
 
@@ -78,7 +101,9 @@ std::string error_time_svg(const std::vector<ReportPoint>& points) {
     }
     if (shown.empty()) ms_lo = 1, ms_hi = 10;
     if (!(db_lo <= db_hi)) db_lo = 20, db_hi = 40;
-    const double x_lo = std::floor(std::log10(ms_lo)), x_hi = std::max(x_lo + 1, std::ceil(std::log10(ms_hi)));
+    // The x range ends on 1-2-5 ticks just outside the data.
+    const double x_lo = std::log10(step_125(ms_lo, false)),
+                 x_hi = std::log10(step_125(ms_hi * 1.0001, true));
     const double step = nice_step(std::max(db_hi - db_lo, 1.0), 6);
     const double y_lo = std::floor((db_lo - 0.3 * step) / step) * step;
     const double y_hi = std::ceil((db_hi + 0.3 * step) / step) * step;
@@ -96,24 +121,27 @@ std::string error_time_svg(const std::vector<ReportPoint>& points) {
            format("%.1f", plot_w) + "\" height=\"" + format("%.1f", plot_h) +
            "\" fill=\"#fafafa\" stroke=\"#888\"/>\n";
     // Grid and ticks: 1, 2, 5 per decade on x; a 1-2-5 step on y.
-    for (double d = x_lo; d <= x_hi; ++d)
+    for (double d = std::floor(x_lo); d <= x_hi; ++d)
         for (double m : {1.0, 2.0, 5.0}) {
             double ms = m * std::pow(10.0, d), x = px(ms);
-            if (std::log10(ms) > x_hi + 1e-9) continue;
-            svg += "<line x1=\"" + format("%.1f", x) + "\" y1=\"" + format("%.1f", top) + "\" x2=\"" +
-                   format("%.1f", x) + "\" y2=\"" + format("%.1f", top + plot_h) + "\" stroke=\"" +
-                   (m == 1.0 ? "#ccc" : "#eee") + "\"/>\n";
-            svg += "<text x=\"" + format("%.1f", x) + "\" y=\"" + format("%.1f", top + plot_h + 14) +
-                   "\" text-anchor=\"middle\">" + format("%g", ms) + "</text>\n";
+            if (std::log10(ms) < x_lo - 1e-9 || std::log10(ms) > x_hi + 1e-9) continue;
+            svg += "<line x1=\"" + format("%.1f", x) + "\" y1=\"" + format("%.1f", top) +
+                   "\" x2=\"" + format("%.1f", x) + "\" y2=\"" + format("%.1f", top + plot_h) +
+                   "\" stroke=\"" + (m == 1.0 ? "#ccc" : "#eee") + "\"/>\n";
+            svg += "<text x=\"" + format("%.1f", x) + "\" y=\"" +
+                   format("%.1f", top + plot_h + 14) + "\" text-anchor=\"middle\">" +
+                   format("%g", ms) + "</text>\n";
         }
     for (double db = y_lo; db <= y_hi + 1e-9; db += step) {
         double y = py(db);
         svg += "<line x1=\"" + format("%.1f", left) + "\" y1=\"" + format("%.1f", y) + "\" x2=\"" +
-               format("%.1f", left + plot_w) + "\" y2=\"" + format("%.1f", y) + "\" stroke=\"#e4e4e4\"/>\n";
+               format("%.1f", left + plot_w) + "\" y2=\"" + format("%.1f", y) +
+               "\" stroke=\"#e4e4e4\"/>\n";
         svg += "<text x=\"" + format("%.1f", left - 6) + "\" y=\"" + format("%.1f", y + 4) +
                "\" text-anchor=\"end\">" + format("%g", db) + "</text>\n";
     }
-    svg += "<text x=\"" + format("%.1f", left + plot_w / 2) + "\" y=\"" + format("%.1f", top + plot_h + 32) +
+    svg += "<text x=\"" + format("%.1f", left + plot_w / 2) + "\" y=\"" +
+           format("%.1f", top + plot_h + 32) +
            "\" text-anchor=\"middle\">ms per synthesized frame (log scale)</text>\n";
     svg += "<text transform=\"translate(16 " + format("%.1f", top + plot_h / 2) +
            ") rotate(-90)\" text-anchor=\"middle\">PSNR, dB (higher is better)</text>\n";
@@ -123,7 +151,8 @@ std::string error_time_svg(const std::vector<ReportPoint>& points) {
         if (std::find(methods.begin(), methods.end(), points[i].method) == methods.end())
             methods.push_back(points[i].method);
     auto color_of = [&](const std::string& method) {
-        return method_color(std::size_t(std::find(methods.begin(), methods.end(), method) - methods.begin()));
+        return method_color(
+            std::size_t(std::find(methods.begin(), methods.end(), method) - methods.begin()));
     };
 
     std::vector<std::size_t> front = pareto_front(points);
@@ -134,7 +163,8 @@ std::string error_time_svg(const std::vector<ReportPoint>& points) {
             path += " H" + format("%.1f", px(points[front[k]].ms)) + " V" +
                     format("%.1f", py(points[front[k]].psnr));
         path += " H" + format("%.1f", left + plot_w);
-        svg += "<path d=\"" + path + "\" fill=\"none\" stroke=\"#222\" stroke-width=\"1.5\" "
+        svg += "<path d=\"" + path +
+               "\" fill=\"none\" stroke=\"#222\" stroke-width=\"1.5\" "
                "stroke-dasharray=\"5 3\"/>\n";
     }
 
@@ -142,37 +172,47 @@ std::string error_time_svg(const std::vector<ReportPoint>& points) {
     for (std::size_t i : shown) {
         const ReportPoint& p = points[i];
         double x = px(p.ms), y = py(p.psnr);
-        taken.push_back({x - 5, y - 5, x + 5, y + 5});
+        taken.push_back({x - 7, y - 7, x + 7, y + 7});
     }
     for (std::size_t i : shown) {
         const ReportPoint& p = points[i];
         const double x = px(p.ms), y = py(p.psnr);
         const bool on_front = std::find(front.begin(), front.end(), i) != front.end();
-        svg += "<g><title>" + escape(p.method + " " + p.setting) + ": " + format("%.2f dB", p.psnr) +
-               ", " + format("%.3g ms", p.ms) + (on_front ? " (Pareto front)" : "") + "</title>";
+        svg += "<g><title>" + escape(p.method + " " + p.setting) + ": " +
+               format("%.2f dB", p.psnr) + ", " + format("%.3g ms", p.ms) +
+               (on_front ? " (Pareto front)" : "") + "</title>";
         if (on_front)
             svg += "<circle cx=\"" + format("%.1f", x) + "\" cy=\"" + format("%.1f", y) +
                    "\" r=\"7\" fill=\"none\" stroke=\"#222\" stroke-width=\"1.5\"/>";
-        svg += "<circle cx=\"" + format("%.1f", x) + "\" cy=\"" + format("%.1f", y) + "\" r=\"4\" fill=\"" +
-               color_of(p.method) + "\"/></g>\n";
-        // The label goes to the first side where it covers no other point or label.
+        svg += "<circle cx=\"" + format("%.1f", x) + "\" cy=\"" + format("%.1f", y) +
+               "\" r=\"4\" fill=\"" + color_of(p.method) + "\"/></g>\n";
+        // The label goes where it covers the least of the other points and labels: beside,
+        // above, below or diagonal to its point, then twice as far out.
         const double text_w = 6.0 * double(p.setting.size()), text_h = 11;
-        const Box candidates[] = {{x + 8, y - text_h / 2, x + 8 + text_w, y + text_h / 2},
-                                  {x - 8 - text_w, y - text_h / 2, x - 8, y + text_h / 2},
-                                  {x - text_w / 2, y - 8 - text_h, x + text_w / 2, y - 8},
-                                  {x - text_w / 2, y + 8, x + text_w / 2, y + 8 + text_h}};
-        Box chosen = candidates[0];
-        for (const Box& c : candidates) {
-            bool free = c.x0 >= 0 && c.x1 <= width && c.y0 >= 0 && c.y1 <= top + plot_h;
-            for (const Box& t : taken) free = free && !c.overlaps(t);
-            if (free) {
-                chosen = c;
-                break;
+        Box chosen{};
+        double least = INFINITY;
+        for (double gap : {10.0, 24.0})  // 10 clears the front marker's ring
+            for (auto [dx, dy] :
+                 {std::pair{1, 0}, {-1, 0}, {0, -1}, {0, 1}, {1, -1}, {1, 1}, {-1, -1}, {-1, 1}}) {
+                const double cx = dx > 0 ? x + gap : dx < 0 ? x - gap - text_w : x - text_w / 2;
+                const double cy = dy > 0 ? y + gap : dy < 0 ? y - gap - text_h : y - text_h / 2;
+                const Box c{cx, cy, cx + text_w, cy + text_h};
+                if (c.x0 < 0 || c.x1 > width || c.y0 < 0 || c.y1 > top + plot_h) continue;
+                double covered = 0.0;
+                for (const Box& t : taken)
+                    if (c.overlaps(t))
+                        covered += (std::min(c.x1, t.x1) - std::max(c.x0, t.x0)) *
+                                   (std::min(c.y1, t.y1) - std::max(c.y0, t.y0));
+                if (covered < least) least = covered, chosen = c;
+                if (covered == 0.0) break;
             }
-        }
+        if (!std::isfinite(least))
+            chosen = {x + 10, y - text_h / 2, x + 10 + text_w, y + text_h / 2};
         taken.push_back(chosen);
-        svg += "<text x=\"" + format("%.1f", chosen.x0) + "\" y=\"" + format("%.1f", chosen.y1 - 2) +
-               "\" font-size=\"10\" fill=\"" + color_of(p.method) + "\">" + escape(p.setting) + "</text>\n";
+        svg += "<text x=\"" + format("%.1f", chosen.x0) + "\" y=\"" +
+               format("%.1f", chosen.y1 - 2) + "\" font-size=\"10\" fill=\"" + color_of(p.method) +
+               "\" stroke=\"#fafafa\" stroke-width=\"3\" paint-order=\"stroke\">" +
+               escape(p.setting) + "</text>\n";
     }
 
     double lx = left;
@@ -183,16 +223,19 @@ std::string error_time_svg(const std::vector<ReportPoint>& points) {
                "\" y=\"" + format("%.1f", ly) + "\">" + escape(m) + "</text>\n";
         lx += 30 + 6.5 * double(m.size());
     }
-    svg += "<path d=\"M" + format("%.1f", lx) + " " + format("%.1f", ly - 4) + " h24\" stroke=\"#222\" "
-           "stroke-width=\"1.5\" stroke-dasharray=\"5 3\"/><text x=\"" + format("%.1f", lx + 30) +
-           "\" y=\"" + format("%.1f", ly) + "\">Pareto front (best PSNR for the time)</text>\n";
+    svg += "<path d=\"M" + format("%.1f", lx) + " " + format("%.1f", ly - 4) +
+           " h24\" stroke=\"#222\" "
+           "stroke-width=\"1.5\" stroke-dasharray=\"5 3\"/><text x=\"" +
+           format("%.1f", lx + 30) + "\" y=\"" + format("%.1f", ly) +
+           "\">Pareto front (best PSNR for the time)</text>\n";
     svg += "</svg>\n";
     return svg;
 }
 
 Status write_html_report(const std::string& path, const Report& report) {
     std::string html =
-        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>" + escape(report.title) +
+        "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>" +
+        escape(report.title) +
         "</title>\n<style>body{font-family:sans-serif;margin:2em;max-width:1100px;color:#222}"
         "table{border-collapse:collapse;font-size:13px;margin:1em 0}"
         "td,th{border:1px solid #ccc;padding:2px 8px;text-align:right}"
@@ -208,20 +251,23 @@ Status write_html_report(const std::string& path, const Report& report) {
         if (!section.note.empty()) html += "<p>" + escape(section.note) + "</p>\n";
         html += error_time_svg(section.points);
         std::vector<std::size_t> front = pareto_front(section.points);
-        html += "<table><tr><th>method</th><th>setting</th><th>PSNR dB</th><th>SSIM</th>"
-                "<th>FLIP</th><th>ms</th><th>Pareto</th></tr>\n";
+        html +=
+            "<table><tr><th>method</th><th>setting</th><th>PSNR dB</th><th>SSIM</th>"
+            "<th>FLIP</th><th>ms</th><th>Pareto</th></tr>\n";
         for (std::size_t i = 0; i < section.points.size(); ++i) {
             const ReportPoint& p = section.points[i];
             const bool on_front = std::find(front.begin(), front.end(), i) != front.end();
-            html += std::string(on_front ? "<tr class=\"front\">" : "<tr>") + "<td>" + escape(p.method) +
-                    "</td><td>" + escape(p.setting) + "</td><td>" + format("%.2f", p.psnr) + "</td><td>" +
-                    format("%.4f", p.ssim) + "</td><td>" + format("%.4f", p.flip) + "</td><td>" +
-                    format("%.3g", p.ms) + "</td><td>" + (on_front ? "front" : "") + "</td></tr>\n";
+            html += std::string(on_front ? "<tr class=\"front\">" : "<tr>") + "<td>" +
+                    escape(p.method) + "</td><td>" + escape(p.setting) + "</td><td>" +
+                    format("%.2f", p.psnr) + "</td><td>" + format("%.4f", p.ssim) + "</td><td>" +
+                    format("%.4f", p.flip) + "</td><td>" + format("%.3g", p.ms) + "</td><td>" +
+                    (on_front ? "front" : "") + "</td></tr>\n";
         }
         html += "</table>\n";
         for (const ReportImage& image : section.images)
-            html += "<figure><img src=\"" + escape(image.file) + "\" alt=\"" + escape(image.caption) +
-                    "\"><figcaption>" + escape(image.caption) + "</figcaption></figure>\n";
+            html += "<figure><img src=\"" + escape(image.file) + "\" alt=\"" +
+                    escape(image.caption) + "\"><figcaption>" + escape(image.caption) +
+                    "</figcaption></figure>\n";
     }
     html += "</body></html>\n";
     std::ofstream file(path, std::ios::binary);

@@ -14,6 +14,7 @@ struct FrameRateConverter::State {
     FrucScratch scratch;
     Frame previous;
     bool has_previous = false;
+    bool previous_starts_shot = false;  // its motion reaches back into another shot: unusable
     std::deque<Frame> ready;
     std::vector<Frame> spare;  // output frames handed back to be reused
 
@@ -64,6 +65,25 @@ struct FrameRateConverter::State {
         out.id.clear();
     }
 
+    void push(Frame&& out) {
+        ready.push_back(std::move(out));
+        ++counters.outputs;
+    }
+
+    // The camera of the instant one frame period before `f` (from its prev_* matrices).
+    static Camera previous_instant(const Frame& f) {
+        Camera c = f.camera;
+        c.view = f.camera.prev_view;
+        c.projection = f.camera.prev_projection;
+        c.time = f.camera.time - (f.fps > 0 ? 1.0 / f.fps : 0.0);
+        return c;
+    }
+    static Frame camera_only(const Camera& camera) {
+        Frame f;
+        f.camera = camera;
+        return f;
+    }
+
     void emit_input(const Frame& frame) {
         Frame out = take_spare();
         out = frame;
@@ -82,8 +102,7 @@ struct FrameRateConverter::State {
         out.depth = frame.depth;
         out.motion.resize(frame.width(), frame.height(), glm::vec2(0.0f));
         finish(out, a, b, s, s - 1.0f / factor);
-        ready.push_back(std::move(out));
-        ++counters.outputs;
+        push(std::move(out));
     }
 };
 
@@ -123,31 +142,36 @@ Status FrameRateConverter::send(const Frame& frame) {
     if (st.options.mode == FrucMode::Interpolate) {
         if (st.has_previous) {
             const Frame& a = st.previous;
+            const bool a_warpable = !a.depth.empty() && !a.motion.empty() && !st.previous_starts_shot;
+            const Frame a_before = State::camera_only(State::previous_instant(a));
             for (int k = 1; k < k_max; ++k) {
                 float s = float(k) / float(k_max);
-                if (cut || !warpable || a.depth.empty() || a.motion.empty()) {
-                    st.emit_copy(s < 0.5f ? a : frame, a, frame, s);  // never blend two shots
+                if (cut && !a_warpable) {
+                    st.emit_copy(a, a, frame, s);
+                } else if (cut) {
+                    // The new shot starts at the new frame: the frames before it belong to the
+                    // old one, continued from its last frame alone; nothing is blended across.
+                    Frame out = st.take_spare();
+                    extrapolate_frame(a, s, st.options, st.scratch, out, st.counters);
+                    st.finish(out, a_before, a, 1.0f + s, 1.0f + s - 1.0f / k_max);
+                    st.push(std::move(out));
+                } else if (!warpable || a.depth.empty() || a.motion.empty()) {
+                    st.emit_copy(s < 0.5f ? a : frame, a, frame, s);
                 } else if (motion_is_zero(frame)) {
                     ++st.counters.copied_still;
                     st.emit_copy(frame, a, frame, s);
                 } else {
                     Frame out = st.take_spare();
-                    interpolate_frame(a, frame, s, st.options, st.scratch, out, st.counters);
+                    interpolate_frame(a, frame, s, a_warpable, st.options, st.scratch, out, st.counters);
                     st.finish(out, a, frame, s, s - 1.0f / k_max);
-                    st.ready.push_back(std::move(out));
-                    ++st.counters.outputs;
+                    st.push(std::move(out));
                 }
             }
         }
         st.emit_input(frame);
     } else {
         st.emit_input(frame);
-        Camera previous_camera = frame.camera;
-        previous_camera.view = frame.camera.prev_view;
-        previous_camera.projection = frame.camera.prev_projection;
-        previous_camera.time = frame.camera.time - (frame.fps > 0 ? 1.0 / frame.fps : 0.0);
-        Frame before;  // only its camera is used by finish()
-        before.camera = previous_camera;
+        const Frame before = State::camera_only(State::previous_instant(frame));
         for (int k = 1; k < k_max; ++k) {
             float s = float(k) / float(k_max);
             if (cut || !warpable) {
@@ -159,13 +183,13 @@ Status FrameRateConverter::send(const Frame& frame) {
                 Frame out = st.take_spare();
                 extrapolate_frame(frame, s, st.options, st.scratch, out, st.counters);
                 st.finish(out, before, frame, 1.0f + s, 1.0f + s - 1.0f / k_max);
-                st.ready.push_back(std::move(out));
-                ++st.counters.outputs;
+                st.push(std::move(out));
             }
         }
     }
     st.previous = frame;
     st.has_previous = true;
+    st.previous_starts_shot = cut;
     return {};
 }
 

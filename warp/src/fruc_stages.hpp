@@ -37,7 +37,8 @@ void fill_holes(ImageView<glm::vec4> color, ImageView<const uint8_t> valid,
                 FrucCounters& counters);
 
 // Frame at fraction s in (0, 1) between a (earlier) and b (later) into out (colour, depth, motion).
-void interpolate_frame(const Frame& a, const Frame& b, float s, const FrucOptions& options,
+// Without use_a (a's motion is not trustworthy, e.g. it starts a shot) only b is warped.
+void interpolate_frame(const Frame& a, const Frame& b, float s, bool use_a, const FrucOptions& options,
                        FrucScratch& scratch, Frame& out, FrucCounters& counters);
 
 // Frame s frame periods after f (Andreev: static layer by camera-only reprojection, holes

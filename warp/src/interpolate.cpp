@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -85,11 +86,16 @@ void fill_holes(ImageView<glm::vec4> color, ImageView<const uint8_t> valid,
     else scratch.andreev.fill(color, valid, depth);
 }
 
-void interpolate_frame(const Frame& a, const Frame& b, float s, const FrucOptions& options,
+void interpolate_frame(const Frame& a, const Frame& b, float s, bool use_a, const FrucOptions& options,
                        FrucScratch& scratch, Frame& out, FrucCounters& counters) {
     const int w = b.width(), h = b.height();
     warp_frame(b, 1.0f - s, options, scratch, scratch.side_b, counters);
-    warp_frame(a, -s, options, scratch, scratch.side_a, counters);
+    if (use_a) {
+        warp_frame(a, -s, options, scratch, scratch.side_a, counters);
+    } else {
+        scratch.side_a.resize(w, h);
+        std::fill_n(scratch.side_a.covered.data(), scratch.side_a.covered.pixel_count(), uint8_t(0));
+    }
     out.color.resize(w, h);
     out.depth.resize(w, h);
     out.motion.resize(w, h);
