@@ -28,5 +28,8 @@ Status bench_fill(const BenchOptions& options);       // pull-push, Andreev vs c
 // Upconversion error against run time, every setting and the peers (ffmpeg minterpolate,
 // OpenCV DIS flow, Telea): OUT/fruc.csv, OUT/fruc_summary.csv, OUT/index.html.
 Status bench_fruc(const BenchOptions& options);
+// Synthesized second eye vs the rendered one, naive DIBR peers and the renderer's second-eye
+// time, per built-in scene (--scenes, --size, --frames up to 5): OUT/stereo.csv.
+Status bench_stereo(const BenchOptions& options);
 
 }  // namespace reprise::cli

@@ -150,6 +150,7 @@ int command_bench(int argc, char** argv) {
     else if (job.what == "grid") result = bench_grid(job);
     else if (job.what == "fill") result = bench_fill(job);
     else if (job.what == "fruc") result = bench_fruc(job);
+    else if (job.what == "stereo") result = bench_stereo(job);
     else result = Status::error("bench: unknown benchmark '" + job.what +
                                 "' (render, exr, reproject, grid, fill, fruc)");
     return report(args, parsed, result);

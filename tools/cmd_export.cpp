@@ -11,6 +11,7 @@
 #include "reprise/core/exr.hpp"
 #include "reprise/core/video.hpp"
 #include "reprise/core/visualize.hpp"
+#include "reprise/stereo/compose.hpp"
 
 namespace reprise::cli {
 
@@ -25,7 +26,7 @@ constexpr int kSheetTileWidth = 480;
 constexpr float kMotionQuantile = 0.98f;  // of the moving pixels, shown fully saturated
 
 struct Options {
-    std::string dir, png, mp4, channel = "color";
+    std::string dir, png, mp4, channel = "color", stereo;
     double fps = 0.0;
     double motion_max = 0.0;
 };
@@ -232,7 +233,53 @@ bool names_folder(const std::string& path) {
     return path.back() == '/' || fs::is_directory(path, ec);
 }
 
+// DIR/left and DIR/right composed frame by frame: a video, a PNG per frame (--png DIR/) or the
+// first pair as one PNG.
+Status export_stereo(const Options& o, stereo::Layout layout) {
+    Sequence left, right;
+    REPRISE_TRY(open_sequence((fs::path(o.dir) / "left").string(), left));
+    REPRISE_TRY(open_sequence((fs::path(o.dir) / "right").string(), right));
+    if (left.files.size() != right.files.size())
+        return Status::error(o.dir + ": left/ has " + std::to_string(left.files.size()) +
+                             " frames, right/ " + std::to_string(right.files.size()));
+    const bool folder = o.mp4.empty() && names_folder(o.png);
+    const std::size_t n = o.mp4.empty() && !folder ? 1 : left.files.size();
+    if (folder) {
+        std::error_code ec;
+        fs::create_directories(o.png, ec);
+        if (ec) return Status::error(o.png + ": cannot create the folder: " + ec.message());
+    }
+    const double fps = o.fps > 0.0 ? o.fps : left.fps > 0.0 ? left.fps : 30.0;
+    Frame l, r;
+    Image<Rgb8> picture;
+    VideoWriter writer;
+    Progress progress("export", n);
+    for (std::size_t i = 0; i < n; ++i) {
+        REPRISE_TRY(read_frame(left.files[i], l));
+        REPRISE_TRY(read_frame(right.files[i], r));
+        if (l.width() != r.width() || l.height() != r.height())
+            return Status::error(right.files[i] + ": size differs from " + left.files[i]);
+        stereo::compose(l.color.view(), r.color.view(), layout, picture);
+        if (!o.mp4.empty()) {
+            if (i == 0) REPRISE_TRY(writer.open(o.mp4, picture.width(), picture.height(), {.fps = fps}));
+            REPRISE_TRY(writer.write(picture.view()));
+        } else if (folder) {
+            REPRISE_TRY(write_png((fs::path(o.png) / (stem(left.files[i]) + ".png")).string(), picture.view()));
+        } else {
+            REPRISE_TRY(write_png(o.png, picture.view()));
+        }
+        progress.step(i + 1);
+    }
+    if (!o.mp4.empty()) REPRISE_TRY(writer.close());
+    progress.finish(o.mp4.empty() ? o.png : o.mp4);
+    return {};
+}
+
 Status run(const Options& o, Channel channel) {
+    if (!o.stereo.empty())
+        return export_stereo(o, o.stereo == "sbs" ? stereo::Layout::SideBySide
+                                : o.stereo == "tb" ? stereo::Layout::TopBottom
+                                                   : stereo::Layout::Anaglyph);
     Sequence seq;
     REPRISE_TRY(open_sequence(o.dir, seq));
     if (!o.mp4.empty()) return export_mp4(o, seq, channel);
@@ -258,6 +305,9 @@ int command_export(int argc, char** argv) {
     args.option("--channel", &o.channel, "color|depth|motion|normal|id (default color)");
     args.option("--fps", &o.fps, "video frame rate (default: the sequence's, else 30)");
     args.option("--motion-max", &o.motion_max, "motion length shown fully saturated, pixels");
+    args.option("--stereo", &o.stereo,
+                "sbs|tb|anaglyph: DIR holds left/ and right/; side by side, top-bottom or red-cyan "
+                "(Dubois) colour pictures (--png FILE: the first pair only)");
     Status parsed = args.parse(argc, argv);
     Channel channel = Channel::Color;
     if (parsed.ok() && !args.help_requested()) {
@@ -269,6 +319,8 @@ int command_export(int argc, char** argv) {
                                    "' is not color, depth, motion, normal or id");
         else if (args.given("--fps") && !(o.fps > 0.0 && o.fps <= 1000.0))
             parsed = Status::error("export: --fps must be in (0, 1000]");
+        else if (!o.stereo.empty() && o.stereo != "sbs" && o.stereo != "tb" && o.stereo != "anaglyph")
+            parsed = Status::error("export: --stereo: '" + o.stereo + "' is not sbs, tb or anaglyph");
         else if (o.motion_max < 0.0)
             parsed = Status::error("export: --motion-max must not be negative");
         else

@@ -8,6 +8,7 @@
 #include "reprise/core/exr.hpp"
 #include "reprise/server/builtin_scenes.hpp"
 #include "reprise/server/renderer.hpp"
+#include "reprise/stereo/rig.hpp"
 
 namespace reprise::cli {
 
@@ -22,6 +23,8 @@ struct RenderJob {
     int start = 0;
     double fps = 30.0;
     bool unlit = false;
+    double stereo = 0.0;       // IPD; > 0 renders both eyes into OUT/left and OUT/right
+    double convergence = 0.0;  // > 0: off-axis rig converging there
 };
 
 Status run_render(const RenderJob& job) {
@@ -33,6 +36,15 @@ Status run_render(const RenderJob& job) {
     if (!(job.fps > 0 && job.fps <= 10000))
         return Status::error("--fps must be in (0, 10000]");
     if (job.out.empty()) return Status::error("--out DIR is required");
+    if (!(job.stereo >= 0.0 && job.stereo <= 1e6)) return Status::error("--stereo IPD must be in [0, 1e6]");
+    if (!(job.convergence >= 0.0 && job.convergence <= 1e30))
+        return Status::error("--convergence must not be negative");
+    const bool stereo = job.stereo > 0.0;
+    const stereo::StereoRig rig{
+        .ipd = float(job.stereo),
+        .convergence = float(job.convergence),
+        .rig = job.convergence > 0.0 ? stereo::Rig::OffAxis : stereo::Rig::Parallel};
+    const std::string left_dir = stereo ? job.out + "/left" : job.out, right_dir = job.out + "/right";
 
     server::Scene scene;
     server::CameraPath path;
@@ -42,8 +54,10 @@ Status run_render(const RenderJob& job) {
         REPRISE_TRY(server::parse_camera_spec(job.camera, scene, fallback, path));
     }
     std::error_code ec;
-    std::filesystem::create_directories(job.out, ec);
-    if (ec) return Status::error(job.out + ": cannot create the folder: " + ec.message());
+    for (const std::string& dir : {left_dir, stereo ? right_dir : left_dir}) {
+        std::filesystem::create_directories(dir, ec);
+        if (ec) return Status::error(dir + ": cannot create the folder: " + ec.message());
+    }
 
     std::unique_ptr<server::Renderer> renderer;
     REPRISE_TRY(server::Renderer::create(renderer));
@@ -56,8 +70,32 @@ Status run_render(const RenderJob& job) {
     Frame frame;
     auto begin = std::chrono::steady_clock::now();
     for (int i = 0; i < job.frames; ++i) {
-        REPRISE_TRY(renderer->render_frame(scene, path, job.start + i, job.fps, settings, frame));
-        REPRISE_TRY(write_frame(frame_path(job.out, i), frame));
+        if (!stereo) {
+            REPRISE_TRY(renderer->render_frame(scene, path, job.start + i, job.fps, settings, frame));
+            REPRISE_TRY(write_frame(frame_path(job.out, i), frame));
+        } else {
+            // The path's camera is the rig's centre; each eye renders with its own view.
+            const double t = (job.start + i) / job.fps;
+            const server::Instant now = server::instant_on_path(path, scene, t, width, height);
+            const server::Instant before =
+                server::instant_on_path(path, scene, t - 1.0 / job.fps, width, height);
+            Camera centre;
+            centre.view = now.view;
+            centre.projection = now.projection;
+            centre.prev_view = before.view;
+            centre.prev_projection = before.projection;
+            const stereo::EyeCameras eyes = stereo::eye_cameras(centre, rig);
+            for (stereo::Eye e : {stereo::Eye::Left, stereo::Eye::Right}) {
+                server::Instant a = now, b = before;
+                a.view = eyes[e].view;
+                a.projection = eyes[e].projection;
+                b.view = eyes[e].prev_view;
+                b.projection = eyes[e].prev_projection;
+                REPRISE_TRY(renderer->render(scene, a, b, settings, frame));
+                frame.fps = job.fps;
+                REPRISE_TRY(write_frame(frame_path(e == stereo::Eye::Left ? left_dir : right_dir, i), frame));
+            }
+        }
         std::fprintf(stderr, "\r[render] %d/%d", i + 1, job.frames);
     }
     double seconds =
@@ -83,6 +121,9 @@ int command_render(int argc, char** argv) {
                 "static|orbit|pan|dolly|shake|cut|gltf[:N] with ,key=value (speed, radius, "
                 "height, shake, time, angle)");
     args.flag("--unlit", &job.unlit, "base colour only (view-independent shading)");
+    args.option("--stereo", &job.stereo,
+                "IPD: render both eyes (the camera is the rig's centre) into OUT/left and OUT/right");
+    args.option("--convergence", &job.convergence, "with --stereo: off-axis rig converging at this distance");
     args.option("--out", &job.out, "output folder (required)");
     Status parsed = args.parse(argc, argv);
     if (!parsed.ok() || args.help_requested()) return report(args, parsed, {});

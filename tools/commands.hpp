@@ -10,5 +10,6 @@ int command_metrics(int argc, char** argv);
 int command_export(int argc, char** argv);
 int command_bench(int argc, char** argv);
 int command_fruc(int argc, char** argv);
+int command_stereo(int argc, char** argv);
 
 }  // namespace reprise::cli

@@ -19,6 +19,7 @@ constexpr Command kCommands[] = {
     {"metrics", reprise::cli::command_metrics, "PSNR, SSIM and FLIP of a sequence against another"},
     {"export", reprise::cli::command_export, "a sequence as PNG contact sheet or MP4"},
     {"fruc", reprise::cli::command_fruc, "frame-rate upconversion (interpolate or extrapolate) x K"},
+    {"stereo", reprise::cli::command_stereo, "the other eye of a sequence by depth warping (OUT/left, OUT/right)"},
     {"bench", reprise::cli::command_bench, "benchmarks (render, exr, reproject, grid, fill, fruc)"},
 };
 

@@ -1,0 +1,81 @@
+#pragma once
+// The second eye from one rendered eye: per-pixel displacement from depth and the two cameras,
+// a forward warp (adaptive grid or splat) with a depth test, history from an earlier frame,
+// then hole filling from the background side.
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+
+#include "reprise/warp/fill.hpp"
+#include "reprise/warp/grid_warp.hpp"
+#include "reprise/warp/splat.hpp"
+
+namespace reprise::stereo {
+
+enum class StereoWarp { Grid, Splat };
+enum class StereoFill { None, PullPush, Andreev };
+
+struct StereoOptions {
+    StereoWarp warp = StereoWarp::Grid;
+    StereoFill fill = StereoFill::PullPush;
+    warp::GridOptions grid;
+    warp::SplatOptions splat;
+    // History and current warp show the same surface when their depths differ by less than this
+    // fraction; the history (a view nearer the target, with its own view-dependent shading) then
+    // wins if its camera stood closer to the target than the rendered one.
+    float history_depth_tolerance = 0.01f;
+};
+
+struct StereoStats {
+    std::size_t covered = 0;       // pixels the rendered eye's warp covered
+    std::size_t holes = 0;         // pixels it left empty
+    std::size_t from_history = 0;  // pixels taken from the history view
+    std::size_t filled = 0;        // pixels invented by the hole filler
+    std::size_t unfilled = 0;      // holes left (no fill, or nothing to fill from): colour 0
+    std::size_t cells = 0;         // grid cells drawn (both warps)
+};
+
+// Sizes its scratch on the first frame and reuses it while the size stays the same.
+class StereoSynthesizer {
+  public:
+    // Makes the view of `target` from `rendered` (colour + depth + camera) into out.color,
+    // out.depth and out.camera (out.motion, normal and id are cleared). Displacements are
+    // exact for static geometry: each pixel is unprojected with the rendered camera and
+    // projected with the target (background +inf by its direction). `history` (may be null),
+    // an earlier view with colour, depth and camera, e.g. the previous frame's other eye, is
+    // warped to the target the same way and fills the holes first. When the rendered frame's
+    // motion is all zero (still camera and scene) and the history's camera is the target, the
+    // history is already the target view and is returned as it is. Cameras without jitter;
+    // projections perspective or orthographic without skew.
+    StereoStats synthesize(const Frame& rendered, const Camera& target, Frame& out,
+                           const StereoOptions& options = {}, const Frame* history = nullptr);
+
+    // 1 where the last synthesis covered the pixel from the rendered eye (size of the output).
+    ImageView<const uint8_t> coverage() const { return covered_.view(); }
+
+  private:
+    std::size_t warp_into(const Frame& source, const Camera& target, const StereoOptions& o,
+                          const warp::WarpTarget& into);
+
+    Frame scratch_;  // the source with its displacement to the target as motion
+    Image<uint8_t> covered_;
+    Image<glm::vec4> history_color_;
+    Image<float> history_depth_;
+    Image<uint8_t> history_covered_;
+    Image<uint8_t> valid_;
+    warp::GridWarper grid_;
+    warp::PullPush pull_push_;
+    warp::AndreevInpaint andreev_;
+};
+
+// One-shot form (allocates its scratch per call).
+StereoStats synthesize_eye(const Frame& rendered, const Camera& target, const StereoOptions& options,
+                           Frame& out, const Frame* history = nullptr);
+
+// Per-pixel displacement (pixels, as backward-motion-style offsets: p + d is where pixel p of
+// `source` lands in `target`) and the landing depth in the target camera. NaN where the point
+// is invalid (NaN or negative depth) or lands behind the target camera.
+void stereo_displacement(const Frame& source, const Camera& target, ImageView<glm::vec2> displacement,
+                         ImageView<float> target_depth);
+
+}  // namespace reprise::stereo

@@ -1,0 +1,76 @@
+// `reprise render --stereo`, `reprise stereo` and `reprise export --stereo` end to end.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <opencv2/imgcodecs.hpp>
+#include <string>
+#include <vector>
+
+#include "commands.hpp"
+#include "reprise/core/exr.hpp"
+#include "reprise/core/metrics.hpp"
+
+using namespace reprise;
+namespace fs = std::filesystem;
+
+namespace {
+
+int run_command(int (*command)(int, char**), std::vector<std::string> args) {
+    std::vector<char*> argv;
+    for (std::string& a : args) argv.push_back(a.data());
+    return command(int(argv.size()), argv.data());
+}
+
+double psnr_of(const std::string& a_file, const std::string& b_file) {
+    Frame a, b;
+    EXPECT_TRUE(read_frame(a_file, a).ok());
+    EXPECT_TRUE(read_frame(b_file, b).ok());
+    Image<glm::vec3> da(a.width(), a.height()), db(b.width(), b.height());
+    to_display(a.color.view(), da.view());
+    to_display(b.color.view(), db.view());
+    return psnr(da.view(), db.view());
+}
+
+}  // namespace
+
+TEST(CliStereo, RenderBothEyesSynthesizeAndExport) {
+    const fs::path dir = fs::temp_directory_path() / ("reprise_cli_stereo_" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    const std::string truth = (dir / "truth").string(), made = (dir / "made").string();
+    ASSERT_EQ(run_command(cli::command_render, {"--scene", "pan", "--frames", "2", "--size", "160x90",
+                                                "--stereo", "0.1", "--out", truth}),
+              0);
+    ASSERT_TRUE(fs::exists(frame_path(truth + "/left", 1)));
+    ASSERT_TRUE(fs::exists(frame_path(truth + "/right", 1)));
+    ASSERT_EQ(run_command(cli::command_stereo,
+                          {"--in", truth + "/left", "--ipd", "0.1", "--temporal", "--out", made}),
+              0);
+    for (int i = 0; i < 2; ++i) {
+        const std::string right = frame_path(truth + "/right", i);
+        const double ours = psnr_of(right, frame_path(made + "/right", i));
+        const double copy = psnr_of(right, frame_path(truth + "/left", i));
+        EXPECT_GT(ours, 28.0);
+        EXPECT_GT(ours, copy + 5.0);
+    }
+    const std::string sbs = (dir / "sbs.png").string();
+    ASSERT_EQ(run_command(cli::command_export, {made, "--stereo", "sbs", "--png", sbs}), 0);
+    cv::Mat picture = cv::imread(sbs);
+    EXPECT_EQ(picture.cols, 320);
+    EXPECT_EQ(picture.rows, 90);
+    const std::string tb = (dir / "tb").string() + "/";
+    ASSERT_EQ(run_command(cli::command_export, {made, "--stereo", "tb", "--png", tb}), 0);
+    EXPECT_EQ(cv::imread(tb + "frame_00001.png").rows, 180);
+    fs::remove_all(dir);
+}
+
+TEST(CliStereo, BadArgumentsExitWithTwo) {
+    EXPECT_EQ(run_command(cli::command_stereo, {"--in", "x", "--out", "y", "--rig", "diagonal"}), 2);
+    EXPECT_EQ(run_command(cli::command_stereo, {"--in", "x", "--out", "y", "--convergence", "-1"}), 2);
+    EXPECT_EQ(run_command(cli::command_stereo, {"--in", "x", "--out", "y", "--ipd", "abc"}), 2);
+    EXPECT_EQ(run_command(cli::command_stereo, {"--out", "y"}), 2);
+    EXPECT_EQ(run_command(cli::command_export, {"x", "--stereo", "3d", "--png", "a.png"}), 2);
+    // A folder that holds no sequence is bad data: exit 1.
+    EXPECT_EQ(run_command(cli::command_stereo, {"--in", "/nonexistent_reprise", "--out",
+                                                (fs::temp_directory_path() / "reprise_stereo_none").string()}),
+              1);
+}

@@ -1,0 +1,331 @@
+// Stereo: rigs and disparity, the synthesized eye against analytic cases and rendered eyes,
+// temporal reuse, extreme inputs, and the composed pictures.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <random>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "reprise/core/metrics.hpp"
+#include "reprise/server/builtin_scenes.hpp"
+#include "reprise/server/renderer.hpp"
+#include "reprise/stereo/compose.hpp"
+#include "reprise/stereo/rig.hpp"
+#include "reprise/stereo/synthesize.hpp"
+
+using namespace reprise;
+using namespace reprise::stereo;
+
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+Camera camera_at(int w, int h) {
+    Camera c;
+    c.view = glm::lookAt(glm::vec3(0.3f, 1.0f, 5.0f), glm::vec3(0.3f, 1.0f, 0.0f), glm::vec3(0, 1, 0));
+    c.prev_view = c.view;
+    c.projection = glm::perspective(0.8f, float(w) / float(h), 0.1f, 100.0f);
+    c.prev_projection = c.projection;
+    c.near = 0.1f;
+    c.far = 100.0f;
+    return c;
+}
+
+// A frame whose colour encodes its column (red) and row (green), at constant depth.
+Frame plane(int w, int h, float depth, const Camera& camera) {
+    Frame f;
+    f.color.resize(w, h);
+    f.depth.resize(w, h, depth);
+    f.motion.resize(w, h);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) f.color(x, y) = {float(x) / w, float(y) / h, 0.25f, 1.0f};
+    f.camera = camera;
+    return f;
+}
+
+float focal_px(const Camera& c, int w) { return c.projection[0][0] * 0.5f * float(w); }
+
+bool all_finite(const Image<glm::vec4>& image) {
+    for (std::size_t i = 0; i < image.pixel_count(); ++i) {
+        const glm::vec4& c = image.data()[i];
+        if (!std::isfinite(c.x) || !std::isfinite(c.y) || !std::isfinite(c.z) || !std::isfinite(c.w))
+            return false;
+    }
+    return true;
+}
+
+double psnr_of(const Image<glm::vec4>& truth, const Image<glm::vec4>& test) {
+    Image<glm::vec3> a(truth.width(), truth.height()), b(truth.width(), truth.height());
+    to_display(truth.view(), a.view());
+    to_display(test.view(), b.view());
+    return psnr(a.view(), b.view());
+}
+
+server::Renderer& renderer() {
+    static std::unique_ptr<server::Renderer> r = [] {
+        std::unique_ptr<server::Renderer> made;
+        Status status = server::Renderer::create(made);
+        if (!status.ok()) ADD_FAILURE() << status.message();
+        return made;
+    }();
+    return *r;
+}
+
+struct EyePair {
+    Frame left, right;
+    EyeCameras cameras;
+};
+
+// Both eyes of `scene_name` rendered at time t (motion from t - dt; dt = 0: a still instant).
+EyePair render_eyes(const std::string& scene_name, double t, double dt, const StereoRig& rig,
+                    int w = 320, int h = 180) {
+    server::Scene scene;
+    server::CameraPath path;
+    EXPECT_TRUE(server::load_scene(scene_name, scene, path).ok());
+    const server::Instant now = server::instant_on_path(path, scene, t, w, h);
+    const server::Instant before = server::instant_on_path(path, scene, t - dt, w, h);
+    Camera centre;
+    centre.view = now.view;
+    centre.projection = now.projection;
+    centre.prev_view = before.view;
+    centre.prev_projection = before.projection;
+    EyePair pair;
+    pair.cameras = eye_cameras(centre, rig);
+    auto render_eye = [&](const Camera& c, Frame& f) {
+        server::Instant a = now, b = before;
+        a.view = c.view;
+        a.projection = c.projection;
+        b.view = c.prev_view;
+        b.projection = c.prev_projection;
+        EXPECT_TRUE(renderer().render(scene, a, b, {.width = w, .height = h}, f).ok());
+    };
+    render_eye(pair.cameras.left, pair.left);
+    render_eye(pair.cameras.right, pair.right);
+    return pair;
+}
+
+}  // namespace
+
+TEST(StereoRig, EyesSitHalfAnIpdEitherSideAndAnchorsKeepTheirCamera) {
+    const Camera c = camera_at(64, 32);
+    const EyeCameras eyes = eye_cameras(c, {.ipd = 0.2f});
+    const glm::vec3 centre = glm::vec3(glm::inverse(c.view)[3]);
+    EXPECT_NEAR(glm::length(glm::vec3(glm::inverse(eyes.left.view)[3]) - centre), 0.1f, 1e-5f);
+    EXPECT_NEAR(glm::vec3(glm::inverse(eyes.right.view)[3]).x - centre.x, 0.1f, 1e-5f);
+    EXPECT_EQ(eyes.left.projection, c.projection);  // parallel: symmetric frusta
+    const EyeCameras anchored = eye_cameras(c, {.ipd = 0.2f}, Anchor::Left);
+    EXPECT_EQ(anchored.left.view, c.view);
+    EXPECT_NEAR(glm::vec3(glm::inverse(anchored.right.view)[3]).x - centre.x, 0.2f, 1e-5f);
+}
+
+TEST(StereoSynthesis, IpdZeroIsABitExactCopy) {
+    const int w = 48, h = 40;
+    Frame f = plane(w, h, 3.0f, camera_at(w, h));
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> u(0.5f, 50.0f);
+    for (std::size_t i = 0; i < f.depth.pixel_count(); ++i) f.depth.data()[i] = i % 7 ? u(rng) : kInf;
+    for (Rig r : {Rig::Parallel, Rig::OffAxis}) {
+        const EyeCameras eyes = eye_cameras(f.camera, {.ipd = 0.0f, .convergence = 4.0f, .rig = r}, Anchor::Left);
+        Frame out;
+        StereoStats stats = synthesize_eye(f, eyes.right, {}, out);
+        EXPECT_EQ(out.color, f.color);
+        EXPECT_EQ(out.depth, f.depth);
+        EXPECT_EQ(stats.covered, std::size_t(w) * h);
+        EXPECT_EQ(stats.holes, 0u);
+    }
+}
+
+TEST(StereoSynthesis, PlaneShiftsLeftByFocalTimesIpdOverDepth) {
+    const int w = 96, h = 48;
+    const float z = 4.0f, shift = 3.0f;
+    const Camera c = camera_at(w, h);
+    const StereoRig rig{.ipd = shift * z / focal_px(c, w)};
+    EXPECT_NEAR(disparity_px(rig, c.projection, w, z), shift, 1e-4f);
+    Frame left = plane(w, h, z, c);
+    const EyeCameras eyes = eye_cameras(c, rig, Anchor::Left);
+    Image<glm::vec2> d(w, h);
+    Image<float> td(w, h);
+    stereo_displacement(left, eyes.right, d.view(), td.view());
+    for (std::size_t i = 0; i < d.pixel_count(); ++i) {
+        ASSERT_NEAR(d.data()[i].x, -shift, 1e-3f);
+        ASSERT_NEAR(d.data()[i].y, 0.0f, 1e-3f);
+        ASSERT_NEAR(td.data()[i], z, 1e-4f);
+    }
+    for (StereoWarp method : {StereoWarp::Grid, StereoWarp::Splat}) {
+        Frame right;
+        StereoStats stats = synthesize_eye(left, eyes.right, {.warp = method}, right);
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x + 3 < w; ++x) {
+                ASSERT_NEAR(right.color(x, y).x, left.color(x + 3, y).x, 1e-3f) << x << "," << y;
+                ASSERT_NEAR(right.color(x, y).y, left.color(x + 3, y).y, 1e-3f) << x << "," << y;
+            }
+        // The right eye's last three columns are unseen by the left eye: holes, filled.
+        EXPECT_EQ(stats.holes, std::size_t(3 * h));
+        EXPECT_EQ(stats.filled, stats.holes);
+        EXPECT_TRUE(all_finite(right.color));
+    }
+}
+
+TEST(StereoSynthesis, OffAxisConvergencePlaneHasZeroDisparityAndParallaxFlipsSign) {
+    const int w = 64, h = 32;
+    const Camera c = camera_at(w, h);
+    const StereoRig rig{.ipd = 0.1f, .convergence = 5.0f, .rig = Rig::OffAxis};
+    const EyeCameras eyes = eye_cameras(c, rig);
+    Image<glm::vec2> d(w, h);
+    Image<float> td(w, h);
+    for (float z : {5.0f, 2.5f, 20.0f}) {
+        Frame left = plane(w, h, z, eyes.left);
+        stereo_displacement(left, eyes.right, d.view(), td.view());
+        const float expected = -disparity_px(rig, c.projection, w, z);  // x_right - x_left
+        for (std::size_t i = 0; i < d.pixel_count(); ++i) ASSERT_NEAR(d.data()[i].x, expected, 2e-3f) << z;
+        if (z == 5.0f) {
+            EXPECT_NEAR(d(10, 10).x, 0.0f, 2e-3f);
+        } else if (z < 5.0f) {
+            EXPECT_LT(d(10, 10).x, -0.5f);  // in front: right eye content shifts left
+        } else {
+            EXPECT_GT(d(10, 10).x, 0.5f);  // behind: shifts right
+        }
+    }
+}
+
+TEST(StereoSynthesis, BackgroundAtInfinityDoesNotMoveInAParallelRig) {
+    const int w = 64, h = 32;
+    const Camera c = camera_at(w, h);
+    Frame left = plane(w, h, kInf, c);
+    const EyeCameras eyes = eye_cameras(c, {.ipd = 0.5f}, Anchor::Left);
+    Image<glm::vec2> d(w, h);
+    Image<float> td(w, h);
+    stereo_displacement(left, eyes.right, d.view(), td.view());
+    for (std::size_t i = 0; i < d.pixel_count(); ++i) {
+        ASSERT_NEAR(d.data()[i].x, 0.0f, 1e-4f);
+        ASSERT_EQ(td.data()[i], kInf);
+    }
+    Frame right;
+    StereoStats stats = synthesize_eye(left, eyes.right, {}, right);
+    EXPECT_EQ(stats.holes, 0u);
+    for (std::size_t i = 0; i < d.pixel_count(); ++i)
+        ASSERT_NEAR(right.color.data()[i].x, left.color.data()[i].x, 1e-4f);
+}
+
+TEST(StereoSynthesis, NonFiniteDepthAndColourNeverSpread) {
+    const int w = 64, h = 48;
+    const Camera c = camera_at(w, h);
+    Frame left = plane(w, h, 3.0f, c);
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    const float bad[] = {nan, -kInf, -1.0f, 0.0f, kInf, 1e-30f, 1e30f};
+    std::mt19937 rng(3);
+    for (std::size_t i = 0; i < left.depth.pixel_count(); ++i)
+        if (rng() % 5 == 0) left.depth.data()[i] = bad[rng() % 7];
+    for (int i = 0; i < 20; ++i) left.color.data()[rng() % left.color.pixel_count()] = glm::vec4(nan);
+    const EyeCameras eyes = eye_cameras(c, {.ipd = 0.3f}, Anchor::Left);
+    for (StereoWarp method : {StereoWarp::Grid, StereoWarp::Splat})
+        for (StereoFill fill : {StereoFill::PullPush, StereoFill::Andreev, StereoFill::None}) {
+            Frame right;
+            StereoStats stats = synthesize_eye(left, eyes.right, {.warp = method, .fill = fill}, right);
+            EXPECT_TRUE(all_finite(right.color)) << int(method) << " " << int(fill);
+            EXPECT_EQ(stats.covered + stats.holes, std::size_t(w) * h);
+        }
+}
+
+TEST(StereoSynthesis, HugeIpdAndNearPlaneObjectsReportCoverage) {
+    const int w = 80, h = 40;
+    const Camera c = camera_at(w, h);
+    Frame left = plane(w, h, 20.0f, c);
+    for (int y = 10; y < 30; ++y)
+        for (int x = 20; x < 60; ++x) left.depth(x, y) = c.near;  // at the near plane
+    for (float ipd : {5.0f, 1e4f, 1e30f})
+        for (StereoWarp method : {StereoWarp::Grid, StereoWarp::Splat}) {
+            const EyeCameras eyes = eye_cameras(c, {.ipd = ipd}, Anchor::Left);
+            Frame right;
+            StereoStats stats = synthesize_eye(left, eyes.right, {.warp = method}, right);
+            EXPECT_EQ(stats.covered + stats.holes, std::size_t(w) * h);
+            EXPECT_GT(stats.holes, 0u) << ipd;
+            EXPECT_TRUE(all_finite(right.color));
+        }
+}
+
+TEST(StereoEye, RendersTheEyeLeadingTheSidewaysMotion) {
+    Camera c = camera_at(64, 32);
+    const StereoRig rig{.ipd = 0.064f};
+    // prev_view = view * T(v): the previous camera stood at (current position - v).
+    c.prev_view = glm::translate(c.view, glm::vec3(-0.05f, 0.0f, 0.0f));  // moves left
+    EXPECT_EQ(choose_rendered_eye(c, rig, Eye::Right), Eye::Left);
+    c.prev_view = glm::translate(c.view, glm::vec3(0.05f, 0.0f, 0.0f));  // moves right
+    EXPECT_EQ(choose_rendered_eye(c, rig, Eye::Left), Eye::Right);
+    c.prev_view = c.view;
+    EXPECT_EQ(choose_rendered_eye(c, rig, Eye::Left), Eye::Left);
+    EXPECT_EQ(choose_rendered_eye(c, rig, Eye::Right), Eye::Right);
+}
+
+TEST(StereoRendered, SynthesizedRightEyeIsCloseToTheRenderedOne) {
+    for (float ipd : {0.064f, 0.2f}) {
+        const StereoRig rig{.ipd = ipd};
+        EyePair pair = render_eyes("pan", 0.5, 1.0 / 30.0, rig);
+        for (StereoWarp method : {StereoWarp::Grid, StereoWarp::Splat}) {
+            Frame right;
+            StereoStats stats = synthesize_eye(pair.left, pair.cameras.right, {.warp = method}, right);
+            const double ours = psnr_of(pair.right.color, right.color);
+            const double copy = psnr_of(pair.right.color, pair.left.color);
+            std::printf("[stereo] pan ipd %.3f %s: %.2f dB (copying the left eye: %.2f dB), %zu holes\n",
+                        ipd, method == StereoWarp::Grid ? "grid" : "splat", ours, copy, stats.holes);
+            if (method == StereoWarp::Grid) {
+                EXPECT_GT(ours, 30.0);
+                EXPECT_GT(ours, copy + 6.0);
+            } else {
+                EXPECT_GT(ours, copy);  // the naive forward splat: nearest-pixel landing
+            }
+        }
+    }
+}
+
+TEST(StereoTemporal, StillCameraAndSceneReproduceTheRenderedEyeExactly) {
+    const StereoRig rig{.ipd = 0.1f};
+    EyePair pair = render_eyes("pan", 0.5, 0.0, rig);  // previous instant = current: still
+    Frame right;
+    StereoSynthesizer synthesizer;
+    StereoStats stats = synthesizer.synthesize(pair.left, pair.cameras.right, right, {}, &pair.right);
+    EXPECT_EQ(right.color, pair.right.color);
+    EXPECT_EQ(stats.from_history, right.color.pixel_count());
+}
+
+TEST(StereoTemporal, PreviousOtherEyeFillsDisocclusions) {
+    const StereoRig rig{.ipd = 0.2f};
+    const double dt = 1.0 / 30.0;
+    EyePair before = render_eyes("pan", 0.5 - dt, dt, rig);
+    EyePair now = render_eyes("pan", 0.5, dt, rig);
+    StereoSynthesizer synthesizer;
+    Frame plain, temporal;
+    synthesizer.synthesize(now.left, now.cameras.right, plain);
+    StereoStats stats = synthesizer.synthesize(now.left, now.cameras.right, temporal, {}, &before.right);
+    const double a = psnr_of(now.right.color, plain.color), b = psnr_of(now.right.color, temporal.color);
+    std::printf("[stereo] temporal: %.2f dB (without: %.2f dB), %zu of %zu holes from history\n", b, a,
+                stats.from_history, stats.holes);
+    EXPECT_GT(stats.from_history, 0u);
+    EXPECT_GT(b, a - 0.5);
+}
+
+TEST(StereoCompose, LayoutsPlaceTheEyesAndAnaglyphUsesDubois) {
+    Image<glm::vec4> left(4, 2, {1.0f, 0.0f, 0.0f, 1.0f}), right(4, 2, {0.0f, 0.0f, 0.0f, 1.0f});
+    Image<Rgb8> out;
+    compose(left.view(), right.view(), Layout::SideBySide, out);
+    ASSERT_EQ(out.width(), 8);
+    ASSERT_EQ(out.height(), 2);
+    EXPECT_EQ(out(0, 0), Rgb8(255, 0, 0));
+    EXPECT_EQ(out(4, 1), Rgb8(0, 0, 0));
+    compose(left.view(), right.view(), Layout::TopBottom, out);
+    ASSERT_EQ(out.width(), 4);
+    ASSERT_EQ(out.height(), 4);
+    EXPECT_EQ(out(3, 1), Rgb8(255, 0, 0));
+    EXPECT_EQ(out(3, 2), Rgb8(0, 0, 0));
+    compose(left.view(), right.view(), Layout::Anaglyph, out);
+    ASSERT_EQ(out.width(), 4);
+    // Red in the left eye only: R = 0.437 (linear), G and B negative -> 0.
+    EXPECT_EQ(out(1, 1), Rgb8(uint8_t(std::lround(linear_to_srgb(0.437f) * 255.0f)), 0, 0));
+    // Grey in both eyes: the rows of the two matrices sum to about 1 in R, G and B.
+    Image<glm::vec4> grey(4, 2, {0.5f, 0.5f, 0.5f, 1.0f});
+    compose(grey.view(), grey.view(), Layout::Anaglyph, out);
+    for (int k = 0; k < 3; ++k) EXPECT_NEAR(out(0, 0)[k], std::lround(linear_to_srgb(0.5f) * 255.0f), 6);
+}

@@ -1,0 +1,120 @@
+// reprise stereo: the other eye of every frame of a rendered sequence.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include "args.hpp"
+#include "commands.hpp"
+#include "reprise/core/exr.hpp"
+#include "reprise/stereo/rig.hpp"
+#include "reprise/stereo/synthesize.hpp"
+
+namespace reprise::cli {
+
+namespace {
+
+struct StereoJob {
+    std::string in, out, rig = "parallel", eye = "left", warp = "grid", fill = "pullpush";
+    double ipd = 0.064;
+    double convergence = 10.0;
+    bool temporal = false;
+};
+
+Status check(const StereoJob& j, stereo::StereoRig& rig, stereo::StereoOptions& options) {
+    if (j.in.empty()) return Status::error("--in DIR is required");
+    if (j.out.empty()) return Status::error("--out DIR is required");
+    if (!(std::abs(j.ipd) <= 1e6)) return Status::error("--ipd must be a finite distance");
+    if (!(j.convergence > 0.0 && j.convergence <= 1e30))
+        return Status::error("--convergence must be a positive distance");
+    if (j.rig != "parallel" && j.rig != "offaxis")
+        return Status::error("--rig: '" + j.rig + "' is not parallel or offaxis");
+    if (j.eye != "left" && j.eye != "right")
+        return Status::error("--eye: '" + j.eye + "' is not left or right");
+    if (j.warp != "grid" && j.warp != "splat")
+        return Status::error("--warp: '" + j.warp + "' is not grid or splat");
+    if (j.fill != "pullpush" && j.fill != "andreev" && j.fill != "none")
+        return Status::error("--fill: '" + j.fill + "' is not pullpush, andreev or none");
+    rig = {.ipd = float(j.ipd),
+           .convergence = float(j.convergence),
+           .rig = j.rig == "offaxis" ? stereo::Rig::OffAxis : stereo::Rig::Parallel};
+    options = {.warp = j.warp == "splat" ? stereo::StereoWarp::Splat : stereo::StereoWarp::Grid,
+               .fill = j.fill == "andreev" ? stereo::StereoFill::Andreev
+                       : j.fill == "none"  ? stereo::StereoFill::None
+                                           : stereo::StereoFill::PullPush};
+    return {};
+}
+
+Status run_stereo(const StereoJob& job, const stereo::StereoRig& rig, const stereo::StereoOptions& options) {
+    Sequence seq;
+    REPRISE_TRY(open_sequence(job.in, seq));
+    const bool given_left = job.eye == "left";
+    const std::string rendered_dir = job.out + (given_left ? "/left" : "/right");
+    const std::string made_dir = job.out + (given_left ? "/right" : "/left");
+    for (const std::string& dir : {rendered_dir, made_dir}) {
+        std::error_code ec;
+        std::filesystem::create_directories(dir, ec);
+        if (ec) return Status::error(dir + ": cannot create the folder: " + ec.message());
+    }
+    stereo::StereoSynthesizer synthesizer;
+    Frame frame, previous, made;
+    bool have_previous = false;
+    double ms = 0.0;
+    std::size_t holes = 0, from_history = 0;
+    for (std::size_t i = 0; i < seq.files.size(); ++i) {
+        const std::string& file = seq.files[i];
+        REPRISE_TRY(read_frame(file, frame));
+        if (frame.depth.width() != frame.width() || frame.depth.height() != frame.height())
+            return Status::error(file + ": needs a depth channel (Z) of the colour's size");
+        const stereo::EyeCameras eyes = stereo::eye_cameras(
+            frame.camera, rig, given_left ? stereo::Anchor::Left : stereo::Anchor::Right);
+        // The file's camera is the rendered eye's as it was rendered; the rig only adds the other.
+        const Camera& target = given_left ? eyes.right : eyes.left;
+        auto begin = std::chrono::steady_clock::now();
+        stereo::StereoStats stats = synthesizer.synthesize(
+            frame, target, made, options, job.temporal && have_previous ? &previous : nullptr);
+        ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - begin).count();
+        holes += stats.holes;
+        from_history += stats.from_history;
+        REPRISE_TRY(write_frame(frame_path(rendered_dir, int(i)), frame));
+        REPRISE_TRY(write_frame(frame_path(made_dir, int(i)), made));
+        if (job.temporal) {
+            std::swap(previous, frame);
+            have_previous = true;
+        }
+    }
+    std::fprintf(stderr, "[stereo] %zu frames, %.2f ms per eye, %zu holes, %zu pixels from history -> %s\n",
+                 seq.files.size(), ms / double(seq.files.size()), holes, from_history, job.out.c_str());
+    return {};
+}
+
+}  // namespace
+
+int command_stereo(int argc, char** argv) {
+    StereoJob job;
+    Args args("stereo",
+              "The other eye of every frame of an EXR sequence (colour + depth + camera) by depth\n"
+              "warping: OUT/left and OUT/right EXR sequences (the input eye copied as it is).\n"
+              "Disparity d = f * ipd * (1/z - 1/convergence) px; near content shifts left in the "
+              "right eye.");
+    args.option("--in", &job.in, "input sequence folder (required)");
+    args.option("--out", &job.out, "output folder (required)");
+    args.option("--ipd", &job.ipd, "eye separation in scene units (default 0.064)");
+    args.option("--convergence", &job.convergence, "zero-disparity distance, offaxis rig (default 10)");
+    args.option("--rig", &job.rig, "parallel|offaxis (default parallel)");
+    args.option("--eye", &job.eye, "which eye the input is: left|right (default left)");
+    args.option("--warp", &job.warp, "grid|splat (default grid)");
+    args.option("--fill", &job.fill, "pullpush|andreev|none (default pullpush)");
+    args.flag("--temporal", &job.temporal, "fill disocclusions from the previous frame first");
+    Status parsed = args.parse(argc, argv);
+    stereo::StereoRig rig;
+    stereo::StereoOptions options;
+    if (parsed.ok() && !args.help_requested()) {
+        Status checked = check(job, rig, options);
+        if (!checked.ok()) parsed = Status::error("stereo: " + checked.message());
+    }
+    if (!parsed.ok() || args.help_requested()) return report(args, parsed, {});
+    return report(args, parsed, run_stereo(job, rig, options));
+}
+
+}  // namespace reprise::cli
