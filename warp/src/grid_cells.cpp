@@ -1,6 +1,6 @@
-// Growing the adaptive grid: each starting cell gets a min/max pyramid of depth and motion, is
-// split in four while it holds a discontinuity, and its leaves get vertices moved along the
-// motion.
+// Growing the adaptive grid: each starting cell is split in four while its pixels depart from
+// what its corner pixels predict (or it holds invalid pixels, or background beside geometry),
+// and its leaves get vertices moved along the motion.
 #include <algorithm>
 #include <cmath>
 #include <vector>
@@ -15,12 +15,17 @@ namespace reprise::warp::grid {
 
 namespace {
 
-constexpr float kInvalidMotion = 1e38f;       // what invalid motion becomes in a Range
 constexpr float kMaxCoordinate = 1048576.0f;  // 2^20 px; further vertices drop their cell
 
-// Depth and motion ranges of a block of pixels. Invalid depth (NaN, negative) enters as -1 and
-// invalid motion as kInvalidMotion, so the ranges alone tell whether the block holds any.
+bool valid_motion(glm::vec2 m) {
+    return std::fabs(m.x) < kHugeMotion && std::fabs(m.y) < kHugeMotion;
+}
+
+// Depth and motion ranges of a few pixels (a smallest cell, the 2x2 around a grid point).
+// Invalid depth (NaN, negative) enters as -1 and invalid motion as kInvalidMotion, so the
+// ranges alone tell whether the block holds any.
 struct Range {
+    static constexpr float kInvalidMotion = 1e38f;
     float zmin, zmax;
     glm::vec2 m0, m1;
 
@@ -38,72 +43,99 @@ struct Range {
         m1 = {std::max(m1.x, o.m1.x), std::max(m1.y, o.m1.y)};
     }
     bool invalid() const { return zmin < 0.0f || m1.x >= kHugeMotion || m1.y >= kHugeMotion; }
-    bool discontinuous(const Params& p) const {
-        return invalid() || (zmin < kBackgroundFrom && zmax >= kBackgroundFrom) ||
-               zmax > zmin * p.z_ratio || m1.x - m0.x > p.motion_threshold ||
-               m1.y - m0.y > p.motion_threshold;
+    bool mixed() const { return zmin < kBackgroundFrom && zmax >= kBackgroundFrom; }
+    // Valid, one kind, depth ratio and motion range within bounds.
+    bool narrow(float z_ratio, float motion) const {
+        return !invalid() && !mixed() && (zmin >= kBackgroundFrom || zmax <= zmin * z_ratio) &&
+               m1.x - m0.x <= motion && m1.y - m0.y <= motion;
     }
 };
 
-// Min/max ranges of blocks, one array per field.
-struct Ranges {
-    float* zmin;
-    float* zmax;
-    glm::vec2* m0;
-    glm::vec2* m1;
-
-    Range get(int k) const { return {zmin[k], zmax[k], m0[k], m1[k]}; }
-    void set(int k, const Range& r) const {
-        zmin[k] = r.zmin;
-        zmax[k] = r.zmax;
-        m0[k] = r.m0;
-        m1[k] = r.m1;
+// The smoothness test of one row of a cell: pixels [begin, n) of the row, at u = i * iu,
+// against the prediction a + u * b of the triangle they lie in (the upper-right one, index 0,
+// where u >= v). A pixel fails when its depth is not of the cell's kind (geometry:
+// |1 - predicted(1/z) * z| > depth_tolerance, which also fails NaN, negative, zero and
+// background depths; background: depth below kBackgroundFrom or NaN), when its motion is
+// invalid, or when it departs from the predicted motion by more than motion_limit on either
+// axis. NaN fails everywhere.
+bool row_fits_scalar(const RowFit& f, const float* z, const glm::vec2* m, int begin, int n) {
+    for (int i = begin; i < n; ++i) {
+        const float u = float(i) * f.iu;
+        const int t = u >= f.v ? 0 : 1;
+        if (f.background) {
+            if (!(z[i] >= kBackgroundFrom)) return false;
+        } else {
+            const float w = f.wa[t] + u * f.wb[t];
+            if (!(std::fabs(1.0f - w * z[i]) <= f.depth_tolerance)) return false;
+        }
+        const float px = f.ma[t].x + u * f.mb[t].x, py = f.ma[t].y + u * f.mb[t].y;
+        if (!(std::fabs(m[i].x - px) <= f.motion_limit && std::fabs(m[i].x) < kHugeMotion &&
+              std::fabs(m[i].y - py) <= f.motion_limit && std::fabs(m[i].y) < kHugeMotion))
+            return false;
     }
-};
+    return true;
+}
 
 #if defined(__SSE2__)
-// Level 0 of one row pair, four 2x2 blocks (eight pixels) a step; `blocks` is a multiple of 4 and
-// every pixel lies in the image. Same ranges as Range::of and Range::add (up to the sign of zeros).
-void base_row_sse2(const float* da, const float* db, const glm::vec2* ma, const glm::vec2* mb,
-                   int blocks, float* zmin, float* zmax, glm::vec2* m0, glm::vec2* m1) {
-    const __m128 zero = _mm_setzero_ps(), minus_one = _mm_set1_ps(-1.0f);
-    const __m128 huge = _mm_set1_ps(kHugeMotion), invalid = _mm_set1_ps(kInvalidMotion);
+// The same, four pixels a step; the pixels past the last whole step go to the scalar loop.
+bool row_fits_sse2(const RowFit& f, const float* z, const glm::vec2* m, int n) {
     const __m128 abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
-    auto select = [](__m128 ok, __m128 a, __m128 b) {
-        return _mm_or_ps(_mm_and_ps(ok, a), _mm_andnot_ps(ok, b));
+    const __m128 lanes = _mm_setr_ps(0.0f, 1.0f, 2.0f, 3.0f), iu = _mm_set1_ps(f.iu);
+    const __m128 v = _mm_set1_ps(f.v), one = _mm_set1_ps(1.0f);
+    const __m128 tz = _mm_set1_ps(f.depth_tolerance), tm = _mm_set1_ps(f.motion_limit);
+    const __m128 background = _mm_set1_ps(kBackgroundFrom), huge = _mm_set1_ps(kHugeMotion);
+    const __m128 wa0 = _mm_set1_ps(f.wa[0]), wa1 = _mm_set1_ps(f.wa[1]);
+    const __m128 wb0 = _mm_set1_ps(f.wb[0]), wb1 = _mm_set1_ps(f.wb[1]);
+    const __m128 ma0 = _mm_setr_ps(f.ma[0].x, f.ma[0].y, f.ma[0].x, f.ma[0].y);
+    const __m128 ma1 = _mm_setr_ps(f.ma[1].x, f.ma[1].y, f.ma[1].x, f.ma[1].y);
+    const __m128 mb0 = _mm_setr_ps(f.mb[0].x, f.mb[0].y, f.mb[0].x, f.mb[0].y);
+    const __m128 mb1 = _mm_setr_ps(f.mb[1].x, f.mb[1].y, f.mb[1].x, f.mb[1].y);
+    auto select = [](__m128 first, __m128 a, __m128 b) {
+        return _mm_or_ps(_mm_and_ps(first, a), _mm_andnot_ps(first, b));
     };
-    auto clean_z = [&](const float* p) {
-        const __m128 z = _mm_loadu_ps(p);
-        return select(_mm_cmpge_ps(z, zero), z, minus_one);
-    };
-    auto clean_m = [&](const glm::vec2* p) {
-        const __m128 m = _mm_loadu_ps(&p->x);
-        return select(_mm_cmplt_ps(_mm_and_ps(m, abs_mask), huge), m, invalid);
-    };
-    constexpr int even = _MM_SHUFFLE(2, 0, 2, 0), odd = _MM_SHUFFLE(3, 1, 3, 1);
-    constexpr int low = _MM_SHUFFLE(1, 0, 1, 0), high = _MM_SHUFFLE(3, 2, 3, 2);
-    for (int i = 0; i < blocks; i += 4) {
-        const int x = 2 * i;
-        const __m128 a0 = clean_z(da + x), a1 = clean_z(da + x + 4);
-        const __m128 b0 = clean_z(db + x), b1 = clean_z(db + x + 4);
-        const __m128 lo0 = _mm_min_ps(a0, b0), lo1 = _mm_min_ps(a1, b1);
-        const __m128 hi0 = _mm_max_ps(a0, b0), hi1 = _mm_max_ps(a1, b1);
-        _mm_storeu_ps(zmin + i,
-                      _mm_min_ps(_mm_shuffle_ps(lo0, lo1, even), _mm_shuffle_ps(lo0, lo1, odd)));
-        _mm_storeu_ps(zmax + i,
-                      _mm_max_ps(_mm_shuffle_ps(hi0, hi1, even), _mm_shuffle_ps(hi0, hi1, odd)));
-        for (int k = 0; k < 4; k += 2) {  // blocks i + k and i + k + 1: (x, y) of two pixels each
-            const int p = x + 2 * k;
-            const __m128 u0 = clean_m(ma + p), u1 = clean_m(ma + p + 2);
-            const __m128 v0 = clean_m(mb + p), v1 = clean_m(mb + p + 2);
-            const __m128 mn0 = _mm_min_ps(u0, v0), mn1 = _mm_min_ps(u1, v1);
-            const __m128 mx0 = _mm_max_ps(u0, v0), mx1 = _mm_max_ps(u1, v1);
-            _mm_storeu_ps(&m0[i + k].x, _mm_min_ps(_mm_shuffle_ps(mn0, mn1, low),
-                                                   _mm_shuffle_ps(mn0, mn1, high)));
-            _mm_storeu_ps(&m1[i + k].x, _mm_max_ps(_mm_shuffle_ps(mx0, mx1, low),
-                                                   _mm_shuffle_ps(mx0, mx1, high)));
+    // Four pixels whose prediction coefficients are (wa, wb) and (ma, mb) lane by lane.
+    auto fits4 = [&](__m128 u, __m128 wa, __m128 wb, __m128 ma01, __m128 mb01, __m128 ma23,
+                     __m128 mb23, const float* zp, const glm::vec2* mp) {
+        const __m128 zz = _mm_loadu_ps(zp);
+        __m128 ok;
+        if (f.background) {
+            ok = _mm_cmpge_ps(zz, background);
+        } else {
+            const __m128 w = _mm_add_ps(wa, _mm_mul_ps(u, wb));
+            ok = _mm_cmple_ps(_mm_and_ps(_mm_sub_ps(one, _mm_mul_ps(w, zz)), abs_mask), tz);
         }
+        auto motion_ok = [&](__m128 uu, __m128 ma, __m128 mb, const glm::vec2* p) {
+            const __m128 mm = _mm_loadu_ps(&p->x);
+            const __m128 predicted = _mm_add_ps(ma, _mm_mul_ps(uu, mb));
+            return _mm_and_ps(_mm_cmple_ps(_mm_and_ps(_mm_sub_ps(mm, predicted), abs_mask), tm),
+                              _mm_cmplt_ps(_mm_and_ps(mm, abs_mask), huge));
+        };
+        const __m128 ok01 = motion_ok(_mm_unpacklo_ps(u, u), ma01, mb01, mp);
+        const __m128 ok23 = motion_ok(_mm_unpackhi_ps(u, u), ma23, mb23, mp + 2);
+        // Lane k of `ok` is pixel k: both axes of it must pass.
+        const __m128 x = _mm_shuffle_ps(ok01, ok23, _MM_SHUFFLE(2, 0, 2, 0));
+        const __m128 y = _mm_shuffle_ps(ok01, ok23, _MM_SHUFFLE(3, 1, 3, 1));
+        return _mm_movemask_ps(_mm_and_ps(ok, _mm_and_ps(x, y))) == 0xf;
+    };
+    int i = 0;
+    for (; i + 4 <= n; i += 4) {
+        const __m128 u = _mm_mul_ps(_mm_add_ps(_mm_set1_ps(float(i)), lanes), iu);
+        const __m128 upper = _mm_cmpge_ps(u, v);
+        const int sides = _mm_movemask_ps(upper);
+        bool ok;
+        if (sides == 0xf) {  // all four in the upper triangle
+            ok = fits4(u, wa0, wb0, ma0, mb0, ma0, mb0, z + i, m + i);
+        } else if (sides == 0) {
+            ok = fits4(u, wa1, wb1, ma1, mb1, ma1, mb1, z + i, m + i);
+        } else {
+            const __m128 up01 = _mm_unpacklo_ps(upper, upper), up23 = _mm_unpackhi_ps(upper, upper);
+            ok = fits4(u, select(upper, wa0, wa1), select(upper, wb0, wb1), select(up01, ma0, ma1),
+                       select(up01, mb0, mb1), select(up23, ma0, ma1), select(up23, mb0, mb1),
+                       z + i, m + i);
+        }
+        if (!ok) return false;
     }
+    return row_fits_scalar(f, z, m, i, n);
 }
 #endif
 
@@ -115,9 +147,7 @@ int32_t to_fixed(float v) {
     return int32_t(i);
 }
 
-// Grows the cells of one row of starting cells. Level 0 of the min/max pyramid (2x2 blocks) is
-// filled for the whole row at once, reading the frame row by row; the levels above it are
-// filled per starting cell: level L holds blocks of 2^(L+1) pixels.
+// Grows the cells of one row of starting cells.
 class Builder {
   public:
     Builder(const Frame& source, const Params& params, bool simd, Scratch& scratch)
@@ -126,23 +156,14 @@ class Builder {
           w_(source.width()),
           h_(source.height()),
           p_(params),
-          simd_(simd),
-          base_blocks_((w_ + 1) / 2) {
-        const std::size_t n = std::size_t(base_blocks_) * std::size_t(std::max(p_.cell / 2, 1));
-        if (scratch.zmin.size() < n) {
-            scratch.zmin.resize(n);
-            scratch.zmax.resize(n);
-            scratch.m0.resize(n);
-            scratch.m1.resize(n);
+          simd_(simd) {
+        const std::size_t count = std::size_t((w_ + p_.cell - 1) / p_.cell);
+        if (scratch.fits.size() < count) {
+            scratch.fits.resize(count);
+            scratch.fitting.resize(count);
         }
-        base_ = {scratch.zmin.data(), scratch.zmax.data(), scratch.m0.data(), scratch.m1.data()};
-        int offset = 0;
-        for (int level = 1, block = 4; block <= p_.cell; ++level, block *= 2) {
-            offset_[level] = offset;
-            side_[level] = p_.cell / block;
-            offset += side_[level] * side_[level];
-        }
-        upper_ = {zmin_, zmax_, m0_, m1_};
+        fits_ = scratch.fits.data();
+        ok_ = scratch.fitting.data();
         lattice_ = p_.cell / p_.min_cell + 1;
         const std::size_t points = std::size_t(lattice_) * std::size_t(lattice_);
         if (scratch.point_state.size() < points) {
@@ -159,77 +180,119 @@ class Builder {
         row.y_hi = std::numeric_limits<int>::min();
         row_ = &row;
         y0_ = top_row * p_.cell;
-        if (p_.cell > 1) fill_base();
-        int top_level = -1;
-        for (int block = 2; block <= p_.cell; block *= 2) ++top_level;
-        for (x0_ = 0; x0_ < w_; x0_ += p_.cell) {
+        const int y1 = std::min(y0_ + p_.cell, h_);
+        // The starting cells of the row are tested together, image row by image row, so that
+        // the frame is read in order; those that fail are split.
+        const int count = (w_ + p_.cell - 1) / p_.cell;
+        if (p_.cell > p_.min_cell) {
+            for (int i = 0; i < count; ++i) {
+                const int x = i * p_.cell;
+                ok_[i] = start(x, y0_, std::min(x + p_.cell, w_), y1, fits_[i]);
+            }
+            for (int j = 0; j < y1 - y0_; ++j)
+                for (int i = 0; i < count; ++i)
+                    if (ok_[i]) ok_[i] = fit_row(fits_[i], j);
+        }
+        for (int i = 0; i < count; ++i) {
+            x0_ = i * p_.cell;
             std::fill_n(state_, lattice_ * lattice_, kUnknown);
-            fill_upper();
-            subdivide(x0_, y0_, p_.cell, top_level);
+            if (p_.cell > p_.min_cell && ok_[i])
+                emit(x0_, y0_, std::min(x0_ + p_.cell, w_), y1, true);
+            else
+                subdivide(x0_, y0_, p_.cell, true);
         }
     }
 
   private:
-    // Blocks reaching past the image repeat its last row or column: same min and max.
-    void fill_base() {
-        for (int j = 0; j < p_.cell / 2; ++j) {
-            const int ya = std::min(y0_ + 2 * j, h_ - 1), yb = std::min(y0_ + 2 * j + 1, h_ - 1);
-            const float* da = depth_.row(ya);
-            const float* db = depth_.row(yb);
-            const glm::vec2* ma = motion_.row(ya);
-            const glm::vec2* mb = motion_.row(yb);
-            const int k = j * base_blocks_;
-            int i = 0;
-#if defined(__SSE2__)
-            if (simd_) {
-                i = (w_ / 2) / 4 * 4;  // whole blocks, four at a time
-                base_row_sse2(da, db, ma, mb, i, base_.zmin + k, base_.zmax + k, base_.m0 + k,
-                              base_.m1 + k);
-            }
-#endif
-            for (; i < base_blocks_; ++i) {
-                const int xa = 2 * i, xb = std::min(2 * i + 1, w_ - 1);
-                Range r = Range::of(da[xa], ma[xa]);
-                r.add(Range::of(da[xb], ma[xb]));
-                r.add(Range::of(db[xa], mb[xa]));
-                r.add(Range::of(db[xb], mb[xb]));
-                base_.set(k + i, r);
-            }
-        }
-    }
-
-    // Levels 1 and up of the starting cell at x0_; blocks past the image's right edge repeat the
-    // last column of blocks.
-    void fill_upper() {
-        for (int level = 1; level < kLevels && side_[level] > 0; ++level)
-            for (int j = 0; j < side_[level]; ++j)
-                for (int i = 0; i < side_[level]; ++i) {
-                    Range r = at(level - 1, 2 * i, 2 * j);
-                    r.add(at(level - 1, 2 * i + 1, 2 * j));
-                    r.add(at(level - 1, 2 * i, 2 * j + 1));
-                    r.add(at(level - 1, 2 * i + 1, 2 * j + 1));
-                    upper_.set(offset_[level] + j * side_[level] + i, r);
-                }
-    }
-
-    Range at(int level, int i, int j) const {
-        if (level > 0) return upper_.get(offset_[level] + j * side_[level] + i);
-        return base_.get(j * base_blocks_ + std::min(x0_ / 2 + i, base_blocks_ - 1));
-    }
-
-    void subdivide(int x, int y, int s, int level) {
+    // `failed`: the block is known not to fit.
+    void subdivide(int x, int y, int s, bool failed = false) {
         if (x >= w_ || y >= h_) return;
-        const Range r = s == 1 ? Range::of(depth_(x, y), motion_(x, y))
-                               : at(level, (x - x0_) / s, (y - y0_) / s);
-        if (s > p_.min_cell && r.discontinuous(p_)) {
-            const int half = s / 2;
-            subdivide(x, y, half, level - 1);
-            subdivide(x + half, y, half, level - 1);
-            subdivide(x, y + half, half, level - 1);
-            subdivide(x + half, y + half, half, level - 1);
-        } else if (!r.invalid()) {
-            emit(x, y, std::min(x + s, w_), std::min(y + s, h_));
+        const int x1 = std::min(x + s, w_), y1 = std::min(y + s, h_);
+        if (s > p_.min_cell) {
+            if (!failed && fits(x, y, x1, y1)) {
+                emit(x, y, x1, y1, true);
+            } else {
+                const int half = s / 2;
+                subdivide(x, y, half);
+                subdivide(x + half, y, half);
+                subdivide(x, y + half, half);
+                subdivide(x + half, y + half, half);
+            }
+            return;
         }
+        // A smallest cell: drawn unless it holds invalid pixels, and smooth by the test of the
+        // pixels around a shared vertex (its pixels are its corners).
+        Range r = Range::of(depth_(x, y), motion_(x, y));
+        for (int j = y; j < y1; ++j)
+            for (int i = x; i < x1; ++i) r.add(Range::of(depth_(i, j), motion_(i, j)));
+        if (!r.invalid()) emit(x, y, x1, y1, r.narrow(p_.vertex_z_ratio, p_.vertex_motion));
+    }
+
+    // The smoothness test of a block: whether every pixel of [x, x1) x [y, y1) is valid, of the
+    // kind of its corners (all geometry or all background) and within the thresholds of the
+    // interpolation of its corner pixels over the two triangles of the cell. Set up by
+    // `start` (false when a corner already fails), then run row by row.
+    bool start(int x, int y, int x1, int y1, CellFit& fit) const {
+        const int n = x1 - x, rows = y1 - y;
+        const int xr = x1 - 1, yb = y1 - 1;
+        // Corners top-left, top-right, bottom-right, bottom-left.
+        const float z[4] = {depth_(x, y), depth_(xr, y), depth_(xr, yb), depth_(x, yb)};
+        const glm::vec2 m[4] = {motion_(x, y), motion_(xr, y), motion_(xr, yb), motion_(x, yb)};
+        int background = 0;
+        for (int k = 0; k < 4; ++k) {
+            if (!(z[k] >= 0.0f) || !valid_motion(m[k])) return false;
+            background += z[k] >= kBackgroundFrom;
+        }
+        if (background != 0 && background != 4) return false;
+        RowFit& f = fit.f;
+        f = {};
+        f.background = background == 4;
+        f.depth_tolerance = p_.depth_tolerance;
+        f.motion_limit = p_.motion_limit;
+        f.iu = n > 1 ? 1.0f / float(n - 1) : 0.0f;
+        fit.iv = rows > 1 ? 1.0f / float(rows - 1) : 0.0f;
+        fit.x = x;
+        fit.y = y;
+        fit.n = n;
+        float w[4];
+        for (int k = 0; k < 4; ++k) w[k] = f.background ? 0.0f : 1.0f / z[k];
+        // Upper triangle (top-left, top-right, bottom-right): c0 + u (c1 - c0) + v (c2 - c1);
+        // lower (top-left, bottom-right, bottom-left): c0 + u (c2 - c3) + v (c3 - c0).
+        f.wb[0] = w[1] - w[0];
+        f.wb[1] = w[2] - w[3];
+        f.mb[0] = m[1] - m[0];
+        f.mb[1] = m[2] - m[3];
+        fit.w0 = w[0];
+        fit.wv[0] = w[2] - w[1];
+        fit.wv[1] = w[3] - w[0];
+        fit.m0 = m[0];
+        fit.mv[0] = m[2] - m[1];
+        fit.mv[1] = m[3] - m[0];
+        return true;
+    }
+
+    // Row j of the block.
+    bool fit_row(CellFit& fit, int j) const {
+        RowFit& f = fit.f;
+        f.v = float(j) * fit.iv;
+        for (int t = 0; t < 2; ++t) {
+            f.wa[t] = fit.w0 + f.v * fit.wv[t];
+            f.ma[t] = {fit.m0.x + f.v * fit.mv[t].x, fit.m0.y + f.v * fit.mv[t].y};
+        }
+        const float* z = depth_.row(fit.y + j) + fit.x;
+        const glm::vec2* m = motion_.row(fit.y + j) + fit.x;
+#if defined(__SSE2__)
+        if (simd_) return row_fits_sse2(f, z, m, fit.n);
+#endif
+        return row_fits_scalar(f, z, m, 0, fit.n);
+    }
+
+    bool fits(int x, int y, int x1, int y1) const {
+        CellFit fit;
+        if (!start(x, y, x1, y1, fit)) return false;
+        for (int j = 0; j < y1 - y; ++j)
+            if (!fit_row(fit, j)) return false;
+        return true;
     }
 
     // Vertex at grid point (cx, cy) moved by depth z and motion m; false when it lands too far.
@@ -255,7 +318,7 @@ class Builder {
                                     motion_(xb, yb)};
             Range r = Range::of(d[0], m[0]);
             for (int i = 1; i < 4; ++i) r.add(Range::of(d[i], m[i]));
-            if (r.discontinuous(p_)) {
+            if (!r.narrow(p_.vertex_z_ratio, p_.vertex_motion)) {
                 state = kTorn;
             } else {
                 const float z = r.zmin < kBackgroundFrom ? ((d[0] + d[1]) + (d[2] + d[3])) * 0.25f
@@ -274,8 +337,9 @@ class Builder {
         return place(cx, cy, d < kBackgroundFrom ? d : kBackgroundDepth, m.x, m.y, v);
     }
 
-    void emit(int x, int y, int x1, int y1) {
+    void emit(int x, int y, int x1, int y1, bool smooth) {
         Cell c;
+        c.perspective = smooth;
         if (!vertex(x, y, x, y, c.v[0]) || !vertex(x1, y, x1 - 1, y, c.v[1]) ||
             !vertex(x1, y1, x1 - 1, y1 - 1, c.v[2]) || !vertex(x, y1, x, y1 - 1, c.v[3]))
             return;
@@ -289,22 +353,16 @@ class Builder {
         row_->cells.push_back(c);
     }
 
-    static constexpr int kLevels = 6;  // block sizes 2..64
     enum : uint8_t { kUnknown, kShared, kFar, kTorn };
-    static constexpr int kUpper = 16 * 16 + 8 * 8 + 4 * 4 + 2 * 2 + 1;
 
     ImageView<const float> depth_;
     ImageView<const glm::vec2> motion_;
     int w_, h_;
     Params p_;
     bool simd_;
-    int base_blocks_;  // level-0 blocks to a row
-    Ranges base_{}, upper_{};
-    float zmin_[kUpper], zmax_[kUpper];
-    glm::vec2 m0_[kUpper], m1_[kUpper];
-    int offset_[kLevels] = {};
-    int side_[kLevels] = {};
-    int lattice_ = 0;  // grid points to a row of the starting cell
+    CellFit* fits_ = nullptr;  // the tests of a row of starting cells
+    uint8_t* ok_ = nullptr;    // which of them still pass
+    int lattice_ = 0;          // grid points to a row of the starting cell
     uint8_t* state_ = nullptr;
     Vertex* shared_ = nullptr;
     int x0_ = 0, y0_ = 0;
@@ -319,8 +377,13 @@ Params make_params(const GridOptions& o, float factor) {
     p.min_cell = std::clamp(o.min_cell, 1, 2);
     p.cell = p.min_cell;
     while (p.cell * 2 <= std::min(o.cell, kMaxCell)) p.cell *= 2;
-    p.z_ratio = 1.0f + std::max(o.depth_threshold, 0.0f);
-    p.motion_threshold = std::max(o.motion_threshold, 0.0f);
+    // NaN thresholds count as 0; the relative depth tolerance stays below 1 so that zero and
+    // negative depths always fail it.
+    p.depth_tolerance = o.depth_threshold > 0.0f ? std::min(o.depth_threshold, 0.5f) : 0.0f;
+    const float motion = o.motion_threshold > 0.0f ? o.motion_threshold : 0.0f;
+    p.motion_limit = factor != 0.0f ? motion / std::fabs(factor) : kInf;
+    p.vertex_z_ratio = 1.0f + 2.0f * p.depth_tolerance;
+    p.vertex_motion = 2.0f * p.motion_limit;
     p.factor = factor;
     return p;
 }

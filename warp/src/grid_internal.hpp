@@ -19,15 +19,35 @@ struct Vertex {
 };
 struct Cell {
     Vertex v[4];  // top-left, top-right, bottom-right, bottom-left
+    // Passed the smoothness test: depth is interpolated as 1/z (perspective-correct). Else (the
+    // smallest cells across an edge) linearly, so that background never pulls geometry along.
+    bool perspective;
 };
 struct Row {  // the cells grown from one row of starting cells
     std::vector<Cell> cells;
     int y_lo = 0, y_hi = -1;  // target rows they may touch
 };
-struct Scratch {  // one thread's: ranges of a row of starting cells, the grid points of a
+// The smoothness test of a cell (grid_cells.cpp), row by row: the prediction of row v, at
+// u = i * iu, is a[t] + u * b[t] in triangle t (0: upper right, where u >= v; 1: lower left).
+struct RowFit {
+    float v, iu;
+    float wa[2], wb[2];      // inverse depth
+    glm::vec2 ma[2], mb[2];  // motion
+    bool background;         // the cell's kind
+    float depth_tolerance, motion_limit;
+};
+struct CellFit {
+    RowFit f;
+    int x, y, n;          // the cell's first pixel and width
+    float iv;             // v = j * iv on row j
+    float w0, wv[2];      // a[t] = corner + v * gradient: inverse depth
+    glm::vec2 m0, mv[2];  // motion
+};
+
+struct Scratch {  // one thread's: the tests of a row of starting cells, the grid points of a
                   // starting cell, a band of target rows
-    std::vector<float> zmin, zmax;
-    std::vector<glm::vec2> m0, m1;
+    std::vector<CellFit> fits;
+    std::vector<uint8_t> fitting;
     std::vector<uint8_t> point_state;
     std::vector<Vertex> points;
     std::vector<glm::vec4> color;
@@ -46,8 +66,10 @@ inline constexpr int kOverlap = kSubpixel / 16;  // edges pushed out by 1/16 px 
 inline constexpr int kMaxCell = 64;
 
 struct Params {
-    float z_ratio;  // 1 + depth_threshold
-    float motion_threshold;
+    float depth_tolerance;  // depth_threshold: allowed |1 - predicted(1/z) * z|
+    float motion_limit;     // motion_threshold / |factor|: allowed motion error, source pixels
+    float vertex_z_ratio;   // 1 + 2 depth_tolerance: 2x2 pixels that share a vertex
+    float vertex_motion;    // 2 motion_limit: their motion range
     int cell, min_cell;
     float factor;
 };
@@ -63,7 +85,7 @@ inline int last_centre(int64_t v) {
 }
 
 // Replaces rows[r] by the cells grown from row r of starting cells, in a fixed order, for r in
-// [begin, end). `simd` picks the vectorised min/max pyramid (same cells).
+// [begin, end). `simd` picks the vectorised smoothness test (same cells).
 void build_rows(const Frame& source, const Params& params, int begin, int end, bool simd,
                 Scratch& scratch, Row* rows);
 

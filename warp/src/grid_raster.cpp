@@ -37,11 +37,26 @@ Edge edge(const Vertex& a, const Vertex& b, int64_t px, int64_t py) {
     return {dx * (py - a.y) - dy * (px - a.x) + push, -dy * kSubpixel, dx * kSubpixel};
 }
 
+#if defined(__SSE2__)
+// A triangle's gradients and bounds in every lane, for the vector kernel.
+struct VectorTriangle {
+    __m128 gz, z_lo, z_hi, depth_lo, depth_hi;
+    __m128 gsx, sx_lo, sx_hi, gsy, sy_lo, sy_hi;
+    __m128 gmx, mx_lo, mx_hi, gmy, my_lo, my_hi;
+    __m128i stride, last_column, last_row;
+};
+#endif
+
 struct Triangle {
     Edge e[3];
-    Plane z, sx, sy, mx, my;
+    Plane z, sx, sy, mx, my;  // z: of 1/depth when `perspective`, else of depth
+    bool perspective;
+    float z_lo, z_hi;                  // the vertices' depth range (perspective)
     float ax, ay;                      // vertex a, pixels
     float sx_lo, sx_hi, sy_lo, sy_hi;  // source positions kept where taps need no clamping
+#if defined(__SSE2__)
+    VectorTriangle vec;  // filled for the vector kernel only
+#endif
 };
 
 class Raster {
@@ -50,12 +65,12 @@ class Raster {
         : src_(source), band_(band), motion_(!band.view.motion.empty()), simd_(simd) {}
 
     void cell(const Cell& c) const {
-        triangle(c.v[0], c.v[1], c.v[2]);
-        triangle(c.v[0], c.v[2], c.v[3]);
+        triangle(c.v[0], c.v[1], c.v[2], c.perspective);
+        triangle(c.v[0], c.v[2], c.v[3], c.perspective);
     }
 
   private:
-    void triangle(const Vertex& a, const Vertex& b_in, const Vertex& c_in) const {
+    void triangle(const Vertex& a, const Vertex& b_in, const Vertex& c_in, bool perspective) const {
         const Vertex* b = &b_in;
         const Vertex* c = &c_in;
         int64_t area = (int64_t(b->x) - a.x) * (int64_t(c->y) - a.y) -
@@ -94,7 +109,17 @@ class Raster {
                          float(double(d2 * e1x - d1 * e2x) * inverse_det), std::min({va, vb, vc}),
                          std::max({va, vb, vc})};
         };
-        t.z = plane(a.z, b->z, c->z);
+        t.perspective = perspective;
+        if (perspective) {
+            // 1/z is affine in screen space on a plane; depth 0 stands in as 1e-30.
+            auto inverse = [](float z) { return 1.0f / std::max(z, 1e-30f); };
+            t.z = plane(inverse(a.z), inverse(b->z), inverse(c->z));
+            t.z_lo = std::min({a.z, b->z, c->z});
+            t.z_hi = std::max({a.z, b->z, c->z});
+        } else {
+            t.z = plane(a.z, b->z, c->z);
+            t.z_lo = t.z_hi = 0.0f;
+        }
         t.sx = plane(a.sx, b->sx, c->sx);
         t.sy = plane(a.sy, b->sy, c->sy);
         if (motion_) {
@@ -111,6 +136,31 @@ class Raster {
         t.sy_lo = std::max(t.sy.lo, 0.5f);
         t.sy_hi = std::min(t.sy.hi, float(src_.height) - 0.5f);
 
+#if defined(__SSE2__)
+        if (simd_) {
+            VectorTriangle& v = t.vec;
+            v.gz = _mm_set1_ps(t.z.gx);
+            v.z_lo = _mm_set1_ps(t.z.lo);
+            v.z_hi = _mm_set1_ps(t.z.hi);
+            v.depth_lo = _mm_set1_ps(t.z_lo);
+            v.depth_hi = _mm_set1_ps(t.z_hi);
+            v.gsx = _mm_set1_ps(t.sx.gx);
+            v.sx_lo = _mm_set1_ps(t.sx_lo);
+            v.sx_hi = _mm_set1_ps(t.sx_hi);
+            v.gsy = _mm_set1_ps(t.sy.gx);
+            v.sy_lo = _mm_set1_ps(t.sy_lo);
+            v.sy_hi = _mm_set1_ps(t.sy_hi);
+            v.gmx = _mm_set1_ps(t.mx.gx);
+            v.mx_lo = _mm_set1_ps(t.mx.lo);
+            v.mx_hi = _mm_set1_ps(t.mx.hi);
+            v.gmy = _mm_set1_ps(t.my.gx);
+            v.my_lo = _mm_set1_ps(t.my.lo);
+            v.my_hi = _mm_set1_ps(t.my.hi);
+            v.stride = _mm_set1_epi32(int(src_.stride));
+            v.last_column = _mm_set1_epi32(src_.width - 1);
+            v.last_row = _mm_set1_epi32(src_.height - 1);
+        }
+#endif
         const bool wide = x_hi - x_lo >= 8;
         float inverse_step[3] = {};
         if (wide)
@@ -180,7 +230,8 @@ class Raster {
         const int last_column = src_.width - 1, last_row = src_.height - 1;
         for (int x = x_first; x <= x_last; ++x) {
             const float k = float(x - x_first);
-            const float zc = clamp_like_sse(s.z + t.z.gx * k, t.z.lo, t.z.hi);
+            float zc = clamp_like_sse(s.z + t.z.gx * k, t.z.lo, t.z.hi);
+            if (t.perspective) zc = clamp_like_sse(1.0f / zc, t.z_lo, t.z_hi);
             if (!(zc < depth[x])) continue;
             depth[x] = zc;
             covered[x] = 1;
@@ -202,9 +253,9 @@ class Raster {
     }
 
 #if defined(__SSE2__)
-    // Four pixels a step: attributes, depth test and tap positions in vector lanes, the taps of
-    // the pixels that pass one by one. Reads (and rewrites unchanged) up to three depths past
-    // the span: band scratch rows are padded for it.
+    // Four pixels a step: attributes, depth test, tap offsets and the depth, motion and coverage
+    // stores in vector lanes; the colour of each pixel that passes on its own. Reads (and
+    // rewrites unchanged) up to three pixels past the span: band scratch rows are padded for it.
     void span_sse2(const Triangle& t, int x_first, int x_last, int y) const {
         const SpanStart s = span_start(t, x_first, y);
         const int row = y - band_.y0;
@@ -212,61 +263,95 @@ class Raster {
         uint8_t* covered = band_.view.covered.row(row) + x_first;
         glm::vec4* color = band_.view.color.row(row) + x_first;
         glm::vec2* motion = motion_ ? band_.view.motion.row(row) + x_first : nullptr;
-        const int last_column = src_.width - 1, last_row = src_.height - 1;
+        const glm::vec4* source = src_.data;
         const int n = x_last - x_first + 1;
         const __m128 lanes = _mm_setr_ps(0.0f, 1.0f, 2.0f, 3.0f), count = _mm_set1_ps(float(n));
-        const __m128 z0 = _mm_set1_ps(s.z), gz = _mm_set1_ps(t.z.gx);
-        const __m128 z_lo = _mm_set1_ps(t.z.lo), z_hi = _mm_set1_ps(t.z.hi);
-        const __m128 sx0 = _mm_set1_ps(s.sx), gsx = _mm_set1_ps(t.sx.gx);
-        const __m128 sy0 = _mm_set1_ps(s.sy), gsy = _mm_set1_ps(t.sy.gx);
-        const __m128 sx_lo = _mm_set1_ps(t.sx_lo), sx_hi = _mm_set1_ps(t.sx_hi);
-        const __m128 sy_lo = _mm_set1_ps(t.sy_lo), sy_hi = _mm_set1_ps(t.sy_hi);
-        const __m128 half = _mm_set1_ps(0.5f);
-        alignas(16) int x0s[4], y0s[4];
-        alignas(16) float wxs[4], wys[4], mxs[4], mys[4];
+        const __m128 half = _mm_set1_ps(0.5f), one = _mm_set1_ps(1.0f);
+        const __m128 z0 = _mm_set1_ps(s.z), sx0 = _mm_set1_ps(s.sx), sy0 = _mm_set1_ps(s.sy);
+        const __m128 mx0 = _mm_set1_ps(s.mx), my0 = _mm_set1_ps(s.my);
+        const VectorTriangle& v = t.vec;
+        alignas(16) int offsets[4], right[4], below[4];
+        alignas(16) float wxs[4], wys[4];
         for (int k = 0; k < n; k += 4) {
             const __m128 kk = _mm_add_ps(_mm_set1_ps(float(k)), lanes);
-            const __m128 zc =
-                _mm_min_ps(_mm_max_ps(_mm_add_ps(z0, _mm_mul_ps(gz, kk)), z_lo), z_hi);
+            __m128 zc =
+                _mm_min_ps(_mm_max_ps(_mm_add_ps(z0, _mm_mul_ps(v.gz, kk)), v.z_lo), v.z_hi);
+            if (t.perspective)
+                zc = _mm_min_ps(_mm_max_ps(_mm_div_ps(one, zc), v.depth_lo), v.depth_hi);
             const __m128 d = _mm_loadu_ps(depth + k);
             const __m128 pass = _mm_and_ps(_mm_cmplt_ps(zc, d), _mm_cmplt_ps(kk, count));
             int mask = _mm_movemask_ps(pass);
             if (!mask) continue;
             _mm_storeu_ps(depth + k, _mm_or_ps(_mm_and_ps(pass, zc), _mm_andnot_ps(pass, d)));
-            const __m128 fx = _mm_sub_ps(
-                _mm_min_ps(_mm_max_ps(_mm_add_ps(sx0, _mm_mul_ps(gsx, kk)), sx_lo), sx_hi), half);
-            const __m128 fy = _mm_sub_ps(
-                _mm_min_ps(_mm_max_ps(_mm_add_ps(sy0, _mm_mul_ps(gsy, kk)), sy_lo), sy_hi), half);
-            const __m128i x0 = _mm_cvttps_epi32(fx), y0 = _mm_cvttps_epi32(fy);
-            _mm_store_si128(reinterpret_cast<__m128i*>(x0s), x0);
-            _mm_store_si128(reinterpret_cast<__m128i*>(y0s), y0);
-            _mm_store_ps(wxs, _mm_sub_ps(fx, _mm_cvtepi32_ps(x0)));
-            _mm_store_ps(wys, _mm_sub_ps(fy, _mm_cvtepi32_ps(y0)));
-            if (motion) {
-                const __m128 mx =
-                    _mm_add_ps(_mm_set1_ps(s.mx), _mm_mul_ps(_mm_set1_ps(t.mx.gx), kk));
-                const __m128 my =
-                    _mm_add_ps(_mm_set1_ps(s.my), _mm_mul_ps(_mm_set1_ps(t.my.gx), kk));
-                _mm_store_ps(
-                    mxs, _mm_min_ps(_mm_max_ps(mx, _mm_set1_ps(t.mx.lo)), _mm_set1_ps(t.mx.hi)));
-                _mm_store_ps(
-                    mys, _mm_min_ps(_mm_max_ps(my, _mm_set1_ps(t.my.lo)), _mm_set1_ps(t.my.hi)));
+            {  // coverage: any non-zero byte where a pixel passed
+                const __m128i p = _mm_castps_si128(pass);
+                const __m128i bytes = _mm_packs_epi16(_mm_packs_epi32(p, p), p);
+                int old, set = _mm_cvtsi128_si32(bytes);
+                std::memcpy(&old, covered + k, 4);
+                old |= set;
+                std::memcpy(covered + k, &old, 4);
             }
-            while (mask) {
-                const int i = __builtin_ctz(unsigned(mask));
-                mask &= mask - 1;
-                covered[k + i] = 1;
-                const glm::vec4* r0 = src_.row(y0s[i]) + x0s[i];
-                const glm::vec4* r1 = y0s[i] < last_row ? r0 + src_.stride : r0;
-                const int dx = x0s[i] < last_column ? 1 : 0;
-                const __m128 wx = _mm_set1_ps(wxs[i]), wy = _mm_set1_ps(wys[i]);
+            if (motion) {
+                const __m128 mx = _mm_min_ps(
+                    _mm_max_ps(_mm_add_ps(mx0, _mm_mul_ps(v.gmx, kk)), v.mx_lo), v.mx_hi);
+                const __m128 my = _mm_min_ps(
+                    _mm_max_ps(_mm_add_ps(my0, _mm_mul_ps(v.gmy, kk)), v.my_lo), v.my_hi);
+                const __m128 pass01 = _mm_unpacklo_ps(pass, pass),
+                             pass23 = _mm_unpackhi_ps(pass, pass);
+                float* m = &motion[k].x;
+                const __m128 old01 = _mm_loadu_ps(m), old23 = _mm_loadu_ps(m + 4);
+                _mm_storeu_ps(m, _mm_or_ps(_mm_and_ps(pass01, _mm_unpacklo_ps(mx, my)),
+                                           _mm_andnot_ps(pass01, old01)));
+                _mm_storeu_ps(m + 4, _mm_or_ps(_mm_and_ps(pass23, _mm_unpackhi_ps(mx, my)),
+                                               _mm_andnot_ps(pass23, old23)));
+            }
+            const __m128 fx = _mm_sub_ps(
+                _mm_min_ps(_mm_max_ps(_mm_add_ps(sx0, _mm_mul_ps(v.gsx, kk)), v.sx_lo), v.sx_hi),
+                half);
+            const __m128 fy = _mm_sub_ps(
+                _mm_min_ps(_mm_max_ps(_mm_add_ps(sy0, _mm_mul_ps(v.gsy, kk)), v.sy_lo), v.sy_hi),
+                half);
+            const __m128i x0 = _mm_cvttps_epi32(fx), y0 = _mm_cvttps_epi32(fy);
+            const __m128 wx4 = _mm_sub_ps(fx, _mm_cvtepi32_ps(x0));
+            const __m128 wy4 = _mm_sub_ps(fy, _mm_cvtepi32_ps(y0));
+            // Tap offsets in pixels: y0 * stride + x0 (SSE2 has no 32-bit lane product), the
+            // right tap one further unless in the last column, the lower one a stride further
+            // unless in the last row.
+            const __m128i even = _mm_mul_epu32(y0, v.stride);
+            const __m128i odd = _mm_mul_epu32(_mm_srli_epi64(y0, 32), v.stride);
+            const __m128i rows =
+                _mm_unpacklo_epi32(_mm_shuffle_epi32(even, _MM_SHUFFLE(0, 0, 2, 0)),
+                                   _mm_shuffle_epi32(odd, _MM_SHUFFLE(0, 0, 2, 0)));
+            _mm_store_si128(reinterpret_cast<__m128i*>(offsets), _mm_add_epi32(rows, x0));
+            _mm_store_si128(reinterpret_cast<__m128i*>(right),
+                            _mm_srli_epi32(_mm_cmplt_epi32(x0, v.last_column), 31));
+            _mm_store_si128(reinterpret_cast<__m128i*>(below),
+                            _mm_and_si128(_mm_cmplt_epi32(y0, v.last_row), v.stride));
+            // The colour of pixel i: weights taken from lane i.
+            auto fetch = [&](int i, __m128 wx, __m128 wy) {
+                const glm::vec4* r0 = source + offsets[i];
+                const glm::vec4* r1 = r0 + below[i];
+                const int dx = right[i];
                 const __m128 a = _mm_loadu_ps(&r0[0].x), b = _mm_loadu_ps(&r0[dx].x);
                 const __m128 c = _mm_loadu_ps(&r1[0].x), e = _mm_loadu_ps(&r1[dx].x);
                 const __m128 top = _mm_add_ps(a, _mm_mul_ps(_mm_sub_ps(b, a), wx));
                 const __m128 bottom = _mm_add_ps(c, _mm_mul_ps(_mm_sub_ps(e, c), wx));
                 _mm_storeu_ps(&color[k + i].x,
                               _mm_add_ps(top, _mm_mul_ps(_mm_sub_ps(bottom, top), wy)));
-                if (motion) motion[k + i] = {mxs[i], mys[i]};
+            };
+            if (mask == 0xf) {  // the common case, without bookkeeping
+                fetch(0, _mm_shuffle_ps(wx4, wx4, 0x00), _mm_shuffle_ps(wy4, wy4, 0x00));
+                fetch(1, _mm_shuffle_ps(wx4, wx4, 0x55), _mm_shuffle_ps(wy4, wy4, 0x55));
+                fetch(2, _mm_shuffle_ps(wx4, wx4, 0xaa), _mm_shuffle_ps(wy4, wy4, 0xaa));
+                fetch(3, _mm_shuffle_ps(wx4, wx4, 0xff), _mm_shuffle_ps(wy4, wy4, 0xff));
+                continue;
+            }
+            _mm_store_ps(wxs, wx4);
+            _mm_store_ps(wys, wy4);
+            while (mask) {
+                const int i = __builtin_ctz(unsigned(mask));
+                mask &= mask - 1;
+                fetch(i, _mm_set1_ps(wxs[i]), _mm_set1_ps(wys[i]));
             }
         }
     }

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <limits>
 
 #include "grid_internal.hpp"
 #include "reprise/core/parallel.hpp"
@@ -24,6 +25,9 @@ void check(const Frame& source, const WarpTarget& t) {
     REPRISE_ASSERT(t.covered.width == t.color.width && t.covered.height == t.color.height);
     REPRISE_ASSERT(t.motion.empty() ||
                    (t.motion.width == t.color.width && t.motion.height == t.color.height));
+    // The vector raster keeps source offsets (in pixels) in 32-bit lanes.
+    REPRISE_ASSERT(source.color.empty() || double(source.width()) * source.height() <
+                                               double(std::numeric_limits<int>::max()));
 }
 
 }  // namespace

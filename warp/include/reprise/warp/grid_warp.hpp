@@ -9,10 +9,14 @@
 namespace reprise::warp {
 
 struct GridOptions {
-    int cell = 32;                  // starting cell size in pixels: min_cell * 2^k, at most 64
-    int min_cell = 2;               // smallest cell (1 or 2)
-    float depth_threshold = 0.02f;  // split when max/min depth in a cell exceeds 1 + this
-    float motion_threshold = 0.5f;  // split when motion inside a cell varies more (pixels)
+    int cell = 32;     // starting cell size in pixels: min_cell * 2^k, at most 64
+    int min_cell = 2;  // smallest cell (1 or 2)
+    // How far a pixel may depart from what its cell's corner pixels predict (interpolated over
+    // the two triangles the cell is drawn as) before the cell splits:
+    // inverse depth (affine in screen space on a plane), relative: |1 - predicted(1/z) * z|;
+    float depth_threshold = 0.01f;  // at most 0.5
+    // motion in target pixels, i.e. |factor| * |motion - predicted motion| on either axis.
+    float motion_threshold = 0.25f;
 };
 
 struct GridStats {
@@ -22,18 +26,24 @@ struct GridStats {
 
 // Holds the cells and the scratch that it sizes once and reuses every frame.
 //
-// A cell splits while it holds a discontinuity: NaN/Inf motion or NaN/negative depth, background
-// (+inf) beside geometry, depth ratio above 1 + depth_threshold or a motion range (per axis)
-// above motion_threshold. Cells holding invalid pixels are not drawn. A cell corner takes the
-// mean depth and motion of the 2x2 pixels around it when those are continuous by the same test
-// (neighbouring cells then share the vertex and the grid stays closed), else those of the pixel
-// of the cell nearest to it (the grid tears or stretches there). Each cell is drawn as two
-// triangles split along the top-left to bottom-right diagonal, with depth interpolated linearly
-// (background as a huge finite depth that loses against all geometry) and colour fetched
-// bilinearly from the source at the interpolated source position. Cell edges are pushed out by
-// 1/16 px so that T-junctions leave no hairline cracks. Cells with a vertex further than 2^20
-// pixels away are dropped, and so is motion of 1e30 px or more. Same pixel coordinates in source
-// and target, whose sizes may differ.
+// A cell splits (down to min_cell) while it holds invalid pixels (NaN/Inf motion, NaN/negative
+// depth), background (+inf) beside geometry, or a pixel whose motion or inverse depth departs
+// from the interpolation of the cell's four corner pixels (over the two triangles it is drawn
+// as) by more than the thresholds above. Every pixel is tested, so a pole one pixel wide inside
+// a cell refines it. A plane seen in perspective (a tilted ground) has affine 1/z and nearly
+// affine motion, so it keeps big cells, while depth and motion edges, silhouettes and curved
+// surfaces refine. Smallest cells holding invalid pixels are not drawn.
+// A cell corner takes the mean depth and motion of the 2x2 pixels around it when those are
+// continuous (one kind, depth ratio within 1 + 2 depth_threshold, motion range within twice
+// the motion threshold: neighbouring cells then share the vertex and the grid stays closed),
+// else those of the pixel of the cell nearest to it (the grid tears or stretches there). Each
+// cell is drawn as two triangles split along the top-left to bottom-right diagonal; depth is
+// interpolated perspective-correctly (1/z linearly) in cells that passed the test, linearly in
+// the smallest cells that hold an edge by the vertex test (background there as a huge finite
+// depth that loses against all geometry); colour is fetched bilinearly from the source at the
+// interpolated source position. Cell edges are pushed out by 1/16 px so that T-junctions leave no
+// hairline cracks. Cells with a vertex further than 2^20 pixels away are dropped, and so is motion
+// of 1e30 px or more. Same pixel coordinates in source and target, whose sizes may differ.
 class GridWarper {
   public:
     GridStats warp(const Frame& source, float factor, const WarpTarget& target,
