@@ -29,7 +29,8 @@ Status bench_fill(const BenchOptions& options);       // pull-push, Andreev vs c
 // OpenCV DIS flow, Telea): OUT/fruc.csv, OUT/fruc_summary.csv, OUT/index.html.
 Status bench_fruc(const BenchOptions& options);
 // Synthesized second eye vs the rendered one, naive DIBR peers and the renderer's second-eye
-// time, per built-in scene (--scenes, --size, --frames up to 5): OUT/stereo.csv.
+// time, per built-in scene (--scenes, --size, --frames up to 5, --repeat): OUT/stereo.csv (with
+// "+disoccluded" rows), OUT/index.html, OUT/SCENE/worst_frame.png and a summary on stdout.
 Status bench_stereo(const BenchOptions& options);
 
 }  // namespace reprise::cli

@@ -1,17 +1,27 @@
 // reprise bench stereo: the synthesized eye against the rendered one, beside naive DIBR peers and
 // the renderer's own time for the second eye, on every built-in scene.
+//
+// OUT/stereo.csv has the project's standard columns scene,method,setting,frame,psnr,ssim,flip,ms.
+// Every row is repeated with the setting suffixed "+disoccluded": the same method scored only on
+// the pixels the left eye does not see (no source pixel lands there under a nearest-pixel splat),
+// ms repeated; PSNR is NaN on a frame without such pixels. OUT/index.html is the error-against-
+// run-time report (report_html), OUT/SCENE/worst_frame.png the worst frame of our best setting.
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
+#include <map>
 #include <sstream>
 
 #include <opencv2/imgproc.hpp>
 
-#include "bench.hpp"
 #include "args.hpp"
+#include "bench.hpp"
+#include "report_html.hpp"
 #include "reprise/core/metrics.hpp"
+#include "reprise/core/parallel.hpp"
+#include "reprise/core/visualize.hpp"
 #include "reprise/server/builtin_scenes.hpp"
 #include "reprise/server/renderer.hpp"
 #include "reprise/stereo/rig.hpp"
@@ -22,15 +32,21 @@ namespace reprise::cli {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+namespace fs = std::filesystem;
+
 double ms_since(Clock::time_point t) {
     return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
 }
 
-struct Row {
-    std::string method;
-    ImageError all, disoccluded;
-    double ms = 0.0;
-};
+// Issue 4's targets.
+constexpr double kPairRatioTarget = 0.6;   // (one render + synthesis) / (two renders)
+constexpr double kSynthesisTargetMs = 8.0;  // at 1920x1080
+
+const char* const kOurs = "ours";
+const char* const kSplatPeer = "dibr-splat";   // forward splat, footprint 1, no fill
+const char* const kRemapPeer = "cv-remap";     // backward remap by the left eye's disparity
+const char* const kCopyPeer = "copy-left-eye";
+const char* const kRender = "render";          // the renderer's second eye (the truth)
 
 // Naive backward DIBR peer: right(x) = left(x + d(x)), d from the left eye's own depth at x.
 void remap_by_disparity(const Frame& left, const stereo::StereoRig& rig, Image<glm::vec4>& out) {
@@ -49,6 +65,153 @@ void remap_by_disparity(const Frame& left, const stereo::StereoRig& rig, Image<g
     cv::remap(src, dst, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
 }
 
+void to_rgb8(ImageView<const glm::vec3> display, Image<Rgb8>& out) {
+    out.resize(display.width, display.height);
+    for (int y = 0; y < display.height; ++y)
+        for (int x = 0; x < display.width; ++x) {
+            glm::vec3 c = glm::clamp(display(x, y), 0.0f, 1.0f) * 255.0f + 0.5f;
+            out(x, y) = Rgb8(uint8_t(c.x), uint8_t(c.y), uint8_t(c.z));
+        }
+}
+
+struct Score {
+    int frame = 0;
+    ImageError all, disoccluded;
+    double ms = 0.0;
+};
+
+struct Run {
+    std::string method, setting;
+    std::vector<Score> scores;
+    std::map<int, Image<Rgb8>> shown;  // per frame, as displayed (for the worst-frame picture)
+    bool ours() const { return method == kOurs; }
+    // Means over frames; `disoccluded` over the frames that have such pixels.
+    ReportPoint mean(bool disoccluded = false) const {
+        ReportPoint p{method, setting};
+        std::size_t n = 0;
+        for (const Score& s : scores) {
+            const ImageError& e = disoccluded ? s.disoccluded : s.all;
+            if (std::isnan(e.psnr)) continue;
+            p.psnr += e.psnr, p.ssim += e.ssim, p.flip += e.flip, p.ms += s.ms, ++n;
+        }
+        if (n == 0) return {method, setting, NAN, NAN, NAN, NAN};
+        p.psnr /= double(n), p.ssim /= double(n), p.flip /= double(n), p.ms /= double(n);
+        return p;
+    }
+    double mean_ms() const {
+        double sum = 0.0;
+        for (const Score& s : scores) sum += s.ms;
+        return scores.empty() ? NAN : sum / double(scores.size());
+    }
+};
+
+// The window of the given size where `a` and `b` differ most (sum of absolute differences).
+void worst_window(const Image<Rgb8>& a, const Image<Rgb8>& b, int cw, int ch, int& best_x,
+                  int& best_y) {
+    const int w = a.width(), h = a.height();
+    std::vector<double> sat(std::size_t(w + 1) * (h + 1), 0.0);
+    auto at = [&](int x, int y) -> double& { return sat[std::size_t(y) * (w + 1) + x]; };
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            glm::ivec3 d = glm::abs(glm::ivec3(a(x, y)) - glm::ivec3(b(x, y)));
+            at(x + 1, y + 1) = d.x + d.y + d.z + at(x, y + 1) + at(x + 1, y) - at(x, y);
+        }
+    double best = -1.0;
+    best_x = best_y = 0;
+    for (int y = 0; y + ch <= h; y += 2)
+        for (int x = 0; x + cw <= w; x += 2) {
+            double sum = at(x + cw, y + ch) - at(x, y + ch) - at(x + cw, y) + at(x, y);
+            if (sum > best) best = sum, best_x = x, best_y = y;
+        }
+}
+
+std::string db(double psnr) {
+    char buffer[32];
+    std::snprintf(buffer, sizeof buffer, "%.2f dB", psnr);
+    return buffer;
+}
+
+// Our best setting's lowest-PSNR frame beside the rendered eye and the best peer, full frames
+// over the window where ours errs most, enlarged.
+Status worst_picture(const Run& ours, const Run& truth, const Run* peer, const std::string& path) {
+    int j = -1;
+    double worst = INFINITY;
+    for (const Score& s : ours.scores)
+        if (j < 0 || s.all.psnr < worst) j = s.frame, worst = s.all.psnr;
+    if (j < 0) return {};
+    const Image<Rgb8>& a = ours.shown.at(j);
+    const Image<Rgb8>& t = truth.shown.at(j);
+    const int w = a.width(), h = a.height();
+    const int cw = std::min(w, 200), ch = std::min(h, 112);
+    int x0 = 0, y0 = 0;
+    worst_window(a, t, cw, ch, x0, y0);
+    std::vector<Image<Rgb8>> images = {a, t};
+    std::vector<std::string> labels = {"ours " + ours.setting + " " + db(worst),
+                                       "rendered right eye, frame " + std::to_string(j)};
+    if (peer && peer->shown.count(j)) {
+        images.push_back(peer->shown.at(j));
+        std::string label = peer->method + " " + peer->setting;
+        for (const Score& s : peer->scores)
+            if (s.frame == j) label += " " + db(s.all.psnr);
+        labels.push_back(label);
+    }
+    const std::size_t columns = images.size();
+    if (cw < w || ch < h)
+        for (std::size_t i = 0; i < columns; ++i) {
+            Image<Rgb8> c(cw, ch);
+            for (int y = 0; y < ch; ++y)
+                for (int x = 0; x < cw; ++x) c(x, y) = images[i](x0 + x, y0 + y);
+            const Rgb8 yellow(255, 220, 0);
+            for (int x = x0; x < x0 + cw; ++x) images[i](x, y0) = images[i](x, y0 + ch - 1) = yellow;
+            for (int y = y0; y < y0 + ch; ++y) images[i](x0, y) = images[i](x0 + cw - 1, y) = yellow;
+            images.push_back(std::move(c));
+            labels.push_back(i == 0 ? "crop where ours errs most" : "same crop");
+        }
+    std::vector<Tile> tiles;
+    for (std::size_t i = 0; i < images.size(); ++i) tiles.push_back({images[i].view(), labels[i]});
+    Image<Rgb8> sheet = contact_sheet(
+        tiles, {.columns = int(columns), .tile_width = std::min(std::max(2 * cw, 320), 640)});
+    return write_png(path, sheet.view());
+}
+
+struct SceneSummary {
+    std::string scene;
+    ReportPoint best, best_dis;       // our best setting (by PSNR on all pixels)
+    ReportPoint fastest, fastest_dis;  // our fastest setting (mean ms)
+    double splat = NAN, remap = NAN, copy = NAN;  // peers' PSNR, all pixels
+    double render_left_ms = NAN, render_right_ms = NAN;
+    double disoccluded_fraction = NAN;
+    double ratio(const ReportPoint& ours) const {
+        return (render_left_ms + ours.ms) / (render_left_ms + render_right_ms);
+    }
+};
+
+std::string summary_table(const std::vector<SceneSummary>& rows, bool full_hd) {
+    std::string out;
+    char line[512];
+    std::snprintf(line, sizeof line, "%-9s %-22s %7s %7s %8s | %7s %7s %7s | %9s %6s %6s %s\n",
+                  "scene", "ours best", "psnr", "psnr_d", "ms", "splat", "remap", "copyL",
+                  "render_ms", "dis%", "ratio", "targets (ratio<=0.6, ms<=8 @1080p)");
+    out += line;
+    for (const SceneSummary& r : rows)
+        for (bool fastest : {false, true}) {
+            const ReportPoint& p = fastest ? r.fastest : r.best;
+            const ReportPoint& d = fastest ? r.fastest_dis : r.best_dis;
+            const double ratio = r.ratio(p);
+            std::string verdict = std::string("ratio ") + (ratio <= kPairRatioTarget ? "met" : "NOT met");
+            verdict += full_hd ? std::string(", ms ") + (p.ms <= kSynthesisTargetMs ? "met" : "NOT met")
+                               : std::string(", ms n/a (not 1920x1080)");
+            const std::string label = (fastest ? "  fastest: " : "") + p.setting;
+            std::snprintf(line, sizeof line,
+                          "%-9s %-22s %7.2f %7.2f %8.2f | %7.2f %7.2f %7.2f | %9.2f %6.2f %6.3f %s\n",
+                          fastest ? "" : r.scene.c_str(), label.c_str(), p.psnr, d.psnr, p.ms,
+                          r.splat, r.remap, r.copy, r.render_right_ms,
+                          100.0 * r.disoccluded_fraction, ratio, verdict.c_str());
+            out += line;
+        }
+    return out;
+}
+
 }  // namespace
 
 Status bench_stereo(const BenchOptions& options) {
@@ -63,32 +226,85 @@ Status bench_stereo(const BenchOptions& options) {
     }
     const std::string out_dir = options.out.empty() ? "out/bench-stereo" : options.out;
     std::error_code ec;
-    std::filesystem::create_directories(out_dir, ec);
+    fs::create_directories(out_dir, ec);
     if (ec) return Status::error(out_dir + ": cannot create the folder: " + ec.message());
     const std::string csv_path = out_dir + "/stereo.csv";
-    std::ofstream csv(csv_path);
+    FILE* csv = std::fopen(csv_path.c_str(), "w");
     if (!csv) return Status::error(csv_path + ": cannot write");
-    csv << "scene,method,setting,frame,psnr,ssim,flip,ms,psnr_disoccluded,ssim_disoccluded,"
-           "flip_disoccluded,disoccluded_pixels\n";
+    std::fprintf(csv, "scene,method,setting,frame,psnr,ssim,flip,ms\n");
 
     std::unique_ptr<server::Renderer> renderer;
     REPRISE_TRY(server::Renderer::create(renderer));
     const stereo::StereoRig rig{.ipd = 0.064f};
     const int frames = std::min(options.frames, 5);
+    const int repeat = std::max(options.repeat, 1);
     const double fps = 30.0;
-    stereo::StereoSynthesizer synthesizer, disocclusion_probe;
-    Frame left, right, made, probe;
+    const bool full_hd = w == 1920 && h == 1080;
+
+    struct OurSetting {
+        std::string setting;
+        stereo::StereoOptions options;
+        bool history = false;
+    };
+    std::vector<OurSetting> settings;
+    for (auto [warp_name, warp] : {std::pair{"grid", stereo::StereoWarp::Grid},
+                                   std::pair{"splat", stereo::StereoWarp::Splat}})
+        for (auto [fill_name, fill] : {std::pair{"none", stereo::StereoFill::None},
+                                       std::pair{"pullpush", stereo::StereoFill::PullPush},
+                                       std::pair{"andreev", stereo::StereoFill::Andreev}})
+            settings.push_back({std::string(warp_name) + "+" + fill_name, {.warp = warp, .fill = fill}});
+    settings.push_back({"grid+pullpush+history", {}, true});
+
+    Report report;
+    report.title = "reprise bench stereo: the second eye, error against run time";
+    char text[2048];
+    std::snprintf(
+        text, sizeof text,
+        "The right eye synthesized from the rendered left eye (parallel rig, ipd %.3f) compared with "
+        "the right eye rendered, %dx%d, %d frames per scene from t = 10/30 s, renderer %s. Display "
+        "values: PSNR, SSIM, LDR-FLIP. Each scene has two plots: all pixels, and only the "
+        "disoccluded pixels (those no left-eye pixel lands on under a nearest-pixel splat).",
+        rig.ipd, w, h, frames, renderer->device().c_str());
+    report.paragraphs.push_back(text);
+    std::snprintf(
+        text, sizeof text,
+        "ms = wall-clock milliseconds per synthesized eye on this machine (%d threads), the fastest "
+        "of %d runs. ours: StereoSynthesizer::synthesize() from the left eye's colour + depth in "
+        "memory, per warp (adaptive grid, splat) and fill (none, pull-push, Andreev); "
+        "+history also warps the previous frame's rendered right eye (as when the rendered eye "
+        "alternates per frame). Peers: dibr-splat = forward splat of footprint 1 with a depth test "
+        "and no fill; cv-remap = cv::remap of the left eye by its own disparity (bilinear); "
+        "copy-left-eye = the left eye as it is (ms = the copy). render = the renderer's time for "
+        "the second eye (PSNR +inf by definition, drawn on the top edge).",
+        thread_count(), repeat);
+    report.paragraphs.push_back(text);
+
+    stereo::StereoSynthesizer synthesizer, probe_synth;
+    Frame left, right, made, probe, history;
     Image<glm::vec3> truth_d(w, h), test_d(w, h);
     Image<uint8_t> disoccluded(w, h);
-    Image<glm::vec4> remapped;
-    std::printf("%-9s %-14s %8s %8s %8s %9s %9s\n", "scene", "method", "psnr", "psnr_dis", "flip", "ms",
-                "render_ms");
-    for (const std::string& name : scenes) {
+    Image<glm::vec4> remapped, copied;
+    std::vector<SceneSummary> summaries;
+    Status failure;
+    for (const std::string& scene_name : scenes) {
         server::Scene scene;
         server::CameraPath path;
-        REPRISE_TRY(server::load_scene(name, scene, path));
-        for (int i = 0; i < frames; ++i) {
-            const double t = (i + 10) / fps;
+        failure = server::load_scene(scene_name, scene, path);
+        if (!failure.ok()) break;
+        const std::string name = fs::path(scene_name).stem().string();
+        fs::create_directories(out_dir + "/" + name, ec);
+        std::vector<Run> runs;
+        for (const OurSetting& s : settings) runs.push_back({kOurs, s.setting});
+        const std::size_t splat_i = runs.size();
+        runs.push_back({kSplatPeer, "nofill"});
+        runs.push_back({kRemapPeer, "linear"});
+        runs.push_back({kCopyPeer, "-"});
+        const std::size_t render_i = runs.size();
+        runs.push_back({kRender, "right eye"});
+        double render_left = 0.0, render_right = 0.0, dis_fraction = 0.0;
+
+        // Renders one eye of the centre camera at time t; the fastest of `times` runs.
+        auto render_eye = [&](double t, stereo::Eye e, int times, Frame& out, double& ms) -> Status {
             const server::Instant now = server::instant_on_path(path, scene, t, w, h);
             const server::Instant before = server::instant_on_path(path, scene, t - 1.0 / fps, w, h);
             Camera centre;
@@ -97,81 +313,170 @@ Status bench_stereo(const BenchOptions& options) {
             centre.prev_view = before.view;
             centre.prev_projection = before.projection;
             const stereo::EyeCameras eyes = stereo::eye_cameras(centre, rig);
-            double render_ms = 1e30;
-            for (stereo::Eye e : {stereo::Eye::Left, stereo::Eye::Right})
-                for (int r = 0; r < (e == stereo::Eye::Right ? options.repeat : 1); ++r) {
-                    server::Instant a = now, b = before;
-                    a.view = eyes[e].view;
-                    a.projection = eyes[e].projection;
-                    b.view = eyes[e].prev_view;
-                    b.projection = eyes[e].prev_projection;
-                    auto begin = Clock::now();
-                    REPRISE_TRY(renderer->render(scene, a, b, {.width = w, .height = h},
-                                                 e == stereo::Eye::Left ? left : right));
-                    if (e == stereo::Eye::Right) render_ms = std::min(render_ms, ms_since(begin));
-                }
-            // Disoccluded: what no source pixel of the left eye lands on (nearest-pixel splat).
-            disocclusion_probe.synthesize(left, eyes.right, probe,
-                                          {.warp = stereo::StereoWarp::Splat,
-                                           .fill = stereo::StereoFill::None,
-                                           .splat = {.footprint = 1}});
+            server::Instant a = now, b = before;
+            a.view = eyes[e].view;
+            a.projection = eyes[e].projection;
+            b.view = eyes[e].prev_view;
+            b.projection = eyes[e].prev_projection;
+            ms = 1e30;
+            for (int r = 0; r < times; ++r) {
+                auto begin = Clock::now();
+                REPRISE_TRY(renderer->render(scene, a, b, {.width = w, .height = h}, out));
+                ms = std::min(ms, ms_since(begin));
+            }
+            return {};
+        };
+
+        {  // warm-up (shader compilation, first upload of the scene): not timed
+            double unused = 0.0;
+            failure = render_eye(10 / fps, stereo::Eye::Left, 1, left, unused);
+        }
+        for (int i = 0; i < frames && failure.ok(); ++i) {
+            const double t = (i + 10) / fps;
+            double left_ms = 0.0, right_ms = 0.0, unused = 0.0;
+            failure = render_eye(t, stereo::Eye::Left, repeat, left, left_ms);
+            if (failure.ok()) failure = render_eye(t, stereo::Eye::Right, repeat, right, right_ms);
+            if (failure.ok()) failure = render_eye(t - 1.0 / fps, stereo::Eye::Right, 1, history, unused);
+            if (!failure.ok()) break;
+            render_left += left_ms / frames, render_right += right_ms / frames;
+            const Camera& target = right.camera;
+
+            probe_synth.synthesize(left, target, probe,
+                                   {.warp = stereo::StereoWarp::Splat,
+                                    .fill = stereo::StereoFill::None,
+                                    .splat = {.footprint = 1}});
             std::size_t dis = 0;
             for (std::size_t k = 0; k < disoccluded.pixel_count(); ++k)
-                dis += disoccluded.data()[k] = !disocclusion_probe.coverage().data[k];
+                dis += disoccluded.data()[k] = !probe_synth.coverage().data[k];
+            dis_fraction += double(dis) / double(disoccluded.pixel_count()) / frames;
             to_display(right.color.view(), truth_d.view());
-            auto measure = [&](const Image<glm::vec4>& test, Row& row) {
+
+            auto record = [&](Run& run, const Image<glm::vec4>& test, double ms) {
                 to_display(test.view(), test_d.view());
-                row.all = image_error(truth_d.view(), test_d.view());
-                row.disoccluded = dis ? image_error(truth_d.view(), test_d.view(), disoccluded.view())
-                                      : ImageError{};
+                Score s{.frame = i, .ms = ms};
+                s.all = image_error(truth_d.view(), test_d.view());
+                s.disoccluded = dis ? image_error(truth_d.view(), test_d.view(), disoccluded.view())
+                                    : ImageError{NAN, NAN, NAN};
+                run.scores.push_back(s);
+                to_rgb8(test_d.view(), run.shown[i]);
             };
-            std::vector<Row> rows;
-            auto ours = [&](const char* method, stereo::StereoOptions o) {
-                Row row{.method = method};
-                row.ms = 1e30;
-                for (int r = 0; r < options.repeat; ++r) {
+            for (std::size_t k = 0; k < settings.size(); ++k) {
+                double ms = 1e30;
+                for (int r = 0; r < repeat; ++r) {
                     auto begin = Clock::now();
-                    synthesizer.synthesize(left, eyes.right, made, o);
-                    row.ms = std::min(row.ms, ms_since(begin));
+                    synthesizer.synthesize(left, target, made, settings[k].options,
+                                           settings[k].history ? &history : nullptr);
+                    ms = std::min(ms, ms_since(begin));
                 }
-                measure(made.color, row);
-                rows.push_back(row);
-            };
-            ours("grid+pullpush", {});
-            ours("grid+andreev", {.fill = stereo::StereoFill::Andreev});
-            ours("splat+pullpush", {.warp = stereo::StereoWarp::Splat});
-            ours("splat+none", {.warp = stereo::StereoWarp::Splat, .fill = stereo::StereoFill::None});
+                record(runs[k], made.color, ms);
+            }
             {
-                Row row{.method = "cv_remap"};
-                row.ms = 1e30;
-                for (int r = 0; r < options.repeat; ++r) {
+                double ms = 1e30;
+                for (int r = 0; r < repeat; ++r) {
+                    auto begin = Clock::now();
+                    synthesizer.synthesize(left, target, made,
+                                           {.warp = stereo::StereoWarp::Splat,
+                                            .fill = stereo::StereoFill::None,
+                                            .splat = {.footprint = 1}});
+                    ms = std::min(ms, ms_since(begin));
+                }
+                record(runs[splat_i], made.color, ms);
+            }
+            {
+                double ms = 1e30;
+                for (int r = 0; r < repeat; ++r) {
                     auto begin = Clock::now();
                     remap_by_disparity(left, rig, remapped);
-                    row.ms = std::min(row.ms, ms_since(begin));
+                    ms = std::min(ms, ms_since(begin));
                 }
-                measure(remapped, row);
-                rows.push_back(row);
+                record(runs[splat_i + 1], remapped, ms);
             }
             {
-                Row row{.method = "render_right"};
-                row.ms = render_ms;
-                measure(right.color, row);
-                rows.push_back(row);
-                Row copy{.method = "copy_left"};
-                measure(left.color, copy);
-                rows.push_back(copy);
+                double ms = 1e30;
+                for (int r = 0; r < repeat; ++r) {
+                    auto begin = Clock::now();
+                    copied = left.color;
+                    ms = std::min(ms, ms_since(begin));
+                }
+                record(runs[splat_i + 2], copied, ms);
             }
-            for (const Row& r : rows) {
-                csv << name << ',' << r.method << ",ipd=" << rig.ipd << ',' << i << ',' << r.all.psnr << ','
-                    << r.all.ssim << ',' << r.all.flip << ',' << r.ms << ',' << r.disoccluded.psnr << ','
-                    << r.disoccluded.ssim << ',' << r.disoccluded.flip << ',' << dis << '\n';
-                if (i == 0)
-                    std::printf("%-9s %-14s %8.2f %8.2f %8.4f %9.2f %9.2f\n", name.c_str(), r.method.c_str(),
-                                r.all.psnr, r.disoccluded.psnr, r.all.flip, r.ms, render_ms);
-            }
+            record(runs[render_i], right.color, right_ms);
+            std::printf("[stereo] %s frame %d: render L %.1f ms, R %.1f ms, %.2f%% disoccluded\n",
+                        name.c_str(), i, left_ms, right_ms, 100.0 * double(dis) / disoccluded.pixel_count());
+            std::fflush(stdout);
         }
+        if (!failure.ok()) break;
+
+        ReportSection all{name}, dis_section{name + ", disoccluded pixels only"};
+        for (const server::SceneInfo& info : server::builtin_scenes())
+            if (scene_name == info.name) all.note = info.stresses;
+        for (const Run& run : runs) {
+            for (const Score& s : run.scores) {
+                std::fprintf(csv, "%s,%s,%s,%d,%.4f,%.6f,%.6f,%.4f\n", name.c_str(), run.method.c_str(),
+                             run.setting.c_str(), s.frame, s.all.psnr, s.all.ssim, s.all.flip, s.ms);
+                std::fprintf(csv, "%s,%s,%s+disoccluded,%d,%.4f,%.6f,%.6f,%.4f\n", name.c_str(),
+                             run.method.c_str(), run.setting.c_str(), s.frame, s.disoccluded.psnr,
+                             s.disoccluded.ssim, s.disoccluded.flip, s.ms);
+            }
+            all.points.push_back(run.mean());
+            dis_section.points.push_back(run.mean(true));
+        }
+        std::fflush(csv);
+
+        SceneSummary row{name};
+        const Run* best = nullptr;
+        const Run* fastest = nullptr;
+        const Run* peer = nullptr;
+        for (const Run& run : runs) {
+            if (run.ours() && (!best || run.mean().psnr > best->mean().psnr)) best = &run;
+            if (run.ours() && (!fastest || run.mean_ms() < fastest->mean_ms())) fastest = &run;
+            if (!run.ours() && run.method != kRender && (!peer || run.mean().psnr > peer->mean().psnr))
+                peer = &run;
+            if (run.method == kSplatPeer) row.splat = run.mean().psnr;
+            if (run.method == kRemapPeer) row.remap = run.mean().psnr;
+            if (run.method == kCopyPeer) row.copy = run.mean().psnr;
+        }
+        row.best = best->mean();
+        row.best.ms = best->mean_ms();
+        row.best_dis = best->mean(true);
+        row.fastest = fastest->mean();
+        row.fastest.ms = fastest->mean_ms();
+        row.fastest_dis = fastest->mean(true);
+        row.render_left_ms = render_left;
+        row.render_right_ms = render_right;
+        row.disoccluded_fraction = dis_fraction;
+        summaries.push_back(row);
+        std::snprintf(text, sizeof text,
+                      " Mean disoccluded fraction %.2f%%; renderer: left eye %.2f ms, right eye %.2f ms; "
+                      "pair ratio (render + ours %s) / (two renders) = %.3f.",
+                      100.0 * dis_fraction, render_left, render_right, best->setting.c_str(), row.ratio(row.best));
+        all.note += text;
+        const std::string picture = name + "/worst_frame.png";
+        failure = worst_picture(*best, runs[render_i], peer, out_dir + "/" + picture);
+        if (!failure.ok()) break;
+        all.images.push_back({picture, "The lowest-PSNR frame of our best setting (" + best->setting +
+                                           ") beside the rendered right eye and the best peer (" +
+                                           (peer ? peer->method : std::string("-")) +
+                                           "); below, the window where ours differs most, enlarged."});
+        report.sections.push_back(std::move(all));
+        report.sections.push_back(std::move(dis_section));
     }
-    std::printf("[bench] %dx%d, %d frames per scene -> %s\n", w, h, frames, csv_path.c_str());
+    std::fclose(csv);
+    REPRISE_TRY(failure);
+
+    const std::string table = summary_table(summaries, full_hd);
+    std::snprintf(text, sizeof text,
+                  "stereo, %dx%d, %d frames per scene, ipd %.3f, fastest of %d runs, %d threads; "
+                  "PSNR dB (psnr_d: disoccluded pixels only); ms per synthesized eye; splat/remap/"
+                  "copyL: peers' PSNR; render_ms: the renderer's right eye; dis%%: disoccluded "
+                  "pixels; ratio = (render L + ours) / (render L + render R); per scene our best setting by PSNR, "
+                  "then our fastest\n",
+                  w, h, frames, rig.ipd, repeat, thread_count());
+    report.preformatted = std::string(text) + table;
+    const std::string html_path = out_dir + "/index.html";
+    REPRISE_TRY(write_html_report(html_path, report));
+    std::printf("%s%s", text, table.c_str());
+    std::printf("report: %s\nrows: %s\n", html_path.c_str(), csv_path.c_str());
     return {};
 }
 

@@ -126,18 +126,19 @@ int command_bench(int argc, char** argv) {
               "Benchmarks. render: renderer frames per second; exr: frame write/read time against "
               "raw file I/O\nof the same bytes, measured in the same run. fruc: frame-rate upconversion "
               "error against run time\nfor every setting beside ffmpeg minterpolate and OpenCV DIS flow "
-              "(CSV + HTML report in --out).");
-    args.positional("WHAT", &job.what, "render | exr | reproject | grid | fill | fruc");
+              "(CSV + HTML report in --out).\nstereo: the synthesized second eye against the rendered one, naive DIBR peers and the "
+              "renderer's\nsecond-eye time (CSV + HTML report in --out).");
+    args.positional("WHAT", &job.what, "render | exr | reproject | grid | fill | fruc | stereo");
     args.option("--scene", &job.scene, "scene to render (default pan)");
-    args.option("--frames", &job.frames, "frames per size (default 10); fruc: input frames (default 20)");
+    args.option("--frames", &job.frames, "frames per size (default 10); fruc: input frames (default 20); stereo: frames per scene (at most 5)");
     args.option("--sizes", &job.sizes, "comma-separated WxH list (default 640x360,1920x1080)");
     args.option("--dir", &job.dir, "exr: folder for the files (default: the temp folder)");
-    args.option("--out", &job.out, "fruc: report folder (default out/bench-fruc)");
-    args.option("--scenes", &job.scenes, "fruc: comma-separated scenes (default: every built-in scene)");
+    args.option("--out", &job.out, "fruc, stereo: report folder (default out/bench-fruc, out/bench-stereo)");
+    args.option("--scenes", &job.scenes, "fruc, stereo: comma-separated scenes (default: every built-in scene)");
     args.option("--factor", &job.factor, "fruc: K, output frames per input frame (default 2)");
-    args.option("--size", &job.size, "fruc: WxH (default 640x360)");
+    args.option("--size", &job.size, "fruc, stereo: WxH (default 640x360)");
     args.flag("--quick", &job.quick, "fruc: a few settings only (grid+pullpush, reverse+pullpush, splat+none, ...)");
-    args.option("--repeat", &job.repeat, "fruc: timed runs, each frame's fastest counts (default 3)");
+    args.option("--repeat", &job.repeat, "fruc, stereo: timed runs, each frame's fastest counts (default 3)");
     args.flag("--exr", &job.exr, "fruc: also write the rendered input and truth as EXR under OUT/SCENE/");
     Status parsed = args.parse(argc, argv);
     if (!parsed.ok() || args.help_requested()) return report(args, parsed, {});
@@ -152,7 +153,7 @@ int command_bench(int argc, char** argv) {
     else if (job.what == "fruc") result = bench_fruc(job);
     else if (job.what == "stereo") result = bench_stereo(job);
     else result = Status::error("bench: unknown benchmark '" + job.what +
-                                "' (render, exr, reproject, grid, fill, fruc)");
+                                "' (render, exr, reproject, grid, fill, fruc, stereo)");
     return report(args, parsed, result);
 }
 

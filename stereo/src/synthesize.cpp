@@ -97,7 +97,7 @@ StereoStats StereoSynthesizer::synthesize(const Frame& rendered, const Camera& t
         }
         stats.cells += warp_into(*history, target, o,
                                  {history_color_.view(), history_depth_.view(), {}, history_covered_.view()});
-        const bool closer = distance_between(history->camera, target) <
+        const bool closer = o.history_replaces && distance_between(history->camera, target) <
                             distance_between(rendered.camera, target);
         const float tol = o.history_depth_tolerance;
         std::size_t taken = 0;
