@@ -2,41 +2,23 @@
 // or a hang. Also walks every glTF file of Debian's assimp-testmodels through `reprise render`.
 #include <gtest/gtest.h>
 
-#include <sys/wait.h>
-
-#include <array>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
 
+#include "support/cli.hpp"
+
 namespace fs = std::filesystem;
+using reprise::test::fresh_directory;
+using reprise::test::Outcome;
 
 namespace {
 
-struct Outcome {
-    int status = -1;  // exit status; 128 + signal when killed, 124 when it timed out
-    std::string output;
-};
-
-Outcome run(const std::string& arguments) {
-    std::string command = "timeout 120 " REPRISE_BINARY " " + arguments + " 2>&1";
-    Outcome r;
-    FILE* pipe = popen(command.c_str(), "r");
-    if (!pipe) return r;
-    std::array<char, 4096> buffer;
-    std::size_t n;
-    while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0) r.output.append(buffer.data(), n);
-    int raw = pclose(pipe);
-    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : 128 + WTERMSIG(raw);
-    return r;
-}
+Outcome run(const std::string& arguments) { return reprise::test::run_reprise(arguments, 120); }
 
 fs::path scratch(const std::string& name) {
-    fs::path dir = fs::temp_directory_path() / ("reprise-cli-" + name);
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    return dir;
+    return fresh_directory(fs::temp_directory_path() / ("reprise-cli-" + name));
 }
 
 void expect_clean_failure(const Outcome& r, const std::string& must_mention, const std::string& what) {

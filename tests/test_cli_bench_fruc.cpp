@@ -1,11 +1,8 @@
 // `reprise bench fruc` end to end on a tiny scene: the CSV rows, the summary and the HTML report.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
-#include <array>
 #include <cmath>
-#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -14,35 +11,14 @@
 #include <string>
 #include <vector>
 
+#include "support/cli.hpp"
+
 namespace fs = std::filesystem;
+using namespace reprise::test;
 
 namespace {
 
-struct Outcome {
-    int status = -1;  // exit status; 128 + signal when killed, 124 when it timed out
-    std::string output;
-};
-
-Outcome run(const std::string& arguments) {
-    std::string command = "timeout 300 " REPRISE_BINARY " " + arguments + " 2>&1";
-    Outcome r;
-    FILE* pipe = popen(command.c_str(), "r");
-    if (!pipe) return r;
-    std::array<char, 4096> buffer;
-    std::size_t n;
-    while ((n = fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
-        r.output.append(buffer.data(), n);
-    int raw = pclose(pipe);
-    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : 128 + WTERMSIG(raw);
-    return r;
-}
-
-std::string read_text(const fs::path& path) {
-    std::ifstream file(path);
-    std::stringstream text;
-    text << file.rdbuf();
-    return text.str();
-}
+Outcome run(const std::string& arguments) { return run_reprise(arguments, 300); }
 
 std::vector<std::string> fields(const std::string& line) {
     std::vector<std::string> out;

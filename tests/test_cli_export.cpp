@@ -13,36 +13,23 @@
 #include "commands.hpp"
 #include "reprise/core/exr.hpp"
 #include "reprise/core/metrics.hpp"
+#include "support/cli.hpp"
 
 using namespace reprise;
 namespace fs = std::filesystem;
 
 namespace {
 
-int run_command(int (*command)(int, char**), std::vector<std::string> args) {
-    std::vector<char*> argv;
-    for (std::string& a : args) argv.push_back(a.data());
-    return command(int(argv.size()), argv.data());
-}
-
-std::string run_output(const std::string& command) {
-    std::string out;
-    FILE* pipe = ::popen(command.c_str(), "r");
-    if (!pipe) return out;
-    char buf[256];
-    while (std::fgets(buf, sizeof buf, pipe)) out += buf;
-    ::pclose(pipe);
-    return out;
-}
+using test::fresh_directory;
+using test::run_command;
+using test::run_output;
 
 class CliExport : public testing::Test {
   protected:
     void SetUp() override {
-        root_ = fs::temp_directory_path() /
-                ("reprise_test_cli_export_" + std::to_string(::getpid()) + "_" +
-                 testing::UnitTest::GetInstance()->current_test_info()->name());
-        fs::remove_all(root_);
-        fs::create_directories(root_);
+        root_ = fresh_directory(fs::temp_directory_path() /
+                                ("reprise_test_cli_export_" + std::to_string(::getpid()) + "_" +
+                                 testing::UnitTest::GetInstance()->current_test_info()->name()));
     }
     void TearDown() override { fs::remove_all(root_); }
 

@@ -9,26 +9,22 @@
 #include "commands.hpp"
 #include "reprise/core/exr.hpp"
 #include "reprise/core/metrics.hpp"
+#include "support/cli.hpp"
+#include "support/frames.hpp"
 
 using namespace reprise;
 namespace fs = std::filesystem;
 
 namespace {
 
-int run_command(int (*command)(int, char**), std::vector<std::string> args) {
-    std::vector<char*> argv;
-    for (std::string& a : args) argv.push_back(a.data());
-    return command(int(argv.size()), argv.data());
-}
+using test::display_psnr;
+using test::run_command;
 
 double psnr_of(const std::string& a_file, const std::string& b_file) {
     Frame a, b;
     EXPECT_TRUE(read_frame(a_file, a).ok());
     EXPECT_TRUE(read_frame(b_file, b).ok());
-    Image<glm::vec3> da(a.width(), a.height()), db(b.width(), b.height());
-    to_display(a.color.view(), da.view());
-    to_display(b.color.view(), db.view());
-    return psnr(da.view(), db.view());
+    return display_psnr(a.color, b.color);
 }
 
 }  // namespace

@@ -10,31 +10,21 @@
 
 #include "reprise/core/video.hpp"
 #include "reprise/core/visualize.hpp"
+#include "support/cli.hpp"
+#include "support/frames.hpp"
 
 using namespace reprise;
 namespace fs = std::filesystem;
 
 namespace {
 
-constexpr float kInf = std::numeric_limits<float>::infinity();
-constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+using test::kInf;
+using test::kNaN;
+using test::run_output;
 
 fs::path temp_dir(const std::string& name) {
-    fs::path dir = fs::temp_directory_path() /
-                   ("reprise_test_export_" + name + "_" + std::to_string(::getpid()));
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    return dir;
-}
-
-std::string run_output(const std::string& command) {
-    std::string out;
-    FILE* pipe = ::popen(command.c_str(), "r");
-    if (!pipe) return out;
-    char buf[256];
-    while (std::fgets(buf, sizeof buf, pipe)) out += buf;
-    ::pclose(pipe);
-    return out;
+    return test::fresh_directory(fs::temp_directory_path() / ("reprise_test_export_" + name + "_" +
+                                                              std::to_string(::getpid())));
 }
 
 }  // namespace

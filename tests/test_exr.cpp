@@ -13,6 +13,8 @@
 #include <random>
 
 #include "reprise/core/exr.hpp"
+#include "support/cli.hpp"
+#include "support/frames.hpp"
 
 namespace fs = std::filesystem;
 using namespace reprise;
@@ -23,10 +25,9 @@ class ExrTest : public ::testing::Test {
   protected:
     void SetUp() override {
         const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-        dir_ = fs::temp_directory_path() /
-               ("reprise_exr_" + std::to_string(::getpid()) + "_" + info->name());
-        fs::remove_all(dir_);
-        fs::create_directories(dir_);
+        dir_ = test::fresh_directory(
+            fs::temp_directory_path() /
+            ("reprise_exr_" + std::to_string(::getpid()) + "_" + info->name()));
     }
     void TearDown() override { fs::remove_all(dir_); }
     std::string path(const std::string& name) const { return (dir_ / name).string(); }
@@ -41,11 +42,7 @@ float random_bits(std::mt19937& rng) {
     return f;
 }
 
-template <class T>
-bool same_bits(const Image<T>& a, const Image<T>& b) {
-    return a.width() == b.width() && a.height() == b.height() &&
-           std::memcmp(a.data(), b.data(), a.pixel_count() * sizeof(T)) == 0;
-}
+using test::same_bits;
 
 bool same_bits(const glm::mat4& a, const glm::mat4& b) {
     return std::memcmp(&a, &b, sizeof a) == 0;

@@ -8,6 +8,7 @@
 #include <random>
 
 #include "reprise/warp/fill.hpp"
+#include "support/frames.hpp"
 
 using glm::vec3;
 using glm::vec4;
@@ -20,8 +21,9 @@ using reprise::warp::PullPush;
 
 namespace {
 
-constexpr float kInf = std::numeric_limits<float>::infinity();
-constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+using reprise::test::kInf;
+using reprise::test::kNaN;
+using reprise::test::same_bits;
 
 Image<vec4> random_image(int w, int h, unsigned seed) {
     Image<vec4> img(w, h);
@@ -53,11 +55,6 @@ Image<float> random_depth(int w, int h, unsigned seed) {
                                       : 10.0f + 100 * r;
     }
     return depth;
-}
-
-bool same_bits(const Image<vec4>& a, const Image<vec4>& b) {
-    return a.pixel_count() == b.pixel_count() &&
-           std::memcmp(a.data(), b.data(), a.pixel_count() * sizeof(vec4)) == 0;
 }
 
 bool all_finite(const Image<vec4>& img) {

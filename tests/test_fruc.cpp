@@ -9,21 +9,16 @@
 #include "reprise/server/builtin_scenes.hpp"
 #include "reprise/server/renderer.hpp"
 #include "reprise/warp/fruc.hpp"
+#include "support/frames.hpp"
+#include "support/renderer.hpp"
 
 using namespace reprise;
 using namespace reprise::warp;
 
 namespace {
 
-server::Renderer& renderer() {
-    static std::unique_ptr<server::Renderer> r = [] {
-        std::unique_ptr<server::Renderer> made;
-        Status status = server::Renderer::create(made);
-        if (!status.ok()) ADD_FAILURE() << status.message();
-        return made;
-    }();
-    return *r;
-}
+using test::display_psnr;
+using test::shared_renderer;
 
 // Frames [first, first + count) of `scene` at `fps`.
 std::vector<Frame> render(const std::string& scene_name, double fps, int first, int count,
@@ -33,15 +28,12 @@ std::vector<Frame> render(const std::string& scene_name, double fps, int first, 
     EXPECT_TRUE(server::load_scene(scene_name, scene, path).ok());
     std::vector<Frame> frames(count);
     for (int i = 0; i < count; ++i)
-        EXPECT_TRUE(renderer().render_frame(scene, path, first + i, fps, {.width = w, .height = h}, frames[i]).ok());
+        EXPECT_TRUE(shared_renderer().render_frame(scene, path, first + i, fps, {.width = w, .height = h}, frames[i]).ok());
     return frames;
 }
 
 double psnr_of(const Frame& truth, const Frame& test) {
-    Image<glm::vec3> a(truth.width(), truth.height()), b(truth.width(), truth.height());
-    to_display(truth.color.view(), a.view());
-    to_display(test.color.view(), b.view());
-    return psnr(a.view(), b.view());
+    return display_psnr(truth.color, test.color);
 }
 
 std::vector<Frame> convert(const std::vector<Frame>& inputs, int factor, const FrucOptions& options,

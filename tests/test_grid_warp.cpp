@@ -3,50 +3,22 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 #include <random>
 
 #include "reprise/warp/grid_warp.hpp"
+#include "support/frames.hpp"
+#include "support/warp.hpp"
 
 using namespace reprise;
 using namespace reprise::warp;
+using namespace reprise::test;
 
 namespace {
 
-constexpr float kInf = std::numeric_limits<float>::infinity();
-constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
-
-Frame flat_frame(int w, int h, float depth, glm::vec2 motion, uint32_t seed = 1) {
-    Frame f;
-    f.color.resize(w, h);
-    f.depth.resize(w, h, depth);
-    f.motion.resize(w, h, motion);
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<float> u(0.0f, 1.0f);
-    for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) f.color(x, y) = {u(rng), u(rng), u(rng), 1.0f};
-    return f;
-}
-
-struct Output {
-    Image<glm::vec4> color;
-    Image<float> depth;
-    Image<glm::vec2> motion;
-    Image<uint8_t> covered;
-    Output(int w, int h)
-        : color(w, h, glm::vec4(-7.0f)),
-          depth(w, h, -3.0f),
-          motion(w, h, glm::vec2(99.0f)),
-          covered(w, h, 5) {}
-    WarpTarget target() { return {color.view(), depth.view(), motion.view(), covered.view()}; }
-};
-
-template <class T>
-bool same_bits(const Image<T>& a, const Image<T>& b) {
-    return a.width() == b.width() && a.height() == b.height() &&
-           std::memcmp(a.data(), b.data(), a.pixel_count() * sizeof(T)) == 0;
-}
+using Output = WarpOutput;
 
 // Runs the threaded warp and the reference and checks that they agree bit for bit.
 GridStats warp_both(const Frame& f, float factor, Output& out, const GridOptions& o = {}) {
@@ -56,11 +28,29 @@ GridStats warp_both(const Frame& f, float factor, Output& out, const GridOptions
     const GridStats slow = warper.warp_reference(f, factor, ref.target(), o);
     EXPECT_EQ(fast.cells, slow.cells);
     EXPECT_EQ(fast.covered, slow.covered);
-    EXPECT_TRUE(same_bits(out.color, ref.color));
-    EXPECT_TRUE(same_bits(out.depth, ref.depth));
-    EXPECT_TRUE(same_bits(out.motion, ref.motion));
-    EXPECT_TRUE(same_bits(out.covered, ref.covered));
+    expect_same(out, ref);
     return fast;
+}
+
+// A level camera above a ground plane (the horizon above the image) that moved forward and
+// sideways since the previous frame: depth varies tenfold down the image, 1/depth is affine in
+// screen space and the motion is projective (neither affine nor constant).
+Frame ground_frame(int w, int h) {
+    const float focal = 200.0f, cx = 0.5f * float(w), cy = -20.0f, height = 1.5f;
+    Frame g = flat_frame(w, h, 1.0f, {0, 0}, 7);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const glm::vec2 p(float(x) + 0.5f, float(y) + 0.5f);
+            const float z = focal * height / (p.y - cy);
+            // The point in the current camera (x right, y down, z ahead), then in the previous
+            // one, which stood 0.3 behind and 0.1 to the left.
+            const glm::vec3 now((p.x - cx) * z / focal, height, z);
+            const glm::vec3 before = now + glm::vec3(0.1f, 0.0f, 0.3f);
+            g.depth(x, y) = z;
+            g.motion(x, y) =
+                glm::vec2(cx + focal * before.x / before.z, cy + focal * before.y / before.z) - p;
+        }
+    return g;
 }
 
 // Depth steps and a sphere-like bump: a frame that refines.
@@ -175,7 +165,7 @@ TEST(GridWarp, NearerOccluderWinsTheFoldOver) {
         }
 }
 
-TEST(GridWarp, StaysCoarseOnAFlatPlaneAndRefinesAtEdges) {
+TEST(GridWarp, StaysCoarseOnPlanesAndRefinesAtEdges) {
     for (auto [w, h] : {std::pair{320, 180}, std::pair{100, 33}, std::pair{32, 32}}) {
         Frame flat = flat_frame(w, h, 7.0f, {2.3f, -1.1f});
         Output out(w, h);
@@ -183,17 +173,72 @@ TEST(GridWarp, StaysCoarseOnAFlatPlaneAndRefinesAtEdges) {
         EXPECT_EQ(s.cells, std::size_t((w + 31) / 32) * ((h + 31) / 32)) << w << "x" << h;
     }
     Frame flat = flat_frame(320, 180, 7.0f, {0, 0});
+    Output out(320, 180);
+    const std::size_t coarse = warp_both(flat, -0.5f, out).cells;  // 10 x 6 starting cells
+
+    // A tilted ground in perspective: within one starting cell depth changes by up to a factor
+    // 2.6 and motion by up to 8 px, yet the cells interpolate it to within the thresholds and
+    // stay big. (A rule on depth ratios or motion ranges splits all of them.)
+    const Frame ground = ground_frame(320, 180);
+    EXPECT_GT(ground.depth(0, 0) / ground.depth(0, 31), 2.5f);
+    EXPECT_GT(std::abs(ground.motion(0, 179).x - ground.motion(31, 179).x), 4.0f);
+    const std::size_t tilted = warp_both(ground, -0.5f, out).cells;
+    std::printf("[grid] tilted ground: %zu cells (%zu starting cells)\n", tilted, coarse);
+    EXPECT_LE(tilted, coarse + coarse / 2);
+
     Frame edge = flat;
     for (int y = 0; y < 180; ++y)
         for (int x = 150; x < 320; ++x) edge.depth(x, y) = 9.0f;  // a depth step at x = 150
-    Output out(320, 180);
-    const std::size_t coarse = warp_both(flat, -0.5f, out).cells;
     const std::size_t refined = warp_both(edge, -0.5f, out).cells;
     EXPECT_GT(refined, coarse + 2 * 180 / 2 / 2);  // at least a column of 2 px cells on each side
     Frame moving = flat;
     for (int y = 90; y < 180; ++y)
         for (int x = 0; x < 320; ++x) moving.motion(x, y) = {3.0f, 0.0f};  // a motion edge
     EXPECT_GT(warp_both(moving, -0.5f, out).cells, coarse);
+    // A pole one pixel wide inside a cell, away from every corner and midpoint of it: every
+    // pixel is tested, so the cells around it split down to the smallest.
+    for (Frame pole : {ground, flat}) {
+        const std::size_t before = warp_both(pole, -0.5f, out).cells;
+        for (int y = 0; y < 180; ++y) {
+            pole.depth(141, y) *= 0.5f;
+            pole.motion(141, y).x += 2.0f;
+        }
+        EXPECT_GT(warp_both(pole, -0.5f, out).cells, before + 180 / 2);
+    }
+    // A curved motion field (a lens-like swirl): big cells depart from it by more than the
+    // threshold, cells of 16 px do not.
+    Frame curved = flat;
+    for (int y = 0; y < 180; ++y)
+        for (int x = 0; x < 320; ++x) {
+            const float dx = float(x) - 160.0f, dy = float(y) - 90.0f;
+            curved.motion(x, y) = 0.004f * glm::vec2(dx * dx, dy * dy);
+        }
+    const std::size_t bent = warp_both(curved, -0.5f, out).cells;
+    EXPECT_GT(bent, 2 * coarse);
+    EXPECT_LE(bent, 4 * coarse);
+    // The thresholds are in target pixels: the same field warped by a tenth of a frame moves
+    // little, and a cell may stay big.
+    EXPECT_EQ(warp_both(curved, -0.1f, out).cells, coarse);
+}
+
+TEST(GridWarp, PerspectiveDepthOnATiltedPlane) {
+    // The ground keeps 32 px cells (no motion to follow at factor 0) over which depth changes
+    // up to 2.6-fold; drawing 1/depth linearly keeps it exact but for the vertex means, where
+    // interpolating depth itself would be off by up to 6 % below the top row of cells (25 % in
+    // it). Vertices on the image border take the depth of the pixels beside them, half a pixel
+    // inside: the cells along the top and bottom borders are off by up to that, 2.4 % here.
+    const Frame ground = ground_frame(320, 180);
+    Output out(320, 180);
+    EXPECT_EQ(warp_both(ground, 0.0f, out).cells, std::size_t(10 * 6));
+    float inside = 0.0f, border = 0.0f;
+    for (int y = 0; y < 180; ++y)
+        for (int x = 0; x < 320; ++x) {
+            ASSERT_EQ(out.covered(x, y), 1);
+            float& worst = y >= 32 && y < 160 ? inside : border;
+            worst = std::max(worst, std::abs(out.depth(x, y) / ground.depth(x, y) - 1.0f));
+        }
+    EXPECT_LT(inside, 5e-4f);
+    EXPECT_LT(border, 0.03f);
 }
 
 TEST(GridWarp, SmoothMotionLeavesNoCracks) {
@@ -283,6 +328,19 @@ TEST(GridWarp, ThreadedEqualsReferenceOnRandomFrames) {
                         (void)warp_both(f, factor, out, {.cell = cell, .min_cell = min_cell});
                     }
         }
+    // Smooth but curved fields, where the smoothness test decides close to its thresholds, with
+    // perspective-correct depth and background.
+    for (auto [w, h] : {std::pair{301, 203}, std::pair{130, 67}}) {
+        Frame g = ground_frame(w, h);
+        for (int x = 0; x < w; ++x) g.depth(x, 0) = kInf;
+        for (float factor : {-0.5f, 0.37f, -1.3f})
+            for (float threshold : {0.05f, 0.25f, 1.0f}) {
+                Output out(w, h);
+                (void)warp_both(
+                    g, factor, out,
+                    {.depth_threshold = threshold * 0.04f, .motion_threshold = threshold});
+            }
+    }
 }
 
 TEST(GridWarp, WorstCasesGiveNoCoverageAndNoCrash) {

@@ -10,21 +10,14 @@
 #include "reprise/server/animation.hpp"
 #include "reprise/server/builtin_scenes.hpp"
 #include "reprise/server/renderer.hpp"
+#include "support/renderer.hpp"
 
 using namespace reprise;
 using namespace reprise::server;
 
 namespace {
 
-Renderer& shared_renderer() {
-    static std::unique_ptr<Renderer> renderer = [] {
-        std::unique_ptr<Renderer> r;
-        Status status = Renderer::create(r);
-        if (!status.ok()) ADD_FAILURE() << status.message();
-        return r;
-    }();
-    return *renderer;
-}
+using reprise::test::shared_renderer;
 
 // A 256x256 texture of smooth stripes.
 Texture stripes() {

@@ -11,14 +11,15 @@
 #include <vector>
 
 #include "reprise/warp/reproject.hpp"
+#include "support/frames.hpp"
 
 namespace {
 
 using namespace reprise;
 using namespace reprise::warp;
 
-constexpr float kInf = std::numeric_limits<float>::infinity();
-constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+using test::kInf;
+using test::kNaN;
 
 struct Buffer {
     int w = 0, h = 0, c = 0;
@@ -32,10 +33,7 @@ struct Buffer {
 };
 
 Frame make_frame(int w, int h, float depth, glm::vec2 motion, uint32_t id = 1) {
-    Frame f;
-    f.color.resize(w, h);
-    f.depth.resize(w, h, depth);
-    f.motion.resize(w, h, motion);
+    Frame f = test::constant_frame(w, h, depth, motion);
     f.normal.resize(w, h);
     f.id.resize(w, h, id);
     return f;

@@ -7,53 +7,16 @@
 #include <random>
 
 #include "reprise/warp/splat.hpp"
+#include "support/frames.hpp"
+#include "support/warp.hpp"
 
 using namespace reprise;
 using namespace reprise::warp;
+using namespace reprise::test;
 
 namespace {
 
-constexpr float kInf = std::numeric_limits<float>::infinity();
-constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
-
-Frame flat_frame(int w, int h, float depth, glm::vec2 motion, uint32_t seed = 1) {
-    Frame f;
-    f.color.resize(w, h);
-    f.depth.resize(w, h, depth);
-    f.motion.resize(w, h, motion);
-    std::mt19937 rng(seed);
-    std::uniform_real_distribution<float> u(0.0f, 1.0f);
-    for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) f.color(x, y) = {u(rng), u(rng), u(rng), 1.0f};
-    return f;
-}
-
-struct Output {
-    Image<glm::vec4> color;
-    Image<float> depth;
-    Image<glm::vec2> motion;
-    Image<uint8_t> covered;
-    // Filled with garbage: the warp must initialise everything itself.
-    Output(int w, int h)
-        : color(w, h, glm::vec4(-7.0f)),
-          depth(w, h, -3.0f),
-          motion(w, h, glm::vec2(99.0f)),
-          covered(w, h, 5) {}
-    WarpTarget target() { return {color.view(), depth.view(), motion.view(), covered.view()}; }
-};
-
-template <class T>
-bool same_bits(const Image<T>& a, const Image<T>& b) {
-    return a.width() == b.width() && a.height() == b.height() &&
-           std::memcmp(a.data(), b.data(), a.pixel_count() * sizeof(T)) == 0;
-}
-
-void expect_same(const Output& a, const Output& b) {
-    EXPECT_TRUE(same_bits(a.color, b.color));
-    EXPECT_TRUE(same_bits(a.depth, b.depth));
-    EXPECT_TRUE(same_bits(a.motion, b.motion));
-    EXPECT_TRUE(same_bits(a.covered, b.covered));
-}
+using Output = WarpOutput;
 
 using SplatFn = std::size_t (*)(const Frame&, float, const WarpTarget&, const SplatOptions&);
 const SplatFn kBoth[] = {&splat, &splat_reference};

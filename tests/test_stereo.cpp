@@ -15,13 +15,17 @@
 #include "reprise/stereo/compose.hpp"
 #include "reprise/stereo/rig.hpp"
 #include "reprise/stereo/synthesize.hpp"
+#include "support/frames.hpp"
+#include "support/renderer.hpp"
 
 using namespace reprise;
 using namespace reprise::stereo;
 
 namespace {
 
-constexpr float kInf = std::numeric_limits<float>::infinity();
+using test::display_psnr;
+using test::kInf;
+using test::shared_renderer;
 
 Camera camera_at(int w, int h) {
     Camera c;
@@ -36,10 +40,7 @@ Camera camera_at(int w, int h) {
 
 // A frame whose colour encodes its column (red) and row (green), at constant depth.
 Frame plane(int w, int h, float depth, const Camera& camera) {
-    Frame f;
-    f.color.resize(w, h);
-    f.depth.resize(w, h, depth);
-    f.motion.resize(w, h);
+    Frame f = test::constant_frame(w, h, depth, {});
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) f.color(x, y) = {float(x) / w, float(y) / h, 0.25f, 1.0f};
     f.camera = camera;
@@ -55,23 +56,6 @@ bool all_finite(const Image<glm::vec4>& image) {
             return false;
     }
     return true;
-}
-
-double psnr_of(const Image<glm::vec4>& truth, const Image<glm::vec4>& test) {
-    Image<glm::vec3> a(truth.width(), truth.height()), b(truth.width(), truth.height());
-    to_display(truth.view(), a.view());
-    to_display(test.view(), b.view());
-    return psnr(a.view(), b.view());
-}
-
-server::Renderer& renderer() {
-    static std::unique_ptr<server::Renderer> r = [] {
-        std::unique_ptr<server::Renderer> made;
-        Status status = server::Renderer::create(made);
-        if (!status.ok()) ADD_FAILURE() << status.message();
-        return made;
-    }();
-    return *r;
 }
 
 struct EyePair {
@@ -100,7 +84,7 @@ EyePair render_eyes(const std::string& scene_name, double t, double dt, const St
         a.projection = c.projection;
         b.view = c.prev_view;
         b.projection = c.prev_projection;
-        EXPECT_TRUE(renderer().render(scene, a, b, {.width = w, .height = h}, f).ok());
+        EXPECT_TRUE(shared_renderer().render(scene, a, b, {.width = w, .height = h}, f).ok());
     };
     render_eye(pair.cameras.left, pair.left);
     render_eye(pair.cameras.right, pair.right);
@@ -267,8 +251,8 @@ TEST(StereoRendered, SynthesizedRightEyeIsCloseToTheRenderedOne) {
         for (StereoWarp method : {StereoWarp::Grid, StereoWarp::Splat}) {
             Frame right;
             StereoStats stats = synthesize_eye(pair.left, pair.cameras.right, {.warp = method}, right);
-            const double ours = psnr_of(pair.right.color, right.color);
-            const double copy = psnr_of(pair.right.color, pair.left.color);
+            const double ours = display_psnr(pair.right.color, right.color);
+            const double copy = display_psnr(pair.right.color, pair.left.color);
             std::printf("[stereo] pan ipd %.3f %s: %.2f dB (copying the left eye: %.2f dB), %zu holes\n",
                         ipd, method == StereoWarp::Grid ? "grid" : "splat", ours, copy, stats.holes);
             if (method == StereoWarp::Grid) {
@@ -300,7 +284,8 @@ TEST(StereoTemporal, PreviousOtherEyeFillsDisocclusions) {
     Frame plain, temporal;
     synthesizer.synthesize(now.left, now.cameras.right, plain);
     StereoStats stats = synthesizer.synthesize(now.left, now.cameras.right, temporal, {}, &before.right);
-    const double a = psnr_of(now.right.color, plain.color), b = psnr_of(now.right.color, temporal.color);
+    const double a = display_psnr(now.right.color, plain.color),
+                 b = display_psnr(now.right.color, temporal.color);
     std::printf("[stereo] temporal: %.2f dB (without: %.2f dB), %zu of %zu holes from history\n", b, a,
                 stats.from_history, stats.holes);
     EXPECT_GT(stats.from_history, 0u);
