@@ -32,6 +32,15 @@ void extrapolate_frame(const Frame& f, float s, const FrucOptions& options, Fruc
     const glm::mat4 unproject = glm::inverse(c.projection * c.view);
     const glm::mat4 to_previous = c.prev_projection * c.prev_view;
     const glm::mat4 to_future = future.projection * future.view;
+    // A perspective projection without skew maps view depth d and NDC (nx, ny) to the view-space
+    // point (d (nx + P20) / P00, d (ny + P21) / P11, -d): two matrix products per pixel instead of six.
+    const glm::mat4& P = c.projection;
+    const bool simple_perspective = P[3][3] == 0.0f && P[2][3] == -1.0f && P[1][0] == 0.0f &&
+                                    P[0][1] == 0.0f && P[3][0] == 0.0f && P[3][1] == 0.0f &&
+                                    P[0][0] != 0.0f && P[1][1] != 0.0f;
+    const glm::mat4 camera_to_world = glm::inverse(c.view);
+    const glm::mat4 view_to_previous = to_previous * camera_to_world;
+    const glm::mat4 view_to_future = to_future * camera_to_world;
 
     // Static layer: pixels whose motion the camera alone explains, moved to the future camera.
     Frame& layer = scratch.layer;
@@ -48,7 +57,15 @@ void extrapolate_frame(const Frame& f, float s, const FrucOptions& options, Fruc
                 glm::vec2 p(x + 0.5f, y + 0.5f);
                 glm::vec4 ndc(2.0f * p.x / w - 1.0f, 1.0f - 2.0f * p.y / h, 0.0f, 1.0f);
                 glm::vec4 world;
-                if (std::isinf(z)) {  // background: the direction through the pixel
+                glm::mat4 const* previous_of = &to_previous;
+                glm::mat4 const* future_of = &to_future;
+                if (simple_perspective) {  // `world` holds the view-space point or direction
+                    float d = std::isinf(z) ? 1.0f : z;
+                    world = glm::vec4(d * (ndc.x + P[2][0]) / P[0][0], d * (ndc.y + P[2][1]) / P[1][1],
+                                      -d, std::isinf(z) ? 0.0f : 1.0f);
+                    previous_of = &view_to_previous;
+                    future_of = &view_to_future;
+                } else if (std::isinf(z)) {  // background: the direction through the pixel
                     glm::vec4 a = unproject * glm::vec4(glm::vec2(ndc), -1.0f, 1.0f);
                     glm::vec4 b = unproject * glm::vec4(glm::vec2(ndc), 0.0f, 1.0f);
                     world = glm::vec4(glm::vec3(b) / b.w - glm::vec3(a) / a.w, 0.0f);
@@ -64,8 +81,8 @@ void extrapolate_frame(const Frame& f, float s, const FrucOptions& options, Fruc
                 glm::vec2 before, later;
                 bool ok = std::isfinite(z) || std::isinf(z);
                 ok = ok && std::isfinite(m.x) && std::isfinite(m.y);
-                ok = ok && to_pixels(to_previous, world, w, h, before) &&
-                     to_pixels(to_future, world, w, h, later);
+                ok = ok && to_pixels(*previous_of, world, w, h, before) &&
+                     to_pixels(*future_of, world, w, h, later);
                 bool still = ok && glm::length(before - p - m) <= options.static_tolerance;
                 if (still) {
                     layer.motion(x, y) = later - p;
