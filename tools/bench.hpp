@@ -3,7 +3,11 @@
 // against a peer (OpenCV, ffmpeg) measured in the same run on the same input.
 #include <string>
 
+#include <memory>
+
 #include "reprise/core/status.hpp"
+#include "reprise/server/builtin_scenes.hpp"
+#include "reprise/server/renderer.hpp"
 
 namespace reprise::cli {
 
@@ -21,6 +25,14 @@ struct BenchOptions {
     bool exr = false;                       // also write the rendered input and truth as EXR
     int repeat = 3;                         // timed runs; each frame's fastest counts
 };
+
+// A scene, its camera path and a renderer: what every benchmark that renders starts from.
+struct BenchScene {
+    server::Scene scene;
+    server::CameraPath path;
+    std::unique_ptr<server::Renderer> renderer;
+};
+Status open_bench_scene(const std::string& name, BenchScene& bench);
 
 Status bench_reproject(const BenchOptions& options);  // reverse reprojection vs cv::remap
 Status bench_grid(const BenchOptions& options);       // splat and adaptive grid warp

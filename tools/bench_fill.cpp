@@ -68,11 +68,9 @@ struct Method {
 }  // namespace
 
 Status bench_fill(const BenchOptions& options) {
-    server::Scene scene;
-    server::CameraPath path;
-    REPRISE_TRY(server::load_scene(options.scene, scene, path));
-    std::unique_ptr<server::Renderer> renderer;
-    REPRISE_TRY(server::Renderer::create(renderer));
+    BenchScene bench;
+    REPRISE_TRY(open_bench_scene(options.scene, bench));
+    auto& [scene, path, renderer] = bench;
     std::printf("hole filling on scene %s, %d frames per size, %d threads (ours), renderer %s\n",
                 options.scene.c_str(), options.frames, thread_count(), renderer->device().c_str());
     std::printf(

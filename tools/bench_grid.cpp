@@ -120,11 +120,9 @@ Status bench_size(server::Renderer& renderer, const server::Scene& scene,
 }  // namespace
 
 Status bench_grid(const BenchOptions& options) {
-    server::Scene scene;
-    server::CameraPath path;
-    REPRISE_TRY(server::load_scene(options.scene, scene, path));
-    std::unique_ptr<server::Renderer> renderer;
-    REPRISE_TRY(server::Renderer::create(renderer));
+    BenchScene bench;
+    REPRISE_TRY(open_bench_scene(options.scene, bench));
+    auto& [scene, path, renderer] = bench;
     cv::setNumThreads(thread_count());
     std::printf(
         "forward warps extrapolating by %.1f frame (RGBA float, depth, motion, coverage) vs "

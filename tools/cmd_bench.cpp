@@ -41,11 +41,9 @@ Status for_each_size(const std::string& sizes, const std::function<Status(int, i
 }
 
 Status bench_render(const BenchJob& job) {
-    server::Scene scene;
-    server::CameraPath path;
-    REPRISE_TRY(server::load_scene(job.scene, scene, path));
-    std::unique_ptr<server::Renderer> renderer;
-    REPRISE_TRY(server::Renderer::create(renderer));
+    BenchScene bench;
+    REPRISE_TRY(open_bench_scene(job.scene, bench));
+    auto& [scene, path, renderer] = bench;
     std::printf("renderer: %s, scene %s, %d frames per size\n", renderer->device().c_str(),
                 job.scene.c_str(), job.frames);
     std::printf("%-11s %10s %10s\n", "size", "ms/frame", "frames/s");
@@ -69,11 +67,9 @@ Status bench_render(const BenchJob& job) {
 // EXR write and read of full G-buffer frames, against writing and reading the same bytes raw
 // (the floor any file format pays), measured in the same run.
 Status bench_exr(const BenchJob& job) {
-    server::Scene scene;
-    server::CameraPath path;
-    REPRISE_TRY(server::load_scene(job.scene, scene, path));
-    std::unique_ptr<server::Renderer> renderer;
-    REPRISE_TRY(server::Renderer::create(renderer));
+    BenchScene bench;
+    REPRISE_TRY(open_bench_scene(job.scene, bench));
+    auto& [scene, path, renderer] = bench;
     std::string dir = job.dir.empty() ? (std::filesystem::temp_directory_path() / "reprise-bench-exr").string()
                                       : job.dir;
     std::error_code ec;
@@ -119,6 +115,11 @@ Status bench_exr(const BenchJob& job) {
 }
 
 }  // namespace
+
+Status open_bench_scene(const std::string& name, BenchScene& bench) {
+    REPRISE_TRY(server::load_scene(name, bench.scene, bench.path));
+    return server::Renderer::create(bench.renderer);
+}
 
 int command_bench(int argc, char** argv) {
     BenchJob job;

@@ -25,32 +25,6 @@ struct Options {
     double ppd = 67.0;
 };
 
-// "mask_9.png" before "mask_10.png", as open_sequence orders frames.
-bool natural_less(const std::string& a, const std::string& b) {
-    auto digit = [](char c) { return std::isdigit(static_cast<unsigned char>(c)) != 0; };
-    std::size_t i = 0, j = 0;
-    while (i < a.size() && j < b.size()) {
-        if (digit(a[i]) && digit(b[j])) {
-            std::size_t i_end = i, j_end = j;
-            while (i_end < a.size() && digit(a[i_end])) ++i_end;
-            while (j_end < b.size() && digit(b[j_end])) ++j_end;
-            std::string x = a.substr(i, i_end - i), y = b.substr(j, j_end - j);
-            x.erase(0, std::min(x.find_first_not_of('0'), x.size()));
-            y.erase(0, std::min(y.find_first_not_of('0'), y.size()));
-            if (x.size() != y.size()) return x.size() < y.size();
-            if (x != y) return x < y;
-            i = i_end;
-            j = j_end;
-        } else {
-            if (a[i] != b[j])
-                return static_cast<unsigned char>(a[i]) < static_cast<unsigned char>(b[j]);
-            ++i;
-            ++j;
-        }
-    }
-    if (a.size() - i != b.size() - j) return a.size() - i < b.size() - j;
-    return a < b;
-}
 
 // One PNG for every frame, or a folder with one PNG per frame.
 Status list_masks(const std::string& path, std::size_t frames, std::vector<std::string>& masks) {

@@ -11,7 +11,15 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// "frame_9" < "frame_10": runs of digits compare as numbers, the rest byte by byte.
+bool is_exr(const fs::path& file) {
+    std::string ext = file.extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(),
+                   [](unsigned char c) { return char(std::tolower(c)); });
+    return ext == ".exr" && file.filename().string().front() != '.';
+}
+
+}  // namespace
+
 bool natural_less(const std::string& a, const std::string& b) {
     auto digit = [](char c) { return std::isdigit(static_cast<unsigned char>(c)) != 0; };
     std::size_t i = 0, j = 0;
@@ -37,14 +45,6 @@ bool natural_less(const std::string& a, const std::string& b) {
     return a < b;  // equal up to leading zeros: keep a total order
 }
 
-bool is_exr(const fs::path& file) {
-    std::string ext = file.extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(),
-                   [](unsigned char c) { return char(std::tolower(c)); });
-    return ext == ".exr" && file.filename().string().front() != '.';
-}
-
-}  // namespace
 
 Status open_sequence(const std::string& path, Sequence& sequence) {
     sequence = Sequence{};

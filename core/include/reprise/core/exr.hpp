@@ -47,6 +47,10 @@ Status open_sequence(const std::string& path, Sequence& sequence);
 glm::mat4 exr_world_to_camera(const glm::mat4& view);
 glm::mat4 exr_world_to_ndc(const glm::mat4& projection, const glm::mat4& view);
 
+// "frame_9" < "frame_10": runs of digits compare as numbers, the rest byte by byte; the order
+// of open_sequence.
+bool natural_less(const std::string& a, const std::string& b);
+
 // "DIR/frame_00042.exr"
 std::string frame_path(const std::string& dir, int index);
 
