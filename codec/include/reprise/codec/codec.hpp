@@ -1,0 +1,129 @@
+#pragma once
+// Scene-aware predictive codec: each frame is predicted by reprojecting a reference the decoder
+// holds with the renderer's depth, cameras and motion; only what prediction gets wrong is coded.
+// Bitstream: docs/bitstream.md. Encoder and decoder are push/pull state machines (as dav1d).
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <vector>
+
+#include "reprise/core/frame.hpp"
+
+namespace reprise::codec {
+
+enum class Chroma : uint8_t { C420 = 0, C444 = 1 };
+enum class DepthMode : uint8_t {
+    Lossless = 0,  // bit-exact float depth
+    Bounded = 1,   // relative error of z (and of 1/z) at most depth_error
+    None = 2,      // no depth, no motion: colour prediction uses camera-free zero motion
+};
+
+struct EncoderOptions {
+    int qp = 28;               // quantiser, 0 (finest) .. 51; constant quality when bitrate_kbps = 0
+    int bitrate_kbps = 0;      // > 0: rate control to this bitrate (frames bounded in size)
+    double fps = 30.0;         // for rate control and timestamps when the frames carry none
+    int keyint = 0;            // a key frame at least every keyint frames; 0 = only on cuts/requests
+    Chroma chroma = Chroma::C420;
+    DepthMode depth = DepthMode::Lossless;
+    float depth_error = 1e-4f;  // relative bound for DepthMode::Bounded
+    // A block whose prediction error stays within this many 8-bit display levels on every
+    // channel is skipped (Mueller et al. 2021: T = 8/255 stays under one JND). 0 = skip only
+    // what quantises to nothing.
+    int skip_threshold = 2;
+    bool detect_cuts = true;   // key frame when the prediction misses most pixels
+};
+
+enum class PacketType : uint8_t { Key = 0, Inter = 1 };
+
+struct Packet {
+    std::vector<uint8_t> data;  // header + payload, as sent
+    uint32_t frame = 0;
+    uint32_t reference = 0;     // frame it was predicted from (== frame for key frames)
+    PacketType type = PacketType::Key;
+};
+
+// Bits per stream and what was left out, accumulated over the frames encoded or decoded.
+struct StreamStats {
+    std::size_t frames = 0;
+    std::size_t key_frames = 0;
+    std::size_t older_reference = 0;  // predicted from a frame before the previous one
+    std::size_t header_bits = 0, camera_bits = 0, depth_bits = 0, motion_bits = 0, color_bits = 0;
+    std::size_t blocks = 0;           // 8x8 colour transform blocks (all planes)
+    std::size_t blocks_skipped = 0;   // coded as a flag only
+    std::size_t intra_blocks = 0;     // macroblocks predicted from the current frame
+    std::size_t motion_residual_pixels = 0;  // pixels whose motion the cameras do not explain
+    std::size_t depth_zero_blocks = 0;       // depth blocks predicted exactly
+    std::size_t total_bits() const {
+        return header_bits + camera_bits + depth_bits + motion_bits + color_bits;
+    }
+};
+
+enum class Result { Ok, NeedMoreData, Error };
+
+class Encoder {
+public:
+    explicit Encoder(const EncoderOptions& options = {});
+    ~Encoder();
+    Encoder(Encoder&&) noexcept;
+    Encoder& operator=(Encoder&&) noexcept;
+
+    // Encodes one frame (colour required; depth, motion and the camera enable prediction).
+    // The packet then comes out of receive_packet().
+    [[nodiscard]] Status send_frame(const Frame& frame);
+    // Ok with the next packet, or NeedMoreData.
+    Result receive_packet(Packet& packet);
+    void flush();  // no delayed frames: kept for the state-machine shape
+
+    // Feedback from the receiver: frame n was decoded / was lost.
+    void acknowledge(uint32_t frame);
+    void report_loss(uint32_t frame);
+    void request_key_frame();
+
+    // What the decoder holds after the last packet: colour in linear light, decoded depth and
+    // motion, camera (bit-identical to the decoder's output).
+    const Frame& reconstruction() const;
+    const StreamStats& stats() const;
+    // Bits of the last packet per stream.
+    const StreamStats& last_frame_stats() const;
+    int last_qp() const;
+
+    struct State;
+
+private:
+    std::unique_ptr<State> state_;
+};
+
+class Decoder {
+public:
+    Decoder();
+    ~Decoder();
+    Decoder(Decoder&&) noexcept;
+    Decoder& operator=(Decoder&&) noexcept;
+
+    // Takes one whole packet (header + payload). A bad packet is an error Status naming the
+    // field; the decoder stays usable and resumes at the next decodable frame.
+    [[nodiscard]] Status send_packet(std::span<const uint8_t> packet);
+    // Ok with the next decoded frame, or NeedMoreData.
+    Result receive_frame(Frame& frame);
+    void flush();
+
+    const StreamStats& stats() const;
+
+    struct State;
+
+private:
+    std::unique_ptr<State> state_;
+};
+
+// A .rps file: a file header followed by packets (docs/bitstream.md).
+[[nodiscard]] Status write_stream_header(std::vector<uint8_t>& out, int width, int height, double fps);
+struct StreamInfo {
+    int width = 0, height = 0;
+    double fps = 0.0;
+};
+// Splits a whole .rps file into its packets (each checked for length and CRC only).
+[[nodiscard]] Status split_stream(std::span<const uint8_t> file, StreamInfo& info,
+                                  std::vector<std::span<const uint8_t>>& packets);
+
+}  // namespace reprise::codec
