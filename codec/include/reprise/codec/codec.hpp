@@ -16,7 +16,7 @@ enum class Chroma : uint8_t { C420 = 0, C444 = 1 };
 enum class DepthMode : uint8_t {
     Lossless = 0,  // bit-exact float depth
     Bounded = 1,   // relative error of z (and of 1/z) at most depth_error
-    None = 2,      // no depth, no motion: colour prediction uses camera-free zero motion
+    None = 2,      // no depth: the renderer's motion is sent whole (1/8 px), predicting colour
 };
 
 struct EncoderOptions {
@@ -115,6 +115,9 @@ public:
 private:
     std::unique_ptr<State> state_;
 };
+
+// Checks one packet (length, version, CRC) and reads its header into `info` (data left empty).
+[[nodiscard]] Status inspect_packet(std::span<const uint8_t> packet, Packet& info, int64_t& timestamp_us);
 
 // A .rps file: a file header followed by packets (docs/bitstream.md).
 [[nodiscard]] Status write_stream_header(std::vector<uint8_t>& out, int width, int height, double fps);
