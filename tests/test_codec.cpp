@@ -155,7 +155,7 @@ TEST(CodecPieces, TransformInvertsWithinThreeLevels) {
     std::mt19937 rng(11);
     for (int trial = 0; trial < 500; ++trial) {
         Block x, c, back;
-        const int range = trial % 2 ? 255 : 510;
+        const int range = trial % 3 == 0 ? 510 : trial % 3 == 1 ? 255 : 48;
         for (auto& v : x) v = int32_t(rng() % (2 * range + 1)) - range;
         forward_dct(x, c);
         inverse_dct(c, back);
@@ -163,10 +163,10 @@ TEST(CodecPieces, TransformInvertsWithinThreeLevels) {
         for (int i = 0; i < 64; ++i) {
             // HEVC's integer basis is orthogonal to within 0.1 % in gain: full-range noise comes
             // back within 3 levels, nearly all within 1.
-            ASSERT_LE(std::abs(back[i] - x[i]), 3) << trial << " " << i;
+            ASSERT_LE(std::abs(back[i] - x[i]), range < 64 ? 1 : 3) << trial << " " << i;
             total += std::abs(back[i] - x[i]);
         }
-        ASSERT_LE(total, 40) << trial;
+        ASSERT_LE(total, 64) << trial;
     }
     Block flat, c;
     flat.fill(100);
