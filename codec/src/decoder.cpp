@@ -31,6 +31,7 @@ void add(StreamStats& total, const StreamStats& f) {
 }  // namespace
 
 struct Decoder::State {
+    DecoderOptions options;
     SequenceParams sp;
     bool started = false;
     Picture refs[kReferences];
@@ -47,7 +48,7 @@ struct Decoder::State {
     }
 };
 
-Decoder::Decoder() : state_(std::make_unique<State>()) {}
+Decoder::Decoder(const DecoderOptions& options) : state_(std::make_unique<State>()) { state_->options = options; }
 Decoder::~Decoder() = default;
 Decoder::Decoder(Decoder&&) noexcept = default;
 Decoder& Decoder::operator=(Decoder&&) noexcept = default;
@@ -67,6 +68,9 @@ Status Decoder::send_packet(std::span<const uint8_t> packet) {
     SequenceParams sp = s.sp;
     if (key) {
         REPRISE_TRY(read_params(r, sp));
+        if (int64_t(sp.width) * sp.height > s.options.max_pixels)
+            return Status::error(where + ": " + std::to_string(sp.width) + "x" + std::to_string(sp.height) +
+                                 " is more than this decoder's limit of " + std::to_string(s.options.max_pixels) + " pixels");
     } else if (!s.started) {
         return Status::error(where + ": inter frame before any key frame");
     }

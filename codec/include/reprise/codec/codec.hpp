@@ -94,9 +94,15 @@ private:
     std::unique_ptr<State> state_;
 };
 
+struct DecoderOptions {
+    // Key frames announcing more pixels are refused: what one stream can make the decoder
+    // allocate is bounded (about 60 bytes per pixel for the references it keeps).
+    int64_t max_pixels = int64_t(8192) * 4320;
+};
+
 class Decoder {
 public:
-    Decoder();
+    explicit Decoder(const DecoderOptions& options = {});
     ~Decoder();
     Decoder(Decoder&&) noexcept;
     Decoder& operator=(Decoder&&) noexcept;
