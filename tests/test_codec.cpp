@@ -216,8 +216,12 @@ TEST(Codec, QualityAndSizeAreMonotoneInQp) {
         }
         EXPECT_LT(psnr, previous_psnr) << "qp " << qp;
         EXPECT_LT(bytes, previous_bytes) << "qp " << qp;
-        if (qp == 4) EXPECT_GT(psnr, 48.0);
-        if (qp == 40) EXPECT_GT(psnr, 26.0);
+        if (qp == 4) {
+            EXPECT_GT(psnr, 48.0);
+        }
+        if (qp == 40) {
+            EXPECT_GT(psnr, 26.0);
+        }
         previous_psnr = psnr;
         previous_bytes = bytes;
     }
@@ -449,7 +453,9 @@ TEST(Codec, EightKFrame) {
         ASSERT_EQ(decoder.receive_frame(out), Result::Ok);
         EXPECT_TRUE(same_bits(out.color, encoder.reconstruction().color));
         EXPECT_GT(display_psnr(f.color, out.color), 35.0);
-        if (i == 1) EXPECT_LE(p.data.size(), 64u);  // nothing changed
+        if (i == 1) {
+            EXPECT_LE(p.data.size(), 64u);  // nothing changed
+        }
     }
 }
 

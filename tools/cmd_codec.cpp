@@ -57,10 +57,10 @@ Status parse_depth_mode(const std::string& text, codec::EncoderOptions& o) {
             char* end = nullptr;
             o.depth_error = std::strtof(text.c_str() + 8, &end);
             if (*end || !(o.depth_error >= 1e-7f && o.depth_error <= 0.1f))
-                return Status::error("--depth " + text + ": the bound must be a number in 1e-7..0.1");
+                return Status::error("encode: --depth " + text + ": the bound must be a number in 1e-7..0.1");
         }
     } else {
-        return Status::error("--depth " + text + ": expected lossless, bounded[:E] or none");
+        return Status::error("encode: --depth " + text + ": expected lossless, bounded[:E] or none");
     }
     return {};
 }
@@ -90,26 +90,29 @@ struct EncodeJob {
     int qp = 28, quality = -1, bitrate = 0, keyint = 0, skip = 2;
 };
 
-Status run_encode(const EncodeJob& job) {
-    if (job.out.empty()) return Status::error("--out FILE.rps is required");
-    codec::EncoderOptions o;
+// Bad option values are argument errors (exit 2), checked before anything is read.
+Status encoder_options(const EncodeJob& job, codec::EncoderOptions& o) {
+    if (job.in.empty()) return Status::error("encode: --in DIR is required");
+    if (job.out.empty()) return Status::error("encode: --out FILE.rps is required");
     o.qp = job.qp;
     if (job.quality >= 0) {
-        if (job.quality > 100) return Status::error("--quality must be in 0..100");
+        if (job.quality > 100) return Status::error("encode: --quality must be in 0..100");
         o.qp = (51 * (100 - job.quality) + 50) / 100;
     }
-    if (o.qp < 0 || o.qp > 51) return Status::error("--qp must be in 0..51");
-    if (job.bitrate < 0) return Status::error("--bitrate must be positive");
-    if (job.keyint < 0) return Status::error("--keyint must be 0 or more");
-    if (job.skip < 0 || job.skip > 255) return Status::error("--skip must be in 0..255");
+    if (o.qp < 0 || o.qp > 51) return Status::error("encode: --qp must be in 0..51");
+    if (job.bitrate < 0) return Status::error("encode: --bitrate must be positive");
+    if (job.keyint < 0) return Status::error("encode: --keyint must be 0 or more");
+    if (job.skip < 0 || job.skip > 255) return Status::error("encode: --skip must be in 0..255");
     o.bitrate_kbps = job.bitrate;
     o.keyint = job.keyint;
     o.skip_threshold = job.skip;
     if (job.chroma == "420") o.chroma = codec::Chroma::C420;
     else if (job.chroma == "444") o.chroma = codec::Chroma::C444;
-    else return Status::error("--chroma " + job.chroma + ": expected 420 or 444");
-    REPRISE_TRY(parse_depth_mode(job.depth, o));
+    else return Status::error("encode: --chroma " + job.chroma + ": expected 420 or 444");
+    return parse_depth_mode(job.depth, o);
+}
 
+Status run_encode(const EncodeJob& job, const codec::EncoderOptions& o) {
     Sequence sequence;
     REPRISE_TRY(open_sequence(job.in, sequence));
     codec::Encoder encoder(o);
@@ -227,8 +230,10 @@ int command_encode(int argc, char** argv) {
     args.option("--skip", &job.skip, "blocks within this many 8-bit levels of their prediction are skipped (default 2)");
     const Status parsed = args.parse(argc, argv);
     if (!parsed.ok() || args.help_requested()) return report(args, parsed, {});
-    if (job.in.empty()) return report(args, Status::error("encode: --in DIR is required"), {});
-    return report(args, parsed, run_encode(job));
+    codec::EncoderOptions options;
+    const Status checked = encoder_options(job, options);
+    if (!checked.ok()) return report(args, checked, {});
+    return report(args, parsed, run_encode(job, options));
 }
 
 int command_decode(int argc, char** argv) {
