@@ -65,9 +65,7 @@ inline void chroma_taps(int x, int size, int& near, int& other) {
 void planes_from_linear(ImageView<const glm::vec4> color, const SequenceParams& sp, Planes& out) {
     const int w = sp.width, h = sp.height, cw = sp.chroma_width(), ch = sp.chroma_height();
     REPRISE_ASSERT(color.width == w && color.height == h);
-    for (int k = 0; k < 3; ++k)
-        if (out.p[k].width() != sp.plane_width(k) || out.p[k].height() != sp.plane_height(k))
-            out.p[k].resize(sp.plane_width(k), sp.plane_height(k));
+    for (int k = 0; k < 3; ++k) ensure_size(out.p[k], sp.plane_width(k), sp.plane_height(k));
     const SrgbEncoder& encode = srgb_encoder();
     const bool sub = sp.chroma == Chroma::C420;
     const int pw = out.p[0].width(), cpw = out.p[1].width();
@@ -118,7 +116,7 @@ void planes_from_linear(ImageView<const glm::vec4> color, const SequenceParams& 
 void linear_from_planes(const Planes& planes, const SequenceParams& sp, ImageView<const float> depth,
                         Image<glm::vec4>& out) {
     const int w = sp.width, h = sp.height, cw = sp.chroma_width(), ch = sp.chroma_height();
-    if (out.width() != w || out.height() != h) out.resize(w, h);
+    ensure_size(out, w, h);
     const auto& lut = srgb_to_linear_table();
     const bool sub = sp.chroma == Chroma::C420;
     const Image<int16_t>& co_plane = planes.p[1];

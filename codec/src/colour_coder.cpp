@@ -293,9 +293,7 @@ std::vector<SliceJob> slice_jobs(const Geometry& g, const Planes* source, const 
 }
 
 void prepare(const SequenceParams& sp, Planes& out) {
-    for (int k = 0; k < 3; ++k)
-        if (out.p[k].width() != sp.plane_width(k) || out.p[k].height() != sp.plane_height(k))
-            out.p[k].resize(sp.plane_width(k), sp.plane_height(k));
+    for (int k = 0; k < 3; ++k) ensure_size(out.p[k], sp.plane_width(k), sp.plane_height(k));
 }
 
 }  // namespace
@@ -305,16 +303,16 @@ ColorEncodeResult encode_color(const FrameContext& fc, const Planes& source, Ima
                                StreamStats& stats) {
     const SequenceParams& sp = *fc.sp;
     prepare(sp, out);
-    Planes predicted;
+    Planes& predicted = fc.work->predicted;
     if (!fc.key) predict_planes(fc.reference->planes, sp, motion, predicted);
     const std::size_t start = bytes.size();
     ByteWriter w(bytes);
     w.u8(uint8_t(qp));
     const Geometry g = geometry(sp);
     std::vector<SliceJob> jobs = slice_jobs(g, &source, fc.key ? nullptr : &predicted, out, qp, skip_threshold);
-    std::vector<std::vector<uint8_t>> scratch;
-    std::vector<uint8_t> body;
-    encode_slices(sp.slices, scratch, body, [&](int s, std::vector<uint8_t>& b) {
+    std::vector<uint8_t>& body = fc.work->section;
+    body.clear();
+    encode_slices(sp.slices, fc.work->slice_bytes, body, [&](int s, std::vector<uint8_t>& b) {
         RangeEncoder rc(b);
         code_slice<true>(jobs[s], rc);
         rc.finish();
@@ -348,12 +346,12 @@ Status decode_color(const FrameContext& fc, ImageView<const glm::vec2> motion, s
     if (qp > 51) return Status::error("colour section: qp " + std::to_string(qp) + " is above 51");
     if (flags & ~kAllSkipped) return Status::error("colour section: unknown flags " + std::to_string(flags));
     if ((flags & kAllSkipped) && fc.key) return Status::error("colour section: a key frame cannot skip its blocks");
-    Planes predicted;
+    Planes& predicted = fc.work->predicted;
     if (!fc.key) predict_planes(fc.reference->planes, sp, motion, predicted);
     const std::size_t blocks = std::size_t(sp.mb_cols()) * sp.mb_rows() * (4 + 2 * (sp.chroma == Chroma::C420 ? 1 : 4));
     if (flags & kAllSkipped) {
         if (r.remaining()) return Status::error("colour section: bytes after an all-skipped flag");
-        out = predicted;
+        for (int k = 0; k < 3; ++k) std::copy(predicted.p[k].data(), predicted.p[k].data() + predicted.p[k].pixel_count(), out.p[k].data());
         stats.blocks += blocks;
         stats.blocks_skipped += blocks;
     } else {

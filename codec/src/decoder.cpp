@@ -40,6 +40,7 @@ struct Decoder::State {
     std::deque<Frame> queue;
     StreamStats stats;
     Picture scratch;
+    Workspace work;
 
     int slot_of(uint32_t frame) const {
         for (int i = 0; i < kReferences; ++i)
@@ -85,7 +86,7 @@ Status Decoder::send_packet(std::span<const uint8_t> packet) {
     if (!r.ok()) return Status::error(r.error());
     if (r.remaining()) return Status::error(where + ": " + std::to_string(r.remaining()) + " bytes after the last section");
 
-    FrameContext fc{&sp, ref, key};
+    FrameContext fc{&sp, ref, key, &s.work};
     Picture& pic = s.scratch;
     StreamStats fs;
     Camera camera;
@@ -93,17 +94,9 @@ Status Decoder::send_packet(std::span<const uint8_t> packet) {
     REPRISE_TRY(decode_camera(sections[0], ref, camera, time));
     REPRISE_TRY(decode_depth(fc, camera, sections[1], pic.depth, fs));
     REPRISE_TRY(decode_motion(fc, camera, pic.depth.view(), sections[2], pic.motion, fs));
-    Image<glm::vec2> to_reference;
-    ImageView<const glm::vec2> motion = pic.motion.view();
-    if (ref && ref->frame + 1 != h.frame) {
-        to_reference.resize(sp.width, sp.height);
-        if (pic.depth.empty())
-            std::fill(to_reference.data(), to_reference.data() + to_reference.pixel_count(), glm::vec2(0.0f));
-        else
-            camera_motion(camera, pic.depth.view(), ref->camera.view, ref->camera.projection, to_reference.view());
-        motion = to_reference.view();
-        fs.older_reference = 1;
-    }
+    const ImageView<const glm::vec2> motion =
+        motion_to_reference(sp, camera, pic.depth, pic.motion, ref, h.frame, s.work);
+    fs.older_reference = ref && ref->frame + 1 != h.frame;
     REPRISE_TRY(decode_color(fc, motion, sections[3], pic.planes, fs));
     fs.camera_bits += 8 * sections[0].size();
     fs.frames = 1;

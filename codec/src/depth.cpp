@@ -215,9 +215,10 @@ void temporal_codes(const FrameContext& fc, const Camera& camera, const Mapping&
         return;
     }
     const int w = fc.sp->width, h = fc.sp->height;
-    Image<float> projected(w, h);
+    Image<float>& projected = fc.work->projected_depth;
+    ensure_size(projected, w, h);
     reproject_depth(fc.reference->camera, fc.reference->depth.view(), camera, projected.view());
-    out.resize(w, h);
+    ensure_size(out, w, h);
     parallel_for(0, h, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y)
             for (int x = 0; x < w; ++x) {
@@ -239,7 +240,7 @@ std::vector<SliceJob> slice_jobs(const SequenceParams& sp, const Mapping& map, I
 }
 
 void depth_from_codes(const Mapping& map, const Image<uint32_t>& codes, Image<float>& out) {
-    out.resize(codes.width(), codes.height());
+    ensure_size(out, codes.width(), codes.height());
     parallel_for(0, codes.height(), [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y) {
             uint32_t last = codes(0, y);
@@ -271,7 +272,11 @@ void encode_depth(const FrameContext& fc, const Camera& camera, ImageView<const 
     }
     const Mapping map = mapping_of(sp);
     const int w = sp.width, h = sp.height;
-    Image<uint32_t> codes(w, h), temporal, residuals(w, h);
+    Image<uint32_t>& codes = fc.work->depth_codes;
+    Image<uint32_t>& temporal = fc.work->temporal_codes;
+    Image<uint32_t>& residuals = fc.work->depth_residuals;
+    ensure_size(codes, w, h);
+    ensure_size(residuals, w, h);
     parallel_for(0, h, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y)
             for (int x = 0; x < w; ++x) codes(x, y) = map.code(source.empty() ? INFINITY : source(x, y));
@@ -287,8 +292,7 @@ void encode_depth(const FrameContext& fc, const Camera& camera, ImageView<const 
         stats.depth_zero_blocks += std::size_t((w + kBlock - 1) / kBlock) * ((h + kBlock - 1) / kBlock);
     } else {
         std::vector<SliceJob> jobs = slice_jobs(sp, map, codes, temporal, residuals);
-        std::vector<std::vector<uint8_t>> scratch;
-        encode_slices(sp.slices, scratch, bytes, [&](int s, std::vector<uint8_t>& b) { encode_slice(jobs[s], b); });
+        encode_slices(sp.slices, fc.work->slice_bytes, bytes, [&](int s, std::vector<uint8_t>& b) { encode_slice(jobs[s], b); });
         for (const SliceJob& j : jobs) stats.depth_zero_blocks += j.zero_blocks;
     }
     stats.depth_bits += 8 * (bytes.size() - start);
@@ -305,7 +309,11 @@ Status decode_depth(const FrameContext& fc, const Camera& camera, std::span<cons
     }
     const Mapping map = mapping_of(sp);
     const int w = sp.width, h = sp.height;
-    Image<uint32_t> codes(w, h), temporal, residuals(w, h);
+    Image<uint32_t>& codes = fc.work->depth_codes;
+    Image<uint32_t>& temporal = fc.work->temporal_codes;
+    Image<uint32_t>& residuals = fc.work->depth_residuals;
+    ensure_size(codes, w, h);
+    ensure_size(residuals, w, h);
     temporal_codes(fc, camera, map, temporal);
     ByteReader r(in, "depth section");
     const uint8_t flags = r.u8();

@@ -44,6 +44,8 @@ struct Encoder::State {
     mutable bool recon_ready = false;
     int newest = -1;  // slot of the newest picture
     Planes source_planes;
+    Picture scratch;
+    Workspace work;
 
     int slot_of(uint32_t frame) const {
         for (int i = 0; i < kReferences; ++i)
@@ -72,7 +74,7 @@ struct Encoder::State {
                   StreamStats& fs, ColorEncodeResult& colour) {
         const bool key = ref_slot < 0;
         const Picture* ref = key ? nullptr : &refs[ref_slot];
-        FrameContext fc{&sp, ref, key};
+        FrameContext fc{&sp, ref, key, &work};
         payload.clear();
         if (key) write_params(sp, payload);
 
@@ -89,17 +91,8 @@ struct Encoder::State {
         encode_motion(fc, frame.camera, pic.depth.view(), frame.motion.view(), pic.motion, section, fs);
         append_section(payload, section);
 
-        Image<glm::vec2> to_reference;
-        ImageView<const glm::vec2> motion = pic.motion.view();
-        if (ref && ref->frame + 1 != next_frame) {
-            to_reference.resize(sp.width, sp.height);
-            if (pic.depth.empty())
-                std::fill(to_reference.data(), to_reference.data() + to_reference.pixel_count(), glm::vec2(0.0f));
-            else
-                camera_motion(frame.camera, pic.depth.view(), ref->camera.view, ref->camera.projection,
-                              to_reference.view());
-            motion = to_reference.view();
-        }
+        const ImageView<const glm::vec2> motion =
+            motion_to_reference(sp, frame.camera, pic.depth, pic.motion, ref, next_frame, work);
         section.clear();
         colour = encode_color(fc, source_planes, motion, qp_now, options.skip_threshold, pic.planes, section, fs);
         append_section(payload, section);
@@ -152,7 +145,7 @@ Status Encoder::send_frame(const Frame& frame) {
     // Rate control: bounded frame sizes, re-encoding with a coarser quantiser when one is too big.
     const double target_bits = s.options.bitrate_kbps > 0 ? s.options.bitrate_kbps * 1000.0 / std::max(1.0, sp.fps) : 0.0;
     int qp = s.qp;
-    Picture pic;
+    Picture& pic = s.scratch;
     std::vector<uint8_t> payload;
     StreamStats fs;
     for (int attempt = 0;; ++attempt) {
@@ -210,7 +203,7 @@ Status Encoder::send_frame(const Frame& frame) {
     }
     s.reference_of[slot] = header.reference;
     s.tainted[slot] = !key && s.tainted[ref];
-    s.refs[slot] = std::move(pic);
+    std::swap(s.refs[slot], pic);
     s.newest = slot;
     s.after_loss = false;
     s.started = true;

@@ -138,6 +138,18 @@ constexpr auto kExp2Series = exp2_series();
 
 }  // namespace
 
+ImageView<const glm::vec2> motion_to_reference(const SequenceParams& sp, const Camera& camera,
+                                               const Image<float>& depth, const Image<glm::vec2>& motion,
+                                               const Picture* reference, uint32_t frame, Workspace& work) {
+    if (!reference || reference->frame + 1 == frame) return motion.view();
+    ensure_size(work.to_reference, sp.width, sp.height);
+    if (depth.empty())
+        std::fill(work.to_reference.data(), work.to_reference.data() + work.to_reference.pixel_count(), glm::vec2(0.0f));
+    else
+        camera_motion(camera, depth.view(), reference->camera.view, reference->camera.projection, work.to_reference.view());
+    return work.to_reference.view();
+}
+
 double exact_log2(double x) {
     int e = 0;
     double m = std::frexp(x, &e);  // x = m 2^e, m in [0.5, 1)

@@ -73,6 +73,8 @@ class ByteReader;
 Status read_params(ByteReader& r, SequenceParams& sp);
 int default_slices(int height);
 
+struct Workspace;
+
 // --- colour.cpp
 // Linear colour -> 8-bit sRGB -> YCoCg-R, chroma averaged 2x2 for 4:2:0.
 void planes_from_linear(ImageView<const glm::vec4> color, const SequenceParams& sp, Planes& out);
@@ -90,9 +92,38 @@ void camera_motion(const Camera& from, ImageView<const float> depth, const glm::
 // NaN where nothing landed. A copy when the cameras are identical.
 void reproject_depth(const Camera& from, ImageView<const float> depth, const Camera& to,
                      ImageView<float> out);
+// What drives colour prediction: the decoded motion when the reference is the previous frame,
+// else the camera motion from this frame to the reference's camera (0 without depth).
+ImageView<const glm::vec2> motion_to_reference(const SequenceParams& sp, const Camera& camera,
+                                               const Image<float>& depth, const Image<glm::vec2>& motion,
+                                               const Picture* reference, uint32_t frame, Workspace& work);
 // Deterministic log2 / exp2 (IEEE double arithmetic only, no libm).
 double exact_log2(double x);
 double exact_exp2(double x);
+
+// One pixel's motion residual, in eighths of a pixel.
+struct MotionResidual {
+    int32_t x = 0, y = 0;
+    bool invalid = false;  // decoded motion is NaN although the cameras explain this pixel
+    bool zero() const { return !invalid && x == 0 && y == 0; }
+};
+
+// Per-frame scratch, sized on the first frame and reused while the size stays the same.
+struct Workspace {
+    Image<uint32_t> depth_codes, temporal_codes, depth_residuals;
+    Image<float> projected_depth;
+    Image<glm::vec2> base_motion, to_reference;
+    std::vector<MotionResidual> motion_targets, motion_residuals;
+    Planes predicted;
+    std::vector<std::vector<uint8_t>> slice_bytes;
+    std::vector<uint8_t> section;
+};
+
+// Sizes an image, keeping its memory (and stale contents) when the size is already right.
+template <class T>
+void ensure_size(Image<T>& image, int width, int height) {
+    if (image.width() != width || image.height() != height) image.resize(width, height);
+}
 
 // --- stream sections. Each encoder appends to `out`; each decoder reads one section and returns
 // an error naming the field. Stats are added to `stats`.
@@ -100,6 +131,7 @@ struct FrameContext {
     const SequenceParams* sp = nullptr;
     const Picture* reference = nullptr;  // null on key frames
     bool key = false;
+    Workspace* work = nullptr;
 };
 
 void encode_camera(const Camera& camera, double time, const Picture* reference, std::vector<uint8_t>& out);

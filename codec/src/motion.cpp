@@ -16,11 +16,7 @@ constexpr int kBlock = 8;
 constexpr uint8_t kNoResidual = 1;
 constexpr int64_t kMaxResidual = 1 << 24;  // eighths of a pixel: 2 million pixels
 
-struct Residual {
-    int32_t x = 0, y = 0;
-    bool invalid = false;  // decoded motion is NaN although the cameras explain this pixel
-    bool zero() const { return !invalid && x == 0 && y == 0; }
-};
+using Residual = MotionResidual;
 
 inline bool finite(glm::vec2 v) { return std::isfinite(v.x) && std::isfinite(v.y); }
 
@@ -55,7 +51,7 @@ struct Models {
 struct SliceJob {
     int width, y0, y1;
     ImageView<const glm::vec2> base;
-    ImageView<const glm::vec2> source;  // encoder only
+    const Residual* targets;            // encoder only: the residual of every pixel
     ImageView<glm::vec2> out;
     Residual* residuals;  // per pixel of the frame, for contexts and prediction
     std::size_t pixels = 0;
@@ -92,7 +88,7 @@ bool code_slice(SliceJob& j, Coder& rc) {
             if constexpr (Encode) {
                 for (int y = by; y < by + bh && !block_nonzero[b]; ++y)
                     for (int x = b * kBlock; x < std::min(j.width, (b + 1) * kBlock); ++x)
-                        if (!residual_of(j.source(x, y), j.base(x, y)).zero()) block_nonzero[b] = 1;
+                        if (!j.targets[std::size_t(y) * j.width + x].zero()) block_nonzero[b] = 1;
                 rc.bit(m.block[previous_block], block_nonzero[b]);
             } else {
                 block_nonzero[b] = uint8_t(rc.bit(m.block[previous_block]));
@@ -105,7 +101,7 @@ bool code_slice(SliceJob& j, Coder& rc) {
                 if (block_nonzero[x / kBlock]) {
                     BitModel& nz = m.nonzero[nonzero_context(j, x, y)];
                     if constexpr (Encode) {
-                        r = residual_of(j.source(x, y), j.base(x, y));
+                        r = j.targets[std::size_t(y) * j.width + x];
                         rc.bit(nz, !r.zero());
                         if (!r.zero()) {
                             rc.bit(m.invalid, r.invalid);
@@ -143,7 +139,7 @@ bool code_slice(SliceJob& j, Coder& rc) {
 
 // Motion the cameras explain (to the previous frame as this frame's camera records it).
 void base_motion(const Camera& camera, ImageView<const float> depth, int w, int h, Image<glm::vec2>& base) {
-    base.resize(w, h);
+    ensure_size(base, w, h);
     if (depth.empty()) {
         std::fill(base.data(), base.data() + base.pixel_count(), glm::vec2(0.0f));
         return;
@@ -151,14 +147,13 @@ void base_motion(const Camera& camera, ImageView<const float> depth, int w, int 
     camera_motion(camera, depth, camera.prev_view, camera.prev_projection, base.view());
 }
 
-std::vector<SliceJob> slice_jobs(const SequenceParams& sp, const Image<glm::vec2>& base,
-                                 ImageView<const glm::vec2> source, Image<glm::vec2>& out,
-                                 std::vector<Residual>& residuals) {
+std::vector<SliceJob> slice_jobs(const SequenceParams& sp, const Image<glm::vec2>& base, const Residual* targets,
+                                 Image<glm::vec2>& out, std::vector<Residual>& residuals) {
     std::vector<SliceJob> jobs;
     for (int s = 0; s < sp.slices; ++s) {
         const int y0 = std::min(sp.height, sp.slice_begin(s) * kMb);
         const int y1 = std::min(sp.height, sp.slice_begin(s + 1) * kMb);
-        jobs.push_back({sp.width, y0, y1, base.view(), source, out.view(), residuals.data()});
+        jobs.push_back({sp.width, y0, y1, base.view(), targets, out.view(), residuals.data()});
     }
     return jobs;
 }
@@ -170,23 +165,32 @@ void encode_motion(const FrameContext& fc, const Camera& camera, ImageView<const
                    StreamStats& stats) {
     const SequenceParams& sp = *fc.sp;
     const int w = sp.width, h = sp.height;
-    Image<glm::vec2> base;
+    Image<glm::vec2>& base = fc.work->base_motion;
     base_motion(camera, depth, w, h, base);
-    out.resize(w, h);
+    ensure_size(out, w, h);
     const std::size_t start = bytes.size();
-    bool any = false;
+    std::vector<Residual>& targets = fc.work->motion_targets;
+    targets.resize(source.empty() ? 0 : std::size_t(w) * h);
+    std::vector<uint8_t> row_any(h, 0);
     if (!source.empty())
-        for (int y = 0; y < h && !any; ++y)
-            for (int x = 0; x < w && !any; ++x) any = !residual_of(source(x, y), base(x, y)).zero();
+        parallel_for(0, h, [&](int y0, int y1) {
+            for (int y = y0; y < y1; ++y)
+                for (int x = 0; x < w; ++x) {
+                    const Residual r = residual_of(source(x, y), base(x, y));
+                    targets[std::size_t(y) * w + x] = r;
+                    row_any[y] |= !r.zero();
+                }
+        });
+    const bool any = std::find(row_any.begin(), row_any.end(), 1) != row_any.end();
     ByteWriter wr(bytes);
     wr.u8(any ? 0 : kNoResidual);
     if (!any) {
         std::copy(base.data(), base.data() + base.pixel_count(), out.data());
     } else {
-        std::vector<Residual> residuals(std::size_t(w) * h);
-        std::vector<SliceJob> jobs = slice_jobs(sp, base, source, out, residuals);
-        std::vector<std::vector<uint8_t>> scratch;
-        encode_slices(sp.slices, scratch, bytes, [&](int s, std::vector<uint8_t>& b) {
+        std::vector<Residual>& residuals = fc.work->motion_residuals;
+        residuals.resize(std::size_t(w) * h);
+        std::vector<SliceJob> jobs = slice_jobs(sp, base, targets.data(), out, residuals);
+        encode_slices(sp.slices, fc.work->slice_bytes, bytes, [&](int s, std::vector<uint8_t>& b) {
             RangeEncoder rc(b);
             code_slice<true>(jobs[s], rc);
             rc.finish();
@@ -200,9 +204,9 @@ Status decode_motion(const FrameContext& fc, const Camera& camera, ImageView<con
                      std::span<const uint8_t> in, Image<glm::vec2>& out, StreamStats& stats) {
     const SequenceParams& sp = *fc.sp;
     const int w = sp.width, h = sp.height;
-    Image<glm::vec2> base;
+    Image<glm::vec2>& base = fc.work->base_motion;
     base_motion(camera, depth, w, h, base);
-    out.resize(w, h);
+    ensure_size(out, w, h);
     ByteReader r(in, "motion section");
     const uint8_t flags = r.u8();
     if (!r.ok()) return Status::error(r.error());
@@ -213,8 +217,9 @@ Status decode_motion(const FrameContext& fc, const Camera& camera, ImageView<con
     } else {
         std::vector<std::span<const uint8_t>> slices;
         if (!read_slices(r, sp.slices, slices)) return Status::error(r.error());
-        std::vector<Residual> residuals(std::size_t(w) * h);
-        std::vector<SliceJob> jobs = slice_jobs(sp, base, {}, out, residuals);
+        std::vector<Residual>& residuals = fc.work->motion_residuals;
+        residuals.resize(std::size_t(w) * h);
+        std::vector<SliceJob> jobs = slice_jobs(sp, base, nullptr, out, residuals);
         std::vector<uint8_t> ok(sp.slices, 0);
         parallel_for(0, sp.slices, [&](int s0, int s1) {
             for (int s = s0; s < s1; ++s) {

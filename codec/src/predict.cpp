@@ -72,9 +72,7 @@ inline glm::vec2 usable(glm::vec2 m) {
 
 void predict_planes(const Planes& ref, const SequenceParams& sp, ImageView<const glm::vec2> motion, Planes& out) {
     const int w = sp.width, h = sp.height;
-    for (int k = 0; k < 3; ++k)
-        if (out.p[k].width() != sp.plane_width(k) || out.p[k].height() != sp.plane_height(k))
-            out.p[k].resize(sp.plane_width(k), sp.plane_height(k));
+    for (int k = 0; k < 3; ++k) ensure_size(out.p[k], sp.plane_width(k), sp.plane_height(k));
     auto motion_at = [&](int x, int y) { return usable(motion(std::min(x, w - 1), std::min(y, h - 1))); };
     for (int k = 0; k < 3; ++k) {
         const int s = sp.shift(k), pw = sp.plane_width(k), ph = sp.plane_height(k);
