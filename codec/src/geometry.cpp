@@ -63,24 +63,45 @@ void camera_motion(const Camera& from, ImageView<const float> depth, const glm::
     }
     const Unprojector un = unprojector(from, w, h);
     const glm::mat4 to_clip = glm::mat4(glm::dmat4(to_projection) * glm::dmat4(between(from.view, to_view)));
+    // Under perspective a finite depth's point is a + z b with a and b affine along a row, so its
+    // clip position is c0 + z c1 with c0 = A0 + x A1 and c1 = B0 + x B1 (per row, in double).
+    const glm::dmat4 p(from.projection), m(to_clip);
     parallel_for(0, h, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y) {
             const float* z = depth.row(y);
-            glm::vec2* m = out.row(y);
+            glm::vec2* out_row = out.row(y);
+            const double y_ndc = 1.0 - 2.0 * (double(y) + 0.5) / double(h);
+            // a = ((x_ndc p33 - p30) / p00, (y_ndc p33 - p31) / p11, 0, 1)
+            // b = ((p20 - x_ndc p23) / p00, (p21 - y_ndc p23) / p11, -1, 0), x_ndc = 2 (x + 0.5) / w - 1
+            const double ay = (y_ndc * p[3][3] - p[3][1]) / p[1][1], by = (p[2][1] - y_ndc * p[2][3]) / p[1][1];
+            const double sx = 2.0 / double(w), x0 = sx * 0.5 - 1.0;  // x_ndc = x0 + sx x
+            const glm::dvec4 a_at0 = m * glm::dvec4((x0 * p[3][3] - p[3][0]) / p[0][0], ay, 0.0, 1.0);
+            const glm::dvec4 a_step = m * glm::dvec4(sx * p[3][3] / p[0][0], 0.0, 0.0, 0.0);
+            const glm::dvec4 b_at0 = m * glm::dvec4((p[2][0] - x0 * p[2][3]) / p[0][0], by, -1.0, 0.0);
+            const glm::dvec4 b_step = m * glm::dvec4(-sx * p[2][3] / p[0][0], 0.0, 0.0, 0.0);
+            const glm::vec4 A0(a_at0), A1(a_step), B0(b_at0), B1(b_step);
+            const float cy = float(y) + 0.5f;
             for (int x = 0; x < w; ++x) {
-                glm::vec4 point;
-                if (!un.point(x, y, z[x], point)) {
-                    m[x] = {kNan, kNan};
-                    continue;
+                const float d = z[x];
+                glm::vec4 clip;
+                if (un.perspective && d >= 0.0f && d < kInf) {
+                    const float fx = float(x);
+                    clip = (A0 + fx * A1) + d * (B0 + fx * B1);
+                } else {
+                    glm::vec4 point;
+                    if (!un.point(x, y, d, point)) {
+                        out_row[x] = {kNan, kNan};
+                        continue;
+                    }
+                    clip = to_clip * point;
                 }
-                const glm::vec4 clip = to_clip * point;
                 if (!(clip.w > 0.0f)) {
-                    m[x] = {kNan, kNan};
+                    out_row[x] = {kNan, kNan};
                     continue;
                 }
                 const float px = (clip.x / clip.w + 1.0f) * 0.5f * float(w);
                 const float py = (1.0f - clip.y / clip.w) * 0.5f * float(h);
-                m[x] = {px - (float(x) + 0.5f), py - (float(y) + 0.5f)};
+                out_row[x] = {px - (float(x) + 0.5f), py - cy};
             }
         }
     });

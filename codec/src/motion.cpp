@@ -29,7 +29,7 @@ Residual residual_of(glm::vec2 source, glm::vec2 base) {
         return r;
     }
     const glm::vec2 d = (source - usable_base(base)) * 8.0f;
-    auto q = [](float v) { return int32_t(std::clamp<double>(std::nearbyint(double(v)), -kMaxResidual, kMaxResidual)); };
+    auto q = [](float v) { return int32_t(std::nearbyint(std::clamp(v, -float(kMaxResidual), float(kMaxResidual)))); };
     r.x = q(d.x);
     r.y = q(d.y);
     return r;

@@ -39,7 +39,8 @@ const std::array<std::array<int32_t, 4>, kPhases>& weights() {
 inline int32_t fixed_position(float centre, float m, int size) {
     float q = (centre + m - 0.5f) * float(kPhases);
     q = std::clamp(q, -4.0f * kPhases, float(size + 4) * kPhases);
-    return int32_t(std::floor(q));
+    const int32_t t = int32_t(q);  // floor without a library call (|q| < 2^21)
+    return t - int32_t(q < float(t));
 }
 
 inline int sample(const Image<int16_t>& ref, int32_t qx, int32_t qy, int lo, int hi) {
