@@ -492,3 +492,27 @@ TEST(Codec, TenThousandFramesWithoutDrift) {
     EXPECT_GT(last_psnr, 30.0);
     EXPECT_GT(last_psnr, first_psnr - 3.0);
 }
+
+// Rate control: the mean lands near the target, no inter frame is more than 3x the per-frame
+// budget and no key frame more than 6x (a streaming link cannot absorb bigger ones).
+TEST(Codec, BitrateTargetWithBoundedFrameSizes) {
+    const auto frames = render("crossing", 24, 192, 108);  // bounded depth is part of the budget
+    for (int kbps : {150, 600}) {
+        Encoder encoder({.bitrate_kbps = kbps, .fps = 30.0, .depth = DepthMode::Bounded, .depth_error = 1e-2f});
+        std::size_t total = 0;
+        const double budget = kbps * 1000.0 / 30.0;
+        for (std::size_t i = 0; i < frames.size(); ++i) {
+            Frame f = frames[i];
+            f.fps = 30.0;
+            ASSERT_TRUE(encoder.send_frame(f).ok());
+            Packet p;
+            ASSERT_EQ(encoder.receive_packet(p), Result::Ok);
+            const double bits = 8.0 * double(p.data.size());
+            total += p.data.size();
+            EXPECT_LE(bits, (p.type == PacketType::Key ? 6.0 : 3.0) * budget) << kbps << " frame " << i;
+        }
+        const double mean_kbps = 8.0 * double(total) / double(frames.size()) * 30.0 / 1000.0;
+        EXPECT_GT(mean_kbps, 0.5 * kbps) << kbps;
+        EXPECT_LT(mean_kbps, 1.5 * kbps) << kbps;
+    }
+}
