@@ -12,6 +12,7 @@
 #include "codec_peers.hpp"
 #include "depth_peers.hpp"
 #include "reprise/core/metrics.hpp"
+#include "support/cli.hpp"
 
 namespace reprise::cli {
 namespace {
@@ -223,6 +224,44 @@ TEST(CodecPeers, BadInputIsAStatus) {
     EXPECT_FALSE(encode_decode_peer({Image<Rgb8>(1, 1)}, {}, 30.0, out).ok());
     EXPECT_TRUE(encode_decode_peer({}, {}, 30.0, out).ok());
     EXPECT_TRUE(out.empty());
+}
+
+// End to end on a tiny scene: every peer's rows, finite figures, the depth coders and the page.
+TEST(CliBenchCodec, TinySceneWritesRowsForEveryPeer) {
+    namespace fs = std::filesystem;
+    const fs::path dir =
+        fs::temp_directory_path() / ("reprise-cli-bench-codec-" + std::to_string(getpid()));
+    fs::remove_all(dir);
+    const test::Outcome result = test::run_reprise(
+        "bench codec --scenes pan --size 96x64 --frames 3 --speed-frames 0 --out " + dir.string(),
+        300);
+    ASSERT_EQ(result.status, 0) << result.output;
+    EXPECT_NE(result.output.find("targets (issue 8"), std::string::npos) << result.output;
+    std::ifstream csv(dir / "codec.csv");
+    std::string line;
+    std::getline(csv, line);
+    EXPECT_EQ(line, "scene,codec,setting,frame,bits,psnr,ssim,flip,encode_ms,decode_ms");
+    std::map<std::string, int> rows;
+    while (std::getline(csv, line)) {
+        std::vector<std::string> cells;
+        std::stringstream stream(line);
+        for (std::string cell; std::getline(stream, cell, ',');) cells.push_back(cell);
+        ASSERT_EQ(cells.size(), 10u) << line;
+        ++rows[cells[1]];
+        EXPECT_GT(std::stod(cells[4]), 0.0) << line;  // bits
+        EXPECT_GT(std::stod(cells[5]), 20.0) << line;  // PSNR: figures seen 27..45 dB
+    }
+    for (PeerKind kind : {PeerKind::X264, PeerKind::X265, PeerKind::SvtAv1}) {
+        if (!peer_available(kind)) continue;
+        const int rate_points = kind == PeerKind::X264 ? 3 * 4 : 4;  // x264: three presets
+        EXPECT_EQ(rows[peer_name(kind)], rate_points * 3) << peer_name(kind);
+    }
+    std::ifstream depth(dir / "depth.csv");
+    std::string depth_text((std::istreambuf_iterator<char>(depth)), {});
+    EXPECT_NE(depth_text.find("pan,zstd-3,2,"), std::string::npos);
+    EXPECT_NE(depth_text.find("pan,rvl-float,2,"), std::string::npos);
+    EXPECT_TRUE(fs::exists(dir / "index.html"));
+    fs::remove_all(dir);
 }
 
 }  // namespace
