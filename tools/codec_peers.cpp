@@ -238,6 +238,7 @@ Status encode_decode_peer(const std::vector<Image<Rgb8>>& frames, const PeerConf
         const uint8_t* src[1] = {padded.row(0)};
         const int src_stride[1] = {padded.stride};
         sws_scale(to_yuv.context, src, src_stride, 0, ph, yuv.frame->data, yuv.frame->linesize);
+        out[i].encode_convert_ms = ms_since(start);
         yuv.frame->pts = int64_t(i);
         err = avcodec_send_frame(encoder.context, yuv.frame);
         ms += ms_since(start);
@@ -285,7 +286,9 @@ Status encode_decode_peer(const std::vector<Image<Rgb8>>& frames, const PeerConf
             if (!to_rgb.context) return Status::error(who + "sws_getContext (YUV -> RGB) failed");
             uint8_t* dst[1] = {shown.row(0)};
             const int dst_stride[1] = {shown.stride};
+            const auto convert_start = BenchClock::now();
             sws_scale(to_rgb.context, f->data, f->linesize, 0, ph, dst, dst_stride);
+            const double convert_ms = ms_since(convert_start);
             ms_of_call += ms_since(start);
             av_frame_unref(f);
             PeerFrame& target = out[next++];
@@ -296,6 +299,7 @@ Status encode_decode_peer(const std::vector<Image<Rgb8>>& frames, const PeerConf
                     target.decoded(x, y) = Rgb8(row[3 * x], row[3 * x + 1], row[3 * x + 2]);
             }
             target.decode_ms += ms_of_call;
+            target.decode_convert_ms = convert_ms;
             ms_of_call = 0.0;
         }
     };

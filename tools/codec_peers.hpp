@@ -32,6 +32,7 @@ struct PeerFrame {
     std::size_t bytes = 0;    // the frame's packet
     double encode_ms = 0.0;   // RGB -> YUV conversion, send_frame and receive_packet
     double decode_ms = 0.0;   // send_packet, receive_frame and YUV -> RGB conversion
+    double encode_convert_ms = 0.0, decode_convert_ms = 0.0;  // the conversions alone
     Image<Rgb8> decoded;      // same size as the input
 };
 
