@@ -22,6 +22,7 @@
 #include "bd_rate.hpp"
 #include "bench.hpp"
 #include "bench_report.hpp"
+#include "reprise/codec/codec.hpp"
 #include "codec_peers.hpp"
 #include "depth_peers.hpp"
 #include "reprise/core/exr.hpp"
@@ -29,9 +30,6 @@
 #include "reprise/core/parallel.hpp"
 #include "reprise/server/builtin_scenes.hpp"
 #include "reprise/server/renderer.hpp"
-#if REPRISE_HAVE_CODEC
-#include "reprise/codec/codec.hpp"
-#endif
 
 namespace reprise::cli {
 
@@ -44,12 +42,6 @@ constexpr const char* kOursColor = "reprise-color";
 constexpr double kColorBdTarget = -20.0;  // % against x264 veryfast, PSNR, mean over scenes
 constexpr double kDecodeOverEncodeTarget = 2.0;
 constexpr double kDepthRatioTarget = 2.0;  // zstd -3 bytes / reprise lossless depth bytes
-
-#if REPRISE_HAVE_CODEC
-constexpr bool kHaveCodec = true;
-#else
-constexpr bool kHaveCodec = false;
-#endif
 
 // One encoded frame, scored.
 struct Sample {
@@ -175,7 +167,6 @@ Status run_peer(const Sequence& seq, const PeerConfig& config, RunResult& run,
     return {};
 }
 
-#if REPRISE_HAVE_CODEC
 // reprise's codec at one qp: every frame encoded, its packet decoded, the decoded colour scored.
 // `color` gets the same frames counted with their colour bits only; `depth_bits` the depth
 // stream's bits per frame.
@@ -215,7 +206,6 @@ Status run_ours(const Sequence& seq, int qp, RunResult& total, RunResult& color,
     }
     return {};
 }
-#endif
 
 void run_depth_peers(const Sequence& seq, std::vector<DepthResult>& results) {
     DepthResult zstd{"zstd-3"}, rvl{"rvl-float"}, rvl16{"rvl-16bit-inverse (lossy)"};
@@ -323,15 +313,11 @@ Status measure_speed(server::Renderer& renderer, const BenchOptions& job, int th
     std::fprintf(stderr, "[codec] speed: x264 ultrafast\n");
     REPRISE_TRY(run_peer(seq, {.kind = PeerKind::X264, .preset = "ultrafast", .crf = 26, .threads = threads}, run));
     speed.x264_ultrafast_encode = run.mean(&Sample::encode_ms);
-#if REPRISE_HAVE_CODEC
     std::fprintf(stderr, "[codec] speed: reprise qp %d\n", mid_qp);
     RunResult color;
     REPRISE_TRY(run_ours(seq, mid_qp, run, color, nullptr));
     speed.ours_encode = run.mean(&Sample::encode_ms);
     speed.ours_decode = run.mean(&Sample::decode_ms);
-#else
-    (void)mid_qp;
-#endif
     speed.measured = true;
     return {};
 }
@@ -364,9 +350,6 @@ Status bench_codec(const BenchOptions& job) {
         else if (peers.empty() || peers.back().kind != c.kind)
             std::printf("note: libavcodec lacks %s; that peer is skipped\n", peer_name(c.kind).c_str());
     }
-    if (!kHaveCodec)
-        std::printf("note: this build has no reprise_codec library: reprise's rows, BD-rates and "
-                    "targets are left out\n");
 
     CsvFile csv, bd_csv, depth_csv, speed_csv;
     REPRISE_TRY(csv.open(out_dir + "/codec.csv",
@@ -415,7 +398,6 @@ Status bench_codec(const BenchOptions& job) {
 
         std::vector<RunResult> runs;
         std::vector<double> our_depth_bits;
-#if REPRISE_HAVE_CODEC
         for (int qp : qps) {
             RunResult total, color;
             REPRISE_TRY(run_ours(seq, qp, total, color, our_depth_bits.empty() ? &our_depth_bits : nullptr));
@@ -426,7 +408,6 @@ Status bench_codec(const BenchOptions& job) {
             runs.push_back(std::move(total));
             runs.push_back(std::move(color));
         }
-#endif
         for (const PeerConfig& config : peers) {
             RunResult run;
             REPRISE_TRY(run_peer(seq, config, run));
@@ -470,20 +451,19 @@ Status bench_codec(const BenchOptions& job) {
 
         // BD-rates of reprise against each peer group.
         const std::vector<std::string> groups = groups_of(runs);
-        if (kHaveCodec)
-            for (const std::string& g : groups) {
-                if (g == kOurs || g == kOursColor) continue;
-                BdRow row{seq.name, g, seq.builtin};
-                row.psnr_color = bd_rate(rd_curve(runs, g, false), rd_curve(runs, kOursColor, false));
-                row.psnr_total = bd_rate(rd_curve(runs, g, false), rd_curve(runs, kOurs, false));
-                row.flip_color = bd_rate(rd_curve(runs, g, true), rd_curve(runs, kOursColor, true));
-                row.flip_total = bd_rate(rd_curve(runs, g, true), rd_curve(runs, kOurs, true));
-                for (auto [metric, bits, v] :
-                     {std::tuple{"psnr", "color", row.psnr_color}, {"psnr", "total", row.psnr_total},
-                      {"flip", "color", row.flip_color}, {"flip", "total", row.flip_total}})
-                    bd_csv.row({seq.name, g, metric, bits, strf("%.3f", v)});
-                bd_rows.push_back(row);
-            }
+        for (const std::string& g : groups) {
+            if (g == kOurs || g == kOursColor) continue;
+            BdRow row{seq.name, g, seq.builtin};
+            row.psnr_color = bd_rate(rd_curve(runs, g, false), rd_curve(runs, kOursColor, false));
+            row.psnr_total = bd_rate(rd_curve(runs, g, false), rd_curve(runs, kOurs, false));
+            row.flip_color = bd_rate(rd_curve(runs, g, true), rd_curve(runs, kOursColor, true));
+            row.flip_total = bd_rate(rd_curve(runs, g, true), rd_curve(runs, kOurs, true));
+            for (auto [metric, bits, v] :
+                 {std::tuple{"psnr", "color", row.psnr_color}, {"psnr", "total", row.psnr_total},
+                  {"flip", "color", row.flip_color}, {"flip", "total", row.flip_total}})
+                bd_csv.row({seq.name, g, metric, bits, strf("%.3f", v)});
+            bd_rows.push_back(row);
+        }
         bd_csv.flush();
 
         // Per-sequence table and report section.
@@ -532,7 +512,7 @@ Status bench_codec(const BenchOptions& job) {
 
     // BD-rate table, with the mean over the built-in scenes.
     std::string bd_text;
-    if (kHaveCodec) {
+    {
         bd_text = strf("BD-rate of reprise against each peer (negative = reprise needs fewer bits "
                        "for the same quality)\n%-10s %-20s %12s %12s %12s %12s\n",
                        "scene", "anchor", "PSNR colour", "PSNR total", "FLIP colour", "FLIP total");
@@ -586,10 +566,9 @@ Status bench_codec(const BenchOptions& job) {
                        strf("%.3f", speed.x264_veryfast_decode)});
         speed_csv.row({strf("%dx%d", speed.w, speed.h), std::to_string(speed.frames), "x264",
                        "ultrafast crf 26", strf("%.3f", speed.x264_ultrafast_encode), ""});
-        if (kHaveCodec)
-            speed_csv.row({strf("%dx%d", speed.w, speed.h), std::to_string(speed.frames), kOurs,
-                           strf("qp %d", qps[qps.size() / 2]), strf("%.3f", speed.ours_encode),
-                           strf("%.3f", speed.ours_decode)});
+        speed_csv.row({strf("%dx%d", speed.w, speed.h), std::to_string(speed.frames), kOurs,
+                       strf("qp %d", qps[qps.size() / 2]), strf("%.3f", speed.ours_encode),
+                       strf("%.3f", speed.ours_decode)});
     }
     std::string speed_text;
     if (speed.measured) {
@@ -601,15 +580,14 @@ Status bench_codec(const BenchOptions& job) {
             speed.w, speed.h, speed.frames, job.threads, thread_count(), speed.x264_veryfast_encode,
             speed.x264_veryfast_decode, speed.rgb_to_yuv, speed.yuv_to_rgb,
             speed.x264_ultrafast_encode);
-        if (kHaveCodec)
-            speed_text += strf(
-                "  reprise qp %d: encode %8.2f  decode %8.2f\n"
-                "  encode speed reprise / x264 veryfast = %.2fx (>= 1 wanted), / ultrafast = %.2fx\n"
-                "  reprise decode speed / its encode speed = %.2fx (>= 2 wanted)\n",
-                qps[qps.size() / 2], speed.ours_encode, speed.ours_decode,
-                speed.x264_veryfast_encode / speed.ours_encode,
-                speed.x264_ultrafast_encode / speed.ours_encode,
-                speed.ours_encode / speed.ours_decode);
+        speed_text += strf(
+            "  reprise qp %d: encode %8.2f  decode %8.2f\n"
+            "  encode speed reprise / x264 veryfast = %.2fx (>= 1 wanted), / ultrafast = %.2fx\n"
+            "  reprise decode speed / its encode speed = %.2fx (>= 2 wanted)\n",
+            qps[qps.size() / 2], speed.ours_encode, speed.ours_decode,
+            speed.x264_veryfast_encode / speed.ours_encode,
+            speed.x264_ultrafast_encode / speed.ours_encode,
+            speed.ours_encode / speed.ours_decode);
     }
 
     // Targets of issue 8 §7.

@@ -126,10 +126,12 @@ int command_info(int argc, char** argv) {
     Args args("info",
               "Size, channels, camera and frame rate of an EXR frame or a folder of them,\n"
               "with min/max/NaN/Inf of every buffer of one frame.");
-    args.positional("PATH", &path, "an .exr frame or a folder of frames");
+    args.positional("PATH", &path, "an .exr frame, a folder of frames, or an .rps stream");
     args.option("--frame", &frame_index, "which frame of a folder to describe (default 0)");
     const Status parsed = args.parse(argc, argv);
     if (!parsed.ok() || args.help_requested()) return report(args, parsed, {});
+    if (path.size() > 4 && path.compare(path.size() - 4, 4, ".rps") == 0)
+        return report(args, parsed, describe_stream(path));
     return report(args, parsed, run(path, frame_index));
 }
 

@@ -15,11 +15,13 @@ struct Command {
 constexpr Command kCommands[] = {
     {"render", reprise::cli::command_render, "render a scene's G-buffer sequence to EXR"},
     {"scenes", reprise::cli::command_scenes, "list the built-in scenes"},
-    {"info", reprise::cli::command_info, "channels, size, camera and frame rate of EXR frames"},
+    {"info", reprise::cli::command_info, "channels, size, camera and frame rate of EXR frames, or of an .rps stream"},
     {"metrics", reprise::cli::command_metrics, "PSNR, SSIM and FLIP of a sequence against another"},
     {"export", reprise::cli::command_export, "a sequence as PNG contact sheet or MP4"},
     {"fruc", reprise::cli::command_fruc, "frame-rate upconversion (interpolate or extrapolate) x K"},
     {"stereo", reprise::cli::command_stereo, "the other eye of a sequence by depth warping (OUT/left, OUT/right)"},
+    {"encode", reprise::cli::command_encode, "encode a sequence with the scene-aware codec (.rps)"},
+    {"decode", reprise::cli::command_decode, "decode an .rps stream into an EXR sequence"},
     {"bench", reprise::cli::command_bench, "benchmarks (render, exr, reproject, grid, fill, fruc)"},
 };
 

@@ -16,7 +16,7 @@ enum class Chroma : uint8_t { C420 = 0, C444 = 1 };
 enum class DepthMode : uint8_t {
     Lossless = 0,  // bit-exact float depth
     Bounded = 1,   // relative error of z (and of 1/z) at most depth_error
-    None = 2,      // no depth, no motion: colour prediction uses camera-free zero motion
+    None = 2,      // no depth: the renderer's motion is sent whole (1/8 px), predicting colour
 };
 
 struct EncoderOptions {
@@ -94,9 +94,15 @@ private:
     std::unique_ptr<State> state_;
 };
 
+struct DecoderOptions {
+    // Key frames announcing more pixels are refused: what one stream can make the decoder
+    // allocate is bounded (about 60 bytes per pixel for the references it keeps).
+    int64_t max_pixels = int64_t(8192) * 4320;
+};
+
 class Decoder {
 public:
-    Decoder();
+    explicit Decoder(const DecoderOptions& options = {});
     ~Decoder();
     Decoder(Decoder&&) noexcept;
     Decoder& operator=(Decoder&&) noexcept;
@@ -115,6 +121,9 @@ public:
 private:
     std::unique_ptr<State> state_;
 };
+
+// Checks one packet (length, version, CRC) and reads its header into `info` (data left empty).
+[[nodiscard]] Status inspect_packet(std::span<const uint8_t> packet, Packet& info, int64_t& timestamp_us);
 
 // A .rps file: a file header followed by packets (docs/bitstream.md).
 [[nodiscard]] Status write_stream_header(std::vector<uint8_t>& out, int width, int height, double fps);

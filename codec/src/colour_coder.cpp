@@ -1,0 +1,383 @@
+// Colour residuals per 16x16 macroblock: inter prediction (reprojected reference) or intra
+// prediction (DC / vertical / horizontal / smooth from decoded neighbours in the same slice),
+// 8x8 integer DCT, dead-zone quantisation, context-coded levels. Inter blocks whose prediction
+// error stays within the skip threshold are not coded at all.
+#include <algorithm>
+#include <cstdlib>
+
+#include "internal.hpp"
+#include "slices.hpp"
+#include "transform.hpp"
+
+namespace reprise::codec {
+
+namespace {
+
+constexpr uint8_t kAllSkipped = 1;
+constexpr int kModes = 4;  // intra: DC, vertical, horizontal, smooth
+constexpr int32_t kMaxLevel = 1 << 16;
+
+struct Models {
+    BitModel mb_skip[3];
+    BitModel mb_intra[3];
+    BitModel mode[2][2];
+    BitModel cbf[4];
+    UintModel<7> last[4];
+    BitModel significant[4][16];
+    BitModel greater1[4][3];
+    UintModel<14> remaining[4];
+};
+
+// Block type for contexts: luma/chroma x intra/inter.
+inline int block_type(int plane, bool intra) { return (plane ? 2 : 0) + (intra ? 0 : 1); }
+
+struct Geometry {
+    const SequenceParams* sp;
+    int blocks_per_side[3];  // 8x8 blocks per macroblock side, per plane
+};
+
+Geometry geometry(const SequenceParams& sp) {
+    Geometry g{&sp, {2, 2, 2}};
+    for (int k = 1; k < 3; ++k) g.blocks_per_side[k] = 2 >> sp.shift(k);
+    return g;
+}
+
+// Intra prediction of the 8x8 block at (bx, by) of plane `rec` from its decoded top row (when
+// by > top, the slice's first row in this plane) and left column.
+void intra_predict(const Image<int16_t>& rec, int bx, int by, int top, int mode, int neutral, Block& pred) {
+    const bool has_top = by > top, has_left = bx > 0;
+    int t[8], l[8];
+    int sum = 0, count = 0;
+    for (int i = 0; i < 8; ++i) {
+        if (has_top) {
+            t[i] = rec(bx + i, by - 1);
+            sum += t[i];
+        }
+        if (has_left) {
+            l[i] = rec(bx - 1, by + i);
+            sum += l[i];
+        }
+    }
+    count = 8 * (int(has_top) + int(has_left));
+    int dc = neutral;
+    if (count) {
+        const int v = sum + count / 2;  // rounded, floor division for negative chroma
+        dc = v >= 0 ? v / count : -((-v + count - 1) / count);
+    }
+    for (int i = 0; i < 8; ++i) {
+        if (!has_top) t[i] = dc;
+        if (!has_left) l[i] = dc;
+    }
+    for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 8; ++x) {
+            int v = dc;
+            if (mode == 1) v = t[x];
+            else if (mode == 2) v = l[y];
+            else if (mode == 3) v = (t[x] + l[y] + 1) >> 1;
+            pred[y * 8 + x] = v;
+        }
+}
+
+void load(const Image<int16_t>& p, int bx, int by, Block& b) {
+    for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 8; ++x) b[y * 8 + x] = p(bx + x, by + y);
+}
+
+template <class Coder>
+void code_levels(Coder& rc, Models& m, int type, const Block& levels) {
+    int last = -1;
+    for (int i = 63; i >= 0; --i)
+        if (levels[kZigzag[i]]) {
+            last = i;
+            break;
+        }
+    encode_uint(rc, m.last[type], uint32_t(last));
+    for (int i = last; i >= 0; --i) {
+        const int32_t v = levels[kZigzag[i]];
+        if (i < last) rc.bit(m.significant[type][std::min(i, 15)], v != 0);
+        if (!v) continue;
+        const uint32_t a = uint32_t(std::abs(v));
+        rc.bit(m.greater1[type][i == 0 ? 0 : i < 6 ? 1 : 2], a > 1);
+        if (a > 1) encode_uint(rc, m.remaining[type], a - 2);
+        rc.bypass(v < 0);
+    }
+}
+
+bool decode_levels(RangeDecoder& rc, Models& m, int type, Block& levels) {
+    levels.fill(0);
+    uint32_t last = 0;
+    if (!decode_uint(rc, m.last[type], last) || last > 63) return false;
+    for (int i = int(last); i >= 0; --i) {
+        if (i < int(last) && !rc.bit(m.significant[type][std::min(i, 15)])) continue;
+        uint32_t a = 1;
+        if (rc.bit(m.greater1[type][i == 0 ? 0 : i < 6 ? 1 : 2])) {
+            uint32_t rest = 0;
+            if (!decode_uint(rc, m.remaining[type], rest) || rest > uint32_t(kMaxLevel)) return false;
+            a = rest + 2;
+        }
+        levels[kZigzag[i]] = rc.bypass() ? -int32_t(a) : int32_t(a);
+    }
+    return true;
+}
+
+void store(Image<int16_t>& p, int bx, int by, const Block& pred, const Block* residual, int lo, int hi) {
+    for (int y = 0; y < 8; ++y)
+        for (int x = 0; x < 8; ++x) {
+            const int v = pred[y * 8 + x] + (residual ? (*residual)[y * 8 + x] : 0);
+            p(bx + x, by + y) = int16_t(std::clamp(v, lo, hi));
+        }
+}
+
+struct SliceJob {
+    const Geometry* g;
+    const Planes* source;     // encoder
+    const Planes* predicted;  // null on key frames
+    Planes* out;
+    int qp, skip_threshold;
+    int mb_y0, mb_y1;
+    std::size_t blocks = 0, skipped = 0, intra = 0, macroblocks = 0;
+};
+
+// Sum of absolute differences of the block against a prediction.
+int sad(const Block& a, const Block& b) {
+    int s = 0;
+    for (int i = 0; i < 64; ++i) s += std::abs(a[i] - b[i]);
+    return s;
+}
+
+// Codes (Encode) or decodes one slice. Returns false on a corrupt slice (decoder only).
+template <bool Encode, class Coder>
+bool code_slice(SliceJob& j, Coder& rc) {
+    const SequenceParams& sp = *j.g->sp;
+    const int32_t scale = quant_scale(j.qp);
+    Models m;
+    const int cols = sp.mb_cols();
+    std::vector<uint8_t> above_skip(cols, 0), above_intra(cols, 0);
+    for (int my = j.mb_y0; my < j.mb_y1; ++my) {
+        int left_skip = 0, left_intra = 0;
+        for (int mx = 0; mx < cols; ++mx) {
+            ++j.macroblocks;
+            const int ctx_skip = left_skip + (my > j.mb_y0 ? above_skip[mx] : 0);
+            const int ctx_intra = left_intra + (my > j.mb_y0 ? above_intra[mx] : 0);
+            bool skip = false, intra = j.predicted == nullptr;
+            // Encoder decisions: intra when its best SAD (on source neighbours) clearly beats
+            // the reprojection, skip when every block stays within the threshold.
+            Block src, pred, pred2, coef, levels, residual;
+            if constexpr (Encode) {
+                if (!intra) {
+                    int inter_sad = 0, intra_sad = 0;
+                    bool all_within = true;
+                    for (int k = 0; k < 3; ++k) {
+                        const int n = j.g->blocks_per_side[k];
+                        const int limit = k ? 2 * j.skip_threshold : j.skip_threshold;
+                        for (int b = 0; b < n * n; ++b) {
+                            const int bx = mx * 8 * n + (b % n) * 8, by = my * 8 * n + (b / n) * 8;
+                            load(j.source->p[k], bx, by, src);
+                            load(j.predicted->p[k], bx, by, pred);
+                            inter_sad += sad(src, pred);
+                            for (int i = 0; i < 64 && all_within; ++i)
+                                all_within = std::abs(src[i] - pred[i]) <= limit;
+                            int best = 1 << 30;
+                            for (int mode = 0; mode < kModes; ++mode) {
+                                intra_predict(j.source->p[k], bx, by, (j.mb_y0 * 8 * n), mode, k ? 0 : 128, pred2);
+                                best = std::min(best, sad(src, pred2));
+                            }
+                            intra_sad += best;
+                        }
+                    }
+                    skip = all_within;
+                    intra = !skip && intra_sad + 1024 < inter_sad;
+                }
+                if (j.predicted) {
+                    rc.bit(m.mb_skip[ctx_skip], skip);
+                    if (!skip) rc.bit(m.mb_intra[ctx_intra], intra);
+                }
+            } else {
+                if (j.predicted) {
+                    skip = rc.bit(m.mb_skip[ctx_skip]);
+                    if (!skip) intra = rc.bit(m.mb_intra[ctx_intra]);
+                }
+            }
+            above_skip[mx] = left_skip = skip;
+            above_intra[mx] = left_intra = intra;
+            j.intra += intra;
+            for (int k = 0; k < 3; ++k) {
+                const int n = j.g->blocks_per_side[k];
+                const int lo = k ? -255 : 0, limit = k ? 2 * j.skip_threshold : j.skip_threshold;
+                const int top = j.mb_y0 * 8 * n;
+                const int type = block_type(k, intra);
+                for (int b = 0; b < n * n; ++b) {
+                    const int bx = mx * 8 * n + (b % n) * 8, by = my * 8 * n + (b / n) * 8;
+                    ++j.blocks;
+                    if (skip) {
+                        load(j.predicted->p[k], bx, by, pred);
+                        store(j.out->p[k], bx, by, pred, nullptr, lo, 255);
+                        ++j.skipped;
+                        continue;
+                    }
+                    int mode = 0;
+                    if constexpr (Encode) {
+                        load(j.source->p[k], bx, by, src);
+                        if (intra) {
+                            int best = 1 << 30;
+                            for (int candidate = 0; candidate < kModes; ++candidate) {
+                                intra_predict(j.out->p[k], bx, by, top, candidate, k ? 0 : 128, pred2);
+                                const int s = sad(src, pred2);
+                                if (s < best) {
+                                    best = s;
+                                    mode = candidate;
+                                    pred = pred2;
+                                }
+                            }
+                            rc.bit(m.mode[k > 0][0], mode >> 1);
+                            rc.bit(m.mode[k > 0][1], mode & 1);
+                        } else {
+                            load(j.predicted->p[k], bx, by, pred);
+                        }
+                        bool coded = true;
+                        if (!intra) {
+                            bool within = true;
+                            for (int i = 0; i < 64 && within; ++i) within = std::abs(src[i] - pred[i]) <= limit;
+                            coded = !within;
+                        }
+                        int nonzero = 0;
+                        if (coded) {
+                            for (int i = 0; i < 64; ++i) residual[i] = src[i] - pred[i];
+                            forward_dct(residual, coef);
+                            nonzero = quantize(coef, scale, intra ? 16 / 3 : 16 / 6, levels);
+                        }
+                        rc.bit(m.cbf[type], nonzero > 0);
+                        if (nonzero) {
+                            code_levels(rc, m, type, levels);
+                            dequantize(levels, scale, coef);
+                            inverse_dct(coef, residual);
+                            store(j.out->p[k], bx, by, pred, &residual, lo, 255);
+                        } else {
+                            store(j.out->p[k], bx, by, pred, nullptr, lo, 255);
+                            j.skipped += !intra;
+                        }
+                    } else {
+                        if (intra) {
+                            mode = rc.bit(m.mode[k > 0][0]) << 1;
+                            mode |= rc.bit(m.mode[k > 0][1]);
+                            intra_predict(j.out->p[k], bx, by, top, mode, k ? 0 : 128, pred);
+                        } else {
+                            load(j.predicted->p[k], bx, by, pred);
+                        }
+                        if (rc.bit(m.cbf[type])) {
+                            if (!decode_levels(rc, m, type, levels)) return false;
+                            dequantize(levels, scale, coef);
+                            inverse_dct(coef, residual);
+                            store(j.out->p[k], bx, by, pred, &residual, lo, 255);
+                        } else {
+                            store(j.out->p[k], bx, by, pred, nullptr, lo, 255);
+                            j.skipped += !intra;
+                        }
+                    }
+                }
+            }
+        }
+        if constexpr (!Encode) {
+            if (rc.overrun() > 8) return false;
+        }
+    }
+    return true;
+}
+
+std::vector<SliceJob> slice_jobs(const Geometry& g, const Planes* source, const Planes* predicted, Planes& out,
+                                 int qp, int skip_threshold) {
+    std::vector<SliceJob> jobs;
+    for (int s = 0; s < g.sp->slices; ++s)
+        jobs.push_back({&g, source, predicted, &out, qp, skip_threshold, g.sp->slice_begin(s), g.sp->slice_begin(s + 1)});
+    return jobs;
+}
+
+void prepare(const SequenceParams& sp, Planes& out) {
+    for (int k = 0; k < 3; ++k)
+        if (out.p[k].width() != sp.plane_width(k) || out.p[k].height() != sp.plane_height(k))
+            out.p[k].resize(sp.plane_width(k), sp.plane_height(k));
+}
+
+}  // namespace
+
+ColorEncodeResult encode_color(const FrameContext& fc, const Planes& source, ImageView<const glm::vec2> motion,
+                               int qp, int skip_threshold, Planes& out, std::vector<uint8_t>& bytes,
+                               StreamStats& stats) {
+    const SequenceParams& sp = *fc.sp;
+    prepare(sp, out);
+    Planes predicted;
+    if (!fc.key) predict_planes(fc.reference->planes, sp, motion, predicted);
+    const std::size_t start = bytes.size();
+    ByteWriter w(bytes);
+    w.u8(uint8_t(qp));
+    const Geometry g = geometry(sp);
+    std::vector<SliceJob> jobs = slice_jobs(g, &source, fc.key ? nullptr : &predicted, out, qp, skip_threshold);
+    std::vector<std::vector<uint8_t>> scratch;
+    std::vector<uint8_t> body;
+    encode_slices(sp.slices, scratch, body, [&](int s, std::vector<uint8_t>& b) {
+        RangeEncoder rc(b);
+        code_slice<true>(jobs[s], rc);
+        rc.finish();
+    });
+    ColorEncodeResult result;
+    std::size_t blocks = 0, skipped = 0;
+    for (const SliceJob& j : jobs) {
+        blocks += j.blocks;
+        skipped += j.skipped;
+        result.intra_macroblocks += j.intra;
+        result.macroblocks += j.macroblocks;
+    }
+    const bool all_skipped = !fc.key && skipped == blocks;
+    w.u8(all_skipped ? kAllSkipped : 0);
+    if (!all_skipped) w.bytes(body);
+    stats.blocks += blocks;
+    stats.blocks_skipped += skipped;
+    stats.intra_blocks += result.intra_macroblocks;
+    stats.color_bits += 8 * (bytes.size() - start);
+    return result;
+}
+
+Status decode_color(const FrameContext& fc, ImageView<const glm::vec2> motion, std::span<const uint8_t> in,
+                    Planes& out, StreamStats& stats) {
+    const SequenceParams& sp = *fc.sp;
+    prepare(sp, out);
+    ByteReader r(in, "colour section");
+    const int qp = r.u8();
+    const uint8_t flags = r.u8();
+    if (!r.ok()) return Status::error(r.error());
+    if (qp > 51) return Status::error("colour section: qp " + std::to_string(qp) + " is above 51");
+    if (flags & ~kAllSkipped) return Status::error("colour section: unknown flags " + std::to_string(flags));
+    if ((flags & kAllSkipped) && fc.key) return Status::error("colour section: a key frame cannot skip its blocks");
+    Planes predicted;
+    if (!fc.key) predict_planes(fc.reference->planes, sp, motion, predicted);
+    const std::size_t blocks = std::size_t(sp.mb_cols()) * sp.mb_rows() * (4 + 2 * (sp.chroma == Chroma::C420 ? 1 : 4));
+    if (flags & kAllSkipped) {
+        if (r.remaining()) return Status::error("colour section: bytes after an all-skipped flag");
+        out = predicted;
+        stats.blocks += blocks;
+        stats.blocks_skipped += blocks;
+    } else {
+        std::vector<std::span<const uint8_t>> slices;
+        if (!read_slices(r, sp.slices, slices)) return Status::error(r.error());
+        const Geometry g = geometry(sp);
+        std::vector<SliceJob> jobs = slice_jobs(g, nullptr, fc.key ? nullptr : &predicted, out, qp, 0);
+        std::vector<uint8_t> ok(sp.slices, 0);
+        parallel_for(0, sp.slices, [&](int s0, int s1) {
+            for (int s = s0; s < s1; ++s) {
+                RangeDecoder rc(slices[s]);
+                ok[s] = code_slice<false>(jobs[s], rc);
+            }
+        }, 1);
+        for (int s = 0; s < sp.slices; ++s)
+            if (!ok[s]) return Status::error("colour section: slice " + std::to_string(s) + " is corrupt");
+        for (const SliceJob& j : jobs) {
+            stats.blocks += j.blocks;
+            stats.blocks_skipped += j.skipped;
+            stats.intra_blocks += j.intra;
+        }
+    }
+    stats.color_bits += 8 * in.size();
+    return {};
+}
+
+}  // namespace reprise::codec

@@ -1,0 +1,158 @@
+// Decoder: checks each packet (length, CRC, parameters, reference held), decodes into a scratch
+// picture and only then commits it, so a bad packet leaves the decoder as it was.
+#include <algorithm>
+#include <deque>
+
+#include "byte_io.hpp"
+#include "internal.hpp"
+
+namespace reprise::codec {
+
+namespace {
+
+constexpr std::size_t kMaxQueuedFrames = 16;
+
+void add(StreamStats& total, const StreamStats& f) {
+    total.frames += f.frames;
+    total.key_frames += f.key_frames;
+    total.older_reference += f.older_reference;
+    total.header_bits += f.header_bits;
+    total.camera_bits += f.camera_bits;
+    total.depth_bits += f.depth_bits;
+    total.motion_bits += f.motion_bits;
+    total.color_bits += f.color_bits;
+    total.blocks += f.blocks;
+    total.blocks_skipped += f.blocks_skipped;
+    total.intra_blocks += f.intra_blocks;
+    total.motion_residual_pixels += f.motion_residual_pixels;
+    total.depth_zero_blocks += f.depth_zero_blocks;
+}
+
+}  // namespace
+
+struct Decoder::State {
+    DecoderOptions options;
+    SequenceParams sp;
+    bool started = false;
+    Picture refs[kReferences];
+    bool have_newest = false;
+    uint32_t newest = 0;
+    std::deque<Frame> queue;
+    StreamStats stats;
+    Picture scratch;
+
+    int slot_of(uint32_t frame) const {
+        for (int i = 0; i < kReferences; ++i)
+            if (refs[i].held && refs[i].frame == frame) return i;
+        return -1;
+    }
+};
+
+Decoder::Decoder(const DecoderOptions& options) : state_(std::make_unique<State>()) { state_->options = options; }
+Decoder::~Decoder() = default;
+Decoder::Decoder(Decoder&&) noexcept = default;
+Decoder& Decoder::operator=(Decoder&&) noexcept = default;
+
+Status Decoder::send_packet(std::span<const uint8_t> packet) {
+    State& s = *state_;
+    PacketHeader h;
+    std::span<const uint8_t> payload;
+    REPRISE_TRY(parse_packet(packet, h, payload));
+    const std::string where = "frame " + std::to_string(h.frame);
+    if (s.queue.size() >= kMaxQueuedFrames)
+        return Status::error(where + ": " + std::to_string(s.queue.size()) + " decoded frames not taken by receive_frame");
+    const bool key = h.type == PacketType::Key;
+    if (!key && s.have_newest && h.frame <= s.newest)
+        return Status::error(where + ": not newer than frame " + std::to_string(s.newest) + " (duplicate or late)");
+    ByteReader r(payload, where);
+    SequenceParams sp = s.sp;
+    if (key) {
+        REPRISE_TRY(read_params(r, sp));
+        if (int64_t(sp.width) * sp.height > s.options.max_pixels)
+            return Status::error(where + ": " + std::to_string(sp.width) + "x" + std::to_string(sp.height) +
+                                 " is more than this decoder's limit of " + std::to_string(s.options.max_pixels) + " pixels");
+    } else if (!s.started) {
+        return Status::error(where + ": inter frame before any key frame");
+    }
+    const Picture* ref = nullptr;
+    if (!key) {
+        const int slot = s.slot_of(h.reference);
+        if (slot < 0) return Status::error(where + ": reference frame " + std::to_string(h.reference) + " is not held");
+        ref = &s.refs[slot];
+    }
+    std::span<const uint8_t> sections[4];
+    for (auto& section : sections) section = r.bytes(r.varint());
+    if (!r.ok()) return Status::error(r.error());
+    if (r.remaining()) return Status::error(where + ": " + std::to_string(r.remaining()) + " bytes after the last section");
+
+    FrameContext fc{&sp, ref, key};
+    Picture& pic = s.scratch;
+    StreamStats fs;
+    Camera camera;
+    double time = 0.0;
+    REPRISE_TRY(decode_camera(sections[0], ref, camera, time));
+    REPRISE_TRY(decode_depth(fc, camera, sections[1], pic.depth, fs));
+    REPRISE_TRY(decode_motion(fc, camera, pic.depth.view(), sections[2], pic.motion, fs));
+    Image<glm::vec2> to_reference;
+    ImageView<const glm::vec2> motion = pic.motion.view();
+    if (ref && ref->frame + 1 != h.frame) {
+        to_reference.resize(sp.width, sp.height);
+        if (pic.depth.empty())
+            std::fill(to_reference.data(), to_reference.data() + to_reference.pixel_count(), glm::vec2(0.0f));
+        else
+            camera_motion(camera, pic.depth.view(), ref->camera.view, ref->camera.projection, to_reference.view());
+        motion = to_reference.view();
+        fs.older_reference = 1;
+    }
+    REPRISE_TRY(decode_color(fc, motion, sections[3], pic.planes, fs));
+    fs.camera_bits += 8 * sections[0].size();
+    fs.frames = 1;
+    fs.key_frames = key;
+    fs.header_bits = 8 * packet.size() - (fs.camera_bits + fs.depth_bits + fs.motion_bits + fs.color_bits);
+
+    // Commit: the picture takes the oldest (or a free) slot; a key frame drops the rest.
+    pic.camera = camera;
+    pic.time = time;
+    pic.frame = h.frame;
+    pic.held = true;
+    if (key) {
+        for (auto& p : s.refs) p.held = false;
+        s.sp = sp;
+        s.started = true;
+    }
+    int slot = 0;
+    for (int i = 0; i < kReferences; ++i) {
+        if (!s.refs[i].held) {
+            slot = i;
+            break;
+        }
+        if (s.refs[i].frame < s.refs[slot].frame) slot = i;
+    }
+    std::swap(s.refs[slot], pic);
+    s.have_newest = true;
+    s.newest = h.frame;
+    add(s.stats, fs);
+
+    const Picture& out = s.refs[slot];
+    Frame frame;
+    linear_from_planes(out.planes, s.sp, out.depth.view(), frame.color);
+    frame.depth = out.depth;
+    frame.motion = out.motion;
+    frame.camera = out.camera;
+    frame.fps = s.sp.fps;
+    s.queue.push_back(std::move(frame));
+    return {};
+}
+
+Result Decoder::receive_frame(Frame& frame) {
+    if (state_->queue.empty()) return Result::NeedMoreData;
+    frame = std::move(state_->queue.front());
+    state_->queue.pop_front();
+    return Result::Ok;
+}
+
+void Decoder::flush() {}
+
+const StreamStats& Decoder::stats() const { return state_->stats; }
+
+}  // namespace reprise::codec

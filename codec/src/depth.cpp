@@ -1,0 +1,339 @@
+// Depth: each pixel as a 32-bit code (the float's bits in an order-preserving map, or the
+// quantised log2 depth), predicted per 8x8 block either from the reference depth
+// forward-projected into this camera or spatially (median edge detector), residuals
+// context-coded. Blocks predicted exactly cost two flags.
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#include "internal.hpp"
+#include "slices.hpp"
+
+namespace reprise::codec {
+
+namespace {
+
+constexpr uint32_t kInfCode = (1u << 30) + 1;
+constexpr uint32_t kInvalidCode = (1u << 30) + 2;
+constexpr int kBlock = 8;
+constexpr uint32_t kNoPrediction = 0xFFFFFFFFu;  // no code maps here in either mode
+constexpr uint8_t kAllPredicted = 1;
+
+struct Mapping {
+    bool lossless;
+    double step;
+
+    uint32_t code(float z) const {
+        if (lossless) {
+            uint32_t u;
+            std::memcpy(&u, &z, 4);
+            const uint32_t o = (u & 0x80000000u) ? ~u : (u | 0x80000000u);
+            return o == kNoPrediction ? o - 1 : o;  // -NaN with all payload bits: one step off
+        }
+        if (z == std::numeric_limits<float>::infinity()) return kInfCode;
+        if (!(z > 0.0f) || !std::isfinite(z)) return kInvalidCode;
+        const double k = std::nearbyint(exact_log2(double(z)) / step);
+        return uint32_t(int32_t(std::clamp(k, -double(1 << 30), double(1 << 30))));
+    }
+    float depth(uint32_t c) const {
+        if (lossless) {
+            const uint32_t u = (c & 0x80000000u) ? (c & 0x7FFFFFFFu) : ~c;
+            float z;
+            std::memcpy(&z, &u, 4);
+            return z;
+        }
+        if (c == kInfCode) return std::numeric_limits<float>::infinity();
+        const int32_t k = int32_t(c);
+        if (k > (1 << 30) || k < -(1 << 30)) return std::numeric_limits<float>::quiet_NaN();
+        return float(exact_exp2(double(k) * step));
+    }
+    uint32_t empty() const { return lossless ? code(std::numeric_limits<float>::infinity()) : kInfCode; }
+};
+
+Mapping mapping_of(const SequenceParams& sp) { return {sp.depth == DepthMode::Lossless, sp.depth_step()}; }
+
+inline uint32_t median_edge(int64_t a, int64_t b, int64_t c) {
+    if (c >= std::max(a, b)) return uint32_t(std::min(a, b));
+    if (c <= std::min(a, b)) return uint32_t(std::max(a, b));
+    return uint32_t(a + b - c);
+}
+
+inline int magnitude_class(uint32_t left, uint32_t top) {
+    auto mag = [](uint32_t r) { return uint64_t(std::abs(int64_t(int32_t(r)))); };
+    const uint64_t s = mag(left) + mag(top);
+    return s == 0 ? 0 : s <= 8 ? 1 : s <= 256 ? 2 : 3;
+}
+
+struct Models {
+    BitModel temporal;
+    BitModel zero_block[2];
+    IntModel<24> residual[2][4];
+};
+
+// The pieces one slice needs; codes (V) and residuals (R) are full-frame images.
+struct SliceJob {
+    const Mapping* map;
+    int width, y0, y1;
+    ImageView<uint32_t> codes;          // decoder fills, encoder has them
+    ImageView<const uint32_t> temporal;  // kNoPrediction where nothing landed; empty on key frames
+    ImageView<uint32_t> residuals;
+    std::size_t zero_blocks = 0;
+};
+
+// Lossless depth is predicted in inverse depth, which is affine across a plane in screen space:
+// the median edge detector there predicts planes to within a few units in the last place.
+inline uint32_t inverse_depth_median(const Mapping& map, uint32_t ca, uint32_t cb, uint32_t cc) {
+    const float a = map.depth(ca), b = map.depth(cb), c = map.depth(cc);
+    if (!(a > 0.0f && b > 0.0f && c > 0.0f && a < INFINITY && b < INFINITY && c < INFINITY))
+        return median_edge(ca, cb, cc);
+    const float ia = 1.0f / a, ib = 1.0f / b, ic = 1.0f / c;
+    float p;
+    if (ic >= std::max(ia, ib)) p = std::min(ia, ib);
+    else if (ic <= std::min(ia, ib)) p = std::max(ia, ib);
+    else p = ia + ib - ic;
+    return map.code(1.0f / p);
+}
+
+inline uint32_t spatial(const SliceJob& j, int x, int y) {
+    const bool left = x > 0, top = y > j.y0;
+    if (left && top) {
+        if (j.map->lossless) return inverse_depth_median(*j.map, j.codes(x - 1, y), j.codes(x, y - 1), j.codes(x - 1, y - 1));
+        return median_edge(j.codes(x - 1, y), j.codes(x, y - 1), j.codes(x - 1, y - 1));
+    }
+    if (left) return j.codes(x - 1, y);
+    if (top) return j.codes(x, y - 1);
+    return j.map->empty();
+}
+
+inline uint32_t predict(const SliceJob& j, int x, int y, bool temporal) {
+    if (temporal) {
+        const uint32_t t = j.temporal(x, y);
+        if (t != kNoPrediction) return t;
+    }
+    return spatial(j, x, y);
+}
+
+inline int residual_context(const SliceJob& j, int x, int y) {
+    return magnitude_class(x > 0 ? j.residuals(x - 1, y) : 0, y > j.y0 ? j.residuals(x, y - 1) : 0);
+}
+
+// Cost estimate of coding a block with one predictor. The encoder knows every code up front
+// (coding is lossless), so spatial predictions are made once into `spatial_codes`.
+uint64_t block_cost(const SliceJob& j, ImageView<const uint32_t> spatial_codes, int bx, int by, int bw, int bh,
+                    bool temporal) {
+    uint64_t cost = 0;
+    for (int y = by; y < by + bh; ++y)
+        for (int x = bx; x < bx + bw; ++x) {
+            uint32_t p = temporal ? j.temporal(x, y) : kNoPrediction;
+            if (p == kNoPrediction) p = spatial_codes(x, y);
+            const int32_t r = int32_t(j.codes(x, y) - p);
+            cost += r == 0 ? 0 : 2 + 2 * uint64_t(std::bit_width(uint32_t(std::abs(int64_t(r)))));
+        }
+    return cost;
+}
+
+void encode_slice(SliceJob& j, std::vector<uint8_t>& bytes) {
+    RangeEncoder rc(bytes);
+    Models m;
+    const bool inter = !j.temporal.empty();
+    Image<uint32_t> spatial_codes(j.width, j.y1 - j.y0);
+    ImageView<uint32_t> sv = spatial_codes.view();
+    sv.data -= std::ptrdiff_t(j.y0) * sv.stride;  // addressed with frame rows
+    for (int y = j.y0; y < j.y1; ++y)
+        for (int x = 0; x < j.width; ++x) sv(x, y) = spatial(j, x, y);
+    std::vector<uint8_t> block_temporal, block_zero;
+    for (int by = j.y0; by < j.y1; by += kBlock) {
+        const int bh = std::min(kBlock, j.y1 - by);
+        const int blocks = (j.width + kBlock - 1) / kBlock;
+        block_temporal.assign(blocks, 0);
+        block_zero.assign(blocks, 0);
+        for (int b = 0; b < blocks; ++b) {
+            const int bx = b * kBlock, bw = std::min(kBlock, j.width - bx);
+            bool use_temporal = false;
+            uint64_t cost = block_cost(j, sv, bx, by, bw, bh, false);
+            if (inter) {
+                const uint64_t t = block_cost(j, sv, bx, by, bw, bh, true);
+                use_temporal = t <= cost;
+                cost = std::min(cost, t);
+                rc.bit(m.temporal, use_temporal);
+            }
+            block_temporal[b] = use_temporal;
+            block_zero[b] = cost == 0;
+            rc.bit(m.zero_block[use_temporal], cost == 0);
+            j.zero_blocks += cost == 0;
+        }
+        for (int y = by; y < by + bh; ++y)
+            for (int x = 0; x < j.width; ++x) {
+                const int b = x / kBlock;
+                uint32_t p = block_temporal[b] ? j.temporal(x, y) : kNoPrediction;
+                if (p == kNoPrediction) p = sv(x, y);
+                const uint32_t r = j.codes(x, y) - p;
+                j.residuals(x, y) = r;
+                if (block_zero[b]) continue;
+                encode_int(rc, m.residual[block_temporal[b]][residual_context(j, x, y)], int64_t(int32_t(r)));
+            }
+    }
+    rc.finish();
+}
+
+bool decode_slice(SliceJob& j, std::span<const uint8_t> bytes) {
+    RangeDecoder rc(bytes);
+    Models m;
+    const bool inter = !j.temporal.empty();
+    std::vector<uint8_t> block_temporal, block_zero;
+    for (int by = j.y0; by < j.y1; by += kBlock) {
+        const int bh = std::min(kBlock, j.y1 - by);
+        const int blocks = (j.width + kBlock - 1) / kBlock;
+        block_temporal.assign(blocks, 0);
+        block_zero.assign(blocks, 0);
+        for (int b = 0; b < blocks; ++b) {
+            block_temporal[b] = inter ? uint8_t(rc.bit(m.temporal)) : 0;
+            block_zero[b] = uint8_t(rc.bit(m.zero_block[block_temporal[b]]));
+            j.zero_blocks += block_zero[b];
+        }
+        for (int y = by; y < by + bh; ++y)
+            for (int x = 0; x < j.width; ++x) {
+                const int b = x / kBlock;
+                int64_t r = 0;
+                if (!block_zero[b] &&
+                    !decode_int(rc, m.residual[block_temporal[b]][residual_context(j, x, y)], r))
+                    return false;
+                j.residuals(x, y) = uint32_t(r);
+                j.codes(x, y) = predict(j, x, y, block_temporal[b]) + uint32_t(r);
+            }
+        if (rc.overrun() > 8) return false;
+    }
+    return rc.overrun() <= 8;
+}
+
+// Codes of the reference depth seen from `camera`; empty on key frames or without reference depth.
+void temporal_codes(const FrameContext& fc, const Camera& camera, const Mapping& map, Image<uint32_t>& out) {
+    if (fc.key || !fc.reference || fc.reference->depth.empty()) {
+        out.clear();
+        return;
+    }
+    const int w = fc.sp->width, h = fc.sp->height;
+    Image<float> projected(w, h);
+    reproject_depth(fc.reference->camera, fc.reference->depth.view(), camera, projected.view());
+    out.resize(w, h);
+    parallel_for(0, h, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y)
+            for (int x = 0; x < w; ++x) {
+                const float z = projected(x, y);
+                out(x, y) = std::isnan(z) ? kNoPrediction : map.code(z);
+            }
+    });
+}
+
+std::vector<SliceJob> slice_jobs(const SequenceParams& sp, const Mapping& map, Image<uint32_t>& codes,
+                                 const Image<uint32_t>& temporal, Image<uint32_t>& residuals) {
+    std::vector<SliceJob> jobs;
+    for (int s = 0; s < sp.slices; ++s) {
+        const int y0 = std::min(sp.height, sp.slice_begin(s) * kMb);
+        const int y1 = std::min(sp.height, sp.slice_begin(s + 1) * kMb);
+        jobs.push_back({&map, sp.width, y0, y1, codes.view(), temporal.view(), residuals.view()});
+    }
+    return jobs;
+}
+
+void depth_from_codes(const Mapping& map, const Image<uint32_t>& codes, Image<float>& out) {
+    out.resize(codes.width(), codes.height());
+    parallel_for(0, codes.height(), [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y) {
+            uint32_t last = codes(0, y);
+            float z = map.depth(last);
+            for (int x = 0; x < codes.width(); ++x) {
+                const uint32_t c = codes(x, y);
+                if (c != last) {
+                    last = c;
+                    z = map.depth(c);
+                }
+                out(x, y) = z;
+            }
+        }
+    });
+}
+
+}  // namespace
+
+// Codes are log2(z) / step rounded: the decoded z is within 2^(step / 2) - 1 of the truth; a
+// little margin keeps float rounding of the result inside the bound.
+double SequenceParams::depth_step() const { return 2.0 * exact_log2(1.0 + 0.999 * double(depth_error)); }
+
+void encode_depth(const FrameContext& fc, const Camera& camera, ImageView<const float> source, Image<float>& out,
+                  std::vector<uint8_t>& bytes, StreamStats& stats) {
+    const SequenceParams& sp = *fc.sp;
+    if (sp.depth == DepthMode::None) {
+        out.clear();
+        return;
+    }
+    const Mapping map = mapping_of(sp);
+    const int w = sp.width, h = sp.height;
+    Image<uint32_t> codes(w, h), temporal, residuals(w, h);
+    parallel_for(0, h, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y)
+            for (int x = 0; x < w; ++x) codes(x, y) = map.code(source.empty() ? INFINITY : source(x, y));
+    });
+    temporal_codes(fc, camera, map, temporal);
+    const std::size_t start = bytes.size();
+    bool all_predicted = !temporal.empty();
+    for (std::size_t i = 0; all_predicted && i < codes.pixel_count(); ++i)
+        all_predicted = codes.data()[i] == temporal.data()[i];
+    ByteWriter wr(bytes);
+    wr.u8(all_predicted ? kAllPredicted : 0);
+    if (all_predicted) {
+        stats.depth_zero_blocks += std::size_t((w + kBlock - 1) / kBlock) * ((h + kBlock - 1) / kBlock);
+    } else {
+        std::vector<SliceJob> jobs = slice_jobs(sp, map, codes, temporal, residuals);
+        std::vector<std::vector<uint8_t>> scratch;
+        encode_slices(sp.slices, scratch, bytes, [&](int s, std::vector<uint8_t>& b) { encode_slice(jobs[s], b); });
+        for (const SliceJob& j : jobs) stats.depth_zero_blocks += j.zero_blocks;
+    }
+    stats.depth_bits += 8 * (bytes.size() - start);
+    depth_from_codes(map, codes, out);
+}
+
+Status decode_depth(const FrameContext& fc, const Camera& camera, std::span<const uint8_t> in, Image<float>& out,
+                    StreamStats& stats) {
+    const SequenceParams& sp = *fc.sp;
+    if (sp.depth == DepthMode::None) {
+        if (!in.empty()) return Status::error("depth section: present in a stream without depth");
+        out.clear();
+        return {};
+    }
+    const Mapping map = mapping_of(sp);
+    const int w = sp.width, h = sp.height;
+    Image<uint32_t> codes(w, h), temporal, residuals(w, h);
+    temporal_codes(fc, camera, map, temporal);
+    ByteReader r(in, "depth section");
+    const uint8_t flags = r.u8();
+    if (!r.ok()) return Status::error(r.error());
+    if (flags & ~kAllPredicted) return Status::error("depth section: unknown flags " + std::to_string(flags));
+    if (flags & kAllPredicted) {
+        if (temporal.empty()) return Status::error("depth section: predicted from a reference on a key frame");
+        if (r.remaining()) return Status::error("depth section: bytes after an all-predicted flag");
+        for (std::size_t i = 0; i < codes.pixel_count(); ++i) {
+            const uint32_t t = temporal.data()[i];
+            codes.data()[i] = t == kNoPrediction ? map.empty() : t;
+        }
+        stats.depth_zero_blocks += std::size_t((w + kBlock - 1) / kBlock) * ((h + kBlock - 1) / kBlock);
+    } else {
+        std::vector<std::span<const uint8_t>> slices;
+        if (!read_slices(r, sp.slices, slices)) return Status::error(r.error());
+        std::vector<SliceJob> jobs = slice_jobs(sp, map, codes, temporal, residuals);
+        std::vector<uint8_t> ok(sp.slices, 0);
+        parallel_for(0, sp.slices, [&](int s0, int s1) {
+            for (int s = s0; s < s1; ++s) ok[s] = decode_slice(jobs[s], slices[s]);
+        }, 1);
+        for (int s = 0; s < sp.slices; ++s)
+            if (!ok[s]) return Status::error("depth section: slice " + std::to_string(s) + " is corrupt");
+        for (const SliceJob& j : jobs) stats.depth_zero_blocks += j.zero_blocks;
+    }
+    stats.depth_bits += 8 * in.size();
+    depth_from_codes(map, codes, out);
+    return {};
+}
+
+}  // namespace reprise::codec

@@ -1,0 +1,285 @@
+// Encoder: reference choice (previous frame, or the newest acknowledged one after a loss), key
+// frames on cuts/requests/intervals, rate control, and the sections in decoding order.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <deque>
+#include <set>
+
+#include "byte_io.hpp"
+#include "internal.hpp"
+
+namespace reprise::codec {
+
+namespace {
+
+constexpr std::size_t kMaxQueuedPackets = 16;
+
+void append_section(std::vector<uint8_t>& payload, const std::vector<uint8_t>& section) {
+    ByteWriter w(payload);
+    w.varint(section.size());
+    w.bytes(section);
+}
+
+}  // namespace
+
+struct Encoder::State {
+    EncoderOptions options;
+    SequenceParams sp;
+    bool started = false;
+    Picture refs[kReferences];
+    uint32_t reference_of[kReferences] = {};
+    bool tainted[kReferences] = {};  // depends on a lost frame
+    uint32_t next_frame = 0;
+    uint32_t last_key = 0;
+    std::deque<Packet> queue;
+    std::set<uint32_t> acknowledged;
+    bool after_loss = false;
+    bool key_requested = false;
+    StreamStats stats, last;
+    int qp = 28;
+    double qp_state = 28.0;
+    // Reconstruction as a Frame, made on request.
+    mutable Frame recon;
+    mutable bool recon_ready = false;
+    int newest = -1;  // slot of the newest picture
+    Planes source_planes;
+
+    int slot_of(uint32_t frame) const {
+        for (int i = 0; i < kReferences; ++i)
+            if (refs[i].held && refs[i].frame == frame) return i;
+        return -1;
+    }
+
+    // The reference for the next frame, or -1 for a key frame.
+    int choose_reference() {
+        const uint32_t n = next_frame;
+        if (!started || key_requested) return -1;
+        if (options.keyint > 0 && n - last_key >= uint32_t(options.keyint)) return -1;
+        if (!after_loss) {
+            const int s = slot_of(n - 1);
+            if (s >= 0 && !tainted[s]) return s;
+        }
+        int best = -1;
+        for (int i = 0; i < kReferences; ++i)
+            if (refs[i].held && !tainted[i] && acknowledged.count(refs[i].frame) &&
+                (best < 0 || refs[i].frame > refs[best].frame))
+                best = i;
+        return best;
+    }
+
+    Status encode(const Frame& frame, int ref_slot, int qp_now, Picture& pic, std::vector<uint8_t>& payload,
+                  StreamStats& fs, ColorEncodeResult& colour) {
+        const bool key = ref_slot < 0;
+        const Picture* ref = key ? nullptr : &refs[ref_slot];
+        FrameContext fc{&sp, ref, key};
+        payload.clear();
+        if (key) write_params(sp, payload);
+
+        std::vector<uint8_t> section;
+        encode_camera(frame.camera, frame.camera.time, ref, section);
+        fs.camera_bits += 8 * section.size();
+        append_section(payload, section);
+
+        section.clear();
+        encode_depth(fc, frame.camera, frame.depth.view(), pic.depth, section, fs);
+        append_section(payload, section);
+
+        section.clear();
+        encode_motion(fc, frame.camera, pic.depth.view(), frame.motion.view(), pic.motion, section, fs);
+        append_section(payload, section);
+
+        Image<glm::vec2> to_reference;
+        ImageView<const glm::vec2> motion = pic.motion.view();
+        if (ref && ref->frame + 1 != next_frame) {
+            to_reference.resize(sp.width, sp.height);
+            if (pic.depth.empty())
+                std::fill(to_reference.data(), to_reference.data() + to_reference.pixel_count(), glm::vec2(0.0f));
+            else
+                camera_motion(frame.camera, pic.depth.view(), ref->camera.view, ref->camera.projection,
+                              to_reference.view());
+            motion = to_reference.view();
+        }
+        section.clear();
+        colour = encode_color(fc, source_planes, motion, qp_now, options.skip_threshold, pic.planes, section, fs);
+        append_section(payload, section);
+        // The packet header, key frame parameters and section lengths.
+        fs.header_bits = 8 * (kPacketHeaderSize + payload.size()) -
+                         (fs.camera_bits + fs.depth_bits + fs.motion_bits + fs.color_bits);
+        pic.camera = frame.camera;
+        pic.time = frame.camera.time;
+        pic.frame = next_frame;
+        pic.held = true;
+        return {};
+    }
+};
+
+Encoder::Encoder(const EncoderOptions& options) : state_(std::make_unique<State>()) {
+    state_->options = options;
+    state_->qp = std::clamp(options.qp, 0, 51);
+    state_->qp_state = state_->qp;
+}
+Encoder::~Encoder() = default;
+Encoder::Encoder(Encoder&&) noexcept = default;
+Encoder& Encoder::operator=(Encoder&&) noexcept = default;
+
+Status Encoder::send_frame(const Frame& frame) {
+    State& s = *state_;
+    const int w = frame.color.width(), h = frame.color.height();
+    REPRISE_TRY(check_image_size(w, h, "encoder input frame " + std::to_string(s.next_frame)));
+    if (!frame.depth.empty() && (frame.depth.width() != w || frame.depth.height() != h))
+        return Status::error("encoder input frame " + std::to_string(s.next_frame) + ": depth size differs from colour");
+    if (!frame.motion.empty() && (frame.motion.width() != w || frame.motion.height() != h))
+        return Status::error("encoder input frame " + std::to_string(s.next_frame) + ": motion size differs from colour");
+    if (s.queue.size() >= kMaxQueuedPackets)
+        return Status::error("encoder: " + std::to_string(s.queue.size()) + " packets not taken by receive_packet");
+    if (s.options.depth == DepthMode::Bounded && !(s.options.depth_error >= 1e-7f && s.options.depth_error <= 0.1f))
+        return Status::error("encoder: depth error bound must lie in 1e-7..0.1");
+
+    SequenceParams sp;
+    sp.width = w;
+    sp.height = h;
+    sp.chroma = s.options.chroma;
+    sp.depth = s.options.depth;
+    sp.depth_error = s.options.depth_error;
+    sp.slices = default_slices(h);
+    sp.fps = frame.fps > 0.0 ? frame.fps : s.options.fps;
+    if (s.started && !(sp == s.sp)) s.started = false;  // new parameters: a key frame
+    s.sp = sp;
+
+    planes_from_linear(frame.color.view(), sp, s.source_planes);
+    int ref = s.choose_reference();
+    // Rate control: bounded frame sizes, re-encoding with a coarser quantiser when one is too big.
+    const double target_bits = s.options.bitrate_kbps > 0 ? s.options.bitrate_kbps * 1000.0 / std::max(1.0, sp.fps) : 0.0;
+    int qp = s.qp;
+    Picture pic;
+    std::vector<uint8_t> payload;
+    StreamStats fs;
+    for (int attempt = 0;; ++attempt) {
+        fs = {};
+        ColorEncodeResult colour;
+        const int qp_now = std::clamp(ref < 0 ? qp - 3 : qp, 0, 51);
+        REPRISE_TRY(s.encode(frame, ref, qp_now, pic, payload, fs, colour));
+        if (ref >= 0 && s.options.detect_cuts && colour.intra_macroblocks * 10 > colour.macroblocks * 6) {
+            ref = -1;  // a cut: most of the frame is new
+            --attempt;
+            continue;
+        }
+        const double bits = 8.0 * (payload.size() + kPacketHeaderSize);
+        const double limit = target_bits * (ref < 0 ? 6.0 : 3.0);
+        if (target_bits > 0 && bits > limit && qp < 51 && attempt < 3) {
+            qp = std::min(51, qp + 6);
+            continue;
+        }
+        break;
+    }
+    if (target_bits > 0) {
+        const double bits = 8.0 * (payload.size() + kPacketHeaderSize);
+        s.qp_state = std::clamp(s.qp_state + 0.5 * 6.0 * std::log2(std::max(bits, 1.0) / target_bits), 4.0, 51.0);
+        s.qp = int(std::lround(s.qp_state));
+    }
+
+    const bool key = ref < 0;
+    PacketHeader header{key ? PacketType::Key : PacketType::Inter, s.next_frame,
+                        key ? s.next_frame : s.refs[ref].frame, int64_t(std::llround(frame.camera.time * 1e6))};
+    Packet packet;
+    write_packet(header, payload, packet.data);
+    packet.frame = header.frame;
+    packet.reference = header.reference;
+    packet.type = header.type;
+    s.queue.push_back(std::move(packet));
+
+    // The new picture replaces the oldest (or a free) slot.
+    int slot = 0;
+    for (int i = 0; i < kReferences; ++i) {
+        if (!s.refs[i].held) {
+            slot = i;
+            break;
+        }
+        if (s.refs[i].frame < s.refs[slot].frame) slot = i;
+    }
+    if (key) {
+        for (auto& r : s.refs) r.held = false;
+        s.last_key = s.next_frame;
+        s.stats.key_frames++;
+        s.key_requested = false;
+        fs.key_frames = 1;
+    } else if (s.refs[ref].frame + 1 != s.next_frame) {
+        s.stats.older_reference++;
+        fs.older_reference = 1;
+    }
+    s.reference_of[slot] = header.reference;
+    s.tainted[slot] = !key && s.tainted[ref];
+    s.refs[slot] = std::move(pic);
+    s.newest = slot;
+    s.after_loss = false;
+    s.started = true;
+    s.next_frame++;
+    fs.frames = 1;
+    s.last = fs;
+    s.stats.frames++;
+    s.stats.header_bits += fs.header_bits;
+    s.stats.camera_bits += fs.camera_bits;
+    s.stats.depth_bits += fs.depth_bits;
+    s.stats.motion_bits += fs.motion_bits;
+    s.stats.color_bits += fs.color_bits;
+    s.stats.blocks += fs.blocks;
+    s.stats.blocks_skipped += fs.blocks_skipped;
+    s.stats.intra_blocks += fs.intra_blocks;
+    s.stats.motion_residual_pixels += fs.motion_residual_pixels;
+    s.stats.depth_zero_blocks += fs.depth_zero_blocks;
+    s.recon_ready = false;
+    return {};
+}
+
+Result Encoder::receive_packet(Packet& packet) {
+    if (state_->queue.empty()) return Result::NeedMoreData;
+    packet = std::move(state_->queue.front());
+    state_->queue.pop_front();
+    return Result::Ok;
+}
+
+void Encoder::flush() {}
+
+void Encoder::acknowledge(uint32_t frame) {
+    State& s = *state_;
+    s.acknowledged.insert(frame);
+    // Only frames still held matter.
+    while (s.acknowledged.size() > 64) s.acknowledged.erase(s.acknowledged.begin());
+}
+
+void Encoder::report_loss(uint32_t frame) {
+    State& s = *state_;
+    s.after_loss = true;
+    // A lost frame and every held frame predicted from it (in frame order) are unusable.
+    for (int pass = 0; pass < kReferences; ++pass)
+        for (int i = 0; i < kReferences; ++i) {
+            if (!s.refs[i].held) continue;
+            if (s.refs[i].frame == frame) s.tainted[i] = true;
+            const int r = s.slot_of(s.reference_of[i]);
+            if (s.reference_of[i] != s.refs[i].frame && (s.reference_of[i] == frame || (r >= 0 && s.tainted[r])))
+                s.tainted[i] = true;
+        }
+}
+
+void Encoder::request_key_frame() { state_->key_requested = true; }
+
+const Frame& Encoder::reconstruction() const {
+    const State& s = *state_;
+    if (!s.recon_ready && s.newest >= 0) {
+        const Picture& p = s.refs[s.newest];
+        linear_from_planes(p.planes, s.sp, p.depth.view(), s.recon.color);
+        s.recon.depth = p.depth;
+        s.recon.motion = p.motion;
+        s.recon.camera = p.camera;
+        s.recon.fps = s.sp.fps;
+        s.recon_ready = true;
+    }
+    return s.recon;
+}
+
+const StreamStats& Encoder::stats() const { return state_->stats; }
+const StreamStats& Encoder::last_frame_stats() const { return state_->last; }
+int Encoder::last_qp() const { return state_->qp; }
+
+}  // namespace reprise::codec

@@ -1,0 +1,164 @@
+// Motion and depth that the cameras explain: both sides compute them from decoded depth with the
+// same float arithmetic, so they agree bit for bit.
+#include <array>
+#include <cmath>
+#include <limits>
+
+#include <glm/mat4x4.hpp>
+
+#include "internal.hpp"
+#include "reprise/core/parallel.hpp"
+
+namespace reprise::codec {
+
+namespace {
+
+constexpr float kNan = std::numeric_limits<float>::quiet_NaN();
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+// Pixel (x, y) with depth z as a homogeneous point in the camera space of `projection`
+// (w = 0: the direction of a background pixel under perspective). False for NaN/negative depth.
+struct Unprojector {
+    glm::mat4 p;
+    bool perspective;
+    float far_plane;
+    float width, height;
+
+    bool point(int x, int y, float z, glm::vec4& out) const {
+        if (!(z >= 0.0f)) return false;
+        const float x_ndc = 2.0f * (float(x) + 0.5f) / width - 1.0f;
+        const float y_ndc = 1.0f - 2.0f * (float(y) + 0.5f) / height;
+        const bool background = z == kInf;
+        if (background && perspective) {
+            const float wc = -p[2][3];
+            out = {(x_ndc * wc + p[2][0]) / p[0][0], (y_ndc * wc + p[2][1]) / p[1][1], -1.0f, 0.0f};
+            return true;
+        }
+        if (background) z = far_plane;
+        const float zv = -z;
+        const float wc = p[2][3] * zv + p[3][3];
+        out = {(x_ndc * wc - p[2][0] * zv - p[3][0]) / p[0][0], (y_ndc * wc - p[2][1] * zv - p[3][1]) / p[1][1],
+               zv, 1.0f};
+        return true;
+    }
+};
+
+Unprojector unprojector(const Camera& c, int w, int h) {
+    return {c.projection, c.projection[2][3] != 0.0f, std::isfinite(c.far) ? c.far : 1e6f, float(w), float(h)};
+}
+
+glm::mat4 between(const glm::mat4& from_view, const glm::mat4& to_view) {
+    return glm::mat4(glm::dmat4(to_view) * glm::inverse(glm::dmat4(from_view)));
+}
+
+}  // namespace
+
+void camera_motion(const Camera& from, ImageView<const float> depth, const glm::mat4& to_view,
+                   const glm::mat4& to_projection, ImageView<glm::vec2> out) {
+    const int w = depth.width, h = depth.height;
+    REPRISE_ASSERT(out.width == w && out.height == h);
+    if (from.view == to_view && from.projection == to_projection) {
+        for (int y = 0; y < h; ++y) std::fill(out.row(y), out.row(y) + w, glm::vec2(0.0f));
+        return;
+    }
+    const Unprojector un = unprojector(from, w, h);
+    const glm::mat4 to_clip = glm::mat4(glm::dmat4(to_projection) * glm::dmat4(between(from.view, to_view)));
+    parallel_for(0, h, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y) {
+            const float* z = depth.row(y);
+            glm::vec2* m = out.row(y);
+            for (int x = 0; x < w; ++x) {
+                glm::vec4 point;
+                if (!un.point(x, y, z[x], point)) {
+                    m[x] = {kNan, kNan};
+                    continue;
+                }
+                const glm::vec4 clip = to_clip * point;
+                if (!(clip.w > 0.0f)) {
+                    m[x] = {kNan, kNan};
+                    continue;
+                }
+                const float px = (clip.x / clip.w + 1.0f) * 0.5f * float(w);
+                const float py = (1.0f - clip.y / clip.w) * 0.5f * float(h);
+                m[x] = {px - (float(x) + 0.5f), py - (float(y) + 0.5f)};
+            }
+        }
+    });
+}
+
+void reproject_depth(const Camera& from, ImageView<const float> depth, const Camera& to, ImageView<float> out) {
+    const int w = depth.width, h = depth.height;
+    REPRISE_ASSERT(out.width == w && out.height == h);
+    if (from.view == to.view && from.projection == to.projection) {
+        for (int y = 0; y < h; ++y) std::copy(depth.row(y), depth.row(y) + w, out.row(y));
+        return;
+    }
+    for (int y = 0; y < h; ++y) std::fill(out.row(y), out.row(y) + w, kNan);
+    const Unprojector un = unprojector(from, w, h);
+    const glm::mat4 to_camera = between(from.view, to.view);
+    const glm::mat4 to_clip = glm::mat4(glm::dmat4(to.projection) * glm::dmat4(to_camera));
+    for (int y = 0; y < h; ++y) {
+        const float* z = depth.row(y);
+        for (int x = 0; x < w; ++x) {
+            glm::vec4 point;
+            if (!(z[x] < kInf) || !un.point(x, y, z[x], point)) continue;
+            const glm::vec4 clip = to_clip * point;
+            if (!(clip.w > 0.0f)) continue;
+            const float px = (clip.x / clip.w + 1.0f) * 0.5f * float(w);
+            const float py = (1.0f - clip.y / clip.w) * 0.5f * float(h);
+            if (!(px >= 0.0f && py >= 0.0f && px < float(w) && py < float(h))) continue;
+            const float tz = -(to_camera * point).z;
+            if (!(tz > 0.0f)) continue;
+            float& slot = out(int(px), int(py));
+            if (!(tz >= slot)) slot = tz;  // NaN slot: first landing wins
+        }
+    }
+}
+
+namespace {
+
+// 2 / (k ln 2) for odd k: log2(m) = sum over odd k of (2 / (k ln 2)) s^k, s = (m - 1) / (m + 1).
+constexpr std::array<double, 11> log2_series() {
+    std::array<double, 11> c{};
+    for (int i = 0; i < 11; ++i) c[i] = 2.0 / (double(2 * i + 1) * 0.69314718055994531);
+    return c;
+}
+// (ln 2)^k / k!: 2^f = sum of these times f^k.
+constexpr std::array<double, 15> exp2_series() {
+    std::array<double, 15> c{};
+    double term = 1.0;
+    for (int k = 0; k < 15; ++k) {
+        c[k] = term;
+        term = term * 0.69314718055994531 / double(k + 1);
+    }
+    return c;
+}
+constexpr auto kLog2Series = log2_series();
+constexpr auto kExp2Series = exp2_series();
+
+}  // namespace
+
+double exact_log2(double x) {
+    int e = 0;
+    double m = std::frexp(x, &e);  // x = m 2^e, m in [0.5, 1)
+    if (m < 0.70710678118654752) {
+        m *= 2.0;
+        --e;
+    }
+    const double s = (m - 1.0) / (m + 1.0), s2 = s * s;
+    double sum = 0.0;
+    for (int i = int(kLog2Series.size()) - 1; i >= 0; --i) sum = sum * s2 + kLog2Series[i];
+    return double(e) + s * sum;
+}
+
+double exact_exp2(double x) {
+    if (x > 1100.0) x = 1100.0;
+    if (x < -1100.0) x = -1100.0;
+    const double n = std::floor(x);
+    const double f = x - n;
+    double sum = 0.0;
+    for (int k = int(kExp2Series.size()) - 1; k >= 0; --k) sum = sum * f + kExp2Series[k];
+    return std::ldexp(sum, int(n));
+}
+
+}  // namespace reprise::codec

@@ -1,0 +1,135 @@
+#pragma once
+// What encoder and decoder share: stream parameters, the reference picture, per-stage entry points.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "range_coder.hpp"
+#include "reprise/codec/codec.hpp"
+
+namespace reprise::codec {
+
+inline constexpr uint32_t kPacketMagic = 0x544B5052;  // "RPKT"
+inline constexpr uint32_t kFileMagic = 0x53525052;    // "RPRS"
+inline constexpr uint8_t kVersion = 1;
+inline constexpr std::size_t kPacketHeaderSize = 32;
+inline constexpr std::size_t kMaxPayload = 256u << 20;
+inline constexpr int kMaxSide = 16384;
+inline constexpr int kMaxSlices = 64;
+inline constexpr int kReferences = 4;  // pictures both sides keep
+inline constexpr int kMb = 16;         // macroblock: 16x16 luma
+
+struct SequenceParams {
+    int width = 0, height = 0;
+    Chroma chroma = Chroma::C420;
+    DepthMode depth = DepthMode::Lossless;
+    float depth_error = 1e-4f;
+    int slices = 1;
+    double fps = 0.0;
+    bool operator==(const SequenceParams&) const = default;
+
+    // Real chroma extent (the planes are padded to whole macroblocks beyond it).
+    int chroma_width() const { return chroma == Chroma::C420 ? (width + 1) / 2 : width; }
+    int chroma_height() const { return chroma == Chroma::C420 ? (height + 1) / 2 : height; }
+    int mb_cols() const { return (width + kMb - 1) / kMb; }
+    int mb_rows() const { return (height + kMb - 1) / kMb; }
+    // Chroma subsampling shift of plane k (0 = Y, 1 = Co, 2 = Cg).
+    int shift(int k) const { return k > 0 && chroma == Chroma::C420 ? 1 : 0; }
+    int plane_width(int k) const { return (mb_cols() * kMb) >> shift(k); }
+    int plane_height(int k) const { return (mb_rows() * kMb) >> shift(k); }
+    // Slice s covers macroblock rows [slice_begin(s), slice_begin(s + 1)).
+    int slice_begin(int s) const { return int(int64_t(mb_rows()) * s / slices); }
+    // log2 step of the bounded depth quantiser: relative error of z at most depth_error.
+    double depth_step() const;
+};
+
+// 8-bit display colour as YCoCg-R planes (Y 0..255, Co and Cg -255..255), padded to whole
+// macroblocks by repeating the last row and column.
+struct Planes {
+    Image<int16_t> p[3];
+};
+
+// What both sides hold of a decoded frame.
+struct Picture {
+    uint32_t frame = 0;
+    bool held = false;
+    Planes planes;
+    Image<float> depth;       // decoded depth (empty when the stream has none)
+    Image<glm::vec2> motion;  // decoded backward motion to the previous frame
+    Camera camera;
+    double time = 0.0;
+};
+
+// --- packet.cpp: the 32-byte packet header (docs/bitstream.md) and the key frame's parameters.
+struct PacketHeader {
+    PacketType type = PacketType::Key;
+    uint32_t frame = 0, reference = 0;
+    int64_t timestamp_us = 0;
+};
+void write_packet(const PacketHeader& header, std::span<const uint8_t> payload, std::vector<uint8_t>& out);
+Status parse_packet(std::span<const uint8_t> packet, PacketHeader& header, std::span<const uint8_t>& payload);
+void write_params(const SequenceParams& sp, std::vector<uint8_t>& out);
+class ByteReader;
+Status read_params(ByteReader& r, SequenceParams& sp);
+int default_slices(int height);
+
+// --- colour.cpp
+// Linear colour -> 8-bit sRGB -> YCoCg-R, chroma averaged 2x2 for 4:2:0.
+void planes_from_linear(ImageView<const glm::vec4> color, const SequenceParams& sp, Planes& out);
+// YCoCg-R planes -> linear RGB (A = alpha_one ? 1 : coverage from depth).
+void linear_from_planes(const Planes& planes, const SequenceParams& sp, ImageView<const float> depth,
+                        Image<glm::vec4>& out);
+
+// --- geometry.cpp
+// Backward motion that the cameras alone explain: pixel p of a frame seen by `from` with depth z
+// lies at p + m in the image of camera `to` (background by its direction). NaN where the point
+// is behind `to` or depth is NaN/negative; 0 everywhere when the cameras are identical.
+void camera_motion(const Camera& from, ImageView<const float> depth, const glm::mat4& to_view,
+                   const glm::mat4& to_projection, ImageView<glm::vec2> out);
+// The reference depth forward-projected into camera `to` (z-buffered, nearest pixel);
+// NaN where nothing landed. A copy when the cameras are identical.
+void reproject_depth(const Camera& from, ImageView<const float> depth, const Camera& to,
+                     ImageView<float> out);
+// Deterministic log2 / exp2 (IEEE double arithmetic only, no libm).
+double exact_log2(double x);
+double exact_exp2(double x);
+
+// --- stream sections. Each encoder appends to `out`; each decoder reads one section and returns
+// an error naming the field. Stats are added to `stats`.
+struct FrameContext {
+    const SequenceParams* sp = nullptr;
+    const Picture* reference = nullptr;  // null on key frames
+    bool key = false;
+};
+
+void encode_camera(const Camera& camera, double time, const Picture* reference, std::vector<uint8_t>& out);
+Status decode_camera(std::span<const uint8_t> in, const Picture* reference, Camera& camera, double& time);
+
+// Depth: `source` is the input depth (any floats), reconstruction goes to `out`.
+void encode_depth(const FrameContext& fc, const Camera& camera, ImageView<const float> source,
+                  Image<float>& out, std::vector<uint8_t>& bytes, StreamStats& stats);
+Status decode_depth(const FrameContext& fc, const Camera& camera, std::span<const uint8_t> in,
+                    Image<float>& out, StreamStats& stats);
+
+// Motion: decoded motion = camera motion + residual / 8.
+void encode_motion(const FrameContext& fc, const Camera& camera, ImageView<const float> depth,
+                   ImageView<const glm::vec2> source, Image<glm::vec2>& out,
+                   std::vector<uint8_t>& bytes, StreamStats& stats);
+Status decode_motion(const FrameContext& fc, const Camera& camera, ImageView<const float> depth,
+                     std::span<const uint8_t> in, Image<glm::vec2>& out, StreamStats& stats);
+
+// Colour. `motion` (to the reference) drives the inter prediction.
+struct ColorEncodeResult {
+    std::size_t intra_macroblocks = 0, macroblocks = 0;
+};
+ColorEncodeResult encode_color(const FrameContext& fc, const Planes& source, ImageView<const glm::vec2> motion,
+                               int qp, int skip_threshold, Planes& out, std::vector<uint8_t>& bytes,
+                               StreamStats& stats);
+Status decode_color(const FrameContext& fc, ImageView<const glm::vec2> motion, std::span<const uint8_t> in,
+                    Planes& out, StreamStats& stats);
+
+// Inter prediction of all three planes from the reference by `motion` (Catmull-Rom, integer).
+void predict_planes(const Planes& reference, const SequenceParams& sp, ImageView<const glm::vec2> motion,
+                    Planes& out);
+
+}  // namespace reprise::codec

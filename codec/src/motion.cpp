@@ -1,0 +1,233 @@
+// Motion: what the two cameras explain is derived from decoded depth on both sides; only the
+// difference (moving, skinned, morphed objects) is sent, quantised to 1/8 pixel, per 8x8 block
+// flagged, so a still world under a moving camera sends a single flag.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "internal.hpp"
+#include "slices.hpp"
+
+namespace reprise::codec {
+
+namespace {
+
+constexpr int kBlock = 8;
+constexpr uint8_t kNoResidual = 1;
+constexpr int64_t kMaxResidual = 1 << 24;  // eighths of a pixel: 2 million pixels
+
+struct Residual {
+    int32_t x = 0, y = 0;
+    bool invalid = false;  // decoded motion is NaN although the cameras explain this pixel
+    bool zero() const { return !invalid && x == 0 && y == 0; }
+};
+
+inline bool finite(glm::vec2 v) { return std::isfinite(v.x) && std::isfinite(v.y); }
+
+inline glm::vec2 usable_base(glm::vec2 base) { return finite(base) ? base : glm::vec2(0.0f); }
+
+Residual residual_of(glm::vec2 source, glm::vec2 base) {
+    Residual r;
+    if (!finite(source)) {
+        r.invalid = finite(base);  // NaN both ways needs nothing
+        return r;
+    }
+    const glm::vec2 d = (source - usable_base(base)) * 8.0f;
+    auto q = [](float v) { return int32_t(std::clamp<double>(std::nearbyint(double(v)), -kMaxResidual, kMaxResidual)); };
+    r.x = q(d.x);
+    r.y = q(d.y);
+    return r;
+}
+
+glm::vec2 apply(glm::vec2 base, const Residual& r) {
+    if (r.invalid) return glm::vec2(std::numeric_limits<float>::quiet_NaN());
+    if (r.x == 0 && r.y == 0) return base;
+    return usable_base(base) + glm::vec2(float(r.x), float(r.y)) * 0.125f;
+}
+
+struct Models {
+    BitModel block[2];
+    BitModel nonzero[3];
+    BitModel invalid;
+    IntModel<20> component[2];
+};
+
+struct SliceJob {
+    int width, y0, y1;
+    ImageView<const glm::vec2> base;
+    ImageView<const glm::vec2> source;  // encoder only
+    ImageView<glm::vec2> out;
+    Residual* residuals;  // per pixel of the frame, for contexts and prediction
+    std::size_t pixels = 0;
+
+    const Residual* at(int x, int y) const {
+        return x >= 0 && y >= y0 ? &residuals[std::size_t(y) * width + x] : nullptr;
+    }
+};
+
+inline int nonzero_context(const SliceJob& j, int x, int y) {
+    const Residual *left = j.at(x - 1, y), *top = j.at(x, y - 1);
+    return (left && !left->zero()) + (top && !top->zero());
+}
+
+// Moving objects have nearly the same residual as their neighbours: predict from the left one,
+// else the top one.
+inline Residual neighbour_prediction(const SliceJob& j, int x, int y) {
+    const Residual *left = j.at(x - 1, y), *top = j.at(x, y - 1);
+    if (left && !left->zero() && !left->invalid) return *left;
+    if (top && !top->zero() && !top->invalid) return *top;
+    return {};
+}
+
+template <bool Encode, class Coder>
+bool code_slice(SliceJob& j, Coder& rc) {
+    Models m;
+    std::vector<uint8_t> block_nonzero;
+    int previous_block = 0;
+    for (int by = j.y0; by < j.y1; by += kBlock) {
+        const int bh = std::min(kBlock, j.y1 - by);
+        const int blocks = (j.width + kBlock - 1) / kBlock;
+        block_nonzero.assign(blocks, 0);
+        for (int b = 0; b < blocks; ++b) {
+            if constexpr (Encode) {
+                for (int y = by; y < by + bh && !block_nonzero[b]; ++y)
+                    for (int x = b * kBlock; x < std::min(j.width, (b + 1) * kBlock); ++x)
+                        if (!residual_of(j.source(x, y), j.base(x, y)).zero()) block_nonzero[b] = 1;
+                rc.bit(m.block[previous_block], block_nonzero[b]);
+            } else {
+                block_nonzero[b] = uint8_t(rc.bit(m.block[previous_block]));
+            }
+            previous_block = block_nonzero[b];
+        }
+        for (int y = by; y < by + bh; ++y)
+            for (int x = 0; x < j.width; ++x) {
+                Residual r;
+                if (block_nonzero[x / kBlock]) {
+                    BitModel& nz = m.nonzero[nonzero_context(j, x, y)];
+                    if constexpr (Encode) {
+                        r = residual_of(j.source(x, y), j.base(x, y));
+                        rc.bit(nz, !r.zero());
+                        if (!r.zero()) {
+                            rc.bit(m.invalid, r.invalid);
+                            if (!r.invalid) {
+                                const Residual p = neighbour_prediction(j, x, y);
+                                encode_int(rc, m.component[0], int64_t(r.x) - p.x);
+                                encode_int(rc, m.component[1], int64_t(r.y) - p.y);
+                            }
+                        }
+                    } else if (rc.bit(nz)) {
+                        r.invalid = rc.bit(m.invalid);
+                        if (!r.invalid) {
+                            int64_t vx = 0, vy = 0;
+                            if (!decode_int(rc, m.component[0], vx) || !decode_int(rc, m.component[1], vy))
+                                return false;
+                            const Residual p = neighbour_prediction(j, x, y);
+                            vx += p.x;
+                            vy += p.y;
+                            if (std::abs(vx) > kMaxResidual || std::abs(vy) > kMaxResidual) return false;
+                            r.x = int32_t(vx);
+                            r.y = int32_t(vy);
+                        }
+                    }
+                }
+                j.residuals[std::size_t(y) * j.width + x] = r;
+                j.pixels += !r.zero();
+                j.out(x, y) = apply(j.base(x, y), r);
+            }
+        if constexpr (!Encode) {
+            if (rc.overrun() > 8) return false;
+        }
+    }
+    return true;
+}
+
+// Motion the cameras explain (to the previous frame as this frame's camera records it).
+void base_motion(const Camera& camera, ImageView<const float> depth, int w, int h, Image<glm::vec2>& base) {
+    base.resize(w, h);
+    if (depth.empty()) {
+        std::fill(base.data(), base.data() + base.pixel_count(), glm::vec2(0.0f));
+        return;
+    }
+    camera_motion(camera, depth, camera.prev_view, camera.prev_projection, base.view());
+}
+
+std::vector<SliceJob> slice_jobs(const SequenceParams& sp, const Image<glm::vec2>& base,
+                                 ImageView<const glm::vec2> source, Image<glm::vec2>& out,
+                                 std::vector<Residual>& residuals) {
+    std::vector<SliceJob> jobs;
+    for (int s = 0; s < sp.slices; ++s) {
+        const int y0 = std::min(sp.height, sp.slice_begin(s) * kMb);
+        const int y1 = std::min(sp.height, sp.slice_begin(s + 1) * kMb);
+        jobs.push_back({sp.width, y0, y1, base.view(), source, out.view(), residuals.data()});
+    }
+    return jobs;
+}
+
+}  // namespace
+
+void encode_motion(const FrameContext& fc, const Camera& camera, ImageView<const float> depth,
+                   ImageView<const glm::vec2> source, Image<glm::vec2>& out, std::vector<uint8_t>& bytes,
+                   StreamStats& stats) {
+    const SequenceParams& sp = *fc.sp;
+    const int w = sp.width, h = sp.height;
+    Image<glm::vec2> base;
+    base_motion(camera, depth, w, h, base);
+    out.resize(w, h);
+    const std::size_t start = bytes.size();
+    bool any = false;
+    if (!source.empty())
+        for (int y = 0; y < h && !any; ++y)
+            for (int x = 0; x < w && !any; ++x) any = !residual_of(source(x, y), base(x, y)).zero();
+    ByteWriter wr(bytes);
+    wr.u8(any ? 0 : kNoResidual);
+    if (!any) {
+        std::copy(base.data(), base.data() + base.pixel_count(), out.data());
+    } else {
+        std::vector<Residual> residuals(std::size_t(w) * h);
+        std::vector<SliceJob> jobs = slice_jobs(sp, base, source, out, residuals);
+        std::vector<std::vector<uint8_t>> scratch;
+        encode_slices(sp.slices, scratch, bytes, [&](int s, std::vector<uint8_t>& b) {
+            RangeEncoder rc(b);
+            code_slice<true>(jobs[s], rc);
+            rc.finish();
+        });
+        for (const SliceJob& j : jobs) stats.motion_residual_pixels += j.pixels;
+    }
+    stats.motion_bits += 8 * (bytes.size() - start);
+}
+
+Status decode_motion(const FrameContext& fc, const Camera& camera, ImageView<const float> depth,
+                     std::span<const uint8_t> in, Image<glm::vec2>& out, StreamStats& stats) {
+    const SequenceParams& sp = *fc.sp;
+    const int w = sp.width, h = sp.height;
+    Image<glm::vec2> base;
+    base_motion(camera, depth, w, h, base);
+    out.resize(w, h);
+    ByteReader r(in, "motion section");
+    const uint8_t flags = r.u8();
+    if (!r.ok()) return Status::error(r.error());
+    if (flags & ~kNoResidual) return Status::error("motion section: unknown flags " + std::to_string(flags));
+    if (flags & kNoResidual) {
+        if (r.remaining()) return Status::error("motion section: bytes after a no-residual flag");
+        std::copy(base.data(), base.data() + base.pixel_count(), out.data());
+    } else {
+        std::vector<std::span<const uint8_t>> slices;
+        if (!read_slices(r, sp.slices, slices)) return Status::error(r.error());
+        std::vector<Residual> residuals(std::size_t(w) * h);
+        std::vector<SliceJob> jobs = slice_jobs(sp, base, {}, out, residuals);
+        std::vector<uint8_t> ok(sp.slices, 0);
+        parallel_for(0, sp.slices, [&](int s0, int s1) {
+            for (int s = s0; s < s1; ++s) {
+                RangeDecoder rc(slices[s]);
+                ok[s] = code_slice<false>(jobs[s], rc);
+            }
+        }, 1);
+        for (int s = 0; s < sp.slices; ++s)
+            if (!ok[s]) return Status::error("motion section: slice " + std::to_string(s) + " is corrupt");
+        for (const SliceJob& j : jobs) stats.motion_residual_pixels += j.pixels;
+    }
+    stats.motion_bits += 8 * in.size();
+    return {};
+}
+
+}  // namespace reprise::codec

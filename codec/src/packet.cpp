@@ -1,0 +1,148 @@
+// Packet header, key frame parameters and the .rps file container (docs/bitstream.md).
+#include <algorithm>
+
+#include "byte_io.hpp"
+#include "crc32c.hpp"
+#include "internal.hpp"
+
+namespace reprise::codec {
+
+int default_slices(int height) {
+    const int mb_rows = (height + kMb - 1) / kMb;
+    return std::clamp((mb_rows + 7) / 8, 1, kMaxSlices);
+}
+
+void write_packet(const PacketHeader& h, std::span<const uint8_t> payload, std::vector<uint8_t>& out) {
+    out.clear();
+    ByteWriter w(out);
+    w.u32(kPacketMagic);
+    w.u8(kVersion);
+    w.u8(uint8_t(h.type));
+    w.u16(0);
+    w.u32(h.frame);
+    w.u32(h.reference);
+    w.u64(uint64_t(h.timestamp_us));
+    w.u32(uint32_t(payload.size()));
+    w.bytes(payload);
+    const uint32_t crc = crc32c(std::span(out).first(28), 0);
+    const uint32_t full = crc32c(std::span(out).subspan(28), crc);
+    std::vector<uint8_t> tail;
+    ByteWriter(tail).u32(full);
+    out.insert(out.begin() + 28, tail.begin(), tail.end());
+}
+
+Status parse_packet(std::span<const uint8_t> packet, PacketHeader& h, std::span<const uint8_t>& payload) {
+    ByteReader r(packet, "packet header");
+    const uint32_t magic = r.u32();
+    const uint8_t version = r.u8();
+    const uint8_t type = r.u8();
+    const uint16_t flags = r.u16();
+    h.frame = r.u32();
+    h.reference = r.u32();
+    h.timestamp_us = int64_t(r.u64());
+    const uint32_t length = r.u32();
+    const uint32_t crc = r.u32();
+    if (!r.ok()) return Status::error(r.error());
+    if (magic != kPacketMagic) return Status::error("packet header: bad magic (not a reprise packet)");
+    if (version != kVersion) return Status::error("packet header: version " + std::to_string(version) + " (this decoder reads 1)");
+    if (type > uint8_t(PacketType::Inter)) return Status::error("packet header: unknown type " + std::to_string(type));
+    if (flags) return Status::error("packet header: reserved flags set");
+    if (length > kMaxPayload) return Status::error("packet header: payload length " + std::to_string(length) + " above the maximum");
+    if (length != r.remaining())
+        return Status::error("packet header: payload length " + std::to_string(length) + " but " +
+                             std::to_string(r.remaining()) + " bytes follow");
+    const uint32_t expected = crc32c(packet.subspan(28 + 4), crc32c(packet.first(28), 0));
+    if (crc != expected) return Status::error("packet " + std::to_string(h.frame) + ": CRC mismatch");
+    h.type = PacketType(type);
+    if (h.type == PacketType::Key && h.reference != h.frame)
+        return Status::error("packet header: key frame " + std::to_string(h.frame) + " names a reference");
+    payload = r.bytes(length);
+    return {};
+}
+
+Status inspect_packet(std::span<const uint8_t> packet, Packet& info, int64_t& timestamp_us) {
+    PacketHeader h;
+    std::span<const uint8_t> payload;
+    REPRISE_TRY(parse_packet(packet, h, payload));
+    info.data.clear();
+    info.frame = h.frame;
+    info.reference = h.reference;
+    info.type = h.type;
+    timestamp_us = h.timestamp_us;
+    return {};
+}
+
+void write_params(const SequenceParams& sp, std::vector<uint8_t>& out) {
+    ByteWriter w(out);
+    w.u16(uint16_t(sp.width));
+    w.u16(uint16_t(sp.height));
+    w.u8(uint8_t(sp.chroma));
+    w.u8(uint8_t(sp.depth));
+    w.f32(sp.depth_error);
+    w.u8(uint8_t(sp.slices));
+    w.f64(sp.fps);
+}
+
+Status read_params(ByteReader& r, SequenceParams& sp) {
+    sp.width = r.u16();
+    sp.height = r.u16();
+    const uint8_t chroma = r.u8(), depth = r.u8();
+    sp.depth_error = r.f32();
+    sp.slices = r.u8();
+    sp.fps = r.f64();
+    if (!r.ok()) return Status::error(r.error());
+    REPRISE_TRY(check_image_size(sp.width, sp.height, "key frame parameters"));
+    if (chroma > uint8_t(Chroma::C444)) return Status::error("key frame parameters: unknown chroma format " + std::to_string(chroma));
+    if (depth > uint8_t(DepthMode::None)) return Status::error("key frame parameters: unknown depth mode " + std::to_string(depth));
+    sp.chroma = Chroma(chroma);
+    sp.depth = DepthMode(depth);
+    if (sp.depth == DepthMode::Bounded && !(sp.depth_error >= 1e-7f && sp.depth_error <= 0.1f))
+        return Status::error("key frame parameters: depth error bound outside 1e-7..0.1");
+    if (sp.slices < 1 || sp.slices > std::min(kMaxSlices, sp.mb_rows()))
+        return Status::error("key frame parameters: " + std::to_string(sp.slices) + " slices for " +
+                             std::to_string(sp.mb_rows()) + " macroblock rows");
+    if (!(sp.fps >= 0.0 && sp.fps <= 1000.0)) return Status::error("key frame parameters: frame rate outside 0..1000");
+    return {};
+}
+
+Status write_stream_header(std::vector<uint8_t>& out, int width, int height, double fps) {
+    REPRISE_TRY(check_image_size(width, height, "stream header"));
+    ByteWriter w(out);
+    w.u32(kFileMagic);
+    w.u8(kVersion);
+    w.u8(0);
+    w.u16(0);
+    w.u32(uint32_t(width));
+    w.u32(uint32_t(height));
+    w.f64(fps);
+    return {};
+}
+
+Status split_stream(std::span<const uint8_t> file, StreamInfo& info, std::vector<std::span<const uint8_t>>& packets) {
+    ByteReader r(file, "stream");
+    const uint32_t magic = r.u32();
+    const uint8_t version = r.u8();
+    r.u8();
+    r.u16();
+    info.width = int(r.u32());
+    info.height = int(r.u32());
+    info.fps = r.f64();
+    if (!r.ok()) return Status::error(r.error());
+    if (magic != kFileMagic) return Status::error("stream: not a reprise stream (bad magic)");
+    if (version != kVersion) return Status::error("stream: version " + std::to_string(version) + " (this reader reads 1)");
+    REPRISE_TRY(check_image_size(info.width, info.height, "stream header"));
+    packets.clear();
+    while (r.remaining()) {
+        const std::size_t at = r.position();
+        if (r.remaining() < kPacketHeaderSize)
+            return Status::error("stream: truncated packet header at byte " + std::to_string(at));
+        ByteReader peek(file.subspan(at + 24, 4), "stream");
+        const uint32_t length = peek.u32();
+        if (length > kMaxPayload || length > r.remaining() - kPacketHeaderSize)
+            return Status::error("stream: packet at byte " + std::to_string(at) + " runs past the end of the file");
+        packets.push_back(r.bytes(kPacketHeaderSize + length));
+    }
+    return {};
+}
+
+}  // namespace reprise::codec

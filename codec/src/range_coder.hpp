@@ -1,0 +1,197 @@
+#pragma once
+// Adaptive binary range coder (LZMA-style carry propagation, 12-bit probabilities) and the
+// integer binarisations built on it. The decoder never reads outside its input: past the end it
+// sees zero bytes and counts them, so a truncated or hostile slice decodes to garbage values that
+// the caller bounds, never to undefined behaviour.
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <vector>
+
+namespace reprise::codec {
+
+inline constexpr int kProbBits = 12;
+inline constexpr int kAdaptShift = 5;
+
+struct BitModel {
+    uint16_t p = 1 << (kProbBits - 1);  // probability of a 0, in 1/4096
+};
+
+class RangeEncoder {
+public:
+    explicit RangeEncoder(std::vector<uint8_t>& out) : out_(out) {}
+
+    void bit(BitModel& m, int b) {
+        const uint32_t bound = (range_ >> kProbBits) * m.p;
+        if (!b) {
+            range_ = bound;
+            m.p += ((1 << kProbBits) - m.p) >> kAdaptShift;
+        } else {
+            low_ += bound;
+            range_ -= bound;
+            m.p -= m.p >> kAdaptShift;
+        }
+        normalize();
+    }
+    void bypass(int b) {
+        range_ >>= 1;
+        if (b) low_ += range_;
+        normalize();
+    }
+    void bypass_bits(uint32_t v, int n) {
+        for (int i = n - 1; i >= 0; --i) bypass((v >> i) & 1);
+    }
+    void finish() {
+        for (int i = 0; i < 5; ++i) shift_low();
+    }
+
+private:
+    void normalize() {
+        while (range_ < (1u << 24)) {
+            range_ <<= 8;
+            shift_low();
+        }
+    }
+    void shift_low() {
+        if (uint32_t(low_) < 0xFF000000u || (low_ >> 32) != 0) {
+            const uint8_t carry = uint8_t(low_ >> 32);
+            uint8_t temp = cache_;
+            do {
+                out_.push_back(uint8_t(temp + carry));
+                temp = 0xFF;
+            } while (--cache_size_ != 0);
+            cache_ = uint8_t(low_ >> 24);
+        }
+        ++cache_size_;
+        low_ = (low_ & 0x00FFFFFFu) << 8;
+    }
+
+    std::vector<uint8_t>& out_;
+    uint64_t low_ = 0;
+    uint32_t range_ = 0xFFFFFFFFu;
+    uint8_t cache_ = 0;
+    uint64_t cache_size_ = 1;
+};
+
+class RangeDecoder {
+public:
+    explicit RangeDecoder(std::span<const uint8_t> in) : in_(in) {
+        for (int i = 0; i < 5; ++i) code_ = (code_ << 8) | next();
+    }
+
+    int bit(BitModel& m) {
+        const uint32_t bound = (range_ >> kProbBits) * m.p;
+        int b;
+        if (code_ < bound) {
+            range_ = bound;
+            m.p += ((1 << kProbBits) - m.p) >> kAdaptShift;
+            b = 0;
+        } else {
+            code_ -= bound;
+            range_ -= bound;
+            m.p -= m.p >> kAdaptShift;
+            b = 1;
+        }
+        normalize();
+        return b;
+    }
+    int bypass() {
+        range_ >>= 1;
+        int b = 0;
+        if (code_ >= range_) {
+            code_ -= range_;
+            b = 1;
+        }
+        normalize();
+        return b;
+    }
+    uint32_t bypass_bits(int n) {
+        uint32_t v = 0;
+        for (int i = 0; i < n; ++i) v = (v << 1) | uint32_t(bypass());
+        return v;
+    }
+    // Bytes read beyond the input (an honest stream reads none).
+    std::size_t overrun() const { return overrun_; }
+
+private:
+    uint8_t next() {
+        if (pos_ < in_.size()) return in_[pos_++];
+        ++overrun_;
+        return 0;
+    }
+    void normalize() {
+        while (range_ < (1u << 24)) {
+            range_ <<= 8;
+            code_ = (code_ << 8) | next();
+        }
+    }
+
+    std::span<const uint8_t> in_;
+    std::size_t pos_ = 0;
+    std::size_t overrun_ = 0;
+    uint32_t code_ = 0;
+    uint32_t range_ = 0xFFFFFFFFu;
+};
+
+// Unsigned integers as an Exp-Golomb code: the bit length of v + 1 in unary, each unary bin with
+// its own model (the last one shared by the rest), then the bits below the leading one in bypass.
+template <int N>
+struct UintModel {
+    BitModel prefix[N];
+};
+
+template <int N>
+void encode_uint(RangeEncoder& rc, UintModel<N>& m, uint32_t v) {
+    const uint64_t x = uint64_t(v) + 1;
+    int n = 0;
+    while ((x >> (n + 1)) != 0) ++n;
+    for (int i = 0; i < n; ++i) rc.bit(m.prefix[i < N ? i : N - 1], 1);
+    rc.bit(m.prefix[n < N ? n : N - 1], 0);
+    for (int i = n - 1; i >= 0; --i) rc.bypass(int((x >> i) & 1));
+}
+
+// Returns false when the prefix is longer than 32 bins (no encoder writes that).
+template <int N>
+bool decode_uint(RangeDecoder& rc, UintModel<N>& m, uint32_t& v) {
+    int n = 0;
+    while (rc.bit(m.prefix[n < N ? n : N - 1])) {
+        if (++n > 32) return false;
+    }
+    uint64_t x = 1;
+    for (int i = 0; i < n; ++i) x = (x << 1) | uint64_t(rc.bypass());
+    if (x - 1 > 0xFFFFFFFFull) return false;
+    v = uint32_t(x - 1);
+    return true;
+}
+
+// Signed: zero flag, sign, magnitude - 1.
+template <int N>
+struct IntModel {
+    BitModel zero;
+    BitModel sign;
+    UintModel<N> magnitude;
+};
+
+template <int N>
+void encode_int(RangeEncoder& rc, IntModel<N>& m, int64_t v) {
+    rc.bit(m.zero, v != 0);
+    if (v == 0) return;
+    rc.bit(m.sign, v < 0);
+    const uint64_t a = v < 0 ? uint64_t(-v) : uint64_t(v);
+    encode_uint(rc, m.magnitude, uint32_t(a - 1));
+}
+
+template <int N>
+bool decode_int(RangeDecoder& rc, IntModel<N>& m, int64_t& v) {
+    if (!rc.bit(m.zero)) {
+        v = 0;
+        return true;
+    }
+    const int negative = rc.bit(m.sign);
+    uint32_t a = 0;
+    if (!decode_uint(rc, m.magnitude, a)) return false;
+    v = negative ? -(int64_t(a) + 1) : int64_t(a) + 1;
+    return true;
+}
+
+}  // namespace reprise::codec

@@ -1,0 +1,23 @@
+#pragma once
+// 8x8 integer DCT (the integer approximation used by HEVC, exact in int32), dead-zone
+// quantisation and the zigzag scan. Forward output = 32 x the orthonormal DCT.
+#include <array>
+#include <cstdint>
+
+namespace reprise::codec {
+
+using Block = std::array<int32_t, 64>;  // row-major 8x8
+
+void forward_dct(const Block& in, Block& out);
+void inverse_dct(const Block& in, Block& out);
+
+// Quantiser step of qp (0..51) in sixteenths of a transform unit: 2^((qp - 4) / 6) * 32 * 16.
+int32_t quant_scale(int qp);
+// Levels from coefficients, rounding offset `deadzone` (fraction of a step, in 1/16 units: 16/3
+// for intra, 16/6 for inter). Returns the number of non-zero levels.
+int quantize(const Block& coefficients, int32_t scale, int32_t deadzone16, Block& levels);
+void dequantize(const Block& levels, int32_t scale, Block& coefficients);
+
+extern const std::array<uint8_t, 64> kZigzag;  // scan index -> raster index
+
+}  // namespace reprise::codec

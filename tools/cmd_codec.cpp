@@ -1,0 +1,244 @@
+// reprise encode / decode, and `reprise info FILE.rps` — the scene-aware codec on EXR sequences.
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+#include "args.hpp"
+#include "commands.hpp"
+#include "reprise/codec/codec.hpp"
+#include "reprise/core/exr.hpp"
+
+namespace reprise::cli {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point start) {
+    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+}
+
+constexpr std::uintmax_t kMaxStreamBytes = std::uintmax_t(4) << 30;
+
+Status read_file(const std::string& path, std::vector<uint8_t>& bytes) {
+    std::error_code ec;
+    const std::uintmax_t size = std::filesystem::file_size(path, ec);
+    if (ec) return Status::error(path + ": " + ec.message());
+    if (size > kMaxStreamBytes) return Status::error(path + ": larger than 4 GiB");
+    std::ifstream in(path, std::ios::binary);
+    bytes.resize(std::size_t(size));
+    if (!in.read(reinterpret_cast<char*>(bytes.data()), std::streamsize(size)))
+        return Status::error(path + ": cannot read");
+    return {};
+}
+
+Status write_file(const std::string& path, const std::vector<uint8_t>& bytes) {
+    const std::string temp = path + ".partial";
+    {
+        std::ofstream out(temp, std::ios::binary | std::ios::trunc);
+        if (!out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size())))
+            return Status::error(path + ": cannot write");
+    }
+    std::error_code ec;
+    std::filesystem::rename(temp, path, ec);
+    if (ec) return Status::error(path + ": " + ec.message());
+    return {};
+}
+
+Status parse_depth_mode(const std::string& text, codec::EncoderOptions& o) {
+    if (text == "lossless") {
+        o.depth = codec::DepthMode::Lossless;
+    } else if (text == "none") {
+        o.depth = codec::DepthMode::None;
+    } else if (text.rfind("bounded", 0) == 0) {
+        o.depth = codec::DepthMode::Bounded;
+        if (text.size() > 8 && text[7] == ':') {
+            char* end = nullptr;
+            o.depth_error = std::strtof(text.c_str() + 8, &end);
+            if (*end || !(o.depth_error >= 1e-7f && o.depth_error <= 0.1f))
+                return Status::error("--depth " + text + ": the bound must be a number in 1e-7..0.1");
+        }
+    } else {
+        return Status::error("--depth " + text + ": expected lossless, bounded[:E] or none");
+    }
+    return {};
+}
+
+void print_stats(const codec::StreamStats& s, double fps) {
+    const double n = double(std::max<std::size_t>(1, s.frames));
+    auto line = [&](const char* what, std::size_t bits) {
+        std::printf("  %-7s %12.1f kbit %10.0f bits/frame %9.1f kbit/s %6.1f %%\n", what, bits / 1e3, bits / n,
+                    bits / n * fps / 1e3, 100.0 * double(bits) / double(std::max<std::size_t>(1, s.total_bits())));
+    };
+    line("header", s.header_bits);
+    line("camera", s.camera_bits);
+    line("depth", s.depth_bits);
+    line("motion", s.motion_bits);
+    line("colour", s.color_bits);
+    line("total", s.total_bits());
+    std::printf("  left out: %zu of %zu colour blocks skipped (%.1f %%), %zu depth blocks predicted exactly, "
+                "motion residual on %zu pixels\n",
+                s.blocks_skipped, s.blocks, 100.0 * double(s.blocks_skipped) / double(std::max<std::size_t>(1, s.blocks)),
+                s.depth_zero_blocks, s.motion_residual_pixels);
+    std::printf("  %zu frames: %zu key, %zu predicted from an older reference, %zu intra macroblocks\n", s.frames,
+                s.key_frames, s.older_reference, s.intra_blocks);
+}
+
+struct EncodeJob {
+    std::string in, out, chroma = "420", depth = "lossless";
+    int qp = 28, quality = -1, bitrate = 0, keyint = 0, skip = 2;
+};
+
+Status run_encode(const EncodeJob& job) {
+    if (job.out.empty()) return Status::error("--out FILE.rps is required");
+    codec::EncoderOptions o;
+    o.qp = job.qp;
+    if (job.quality >= 0) {
+        if (job.quality > 100) return Status::error("--quality must be in 0..100");
+        o.qp = (51 * (100 - job.quality) + 50) / 100;
+    }
+    if (o.qp < 0 || o.qp > 51) return Status::error("--qp must be in 0..51");
+    if (job.bitrate < 0) return Status::error("--bitrate must be positive");
+    if (job.keyint < 0) return Status::error("--keyint must be 0 or more");
+    if (job.skip < 0 || job.skip > 255) return Status::error("--skip must be in 0..255");
+    o.bitrate_kbps = job.bitrate;
+    o.keyint = job.keyint;
+    o.skip_threshold = job.skip;
+    if (job.chroma == "420") o.chroma = codec::Chroma::C420;
+    else if (job.chroma == "444") o.chroma = codec::Chroma::C444;
+    else return Status::error("--chroma " + job.chroma + ": expected 420 or 444");
+    REPRISE_TRY(parse_depth_mode(job.depth, o));
+
+    Sequence sequence;
+    REPRISE_TRY(open_sequence(job.in, sequence));
+    codec::Encoder encoder(o);
+    std::vector<uint8_t> file;
+    Frame frame;
+    double busy_ms = 0.0;
+    double fps = sequence.fps > 0 ? sequence.fps : 30.0;
+    const std::size_t n = sequence.files.size();
+    for (std::size_t i = 0; i < n; ++i) {
+        REPRISE_TRY(read_frame(sequence.files[i], frame));
+        if (frame.fps <= 0) frame.fps = fps;
+        if (i == 0) REPRISE_TRY(codec::write_stream_header(file, frame.width(), frame.height(), fps));
+        const auto start = Clock::now();
+        const Status sent = encoder.send_frame(frame);
+        busy_ms += ms_since(start);
+        if (!sent.ok()) return Status::error(sequence.files[i] + ": " + sent.message());
+        codec::Packet packet;
+        while (encoder.receive_packet(packet) == codec::Result::Ok)
+            file.insert(file.end(), packet.data.begin(), packet.data.end());
+        std::fprintf(stderr, "\r[encode] %zu/%zu frames, %zu bytes", i + 1, n, file.size());
+    }
+    std::fprintf(stderr, "\n");
+    REPRISE_TRY(write_file(job.out, file));
+    std::printf("encoded %zu frames (%dx%d at %.3g fps) into %s: %zu bytes, %.2f ms per frame (without file I/O)\n", n,
+                frame.width(), frame.height(), fps, job.out.c_str(), file.size(), busy_ms / double(std::max<std::size_t>(1, n)));
+    print_stats(encoder.stats(), fps);
+    return {};
+}
+
+Status run_decode(const std::string& in, const std::string& out) {
+    if (out.empty()) return Status::error("--out DIR is required");
+    std::vector<uint8_t> bytes;
+    REPRISE_TRY(read_file(in, bytes));
+    codec::StreamInfo info;
+    std::vector<std::span<const uint8_t>> packets;
+    const Status split = codec::split_stream(bytes, info, packets);
+    if (!split.ok()) return Status::error(in + ": " + split.message());
+    std::error_code ec;
+    std::filesystem::create_directories(out, ec);
+    if (ec) return Status::error(out + ": cannot create the folder: " + ec.message());
+    codec::Decoder decoder;
+    int written = 0, failed = 0;
+    double busy_ms = 0.0;
+    std::string first_error;
+    Frame frame;
+    for (std::size_t i = 0; i < packets.size(); ++i) {
+        const auto start = Clock::now();
+        const Status s = decoder.send_packet(packets[i]);
+        busy_ms += ms_since(start);
+        if (!s.ok()) {
+            ++failed;
+            std::fprintf(stderr, "\n%s: packet %zu: %s\n", in.c_str(), i, s.message().c_str());
+            if (first_error.empty()) first_error = in + ": packet " + std::to_string(i) + ": " + s.message();
+        }
+        while (decoder.receive_frame(frame) == codec::Result::Ok) REPRISE_TRY(write_frame(frame_path(out, written++), frame));
+        std::fprintf(stderr, "\r[decode] %zu/%zu packets, %d frames written", i + 1, packets.size(), written);
+    }
+    std::fprintf(stderr, "\n");
+    std::printf("decoded %d frames of %zu packets into %s, %.2f ms per frame (without file I/O)\n", written,
+                packets.size(), out.c_str(), busy_ms / double(std::max(1, written)));
+    print_stats(decoder.stats(), info.fps > 0 ? info.fps : 30.0);
+    if (failed) return Status::error(std::to_string(failed) + " packets could not be decoded; first: " + first_error);
+    return {};
+}
+
+}  // namespace
+
+Status describe_stream(const std::string& path) {
+    std::vector<uint8_t> bytes;
+    REPRISE_TRY(read_file(path, bytes));
+    codec::StreamInfo info;
+    std::vector<std::span<const uint8_t>> packets;
+    const Status split = codec::split_stream(bytes, info, packets);
+    if (!split.ok()) return Status::error(path + ": " + split.message());
+    std::printf("%s: reprise stream, %dx%d, %.3g fps, %zu packets, %zu bytes\n", path.c_str(), info.width, info.height,
+                info.fps, packets.size(), bytes.size());
+    std::size_t keys = 0, older = 0, key_bytes = 0, inter_bytes = 0, bad = 0, largest = 0;
+    for (std::size_t i = 0; i < packets.size(); ++i) {
+        codec::Packet p;
+        int64_t ts = 0;
+        const Status s = codec::inspect_packet(packets[i], p, ts);
+        if (!s.ok()) {
+            std::printf("  packet %zu: %s\n", i, s.message().c_str());
+            ++bad;
+            continue;
+        }
+        const bool key = p.type == codec::PacketType::Key;
+        keys += key;
+        older += !key && p.reference + 1 != p.frame;
+        (key ? key_bytes : inter_bytes) += packets[i].size();
+        largest = std::max(largest, packets[i].size());
+    }
+    std::printf("  key frames: %zu (%zu bytes), inter frames: %zu (%zu bytes), %zu from an older reference\n", keys,
+                key_bytes, packets.size() - keys - bad, inter_bytes, older);
+    const double fps = info.fps > 0 ? info.fps : 30.0;
+    std::printf("  mean %.1f kbit/s, largest packet %zu bytes\n",
+                packets.empty() ? 0.0 : 8.0 * double(bytes.size()) / double(packets.size()) * fps / 1e3, largest);
+    if (bad) return Status::error(path + ": " + std::to_string(bad) + " packets are damaged");
+    return {};
+}
+
+int command_encode(int argc, char** argv) {
+    EncodeJob job;
+    Args args("encode",
+              "Encodes an EXR sequence with reprise's scene-aware codec: each frame predicted by reprojecting\n"
+              "the previous decoded frame with the rendered depth and motion; prints bits per stream.");
+    args.option("--in", &job.in, "input sequence (folder of EXR frames)");
+    args.option("--out", &job.out, "output stream (.rps)");
+    args.option("--qp", &job.qp, "quantiser 0 (finest) .. 51 (default 28), constant quality");
+    args.option("--quality", &job.quality, "0..100 (100 best), instead of --qp");
+    args.option("--bitrate", &job.bitrate, "target kbit/s with bounded frame sizes (default: constant quality)");
+    args.option("--keyint", &job.keyint, "a key frame at least every N frames (default 0: cuts and requests only)");
+    args.option("--chroma", &job.chroma, "420 | 444 (default 420)");
+    args.option("--depth", &job.depth, "lossless | bounded[:E] (relative error E, default 1e-4) | none");
+    args.option("--skip", &job.skip, "blocks within this many 8-bit levels of their prediction are skipped (default 2)");
+    const Status parsed = args.parse(argc, argv);
+    if (!parsed.ok() || args.help_requested()) return report(args, parsed, {});
+    if (job.in.empty()) return report(args, Status::error("encode: --in DIR is required"), {});
+    return report(args, parsed, run_encode(job));
+}
+
+int command_decode(int argc, char** argv) {
+    std::string in, out;
+    Args args("decode", "Decodes a reprise stream (.rps) into an EXR sequence (colour, depth, motion, camera).");
+    args.positional("FILE", &in, "the .rps stream");
+    args.option("--out", &out, "output folder");
+    const Status parsed = args.parse(argc, argv);
+    if (!parsed.ok() || args.help_requested()) return report(args, parsed, {});
+    return report(args, parsed, run_decode(in, out));
+}
+
+}  // namespace reprise::cli
