@@ -24,6 +24,13 @@ struct BenchOptions {
     bool quick = false;                     // a few settings only
     bool exr = false;                       // also write the rendered input and truth as EXR
     int repeat = 3;                         // timed runs; each frame's fastest counts
+    // bench codec
+    std::string in;                         // a sequence folder, besides the scenes
+    int threads = 2;                        // per codec
+    std::string qps = "22,28,34,40";        // reprise's rate points
+    std::string speed_size = "1920x1080";   // the speed ratios' size
+    std::string speed_scene = "pan";
+    int speed_frames = 10;                  // 0 = no speed run
 };
 
 // A scene, its camera path and a renderer: what every benchmark that renders starts from.
@@ -44,5 +51,10 @@ Status bench_fruc(const BenchOptions& options);
 // time, per built-in scene (--scenes, --size, --frames up to 5, --repeat): OUT/stereo.csv (with
 // "+disoccluded" rows), OUT/index.html, OUT/SCENE/worst_frame.png and a summary on stdout.
 Status bench_stereo(const BenchOptions& options);
+// reprise's codec against x264, x265, SVT-AV1 (libavcodec) on the same frames: bits, PSNR, SSIM,
+// FLIP, encode and decode ms per frame; BD-rates; depth against zstd -3 and RVL; speed ratios at
+// 1080p; issue 8's targets as met / not met: OUT/codec.csv, bd_rate.csv, depth.csv, speed.csv,
+// index.html.
+Status bench_codec(const BenchOptions& options);
 
 }  // namespace reprise::cli

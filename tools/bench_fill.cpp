@@ -1,7 +1,6 @@
 // reprise bench fill — pull-push (plain and depth-aware) and Andreev inpainting against OpenCV's
 // Telea inpainting (cv::inpaint, radius 3) on the same rendered frames and the same holes.
 #include <algorithm>
-#include <chrono>
 #include <cstdio>
 #include <random>
 #include <string>
@@ -12,6 +11,7 @@
 
 #include "args.hpp"
 #include "bench.hpp"
+#include "bench_report.hpp"
 #include "reprise/core/metrics.hpp"
 #include "reprise/core/parallel.hpp"
 #include "reprise/server/builtin_scenes.hpp"
@@ -22,14 +22,9 @@ namespace reprise::cli {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
 using glm::vec3;
 using glm::vec4;
 constexpr double kHoleTarget = 0.04;
-
-double ms_since(Clock::time_point start) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 enum HoleKind : uint8_t { kValid = 0, kStrip = 1, kBlob = 2 };
 
@@ -136,7 +131,7 @@ Status bench_fill(const BenchOptions& options) {
             };
             auto run = [&](Method& m, auto&& fill) {
                 work = holed;
-                const auto t = Clock::now();
+                const auto t = BenchClock::now();
                 fill();
                 const double ms = ms_since(t);
                 to_display(work.view(), shown.view());
@@ -152,7 +147,7 @@ Status bench_fill(const BenchOptions& options) {
             run(methods[3], [&] {
                 (void)andreev.fill(work.view(), valid.view(), frame.depth.view());
             });
-            const auto t = Clock::now();
+            const auto t = BenchClock::now();
             cv::inpaint(bgr, cv_mask, cv_out, 3.0, cv::INPAINT_TELEA);
             const double telea_ms = ms_since(t);
             if (f < 0) continue;

@@ -1,7 +1,6 @@
 // reprise bench fruc — frame-rate upconversion error against run time: every mode, warp and fill
 // beside ffmpeg's minterpolate, OpenCV DIS flow and Telea inpainting, on the same rendered frames.
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -16,7 +15,7 @@
 #include "bench.hpp"
 #include "fruc_options.hpp"
 #include "peers.hpp"
-#include "report_html.hpp"
+#include "bench_report.hpp"
 #include "reprise/core/exr.hpp"
 #include "reprise/core/metrics.hpp"
 #include "reprise/core/parallel.hpp"
@@ -28,12 +27,7 @@ namespace reprise::cli {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
 namespace fs = std::filesystem;
-
-double ms_since(Clock::time_point start) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-}
 
 const char* const kFfmpeg = "ffmpeg-minterpolate";
 const char* const kDis = "opencv-dis";
@@ -103,21 +97,6 @@ struct SceneFrames {
     bool scored(int j) const { return j % factor != 0 && j > 0 && j < last(); }
 };
 
-void to_rgb8(ImageView<const glm::vec3> display, Image<Rgb8>& out) {
-    out.resize(display.width, display.height);
-    for (int y = 0; y < display.height; ++y)
-        for (int x = 0; x < display.width; ++x) {
-            glm::vec3 c = glm::clamp(display(x, y), 0.0f, 1.0f) * 255.0f + 0.5f;
-            out(x, y) = Rgb8(uint8_t(c.x), uint8_t(c.y), uint8_t(c.z));
-        }
-}
-
-void from_rgb8(ImageView<const Rgb8> shown, Image<glm::vec3>& out) {
-    out.resize(shown.width, shown.height);
-    for (int y = 0; y < shown.height; ++y)
-        for (int x = 0; x < shown.width; ++x) out(x, y) = glm::vec3(shown(x, y)) / 255.0f;
-}
-
 void record(Run& run, int frame, const Image<glm::vec3>& display, const Image<glm::vec3>& truth,
             double ms, bool keep_frame) {
     Score score{frame, image_error(truth.view(), display.view()), ms};
@@ -172,11 +151,6 @@ Status render_scene(server::Renderer& renderer, const std::string& scene_name, i
     return {};
 }
 
-void keep_fastest(std::map<int, double>& fastest, int frame, double ms) {
-    auto [it, inserted] = fastest.try_emplace(frame, ms);
-    if (!inserted) it->second = std::min(it->second, ms);
-}
-
 // Times send() alone; each frame it made gets an equal share of that time, the fastest of
 // `repeat` runs over the sequence. Frames are scored on the first run.
 Status run_ours(const SceneFrames& scene, const Setting& setting, int repeat, Run& run,
@@ -190,7 +164,7 @@ Status run_ours(const SceneFrames& scene, const Setting& setting, int repeat, Ru
         warp::FrameRateConverter converter(scene.factor, setting.options);
         int index = 0;
         for (const Frame& input : scene.input) {
-            auto start = Clock::now();
+            auto start = BenchClock::now();
             REPRISE_TRY(converter.send(input));
             const double ms = ms_since(start);
             std::vector<int> made;
@@ -207,7 +181,7 @@ Status run_ours(const SceneFrames& scene, const Setting& setting, int repeat, Ru
                     for (int x = 0; x < w; ++x)
                         holes(x, y) =
                             out.color(x, y) == glm::vec4(0.0f) && std::isinf(out.depth(x, y));
-                auto telea_start = Clock::now();
+                auto telea_start = BenchClock::now();
                 inpaint_telea(display.view(), holes.view());
                 keep_fastest(telea_ms, j, ms_since(telea_start));
                 if (rep == 0) record(*telea, j, display, scene.truth[j], 0.0, false);
@@ -229,11 +203,11 @@ void run_dis(const SceneFrames& scene, int repeat, Run& run) {
     std::map<int, double> fastest;
     for (int rep = 0; rep < repeat; ++rep)
         for (std::size_t i = 0; i + 1 < scene.input.size(); ++i) {
-            auto start = Clock::now();
+            auto start = BenchClock::now();
             dis.set_pair(scene.input_shown[i].view(), scene.input_shown[i + 1].view());
             const double pair_ms = ms_since(start);
             for (int k = 1; k < k_max; ++k) {
-                start = Clock::now();
+                start = BenchClock::now();
                 dis.interpolate(float(k) / float(k_max), shown.view());
                 const int j = int(i) * k_max + k;
                 keep_fastest(fastest, j, ms_since(start) + pair_ms / (k_max - 1));
@@ -263,57 +237,12 @@ Status run_ffmpeg(const SceneFrames& scene, const std::string& scratch_dir, int 
     return {};
 }
 
-// The window of the given size where `a` and `b` differ most (sum of absolute differences).
-void worst_window(const Image<Rgb8>& a, const Image<Rgb8>& b, int cw, int ch, int& best_x,
-                  int& best_y) {
-    const int w = a.width(), h = a.height();
-    std::vector<double> sat(std::size_t(w + 1) * (h + 1), 0.0);  // summed-area table
-    auto at = [&](int x, int y) -> double& { return sat[std::size_t(y) * (w + 1) + x]; };
-    for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) {
-            glm::ivec3 d = glm::abs(glm::ivec3(a(x, y)) - glm::ivec3(b(x, y)));
-            at(x + 1, y + 1) = d.x + d.y + d.z + at(x, y + 1) + at(x + 1, y) - at(x, y);
-        }
-    double best = -1.0;
-    best_x = best_y = 0;
-    for (int y = 0; y + ch <= h; y += 2)
-        for (int x = 0; x + cw <= w; x += 2) {
-            double sum = at(x + cw, y + ch) - at(x, y + ch) - at(x + cw, y) + at(x, y);
-            if (sum > best) best = sum, best_x = x, best_y = y;
-        }
-}
-
-Image<Rgb8> crop(const Image<Rgb8>& image, int x0, int y0, int cw, int ch) {
-    Image<Rgb8> out(cw, ch);
-    for (int y = 0; y < ch; ++y)
-        for (int x = 0; x < cw; ++x) out(x, y) = image(x0 + x, y0 + y);
-    return out;
-}
-
-Image<Rgb8> outlined(Image<Rgb8> image, int x0, int y0, int cw, int ch) {
-    const Rgb8 yellow(255, 220, 0);
-    for (int x = x0; x < x0 + cw; ++x) image(x, y0) = image(x, y0 + ch - 1) = yellow;
-    for (int y = y0; y < y0 + ch; ++y) image(x0, y) = image(x0 + cw - 1, y) = yellow;
-    return image;
-}
-
-std::string db(double psnr) {
-    char buffer[32];
-    std::snprintf(buffer, sizeof buffer, "%.2f dB", psnr);
-    return buffer;
-}
-
 // Full frames and the crop where ours errs most: ours, truth, the better peer.
 Status comparison_picture(const SceneFrames& scene, const Run& ours, const Run* peer,
                           const std::string& path) {
     const int j = ours.worst_frame;
     Image<Rgb8> truth;
     to_rgb8(scene.truth[j].view(), truth);
-    const int w = truth.width(), h = truth.height();
-    const int cw = std::min(w, 200), ch = std::min(h, 112);
-    const bool cropped = cw < w || ch < h;
-    int x0 = 0, y0 = 0;
-    worst_window(ours.worst, truth, cw, ch, x0, y0);
     std::vector<Image<Rgb8>> images = {ours.worst, truth};
     std::vector<std::string> labels = {"ours " + ours.setting + " " + db(ours.worst_psnr),
                                        "truth, frame " + std::to_string(j)};
@@ -324,29 +253,7 @@ Status comparison_picture(const SceneFrames& scene, const Run& ours, const Run* 
             if (s.frame == j) label += " " + db(s.error.psnr);
         labels.push_back(label);
     }
-    const std::size_t columns = images.size();
-    if (cropped)
-        for (std::size_t i = 0; i < columns; ++i) {
-            images.push_back(crop(images[i], x0, y0, cw, ch));
-            images[i] = outlined(images[i], x0, y0, cw, ch);
-            labels.push_back(i == 0 ? "crop where ours errs most" : "same crop");
-        }
-    std::vector<Tile> tiles;
-    for (std::size_t i = 0; i < images.size(); ++i) tiles.push_back({images[i].view(), labels[i]});
-    Image<Rgb8> sheet =
-        contact_sheet(tiles, {.columns = int(columns), .tile_width = std::max(2 * cw, 320)});
-    return write_png(path, sheet.view());
-}
-
-std::vector<std::string> split(const std::string& list) {
-    std::vector<std::string> items;
-    std::size_t start = 0;
-    while (start <= list.size()) {
-        std::size_t end = std::min(list.find(',', start), list.size());
-        if (end > start) items.push_back(list.substr(start, end - start));
-        start = end + 1;
-    }
-    return items;
+    return write_worst_window_sheet(path, std::move(images), std::move(labels), truth);
 }
 
 const Run* best_of(const std::vector<Run>& runs, const std::function<bool(const Run&)>& wanted) {
@@ -425,7 +332,7 @@ Status bench_fruc(const BenchOptions& job) {
         return Status::error("bench fruc: --repeat must be in 1..100");
     int w = 0, h = 0;
     REPRISE_TRY(parse_size(job.size, w, h));
-    std::vector<std::string> scenes = split(job.scenes);
+    std::vector<std::string> scenes = split_list(job.scenes);
     if (scenes.empty())
         for (const server::SceneInfo& s : server::builtin_scenes()) scenes.push_back(s.name);
     const std::string out_dir = job.out.empty() ? "out/bench-fruc" : job.out;
@@ -442,15 +349,9 @@ Status bench_fruc(const BenchOptions& job) {
 
     const std::string csv_path = out_dir + "/fruc.csv",
                       summary_path = out_dir + "/fruc_summary.csv";
-    FILE* csv = std::fopen(csv_path.c_str(), "w");
-    FILE* summary_csv = std::fopen(summary_path.c_str(), "w");
-    if (!csv || !summary_csv) {
-        if (csv) std::fclose(csv);
-        if (summary_csv) std::fclose(summary_csv);
-        return Status::error(out_dir + ": cannot write fruc.csv / fruc_summary.csv");
-    }
-    std::fprintf(csv, "scene,method,setting,frame,psnr,ssim,flip,ms\n");
-    std::fprintf(summary_csv, "scene,method,setting,frames,psnr,ssim,flip,ms\n");
+    CsvFile csv, summary_csv;
+    REPRISE_TRY(csv.open(csv_path, kErrorTimeColumns));
+    REPRISE_TRY(summary_csv.open(summary_path, "scene,method,setting,frames,psnr,ssim,flip,ms"));
 
     Report report;
     report.title = "reprise bench fruc: frame-rate upconversion, error against run time";
@@ -523,13 +424,11 @@ Status bench_fruc(const BenchOptions& job) {
             if (scene_name == info.name) section.note = info.stresses;
         for (const Run& run : runs) {
             for (const Score& s : run.scores)
-                std::fprintf(csv, "%s,%s,%s,%d,%.4f,%.6f,%.6f,%.4f\n", scene.name.c_str(),
-                             run.method.c_str(), run.setting.c_str(), s.frame, s.error.psnr,
-                             s.error.ssim, s.error.flip, s.ms);
+                csv.error_row(scene.name, run.method, run.setting, s.frame, s.error, s.ms);
             ReportPoint p = run.mean();
-            std::fprintf(summary_csv, "%s,%s,%s,%zu,%.4f,%.6f,%.6f,%.4f\n", scene.name.c_str(),
-                         run.method.c_str(), run.setting.c_str(), run.scores.size(), p.psnr, p.ssim,
-                         p.flip, p.ms);
+            std::fprintf(summary_csv.file(), "%s,%s,%s,%zu,%.4f,%.6f,%.6f,%.4f\n",
+                         scene.name.c_str(), run.method.c_str(), run.setting.c_str(),
+                         run.scores.size(), p.psnr, p.ssim, p.flip, p.ms);
             section.points.push_back(p);
         }
 
@@ -560,11 +459,9 @@ Status bench_fruc(const BenchOptions& job) {
                      "; below, the window where ours differs most from the truth, enlarged."});
         }
         report.sections.push_back(std::move(section));
-        std::fflush(csv);
-        std::fflush(summary_csv);
+        csv.flush();
+        summary_csv.flush();
     }
-    std::fclose(csv);
-    std::fclose(summary_csv);
     REPRISE_TRY(failure);
 
     std::string table = summary_table(summaries);

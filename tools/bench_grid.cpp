@@ -2,7 +2,6 @@
 // and without the motion output), extrapolating half a frame, against cv::remap (INTER_LINEAR,
 // CV_32FC4) of the same image with a map made from the same motion.
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <opencv2/core.hpp>
@@ -12,6 +11,7 @@
 
 #include "args.hpp"
 #include "bench.hpp"
+#include "bench_report.hpp"
 #include "reprise/core/parallel.hpp"
 #include "reprise/server/builtin_scenes.hpp"
 #include "reprise/server/renderer.hpp"
@@ -22,25 +22,8 @@ namespace reprise::cli {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
 constexpr float kFactor = -0.5f;  // extrapolation by half a frame
 constexpr double kGridBudgetMs = 8.0;
-
-struct Timing {
-    std::vector<double> ms;
-    double median() const {
-        std::vector<double> s = ms;
-        std::sort(s.begin(), s.end());
-        return s[s.size() / 2];
-    }
-};
-
-template <class F>
-void time_once(Timing& t, F&& f) {
-    auto start = Clock::now();
-    f();
-    t.ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
-}
 
 struct Target {
     Image<glm::vec4> color;

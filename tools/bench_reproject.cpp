@@ -1,7 +1,6 @@
 // reprise bench reproject — reverse reprojection (depth + id cache test, bilinear RGBA fetch)
 // against cv::remap (INTER_LINEAR, CV_32FC4) on the same image with the same map.
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <opencv2/core.hpp>
@@ -12,6 +11,7 @@
 
 #include "args.hpp"
 #include "bench.hpp"
+#include "bench_report.hpp"
 #include "reprise/core/parallel.hpp"
 #include "reprise/server/builtin_scenes.hpp"
 #include "reprise/server/renderer.hpp"
@@ -21,24 +21,6 @@ namespace reprise::cli {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-struct Timing {
-    std::vector<double> ms;
-    double best() const { return *std::min_element(ms.begin(), ms.end()); }
-    double median() const {
-        std::vector<double> s = ms;
-        std::sort(s.begin(), s.end());
-        return s[s.size() / 2];
-    }
-};
-
-template <class F>
-void time_once(Timing& t, F&& f) {
-    auto start = Clock::now();
-    f();
-    t.ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
-}
 
 Status bench_size(server::Renderer& renderer, const server::Scene& scene,
                   const server::CameraPath& path, int w, int h, int repetitions) {

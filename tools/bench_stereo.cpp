@@ -7,7 +7,6 @@
 // ms repeated; PSNR is NaN on a frame without such pixels. OUT/index.html is the error-against-
 // run-time report (report_html), OUT/SCENE/worst_frame.png the worst frame of our best setting.
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -18,7 +17,7 @@
 
 #include "args.hpp"
 #include "bench.hpp"
-#include "report_html.hpp"
+#include "bench_report.hpp"
 #include "reprise/core/metrics.hpp"
 #include "reprise/core/parallel.hpp"
 #include "reprise/core/visualize.hpp"
@@ -31,12 +30,7 @@ namespace reprise::cli {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
 namespace fs = std::filesystem;
-
-double ms_since(Clock::time_point t) {
-    return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
-}
 
 // Issue 4's targets.
 constexpr double kPairRatioTarget = 0.6;   // (one render + synthesis) / (two renders)
@@ -63,15 +57,6 @@ void remap_by_disparity(const Frame& left, const stereo::StereoRig& rig, Image<g
     cv::Mat src(h, w, CV_32FC4, const_cast<glm::vec4*>(left.color.data()));
     cv::Mat dst(h, w, CV_32FC4, out.data());
     cv::remap(src, dst, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_REPLICATE);
-}
-
-void to_rgb8(ImageView<const glm::vec3> display, Image<Rgb8>& out) {
-    out.resize(display.width, display.height);
-    for (int y = 0; y < display.height; ++y)
-        for (int x = 0; x < display.width; ++x) {
-            glm::vec3 c = glm::clamp(display(x, y), 0.0f, 1.0f) * 255.0f + 0.5f;
-            out(x, y) = Rgb8(uint8_t(c.x), uint8_t(c.y), uint8_t(c.z));
-        }
 }
 
 struct Score {
@@ -105,32 +90,6 @@ struct Run {
     }
 };
 
-// The window of the given size where `a` and `b` differ most (sum of absolute differences).
-void worst_window(const Image<Rgb8>& a, const Image<Rgb8>& b, int cw, int ch, int& best_x,
-                  int& best_y) {
-    const int w = a.width(), h = a.height();
-    std::vector<double> sat(std::size_t(w + 1) * (h + 1), 0.0);
-    auto at = [&](int x, int y) -> double& { return sat[std::size_t(y) * (w + 1) + x]; };
-    for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) {
-            glm::ivec3 d = glm::abs(glm::ivec3(a(x, y)) - glm::ivec3(b(x, y)));
-            at(x + 1, y + 1) = d.x + d.y + d.z + at(x, y + 1) + at(x + 1, y) - at(x, y);
-        }
-    double best = -1.0;
-    best_x = best_y = 0;
-    for (int y = 0; y + ch <= h; y += 2)
-        for (int x = 0; x + cw <= w; x += 2) {
-            double sum = at(x + cw, y + ch) - at(x, y + ch) - at(x + cw, y) + at(x, y);
-            if (sum > best) best = sum, best_x = x, best_y = y;
-        }
-}
-
-std::string db(double psnr) {
-    char buffer[32];
-    std::snprintf(buffer, sizeof buffer, "%.2f dB", psnr);
-    return buffer;
-}
-
 // Our best setting's lowest-PSNR frame beside the rendered eye and the best peer, full frames
 // over the window where ours errs most, enlarged.
 Status worst_picture(const Run& ours, const Run& truth, const Run* peer, const std::string& path) {
@@ -141,10 +100,6 @@ Status worst_picture(const Run& ours, const Run& truth, const Run* peer, const s
     if (j < 0) return {};
     const Image<Rgb8>& a = ours.shown.at(j);
     const Image<Rgb8>& t = truth.shown.at(j);
-    const int w = a.width(), h = a.height();
-    const int cw = std::min(w, 200), ch = std::min(h, 112);
-    int x0 = 0, y0 = 0;
-    worst_window(a, t, cw, ch, x0, y0);
     std::vector<Image<Rgb8>> images = {a, t};
     std::vector<std::string> labels = {"ours " + ours.setting + " " + db(worst),
                                        "rendered right eye, frame " + std::to_string(j)};
@@ -155,23 +110,7 @@ Status worst_picture(const Run& ours, const Run& truth, const Run* peer, const s
             if (s.frame == j) label += " " + db(s.all.psnr);
         labels.push_back(label);
     }
-    const std::size_t columns = images.size();
-    if (cw < w || ch < h)
-        for (std::size_t i = 0; i < columns; ++i) {
-            Image<Rgb8> c(cw, ch);
-            for (int y = 0; y < ch; ++y)
-                for (int x = 0; x < cw; ++x) c(x, y) = images[i](x0 + x, y0 + y);
-            const Rgb8 yellow(255, 220, 0);
-            for (int x = x0; x < x0 + cw; ++x) images[i](x, y0) = images[i](x, y0 + ch - 1) = yellow;
-            for (int y = y0; y < y0 + ch; ++y) images[i](x0, y) = images[i](x0 + cw - 1, y) = yellow;
-            images.push_back(std::move(c));
-            labels.push_back(i == 0 ? "crop where ours errs most" : "same crop");
-        }
-    std::vector<Tile> tiles;
-    for (std::size_t i = 0; i < images.size(); ++i) tiles.push_back({images[i].view(), labels[i]});
-    Image<Rgb8> sheet = contact_sheet(
-        tiles, {.columns = int(columns), .tile_width = std::min(std::max(2 * cw, 320), 640)});
-    return write_png(path, sheet.view());
+    return write_worst_window_sheet(path, std::move(images), std::move(labels), t, 640);
 }
 
 struct SceneSummary {
@@ -229,9 +168,8 @@ Status bench_stereo(const BenchOptions& options) {
     fs::create_directories(out_dir, ec);
     if (ec) return Status::error(out_dir + ": cannot create the folder: " + ec.message());
     const std::string csv_path = out_dir + "/stereo.csv";
-    FILE* csv = std::fopen(csv_path.c_str(), "w");
-    if (!csv) return Status::error(csv_path + ": cannot write");
-    std::fprintf(csv, "scene,method,setting,frame,psnr,ssim,flip,ms\n");
+    CsvFile csv;
+    REPRISE_TRY(csv.open(csv_path, kErrorTimeColumns));
 
     std::unique_ptr<server::Renderer> renderer;
     REPRISE_TRY(server::Renderer::create(renderer));
@@ -320,7 +258,7 @@ Status bench_stereo(const BenchOptions& options) {
             b.projection = eyes[e].prev_projection;
             ms = 1e30;
             for (int r = 0; r < times; ++r) {
-                auto begin = Clock::now();
+                auto begin = BenchClock::now();
                 REPRISE_TRY(renderer->render(scene, a, b, {.width = w, .height = h}, out));
                 ms = std::min(ms, ms_since(begin));
             }
@@ -363,7 +301,7 @@ Status bench_stereo(const BenchOptions& options) {
             for (std::size_t k = 0; k < settings.size(); ++k) {
                 double ms = 1e30;
                 for (int r = 0; r < repeat; ++r) {
-                    auto begin = Clock::now();
+                    auto begin = BenchClock::now();
                     synthesizer.synthesize(left, target, made, settings[k].options,
                                            settings[k].history ? &history : nullptr);
                     ms = std::min(ms, ms_since(begin));
@@ -373,7 +311,7 @@ Status bench_stereo(const BenchOptions& options) {
             {
                 double ms = 1e30;
                 for (int r = 0; r < repeat; ++r) {
-                    auto begin = Clock::now();
+                    auto begin = BenchClock::now();
                     synthesizer.synthesize(left, target, made,
                                            {.warp = stereo::StereoWarp::Splat,
                                             .fill = stereo::StereoFill::None,
@@ -385,7 +323,7 @@ Status bench_stereo(const BenchOptions& options) {
             {
                 double ms = 1e30;
                 for (int r = 0; r < repeat; ++r) {
-                    auto begin = Clock::now();
+                    auto begin = BenchClock::now();
                     remap_by_disparity(left, rig, remapped);
                     ms = std::min(ms, ms_since(begin));
                 }
@@ -394,7 +332,7 @@ Status bench_stereo(const BenchOptions& options) {
             {
                 double ms = 1e30;
                 for (int r = 0; r < repeat; ++r) {
-                    auto begin = Clock::now();
+                    auto begin = BenchClock::now();
                     copied = left.color;
                     ms = std::min(ms, ms_since(begin));
                 }
@@ -412,16 +350,14 @@ Status bench_stereo(const BenchOptions& options) {
             if (scene_name == info.name) all.note = info.stresses;
         for (const Run& run : runs) {
             for (const Score& s : run.scores) {
-                std::fprintf(csv, "%s,%s,%s,%d,%.4f,%.6f,%.6f,%.4f\n", name.c_str(), run.method.c_str(),
-                             run.setting.c_str(), s.frame, s.all.psnr, s.all.ssim, s.all.flip, s.ms);
-                std::fprintf(csv, "%s,%s,%s+disoccluded,%d,%.4f,%.6f,%.6f,%.4f\n", name.c_str(),
-                             run.method.c_str(), run.setting.c_str(), s.frame, s.disoccluded.psnr,
-                             s.disoccluded.ssim, s.disoccluded.flip, s.ms);
+                csv.error_row(name, run.method, run.setting, s.frame, s.all, s.ms);
+                csv.error_row(name, run.method, run.setting + "+disoccluded", s.frame,
+                              s.disoccluded, s.ms);
             }
             all.points.push_back(run.mean());
             dis_section.points.push_back(run.mean(true));
         }
-        std::fflush(csv);
+        csv.flush();
 
         SceneSummary row{name};
         const Run* best = nullptr;
@@ -461,7 +397,6 @@ Status bench_stereo(const BenchOptions& options) {
         report.sections.push_back(std::move(all));
         report.sections.push_back(std::move(dis_section));
     }
-    std::fclose(csv);
     REPRISE_TRY(failure);
 
     const std::string table = summary_table(summaries, full_hd);

@@ -128,22 +128,30 @@ int command_bench(int argc, char** argv) {
               "raw file I/O\nof the same bytes, measured in the same run. fruc: frame-rate upconversion "
               "error against run time\nfor every setting beside ffmpeg minterpolate and OpenCV DIS flow "
               "(CSV + HTML report in --out).\nstereo: the synthesized second eye against the rendered one, naive DIBR peers and the "
-              "renderer's\nsecond-eye time (CSV + HTML report in --out).");
-    args.positional("WHAT", &job.what, "render | exr | reproject | grid | fill | fruc | stereo");
+              "renderer's\nsecond-eye time (CSV + HTML report in --out). codec: reprise's codec beside x264, x265 and SVT-AV1\n(bits, PSNR/SSIM/FLIP, ms, BD-rates, depth coders, 1080p speed; CSV + HTML report in --out).");
+    args.positional("WHAT", &job.what, "render | exr | reproject | grid | fill | fruc | stereo | codec");
     args.option("--scene", &job.scene, "scene to render (default pan)");
     args.option("--frames", &job.frames, "frames per size (default 10); fruc: input frames (default 20); stereo: frames per scene (at most 5)");
     args.option("--sizes", &job.sizes, "comma-separated WxH list (default 640x360,1920x1080)");
     args.option("--dir", &job.dir, "exr: folder for the files (default: the temp folder)");
-    args.option("--out", &job.out, "fruc, stereo: report folder (default out/bench-fruc, out/bench-stereo)");
-    args.option("--scenes", &job.scenes, "fruc, stereo: comma-separated scenes (default: every built-in scene)");
+    args.option("--out", &job.out, "fruc, stereo, codec: report folder (default out/bench-WHAT)");
+    args.option("--scenes", &job.scenes, "fruc, stereo, codec: comma-separated scenes (default: every built-in scene)");
     args.option("--factor", &job.factor, "fruc: K, output frames per input frame (default 2)");
-    args.option("--size", &job.size, "fruc, stereo: WxH (default 640x360)");
+    args.option("--size", &job.size, "fruc, stereo: WxH (default 640x360); codec: default 1280x720");
     args.flag("--quick", &job.quick, "fruc: a few settings only (grid+pullpush, reverse+pullpush, splat+none, ...)");
     args.option("--repeat", &job.repeat, "fruc, stereo: timed runs, each frame's fastest counts (default 3)");
+    args.option("--in", &job.in, "codec: also a sequence folder (EXR frames, up to --frames)");
+    args.option("--threads", &job.threads, "codec: threads per codec (default 2)");
+    args.option("--qps", &job.qps, "codec: reprise's qp rate points (default 22,28,34,40)");
+    args.option("--speed-size", &job.speed_size, "codec: size of the speed run (default 1920x1080)");
+    args.option("--speed-scene", &job.speed_scene, "codec: scene of the speed run (default pan)");
+    args.option("--speed-frames", &job.speed_frames, "codec: frames of the speed run (default 10, 0 = none)");
     args.flag("--exr", &job.exr, "fruc: also write the rendered input and truth as EXR under OUT/SCENE/");
     Status parsed = args.parse(argc, argv);
     if (!parsed.ok() || args.help_requested()) return report(args, parsed, {});
     if (job.what == "fruc" && !args.given("--frames")) job.frames = 20;  // reaches the cut at 0.5 s
+    if (job.what == "codec" && !args.given("--frames")) job.frames = 30;
+    if (job.what == "codec" && !args.given("--size")) job.size = "1280x720";
     Status result;
     if (job.frames < 1 || job.frames > 100000) result = Status::error("bench: --frames must be in 1..100000");
     else if (job.what == "render") result = bench_render(job);
@@ -153,8 +161,9 @@ int command_bench(int argc, char** argv) {
     else if (job.what == "fill") result = bench_fill(job);
     else if (job.what == "fruc") result = bench_fruc(job);
     else if (job.what == "stereo") result = bench_stereo(job);
+    else if (job.what == "codec") result = bench_codec(job);
     else result = Status::error("bench: unknown benchmark '" + job.what +
-                                "' (render, exr, reproject, grid, fill, fruc, stereo)");
+                                "' (render, exr, reproject, grid, fill, fruc, stereo, codec)");
     return report(args, parsed, result);
 }
 

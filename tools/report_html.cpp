@@ -87,7 +87,7 @@ std::vector<std::size_t> pareto_front(const std::vector<ReportPoint>& points) {
     return front;
 }
 
-std::string error_time_svg(const std::vector<ReportPoint>& points) {
+std::string error_time_svg(const std::vector<ReportPoint>& points, const std::string& time_label) {
     const double width = 760, height = 460, left = 64, right = 24, top = 20, bottom = 84;
     const double plot_w = width - left - right, plot_h = height - top - bottom;
     std::vector<std::size_t> shown;
@@ -142,7 +142,7 @@ std::string error_time_svg(const std::vector<ReportPoint>& points) {
     }
     svg += "<text x=\"" + format("%.1f", left + plot_w / 2) + "\" y=\"" +
            format("%.1f", top + plot_h + 32) +
-           "\" text-anchor=\"middle\">ms per synthesized frame (log scale)</text>\n";
+           "\" text-anchor=\"middle\">" + escape(time_label) + "</text>\n";
     svg += "<text transform=\"translate(16 " + format("%.1f", top + plot_h / 2) +
            ") rotate(-90)\" text-anchor=\"middle\">PSNR, dB (higher is better)</text>\n";
 
@@ -232,6 +232,141 @@ std::string error_time_svg(const std::vector<ReportPoint>& points) {
     return svg;
 }
 
+std::string line_plot_svg(const std::vector<PlotSeries>& series, const PlotAxes& axes) {
+    const double width = 760, height = 420, left = 64, right = 24, top = 20;
+    const double legend_rows = double((series.size() + 3) / 4);
+    const double bottom = 48 + 16 * legend_rows;
+    const double plot_w = width - left - right, plot_h = height - top - bottom;
+    auto xv = [&](double x) { return axes.log_x ? std::log10(x) : x; };
+    auto usable = [&](double x, double y) {
+        return std::isfinite(x) && std::isfinite(y) && (!axes.log_x || x > 0.0);
+    };
+    double x_lo = INFINITY, x_hi = -INFINITY, y_lo = INFINITY, y_hi = -INFINITY;
+    for (const PlotSeries& s : series)
+        for (std::size_t i = 0; i < std::min(s.x.size(), s.y.size()); ++i)
+            if (usable(s.x[i], s.y[i])) {
+                x_lo = std::min(x_lo, xv(s.x[i])), x_hi = std::max(x_hi, xv(s.x[i]));
+                y_lo = std::min(y_lo, s.y[i]), y_hi = std::max(y_hi, s.y[i]);
+            }
+    if (!(x_lo <= x_hi)) x_lo = 0, x_hi = 1;
+    if (!(y_lo <= y_hi)) y_lo = 0, y_hi = 1;
+    if (axes.log_x) x_lo = std::floor(x_lo * 4) / 4, x_hi = std::ceil(x_hi * 4) / 4;
+    if (x_hi - x_lo < 1e-9) x_lo -= 0.5, x_hi += 0.5;
+    const double y_step = nice_step(std::max(y_hi - y_lo, 1e-6), 6);
+    y_lo = std::floor(y_lo / y_step) * y_step, y_hi = std::ceil(y_hi / y_step) * y_step;
+    if (y_hi - y_lo < 1e-12) y_hi = y_lo + y_step;
+    auto px = [&](double x) { return left + (xv(x) - x_lo) / (x_hi - x_lo) * plot_w; };
+    auto py = [&](double y) { return top + (y_hi - y) / (y_hi - y_lo) * plot_h; };
+    std::string svg = "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + format("%.0f", width) +
+                      "\" height=\"" + format("%.0f", height) + "\" font-family=\"sans-serif\" "
+                      "font-size=\"11\">\n<rect x=\"" + format("%.1f", left) + "\" y=\"" +
+                      format("%.1f", top) + "\" width=\"" + format("%.1f", plot_w) +
+                      "\" height=\"" + format("%.1f", plot_h) +
+                      "\" fill=\"#fafafa\" stroke=\"#888\"/>\n";
+    auto vline = [&](double x, const char* color) {
+        svg += "<line x1=\"" + format("%.1f", x) + "\" y1=\"" + format("%.1f", top) + "\" x2=\"" +
+               format("%.1f", x) + "\" y2=\"" + format("%.1f", top + plot_h) + "\" stroke=\"" +
+               color + "\"/>\n";
+    };
+    if (axes.log_x) {
+        for (double d = std::floor(x_lo); d <= x_hi; ++d)
+            for (double m : {1.0, 2.0, 5.0}) {
+                const double v = m * std::pow(10.0, d);
+                if (std::log10(v) < x_lo - 1e-9 || std::log10(v) > x_hi + 1e-9) continue;
+                vline(px(v), m == 1.0 ? "#ccc" : "#eee");
+                svg += "<text x=\"" + format("%.1f", px(v)) + "\" y=\"" +
+                       format("%.1f", top + plot_h + 14) + "\" text-anchor=\"middle\">" +
+                       format("%g", v) + "</text>\n";
+            }
+    } else {
+        const double step = nice_step(x_hi - x_lo, 8);
+        for (double v = std::ceil(x_lo / step) * step; v <= x_hi + 1e-9; v += step) {
+            vline(px(v), "#e4e4e4");
+            svg += "<text x=\"" + format("%.1f", px(v)) + "\" y=\"" +
+                   format("%.1f", top + plot_h + 14) + "\" text-anchor=\"middle\">" +
+                   format("%g", v) + "</text>\n";
+        }
+    }
+    for (double v = y_lo; v <= y_hi + 1e-9 * y_step; v += y_step) {
+        svg += "<line x1=\"" + format("%.1f", left) + "\" y1=\"" + format("%.1f", py(v)) +
+               "\" x2=\"" + format("%.1f", left + plot_w) + "\" y2=\"" + format("%.1f", py(v)) +
+               "\" stroke=\"#e4e4e4\"/>\n<text x=\"" + format("%.1f", left - 6) + "\" y=\"" +
+               format("%.1f", py(v) + 4) + "\" text-anchor=\"end\">" + format("%g", v) +
+               "</text>\n";
+    }
+    svg += "<text x=\"" + format("%.1f", left + plot_w / 2) + "\" y=\"" +
+           format("%.1f", top + plot_h + 30) + "\" text-anchor=\"middle\">" +
+           escape(axes.x_label) + (axes.log_x ? " (log scale)" : "") + "</text>\n";
+    svg += "<text transform=\"translate(16 " + format("%.1f", top + plot_h / 2) +
+           ") rotate(-90)\" text-anchor=\"middle\">" + escape(axes.y_label) + "</text>\n";
+    for (std::size_t k = 0; k < series.size(); ++k) {
+        const PlotSeries& s = series[k];
+        const char* color = method_color(k);
+        std::string path;
+        std::string dots;
+        for (std::size_t i = 0; i < std::min(s.x.size(), s.y.size()); ++i) {
+            if (!usable(s.x[i], s.y[i])) continue;
+            const double x = px(s.x[i]), y = py(s.y[i]);
+            path += (path.empty() ? "M" : " L") + format("%.1f", x) + " " + format("%.1f", y);
+            dots += "<circle cx=\"" + format("%.1f", x) + "\" cy=\"" + format("%.1f", y) +
+                    "\" r=\"3\" fill=\"" + color + "\"><title>" + escape(s.name) + ": " +
+                    format("%.4g", s.x[i]) + ", " + format("%.4g", s.y[i]) + "</title></circle>";
+        }
+        svg += "<path d=\"" + path + "\" fill=\"none\" stroke=\"" + color +
+               "\" stroke-width=\"1.5\"" + (s.dashed ? " stroke-dasharray=\"5 3\"" : "") +
+               "/>" + dots + "\n";
+        const double lx = left + double(k % 4) * (plot_w / 4);
+        const double ly = top + plot_h + 48 + 16 * double(k / 4);
+        svg += "<path d=\"M" + format("%.1f", lx) + " " + format("%.1f", ly - 4) + " h18\" stroke=\"" +
+               color + "\" stroke-width=\"2\"" + (s.dashed ? " stroke-dasharray=\"5 3\"" : "") +
+               "/><text x=\"" + format("%.1f", lx + 22) + "\" y=\"" + format("%.1f", ly) + "\">" +
+               escape(s.name) + "</text>\n";
+    }
+    svg += "</svg>\n";
+    return svg;
+}
+
+std::string bar_chart_svg(const std::vector<BarRow>& rows, const std::vector<std::string>& value_names,
+                          const std::string& unit) {
+    const std::size_t bars = std::max<std::size_t>(1, value_names.size());
+    const double label_w = 230, width = 760, bar_h = 11, row_h = bar_h * double(bars) + 8;
+    const double top = 24, plot_w = width - label_w - 90;
+    const double height = top + row_h * double(rows.size()) + 28;
+    double hi = 0.0;
+    for (const BarRow& r : rows)
+        for (double v : r.values)
+            if (std::isfinite(v)) hi = std::max(hi, v);
+    if (!(hi > 0.0)) hi = 1.0;
+    std::string svg = "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + format("%.0f", width) +
+                      "\" height=\"" + format("%.0f", height) +
+                      "\" font-family=\"sans-serif\" font-size=\"11\">\n";
+    double lx = label_w;
+    for (std::size_t b = 0; b < value_names.size(); ++b) {
+        svg += "<rect x=\"" + format("%.1f", lx) + "\" y=\"6\" width=\"10\" height=\"10\" fill=\"" +
+               method_color(b) + "\"/><text x=\"" + format("%.1f", lx + 14) + "\" y=\"15\">" +
+               escape(value_names[b]) + " (" + escape(unit) + ")</text>\n";
+        lx += 40 + 6.5 * double(value_names[b].size() + unit.size());
+    }
+    for (std::size_t r = 0; r < rows.size(); ++r) {
+        const double y0 = top + row_h * double(r);
+        svg += "<text x=\"" + format("%.1f", label_w - 6) + "\" y=\"" +
+               format("%.1f", y0 + row_h / 2 + 3) + "\" text-anchor=\"end\">" +
+               escape(rows[r].label) + "</text>\n";
+        for (std::size_t b = 0; b < rows[r].values.size(); ++b) {
+            const double v = rows[r].values[b];
+            if (!std::isfinite(v)) continue;
+            const double y = y0 + 4 + bar_h * double(b), w = std::max(1.0, v / hi * plot_w);
+            svg += "<rect x=\"" + format("%.1f", label_w) + "\" y=\"" + format("%.1f", y) +
+                   "\" width=\"" + format("%.1f", w) + "\" height=\"" + format("%.1f", bar_h - 1) +
+                   "\" fill=\"" + method_color(b) + "\"/><text x=\"" +
+                   format("%.1f", label_w + w + 4) + "\" y=\"" + format("%.1f", y + bar_h - 2) +
+                   "\" font-size=\"10\">" + format("%.3g", v) + "</text>\n";
+        }
+    }
+    svg += "</svg>\n";
+    return svg;
+}
+
 Status write_html_report(const std::string& path, const Report& report) {
     std::string html =
         "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\"><title>" +
@@ -249,9 +384,10 @@ Status write_html_report(const std::string& path, const Report& report) {
     for (const ReportSection& section : report.sections) {
         html += "<h2>" + escape(section.title) + "</h2>\n";
         if (!section.note.empty()) html += "<p>" + escape(section.note) + "</p>\n";
-        html += error_time_svg(section.points);
+        html += section.html;
+        if (!section.points.empty()) html += error_time_svg(section.points, section.time_label);
         std::vector<std::size_t> front = pareto_front(section.points);
-        html +=
+        if (!section.points.empty()) html +=
             "<table><tr><th>method</th><th>setting</th><th>PSNR dB</th><th>SSIM</th>"
             "<th>FLIP</th><th>ms</th><th>Pareto</th></tr>\n";
         for (std::size_t i = 0; i < section.points.size(); ++i) {
@@ -263,7 +399,7 @@ Status write_html_report(const std::string& path, const Report& report) {
                     format("%.4f", p.flip) + "</td><td>" + format("%.3g", p.ms) + "</td><td>" +
                     (on_front ? "front" : "") + "</td></tr>\n";
         }
-        html += "</table>\n";
+        if (!section.points.empty()) html += "</table>\n";
         for (const ReportImage& image : section.images)
             html += "<figure><img src=\"" + escape(image.file) + "\" alt=\"" +
                     escape(image.caption) + "\"><figcaption>" + escape(image.caption) +

@@ -24,7 +24,10 @@ struct ReportImage {
 struct ReportSection {
     std::string title;
     std::string note;  // plain text under the title
+    std::string html;  // markup from the plot helpers below, placed under the note
+    // The error-against-time plot and table; none when empty.
     std::vector<ReportPoint> points;
+    std::string time_label = "ms per synthesized frame (log scale)";  // its x axis
     std::vector<ReportImage> images;
 };
 
@@ -40,7 +43,29 @@ struct Report {
 std::vector<std::size_t> pareto_front(const std::vector<ReportPoint>& points);
 
 // PSNR (y) against ms (x, log scale), every point labelled, the Pareto front as a staircase.
-std::string error_time_svg(const std::vector<ReportPoint>& points);
+std::string error_time_svg(const std::vector<ReportPoint>& points,
+                           const std::string& time_label = "ms per synthesized frame (log scale)");
+
+// Curves of y against x (e.g. PSNR against bits), one colour per series, points joined in the
+// order given; NaN and infinite points are left out.
+struct PlotSeries {
+    std::string name;
+    std::vector<double> x, y;
+    bool dashed = false;
+};
+struct PlotAxes {
+    std::string x_label, y_label;
+    bool log_x = true;
+};
+std::string line_plot_svg(const std::vector<PlotSeries>& series, const PlotAxes& axes);
+
+// Horizontal bars: per row a label and one bar per value (values[i] named by value_names[i]).
+struct BarRow {
+    std::string label;
+    std::vector<double> values;
+};
+std::string bar_chart_svg(const std::vector<BarRow>& rows, const std::vector<std::string>& value_names,
+                          const std::string& unit);
 
 Status write_html_report(const std::string& path, const Report& report);
 

@@ -1,0 +1,268 @@
+// The pieces of `reprise bench codec`: Bjøntegaard delta rate on analytic curves, the depth
+// peers' round trips (zstd, RVL) and a tiny encode/decode through each libavcodec peer.
+#include <gtest/gtest.h>
+
+#include <bit>
+#include <cstdio>
+#include <cmath>
+#include <random>
+
+#include "bd_rate.hpp"
+#include "bench_report.hpp"
+#include "codec_peers.hpp"
+#include "depth_peers.hpp"
+#include "reprise/core/metrics.hpp"
+#include "support/cli.hpp"
+
+namespace reprise::cli {
+namespace {
+
+// A convex, non-linear rate-quality curve: quality in dB grows with log rate, more slowly at
+// high rates.
+std::vector<RatePoint> curve(double rate_scale, std::vector<double> rates) {
+    std::vector<RatePoint> points;
+    for (double r : rates) {
+        const double lr = std::log10(r);
+        points.push_back({r * rate_scale, 12.0 * lr - 0.9 * lr * lr});
+    }
+    return points;
+}
+
+TEST(BdRate, RateScaledByAConstantGivesThatScale) {
+    const std::vector<double> rates = {1e4, 3e4, 1e5, 3e5, 1e6};
+    const auto anchor = curve(1.0, rates);
+    EXPECT_NEAR(bd_rate(anchor, curve(0.8, rates)), -20.0, 0.1);
+    EXPECT_NEAR(bd_rate(anchor, curve(1.5, rates)), 50.0, 0.1);
+    EXPECT_NEAR(bd_rate(curve(0.8, rates), anchor), 25.0, 0.1);
+    // The test sampled at other rates (a partial overlap): still the same curve, 20 % cheaper.
+    EXPECT_NEAR(bd_rate(anchor, curve(0.8, {2e4, 5e4, 2e5, 7e5, 2e6})), -20.0, 0.5);
+}
+
+TEST(BdRate, QualityShiftOnALogLinearCurve) {
+    // quality = 10 log10(rate): +1 dB at equal rate is 10^(-0.1) of the rate at equal quality.
+    std::vector<RatePoint> anchor, test;
+    for (double r : {1e3, 4e3, 1.6e4, 6.4e4}) {
+        anchor.push_back({r, 10.0 * std::log10(r)});
+        test.push_back({r, 10.0 * std::log10(r) + 1.0});
+    }
+    EXPECT_NEAR(bd_rate(anchor, test), (std::pow(10.0, -0.1) - 1.0) * 100.0, 1e-6);
+}
+
+TEST(BdRate, LinearLogRateIntegratesExactly) {
+    std::vector<RatePoint> points;
+    for (double q : {30.0, 33.0, 37.0, 40.0}) points.push_back({std::pow(10.0, 2.0 + 0.1 * q), q});
+    // ∫_31^39 (2 + 0.1 q) dq = 16 + 0.05 (39² - 31²) = 44.
+    EXPECT_NEAR(integrate_log_rate(points, 31.0, 39.0), 44.0, 1e-9);
+}
+
+TEST(BdRate, NoOverlapOrTooFewPointsIsNaN) {
+    const auto low = curve(1.0, {1e3, 2e3, 4e3, 8e3});
+    const auto high = curve(1.0, {1e6, 2e6, 4e6, 8e6});
+    EXPECT_TRUE(std::isnan(bd_rate(low, high)));
+    EXPECT_TRUE(std::isnan(bd_rate(low, {{1e3, 10.0}})));
+    EXPECT_TRUE(std::isnan(bd_rate(low, {{1e3, 10.0}, {2e3, 10.0}})));  // one distinct quality
+}
+
+std::vector<float> test_depth(int w, int h) {
+    std::vector<float> depth(std::size_t(w) * h);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            float z = 2.0f + 0.01f * x + 0.003f * y * y / h;  // a smooth surface
+            if ((x - w / 2) * (x - w / 2) + (y - h / 3) * (y - h / 3) < w * h / 40) z = 1.25f + 0.001f * x;
+            if (y < h / 5) z = INFINITY;  // sky
+            depth[std::size_t(y) * w + x] = z;
+        }
+    // The values a lossless coder must keep too.
+    depth[3] = NAN;
+    depth[4] = -INFINITY;
+    depth[5] = 0.0f;
+    depth[6] = -0.0f;
+    depth[7] = -5.0f;
+    depth[8] = std::numeric_limits<float>::denorm_min();
+    depth[9] = std::numeric_limits<float>::max();
+    return depth;
+}
+
+bool bit_equal(const std::vector<float>& a, const std::vector<float>& b) {
+    if (a.size() != b.size()) return false;
+    for (std::size_t i = 0; i < a.size(); ++i)
+        if (std::bit_cast<uint32_t>(a[i]) != std::bit_cast<uint32_t>(b[i])) return false;
+    return true;
+}
+
+TEST(DepthPeers, ZstdRoundTripIsBitExact) {
+    const std::vector<float> depth = test_depth(160, 90);
+    std::vector<uint8_t> bytes;
+    zstd_compress_depth(depth, 3, bytes);
+    EXPECT_LT(bytes.size(), depth.size() * 4);
+    std::vector<float> back;
+    ASSERT_TRUE(zstd_decompress_depth(bytes, depth.size(), back).ok());
+    EXPECT_TRUE(bit_equal(depth, back));
+    EXPECT_FALSE(zstd_decompress_depth(bytes, depth.size() + 1, back).ok());
+    bytes.resize(bytes.size() / 2);
+    EXPECT_FALSE(zstd_decompress_depth(bytes, depth.size(), back).ok());
+}
+
+TEST(DepthPeers, RvlFloatBitsRoundTripIsBitExact) {
+    const std::vector<float> depth = test_depth(160, 90);
+    std::vector<uint8_t> bytes;
+    rvl_encode(depth, {}, bytes);
+    std::vector<float> back;
+    ASSERT_TRUE(rvl_decode(bytes, depth.size(), {}, back).ok());
+    EXPECT_TRUE(bit_equal(depth, back));
+    EXPECT_LT(bytes.size(), depth.size() * 3);  // a smooth surface and sky: under 24 bits/px
+
+    // Every bit pattern, one by one.
+    std::mt19937 random(7);
+    std::vector<float> noise(4096);
+    for (float& v : noise) v = std::bit_cast<float>(uint32_t(random()));
+    rvl_encode(noise, {}, bytes);
+    ASSERT_TRUE(rvl_decode(bytes, noise.size(), {}, back).ok());
+    EXPECT_TRUE(bit_equal(noise, back));
+}
+
+TEST(DepthPeers, RvlInverse16KeepsInverseDepthWithinOneStep) {
+    const RvlOptions options{.mode = RvlMode::Inverse16, .near = 0.5f, .far = 100.0f};
+    std::vector<float> depth = test_depth(160, 90);
+    std::vector<uint8_t> bytes;
+    rvl_encode(depth, options, bytes);
+    std::vector<float> back;
+    ASSERT_TRUE(rvl_decode(bytes, depth.size(), options, back).ok());
+    const double step = (1.0 / options.near - 1.0 / options.far) / 65534.0;
+    for (std::size_t i = 0; i < depth.size(); ++i) {
+        const float z = depth[i];
+        if (z >= options.near && z <= options.far)
+            ASSERT_LE(std::abs(1.0 / back[i] - 1.0 / z), 0.5 * step + 1e-9) << i;
+        else
+            ASSERT_TRUE(std::isinf(back[i])) << i;
+    }
+}
+
+TEST(DepthPeers, RvlBadInputIsAStatus) {
+    const std::vector<float> depth = test_depth(64, 32);
+    std::vector<uint8_t> bytes;
+    rvl_encode(depth, {}, bytes);
+    std::vector<float> back;
+    for (std::size_t cut : {std::size_t(0), std::size_t(1), bytes.size() / 2, bytes.size() - 1}) {
+        std::vector<uint8_t> part(bytes.begin(), bytes.begin() + long(cut));
+        EXPECT_FALSE(rvl_decode(part, depth.size(), {}, back).ok()) << cut;
+    }
+    std::vector<uint8_t> longer = bytes;
+    longer.push_back(0);
+    EXPECT_FALSE(rvl_decode(longer, depth.size(), {}, back).ok());
+    EXPECT_FALSE(rvl_decode(bytes, depth.size() - 1, {}, back).ok());
+    // Absurd run lengths.
+    std::vector<uint8_t> absurd(16, 0xff);
+    absurd.push_back(0x00);
+    EXPECT_FALSE(rvl_decode(absurd, depth.size(), {}, back).ok());
+}
+
+// A smooth gradient with a square moving 2 px right per frame.
+std::vector<Image<Rgb8>> moving_square(int w, int h, int frames) {
+    std::vector<Image<Rgb8>> out(frames);
+    for (int f = 0; f < frames; ++f) {
+        out[f].resize(w, h);
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                Rgb8 c(uint8_t(40 + 150 * x / w), uint8_t(60 + 120 * y / h), 128);
+                if (x >= 10 + 2 * f && x < 30 + 2 * f && y >= 12 && y < 32) c = Rgb8(230, 40, 30);
+                out[f](x, y) = c;
+            }
+    }
+    return out;
+}
+
+double psnr_of(const Image<Rgb8>& a, const Image<Rgb8>& b) {
+    Image<glm::vec3> da, dbv;
+    from_rgb8(a.view(), da);
+    from_rgb8(b.view(), dbv);
+    return psnr(da.view(), dbv.view());
+}
+
+void expect_round_trip(const PeerConfig& config, int w, int h, double min_psnr) {
+    if (!peer_available(config.kind)) GTEST_SKIP() << peer_name(config.kind) << " not in libavcodec";
+    const auto frames = moving_square(w, h, 3);
+    std::vector<PeerFrame> out;
+    const Status status = encode_decode_peer(frames, config, 30.0, out);
+    ASSERT_TRUE(status.ok()) << status.message();
+    ASSERT_EQ(out.size(), frames.size());
+    for (std::size_t i = 0; i < out.size(); ++i) {
+        EXPECT_GT(out[i].bytes, 0u) << i;
+        ASSERT_EQ(out[i].decoded.width(), w);
+        ASSERT_EQ(out[i].decoded.height(), h);
+        const double db_seen = psnr_of(frames[i], out[i].decoded);
+        std::printf("%s %s %dx%d frame %zu: %zu bytes, %.2f dB\n", peer_name(config.kind).c_str(),
+                    peer_setting(config).c_str(), w, h, i, out[i].bytes, db_seen);
+        EXPECT_GT(db_seen, min_psnr) << peer_setting(config) << " " << i;
+        EXPECT_GE(out[i].encode_ms, 0.0);
+        EXPECT_GE(out[i].decode_ms, 0.0);
+    }
+    EXPECT_LT(out[1].bytes, out[0].bytes);  // an inter frame costs less than the key frame
+}
+
+TEST(CodecPeers, X264UltrafastRoundTrip) {
+    expect_round_trip({.kind = PeerKind::X264, .preset = "ultrafast", .crf = 20}, 64, 64, 32.0);
+}
+
+TEST(CodecPeers, OddSizeIsPaddedAndCroppedBack) {
+    expect_round_trip({.kind = PeerKind::X264, .preset = "ultrafast", .crf = 20}, 63, 37, 30.0);
+}
+
+TEST(CodecPeers, X265RoundTrip) {
+    expect_round_trip({.kind = PeerKind::X265, .preset = "ultrafast", .crf = 20}, 64, 64, 32.0);
+}
+
+TEST(CodecPeers, SvtAv1RoundTrip) {
+    expect_round_trip({.kind = PeerKind::SvtAv1, .preset = "10", .crf = 28}, 72, 40, 30.0);
+}
+
+TEST(CodecPeers, BadInputIsAStatus) {
+    std::vector<PeerFrame> out;
+    auto frames = moving_square(64, 64, 2);
+    frames[1].resize(32, 32);
+    EXPECT_FALSE(encode_decode_peer(frames, {}, 30.0, out).ok());
+    EXPECT_FALSE(encode_decode_peer({Image<Rgb8>(1, 1)}, {}, 30.0, out).ok());
+    EXPECT_TRUE(encode_decode_peer({}, {}, 30.0, out).ok());
+    EXPECT_TRUE(out.empty());
+}
+
+// End to end on a tiny scene: every peer's rows, finite figures, the depth coders and the page.
+TEST(CliBenchCodec, TinySceneWritesRowsForEveryPeer) {
+    namespace fs = std::filesystem;
+    const fs::path dir =
+        fs::temp_directory_path() / ("reprise-cli-bench-codec-" + std::to_string(getpid()));
+    fs::remove_all(dir);
+    const test::Outcome result = test::run_reprise(
+        "bench codec --scenes pan --size 96x64 --frames 3 --speed-frames 0 --out " + dir.string(),
+        300);
+    ASSERT_EQ(result.status, 0) << result.output;
+    EXPECT_NE(result.output.find("targets (issue 8"), std::string::npos) << result.output;
+    std::ifstream csv(dir / "codec.csv");
+    std::string line;
+    std::getline(csv, line);
+    EXPECT_EQ(line, "scene,codec,setting,frame,bits,psnr,ssim,flip,encode_ms,decode_ms");
+    std::map<std::string, int> rows;
+    while (std::getline(csv, line)) {
+        std::vector<std::string> cells;
+        std::stringstream stream(line);
+        for (std::string cell; std::getline(stream, cell, ',');) cells.push_back(cell);
+        ASSERT_EQ(cells.size(), 10u) << line;
+        ++rows[cells[1]];
+        EXPECT_GT(std::stod(cells[4]), 0.0) << line;  // bits
+        EXPECT_GT(std::stod(cells[5]), 20.0) << line;  // PSNR: figures seen 27..45 dB
+    }
+    for (PeerKind kind : {PeerKind::X264, PeerKind::X265, PeerKind::SvtAv1}) {
+        if (!peer_available(kind)) continue;
+        const int rate_points = kind == PeerKind::X264 ? 3 * 4 : 4;  // x264: three presets
+        EXPECT_EQ(rows[peer_name(kind)], rate_points * 3) << peer_name(kind);
+    }
+    std::ifstream depth(dir / "depth.csv");
+    std::string depth_text((std::istreambuf_iterator<char>(depth)), {});
+    EXPECT_NE(depth_text.find("pan,zstd-3,2,"), std::string::npos);
+    EXPECT_NE(depth_text.find("pan,rvl-float,2,"), std::string::npos);
+    EXPECT_TRUE(fs::exists(dir / "index.html"));
+    fs::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace reprise::cli

@@ -1,0 +1,629 @@
+// reprise bench codec — error against bits against run time: reprise's scene-aware codec beside
+// x264, x265 and SVT-AV1 (through libavcodec) on the same 8-bit display frames, Bjøntegaard
+// delta rates, the depth coders (reprise lossless, zstd -3, RVL) and the speed ratios at 1080p.
+//
+// OUT/codec.csv: scene,codec,setting,frame,bits,psnr,ssim,flip,encode_ms,decode_ms (display
+// values against the original colour; codec "reprise" counts all its bits, "reprise-color" the
+// same frames with its colour bits only). OUT/bd_rate.csv, OUT/depth.csv, OUT/speed.csv,
+// OUT/index.html (rate-distortion curves and time bars).
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <span>
+#include <string>
+#include <tuple>
+#include <vector>
+
+#include "args.hpp"
+#include "bd_rate.hpp"
+#include "bench.hpp"
+#include "bench_report.hpp"
+#include "reprise/codec/codec.hpp"
+#include "codec_peers.hpp"
+#include "depth_peers.hpp"
+#include "reprise/core/exr.hpp"
+#include "reprise/core/metrics.hpp"
+#include "reprise/core/parallel.hpp"
+#include "reprise/server/builtin_scenes.hpp"
+#include "reprise/server/renderer.hpp"
+
+namespace reprise::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+constexpr const char* kOurs = "reprise";
+constexpr const char* kOursColor = "reprise-color";
+constexpr double kColorBdTarget = -20.0;  // % against x264 veryfast, PSNR, mean over scenes
+constexpr double kDecodeOverEncodeTarget = 2.0;
+constexpr double kDepthRatioTarget = 2.0;  // zstd -3 bytes / reprise lossless depth bytes
+
+// One encoded frame, scored.
+struct Sample {
+    int frame = 0;
+    double bits = 0.0;
+    ImageError error;
+    double encode_ms = 0.0, decode_ms = 0.0;
+};
+
+// One codec at one rate point on one sequence.
+struct RunResult {
+    std::string codec, setting, group;  // group: the curve it belongs to ("x264 veryfast")
+    std::vector<Sample> samples;
+    double mean(double Sample::*field) const {
+        double sum = 0.0;
+        for (const Sample& s : samples) sum += s.*field;
+        return samples.empty() ? NAN : sum / double(samples.size());
+    }
+    double mean_error(double ImageError::*field) const {
+        double sum = 0.0;
+        for (const Sample& s : samples) sum += s.error.*field;
+        return samples.empty() ? NAN : sum / double(samples.size());
+    }
+};
+
+struct Sequence {
+    std::string name, note;
+    bool builtin = false;
+    double fps = 30.0;
+    std::vector<Frame> frames;               // the G-buffers (colour, depth, motion, camera)
+    std::vector<Image<Rgb8>> shown;          // 8-bit display values: what every codec gets
+    std::vector<Image<glm::vec3>> truth;     // display values of the original colour
+};
+
+struct DepthResult {
+    std::string coder;
+    std::vector<double> bytes, encode_ms, decode_ms;
+    bool lossless = true;
+    double total_bytes() const {
+        double sum = 0.0;
+        for (double b : bytes) sum += b;
+        return sum;
+    }
+};
+
+void add_frame(Sequence& seq, Frame&& frame) {
+    frame.normal.clear();  // no codec reads them; a 30-frame 1080p sequence stays under 2 GB
+    frame.id.clear();
+    Image<glm::vec3> display(frame.width(), frame.height());
+    to_display(frame.color.view(), display.view());
+    Image<Rgb8> shown(frame.width(), frame.height());
+    visualize_color(frame.color.view(), shown.view());
+    seq.truth.push_back(std::move(display));
+    seq.shown.push_back(std::move(shown));
+    seq.frames.push_back(std::move(frame));
+}
+
+Status render_sequence(server::Renderer& renderer, const std::string& scene_name, int frames,
+                       int w, int h, Sequence& seq) {
+    server::Scene scene;
+    server::CameraPath path;
+    REPRISE_TRY(server::load_scene(scene_name, scene, path));
+    seq.name = fs::path(scene_name).stem().string();
+    seq.fps = 30.0;
+    for (const server::SceneInfo& info : server::builtin_scenes())
+        if (info.name == scene_name) seq.note = info.stresses, seq.builtin = true;
+    for (int i = 0; i < frames; ++i) {
+        Frame frame;
+        REPRISE_TRY(renderer.render_frame(scene, path, i, seq.fps, {.width = w, .height = h}, frame));
+        add_frame(seq, std::move(frame));
+        std::fprintf(stderr, "\r[codec] %s: rendering %d/%d   ", seq.name.c_str(), i + 1, frames);
+    }
+    std::fprintf(stderr, "\n");
+    return {};
+}
+
+Status read_sequence(const std::string& dir, int frames, Sequence& seq) {
+    reprise::Sequence files;
+    REPRISE_TRY(open_sequence(dir, files));
+    seq.name = fs::path(dir).filename().string();
+    if (seq.name.empty()) seq.name = fs::path(dir).parent_path().filename().string();
+    seq.note = "sequence folder " + dir;
+    seq.fps = files.fps > 0.0 ? files.fps : 30.0;
+    const int n = std::min<int>(frames, int(files.files.size()));
+    for (int i = 0; i < n; ++i) {
+        Frame frame;
+        REPRISE_TRY(read_frame(files.files[i], frame));
+        if (i > 0 && (frame.width() != seq.frames[0].width() || frame.height() != seq.frames[0].height()))
+            return Status::error(files.files[i] + ": size differs from the first frame");
+        add_frame(seq, std::move(frame));
+        std::fprintf(stderr, "\r[codec] %s: reading %d/%d   ", seq.name.c_str(), i + 1, n);
+    }
+    std::fprintf(stderr, "\n");
+    if (seq.frames.empty()) return Status::error(dir + ": no frames");
+    return {};
+}
+
+ImageError score(const Image<glm::vec3>& truth, const Image<Rgb8>& decoded, Image<glm::vec3>& scratch) {
+    from_rgb8(decoded.view(), scratch);
+    return image_error(truth.view(), scratch.view());
+}
+
+std::string peer_group(const PeerConfig& c) {
+    return peer_name(c.kind) + " " + (c.kind == PeerKind::SvtAv1 ? "p" : "") + c.preset;
+}
+
+Status run_peer(const Sequence& seq, const PeerConfig& config, RunResult& run,
+                double* convert_ms = nullptr) {
+    std::vector<PeerFrame> out;
+    REPRISE_TRY(encode_decode_peer(seq.shown, config, seq.fps, out));
+    if (convert_ms) {
+        convert_ms[0] = convert_ms[1] = 0.0;
+        for (const PeerFrame& f : out)
+            convert_ms[0] += f.encode_convert_ms / double(out.size()),
+                convert_ms[1] += f.decode_convert_ms / double(out.size());
+    }
+    run = {peer_name(config.kind), peer_setting(config), peer_group(config), {}};
+    Image<glm::vec3> scratch;
+    for (std::size_t i = 0; i < out.size(); ++i)
+        run.samples.push_back({int(i), 8.0 * double(out[i].bytes),
+                               score(seq.truth[i], out[i].decoded, scratch), out[i].encode_ms,
+                               out[i].decode_ms});
+    return {};
+}
+
+// reprise's codec at one qp: every frame encoded, its packet decoded, the decoded colour scored.
+// `color` gets the same frames counted with their colour bits only; `depth_bits` the depth
+// stream's bits per frame.
+Status run_ours(const Sequence& seq, int qp, RunResult& total, RunResult& color,
+                std::vector<double>* depth_bits) {
+    const std::string setting = "qp " + std::to_string(qp);
+    total = {kOurs, setting, kOurs, {}};
+    color = {kOursColor, setting, kOursColor, {}};
+    codec::Encoder encoder({.qp = qp, .fps = seq.fps});
+    codec::Decoder decoder;
+    codec::Packet packet;
+    Frame decoded;
+    Image<glm::vec3> display;
+    for (std::size_t i = 0; i < seq.frames.size(); ++i) {
+        auto start = BenchClock::now();
+        REPRISE_TRY(encoder.send_frame(seq.frames[i]));
+        if (encoder.receive_packet(packet) != codec::Result::Ok)
+            return Status::error("reprise codec: no packet for frame " + std::to_string(i));
+        const double encode_ms = ms_since(start);
+        start = BenchClock::now();
+        REPRISE_TRY(decoder.send_packet(packet.data));
+        if (decoder.receive_frame(decoded) != codec::Result::Ok)
+            return Status::error("reprise codec: no decoded frame for frame " + std::to_string(i));
+        const double decode_ms = ms_since(start);
+        const codec::StreamStats& stats = encoder.last_frame_stats();
+        if (8 * packet.data.size() < stats.total_bits() && i == 0)
+            std::fprintf(stderr, "[codec] note: reprise's stream stats count %zu bits, its packet "
+                         "has %zu\n", stats.total_bits(), 8 * packet.data.size());
+        display.resize(decoded.width(), decoded.height());
+        to_display(decoded.color.view(), display.view());
+        Sample s{int(i), 8.0 * double(packet.data.size()),
+                 image_error(seq.truth[i].view(), display.view()), encode_ms, decode_ms};
+        total.samples.push_back(s);
+        s.bits = double(stats.color_bits);
+        color.samples.push_back(s);
+        if (depth_bits) depth_bits->push_back(double(stats.depth_bits));
+    }
+    return {};
+}
+
+void run_depth_peers(const Sequence& seq, std::vector<DepthResult>& results) {
+    DepthResult zstd{"zstd-3"}, rvl{"rvl-float"}, rvl16{"rvl-16bit-inverse (lossy)"};
+    rvl16.lossless = false;
+    std::vector<uint8_t> bytes;
+    std::vector<float> back;
+    for (const Frame& frame : seq.frames) {
+        const std::span<const float> depth(frame.depth.data(), frame.depth.pixel_count());
+        auto start = BenchClock::now();
+        zstd_compress_depth(depth, 3, bytes);
+        zstd.encode_ms.push_back(ms_since(start));
+        zstd.bytes.push_back(double(bytes.size()));
+        start = BenchClock::now();
+        Status ok = zstd_decompress_depth(bytes, depth.size(), back);
+        zstd.decode_ms.push_back(ms_since(start));
+        REPRISE_ASSERT(ok.ok());
+        for (DepthResult* r : {&rvl, &rvl16}) {
+            const RvlOptions options{.mode = r == &rvl ? RvlMode::FloatBits : RvlMode::Inverse16,
+                                     .near = frame.camera.near, .far = frame.camera.far};
+            start = BenchClock::now();
+            rvl_encode(depth, options, bytes);
+            r->encode_ms.push_back(ms_since(start));
+            r->bytes.push_back(double(bytes.size()));
+            start = BenchClock::now();
+            ok = rvl_decode(bytes, depth.size(), options, back);
+            r->decode_ms.push_back(ms_since(start));
+            REPRISE_ASSERT(ok.ok());
+        }
+    }
+    results.push_back(std::move(zstd));
+    results.push_back(std::move(rvl));
+    results.push_back(std::move(rvl16));
+}
+
+std::vector<int> parse_qps(const std::string& list, Status& status) {
+    std::vector<int> qps;
+    for (const std::string& item : split_list(list)) {
+        char* end = nullptr;
+        const long qp = std::strtol(item.c_str(), &end, 10);
+        if (!end || *end || qp < 0 || qp > 51) {
+            status = Status::error("bench codec: --qps: '" + item + "' is not a qp in 0..51");
+            return {};
+        }
+        qps.push_back(int(qp));
+    }
+    if (qps.size() < 2) status = Status::error("bench codec: --qps needs at least two qp values");
+    return qps;
+}
+
+// A rate-distortion curve: one point per rate point of one codec group.
+std::vector<RatePoint> rd_curve(const std::vector<RunResult>& runs, const std::string& group,
+                                bool flip) {
+    std::vector<RatePoint> points;
+    for (const RunResult& r : runs)
+        if (r.group == group)
+            points.push_back({r.mean(&Sample::bits),
+                              flip ? -r.mean_error(&ImageError::flip) : r.mean_error(&ImageError::psnr)});
+    return points;
+}
+
+std::vector<std::string> groups_of(const std::vector<RunResult>& runs) {
+    std::vector<std::string> groups;
+    for (const RunResult& r : runs)
+        if (std::find(groups.begin(), groups.end(), r.group) == groups.end()) groups.push_back(r.group);
+    return groups;
+}
+
+struct BdRow {
+    std::string scene, peer;
+    bool builtin = false;
+    double psnr_color = NAN, psnr_total = NAN, flip_color = NAN, flip_total = NAN;
+};
+
+std::string pct(double v) { return std::isnan(v) ? std::string("n/a") : strf("%+.1f%%", v); }
+
+std::string verdict(bool known, bool met) {
+    return !known ? "n/a" : met ? "met" : "NOT met";
+}
+
+struct SpeedResult {
+    bool measured = false;
+    int w = 0, h = 0, frames = 0;
+    double ours_encode = NAN, ours_decode = NAN;  // mean ms per frame
+    double x264_veryfast_encode = NAN, x264_veryfast_decode = NAN;
+    double rgb_to_yuv = NAN, yuv_to_rgb = NAN;  // x264 veryfast's conversions, inside its times
+    double x264_ultrafast_encode = NAN;
+};
+
+Status measure_speed(server::Renderer& renderer, const BenchOptions& job, int threads,
+                     int mid_qp, SpeedResult& speed) {
+    REPRISE_TRY(parse_size(job.speed_size, speed.w, speed.h));
+    Sequence seq;
+    REPRISE_TRY(render_sequence(renderer, job.speed_scene, job.speed_frames, speed.w, speed.h, seq));
+    seq.name = "speed-" + seq.name;
+    speed.frames = int(seq.frames.size());
+    RunResult run;
+    std::fprintf(stderr, "[codec] speed: x264 veryfast at %dx%d\n", speed.w, speed.h);
+    double convert_ms[2] = {NAN, NAN};
+    REPRISE_TRY(run_peer(seq, {.kind = PeerKind::X264, .preset = "veryfast", .crf = 26, .threads = threads},
+                         run, convert_ms));
+    speed.rgb_to_yuv = convert_ms[0];
+    speed.yuv_to_rgb = convert_ms[1];
+    speed.x264_veryfast_encode = run.mean(&Sample::encode_ms);
+    speed.x264_veryfast_decode = run.mean(&Sample::decode_ms);
+    std::fprintf(stderr, "[codec] speed: x264 ultrafast\n");
+    REPRISE_TRY(run_peer(seq, {.kind = PeerKind::X264, .preset = "ultrafast", .crf = 26, .threads = threads}, run));
+    speed.x264_ultrafast_encode = run.mean(&Sample::encode_ms);
+    std::fprintf(stderr, "[codec] speed: reprise qp %d\n", mid_qp);
+    RunResult color;
+    REPRISE_TRY(run_ours(seq, mid_qp, run, color, nullptr));
+    speed.ours_encode = run.mean(&Sample::encode_ms);
+    speed.ours_decode = run.mean(&Sample::decode_ms);
+    speed.measured = true;
+    return {};
+}
+
+}  // namespace
+
+Status bench_codec(const BenchOptions& job) {
+    if (job.frames < 2 || job.frames > 1000)
+        return Status::error("bench codec: --frames must be in 2..1000");
+    if (job.threads < 1 || job.threads > 64)
+        return Status::error("bench codec: --threads must be in 1..64");
+    if (job.speed_frames < 0 || job.speed_frames > 1000)
+        return Status::error("bench codec: --speed-frames must be in 0..1000 (0 = no speed run)");
+    int w = 0, h = 0;
+    REPRISE_TRY(parse_size(job.size, w, h));
+    Status parsed;
+    const std::vector<int> qps = parse_qps(job.qps, parsed);
+    REPRISE_TRY(parsed);
+    std::vector<std::string> scenes = split_list(job.scenes);
+    if (scenes.empty() && job.in.empty())
+        for (const server::SceneInfo& s : server::builtin_scenes()) scenes.push_back(s.name);
+    const std::string out_dir = job.out.empty() ? "out/bench-codec" : job.out;
+    std::error_code ec;
+    fs::create_directories(out_dir, ec);
+    if (ec) return Status::error(out_dir + ": cannot create the folder: " + ec.message());
+
+    std::vector<PeerConfig> peers;
+    for (const PeerConfig& c : standard_peer_configs(job.threads)) {
+        if (peer_available(c.kind)) peers.push_back(c);
+        else if (peers.empty() || peers.back().kind != c.kind)
+            std::printf("note: libavcodec lacks %s; that peer is skipped\n", peer_name(c.kind).c_str());
+    }
+
+    CsvFile csv, bd_csv, depth_csv, speed_csv;
+    REPRISE_TRY(csv.open(out_dir + "/codec.csv",
+                         "scene,codec,setting,frame,bits,psnr,ssim,flip,encode_ms,decode_ms"));
+    REPRISE_TRY(bd_csv.open(out_dir + "/bd_rate.csv", "scene,anchor,metric,reprise_bits,bd_rate_percent"));
+    REPRISE_TRY(depth_csv.open(out_dir + "/depth.csv", "scene,coder,frame,bytes,encode_ms,decode_ms"));
+    REPRISE_TRY(speed_csv.open(out_dir + "/speed.csv", "size,frames,codec,setting,encode_ms,decode_ms"));
+
+    std::unique_ptr<server::Renderer> renderer;
+    REPRISE_TRY(server::Renderer::create(renderer));
+
+    Report report;
+    report.title = "reprise bench codec: error against bits against run time";
+    report.paragraphs.push_back(strf(
+        "Every codec gets the same 8-bit sRGB display frames (reprise's codec its G-buffers: "
+        "linear colour, depth, motion, cameras) and is scored on display values of its decoded "
+        "frames against the original colour (PSNR, SSIM, LDR-FLIP). %dx%d, %d frames per built-in "
+        "scene at 30 Hz; %d threads per codec. Peers through libavcodec, low delay as streaming "
+        "uses them: x264 (ultrafast, veryfast, medium; tune zerolatency, no B-frames), x265 "
+        "ultrafast zerolatency, SVT-AV1 preset 10 with its low-delay prediction structure "
+        "(which SVT-AV1 1.4 calls work in progress), CRF at four rate points each; yuv420p via "
+        "swscale (BT.601, limited range).",
+        w, h, job.frames, job.threads));
+    report.paragraphs.push_back(
+        "Times are wall-clock ms per frame on this machine: encode = RGB to YUV conversion + "
+        "send_frame + receive_packet (peers), send_frame + receive_packet (reprise); decode = "
+        "send_packet + receive_frame (+ YUV to RGB for peers). Bits include every header (x264's "
+        "SPS/PPS in band). BD-rate: Bjøntegaard delta rate of reprise against each peer over the "
+        "common quality interval (monotone cubic interpolation of log rate), counting reprise's "
+        "colour bits alone and its total bits (camera, depth, motion, colour, headers).");
+
+    std::vector<BdRow> bd_rows;
+    struct DepthSummary {
+        std::string scene;
+        double raw = 0, zstd = 0, rvl = 0, rvl16 = 0, ours = NAN;
+    };
+    std::vector<DepthSummary> depth_rows;
+
+    std::vector<std::string> inputs = scenes;
+    if (!job.in.empty()) inputs.push_back("in:" + job.in);
+    for (const std::string& input : inputs) {
+        Sequence seq;
+        if (input.rfind("in:", 0) == 0) REPRISE_TRY(read_sequence(input.substr(3), job.frames, seq));
+        else REPRISE_TRY(render_sequence(*renderer, input, job.frames, w, h, seq));
+        const int sw = seq.frames[0].width(), sh = seq.frames[0].height();
+
+        std::vector<RunResult> runs;
+        std::vector<double> our_depth_bits;
+        for (int qp : qps) {
+            RunResult total, color;
+            REPRISE_TRY(run_ours(seq, qp, total, color, our_depth_bits.empty() ? &our_depth_bits : nullptr));
+            std::fprintf(stderr, "[codec] %s: reprise qp %2d: %9.0f bits/frame (colour %9.0f) %6.2f dB %8.2f ms enc %8.2f ms dec\n",
+                         seq.name.c_str(), qp, total.mean(&Sample::bits), color.mean(&Sample::bits),
+                         total.mean_error(&ImageError::psnr), total.mean(&Sample::encode_ms),
+                         total.mean(&Sample::decode_ms));
+            runs.push_back(std::move(total));
+            runs.push_back(std::move(color));
+        }
+        for (const PeerConfig& config : peers) {
+            RunResult run;
+            REPRISE_TRY(run_peer(seq, config, run));
+            std::fprintf(stderr, "[codec] %s: %-8s %-18s %9.0f bits/frame %6.2f dB %8.2f ms enc %8.2f ms dec\n",
+                         seq.name.c_str(), run.codec.c_str(), run.setting.c_str(),
+                         run.mean(&Sample::bits), run.mean_error(&ImageError::psnr),
+                         run.mean(&Sample::encode_ms), run.mean(&Sample::decode_ms));
+            runs.push_back(std::move(run));
+        }
+        for (const RunResult& r : runs)
+            for (const Sample& s : r.samples)
+                csv.row({seq.name, r.codec, r.setting, std::to_string(s.frame), strf("%.0f", s.bits),
+                         strf("%.4f", s.error.psnr), strf("%.6f", s.error.ssim),
+                         strf("%.6f", s.error.flip), strf("%.4f", s.encode_ms),
+                         strf("%.4f", s.decode_ms)});
+        csv.flush();
+
+        // Depth coders.
+        std::vector<DepthResult> depth;
+        run_depth_peers(seq, depth);
+        if (!our_depth_bits.empty()) {
+            DepthResult ours{"reprise-lossless"};
+            for (double b : our_depth_bits) ours.bytes.push_back(b / 8.0);
+            ours.encode_ms.assign(ours.bytes.size(), NAN);  // inside the codec's frame time
+            ours.decode_ms.assign(ours.bytes.size(), NAN);
+            depth.insert(depth.begin(), std::move(ours));
+        }
+        DepthSummary ds{seq.name};
+        ds.raw = 4.0 * double(sw) * sh * double(seq.frames.size());
+        for (const DepthResult& d : depth) {
+            for (std::size_t i = 0; i < d.bytes.size(); ++i)
+                depth_csv.row({seq.name, d.coder, std::to_string(i), strf("%.0f", d.bytes[i]),
+                               strf("%.4f", d.encode_ms[i]), strf("%.4f", d.decode_ms[i])});
+            if (d.coder == "zstd-3") ds.zstd = d.total_bytes();
+            if (d.coder == "rvl-float") ds.rvl = d.total_bytes();
+            if (d.coder == "rvl-16bit-inverse (lossy)") ds.rvl16 = d.total_bytes();
+            if (d.coder == "reprise-lossless") ds.ours = d.total_bytes();
+        }
+        depth_rows.push_back(ds);
+        depth_csv.flush();
+
+        // BD-rates of reprise against each peer group.
+        const std::vector<std::string> groups = groups_of(runs);
+        for (const std::string& g : groups) {
+            if (g == kOurs || g == kOursColor) continue;
+            BdRow row{seq.name, g, seq.builtin};
+            row.psnr_color = bd_rate(rd_curve(runs, g, false), rd_curve(runs, kOursColor, false));
+            row.psnr_total = bd_rate(rd_curve(runs, g, false), rd_curve(runs, kOurs, false));
+            row.flip_color = bd_rate(rd_curve(runs, g, true), rd_curve(runs, kOursColor, true));
+            row.flip_total = bd_rate(rd_curve(runs, g, true), rd_curve(runs, kOurs, true));
+            for (auto [metric, bits, v] :
+                 {std::tuple{"psnr", "color", row.psnr_color}, {"psnr", "total", row.psnr_total},
+                  {"flip", "color", row.flip_color}, {"flip", "total", row.flip_total}})
+                bd_csv.row({seq.name, g, metric, bits, strf("%.3f", v)});
+            bd_rows.push_back(row);
+        }
+        bd_csv.flush();
+
+        // Per-sequence table and report section.
+        std::string table = strf("%s (%dx%d, %zu frames)\n%-22s %-16s %12s %8s %8s %8s %9s %9s\n",
+                                 seq.name.c_str(), sw, sh, seq.frames.size(), "codec", "setting",
+                                 "bits/frame", "PSNR", "SSIM", "FLIP", "enc ms", "dec ms");
+        ReportSection section{seq.name, seq.note};
+        std::vector<PlotSeries> psnr_series, flip_series;
+        std::vector<BarRow> bars;
+        for (const std::string& g : groups) {
+            PlotSeries ps{g}, fs_{g};
+            ps.dashed = fs_.dashed = g == kOursColor;
+            double enc = 0.0, dec = 0.0;
+            int n = 0;
+            for (const RunResult& r : runs) {
+                if (r.group != g) continue;
+                const double bits = r.mean(&Sample::bits);
+                ps.x.push_back(bits), ps.y.push_back(r.mean_error(&ImageError::psnr));
+                fs_.x.push_back(bits), fs_.y.push_back(r.mean_error(&ImageError::flip));
+                enc += r.mean(&Sample::encode_ms), dec += r.mean(&Sample::decode_ms), ++n;
+                table += strf("%-22s %-16s %12.0f %8.2f %8.4f %8.4f %9.2f %9.2f\n", r.codec.c_str(),
+                              r.setting.c_str(), bits, r.mean_error(&ImageError::psnr),
+                              r.mean_error(&ImageError::ssim), r.mean_error(&ImageError::flip),
+                              r.mean(&Sample::encode_ms), r.mean(&Sample::decode_ms));
+                if (r.codec != kOursColor)
+                    section.points.push_back({r.codec == kOurs ? std::string(kOurs) : r.group,
+                                              r.setting, r.mean_error(&ImageError::psnr),
+                                              r.mean_error(&ImageError::ssim),
+                                              r.mean_error(&ImageError::flip), r.mean(&Sample::encode_ms)});
+            }
+            psnr_series.push_back(std::move(ps));
+            flip_series.push_back(std::move(fs_));
+            if (g != kOursColor) bars.push_back({g, {enc / n, dec / n}});
+        }
+        section.html = "<p>PSNR against bits per frame</p>\n" +
+                       line_plot_svg(psnr_series, {"bits per frame", "PSNR, dB (higher is better)"}) +
+                       "<p>FLIP against bits per frame</p>\n" +
+                       line_plot_svg(flip_series, {"bits per frame", "LDR-FLIP (lower is better)"}) +
+                       "<p>Time per frame, mean over the rate points</p>\n" +
+                       bar_chart_svg(bars, {"encode", "decode"}, "ms per frame");
+        section.time_label = "encode ms per frame (log scale)";
+        report.sections.push_back(std::move(section));
+        std::printf("%s\n", table.c_str());
+        std::fflush(stdout);
+    }
+
+    // BD-rate table, with the mean over the built-in scenes.
+    std::string bd_text;
+    {
+        bd_text = strf("BD-rate of reprise against each peer (negative = reprise needs fewer bits "
+                       "for the same quality)\n%-10s %-20s %12s %12s %12s %12s\n",
+                       "scene", "anchor", "PSNR colour", "PSNR total", "FLIP colour", "FLIP total");
+        std::map<std::string, std::vector<const BdRow*>> by_peer;
+        for (const BdRow& r : bd_rows) {
+            bd_text += strf("%-10s %-20s %12s %12s %12s %12s\n", r.scene.c_str(), r.peer.c_str(),
+                            pct(r.psnr_color).c_str(), pct(r.psnr_total).c_str(),
+                            pct(r.flip_color).c_str(), pct(r.flip_total).c_str());
+            if (r.builtin) by_peer[r.peer].push_back(&r);
+        }
+        for (const auto& [peer, rows] : by_peer) {
+            double sums[4] = {0, 0, 0, 0};
+            int counts[4] = {0, 0, 0, 0};
+            for (const BdRow* r : rows) {
+                const double v[4] = {r->psnr_color, r->psnr_total, r->flip_color, r->flip_total};
+                for (int k = 0; k < 4; ++k)
+                    if (!std::isnan(v[k])) sums[k] += v[k], ++counts[k];
+            }
+            double m[4];
+            for (int k = 0; k < 4; ++k) m[k] = counts[k] ? sums[k] / counts[k] : NAN;
+            bd_text += strf("%-10s %-20s %12s %12s %12s %12s\n", "mean", peer.c_str(),
+                            pct(m[0]).c_str(), pct(m[1]).c_str(), pct(m[2]).c_str(), pct(m[3]).c_str());
+            for (auto [metric, bits, v] : {std::tuple{"psnr", "color", m[0]}, {"psnr", "total", m[1]},
+                                           {"flip", "color", m[2]}, {"flip", "total", m[3]}})
+                bd_csv.row({"mean-builtin", peer, metric, bits, strf("%.3f", v)});
+        }
+    }
+
+    // Depth table.
+    std::string depth_text = strf("depth, bytes over all frames (raw float = 4 bytes/pixel)\n"
+                                  "%-10s %12s %12s %12s %12s %14s %12s\n", "scene", "raw",
+                                  "zstd -3", "rvl float", "rvl 16 lossy", "reprise lossl.",
+                                  "zstd/reprise");
+    double depth_ratio_sum = 0.0;
+    int depth_ratio_n = 0;
+    for (const DepthSummary& d : depth_rows) {
+        const double ratio = d.zstd / d.ours;
+        depth_text += strf("%-10s %12.0f %12.0f %12.0f %12.0f %14s %12s\n", d.scene.c_str(), d.raw,
+                           d.zstd, d.rvl, d.rvl16,
+                           std::isnan(d.ours) ? "n/a" : strf("%.0f", d.ours).c_str(),
+                           std::isnan(ratio) ? "n/a" : strf("%.2fx", ratio).c_str());
+        if (!std::isnan(ratio)) depth_ratio_sum += ratio, ++depth_ratio_n;
+    }
+
+    // Speed at 1080p.
+    SpeedResult speed;
+    if (job.speed_frames > 0) {
+        REPRISE_TRY(measure_speed(*renderer, job, job.threads, qps[qps.size() / 2], speed));
+        speed_csv.row({strf("%dx%d", speed.w, speed.h), std::to_string(speed.frames), "x264",
+                       "veryfast crf 26", strf("%.3f", speed.x264_veryfast_encode),
+                       strf("%.3f", speed.x264_veryfast_decode)});
+        speed_csv.row({strf("%dx%d", speed.w, speed.h), std::to_string(speed.frames), "x264",
+                       "ultrafast crf 26", strf("%.3f", speed.x264_ultrafast_encode), ""});
+        speed_csv.row({strf("%dx%d", speed.w, speed.h), std::to_string(speed.frames), kOurs,
+                       strf("qp %d", qps[qps.size() / 2]), strf("%.3f", speed.ours_encode),
+                       strf("%.3f", speed.ours_decode)});
+    }
+    std::string speed_text;
+    if (speed.measured) {
+        speed_text = strf(
+            "speed at %dx%d, %d frames, %d threads per codec (reprise: %d pool threads), mean ms "
+            "per frame\n  x264 veryfast zerolatency: encode %8.2f  decode %8.2f  (of which "
+            "swscale RGB->YUV %.2f, YUV->RGB %.2f)\n"
+            "  x264 ultrafast zerolatency: encode %7.2f\n",
+            speed.w, speed.h, speed.frames, job.threads, thread_count(), speed.x264_veryfast_encode,
+            speed.x264_veryfast_decode, speed.rgb_to_yuv, speed.yuv_to_rgb,
+            speed.x264_ultrafast_encode);
+        speed_text += strf(
+            "  reprise qp %d: encode %8.2f  decode %8.2f\n"
+            "  encode speed reprise / x264 veryfast = %.2fx (>= 1 wanted), / ultrafast = %.2fx\n"
+            "  reprise decode speed / its encode speed = %.2fx (>= 2 wanted)\n",
+            qps[qps.size() / 2], speed.ours_encode, speed.ours_decode,
+            speed.x264_veryfast_encode / speed.ours_encode,
+            speed.x264_ultrafast_encode / speed.ours_encode,
+            speed.ours_encode / speed.ours_decode);
+    }
+
+    // Targets of issue 8 §7.
+    double bd_vf = NAN;
+    {
+        double sum = 0.0;
+        int n = 0;
+        for (const BdRow& r : bd_rows)
+            if (r.builtin && r.peer == "x264 veryfast" && !std::isnan(r.psnr_color)) sum += r.psnr_color, ++n;
+        if (n) bd_vf = sum / n;
+    }
+    const double enc_ratio = speed.x264_veryfast_encode / speed.ours_encode;
+    const double dec_ratio = speed.ours_encode / speed.ours_decode;
+    const double depth_ratio = depth_ratio_n ? depth_ratio_sum / depth_ratio_n : NAN;
+    const bool full_hd = speed.w == 1920 && speed.h == 1080;
+    std::string targets = "targets (issue 8 §7)\n";
+    targets += strf("  colour BD-rate (PSNR) vs x264 veryfast, mean over built-in scenes: %s (<= %.0f%%): %s\n",
+                    pct(bd_vf).c_str(), kColorBdTarget,
+                    verdict(!std::isnan(bd_vf), bd_vf <= kColorBdTarget).c_str());
+    targets += strf("  encode at least as fast as x264 veryfast at 1920x1080, %d threads: %.2fx: %s%s\n",
+                    job.threads, enc_ratio, verdict(!std::isnan(enc_ratio), enc_ratio >= 1.0).c_str(),
+                    full_hd || !speed.measured ? "" : strf(" (measured at %dx%d)", speed.w, speed.h).c_str());
+    targets += strf("  decode >= %.0fx our encode speed: %.2fx: %s\n", kDecodeOverEncodeTarget,
+                    dec_ratio, verdict(!std::isnan(dec_ratio), dec_ratio >= kDecodeOverEncodeTarget).c_str());
+    targets += strf("  lossless depth >= %.0fx smaller than zstd -3 (mean ratio over sequences): %.2fx: %s\n",
+                    kDepthRatioTarget, depth_ratio,
+                    verdict(!std::isnan(depth_ratio), depth_ratio >= kDepthRatioTarget).c_str());
+
+    const std::string text = bd_text + (bd_text.empty() ? "" : "\n") + depth_text + "\n" +
+                             speed_text + (speed_text.empty() ? "" : "\n") + targets;
+    std::printf("%s", text.c_str());
+    report.preformatted = text;
+    const std::string html_path = out_dir + "/index.html";
+    REPRISE_TRY(write_html_report(html_path, report));
+    std::printf("report: %s\nrows: %s\n", html_path.c_str(), csv.path().c_str());
+    return {};
+}
+
+}  // namespace reprise::cli
