@@ -138,6 +138,26 @@ struct SliceJob {
     std::size_t blocks = 0, skipped = 0, intra = 0, macroblocks = 0;
 };
 
+// An inter block holding only a few scattered +-1 levels costs more bits than the error it
+// removes is worth: each level scores by the run of zeros before it (in scan order), and a block
+// scoring under 4 is dropped (the decimation video encoders do; encoder-only).
+bool worth_dropping(const Block& levels) {
+    static constexpr int kRunScore[16] = {3, 2, 2, 1, 1, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0};
+    int score = 0, run = 0;
+    for (int i = 0; i < 64; ++i) {
+        const int32_t v = levels[kZigzag[i]];
+        if (!v) {
+            ++run;
+            continue;
+        }
+        if (v > 1 || v < -1) return false;
+        score += kRunScore[std::min(run, 15)];
+        if (score >= 4) return false;
+        run = 0;
+    }
+    return true;
+}
+
 // Sum of absolute differences of the block against a prediction.
 int sad(const Block& a, const Block& b) {
     int s = 0;
@@ -245,6 +265,10 @@ bool code_slice(SliceJob& j, Coder& rc) {
                             for (int i = 0; i < 64; ++i) residual[i] = src[i] - pred[i];
                             forward_dct(residual, coef);
                             nonzero = quantize(coef, scale, intra ? 16 / 3 : 16 / 6, levels);
+                            if (!intra && nonzero && worth_dropping(levels)) {
+                                levels.fill(0);
+                                nonzero = 0;
+                            }
                         }
                         rc.bit(m.cbf[type], nonzero > 0);
                         if (nonzero) {
