@@ -39,6 +39,8 @@ namespace fs = std::filesystem;
 
 constexpr const char* kOurs = "reprise";
 constexpr const char* kOursColor = "reprise-color";
+// Total bits with depth bounded to a relative error of 1e-3, the streaming setting.
+constexpr const char* kOursBounded = "reprise-depth1e-3";
 constexpr double kColorBdTarget = -20.0;  // % against x264 veryfast, PSNR, mean over scenes
 constexpr double kDecodeOverEncodeTarget = 2.0;
 constexpr double kDepthRatioTarget = 2.0;  // zstd -3 bytes / reprise lossless depth bytes
@@ -170,12 +172,16 @@ Status run_peer(const Sequence& seq, const PeerConfig& config, RunResult& run,
 // reprise's codec at one qp: every frame encoded, its packet decoded, the decoded colour scored.
 // `color` gets the same frames counted with their colour bits only; `depth_bits` the depth
 // stream's bits per frame.
-Status run_ours(const Sequence& seq, int qp, RunResult& total, RunResult& color,
+Status run_ours(const Sequence& seq, int qp, bool bounded_depth, RunResult& total, RunResult& color,
                 std::vector<double>* depth_bits) {
     const std::string setting = "qp " + std::to_string(qp);
-    total = {kOurs, setting, kOurs, {}};
+    const char* name = bounded_depth ? kOursBounded : kOurs;
+    total = {name, setting, name, {}};
     color = {kOursColor, setting, kOursColor, {}};
-    codec::Encoder encoder({.qp = qp, .fps = seq.fps});
+    codec::Encoder encoder({.qp = qp,
+                            .fps = seq.fps,
+                            .depth = bounded_depth ? codec::DepthMode::Bounded : codec::DepthMode::Lossless,
+                            .depth_error = 1e-3f});
     codec::Decoder decoder;
     codec::Packet packet;
     Frame decoded;
@@ -277,6 +283,7 @@ struct BdRow {
     std::string scene, peer;
     bool builtin = false;
     double psnr_color = NAN, psnr_total = NAN, flip_color = NAN, flip_total = NAN;
+    double psnr_bounded = NAN, flip_bounded = NAN;  // total bits, depth within 1e-3
 };
 
 std::string pct(double v) { return std::isnan(v) ? std::string("n/a") : strf("%+.1f%%", v); }
@@ -315,7 +322,7 @@ Status measure_speed(server::Renderer& renderer, const BenchOptions& job, int th
     speed.x264_ultrafast_encode = run.mean(&Sample::encode_ms);
     std::fprintf(stderr, "[codec] speed: reprise qp %d\n", mid_qp);
     RunResult color;
-    REPRISE_TRY(run_ours(seq, mid_qp, run, color, nullptr));
+    REPRISE_TRY(run_ours(seq, mid_qp, false, run, color, nullptr));
     speed.ours_encode = run.mean(&Sample::encode_ms);
     speed.ours_decode = run.mean(&Sample::decode_ms);
     speed.measured = true;
@@ -400,13 +407,16 @@ Status bench_codec(const BenchOptions& job) {
         std::vector<double> our_depth_bits;
         for (int qp : qps) {
             RunResult total, color;
-            REPRISE_TRY(run_ours(seq, qp, total, color, our_depth_bits.empty() ? &our_depth_bits : nullptr));
+            REPRISE_TRY(run_ours(seq, qp, false, total, color, our_depth_bits.empty() ? &our_depth_bits : nullptr));
             std::fprintf(stderr, "[codec] %s: reprise qp %2d: %9.0f bits/frame (colour %9.0f) %6.2f dB %8.2f ms enc %8.2f ms dec\n",
                          seq.name.c_str(), qp, total.mean(&Sample::bits), color.mean(&Sample::bits),
                          total.mean_error(&ImageError::psnr), total.mean(&Sample::encode_ms),
                          total.mean(&Sample::decode_ms));
             runs.push_back(std::move(total));
             runs.push_back(std::move(color));
+            RunResult bounded, unused;
+            REPRISE_TRY(run_ours(seq, qp, true, bounded, unused, nullptr));
+            runs.push_back(std::move(bounded));
         }
         for (const PeerConfig& config : peers) {
             RunResult run;
@@ -452,15 +462,18 @@ Status bench_codec(const BenchOptions& job) {
         // BD-rates of reprise against each peer group.
         const std::vector<std::string> groups = groups_of(runs);
         for (const std::string& g : groups) {
-            if (g == kOurs || g == kOursColor) continue;
+            if (g == kOurs || g == kOursColor || g == kOursBounded) continue;
             BdRow row{seq.name, g, seq.builtin};
             row.psnr_color = bd_rate(rd_curve(runs, g, false), rd_curve(runs, kOursColor, false));
             row.psnr_total = bd_rate(rd_curve(runs, g, false), rd_curve(runs, kOurs, false));
             row.flip_color = bd_rate(rd_curve(runs, g, true), rd_curve(runs, kOursColor, true));
             row.flip_total = bd_rate(rd_curve(runs, g, true), rd_curve(runs, kOurs, true));
+            row.psnr_bounded = bd_rate(rd_curve(runs, g, false), rd_curve(runs, kOursBounded, false));
+            row.flip_bounded = bd_rate(rd_curve(runs, g, true), rd_curve(runs, kOursBounded, true));
             for (auto [metric, bits, v] :
                  {std::tuple{"psnr", "color", row.psnr_color}, {"psnr", "total", row.psnr_total},
-                  {"flip", "color", row.flip_color}, {"flip", "total", row.flip_total}})
+                  {"flip", "color", row.flip_color}, {"flip", "total", row.flip_total},
+                  {"psnr", "total-depth1e-3", row.psnr_bounded}, {"flip", "total-depth1e-3", row.flip_bounded}})
                 bd_csv.row({seq.name, g, metric, bits, strf("%.3f", v)});
             bd_rows.push_back(row);
         }
@@ -514,29 +527,35 @@ Status bench_codec(const BenchOptions& job) {
     std::string bd_text;
     {
         bd_text = strf("BD-rate of reprise against each peer (negative = reprise needs fewer bits "
-                       "for the same quality)\n%-10s %-20s %12s %12s %12s %12s\n",
-                       "scene", "anchor", "PSNR colour", "PSNR total", "FLIP colour", "FLIP total");
+                       "for the same quality; total: all bits with lossless depth, and with depth within 1e-3)\n"
+                       "%-10s %-20s %12s %12s %12s %12s %14s %14s\n",
+                       "scene", "anchor", "PSNR colour", "PSNR total", "FLIP colour", "FLIP total",
+                       "PSNR tot 1e-3", "FLIP tot 1e-3");
         std::map<std::string, std::vector<const BdRow*>> by_peer;
         for (const BdRow& r : bd_rows) {
-            bd_text += strf("%-10s %-20s %12s %12s %12s %12s\n", r.scene.c_str(), r.peer.c_str(),
+            bd_text += strf("%-10s %-20s %12s %12s %12s %12s %14s %14s\n", r.scene.c_str(), r.peer.c_str(),
                             pct(r.psnr_color).c_str(), pct(r.psnr_total).c_str(),
-                            pct(r.flip_color).c_str(), pct(r.flip_total).c_str());
+                            pct(r.flip_color).c_str(), pct(r.flip_total).c_str(),
+                            pct(r.psnr_bounded).c_str(), pct(r.flip_bounded).c_str());
             if (r.builtin) by_peer[r.peer].push_back(&r);
         }
         for (const auto& [peer, rows] : by_peer) {
-            double sums[4] = {0, 0, 0, 0};
-            int counts[4] = {0, 0, 0, 0};
+            double sums[6] = {0, 0, 0, 0, 0, 0};
+            int counts[6] = {0, 0, 0, 0, 0, 0};
             for (const BdRow* r : rows) {
-                const double v[4] = {r->psnr_color, r->psnr_total, r->flip_color, r->flip_total};
-                for (int k = 0; k < 4; ++k)
+                const double v[6] = {r->psnr_color, r->psnr_total, r->flip_color, r->flip_total,
+                                     r->psnr_bounded, r->flip_bounded};
+                for (int k = 0; k < 6; ++k)
                     if (!std::isnan(v[k])) sums[k] += v[k], ++counts[k];
             }
-            double m[4];
-            for (int k = 0; k < 4; ++k) m[k] = counts[k] ? sums[k] / counts[k] : NAN;
-            bd_text += strf("%-10s %-20s %12s %12s %12s %12s\n", "mean", peer.c_str(),
-                            pct(m[0]).c_str(), pct(m[1]).c_str(), pct(m[2]).c_str(), pct(m[3]).c_str());
+            double m[6];
+            for (int k = 0; k < 6; ++k) m[k] = counts[k] ? sums[k] / counts[k] : NAN;
+            bd_text += strf("%-10s %-20s %12s %12s %12s %12s %14s %14s\n", "mean", peer.c_str(),
+                            pct(m[0]).c_str(), pct(m[1]).c_str(), pct(m[2]).c_str(), pct(m[3]).c_str(),
+                            pct(m[4]).c_str(), pct(m[5]).c_str());
             for (auto [metric, bits, v] : {std::tuple{"psnr", "color", m[0]}, {"psnr", "total", m[1]},
-                                           {"flip", "color", m[2]}, {"flip", "total", m[3]}})
+                                           {"flip", "color", m[2]}, {"flip", "total", m[3]},
+                                           {"psnr", "total-depth1e-3", m[4]}, {"flip", "total-depth1e-3", m[5]}})
                 bd_csv.row({"mean-builtin", peer, metric, bits, strf("%.3f", v)});
         }
     }
