@@ -29,7 +29,12 @@ Residual residual_of(glm::vec2 source, glm::vec2 base) {
         return r;
     }
     const glm::vec2 d = (source - usable_base(base)) * 8.0f;
-    auto q = [](float v) { return int32_t(std::nearbyint(std::clamp(v, -float(kMaxResidual), float(kMaxResidual)))); };
+    // Rounded half up without a library call (only the encoder rounds: any rounding is valid).
+    auto q = [](float v) {
+        v = std::clamp(v, -float(kMaxResidual), float(kMaxResidual)) + 0.5f;
+        const int32_t t = int32_t(v);
+        return t - int32_t(v < float(t));
+    };
     r.x = q(d.x);
     r.y = q(d.y);
     return r;
