@@ -383,15 +383,10 @@ Status decode_color(const FrameContext& fc, ImageView<const glm::vec2> motion, s
         if (!read_slices(r, sp.slices, slices)) return Status::error(r.error());
         const Geometry g = geometry(sp);
         std::vector<SliceJob> jobs = slice_jobs(g, nullptr, fc.key ? nullptr : &predicted, out, qp, 0);
-        std::vector<uint8_t> ok(sp.slices, 0);
-        parallel_for(0, sp.slices, [&](int s0, int s1) {
-            for (int s = s0; s < s1; ++s) {
-                RangeDecoder rc(slices[s]);
-                ok[s] = code_slice<false>(jobs[s], rc);
-            }
-        }, 1);
-        for (int s = 0; s < sp.slices; ++s)
-            if (!ok[s]) return Status::error("colour section: slice " + std::to_string(s) + " is corrupt");
+        REPRISE_TRY(decode_slices(slices, "colour section", [&](int s, std::span<const uint8_t> bytes) {
+            RangeDecoder rc(bytes);
+            return code_slice<false>(jobs[s], rc);
+        }));
         for (const SliceJob& j : jobs) {
             stats.blocks += j.blocks;
             stats.blocks_skipped += j.skipped;

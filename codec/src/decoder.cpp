@@ -12,21 +12,6 @@ namespace {
 
 constexpr std::size_t kMaxQueuedFrames = 16;
 
-void add(StreamStats& total, const StreamStats& f) {
-    total.frames += f.frames;
-    total.key_frames += f.key_frames;
-    total.older_reference += f.older_reference;
-    total.header_bits += f.header_bits;
-    total.camera_bits += f.camera_bits;
-    total.depth_bits += f.depth_bits;
-    total.motion_bits += f.motion_bits;
-    total.color_bits += f.color_bits;
-    total.blocks += f.blocks;
-    total.blocks_skipped += f.blocks_skipped;
-    total.intra_blocks += f.intra_blocks;
-    total.motion_residual_pixels += f.motion_residual_pixels;
-    total.depth_zero_blocks += f.depth_zero_blocks;
-}
 
 }  // namespace
 
@@ -113,18 +98,11 @@ Status Decoder::send_packet(std::span<const uint8_t> packet) {
         s.sp = sp;
         s.started = true;
     }
-    int slot = 0;
-    for (int i = 0; i < kReferences; ++i) {
-        if (!s.refs[i].held) {
-            slot = i;
-            break;
-        }
-        if (s.refs[i].frame < s.refs[slot].frame) slot = i;
-    }
+    const int slot = replacement_slot(s.refs);
     std::swap(s.refs[slot], pic);
     s.have_newest = true;
     s.newest = h.frame;
-    add(s.stats, fs);
+    add_stats(s.stats, fs);
 
     const Picture& out = s.refs[slot];
     Frame frame;

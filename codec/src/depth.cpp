@@ -331,12 +331,8 @@ Status decode_depth(const FrameContext& fc, const Camera& camera, std::span<cons
         std::vector<std::span<const uint8_t>> slices;
         if (!read_slices(r, sp.slices, slices)) return Status::error(r.error());
         std::vector<SliceJob> jobs = slice_jobs(sp, map, codes, temporal, residuals);
-        std::vector<uint8_t> ok(sp.slices, 0);
-        parallel_for(0, sp.slices, [&](int s0, int s1) {
-            for (int s = s0; s < s1; ++s) ok[s] = decode_slice(jobs[s], slices[s]);
-        }, 1);
-        for (int s = 0; s < sp.slices; ++s)
-            if (!ok[s]) return Status::error("depth section: slice " + std::to_string(s) + " is corrupt");
+        REPRISE_TRY(decode_slices(slices, "depth section",
+                                  [&](int s, std::span<const uint8_t> bytes) { return decode_slice(jobs[s], bytes); }));
         for (const SliceJob& j : jobs) stats.depth_zero_blocks += j.zero_blocks;
     }
     stats.depth_bits += 8 * in.size();

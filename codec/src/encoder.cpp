@@ -183,22 +183,13 @@ Status Encoder::send_frame(const Frame& frame) {
     s.queue.push_back(std::move(packet));
 
     // The new picture replaces the oldest (or a free) slot.
-    int slot = 0;
-    for (int i = 0; i < kReferences; ++i) {
-        if (!s.refs[i].held) {
-            slot = i;
-            break;
-        }
-        if (s.refs[i].frame < s.refs[slot].frame) slot = i;
-    }
+    const int slot = replacement_slot(s.refs);
     if (key) {
         for (auto& r : s.refs) r.held = false;
         s.last_key = s.next_frame;
-        s.stats.key_frames++;
         s.key_requested = false;
         fs.key_frames = 1;
     } else if (s.refs[ref].frame + 1 != s.next_frame) {
-        s.stats.older_reference++;
         fs.older_reference = 1;
     }
     s.reference_of[slot] = header.reference;
@@ -210,17 +201,7 @@ Status Encoder::send_frame(const Frame& frame) {
     s.next_frame++;
     fs.frames = 1;
     s.last = fs;
-    s.stats.frames++;
-    s.stats.header_bits += fs.header_bits;
-    s.stats.camera_bits += fs.camera_bits;
-    s.stats.depth_bits += fs.depth_bits;
-    s.stats.motion_bits += fs.motion_bits;
-    s.stats.color_bits += fs.color_bits;
-    s.stats.blocks += fs.blocks;
-    s.stats.blocks_skipped += fs.blocks_skipped;
-    s.stats.intra_blocks += fs.intra_blocks;
-    s.stats.motion_residual_pixels += fs.motion_residual_pixels;
-    s.stats.depth_zero_blocks += fs.depth_zero_blocks;
+    add_stats(s.stats, fs);
     s.recon_ready = false;
     return {};
 }

@@ -75,6 +75,11 @@ int default_slices(int height);
 
 struct Workspace;
 
+// Adds one frame's counts to a running total.
+void add_stats(StreamStats& total, const StreamStats& frame);
+// The slot a new picture goes to: a free one, else the one with the smallest frame number.
+int replacement_slot(const Picture (&refs)[kReferences]);
+
 // --- colour.cpp
 // Linear colour -> 8-bit sRGB -> YCoCg-R, chroma averaged 2x2 for 4:2:0.
 void planes_from_linear(ImageView<const glm::vec4> color, const SequenceParams& sp, Planes& out);

@@ -225,15 +225,10 @@ Status decode_motion(const FrameContext& fc, const Camera& camera, ImageView<con
         std::vector<Residual>& residuals = fc.work->motion_residuals;
         residuals.resize(std::size_t(w) * h);
         std::vector<SliceJob> jobs = slice_jobs(sp, base, nullptr, out, residuals);
-        std::vector<uint8_t> ok(sp.slices, 0);
-        parallel_for(0, sp.slices, [&](int s0, int s1) {
-            for (int s = s0; s < s1; ++s) {
-                RangeDecoder rc(slices[s]);
-                ok[s] = code_slice<false>(jobs[s], rc);
-            }
-        }, 1);
-        for (int s = 0; s < sp.slices; ++s)
-            if (!ok[s]) return Status::error("motion section: slice " + std::to_string(s) + " is corrupt");
+        REPRISE_TRY(decode_slices(slices, "motion section", [&](int s, std::span<const uint8_t> bytes) {
+            RangeDecoder rc(bytes);
+            return code_slice<false>(jobs[s], rc);
+        }));
         for (const SliceJob& j : jobs) stats.motion_residual_pixels += j.pixels;
     }
     stats.motion_bits += 8 * in.size();
