@@ -23,6 +23,7 @@ struct Decoder::State {
     bool have_newest = false;
     uint32_t newest = 0;
     std::deque<Frame> queue;
+    std::vector<Frame> spare;  // frames handed back by receive_frame, reused for output
     StreamStats stats;
     Picture scratch;
     Workspace work;
@@ -106,6 +107,12 @@ Status Decoder::send_packet(std::span<const uint8_t> packet) {
 
     const Picture& out = s.refs[slot];
     Frame frame;
+    if (!s.spare.empty()) {
+        frame = std::move(s.spare.back());
+        s.spare.pop_back();
+        frame.normal.clear();
+        frame.id.clear();
+    }
     linear_from_planes(out.planes, s.sp, out.depth.view(), frame.color);
     frame.depth = out.depth;
     frame.motion = out.motion;
@@ -116,9 +123,14 @@ Status Decoder::send_packet(std::span<const uint8_t> packet) {
 }
 
 Result Decoder::receive_frame(Frame& frame) {
-    if (state_->queue.empty()) return Result::NeedMoreData;
-    frame = std::move(state_->queue.front());
-    state_->queue.pop_front();
+    State& s = *state_;
+    if (s.queue.empty()) return Result::NeedMoreData;
+    std::swap(frame, s.queue.front());
+    // The caller's previous buffers come back for the next output (no allocation per frame).
+    Frame old = std::move(s.queue.front());
+    s.queue.pop_front();
+    if (old.color.width() == s.sp.width && old.color.height() == s.sp.height && s.spare.size() < 2)
+        s.spare.push_back(std::move(old));
     return Result::Ok;
 }
 
