@@ -165,6 +165,15 @@ int sad(const Block& a, const Block& b) {
     return s;
 }
 
+// Calls f(plane, x, y) for the 8x8 blocks of macroblock (mx, my) in coding order.
+template <class F>
+void for_each_block(const SliceJob& j, int mx, int my, const F& f) {
+    for (int k = 0; k < 3; ++k) {
+        const int n = j.g->blocks_per_side[k];
+        for (int b = 0; b < n * n; ++b) f(k, mx * 8 * n + (b % n) * 8, my * 8 * n + (b / n) * 8);
+    }
+}
+
 // Codes (Encode) or decodes one slice. Returns false on a corrupt slice (decoder only).
 template <bool Encode, class Coder>
 bool code_slice(SliceJob& j, Coder& rc) {
@@ -185,28 +194,33 @@ bool code_slice(SliceJob& j, Coder& rc) {
             Block src, pred, pred2, coef, levels, residual;
             if constexpr (Encode) {
                 if (!intra) {
-                    int inter_sad = 0, intra_sad = 0;
+                    // Inter error first; intra is only tried where the reprojection is poor
+                    // (more than 2 levels off on average).
+                    int inter_sad = 0, samples = 0;
                     bool all_within = true;
-                    for (int k = 0; k < 3; ++k) {
-                        const int n = j.g->blocks_per_side[k];
+                    for_each_block(j, mx, my, [&](int k, int bx, int by) {
                         const int limit = k ? 2 * j.skip_threshold : j.skip_threshold;
-                        for (int b = 0; b < n * n; ++b) {
-                            const int bx = mx * 8 * n + (b % n) * 8, by = my * 8 * n + (b / n) * 8;
+                        load(j.source->p[k], bx, by, src);
+                        load(j.predicted->p[k], bx, by, pred);
+                        inter_sad += sad(src, pred);
+                        samples += 64;
+                        for (int i = 0; i < 64 && all_within; ++i) all_within = std::abs(src[i] - pred[i]) <= limit;
+                    });
+                    skip = all_within;
+                    if (!skip && inter_sad > 2 * samples) {
+                        int intra_sad = 0;
+                        for_each_block(j, mx, my, [&](int k, int bx, int by) {
+                            const int n = j.g->blocks_per_side[k];
                             load(j.source->p[k], bx, by, src);
-                            load(j.predicted->p[k], bx, by, pred);
-                            inter_sad += sad(src, pred);
-                            for (int i = 0; i < 64 && all_within; ++i)
-                                all_within = std::abs(src[i] - pred[i]) <= limit;
                             int best = 1 << 30;
                             for (int mode = 0; mode < kModes; ++mode) {
-                                intra_predict(j.source->p[k], bx, by, (j.mb_y0 * 8 * n), mode, k ? 0 : 128, pred2);
+                                intra_predict(j.source->p[k], bx, by, j.mb_y0 * 8 * n, mode, k ? 0 : 128, pred2);
                                 best = std::min(best, sad(src, pred2));
                             }
                             intra_sad += best;
-                        }
+                        });
+                        intra = intra_sad + 1024 < inter_sad;
                     }
-                    skip = all_within;
-                    intra = !skip && intra_sad + 1024 < inter_sad;
                 }
                 if (j.predicted) {
                     rc.bit(m.mb_skip[ctx_skip], skip);
