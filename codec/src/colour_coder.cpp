@@ -135,7 +135,12 @@ struct SliceJob {
     Planes* out;
     int qp, skip_threshold;
     int mb_y0, mb_y1;
+    std::vector<uint8_t>* coded;  // per plane, per 8x8 block
     std::size_t blocks = 0, skipped = 0, intra = 0, macroblocks = 0;
+
+    void mark(int k, int bx, int by, bool is_coded) const {
+        coded[k][std::size_t(by / 8) * (out->p[k].width() / 8) + bx / 8] = is_coded;
+    }
 };
 
 // An inter block holding only a few scattered +-1 levels costs more bits than the error it
@@ -246,6 +251,7 @@ bool code_slice(SliceJob& j, Coder& rc) {
                     if (skip) {
                         load(j.predicted->p[k], bx, by, pred);
                         store(j.out->p[k], bx, by, pred, nullptr, lo, 255);
+                        j.mark(k, bx, by, false);
                         ++j.skipped;
                         continue;
                     }
@@ -285,6 +291,7 @@ bool code_slice(SliceJob& j, Coder& rc) {
                             }
                         }
                         rc.bit(m.cbf[type], nonzero > 0);
+                        j.mark(k, bx, by, intra || nonzero);
                         if (nonzero) {
                             code_levels(rc, m, type, levels);
                             dequantize(levels, scale, coef);
@@ -302,7 +309,9 @@ bool code_slice(SliceJob& j, Coder& rc) {
                         } else {
                             load(j.predicted->p[k], bx, by, pred);
                         }
-                        if (rc.bit(m.cbf[type])) {
+                        const bool cbf = rc.bit(m.cbf[type]);
+                        j.mark(k, bx, by, intra || cbf);
+                        if (cbf) {
                             if (!decode_levels(rc, m, type, levels)) return false;
                             dequantize(levels, scale, coef);
                             inverse_dct(coef, residual);
@@ -323,15 +332,19 @@ bool code_slice(SliceJob& j, Coder& rc) {
 }
 
 std::vector<SliceJob> slice_jobs(const Geometry& g, const Planes* source, const Planes* predicted, Planes& out,
-                                 int qp, int skip_threshold) {
+                                 int qp, int skip_threshold, Workspace& work) {
     std::vector<SliceJob> jobs;
     for (int s = 0; s < g.sp->slices; ++s)
-        jobs.push_back({&g, source, predicted, &out, qp, skip_threshold, g.sp->slice_begin(s), g.sp->slice_begin(s + 1)});
+        jobs.push_back({&g, source, predicted, &out, qp, skip_threshold, g.sp->slice_begin(s), g.sp->slice_begin(s + 1),
+                        work.coded_blocks});
     return jobs;
 }
 
-void prepare(const SequenceParams& sp, Planes& out) {
-    for (int k = 0; k < 3; ++k) ensure_size(out.p[k], sp.plane_width(k), sp.plane_height(k));
+void prepare(const SequenceParams& sp, Planes& out, Workspace& work) {
+    for (int k = 0; k < 3; ++k) {
+        ensure_size(out.p[k], sp.plane_width(k), sp.plane_height(k));
+        work.coded_blocks[k].resize(std::size_t(sp.plane_width(k) / 8) * (sp.plane_height(k) / 8));
+    }
 }
 
 }  // namespace
@@ -340,14 +353,14 @@ ColorEncodeResult encode_color(const FrameContext& fc, const Planes& source, Ima
                                int qp, int skip_threshold, Planes& out, std::vector<uint8_t>& bytes,
                                StreamStats& stats) {
     const SequenceParams& sp = *fc.sp;
-    prepare(sp, out);
+    prepare(sp, out, *fc.work);
     Planes& predicted = fc.work->predicted;
     if (!fc.key) predict_planes(fc.reference->planes, sp, motion, predicted);
     const std::size_t start = bytes.size();
     ByteWriter w(bytes);
     w.u8(uint8_t(qp));
     const Geometry g = geometry(sp);
-    std::vector<SliceJob> jobs = slice_jobs(g, &source, fc.key ? nullptr : &predicted, out, qp, skip_threshold);
+    std::vector<SliceJob> jobs = slice_jobs(g, &source, fc.key ? nullptr : &predicted, out, qp, skip_threshold, *fc.work);
     std::vector<uint8_t>& body = fc.work->section;
     body.clear();
     encode_slices(sp.slices, fc.work->slice_bytes, body, [&](int s, std::vector<uint8_t>& b) {
@@ -365,7 +378,10 @@ ColorEncodeResult encode_color(const FrameContext& fc, const Planes& source, Ima
     }
     const bool all_skipped = !fc.key && skipped == blocks;
     w.u8(all_skipped ? kAllSkipped : 0);
-    if (!all_skipped) w.bytes(body);
+    if (!all_skipped) {
+        w.bytes(body);
+        deblock(out, fc.work->coded_blocks, qp);
+    }
     stats.blocks += blocks;
     stats.blocks_skipped += skipped;
     stats.intra_blocks += result.intra_macroblocks;
@@ -376,7 +392,7 @@ ColorEncodeResult encode_color(const FrameContext& fc, const Planes& source, Ima
 Status decode_color(const FrameContext& fc, ImageView<const glm::vec2> motion, std::span<const uint8_t> in,
                     Planes& out, StreamStats& stats) {
     const SequenceParams& sp = *fc.sp;
-    prepare(sp, out);
+    prepare(sp, out, *fc.work);
     ByteReader r(in, "colour section");
     const int qp = r.u8();
     const uint8_t flags = r.u8();
@@ -396,7 +412,7 @@ Status decode_color(const FrameContext& fc, ImageView<const glm::vec2> motion, s
         std::vector<std::span<const uint8_t>> slices;
         if (!read_slices(r, sp.slices, slices)) return Status::error(r.error());
         const Geometry g = geometry(sp);
-        std::vector<SliceJob> jobs = slice_jobs(g, nullptr, fc.key ? nullptr : &predicted, out, qp, 0);
+        std::vector<SliceJob> jobs = slice_jobs(g, nullptr, fc.key ? nullptr : &predicted, out, qp, 0, *fc.work);
         REPRISE_TRY(decode_slices(slices, "colour section", [&](int s, std::span<const uint8_t> bytes) {
             RangeDecoder rc(bytes);
             return code_slice<false>(jobs[s], rc);
@@ -406,6 +422,7 @@ Status decode_color(const FrameContext& fc, ImageView<const glm::vec2> motion, s
             stats.blocks_skipped += j.skipped;
             stats.intra_blocks += j.intra;
         }
+        deblock(out, fc.work->coded_blocks, qp);
     }
     stats.color_bits += 8 * in.size();
     return {};

@@ -120,6 +120,7 @@ struct Workspace {
     Image<glm::vec2> base_motion, to_reference;
     std::vector<MotionResidual> motion_targets, motion_residuals;
     Planes predicted;
+    std::vector<uint8_t> coded_blocks[3];  // per 8x8 block of each plane: intra or with a residual
     std::vector<std::vector<uint8_t>> slice_bytes;
     std::vector<uint8_t> section;
 };
@@ -164,6 +165,9 @@ ColorEncodeResult encode_color(const FrameContext& fc, const Planes& source, Ima
                                StreamStats& stats);
 Status decode_color(const FrameContext& fc, ImageView<const glm::vec2> motion, std::span<const uint8_t> in,
                     Planes& out, StreamStats& stats);
+
+// --- deblock.cpp: in-loop filter of the 8x8 edges next to coded blocks.
+void deblock(Planes& planes, const std::vector<uint8_t> (&coded)[3], int qp);
 
 // Inter prediction of all three planes from the reference by `motion` (Catmull-Rom, integer).
 void predict_planes(const Planes& reference, const SequenceParams& sp, ImageView<const glm::vec2> motion,
