@@ -35,7 +35,7 @@ struct Buffer {
 Frame make_frame(int w, int h, float depth, glm::vec2 motion, uint32_t id = 1) {
     Frame f = test::constant_frame(w, h, depth, motion);
     f.normal.resize(w, h);
-    f.id.resize(w, h, id);
+    f.id.assign(w, h, id);
     return f;
 }
 
@@ -135,7 +135,7 @@ TEST(Reproject, DepthModelFollowsCameraAlongItsAxis) {
             ASSERT_NEAR(out.at(x, y), 0.25f * q.x + 0.5f * q.y, 1e-4f);
         }
     // The previous depth buffer of a camera that did not move: every pixel is occluded.
-    prev.depth.resize(w, h, float(D));
+    prev.depth.assign(w, h, float(D));
     c = reproject(cur, prev, payload.cview(), out.view(), {}, tight);
     EXPECT_EQ(c.occluded, std::size_t(w * h));
 }

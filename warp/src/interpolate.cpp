@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 
@@ -16,11 +17,13 @@ void WarpBuffers::resize(int w, int h) {
     covered.resize(w, h);
 }
 
-bool motion_is_zero(const Frame& f) {
+bool motion_is_zero(const GBufferView& f) {
     if (f.motion.empty()) return false;
-    const glm::vec2* m = f.motion.data();
-    for (std::size_t i = 0, n = f.motion.pixel_count(); i < n; ++i)
-        if (m[i].x != 0.0f || m[i].y != 0.0f) return false;
+    for (int y = 0; y < f.motion.height; ++y) {
+        const glm::vec2* m = f.motion.row(y);
+        for (int x = 0; x < f.motion.width; ++x)
+            if (m[x].x != 0.0f || m[x].y != 0.0f) return false;
+    }
     return true;
 }
 
@@ -30,8 +33,8 @@ namespace {
 // refine p = q - factor * motion(p) with the source's own (bilinear) motion and fetch colour
 // bilinearly there. Taps are not depth-tested: across silhouettes the blend measured closer to the
 // rendered truth than keeping either surface.
-void refetch(const Frame& source, float factor, WarpBuffers& out) {
-    const int w = out.color.width(), h = out.color.height();
+void refetch(const GBufferView& source, float factor, const WarpTarget& out) {
+    const int w = out.color.width, h = out.color.height;
     parallel_for(0, h, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y)
             for (int x = 0; x < w; ++x) {
@@ -40,12 +43,12 @@ void refetch(const Frame& source, float factor, WarpBuffers& out) {
                 glm::vec2 p = q - factor * out.motion(x, y);
                 Bilinear b = bilinear_taps(p.x, p.y, source.width(), source.height());
                 if (!b.inside) continue;
-                glm::vec2 m = bilinear_fetch(source.motion.view(), b);
+                glm::vec2 m = bilinear_fetch(source.motion, b);
                 if (!std::isfinite(m.x) || !std::isfinite(m.y)) continue;
                 p = q - factor * m;
                 b = bilinear_taps(p.x, p.y, source.width(), source.height());
                 if (!b.inside) continue;
-                glm::vec4 c = bicubic_fetch(source.color.view(), p.x, p.y);
+                glm::vec4 c = bicubic_fetch(source.color, p.x, p.y);
                 if (std::isfinite(c.r + c.g + c.b + c.a)) out.color(x, y) = c;
             }
     });
@@ -53,29 +56,34 @@ void refetch(const Frame& source, float factor, WarpBuffers& out) {
 
 }  // namespace
 
-void warp_frame(const Frame& source, float factor, const FrucOptions& options, FrucScratch& scratch,
-                WarpBuffers& out, FrucCounters& counters) {
-    out.resize(source.width(), source.height());
+std::size_t warp_into(const GBufferView& source, float factor, const FrucOptions& options,
+                      FrucScratch& scratch, const WarpTarget& out, FrucCounters& counters) {
     switch (options.warp) {
-        case WarpMethod::Grid:
-            counters.grid_cells += scratch.grid.warp(source, factor, out.target(), options.grid).cells;
-            return;
+        case WarpMethod::Grid: {
+            const GridStats stats = scratch.grid.warp(source, factor, out, options.grid);
+            counters.grid_cells += stats.cells;
+            return stats.covered;
+        }
         case WarpMethod::Splat:
-            splat(source, factor, out.target(), options.splat);
-            return;
-        case WarpMethod::Reverse:
-            splat(source, factor, out.target(), {.footprint = 2});
+            return splat(source, factor, out, options.splat);
+        case WarpMethod::Reverse: {
+            const std::size_t covered = splat(source, factor, out, {.footprint = 2});
             refetch(source, factor, out);
-            return;
+            return covered;
+        }
     }
+    return 0;
+}
+
+void warp_frame(const GBufferView& source, float factor, const FrucOptions& options,
+                FrucScratch& scratch, WarpBuffers& out, FrucCounters& counters) {
+    out.resize(source.width(), source.height());
+    warp_into(source, factor, options, scratch, out.target(), counters);
 }
 
 void fill_holes(ImageView<glm::vec4> color, ImageView<const uint8_t> valid,
-                ImageView<const float> depth, const FrucOptions& options, FrucScratch& scratch,
-                FrucCounters& counters) {
-    std::size_t holes = 0;
-    for (int y = 0; y < valid.height; ++y)
-        for (int x = 0; x < valid.width; ++x) holes += valid(x, y) == 0;
+                ImageView<const float> depth, std::size_t holes, const FrucOptions& options,
+                FrucScratch& scratch, FrucCounters& counters) {
     counters.hole_pixels += holes;
     if (holes == 0 || options.fill == FillMethod::None) {
         counters.fills_skipped += holes == 0;
@@ -86,15 +94,16 @@ void fill_holes(ImageView<glm::vec4> color, ImageView<const uint8_t> valid,
     else scratch.andreev.fill(color, valid, depth);
 }
 
-void interpolate_frame(const Frame& a, const Frame& b, float s, bool use_a, const FrucOptions& options,
-                       FrucScratch& scratch, Frame& out, FrucCounters& counters) {
+void interpolate_frame(const GBufferView& a, const GBufferView& b, float s, bool use_a,
+                       float motion_scale, const FrucOptions& options, FrucScratch& scratch,
+                       Frame& out, FrucCounters& counters) {
     const int w = b.width(), h = b.height();
     warp_frame(b, 1.0f - s, options, scratch, scratch.side_b, counters);
     if (use_a) {
         warp_frame(a, -s, options, scratch, scratch.side_a, counters);
     } else {
         scratch.side_a.resize(w, h);
-        std::fill_n(scratch.side_a.covered.data(), scratch.side_a.covered.pixel_count(), uint8_t(0));
+        scratch.side_a.covered.fill(0);
     }
     out.color.resize(w, h);
     out.depth.resize(w, h);
@@ -102,7 +111,9 @@ void interpolate_frame(const Frame& a, const Frame& b, float s, bool use_a, cons
     scratch.valid.resize(w, h);
     const WarpBuffers &wa = scratch.side_a, &wb = scratch.side_b;
     const float inf = std::numeric_limits<float>::infinity();
+    std::atomic<std::size_t> holes{0};
     parallel_for(0, h, [&](int y0, int y1) {
+        std::size_t local_holes = 0;
         for (int y = y0; y < y1; ++y)
             for (int x = 0; x < w; ++x) {
                 bool ca = wa.covered(x, y), cb = wb.covered(x, y);
@@ -124,11 +135,14 @@ void interpolate_frame(const Frame& a, const Frame& b, float s, bool use_a, cons
                 }
                 out.color(x, y) = color;
                 out.depth(x, y) = z;
-                out.motion(x, y) = m;
+                out.motion(x, y) = m * motion_scale;
                 scratch.valid(x, y) = ca || cb;
+                local_holes += !(ca || cb);
             }
+        holes += local_holes;
     });
-    fill_holes(out.color.view(), scratch.valid.view(), out.depth.view(), options, scratch, counters);
+    fill_holes(out.color.view(), scratch.valid.view(), out.depth.view(), holes.load(), options,
+               scratch, counters);
 }
 
 }  // namespace reprise::warp

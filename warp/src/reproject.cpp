@@ -36,7 +36,8 @@ struct Setup {
     bool use_ids, background;
 };
 
-Setup make_setup(const Frame& current, const Frame& previous, const ReprojectOptions& options) {
+Setup make_setup(const GBufferView& current, const GBufferView& previous,
+                 const ReprojectOptions& options) {
     const Camera& c = current.camera;
     const glm::dmat4 p(c.projection);
     // Unprojection at a known depth solves a 2x2 system for (x_view, y_view); that needs a clip w
@@ -46,7 +47,7 @@ Setup make_setup(const Frame& current, const Frame& previous, const ReprojectOpt
     const glm::dmat4 t = glm::dmat4(c.prev_view) * glm::inverse(glm::dmat4(c.view));
     const double m00 = d / det, m01 = -b / det, m10 = -cc / det, m11 = a / det;
     const double u0 = t[0][2] * m00 + t[1][2] * m10, u1 = t[0][2] * m01 + t[1][2] * m11;
-    const double w = current.depth.width(), h = current.depth.height();
+    const double w = current.depth.width, h = current.depth.height;
     double k[7] = {-2.0 * u0 / w,
                    2.0 * u1 / h,
                    u0 - u1,
@@ -86,14 +87,13 @@ inline float expected_depth(const Setup& s, float px, float row, float z) {
     return w * (s.kx * px + row) + (s.kz * z + s.k1);
 }
 
-void check_contract(const Frame& current, const Frame& previous, const ConstPayload& in,
+void check_contract(const GBufferView& current, const GBufferView& previous, const ConstPayload& in,
                     const Payload& out, const ImageView<uint8_t>& hit) {
-    const int w = current.depth.width(), h = current.depth.height();
-    REPRISE_ASSERT(current.motion.width() == w && current.motion.height() == h);
-    REPRISE_ASSERT(current.id.empty() || (current.id.width() == w && current.id.height() == h));
-    const int pw = previous.depth.width(), ph = previous.depth.height();
-    REPRISE_ASSERT(previous.id.empty() ||
-                   (previous.id.width() == pw && previous.id.height() == ph));
+    const int w = current.depth.width, h = current.depth.height;
+    REPRISE_ASSERT(current.motion.width == w && current.motion.height == h);
+    REPRISE_ASSERT(current.id.empty() || (current.id.width == w && current.id.height == h));
+    const int pw = previous.depth.width, ph = previous.depth.height;
+    REPRISE_ASSERT(previous.id.empty() || (previous.id.width == pw && previous.id.height == ph));
     REPRISE_ASSERT(in.width == pw && in.height == ph && in.channels >= 1);
     REPRISE_ASSERT(out.width == w && out.height == h && out.channels == in.channels);
     REPRISE_ASSERT(hit.empty() || (hit.width == w && hit.height == h));
@@ -425,26 +425,26 @@ void reproject_rows(const Kernel& kernel, int y_begin, int y_end, std::size_t* c
 
 }  // namespace
 
-ReprojectCounts reproject(const Frame& current, const Frame& previous,
+ReprojectCounts reproject(const GBufferView& current, const GBufferView& previous,
                           ConstPayload previous_payload, Payload out, ImageView<uint8_t> hit,
                           const ReprojectOptions& options) {
     check_contract(current, previous, previous_payload, out, hit);
     const Setup s = make_setup(current, previous, options);
     const Kernel k{s,
-                   current.depth.width(),
-                   previous.depth.width(),
-                   previous.depth.height(),
+                   current.depth.width,
+                   previous.depth.width,
+                   previous.depth.height,
                    previous_payload.channels,
-                   current.depth.data(),
-                   current.depth.width(),
-                   current.motion.data(),
-                   current.motion.width(),
-                   current.id.data(),
-                   current.id.width(),
-                   previous.depth.data(),
-                   previous.depth.width(),
-                   previous.id.data(),
-                   previous.id.width(),
+                   current.depth.data,
+                   current.depth.stride,
+                   current.motion.data,
+                   current.motion.stride,
+                   current.id.data,
+                   current.id.stride,
+                   previous.depth.data,
+                   previous.depth.stride,
+                   previous.id.data,
+                   previous.id.stride,
                    previous_payload.data,
                    previous_payload.stride,
                    out.data,
@@ -458,7 +458,7 @@ ReprojectCounts reproject(const Frame& current, const Frame& previous,
     std::atomic<std::size_t> total[OutcomeCount] = {};
     const int grain = std::max(1, 4096 / std::max(1, k.width));
     parallel_for(
-        0, current.depth.height(),
+        0, current.depth.height,
         [&](int y0, int y1) {
             std::size_t n[OutcomeCount] = {};
             rows(k, y0, y1, n);
@@ -471,13 +471,13 @@ ReprojectCounts reproject(const Frame& current, const Frame& previous,
     return to_counts(n);
 }
 
-ReprojectCounts reproject_reference(const Frame& current, const Frame& previous,
+ReprojectCounts reproject_reference(const GBufferView& current, const GBufferView& previous,
                                     ConstPayload previous_payload, Payload out,
                                     ImageView<uint8_t> hit, const ReprojectOptions& options) {
     check_contract(current, previous, previous_payload, out, hit);
     const Setup s = make_setup(current, previous, options);
-    const int w = current.depth.width(), h = current.depth.height();
-    const int pw = previous.depth.width(), ph = previous.depth.height();
+    const int w = current.depth.width, h = current.depth.height;
+    const int pw = previous.depth.width, ph = previous.depth.height;
     const int channels = previous_payload.channels;
     std::size_t n[OutcomeCount] = {};
     for (int y = 0; y < h; ++y) {
@@ -516,7 +516,7 @@ ReprojectCounts reproject_reference(const Frame& current, const Frame& previous,
                     if (!all_background) return Occluded;
                 } else {
                     if (!all_finite) return Occluded;
-                    const float z_previous = bilinear_fetch(previous.depth.view(), b);
+                    const float z_previous = bilinear_fetch(previous.depth, b);
                     const float tolerance = s.use_ids && ids_agree ? s.id_tolerance : s.tolerance;
                     if (!(std::abs(z_expected - z_previous) <= tolerance * z_expected))
                         return Occluded;
