@@ -18,7 +18,8 @@ struct WarpBuffers {
 
 // Scratch for one converter: every per-frame buffer lives here.
 struct FrucScratch {
-    WarpBuffers side_a, side_b;
+    WarpBuffers side_a;       // interpolation: frame a warped; extrapolation: the dynamic layer
+    WarpBuffers side_b;       // interpolation: b's coverage (b is warped into the output)
     Image<float> layer_depth;        // extrapolation: the input's depth with some pixels left out
     Image<glm::vec2> layer_motion;   // and the static layer's displacement
     Image<uint8_t> valid;
@@ -32,9 +33,6 @@ struct FrucScratch {
 // number of covered pixels (the target's contract: colour 0, depth +inf, motion 0 elsewhere).
 std::size_t warp_into(const GBufferView& source, float factor, const FrucOptions& options,
                       FrucScratch& scratch, const WarpTarget& out, FrucCounters& counters);
-// The same into the buffers of `out`, sized to the source.
-void warp_frame(const GBufferView& source, float factor, const FrucOptions& options,
-                FrucScratch& scratch, WarpBuffers& out, FrucCounters& counters);
 
 // Fills the holes of `color` (valid = 0; `holes` of them, counted by the caller) as options.fill
 // says, using depth for the side to prefer; counts what it did or skipped.

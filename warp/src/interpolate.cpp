@@ -36,11 +36,14 @@ namespace {
 void refetch(const GBufferView& source, float factor, const WarpTarget& out) {
     const int w = out.color.width, h = out.color.height;
     parallel_for(0, h, [&](int y0, int y1) {
-        for (int y = y0; y < y1; ++y)
+        for (int y = y0; y < y1; ++y) {
+            const uint8_t* covered = out.covered.row(y);
+            const glm::vec2* motion = out.motion.row(y);
+            glm::vec4* color = out.color.row(y);
             for (int x = 0; x < w; ++x) {
-                if (!out.covered(x, y)) continue;
+                if (!covered[x]) continue;
                 glm::vec2 q(x + 0.5f, y + 0.5f);
-                glm::vec2 p = q - factor * out.motion(x, y);
+                glm::vec2 p = q - factor * motion[x];
                 Bilinear b = bilinear_taps(p.x, p.y, source.width(), source.height());
                 if (!b.inside) continue;
                 glm::vec2 m = bilinear_fetch(source.motion, b);
@@ -49,8 +52,9 @@ void refetch(const GBufferView& source, float factor, const WarpTarget& out) {
                 b = bilinear_taps(p.x, p.y, source.width(), source.height());
                 if (!b.inside) continue;
                 glm::vec4 c = bicubic_fetch(source.color, p.x, p.y);
-                if (std::isfinite(c.r + c.g + c.b + c.a)) out.color(x, y) = c;
+                if (std::isfinite(c.r + c.g + c.b + c.a)) color[x] = c;
             }
+        }
     });
 }
 
@@ -75,12 +79,6 @@ std::size_t warp_into(const GBufferView& source, float factor, const FrucOptions
     return 0;
 }
 
-void warp_frame(const GBufferView& source, float factor, const FrucOptions& options,
-                FrucScratch& scratch, WarpBuffers& out, FrucCounters& counters) {
-    out.resize(source.width(), source.height());
-    warp_into(source, factor, options, scratch, out.target(), counters);
-}
-
 void fill_holes(ImageView<glm::vec4> color, ImageView<const uint8_t> valid,
                 ImageView<const float> depth, std::size_t holes, const FrucOptions& options,
                 FrucScratch& scratch, FrucCounters& counters) {
@@ -98,47 +96,54 @@ void interpolate_frame(const GBufferView& a, const GBufferView& b, float s, bool
                        float motion_scale, const FrucOptions& options, FrucScratch& scratch,
                        Frame& out, FrucCounters& counters) {
     const int w = b.width(), h = b.height();
-    warp_frame(b, 1.0f - s, options, scratch, scratch.side_b, counters);
-    if (use_a) {
-        warp_frame(a, -s, options, scratch, scratch.side_a, counters);
-    } else {
-        scratch.side_a.resize(w, h);
-        scratch.side_a.covered.fill(0);
-    }
     out.color.resize(w, h);
     out.depth.resize(w, h);
     out.motion.resize(w, h);
     scratch.valid.resize(w, h);
-    const WarpBuffers &wa = scratch.side_a, &wb = scratch.side_b;
+    // b is warped straight into the output, a beside it; the blend then merges a in place.
+    WarpBuffers& wa = scratch.side_a;
+    wa.resize(w, h);
+    scratch.side_b.covered.resize(w, h);
+    const WarpTarget into_out{out.color.view(), out.depth.view(), out.motion.view(),
+                              scratch.side_b.covered.view()};
+    warp_into(b, 1.0f - s, options, scratch, into_out, counters);
+    if (use_a) warp_into(a, -s, options, scratch, wa.target(), counters);
+    else wa.covered.fill(0);
     const float inf = std::numeric_limits<float>::infinity();
     std::atomic<std::size_t> holes{0};
     parallel_for(0, h, [&](int y0, int y1) {
         std::size_t local_holes = 0;
-        for (int y = y0; y < y1; ++y)
+        for (int y = y0; y < y1; ++y) {
+            const uint8_t* cov_a = &wa.covered(0, y);
+            const uint8_t* cov_b = &scratch.side_b.covered(0, y);
+            const float* depth_a = &wa.depth(0, y);
+            const glm::vec4* color_a = &wa.color(0, y);
+            const glm::vec2* motion_a = &wa.motion(0, y);
+            float* depth = &out.depth(0, y);
+            glm::vec4* color = &out.color(0, y);
+            glm::vec2* motion = &out.motion(0, y);
+            uint8_t* valid = &scratch.valid(0, y);
             for (int x = 0; x < w; ++x) {
-                bool ca = wa.covered(x, y), cb = wb.covered(x, y);
-                float za = wa.depth(x, y), zb = wb.depth(x, y);
-                glm::vec4 color(0.0f);
-                float z = inf;
-                glm::vec2 m(0.0f);
-                if (ca && cb && std::abs(za - zb) <= 0.02f * std::min(za, zb)) {
-                    color = (1.0f - s) * wa.color(x, y) + s * wb.color(x, y);
-                    z = std::min(za, zb);
-                    m = wb.motion(x, y);
-                } else if (ca && cb && std::isinf(za) && std::isinf(zb)) {
-                    color = (1.0f - s) * wa.color(x, y) + s * wb.color(x, y);
-                    m = wb.motion(x, y);
-                } else if (cb && (!ca || zb < za)) {
-                    color = wb.color(x, y), z = zb, m = wb.motion(x, y);
-                } else if (ca) {
-                    color = wa.color(x, y), z = za, m = wa.motion(x, y);
+                const bool ca = cov_a[x], cb = cov_b[x];
+                const float za = depth_a[x], zb = depth[x];
+                valid[x] = ca || cb;
+                if (!ca) {  // b alone (or nothing: colour 0, depth +inf, motion 0 already)
+                    local_holes += !cb;
+                    motion[x] *= motion_scale;
+                    continue;
                 }
-                out.color(x, y) = color;
-                out.depth(x, y) = z;
-                out.motion(x, y) = m * motion_scale;
-                scratch.valid(x, y) = ca || cb;
-                local_holes += !(ca || cb);
+                if (cb && std::abs(za - zb) <= 0.02f * std::min(za, zb)) {
+                    color[x] = (1.0f - s) * color_a[x] + s * color[x];
+                    depth[x] = std::min(za, zb);
+                } else if (cb && std::isinf(za) && std::isinf(zb)) {
+                    color[x] = (1.0f - s) * color_a[x] + s * color[x];
+                    depth[x] = inf;
+                } else if (!cb || !(zb < za)) {
+                    color[x] = color_a[x], depth[x] = za, motion[x] = motion_a[x];
+                }
+                motion[x] *= motion_scale;
             }
+        }
         holes += local_holes;
     });
     fill_holes(out.color.view(), scratch.valid.view(), out.depth.view(), holes.load(), options,

@@ -190,7 +190,7 @@ inline bool fetch(const float* a, const float* b, const float* c, const float* d
 // Rows [y_begin, y_end) with C payload channels (0: any). Everything the loop reads is copied
 // into locals first: the float stores to `out` could otherwise alias them.
 template <int C>
-void reproject_rows(const Kernel& kernel, int y_begin, int y_end, std::size_t* counts) {
+void reproject_rows(const Kernel& kernel, int y_begin, int y_end, int step, std::size_t* counts) {
     const Setup s = kernel.s;
     const int width = kernel.width, pw = kernel.pw, ph = kernel.ph;
     const int n = C > 0 ? C : kernel.channels;
@@ -217,7 +217,7 @@ void reproject_rows(const Kernel& kernel, int y_begin, int y_end, std::size_t* c
             ++counts[o];
         if (hrow) hrow[x] = o == Hit;
     };
-    for (int y = y_begin; y < y_end; ++y) {
+    for (int y = y_begin; y < y_end; y += step) {
         const float* const zr = depth + y * depth_stride;
         const glm::vec2* const mr = motion + y * motion_stride;
         const uint32_t* const ir = use_ids ? id + y * id_stride : nullptr;
@@ -280,6 +280,10 @@ void reproject_rows(const Kernel& kernel, int y_begin, int y_end, std::size_t* c
         };
 
         int x = 0;
+        if (step > 1) {
+            for (; x < width; x += step) record(x, classify(x), hrow);
+            continue;
+        }
 #if defined(__SSE2__)
         // Four pixels at a time: the same arithmetic lane by lane (so the same bits as the scalar
         // code), with the taps gathered per lane. Blocks with any pixel that is invalid, behind or
@@ -451,17 +455,19 @@ ReprojectCounts reproject(const GBufferView& current, const GBufferView& previou
                    out.stride,
                    hit.empty() ? nullptr : hit.data,
                    hit.stride};
-    using Rows = void (*)(const Kernel&, int, int, std::size_t*);
+    using Rows = void (*)(const Kernel&, int, int, int, std::size_t*);
     constexpr Rows kRows[5] = {reproject_rows<0>, reproject_rows<1>, reproject_rows<2>,
                                reproject_rows<3>, reproject_rows<4>};
     const Rows rows = kRows[k.channels <= 4 ? k.channels : 0];
     std::atomic<std::size_t> total[OutcomeCount] = {};
-    const int grain = std::max(1, 4096 / std::max(1, k.width));
+    const int step = std::max(1, options.step);
+    const int height = current.depth.height, sampled_rows = (height + step - 1) / step;
+    const int grain = std::max(1, 4096 * step / std::max(1, k.width));
     parallel_for(
-        0, current.depth.height,
-        [&](int y0, int y1) {
+        0, sampled_rows,
+        [&](int r0, int r1) {
             std::size_t n[OutcomeCount] = {};
-            rows(k, y0, y1, n);
+            rows(k, r0 * step, std::min(r1 * step, height), step, n);
             for (int i = 0; i < OutcomeCount; ++i)
                 total[i].fetch_add(n[i], std::memory_order_relaxed);
         },
@@ -480,8 +486,9 @@ ReprojectCounts reproject_reference(const GBufferView& current, const GBufferVie
     const int pw = previous.depth.width, ph = previous.depth.height;
     const int channels = previous_payload.channels;
     std::size_t n[OutcomeCount] = {};
-    for (int y = 0; y < h; ++y) {
-        for (int x = 0; x < w; ++x) {
+    const int step = std::max(1, options.step);
+    for (int y = 0; y < h; y += step) {
+        for (int x = 0; x < w; x += step) {
             auto outcome = [&]() -> Outcome {
                 const float z = current.depth(x, y);
                 const glm::vec2 m = current.motion(x, y);

@@ -43,6 +43,10 @@ struct ReprojectOptions {
     // Background (depth +inf, id 0) hits where all four previous taps are background too; its
     // motion is that of the point at infinity. When false, background pixels count as invalid.
     bool background = true;
+    // Only every step-th pixel of every step-th row (x and y multiples of step) is looked up;
+    // the others keep their `out` and `hit`, and the counts are of the looked-up pixels. A cheap
+    // survey, e.g. for a shot-change test.
+    int step = 1;
 };
 
 struct ReprojectCounts {
