@@ -1,11 +1,17 @@
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <utility>
 #include <vector>
 
 #include "fruc_stages.hpp"
 #include "reprise/core/metrics.hpp"
 #include "reprise/core/parallel.hpp"
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace reprise::warp {
 
@@ -50,9 +56,43 @@ void size_like(Image<T>& image, const ImageView<const T>& like) {
     else image.resize(like.width, like.height);
 }
 
+// Row bytes into one or two destinations with streaming stores where everything is 16-byte
+// aligned: the copies are larger than any cache and not read back soon, so their lines need not
+// be fetched first.
+void stream_row(const void* from, void* to, void* to2, std::size_t bytes) {
+#if defined(__SSE2__)
+    const auto aligned = [](const void* p) { return reinterpret_cast<std::uintptr_t>(p) % 16 == 0; };
+    if (aligned(from) && aligned(to) && (!to2 || aligned(to2))) {
+        const __m128i* s = static_cast<const __m128i*>(from);
+        __m128i* d = static_cast<__m128i*>(to);
+        __m128i* d2 = static_cast<__m128i*>(to2);
+        const std::size_t n = bytes / 16;
+        for (std::size_t i = 0; i < n; ++i) {
+            const __m128i v = _mm_load_si128(s + i);
+            _mm_stream_si128(d + i, v);
+            if (d2) _mm_stream_si128(d2 + i, v);
+        }
+        const std::size_t done = n * 16;
+        std::memcpy(static_cast<char*>(to) + done, static_cast<const char*>(from) + done, bytes - done);
+        if (to2)
+            std::memcpy(static_cast<char*>(to2) + done, static_cast<const char*>(from) + done,
+                        bytes - done);
+        return;
+    }
+#endif
+    std::memcpy(to, from, bytes);
+    if (to2) std::memcpy(to2, from, bytes);
+}
+
+// Rows [y0, y1) of `from` into `to` and, when not null, `to2` (both sized like it).
 template <class T>
-void copy_rows(ImageView<const T> from, Image<T>& to, int y0, int y1) {
-    for (int y = y0; y < y1; ++y) std::copy_n(from.row(y), from.width, &to(0, y));
+void copy_rows(ImageView<const T> from, Image<T>& to, int y0, int y1, Image<T>* to2 = nullptr) {
+    for (int y = y0; y < y1; ++y)
+        stream_row(from.row(y), &to(0, y), to2 ? &(*to2)(0, y) : nullptr,
+                   std::size_t(from.width) * sizeof(T));
+#if defined(__SSE2__)
+    _mm_sfence();  // streaming stores are weakly ordered
+#endif
 }
 
 // `from` into `to` (sized like it), rows in parallel.
@@ -148,11 +188,9 @@ struct FrameRateConverter::State {
             return std::pair(std::min(y0, view.height), std::min(y1, view.height));
         };
         parallel_for(0, frame.height(), [&](int y0, int y1) {
-            copy_rows(in.color, out.color, y0, y1);
-            copy_rows(in.color, previous.color, y0, y1);
+            copy_rows(in.color, out.color, y0, y1, &previous.color);
             auto [d0, d1] = rows_of(in.depth, y0, y1);
-            copy_rows(in.depth, out.depth, d0, d1);
-            copy_rows(in.depth, previous.depth, d0, d1);
+            copy_rows(in.depth, out.depth, d0, d1, &previous.depth);
             auto [m0, m1] = rows_of(in.motion, y0, y1);
             copy_rows(in.motion, previous.motion, m0, m1);
             for (int y = m0; y < m1; ++y) {
@@ -163,8 +201,7 @@ struct FrameRateConverter::State {
             auto [n0, n1] = rows_of(in.normal, y0, y1);
             copy_rows(in.normal, out.normal, n0, n1);
             auto [i0, i1] = rows_of(in.id, y0, y1);
-            copy_rows(in.id, out.id, i0, i1);
-            copy_rows(in.id, previous.id, i0, i1);
+            copy_rows(in.id, out.id, i0, i1, &previous.id);
         }, 32);
         out.camera = previous.camera = frame.camera;
         out.fps = frame.fps > 0 ? frame.fps * factor : 0.0;
