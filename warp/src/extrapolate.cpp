@@ -8,6 +8,93 @@
 
 namespace reprise::warp {
 
+namespace {
+
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+
+// The static-layer test of row y: a pixel is static when the camera alone explains its motion
+// (its surface point lands within the tolerance of where its motion says it was); static pixels
+// keep their depth and get their displacement to the future camera, the others NaN. Returns the
+// number of others.
+std::size_t classify_row(const GBufferView& f, int y, const StaticReprojection& to_previous,
+                         const StaticReprojection& to_future, float tolerance2, float* depth_out,
+                         glm::vec2* motion_out) {
+    const Unprojector& unproject = to_previous.unprojector();
+    const float* z_row = f.depth.row(y);
+    const glm::vec2* m_row = f.motion.row(y);
+    const float py = float(y) + 0.5f, ny = unproject.ndc_y(py);
+    std::size_t dynamic = 0;
+    for (int x = 0; x < f.depth.width; ++x) {
+        const float z = z_row[x];
+        const glm::vec2 m = m_row[x];
+        const glm::vec2 p(float(x) + 0.5f, py);
+        glm::vec2 before, later;
+        bool still = !std::isnan(z) && std::isfinite(m.x) && std::isfinite(m.y);
+        if (still) {
+            const glm::vec4 point = unproject.point_ndc(unproject.ndc_x(p.x), ny, z);
+            still = to_previous.land(point, before) && to_future.land(point, later);
+            const glm::vec2 error = before - p - m;
+            still = still && glm::dot(error, error) <= tolerance2;
+        }
+        depth_out[x] = still ? z : kNaN;
+        motion_out[x] = still ? later - p : glm::vec2(kNaN);
+        dynamic += !still;
+    }
+    return dynamic;
+}
+
+// The same for an axis-aligned projection, written without branches so that it vectorises:
+// Unprojector::point_ndc and StaticReprojection::land spelled out.
+std::size_t classify_row_axis_aligned(const GBufferView& f, int y,
+                                      const StaticReprojection& to_previous,
+                                      const StaticReprojection& to_future, float tolerance2,
+                                      float* depth_out, glm::vec2* motion_out) {
+    const Unprojector& unproject = to_previous.unprojector();
+    // Copies: the stores below could otherwise alias the matrices and the loop would not vectorise.
+    const glm::mat4 P = unproject.projection();
+    const glm::mat4 A = to_previous.to_clip(), B = to_future.to_clip();
+    const bool perspective = unproject.perspective();
+    const float background_zv = perspective ? -1.0f : -unproject.far_plane();
+    const float background_w = perspective ? 0.0f : 1.0f;
+    const float fw = float(f.depth.width), fh = float(f.depth.height);
+    const float* __restrict z_row = f.depth.row(y);
+    const float* __restrict m_row = &f.motion.row(y)->x;
+    float* __restrict m_out = &motion_out->x;
+    float* __restrict d_out = depth_out;
+    const float py = float(y) + 0.5f, ny = unproject.ndc_y(py);
+    const float inf = std::numeric_limits<float>::infinity();
+    const int width = f.depth.width;
+    unsigned dynamic = 0;
+    for (int x = 0; x < width; ++x) {
+        const float z = z_row[x], mx = m_row[2 * x], my = m_row[2 * x + 1];
+        const float px = float(x) + 0.5f, nx = unproject.ndc_x(px);
+        const bool background = z == inf;
+        const float zv = background ? background_zv : -z;
+        const float w = background ? background_w : 1.0f;
+        const float wc = P[2][3] * zv + P[3][3] * w;
+        const float vx = (nx * wc - P[2][0] * zv - P[3][0] * w) / P[0][0];
+        const float vy = (ny * wc - P[2][1] * zv - P[3][1] * w) / P[1][1];
+        auto clip = [&](const glm::mat4& M, int row) {
+            return M[0][row] * vx + M[1][row] * vy + M[2][row] * zv + M[3][row] * w;
+        };
+        const float aw = clip(A, 3), bw = clip(B, 3);
+        const float bx = (clip(A, 0) / aw * 0.5f + 0.5f) * fw;
+        const float by = (0.5f - 0.5f * clip(A, 1) / aw) * fh;
+        const float lx = (clip(B, 0) / bw * 0.5f + 0.5f) * fw;
+        const float ly = (0.5f - 0.5f * clip(B, 1) / bw) * fh;
+        const float ex = bx - px - mx, ey = by - py - my;
+        const bool still = (z == z) & (mx - mx == 0.0f) & (my - my == 0.0f) & (aw > 0.0f) &
+                           (bw > 0.0f) & (ex * ex + ey * ey <= tolerance2);
+        d_out[x] = still ? z : kNaN;
+        m_out[2 * x] = still ? lx - px : kNaN;
+        m_out[2 * x + 1] = still ? ly - py : kNaN;
+        dynamic += !still;
+    }
+    return dynamic;
+}
+
+}  // namespace
+
 void extrapolate_frame(const GBufferView& f, float s, float motion_scale, const FrucOptions& options,
                        FrucScratch& scratch, Frame& out, FrucCounters& counters) {
     const int w = f.width(), h = f.height();
@@ -31,34 +118,16 @@ void extrapolate_frame(const GBufferView& f, float s, float motion_scale, const 
     const ImageView<float> layer_depth = scratch.layer_depth.view();
     const ImageView<glm::vec2> layer_motion = scratch.layer_motion.view();
     std::atomic<std::size_t> dynamic{0};
+    const float tolerance2 = options.static_tolerance * options.static_tolerance;
     parallel_for(0, h, [&](int y0, int y1) {
         std::size_t local = 0;
         for (int y = y0; y < y1; ++y) {
-            const float* z_row = f.depth.row(y);
-            const glm::vec2* m_row = f.motion.row(y);
-            float* d_out = layer_depth.row(y);
-            glm::vec2* m_out = layer_motion.row(y);
-            const float py = float(y) + 0.5f, ny = unproject.ndc_y(py);
-            for (int x = 0; x < w; ++x) {
-                const float z = z_row[x];
-                const glm::vec2 m = m_row[x];
-                const glm::vec2 p(float(x) + 0.5f, py);
-                glm::vec2 before, later;
-                bool still = !std::isnan(z) && std::isfinite(m.x) && std::isfinite(m.y);
-                if (still) {
-                    const glm::vec4 point = unproject.point_ndc(unproject.ndc_x(p.x), ny, z);
-                    still = to_previous.land(point, before) && to_future.land(point, later) &&
-                            glm::length(before - p - m) <= options.static_tolerance;
-                }
-                if (still) {
-                    d_out[x] = z;
-                    m_out[x] = later - p;
-                } else {
-                    d_out[x] = nan;
-                    m_out[x] = glm::vec2(nan);
-                    ++local;
-                }
-            }
+            if (unproject.axis_aligned())
+                local += classify_row_axis_aligned(f, y, to_previous, to_future, tolerance2,
+                                                   layer_depth.row(y), layer_motion.row(y));
+            else
+                local += classify_row(f, y, to_previous, to_future, tolerance2, layer_depth.row(y),
+                                      layer_motion.row(y));
         }
         dynamic += local;
     });

@@ -47,6 +47,11 @@ public:
     float ndc_x(float px) const { return 2.0f * px / width_ - 1.0f; }
     float ndc_y(float py) const { return 1.0f - 2.0f * py / height_; }
     bool perspective() const { return perspective_; }
+    // point_ndc is then ((nx wc - P20 zv - P30 w) / P00, (ny wc - P21 zv - P31 w) / P11, zv, w)
+    // with wc = P23 zv + P33 w: no x/y coupling, the form per-pixel loops can inline.
+    bool axis_aligned() const { return axis_aligned_; }
+    const glm::mat4& projection() const { return p_; }
+    float far_plane() const { return far_; }
 
     // The point (w = 1) at view depth `depth` through NDC (nx, ny). Background (+inf) is the
     // point at infinity through the pixel (w = 0, z_view = -1) for a perspective projection and
@@ -117,6 +122,7 @@ public:
           height_(height) {}
 
     const Unprojector& unprojector() const { return unproject_; }
+    const glm::mat4& to_clip() const { return to_clip_; }
 
     // The target pixel position of view point `point` (w = 0: a direction); false behind the
     // target camera.
