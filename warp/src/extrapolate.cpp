@@ -74,9 +74,7 @@ std::size_t classify_row_axis_aligned(const GBufferView& f, int y,
         const float wc = P[2][3] * zv + P[3][3] * w;
         const float vx = (nx * wc - P[2][0] * zv - P[3][0] * w) / P[0][0];
         const float vy = (ny * wc - P[2][1] * zv - P[3][1] * w) / P[1][1];
-        auto clip = [&](const glm::mat4& M, int row) {
-            return M[0][row] * vx + M[1][row] * vy + M[2][row] * zv + M[3][row] * w;
-        };
+        auto clip = [&](const glm::mat4& M, int row) { return transform_row(M, row, vx, vy, zv, w); };
         const float aw = clip(A, 3), bw = clip(B, 3);
         const float bx = (clip(A, 0) / aw * 0.5f + 0.5f) * fw;
         const float by = (0.5f - 0.5f * clip(A, 1) / aw) * fh;

@@ -102,6 +102,12 @@ private:
     bool linear_ = false, axis_aligned_ = false, perspective_ = true;
 };
 
+// Row r of m * (x, y, z, w), summed as glm's matrix product does: per-pixel loops that spell
+// the product out get the same bits as the generic code.
+inline float transform_row(const glm::mat4& m, int r, float x, float y, float z, float w) {
+    return (m[0][r] * x + m[1][r] * y) + (m[2][r] * z + m[3][r] * w);
+}
+
 // From the view space of one camera to the clip space of another (its view and projection).
 inline glm::mat4 view_to_clip(const glm::mat4& from_view, const glm::mat4& to_view,
                               const glm::mat4& to_projection) {
@@ -122,7 +128,8 @@ public:
           height_(height) {}
 
     const Unprojector& unprojector() const { return unproject_; }
-    const glm::mat4& to_clip() const { return to_clip_; }
+    const glm::mat4& to_clip() const { return to_clip_; }  // view point -> target clip
+    const glm::mat4& to_view() const { return to_view_; }  // view point -> target view
 
     // The target pixel position of view point `point` (w = 0: a direction); false behind the
     // target camera.
