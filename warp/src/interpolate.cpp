@@ -35,6 +35,7 @@ namespace {
 // rendered truth than keeping either surface.
 void refetch(const GBufferView& source, float factor, const WarpTarget& out) {
     const int w = out.color.width, h = out.color.height;
+    const float sw = float(source.width()), sh = float(source.height());
     parallel_for(0, h, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y) {
             const uint8_t* covered = out.covered.row(y);
@@ -49,8 +50,7 @@ void refetch(const GBufferView& source, float factor, const WarpTarget& out) {
                 glm::vec2 m = bilinear_fetch(source.motion, b);
                 if (!std::isfinite(m.x) || !std::isfinite(m.y)) continue;
                 p = q - factor * m;
-                b = bilinear_taps(p.x, p.y, source.width(), source.height());
-                if (!b.inside) continue;
+                if (!(p.x >= 0.0f && p.y >= 0.0f && p.x <= sw && p.y <= sh)) continue;  // outside
                 glm::vec4 c = bicubic_fetch(source.color, p.x, p.y);
                 if (std::isfinite(c.r + c.g + c.b + c.a)) color[x] = c;
             }
