@@ -33,8 +33,10 @@ std::size_t classify_row(const GBufferView& f, int y, const StaticReprojection& 
         if (still) {
             const glm::vec4 point = unproject.point_ndc(unproject.ndc_x(p.x), ny, z);
             still = to_previous.land(point, before) && to_future.land(point, later);
-            const glm::vec2 error = before - p - m;
-            still = still && glm::dot(error, error) <= tolerance2;
+            if (still) {
+                const glm::vec2 error = before - p - m;
+                still = glm::dot(error, error) <= tolerance2;
+            }
         }
         depth_out[x] = still ? z : kNaN;
         motion_out[x] = still ? later - p : glm::vec2(kNaN);
