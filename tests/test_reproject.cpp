@@ -372,6 +372,43 @@ TEST(Reproject, FastMatchesReferenceOnRandomFrames) {
             }
 }
 
+TEST(Reproject, StepLooksUpOnlyTheSampledPixelsAndAgreesWithTheFullRun) {
+    for (int step : {2, 4, 5}) {
+        Case k = random_case("step", 301, 97, 4, 900u + unsigned(step), false);
+        const int w = 301, h = 97;
+        Buffer full(w, h, 4, -3.0f), sampled(w, h, 4, -3.0f), sampled_ref(w, h, 4, -3.0f);
+        Image<uint8_t> hit_full(w, h, 9), hit_sampled(w, h, 9), hit_ref(w, h, 9);
+        reproject(k.cur, k.prev, k.payload.cview(), full.view(), hit_full.view());
+        ReprojectOptions options{.step = step};
+        const ReprojectCounts counts =
+            reproject(k.cur, k.prev, k.payload.cview(), sampled.view(), hit_sampled.view(), options);
+        const ReprojectCounts ref = reproject_reference(k.cur, k.prev, k.payload.cview(),
+                                                        sampled_ref.view(), hit_ref.view(), options);
+        EXPECT_EQ(counts, ref);
+        EXPECT_TRUE(hit_sampled == hit_ref);
+        EXPECT_EQ(0, std::memcmp(sampled.v.data(), sampled_ref.v.data(), sampled.v.size() * sizeof(float)));
+        std::size_t looked = 0, hits = 0;
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                const bool on = x % step == 0 && y % step == 0;
+                if (!on) {  // untouched
+                    ASSERT_EQ(hit_sampled(x, y), 9) << x << "," << y;
+                    ASSERT_EQ(sampled.at(x, y, 0), -3.0f);
+                    continue;
+                }
+                ++looked;
+                hits += hit_full(x, y);
+                ASSERT_EQ(hit_sampled(x, y), hit_full(x, y)) << x << "," << y;
+                if (hit_full(x, y)) {
+                    for (int c = 0; c < 4; ++c) ASSERT_EQ(sampled.at(x, y, c), full.at(x, y, c));
+                }
+            }
+        EXPECT_EQ(total(counts), looked);
+        EXPECT_EQ(counts.hits, hits);
+        EXPECT_GT(hits, 0u);
+    }
+}
+
 TEST(Reproject, FastMatchesReferenceOnWorstCases) {
     std::vector<Case> cases;
     auto add = [&](const char* name, auto&& edit) {
