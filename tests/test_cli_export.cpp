@@ -43,7 +43,7 @@ class CliExport : public testing::Test {
             Frame f;
             f.fps = fps;
             f.color.resize(w, h);
-            f.depth.resize(w, h, std::numeric_limits<float>::infinity());
+            f.depth.assign(w, h, std::numeric_limits<float>::infinity());
             f.motion.resize(w, h);
             for (int y = 0; y < h; ++y)
                 for (int x = 0; x < w; ++x) {

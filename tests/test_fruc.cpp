@@ -100,7 +100,7 @@ TEST(Fruc, StillFramesAreCopiedNotWarped) {
     std::vector<Frame> input = render("pan", 30.0, 0, 3, 64, 36);
     for (Frame& f : input) {
         f.color = input[0].color;
-        f.motion.resize(64, 36, glm::vec2(0.0f));
+        f.motion.assign(64, 36, glm::vec2(0.0f));
     }
     for (FrucMode mode : {FrucMode::Interpolate, FrucMode::Extrapolate}) {
         FrucCounters counters;

@@ -79,7 +79,7 @@ Frame scene_frame(int w, int h, glm::vec2 pan, uint32_t seed) {
 TEST(GridWarp, ZeroMotionCopiesExactly) {
     for (int min_cell : {1, 2}) {
         Frame f = scene_frame(101, 67, {0, 0}, 3);
-        f.motion.resize(101, 67, glm::vec2(0.0f));
+        f.motion.assign(101, 67, glm::vec2(0.0f));
         Output out(101, 67);
         const GridStats s = warp_both(f, -0.5f, out, {.min_cell = min_cell});
         EXPECT_EQ(s.covered, 101u * 67u);
@@ -394,9 +394,9 @@ TEST(GridWarp, TargetOfAnotherSizeAndScratchReuse) {
 TEST(GridWarp, LargeFrameRuns) {
     const int w = 8192, h = 4320;
     Frame f;
-    f.color.resize(w, h, glm::vec4(0.5f));
-    f.depth.resize(w, h, 3.0f);
-    f.motion.resize(w, h, glm::vec2(1.25f, -0.75f));
+    f.color.assign(w, h, glm::vec4(0.5f));
+    f.depth.assign(w, h, 3.0f);
+    f.motion.assign(w, h, glm::vec2(1.25f, -0.75f));
     for (int y = 1000; y < 2000; ++y)
         for (int x = 3000; x < 4000; ++x) f.depth(x, y) = 1.0f;
     Output out(w, h);

@@ -35,7 +35,7 @@ struct Buffer {
 Frame make_frame(int w, int h, float depth, glm::vec2 motion, uint32_t id = 1) {
     Frame f = test::constant_frame(w, h, depth, motion);
     f.normal.resize(w, h);
-    f.id.resize(w, h, id);
+    f.id.assign(w, h, id);
     return f;
 }
 
@@ -135,7 +135,7 @@ TEST(Reproject, DepthModelFollowsCameraAlongItsAxis) {
             ASSERT_NEAR(out.at(x, y), 0.25f * q.x + 0.5f * q.y, 1e-4f);
         }
     // The previous depth buffer of a camera that did not move: every pixel is occluded.
-    prev.depth.resize(w, h, float(D));
+    prev.depth.assign(w, h, float(D));
     c = reproject(cur, prev, payload.cview(), out.view(), {}, tight);
     EXPECT_EQ(c.occluded, std::size_t(w * h));
 }
@@ -370,6 +370,43 @@ TEST(Reproject, FastMatchesReferenceOnRandomFrames) {
                 k.options = {.depth_tolerance = 0.05f, .match_ids = false, .background = false};
                 expect_same(k);
             }
+}
+
+TEST(Reproject, StepLooksUpOnlyTheSampledPixelsAndAgreesWithTheFullRun) {
+    for (int step : {2, 4, 5}) {
+        Case k = random_case("step", 301, 97, 4, 900u + unsigned(step), false);
+        const int w = 301, h = 97;
+        Buffer full(w, h, 4, -3.0f), sampled(w, h, 4, -3.0f), sampled_ref(w, h, 4, -3.0f);
+        Image<uint8_t> hit_full(w, h, 9), hit_sampled(w, h, 9), hit_ref(w, h, 9);
+        reproject(k.cur, k.prev, k.payload.cview(), full.view(), hit_full.view());
+        ReprojectOptions options{.step = step};
+        const ReprojectCounts counts =
+            reproject(k.cur, k.prev, k.payload.cview(), sampled.view(), hit_sampled.view(), options);
+        const ReprojectCounts ref = reproject_reference(k.cur, k.prev, k.payload.cview(),
+                                                        sampled_ref.view(), hit_ref.view(), options);
+        EXPECT_EQ(counts, ref);
+        EXPECT_TRUE(hit_sampled == hit_ref);
+        EXPECT_EQ(0, std::memcmp(sampled.v.data(), sampled_ref.v.data(), sampled.v.size() * sizeof(float)));
+        std::size_t looked = 0, hits = 0;
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                const bool on = x % step == 0 && y % step == 0;
+                if (!on) {  // untouched
+                    ASSERT_EQ(hit_sampled(x, y), 9) << x << "," << y;
+                    ASSERT_EQ(sampled.at(x, y, 0), -3.0f);
+                    continue;
+                }
+                ++looked;
+                hits += hit_full(x, y);
+                ASSERT_EQ(hit_sampled(x, y), hit_full(x, y)) << x << "," << y;
+                if (hit_full(x, y)) {
+                    for (int c = 0; c < 4; ++c) ASSERT_EQ(sampled.at(x, y, c), full.at(x, y, c));
+                }
+            }
+        EXPECT_EQ(total(counts), looked);
+        EXPECT_EQ(counts.hits, hits);
+        EXPECT_GT(hits, 0u);
+    }
 }
 
 TEST(Reproject, FastMatchesReferenceOnWorstCases) {

@@ -18,7 +18,7 @@ namespace {
 
 using Output = WarpOutput;
 
-using SplatFn = std::size_t (*)(const Frame&, float, const WarpTarget&, const SplatOptions&);
+using SplatFn = std::size_t (*)(const GBufferView&, float, const WarpTarget&, const SplatOptions&);
 const SplatFn kBoth[] = {&splat, &splat_reference};
 
 }  // namespace
@@ -198,9 +198,9 @@ TEST(Splat, WithoutMotionTargetAndAcrossSizes) {
 TEST(Splat, LargeFrameRuns) {
     const int w = 8192, h = 4320;
     Frame f;
-    f.color.resize(w, h, glm::vec4(0.5f));
-    f.depth.resize(w, h, 3.0f);
-    f.motion.resize(w, h, glm::vec2(1.25f, -0.75f));
+    f.color.assign(w, h, glm::vec4(0.5f));
+    f.depth.assign(w, h, 3.0f);
+    f.motion.assign(w, h, glm::vec2(1.25f, -0.75f));
     Output out(w, h);
     const std::size_t covered = splat(f, -1.0f, out.target());
     EXPECT_GT(covered, std::size_t(w - 2) * (h - 2));

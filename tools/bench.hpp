@@ -44,6 +44,8 @@ Status open_bench_scene(const std::string& name, BenchScene& bench);
 Status bench_reproject(const BenchOptions& options);  // reverse reprojection vs cv::remap
 Status bench_grid(const BenchOptions& options);       // splat and adaptive grid warp
 Status bench_fill(const BenchOptions& options);       // pull-push, Andreev vs cv::inpaint (Telea)
+// Whole made frames (interpolation, extrapolation, the second eye) against cv::remap, one run.
+Status bench_paths(const BenchOptions& options);
 // Upconversion error against run time, every setting and the peers (ffmpeg minterpolate,
 // OpenCV DIS flow, Telea): OUT/fruc.csv, OUT/fruc_summary.csv, OUT/index.html.
 Status bench_fruc(const BenchOptions& options);

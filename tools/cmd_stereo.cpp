@@ -73,6 +73,7 @@ Status run_stereo(const StereoJob& job, const stereo::StereoRig& rig, const ster
         auto begin = std::chrono::steady_clock::now();
         stereo::StereoStats stats = synthesizer.synthesize(
             frame, target, made, options, job.temporal && have_previous ? &previous : nullptr);
+        made.fps = frame.fps;
         ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - begin).count();
         holes += stats.holes;
         from_history += stats.from_history;

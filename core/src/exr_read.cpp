@@ -255,7 +255,7 @@ void add_target(std::vector<Target>& targets, int channel, Image<T>& image, int 
 template <class T>
 void fit(Image<T>& image, bool present, int width, int height) {
     if (present)
-        image.resize(width, height);
+        image.assign(width, height, T{});  // channels the file lacks read as 0
     else
         image.clear();
 }
@@ -288,7 +288,7 @@ Status read_frame(const std::string& path, Frame& frame) {
 
     const int width = spec.width;
     const int height = spec.height;
-    frame.color.resize(width, height, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
+    frame.color.assign(width, height, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
     fit(frame.depth, c[Z] >= 0, width, height);
     fit(frame.motion, c[MotionX] >= 0, width, height);
     fit(frame.normal, c[NormalX] >= 0, width, height);

@@ -12,6 +12,8 @@ namespace reprise {
 
 namespace {
 
+using Task = void (*)(const void* context, int index);
+
 class Pool {
 public:
     explicit Pool(int threads) {
@@ -27,11 +29,12 @@ public:
     }
     int size() const { return int(workers_.size()) + 1; }
 
-    // Runs task(i) for i in [0, count); the caller takes part.
-    void run(int count, const std::function<void(int)>& task) {
+    // Runs task(context, i) for i in [0, count); the caller takes part.
+    void run(int count, Task task, const void* context) {
         std::lock_guard one_caller_at_a_time(busy_);
         std::unique_lock lock(mutex_);
-        task_ = &task;
+        task_ = task;
+        context_ = context;
         count_ = count;
         next_ = 0;
         pending_ = count;
@@ -46,9 +49,10 @@ private:
     void drain(std::unique_lock<std::mutex>& lock) {
         while (task_ && next_ < count_) {
             int i = next_++;
-            const std::function<void(int)>* task = task_;
+            const Task task = task_;
+            const void* context = context_;
             lock.unlock();
-            (*task)(i);
+            task(context, i);
             lock.lock();
             if (--pending_ == 0) done_.notify_all();
         }
@@ -67,7 +71,8 @@ private:
     std::vector<std::thread> workers_;
     std::mutex busy_, mutex_;
     std::condition_variable wake_, done_;
-    const std::function<void(int)>* task_ = nullptr;
+    Task task_ = nullptr;
+    const void* context_ = nullptr;
     int count_ = 0, next_ = 0, pending_ = 0;
     unsigned long generation_ = 0;
     bool stop_ = false;
@@ -93,7 +98,7 @@ thread_local bool inside_parallel = false;
 
 int thread_count() { return pool().size(); }
 
-void parallel_for(int begin, int end, const std::function<void(int, int)>& body, int grain) {
+void parallel_for_ref(int begin, int end, RangeBody body, int grain) {
     const int n = end - begin;
     if (n <= 0) return;
     const int threads = inside_parallel ? 1 : thread_count();
@@ -101,14 +106,19 @@ void parallel_for(int begin, int end, const std::function<void(int, int)>& body,
         body(begin, end);
         return;
     }
-    const int chunks = std::min(n / std::max(grain, 1), threads * 4);
-    std::function<void(int)> task = [&](int c) {
-        inside_parallel = true;
-        int a = begin + int(std::int64_t(n) * c / chunks), b = begin + int(std::int64_t(n) * (c + 1) / chunks);
-        body(a, b);
-        inside_parallel = false;
+    struct Split {
+        int begin, n, chunks;
+        RangeBody body;
     };
-    pool().run(chunks, task);
+    const Split split{begin, n, std::min(n / std::max(grain, 1), threads * 4), body};
+    pool().run(split.chunks, [](const void* context, int c) {
+        const Split& s = *static_cast<const Split*>(context);
+        inside_parallel = true;
+        const int a = s.begin + int(std::int64_t(s.n) * c / s.chunks);
+        const int b = s.begin + int(std::int64_t(s.n) * (c + 1) / s.chunks);
+        s.body(a, b);
+        inside_parallel = false;
+    }, &split);
 }
 
 }  // namespace reprise

@@ -2,71 +2,89 @@
 #include <cmath>
 #include <limits>
 
-#include <glm/mat4x4.hpp>
-
+#include "reprise/core/camera_math.hpp"
 #include "reprise/core/parallel.hpp"
 #include "reprise/stereo/synthesize.hpp"
 
 namespace reprise::stereo {
 
-void stereo_displacement(const Frame& source, const Camera& target, ImageView<glm::vec2> displacement,
-                         ImageView<float> target_depth) {
-    const int w = source.width(), h = source.height();
-    REPRISE_ASSERT(source.depth.width() == w && source.depth.height() == h);
-    REPRISE_ASSERT(displacement.width == w && displacement.height == h);
-    REPRISE_ASSERT(target_depth.width == w && target_depth.height == h);
-    const glm::mat4& p = source.camera.projection;
-    const bool perspective = p[2][3] != 0.0f;
-    // Source camera space -> target camera space.
-    const glm::mat4 to_target = target.view * glm::inverse(source.camera.view);
-    const glm::mat4 target_clip = target.projection * to_target;
+namespace {
+
+// Row y for an axis-aligned projection, branch-free so that it vectorises (Unprojector::point_ndc
+// and StaticReprojection::land spelled out, same arithmetic).
+void displace_row_axis_aligned(const GBufferView& source, const StaticReprojection& to_target, int y,
+                               glm::vec2* displacement, float* target_depth) {
+    const Unprojector& unproject = to_target.unprojector();
+    // Copies: the stores below could otherwise alias them and the loop would not vectorise.
+    const glm::mat4 P = unproject.projection(), M = to_target.to_clip(), V = to_target.to_view();
+    const bool perspective = unproject.perspective();
+    const float background_zv = perspective ? -1.0f : -unproject.far_plane();
+    const float background_w = perspective ? 0.0f : 1.0f;
+    const float fw = float(source.depth.width), fh = float(source.depth.height);
     const float nan = std::numeric_limits<float>::quiet_NaN();
     const float inf = std::numeric_limits<float>::infinity();
-    // Orthographic background has no direction: it is the far plane.
-    const float ortho_far = std::isfinite(source.camera.far) ? source.camera.far : 1e6f;
+    const float* __restrict z_row = source.depth.row(y);
+    float* __restrict d_out = &displacement->x;
+    float* __restrict t_out = target_depth;
+    const float py = float(y) + 0.5f, ny = unproject.ndc_y(py);
+    const int width = source.depth.width;
+    for (int x = 0; x < width; ++x) {
+        const float z = z_row[x];
+        const float px = float(x) + 0.5f, nx = unproject.ndc_x(px);
+        const bool background = z == inf;
+        const float zv = background ? background_zv : -z;
+        const float w = background ? background_w : 1.0f;
+        const float wc = P[2][3] * zv + P[3][3] * w;
+        const float vx = (nx * wc - P[2][0] * zv - P[3][0] * w) / P[0][0];
+        const float vy = (ny * wc - P[2][1] * zv - P[3][1] * w) / P[1][1];
+        const float cw = transform_row(M, 3, vx, vy, zv, w);
+        const float lx = (transform_row(M, 0, vx, vy, zv, w) / cw * 0.5f + 0.5f) * fw;
+        const float ly = (0.5f - 0.5f * transform_row(M, 1, vx, vy, zv, w) / cw) * fh;
+        const float tz = -transform_row(V, 2, vx, vy, zv, w);
+        const bool ok = (z >= 0.0f) & (cw > 0.0f) & (lx - lx == 0.0f) & (ly - ly == 0.0f);
+        d_out[2 * x] = ok ? lx - px : nan;
+        d_out[2 * x + 1] = ok ? ly - py : nan;
+        t_out[x] = ok ? (background ? inf : tz) : nan;
+    }
+}
+
+}  // namespace
+
+void stereo_displacement(const GBufferView& source, const Camera& target,
+                         ImageView<glm::vec2> displacement, ImageView<float> target_depth) {
+    const int w = source.depth.width, h = source.depth.height;
+    REPRISE_ASSERT(displacement.width == w && displacement.height == h);
+    REPRISE_ASSERT(target_depth.width == w && target_depth.height == h);
+    // Orthographic background has no direction: it is the far plane (Unprojector).
+    const StaticReprojection to_target(source.camera, target.view, target.projection, w, h);
+    const Unprojector& unproject = to_target.unprojector();
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    const float inf = std::numeric_limits<float>::infinity();
 
     parallel_for(0, h, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y) {
-            const float* z_row = source.depth.data() + std::size_t(y) * w;
+            if (unproject.axis_aligned()) {
+                displace_row_axis_aligned(source, to_target, y, displacement.row(y), target_depth.row(y));
+                continue;
+            }
+            const float* z_row = source.depth.row(y);
             glm::vec2* d_row = displacement.row(y);
             float* t_row = target_depth.row(y);
-            const float py = float(y) + 0.5f;
-            const float y_ndc = 1.0f - 2.0f * py / float(h);
+            const float py = float(y) + 0.5f, ny = unproject.ndc_y(py);
             for (int x = 0; x < w; ++x) {
                 const float px = float(x) + 0.5f;
-                const float x_ndc = 2.0f * px / float(w) - 1.0f;
-                float z = z_row[x];
-                if (!(z >= 0.0f)) {  // NaN or negative
+                const float z = z_row[x];
+                glm::vec2 landing;
+                const glm::vec4 point =
+                    z >= 0.0f ? unproject.point_ndc(unproject.ndc_x(px), ny, z) : glm::vec4(nan);
+                if (!(z >= 0.0f) || !to_target.land(point, landing) || !std::isfinite(landing.x) ||
+                    !std::isfinite(landing.y)) {  // NaN or negative depth, behind the target
                     d_row[x] = {nan, nan};
                     t_row[x] = nan;
                     continue;
                 }
-                const bool background = z == inf;
-                if (background && !perspective) z = ortho_far;
-                glm::vec4 point;
-                if (background && perspective) {
-                    // The point at infinity through the pixel: direction with z_view = -1, w = 0.
-                    // x_ndc = (P00 x + P20 z_v) / (P23 z_v) with P23 = -1.
-                    const float wc = -p[2][3];
-                    point = {(x_ndc * wc + p[2][0]) / p[0][0], (y_ndc * wc + p[2][1]) / p[1][1], -1.0f,
-                             0.0f};
-                } else {
-                    const float zv = -z;
-                    const float wc = p[2][3] * zv + p[3][3];
-                    point = {(x_ndc * wc - p[2][0] * zv - p[3][0]) / p[0][0],
-                             (y_ndc * wc - p[2][1] * zv - p[3][1]) / p[1][1], zv, 1.0f};
-                }
-                const glm::vec4 clip = target_clip * point;
-                const float tz = -(to_target * point).z;
-                if (!(clip.w > 0.0f) || !std::isfinite(clip.x) || !std::isfinite(clip.y)) {
-                    d_row[x] = {nan, nan};
-                    t_row[x] = nan;
-                    continue;
-                }
-                const float tx = (clip.x / clip.w * 0.5f + 0.5f) * float(w);
-                const float ty = (0.5f - 0.5f * clip.y / clip.w) * float(h);
-                d_row[x] = {tx - px, ty - py};
-                t_row[x] = background ? inf : tz;
+                d_row[x] = {landing.x - px, landing.y - py};
+                t_row[x] = z == inf ? inf : to_target.target_depth(point);
             }
         }
     });

@@ -25,8 +25,8 @@ bool same_bits(const Image<T>& a, const Image<T>& b) {
 inline Frame constant_frame(int w, int h, float depth, glm::vec2 motion) {
     Frame f;
     f.color.resize(w, h);
-    f.depth.resize(w, h, depth);
-    f.motion.resize(w, h, motion);
+    f.depth.assign(w, h, depth);
+    f.motion.assign(w, h, motion);
     return f;
 }
 

@@ -18,11 +18,10 @@ namespace {
 constexpr float kInf = std::numeric_limits<float>::infinity();
 constexpr int kBandRows = 8;  // a band's scratch stays in a core's cache
 
-void check_target(const Frame& source, const WarpTarget& t) {
-    REPRISE_ASSERT(source.depth.width() == source.width() &&
-                   source.depth.height() == source.height());
-    REPRISE_ASSERT(source.motion.width() == source.width() &&
-                   source.motion.height() == source.height());
+void check_target(const GBufferView& source, const WarpTarget& t) {
+    REPRISE_ASSERT(source.depth.width == source.width() && source.depth.height == source.height());
+    REPRISE_ASSERT(source.motion.width == source.width() &&
+                   source.motion.height == source.height());
     REPRISE_ASSERT(t.depth.width == t.color.width && t.depth.height == t.color.height);
     REPRISE_ASSERT(t.covered.width == t.color.width && t.covered.height == t.color.height);
     REPRISE_ASSERT(t.motion.empty() ||
@@ -139,13 +138,13 @@ struct Scatter {
     }
 };
 
-Scatter make_scatter(const Frame& source, float factor, const WarpTarget& target,
+Scatter make_scatter(const GBufferView& source, float factor, const WarpTarget& target,
                      const SplatOptions& options) {
     check_target(source, target);
     REPRISE_ASSERT(options.footprint == 1 || options.footprint == 2);
     REPRISE_ASSERT(std::isfinite(factor));
     const float tol = std::clamp(options.depth_tolerance, 0.0f, 0.5f);
-    return {source.color.view(), source.depth.view(), source.motion.view(), factor,
+    return {source.color, source.depth, source.motion, factor,
             options.footprint,   1.0f - tol,          1.0f + tol,           target.color.width,
             target.color.height};
 }
@@ -166,7 +165,7 @@ Scratch& thread_scratch() {
 
 }  // namespace
 
-std::size_t splat(const Frame& source, float factor, const WarpTarget& target,
+std::size_t splat(const GBufferView& source, float factor, const WarpTarget& target,
                   const SplatOptions& options) {
     const Scatter scatter = make_scatter(source, factor, target, options);
     if (target.color.empty()) return 0;
@@ -212,7 +211,7 @@ std::size_t splat(const Frame& source, float factor, const WarpTarget& target,
     return covered;
 }
 
-std::size_t splat_reference(const Frame& source, float factor, const WarpTarget& target,
+std::size_t splat_reference(const GBufferView& source, float factor, const WarpTarget& target,
                             const SplatOptions& options) {
     const Scatter scatter = make_scatter(source, factor, target, options);
     if (target.color.empty()) return 0;

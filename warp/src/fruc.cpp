@@ -1,32 +1,143 @@
+#include <algorithm>
+#include <atomic>
 #include <cmath>
-#include <deque>
+#include <cstdint>
+#include <cstring>
 #include <utility>
+#include <vector>
 
 #include "fruc_stages.hpp"
 #include "reprise/core/metrics.hpp"
+#include "reprise/core/parallel.hpp"
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 namespace reprise::warp {
+
+namespace {
+
+// Output frames waiting for receive(), in a ring whose slots keep their buffers: a slot handed
+// out by receive() gets the caller's previous frame in exchange, so the steady state reuses the
+// same images and allocates nothing.
+class FrameQueue {
+public:
+    bool empty() const { return count_ == 0; }
+    // The next slot to fill (its old contents are to be overwritten).
+    Frame& push() {
+        if (count_ == slots_.size()) grow();
+        Frame& f = slots_[(head_ + count_) % slots_.size()];
+        ++count_;
+        return f;
+    }
+    void pop_into(Frame& out) {
+        std::swap(out, slots_[head_]);
+        head_ = (head_ + 1) % slots_.size();
+        --count_;
+    }
+
+private:
+    void grow() {
+        std::vector<Frame> bigger(std::max<std::size_t>(4, 2 * slots_.size()));
+        for (std::size_t i = 0; i < slots_.size(); ++i)
+            std::swap(bigger[i], slots_[(head_ + i) % slots_.size()]);
+        slots_.swap(bigger);
+        head_ = 0;
+    }
+    std::vector<Frame> slots_;
+    std::size_t head_ = 0, count_ = 0;
+};
+
+constexpr int kCutStep = 4;  // the shot-change test looks at every 4th pixel of every 4th row
+
+// linear_to_srgb from a table with linear interpolation (within 4e-4 of it; exact on the linear
+// segment near 0): the shot-change test compares thousands of pixels against a 0.12 threshold.
+class DisplayTable {
+public:
+    DisplayTable() {
+        for (int i = 0; i <= kSize; ++i) values_[i] = linear_to_srgb(float(i) / kSize);
+    }
+    float operator()(float linear) const {
+        const float c = linear >= 0.0f ? std::min(linear, 1.0f) * kSize : 0.0f;  // NaN -> 0
+        const int i = std::min(int(c), kSize - 1);
+        const float t = c - float(i);
+        return values_[i] + (values_[i + 1] - values_[i]) * t;
+    }
+
+private:
+    static constexpr int kSize = 1024;
+    float values_[kSize + 1];
+};
+
+template <class T>
+void size_like(Image<T>& image, const ImageView<const T>& like) {
+    if (like.empty()) image.clear();
+    else image.resize(like.width, like.height);
+}
+
+// Row bytes into one or two destinations with streaming stores where everything is 16-byte
+// aligned: the copies are larger than any cache and not read back soon, so their lines need not
+// be fetched first.
+void stream_row(const void* from, void* to, void* to2, std::size_t bytes) {
+#if defined(__SSE2__)
+    const auto aligned = [](const void* p) { return reinterpret_cast<std::uintptr_t>(p) % 16 == 0; };
+    if (aligned(from) && aligned(to) && (!to2 || aligned(to2))) {
+        const __m128i* s = static_cast<const __m128i*>(from);
+        __m128i* d = static_cast<__m128i*>(to);
+        __m128i* d2 = static_cast<__m128i*>(to2);
+        const std::size_t n = bytes / 16;
+        for (std::size_t i = 0; i < n; ++i) {
+            const __m128i v = _mm_load_si128(s + i);
+            _mm_stream_si128(d + i, v);
+            if (d2) _mm_stream_si128(d2 + i, v);
+        }
+        const std::size_t done = n * 16;
+        std::memcpy(static_cast<char*>(to) + done, static_cast<const char*>(from) + done, bytes - done);
+        if (to2)
+            std::memcpy(static_cast<char*>(to2) + done, static_cast<const char*>(from) + done,
+                        bytes - done);
+        return;
+    }
+#endif
+    std::memcpy(to, from, bytes);
+    if (to2) std::memcpy(to2, from, bytes);
+}
+
+// Rows [y0, y1) of `from` into `to` and, when not null, `to2` (both sized like it).
+template <class T>
+void copy_rows(ImageView<const T> from, Image<T>& to, int y0, int y1, Image<T>* to2 = nullptr) {
+    for (int y = y0; y < y1; ++y)
+        stream_row(from.row(y), &to(0, y), to2 ? &(*to2)(0, y) : nullptr,
+                   std::size_t(from.width) * sizeof(T));
+#if defined(__SSE2__)
+    _mm_sfence();  // streaming stores are weakly ordered
+#endif
+}
+
+// `from` into `to` (sized like it), rows in parallel.
+template <class T>
+void copy_image(ImageView<const T> from, Image<T>& to) {
+    size_like(to, from);
+    parallel_for(0, from.height, [&](int y0, int y1) { copy_rows(from, to, y0, y1); }, 64);
+}
+
+}  // namespace
 
 struct FrameRateConverter::State {
     int factor;
     FrucOptions options;
     FrucCounters counters;
     FrucScratch scratch;
-    Frame previous;
+    Frame previous;  // colour, depth, motion and ids of the last input (no normals)
     bool has_previous = false;
     bool previous_starts_shot = false;  // its motion reaches back into another shot: unusable
-    std::deque<Frame> ready;
-    std::vector<Frame> spare;  // output frames handed back to be reused
+    FrameQueue ready;
 
-    Frame take_spare() {
-        if (spare.empty()) return {};
-        Frame f = std::move(spare.back());
-        spare.pop_back();
-        return f;
-    }
+    float motion_scale() const { return 1.0f / float(factor); }
 
     // A shot change between `previous` and `frame`: most of the new frame has no counterpart in
-    // the old one, or what does differs in colour.
+    // the old one, or what does differs in colour. Surveyed on every 4th pixel of every 4th row.
     bool is_cut(const Frame& frame) {
         const int w = frame.width(), h = frame.height();
         if (previous.width() != w || previous.height() != h) return true;
@@ -35,78 +146,102 @@ struct FrameRateConverter::State {
         scratch.valid.resize(w, h);
         ReprojectCounts counts = reproject(frame, previous, payload_of(std::as_const(previous.color).view()),
                                            payload_of(scratch.reprojected.view()),
-                                           scratch.valid.view(), {.depth_tolerance = 0.05f});
-        const double pixels = double(w) * h;
+                                           scratch.valid.view(),
+                                           {.depth_tolerance = 0.05f, .step = kCutStep});
+        const double pixels = double((w + kCutStep - 1) / kCutStep) * ((h + kCutStep - 1) / kCutStep);
         const double lost = double(counts.behind + counts.occluded + counts.other_id + counts.invalid);
         if (lost > options.cut_misses * pixels) return true;
         if (counts.hits == 0) return counts.offscreen > options.cut_misses * pixels;
-        // Mean display-colour difference over the hits, on every 4th pixel of every 4th row.
-        double difference = 0.0;
-        std::size_t sampled = 0;
-        for (int y = 0; y < h; y += 4)
-            for (int x = 0; x < w; x += 4) {
-                if (!scratch.valid(x, y)) continue;
-                glm::vec4 a = frame.color(x, y), b = scratch.reprojected(x, y);
-                for (int k = 0; k < 3; ++k)
-                    difference += std::abs(linear_to_srgb(a[k]) - linear_to_srgb(b[k]));
-                ++sampled;
-            }
+        // Mean display-colour difference over the hits.
+        static const DisplayTable display;
+        std::atomic<std::size_t> sampled{0};
+        std::atomic<long long> difference{0};  // in units of 2^-20, summed exactly in any order
+        const int rows = (h + kCutStep - 1) / kCutStep;
+        parallel_for(0, rows, [&](int r0, int r1) {
+            double local = 0.0;
+            std::size_t count = 0;
+            for (int y = r0 * kCutStep; y < std::min(r1 * kCutStep, h); y += kCutStep)
+                for (int x = 0; x < w; x += kCutStep) {
+                    if (!scratch.valid(x, y)) continue;
+                    const glm::vec4 a = frame.color(x, y), b = scratch.reprojected(x, y);
+                    for (int k = 0; k < 3; ++k) local += std::abs(display(a[k]) - display(b[k]));
+                    ++count;
+                }
+            difference += std::llround(local * 1048576.0);
+            sampled += count;
+        }, 8);
         if (sampled == 0) return false;
-        return difference / (3.0 * double(sampled)) > options.cut_color;
+        return double(difference) / 1048576.0 / (3.0 * double(sampled)) > options.cut_color;
     }
 
-    // Scales motion from input periods to output periods and stamps the camera and time.
-    void finish(Frame& out, const Frame& a, const Frame& b, float s, float previous_s) {
-        const float scale = 1.0f / float(factor);
-        for (std::size_t i = 0, n = out.motion.pixel_count(); i < n; ++i)
-            out.motion.data()[i] *= scale;
-        Camera before = camera_between(a.camera, b.camera, previous_s);
-        out.camera = camera_between(a.camera, b.camera, s);
+    // Stamps the camera and time of a made frame (its motion is already per output period).
+    void finish(Frame& out, const Camera& a, const Camera& b, double fps, float s, float previous_s) {
+        Camera before = camera_between(a, b, previous_s);
+        out.camera = camera_between(a, b, s);
         out.camera.prev_view = before.view;
         out.camera.prev_projection = before.projection;
-        out.fps = b.fps > 0 ? b.fps * factor : 0.0;
+        out.fps = fps > 0 ? fps * factor : 0.0;
         out.normal.clear();
         out.id.clear();
-    }
-
-    void push(Frame&& out) {
-        ready.push_back(std::move(out));
         ++counters.outputs;
     }
 
     // The camera of the instant one frame period before `f` (from its prev_* matrices).
-    static Camera previous_instant(const Frame& f) {
-        Camera c = f.camera;
-        c.view = f.camera.prev_view;
-        c.projection = f.camera.prev_projection;
-        c.time = f.camera.time - (f.fps > 0 ? 1.0 / f.fps : 0.0);
+    static Camera previous_instant(const Camera& camera, double fps) {
+        Camera c = camera;
+        c.view = camera.prev_view;
+        c.projection = camera.prev_projection;
+        c.time = camera.time - (fps > 0 ? 1.0 / fps : 0.0);
         return c;
     }
-    static Frame camera_only(const Camera& camera) {
-        Frame f;
-        f.camera = camera;
-        return f;
-    }
 
+    // The input itself as an output (motion per output period) and as the next `previous`, in
+    // one pass over it.
     void emit_input(const Frame& frame) {
-        Frame out = take_spare();
-        out = frame;
-        if (!out.motion.empty()) {
-            const float scale = 1.0f / float(factor);
-            for (std::size_t i = 0, n = out.motion.pixel_count(); i < n; ++i)
-                out.motion.data()[i] *= scale;
-        }
-        if (frame.fps > 0) out.fps = frame.fps * factor;
-        ready.push_back(std::move(out));
+        Frame& out = ready.push();
+        const GBufferView in = frame.view();
+        size_like(out.color, in.color);
+        size_like(out.depth, in.depth);
+        size_like(out.motion, in.motion);
+        size_like(out.normal, in.normal);
+        size_like(out.id, in.id);
+        size_like(previous.color, in.color);
+        size_like(previous.depth, in.depth);
+        size_like(previous.motion, in.motion);
+        size_like(previous.id, in.id);
+        previous.normal.clear();
+        const float scale = motion_scale();
+        auto rows_of = [](const auto& view, int y0, int y1) {
+            return std::pair(std::min(y0, view.height), std::min(y1, view.height));
+        };
+        parallel_for(0, frame.height(), [&](int y0, int y1) {
+            copy_rows(in.color, out.color, y0, y1, &previous.color);
+            auto [d0, d1] = rows_of(in.depth, y0, y1);
+            copy_rows(in.depth, out.depth, d0, d1, &previous.depth);
+            auto [m0, m1] = rows_of(in.motion, y0, y1);
+            copy_rows(in.motion, previous.motion, m0, m1);
+            for (int y = m0; y < m1; ++y) {
+                const glm::vec2* from = in.motion.row(y);
+                glm::vec2* to = &out.motion(0, y);
+                for (int x = 0; x < in.motion.width; ++x) to[x] = from[x] * scale;
+            }
+            auto [n0, n1] = rows_of(in.normal, y0, y1);
+            copy_rows(in.normal, out.normal, n0, n1);
+            auto [i0, i1] = rows_of(in.id, y0, y1);
+            copy_rows(in.id, out.id, i0, i1, &previous.id);
+        }, 32);
+        out.camera = previous.camera = frame.camera;
+        out.fps = frame.fps > 0 ? frame.fps * factor : 0.0;
+        previous.fps = frame.fps;
     }
 
-    void emit_copy(const Frame& frame, const Frame& a, const Frame& b, float s) {
-        Frame out = take_spare();
-        out.color = frame.color;
-        out.depth = frame.depth;
-        out.motion.resize(frame.width(), frame.height(), glm::vec2(0.0f));
-        finish(out, a, b, s, s - 1.0f / factor);
-        push(std::move(out));
+    // Colour and depth of `frame` with zero motion.
+    void emit_copy(const GBufferView& frame, const Camera& a, const Camera& b, double fps, float s) {
+        Frame& out = ready.push();
+        copy_image(frame.color, out.color);
+        copy_image(frame.depth, out.depth);
+        out.motion.assign(frame.width(), frame.height(), glm::vec2(0.0f));
+        finish(out, a, b, fps, s, s - 1.0f / factor);
     }
 };
 
@@ -124,9 +259,7 @@ const FrucCounters& FrameRateConverter::counters() const { return state_->counte
 bool FrameRateConverter::receive(Frame& out) {
     State& st = *state_;
     if (st.ready.empty()) return false;
-    if (!out.color.empty()) st.spare.push_back(std::move(out));
-    out = std::move(st.ready.front());
-    st.ready.pop_front();
+    st.ready.pop_into(out);
     return true;
 }
 
@@ -143,55 +276,54 @@ Status FrameRateConverter::send(const Frame& frame) {
     st.counters.cuts += cut;
     const int k_max = st.factor;
 
+    const double fps = frame.fps;
+    const float scale = st.motion_scale();
     if (st.options.mode == FrucMode::Interpolate) {
         if (st.has_previous) {
             const Frame& a = st.previous;
             const bool a_warpable = !a.depth.empty() && !a.motion.empty() && !st.previous_starts_shot;
-            const Frame a_before = State::camera_only(State::previous_instant(a));
+            const Camera a_before = State::previous_instant(a.camera, a.fps);
             for (int k = 1; k < k_max; ++k) {
                 float s = float(k) / float(k_max);
                 if (cut && !a_warpable) {
-                    st.emit_copy(a, a, frame, s);
+                    st.emit_copy(a, a.camera, frame.camera, fps, s);
                 } else if (cut) {
                     // The new shot starts at the new frame: the frames before it belong to the
                     // old one, continued from its last frame alone; nothing is blended across.
-                    Frame out = st.take_spare();
-                    extrapolate_frame(a, s, st.options, st.scratch, out, st.counters);
-                    st.finish(out, a_before, a, 1.0f + s, 1.0f + s - 1.0f / k_max);
-                    st.push(std::move(out));
+                    Frame& out = st.ready.push();
+                    extrapolate_frame(a, s, scale, st.options, st.scratch, out, st.counters);
+                    st.finish(out, a_before, a.camera, a.fps, 1.0f + s, 1.0f + s - 1.0f / k_max);
                 } else if (!warpable || a.depth.empty() || a.motion.empty()) {
-                    st.emit_copy(s < 0.5f ? a : frame, a, frame, s);
+                    st.emit_copy(s < 0.5f ? a.view() : frame.view(), a.camera, frame.camera, fps, s);
                 } else if (motion_is_zero(frame)) {
                     ++st.counters.copied_still;
-                    st.emit_copy(frame, a, frame, s);
+                    st.emit_copy(frame, a.camera, frame.camera, fps, s);
                 } else {
-                    Frame out = st.take_spare();
-                    interpolate_frame(a, frame, s, a_warpable, st.options, st.scratch, out, st.counters);
-                    st.finish(out, a, frame, s, s - 1.0f / k_max);
-                    st.push(std::move(out));
+                    Frame& out = st.ready.push();
+                    interpolate_frame(a, frame, s, a_warpable, scale, st.options, st.scratch, out,
+                                      st.counters);
+                    st.finish(out, a.camera, frame.camera, fps, s, s - 1.0f / k_max);
                 }
             }
         }
         st.emit_input(frame);
     } else {
         st.emit_input(frame);
-        const Frame before = State::camera_only(State::previous_instant(frame));
+        const Camera before = State::previous_instant(frame.camera, fps);
         for (int k = 1; k < k_max; ++k) {
             float s = float(k) / float(k_max);
             if (cut || !warpable) {
-                st.emit_copy(frame, before, frame, 1.0f + s);
+                st.emit_copy(frame, before, frame.camera, fps, 1.0f + s);
             } else if (motion_is_zero(frame)) {
                 ++st.counters.copied_still;
-                st.emit_copy(frame, before, frame, 1.0f + s);
+                st.emit_copy(frame, before, frame.camera, fps, 1.0f + s);
             } else {
-                Frame out = st.take_spare();
-                extrapolate_frame(frame, s, st.options, st.scratch, out, st.counters);
-                st.finish(out, before, frame, 1.0f + s, 1.0f + s - 1.0f / k_max);
-                st.push(std::move(out));
+                Frame& out = st.ready.push();
+                extrapolate_frame(frame, s, scale, st.options, st.scratch, out, st.counters);
+                st.finish(out, before, frame.camera, fps, 1.0f + s, 1.0f + s - 1.0f / k_max);
             }
         }
     }
-    st.previous = frame;
     st.has_previous = true;
     st.previous_starts_shot = cut;
     return {};

@@ -150,9 +150,9 @@ int32_t to_fixed(float v) {
 // Grows the cells of one row of starting cells.
 class Builder {
   public:
-    Builder(const Frame& source, const Params& params, bool simd, Scratch& scratch)
-        : depth_(source.depth.view()),
-          motion_(source.motion.view()),
+    Builder(const GBufferView& source, const Params& params, bool simd, Scratch& scratch)
+        : depth_(source.depth),
+          motion_(source.motion),
           w_(source.width()),
           h_(source.height()),
           p_(params),
@@ -388,7 +388,25 @@ Params make_params(const GridOptions& o, float factor) {
     return p;
 }
 
-void build_rows(const Frame& source, const Params& params, int begin, int end, bool simd,
+void size_scratch(Scratch& scratch, const Params& params, int source_width, int target_width,
+                  int band_rows, bool motion) {
+    const std::size_t count = std::size_t((source_width + params.cell - 1) / params.cell);
+    if (scratch.fits.size() < count) {
+        scratch.fits.resize(count);
+        scratch.fitting.resize(count);
+    }
+    const std::size_t lattice = std::size_t(params.cell / params.min_cell + 1);
+    if (scratch.point_state.size() < lattice * lattice) {
+        scratch.point_state.resize(lattice * lattice);
+        scratch.points.resize(lattice * lattice);
+    }
+    scratch_rows(scratch.color, target_width, band_rows);
+    scratch_rows(scratch.depth, target_width, band_rows);
+    scratch_rows(scratch.covered, target_width, band_rows);
+    if (motion) scratch_rows(scratch.motion, target_width, band_rows);
+}
+
+void build_rows(const GBufferView& source, const Params& params, int begin, int end, bool simd,
                 Scratch& scratch, Row* rows) {
     Builder builder(source, params, simd, scratch);
     for (int r = begin; r < end; ++r) builder.build_row(r, rows[r]);

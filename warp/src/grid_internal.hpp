@@ -86,8 +86,13 @@ inline int last_centre(int64_t v) {
 
 // Replaces rows[r] by the cells grown from row r of starting cells, in a fixed order, for r in
 // [begin, end). `simd` picks the vectorised smoothness test (same cells).
-void build_rows(const Frame& source, const Params& params, int begin, int end, bool simd,
+void build_rows(const GBufferView& source, const Params& params, int begin, int end, bool simd,
                 Scratch& scratch, Row* rows);
+
+// Sizes one worker's scratch for a source `source_width` pixels wide and bands of `band_rows`
+// target rows (`motion`: with a motion band).
+void size_scratch(Scratch& scratch, const Params& params, int source_width, int target_width,
+                  int band_rows, bool motion);
 
 // `simd` picks the vectorised span kernel (same result); it reads up to three depths past a
 // span, so band rows must be padded (scratch_rows).

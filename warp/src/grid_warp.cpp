@@ -16,11 +16,10 @@ namespace {
 
 constexpr int kBandRows = 8;  // a band's scratch (29 bytes a pixel) stays in a core's cache
 
-void check(const Frame& source, const WarpTarget& t) {
-    REPRISE_ASSERT(source.depth.width() == source.width() &&
-                   source.depth.height() == source.height());
-    REPRISE_ASSERT(source.motion.width() == source.width() &&
-                   source.motion.height() == source.height());
+void check(const GBufferView& source, const WarpTarget& t) {
+    REPRISE_ASSERT(source.depth.width == source.width() && source.depth.height == source.height());
+    REPRISE_ASSERT(source.motion.width == source.width() &&
+                   source.motion.height == source.height());
     REPRISE_ASSERT(t.depth.width == t.color.width && t.depth.height == t.color.height);
     REPRISE_ASSERT(t.covered.width == t.color.width && t.covered.height == t.color.height);
     REPRISE_ASSERT(t.motion.empty() ||
@@ -37,7 +36,7 @@ GridWarper::~GridWarper() = default;
 GridWarper::GridWarper(GridWarper&&) noexcept = default;
 GridWarper& GridWarper::operator=(GridWarper&&) noexcept = default;
 
-GridStats GridWarper::run(const Frame& source, float factor, const WarpTarget& target,
+GridStats GridWarper::run(const GBufferView& source, float factor, const WarpTarget& target,
                           const GridOptions& options, bool threaded) {
     check(source, target);
     const grid::Params params = grid::make_params(options, factor);
@@ -53,6 +52,11 @@ GridStats GridWarper::run(const Frame& source, float factor, const WarpTarget& t
     const int workers =
         threaded ? std::max(1, std::min(thread_count(), std::max(top_rows, bands))) : 1;
     if (int(st.scratch.size()) < workers) st.scratch.resize(std::size_t(workers));
+    // Sized here, not on first use: which worker gets work depends on scheduling, and a worker
+    // that first gets some in a later frame must not allocate then.
+    for (int k = 0; k < workers; ++k)
+        grid::size_scratch(st.scratch[std::size_t(k)], params, source.width(),
+                           target.color.width, kBandRows, !target.motion.empty());
     if (threaded) {
         std::atomic<int> next{0};
         parallel_for(
@@ -69,7 +73,7 @@ GridStats GridWarper::run(const Frame& source, float factor, const WarpTarget& t
     }
     for (int r = 0; r < top_rows; ++r) stats.cells += st.rows[std::size_t(r)].cells.size();
 
-    const ImageView<const glm::vec4> color = source.color.view();
+    const ImageView<const glm::vec4> color = source.color;
     auto draw = [&](const Band& band, bool simd) {
         clear_band(band);
         const int y_end = band.y0 + band.view.color.height;
@@ -115,12 +119,12 @@ GridStats GridWarper::run(const Frame& source, float factor, const WarpTarget& t
     return stats;
 }
 
-GridStats GridWarper::warp(const Frame& source, float factor, const WarpTarget& target,
+GridStats GridWarper::warp(const GBufferView& source, float factor, const WarpTarget& target,
                            const GridOptions& options) {
     return run(source, factor, target, options, true);
 }
 
-GridStats GridWarper::warp_reference(const Frame& source, float factor, const WarpTarget& target,
+GridStats GridWarper::warp_reference(const GBufferView& source, float factor, const WarpTarget& target,
                                      const GridOptions& options) {
     return run(source, factor, target, options, false);
 }

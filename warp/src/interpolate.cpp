@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 
@@ -16,11 +17,13 @@ void WarpBuffers::resize(int w, int h) {
     covered.resize(w, h);
 }
 
-bool motion_is_zero(const Frame& f) {
+bool motion_is_zero(const GBufferView& f) {
     if (f.motion.empty()) return false;
-    const glm::vec2* m = f.motion.data();
-    for (std::size_t i = 0, n = f.motion.pixel_count(); i < n; ++i)
-        if (m[i].x != 0.0f || m[i].y != 0.0f) return false;
+    for (int y = 0; y < f.motion.height; ++y) {
+        const glm::vec2* m = f.motion.row(y);
+        for (int x = 0; x < f.motion.width; ++x)
+            if (m[x].x != 0.0f || m[x].y != 0.0f) return false;
+    }
     return true;
 }
 
@@ -30,52 +33,55 @@ namespace {
 // refine p = q - factor * motion(p) with the source's own (bilinear) motion and fetch colour
 // bilinearly there. Taps are not depth-tested: across silhouettes the blend measured closer to the
 // rendered truth than keeping either surface.
-void refetch(const Frame& source, float factor, WarpBuffers& out) {
-    const int w = out.color.width(), h = out.color.height();
+void refetch(const GBufferView& source, float factor, const WarpTarget& out) {
+    const int w = out.color.width, h = out.color.height;
+    const float sw = float(source.width()), sh = float(source.height());
     parallel_for(0, h, [&](int y0, int y1) {
-        for (int y = y0; y < y1; ++y)
+        for (int y = y0; y < y1; ++y) {
+            const uint8_t* covered = out.covered.row(y);
+            const glm::vec2* motion = out.motion.row(y);
+            glm::vec4* color = out.color.row(y);
             for (int x = 0; x < w; ++x) {
-                if (!out.covered(x, y)) continue;
+                if (!covered[x]) continue;
                 glm::vec2 q(x + 0.5f, y + 0.5f);
-                glm::vec2 p = q - factor * out.motion(x, y);
+                glm::vec2 p = q - factor * motion[x];
                 Bilinear b = bilinear_taps(p.x, p.y, source.width(), source.height());
                 if (!b.inside) continue;
-                glm::vec2 m = bilinear_fetch(source.motion.view(), b);
+                glm::vec2 m = bilinear_fetch(source.motion, b);
                 if (!std::isfinite(m.x) || !std::isfinite(m.y)) continue;
                 p = q - factor * m;
-                b = bilinear_taps(p.x, p.y, source.width(), source.height());
-                if (!b.inside) continue;
-                glm::vec4 c = bicubic_fetch(source.color.view(), p.x, p.y);
-                if (std::isfinite(c.r + c.g + c.b + c.a)) out.color(x, y) = c;
+                if (!(p.x >= 0.0f && p.y >= 0.0f && p.x <= sw && p.y <= sh)) continue;  // outside
+                glm::vec4 c = bicubic_fetch(source.color, p.x, p.y);
+                if (std::isfinite(c.r + c.g + c.b + c.a)) color[x] = c;
             }
+        }
     });
 }
 
 }  // namespace
 
-void warp_frame(const Frame& source, float factor, const FrucOptions& options, FrucScratch& scratch,
-                WarpBuffers& out, FrucCounters& counters) {
-    out.resize(source.width(), source.height());
+std::size_t warp_into(const GBufferView& source, float factor, const FrucOptions& options,
+                      FrucScratch& scratch, const WarpTarget& out, FrucCounters& counters) {
     switch (options.warp) {
-        case WarpMethod::Grid:
-            counters.grid_cells += scratch.grid.warp(source, factor, out.target(), options.grid).cells;
-            return;
+        case WarpMethod::Grid: {
+            const GridStats stats = scratch.grid.warp(source, factor, out, options.grid);
+            counters.grid_cells += stats.cells;
+            return stats.covered;
+        }
         case WarpMethod::Splat:
-            splat(source, factor, out.target(), options.splat);
-            return;
-        case WarpMethod::Reverse:
-            splat(source, factor, out.target(), {.footprint = 2});
+            return splat(source, factor, out, options.splat);
+        case WarpMethod::Reverse: {
+            const std::size_t covered = splat(source, factor, out, {.footprint = 2});
             refetch(source, factor, out);
-            return;
+            return covered;
+        }
     }
+    return 0;
 }
 
 void fill_holes(ImageView<glm::vec4> color, ImageView<const uint8_t> valid,
-                ImageView<const float> depth, const FrucOptions& options, FrucScratch& scratch,
-                FrucCounters& counters) {
-    std::size_t holes = 0;
-    for (int y = 0; y < valid.height; ++y)
-        for (int x = 0; x < valid.width; ++x) holes += valid(x, y) == 0;
+                ImageView<const float> depth, std::size_t holes, const FrucOptions& options,
+                FrucScratch& scratch, FrucCounters& counters) {
     counters.hole_pixels += holes;
     if (holes == 0 || options.fill == FillMethod::None) {
         counters.fills_skipped += holes == 0;
@@ -86,49 +92,62 @@ void fill_holes(ImageView<glm::vec4> color, ImageView<const uint8_t> valid,
     else scratch.andreev.fill(color, valid, depth);
 }
 
-void interpolate_frame(const Frame& a, const Frame& b, float s, bool use_a, const FrucOptions& options,
-                       FrucScratch& scratch, Frame& out, FrucCounters& counters) {
+void interpolate_frame(const GBufferView& a, const GBufferView& b, float s, bool use_a,
+                       float motion_scale, const FrucOptions& options, FrucScratch& scratch,
+                       Frame& out, FrucCounters& counters) {
     const int w = b.width(), h = b.height();
-    warp_frame(b, 1.0f - s, options, scratch, scratch.side_b, counters);
-    if (use_a) {
-        warp_frame(a, -s, options, scratch, scratch.side_a, counters);
-    } else {
-        scratch.side_a.resize(w, h);
-        std::fill_n(scratch.side_a.covered.data(), scratch.side_a.covered.pixel_count(), uint8_t(0));
-    }
     out.color.resize(w, h);
     out.depth.resize(w, h);
     out.motion.resize(w, h);
     scratch.valid.resize(w, h);
-    const WarpBuffers &wa = scratch.side_a, &wb = scratch.side_b;
+    // b is warped straight into the output, a beside it; the blend then merges a in place.
+    WarpBuffers& wa = scratch.side_a;
+    wa.resize(w, h);
+    scratch.side_b.covered.resize(w, h);
+    const WarpTarget into_out{out.color.view(), out.depth.view(), out.motion.view(),
+                              scratch.side_b.covered.view()};
+    warp_into(b, 1.0f - s, options, scratch, into_out, counters);
+    if (use_a) warp_into(a, -s, options, scratch, wa.target(), counters);
+    else wa.covered.fill(0);
     const float inf = std::numeric_limits<float>::infinity();
+    std::atomic<std::size_t> holes{0};
     parallel_for(0, h, [&](int y0, int y1) {
-        for (int y = y0; y < y1; ++y)
+        std::size_t local_holes = 0;
+        for (int y = y0; y < y1; ++y) {
+            const uint8_t* cov_a = &wa.covered(0, y);
+            const uint8_t* cov_b = &scratch.side_b.covered(0, y);
+            const float* depth_a = &wa.depth(0, y);
+            const glm::vec4* color_a = &wa.color(0, y);
+            const glm::vec2* motion_a = &wa.motion(0, y);
+            float* depth = &out.depth(0, y);
+            glm::vec4* color = &out.color(0, y);
+            glm::vec2* motion = &out.motion(0, y);
+            uint8_t* valid = &scratch.valid(0, y);
             for (int x = 0; x < w; ++x) {
-                bool ca = wa.covered(x, y), cb = wb.covered(x, y);
-                float za = wa.depth(x, y), zb = wb.depth(x, y);
-                glm::vec4 color(0.0f);
-                float z = inf;
-                glm::vec2 m(0.0f);
-                if (ca && cb && std::abs(za - zb) <= 0.02f * std::min(za, zb)) {
-                    color = (1.0f - s) * wa.color(x, y) + s * wb.color(x, y);
-                    z = std::min(za, zb);
-                    m = wb.motion(x, y);
-                } else if (ca && cb && std::isinf(za) && std::isinf(zb)) {
-                    color = (1.0f - s) * wa.color(x, y) + s * wb.color(x, y);
-                    m = wb.motion(x, y);
-                } else if (cb && (!ca || zb < za)) {
-                    color = wb.color(x, y), z = zb, m = wb.motion(x, y);
-                } else if (ca) {
-                    color = wa.color(x, y), z = za, m = wa.motion(x, y);
+                const bool ca = cov_a[x], cb = cov_b[x];
+                const float za = depth_a[x], zb = depth[x];
+                valid[x] = ca || cb;
+                if (!ca) {  // b alone (or nothing: colour 0, depth +inf, motion 0 already)
+                    local_holes += !cb;
+                    motion[x] *= motion_scale;
+                    continue;
                 }
-                out.color(x, y) = color;
-                out.depth(x, y) = z;
-                out.motion(x, y) = m;
-                scratch.valid(x, y) = ca || cb;
+                if (cb && std::abs(za - zb) <= 0.02f * std::min(za, zb)) {
+                    color[x] = (1.0f - s) * color_a[x] + s * color[x];
+                    depth[x] = std::min(za, zb);
+                } else if (cb && std::isinf(za) && std::isinf(zb)) {
+                    color[x] = (1.0f - s) * color_a[x] + s * color[x];
+                    depth[x] = inf;
+                } else if (!cb || !(zb < za)) {
+                    color[x] = color_a[x], depth[x] = za, motion[x] = motion_a[x];
+                }
+                motion[x] *= motion_scale;
             }
+        }
+        holes += local_holes;
     });
-    fill_holes(out.color.view(), scratch.valid.view(), out.depth.view(), options, scratch, counters);
+    fill_holes(out.color.view(), scratch.valid.view(), out.depth.view(), holes.load(), options,
+               scratch, counters);
 }
 
 }  // namespace reprise::warp

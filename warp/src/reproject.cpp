@@ -36,7 +36,8 @@ struct Setup {
     bool use_ids, background;
 };
 
-Setup make_setup(const Frame& current, const Frame& previous, const ReprojectOptions& options) {
+Setup make_setup(const GBufferView& current, const GBufferView& previous,
+                 const ReprojectOptions& options) {
     const Camera& c = current.camera;
     const glm::dmat4 p(c.projection);
     // Unprojection at a known depth solves a 2x2 system for (x_view, y_view); that needs a clip w
@@ -46,7 +47,7 @@ Setup make_setup(const Frame& current, const Frame& previous, const ReprojectOpt
     const glm::dmat4 t = glm::dmat4(c.prev_view) * glm::inverse(glm::dmat4(c.view));
     const double m00 = d / det, m01 = -b / det, m10 = -cc / det, m11 = a / det;
     const double u0 = t[0][2] * m00 + t[1][2] * m10, u1 = t[0][2] * m01 + t[1][2] * m11;
-    const double w = current.depth.width(), h = current.depth.height();
+    const double w = current.depth.width, h = current.depth.height;
     double k[7] = {-2.0 * u0 / w,
                    2.0 * u1 / h,
                    u0 - u1,
@@ -86,14 +87,13 @@ inline float expected_depth(const Setup& s, float px, float row, float z) {
     return w * (s.kx * px + row) + (s.kz * z + s.k1);
 }
 
-void check_contract(const Frame& current, const Frame& previous, const ConstPayload& in,
+void check_contract(const GBufferView& current, const GBufferView& previous, const ConstPayload& in,
                     const Payload& out, const ImageView<uint8_t>& hit) {
-    const int w = current.depth.width(), h = current.depth.height();
-    REPRISE_ASSERT(current.motion.width() == w && current.motion.height() == h);
-    REPRISE_ASSERT(current.id.empty() || (current.id.width() == w && current.id.height() == h));
-    const int pw = previous.depth.width(), ph = previous.depth.height();
-    REPRISE_ASSERT(previous.id.empty() ||
-                   (previous.id.width() == pw && previous.id.height() == ph));
+    const int w = current.depth.width, h = current.depth.height;
+    REPRISE_ASSERT(current.motion.width == w && current.motion.height == h);
+    REPRISE_ASSERT(current.id.empty() || (current.id.width == w && current.id.height == h));
+    const int pw = previous.depth.width, ph = previous.depth.height;
+    REPRISE_ASSERT(previous.id.empty() || (previous.id.width == pw && previous.id.height == ph));
     REPRISE_ASSERT(in.width == pw && in.height == ph && in.channels >= 1);
     REPRISE_ASSERT(out.width == w && out.height == h && out.channels == in.channels);
     REPRISE_ASSERT(hit.empty() || (hit.width == w && hit.height == h));
@@ -190,7 +190,7 @@ inline bool fetch(const float* a, const float* b, const float* c, const float* d
 // Rows [y_begin, y_end) with C payload channels (0: any). Everything the loop reads is copied
 // into locals first: the float stores to `out` could otherwise alias them.
 template <int C>
-void reproject_rows(const Kernel& kernel, int y_begin, int y_end, std::size_t* counts) {
+void reproject_rows(const Kernel& kernel, int y_begin, int y_end, int step, std::size_t* counts) {
     const Setup s = kernel.s;
     const int width = kernel.width, pw = kernel.pw, ph = kernel.ph;
     const int n = C > 0 ? C : kernel.channels;
@@ -217,7 +217,7 @@ void reproject_rows(const Kernel& kernel, int y_begin, int y_end, std::size_t* c
             ++counts[o];
         if (hrow) hrow[x] = o == Hit;
     };
-    for (int y = y_begin; y < y_end; ++y) {
+    for (int y = y_begin; y < y_end; y += step) {
         const float* const zr = depth + y * depth_stride;
         const glm::vec2* const mr = motion + y * motion_stride;
         const uint32_t* const ir = use_ids ? id + y * id_stride : nullptr;
@@ -280,6 +280,10 @@ void reproject_rows(const Kernel& kernel, int y_begin, int y_end, std::size_t* c
         };
 
         int x = 0;
+        if (step > 1) {
+            for (; x < width; x += step) record(x, classify(x), hrow);
+            continue;
+        }
 #if defined(__SSE2__)
         // Four pixels at a time: the same arithmetic lane by lane (so the same bits as the scalar
         // code), with the taps gathered per lane. Blocks with any pixel that is invalid, behind or
@@ -425,43 +429,45 @@ void reproject_rows(const Kernel& kernel, int y_begin, int y_end, std::size_t* c
 
 }  // namespace
 
-ReprojectCounts reproject(const Frame& current, const Frame& previous,
+ReprojectCounts reproject(const GBufferView& current, const GBufferView& previous,
                           ConstPayload previous_payload, Payload out, ImageView<uint8_t> hit,
                           const ReprojectOptions& options) {
     check_contract(current, previous, previous_payload, out, hit);
     const Setup s = make_setup(current, previous, options);
     const Kernel k{s,
-                   current.depth.width(),
-                   previous.depth.width(),
-                   previous.depth.height(),
+                   current.depth.width,
+                   previous.depth.width,
+                   previous.depth.height,
                    previous_payload.channels,
-                   current.depth.data(),
-                   current.depth.width(),
-                   current.motion.data(),
-                   current.motion.width(),
-                   current.id.data(),
-                   current.id.width(),
-                   previous.depth.data(),
-                   previous.depth.width(),
-                   previous.id.data(),
-                   previous.id.width(),
+                   current.depth.data,
+                   current.depth.stride,
+                   current.motion.data,
+                   current.motion.stride,
+                   current.id.data,
+                   current.id.stride,
+                   previous.depth.data,
+                   previous.depth.stride,
+                   previous.id.data,
+                   previous.id.stride,
                    previous_payload.data,
                    previous_payload.stride,
                    out.data,
                    out.stride,
                    hit.empty() ? nullptr : hit.data,
                    hit.stride};
-    using Rows = void (*)(const Kernel&, int, int, std::size_t*);
+    using Rows = void (*)(const Kernel&, int, int, int, std::size_t*);
     constexpr Rows kRows[5] = {reproject_rows<0>, reproject_rows<1>, reproject_rows<2>,
                                reproject_rows<3>, reproject_rows<4>};
     const Rows rows = kRows[k.channels <= 4 ? k.channels : 0];
     std::atomic<std::size_t> total[OutcomeCount] = {};
-    const int grain = std::max(1, 4096 / std::max(1, k.width));
+    const int step = std::max(1, options.step);
+    const int height = current.depth.height, sampled_rows = (height + step - 1) / step;
+    const int grain = std::max(1, 4096 * step / std::max(1, k.width));
     parallel_for(
-        0, current.depth.height(),
-        [&](int y0, int y1) {
+        0, sampled_rows,
+        [&](int r0, int r1) {
             std::size_t n[OutcomeCount] = {};
-            rows(k, y0, y1, n);
+            rows(k, r0 * step, std::min(r1 * step, height), step, n);
             for (int i = 0; i < OutcomeCount; ++i)
                 total[i].fetch_add(n[i], std::memory_order_relaxed);
         },
@@ -471,17 +477,18 @@ ReprojectCounts reproject(const Frame& current, const Frame& previous,
     return to_counts(n);
 }
 
-ReprojectCounts reproject_reference(const Frame& current, const Frame& previous,
+ReprojectCounts reproject_reference(const GBufferView& current, const GBufferView& previous,
                                     ConstPayload previous_payload, Payload out,
                                     ImageView<uint8_t> hit, const ReprojectOptions& options) {
     check_contract(current, previous, previous_payload, out, hit);
     const Setup s = make_setup(current, previous, options);
-    const int w = current.depth.width(), h = current.depth.height();
-    const int pw = previous.depth.width(), ph = previous.depth.height();
+    const int w = current.depth.width, h = current.depth.height;
+    const int pw = previous.depth.width, ph = previous.depth.height;
     const int channels = previous_payload.channels;
     std::size_t n[OutcomeCount] = {};
-    for (int y = 0; y < h; ++y) {
-        for (int x = 0; x < w; ++x) {
+    const int step = std::max(1, options.step);
+    for (int y = 0; y < h; y += step) {
+        for (int x = 0; x < w; x += step) {
             auto outcome = [&]() -> Outcome {
                 const float z = current.depth(x, y);
                 const glm::vec2 m = current.motion(x, y);
@@ -516,7 +523,7 @@ ReprojectCounts reproject_reference(const Frame& current, const Frame& previous,
                     if (!all_background) return Occluded;
                 } else {
                     if (!all_finite) return Occluded;
-                    const float z_previous = bilinear_fetch(previous.depth.view(), b);
+                    const float z_previous = bilinear_fetch(previous.depth, b);
                     const float tolerance = s.use_ids && ids_agree ? s.id_tolerance : s.tolerance;
                     if (!(std::abs(z_expected - z_previous) <= tolerance * z_expected))
                         return Occluded;

@@ -2,7 +2,10 @@
 // Non-owning image views and owning images with a typed pixel format.
 // Rows are `stride` elements apart; pixel (x, y) has its centre at (x + 0.5, y + 0.5).
 #include <cstddef>
+#include <algorithm>
 #include <cstdint>
+#include <string>
+#include <string_view>
 #include <type_traits>
 #include <vector>
 
@@ -37,14 +40,23 @@ template <class T>
 class Image {
 public:
     Image() = default;
-    Image(int width, int height, T fill = T{}) { resize(width, height, fill); }
+    Image(int width, int height, T value = T{}) { assign(width, height, value); }
 
-    void resize(int width, int height, T fill = T{}) {
+    // A new size gives zero pixels (T{}); the current size keeps them as they are: no
+    // reallocation and no clearing, so per-frame code can size its buffers every frame.
+    void resize(int width, int height) {
         REPRISE_ASSERT(width >= 0 && height >= 0);
+        if (width == width_ && height == height_) return;
         width_ = width;
         height_ = height;
-        pixels_.assign(std::size_t(width) * std::size_t(height), fill);
+        pixels_.assign(std::size_t(width) * std::size_t(height), T{});
     }
+    // Sizes the image and sets every pixel to `value`.
+    void assign(int width, int height, T value) {
+        resize(width, height);
+        fill(value);
+    }
+    void fill(T value) { std::fill(pixels_.begin(), pixels_.end(), value); }
     void clear() { resize(0, 0); }
 
     int width() const { return width_; }
@@ -72,9 +84,9 @@ private:
 inline constexpr int kMaxImageSide = 16384;
 
 // Checks a size that came from untrusted data; `what` names its origin.
-inline Status check_image_size(int width, int height, const std::string& what) {
+inline Status check_image_size(int width, int height, std::string_view what) {
     if (width <= 0 || height <= 0 || width > kMaxImageSide || height > kMaxImageSide)
-        return Status::error(what + ": image size " + std::to_string(width) + "x" +
+        return Status::error(std::string(what) + ": image size " + std::to_string(width) + "x" +
                              std::to_string(height) + " is outside 1.." +
                              std::to_string(kMaxImageSide));
     return {};

@@ -42,7 +42,7 @@ struct StereoStats {
 class StereoSynthesizer {
   public:
     // Makes the view of `target` from `rendered` (colour + depth + camera) into out.color,
-    // out.depth and out.camera (out.motion, normal and id are cleared). Displacements are
+    // out.depth and out.camera (out.motion, normal and id are cleared; out.fps is left as it is). Displacements are
     // exact for static geometry: each pixel is unprojected with the rendered camera and
     // projected with the target (background +inf by its direction). `history` (may be null),
     // an earlier view with colour, depth and camera, e.g. the previous frame's other eye, is
@@ -50,17 +50,25 @@ class StereoSynthesizer {
     // motion is all zero (still camera and scene) and the history's camera is the target, the
     // history is already the target view and is returned as it is. Cameras without jitter;
     // projections perspective or orthographic without skew.
-    StereoStats synthesize(const Frame& rendered, const Camera& target, Frame& out,
-                           const StereoOptions& options = {}, const Frame* history = nullptr);
+    StereoStats synthesize(const GBufferView& rendered, const Camera& target, Frame& out,
+                           const StereoOptions& options = {},
+                           const GBufferView* history = nullptr);
+    StereoStats synthesize(const GBufferView& rendered, const Camera& target, Frame& out,
+                           const StereoOptions& options, const Frame* history) {
+        const GBufferView h = history ? history->view() : GBufferView{};
+        return synthesize(rendered, target, out, options, history ? &h : nullptr);
+    }
 
     // 1 where the last synthesis covered the pixel from the rendered eye (size of the output).
     ImageView<const uint8_t> coverage() const { return covered_.view(); }
 
   private:
-    std::size_t warp_into(const Frame& source, const Camera& target, const StereoOptions& o,
-                          const warp::WarpTarget& into);
+    // Warps `source` to `target` into `into`; returns the covered pixel count (cells in `cells`).
+    std::size_t warp_into(const GBufferView& source, const Camera& target, const StereoOptions& o,
+                          const warp::WarpTarget& into, std::size_t& cells);
 
-    Frame scratch_;  // the source with its displacement to the target as motion
+    Image<glm::vec2> displacement_;  // the source's displacement to the target, as motion
+    Image<float> target_depth_;      // and its depth seen from the target
     Image<uint8_t> covered_;
     Image<glm::vec4> history_color_;
     Image<float> history_depth_;
@@ -72,13 +80,15 @@ class StereoSynthesizer {
 };
 
 // One-shot form (allocates its scratch per call).
-StereoStats synthesize_eye(const Frame& rendered, const Camera& target, const StereoOptions& options,
-                           Frame& out, const Frame* history = nullptr);
+StereoStats synthesize_eye(const GBufferView& rendered, const Camera& target,
+                           const StereoOptions& options, Frame& out,
+                           const GBufferView* history = nullptr);
 
 // Per-pixel displacement (pixels, as backward-motion-style offsets: p + d is where pixel p of
 // `source` lands in `target`) and the landing depth in the target camera. NaN where the point
 // is invalid (NaN or negative depth) or lands behind the target camera.
-void stereo_displacement(const Frame& source, const Camera& target, ImageView<glm::vec2> displacement,
-                         ImageView<float> target_depth);
+// The size is the depth's.
+void stereo_displacement(const GBufferView& source, const Camera& target,
+                         ImageView<glm::vec2> displacement, ImageView<float> target_depth);
 
 }  // namespace reprise::stereo

@@ -46,10 +46,10 @@ struct GridStats {
 // of 1e30 px or more. Same pixel coordinates in source and target, whose sizes may differ.
 class GridWarper {
   public:
-    GridStats warp(const Frame& source, float factor, const WarpTarget& target,
+    GridStats warp(const GBufferView& source, float factor, const WarpTarget& target,
                    const GridOptions& options = {});
     // The single-threaded scalar reference.
-    GridStats warp_reference(const Frame& source, float factor, const WarpTarget& target,
+    GridStats warp_reference(const GBufferView& source, float factor, const WarpTarget& target,
                              const GridOptions& options = {});
 
     GridWarper();
@@ -60,7 +60,7 @@ class GridWarper {
     struct State;  // cells and per-thread scratch (grid_internal.hpp)
 
   private:
-    GridStats run(const Frame& source, float factor, const WarpTarget& target,
+    GridStats run(const GBufferView& source, float factor, const WarpTarget& target,
                   const GridOptions& options, bool threaded);
     std::unique_ptr<State> state_;
 };

@@ -5,6 +5,7 @@
 #include <cstdint>
 
 #include "reprise/core/frame.hpp"
+#include "reprise/core/gbuffer.hpp"
 
 namespace reprise::warp {
 
@@ -42,6 +43,10 @@ struct ReprojectOptions {
     // Background (depth +inf, id 0) hits where all four previous taps are background too; its
     // motion is that of the point at infinity. When false, background pixels count as invalid.
     bool background = true;
+    // Only every step-th pixel of every step-th row (x and y multiples of step) is looked up;
+    // the others keep their `out` and `hit`, and the counts are of the looked-up pixels. A cheap
+    // survey, e.g. for a shot-change test.
+    int step = 1;
 };
 
 struct ReprojectCounts {
@@ -63,10 +68,10 @@ struct ReprojectCounts {
 // at its own jittered positions). Taps of zero bilinear weight are ignored, so integer motion
 // copies exactly. A camera whose projection is neither perspective nor orthographic (last row
 // with x/y terms) or not invertible makes every non-background pixel invalid.
-ReprojectCounts reproject(const Frame& current, const Frame& previous, ConstPayload previous_payload,
-                          Payload out, ImageView<uint8_t> hit, const ReprojectOptions& options = {});
+ReprojectCounts reproject(const GBufferView& current, const GBufferView& previous,
+                          ConstPayload previous_payload, Payload out, ImageView<uint8_t> hit, const ReprojectOptions& options = {});
 // The scalar single-threaded reference of the same function (tests compare the two).
-ReprojectCounts reproject_reference(const Frame& current, const Frame& previous,
+ReprojectCounts reproject_reference(const GBufferView& current, const GBufferView& previous,
                                     ConstPayload previous_payload, Payload out,
                                     ImageView<uint8_t> hit, const ReprojectOptions& options = {});
 

@@ -4,6 +4,7 @@
 #include <cstdint>
 
 #include "reprise/core/frame.hpp"
+#include "reprise/core/gbuffer.hpp"
 
 namespace reprise::warp {
 
@@ -34,9 +35,9 @@ struct SplatOptions {
 // negative depth, are dropped, and so is whatever lands off the target. Returns the number of
 // covered pixels. The target may differ in size from the source (same pixel coordinates).
 // Keeps a per-thread scratch (two ints per source row, eight target rows), grown on first use.
-std::size_t splat(const Frame& source, float factor, const WarpTarget& target,
+std::size_t splat(const GBufferView& source, float factor, const WarpTarget& target,
                   const SplatOptions& options = {});
-std::size_t splat_reference(const Frame& source, float factor, const WarpTarget& target,
+std::size_t splat_reference(const GBufferView& source, float factor, const WarpTarget& target,
                             const SplatOptions& options = {});
 
 }  // namespace reprise::warp

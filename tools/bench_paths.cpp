@@ -1,0 +1,144 @@
+// reprise bench paths — whole made frames (interpolated with the grid and the reverse warp,
+// extrapolated, the second eye) against cv::remap of the same frame, timed interleaved in one run.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+#include <string>
+#include <vector>
+
+#include "args.hpp"
+#include "bench.hpp"
+#include "reprise/core/parallel.hpp"
+#include "reprise/stereo/rig.hpp"
+#include "reprise/stereo/synthesize.hpp"
+#include "reprise/warp/fruc.hpp"
+
+namespace reprise::cli {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+struct Times {
+    std::vector<double> ms;
+    double best() const { return *std::min_element(ms.begin(), ms.end()); }
+    double median() const {
+        std::vector<double> s = ms;
+        std::sort(s.begin(), s.end());
+        return s[s.size() / 2];
+    }
+};
+
+template <class F>
+void time_into(Times& t, F&& f) {
+    const auto start = Clock::now();
+    f();
+    t.ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
+}
+
+struct Converter {
+    const char* name;
+    warp::FrameRateConverter converter;
+    Frame out;
+    Times times;
+};
+
+Status bench_paths_size(const BenchScene& bench, int w, int h, int timed) {
+    // timed + 2 consecutive frames: the converters are fed in order, the first two untimed.
+    std::vector<Frame> frames(std::size_t(timed + 2));
+    for (int i = 0; i < timed + 2; ++i) {
+        REPRISE_TRY(bench.renderer->render_frame(bench.scene, bench.path, 10 + i, 30.0,
+                                                 {.width = w, .height = h}, frames[std::size_t(i)]));
+        std::fprintf(stderr, "\r[bench] rendering %d/%d", i + 1, timed + 2);
+    }
+    std::fprintf(stderr, "\r%40s\r", "");
+
+    using warp::FrucMode, warp::WarpMethod, warp::FillMethod;
+    Converter converters[] = {
+        {"interpolate grid+pullpush", {2, {.mode = FrucMode::Interpolate, .warp = WarpMethod::Grid}}},
+        {"interpolate reverse+pullpush",
+         {2, {.mode = FrucMode::Interpolate, .warp = WarpMethod::Reverse}}},
+        {"extrapolate grid+pullpush", {2, {.mode = FrucMode::Extrapolate, .warp = WarpMethod::Grid}}},
+    };
+    stereo::StereoSynthesizer synthesizer;
+    Frame eye;
+    Times stereo_times, remap_times;
+    cv::Mat map_x(h, w, CV_32FC1), map_y(h, w, CV_32FC1);
+    Image<glm::vec4> remapped(w, h);
+    cv::Mat dst(h, w, CV_32FC4, remapped.data());
+
+    for (int i = 0; i < timed + 2; ++i) {
+        const Frame& f = frames[std::size_t(i)];
+        const bool timing = i >= 2;
+        for (Converter& c : converters) {
+            Status sent;
+            auto run = [&] {
+                sent = c.converter.send(f);
+                while (c.converter.receive(c.out)) {
+                }
+            };
+            if (timing) time_into(c.times, run);
+            else run();
+            REPRISE_TRY(sent);
+        }
+        const stereo::EyeCameras eyes = stereo::eye_cameras(f.camera, {}, stereo::Anchor::Left);
+        auto synthesize = [&] { synthesizer.synthesize(f, eyes.right, eye); };
+        if (timing) time_into(stereo_times, synthesize);
+        else synthesize();
+        // The peer: cv::remap of this frame's colour along its motion (bilinear, float maps).
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                const glm::vec2 m = f.motion(x, y);
+                const bool ok = std::isfinite(m.x) && std::isfinite(m.y);
+                map_x.at<float>(y, x) = ok ? float(x) + 0.5f * m.x : -1e6f;
+                map_y.at<float>(y, x) = ok ? float(y) + 0.5f * m.y : -1e6f;
+            }
+        const cv::Mat src(h, w, CV_32FC4, const_cast<glm::vec4*>(f.color.data()));
+        auto remap = [&] { cv::remap(src, dst, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT); };
+        if (timing) time_into(remap_times, remap);
+        else remap();
+        std::fprintf(stderr, "\r[bench] %dx%d %d/%d", w, h, i + 1, timed + 2);
+    }
+    std::fprintf(stderr, "\r%40s\r", "");
+
+    const std::string size = std::to_string(w) + "x" + std::to_string(h);
+    auto row = [&](const char* name, const Times& t) {
+        std::printf("%-10s %-30s %9.2f %9.2f %8.2fx %8.2fx\n", size.c_str(), name, t.best(),
+                    t.median(), t.best() / remap_times.best(), t.median() / remap_times.median());
+    };
+    for (const Converter& c : converters) row(c.name, c.times);
+    row("stereo eye grid+pullpush", stereo_times);
+    row("cv::remap (peer)", remap_times);
+    return {};
+}
+
+}  // namespace
+
+Status bench_paths(const BenchOptions& options) {
+    BenchScene bench;
+    REPRISE_TRY(open_bench_scene(options.scene, bench));
+    cv::setNumThreads(thread_count());
+    std::printf(
+        "whole made frames vs cv::remap (INTER_LINEAR, CV_32FC4, float maps) of the same frame, "
+        "interleaved\nscene %s from frame 10, %d timed frames, %d threads (reprise) / %d (OpenCV); "
+        "fruc x2: one send() + receive() per frame (the made frame, the input passed through, "
+        "the shot-change test); stereo: the right eye from the left (ipd 0.064)\n",
+        options.scene.c_str(), options.frames, thread_count(), cv::getNumThreads());
+    std::printf("%-10s %-30s %9s %9s %9s %9s\n", "size", "path", "best ms", "median ms",
+                "best/remap", "med/remap");
+    std::size_t start = 0;
+    while (start <= options.sizes.size()) {
+        std::size_t end = options.sizes.find(',', start);
+        if (end == std::string::npos) end = options.sizes.size();
+        int w = 0, h = 0;
+        REPRISE_TRY(parse_size(options.sizes.substr(start, end - start), w, h));
+        REPRISE_TRY(bench_paths_size(bench, w, h, options.frames));
+        start = end + 1;
+    }
+    return {};
+}
+
+}  // namespace reprise::cli
