@@ -28,11 +28,7 @@ struct Decoder::State {
     Picture scratch;
     Workspace work;
 
-    int slot_of(uint32_t frame) const {
-        for (int i = 0; i < kReferences; ++i)
-            if (refs[i].held && refs[i].frame == frame) return i;
-        return -1;
-    }
+    int slot_of(uint32_t frame) const { return held_slot(refs, frame); }
 };
 
 Decoder::Decoder(const DecoderOptions& options) : state_(std::make_unique<State>()) { state_->options = options; }

@@ -47,11 +47,7 @@ struct Encoder::State {
     Picture scratch;
     Workspace work;
 
-    int slot_of(uint32_t frame) const {
-        for (int i = 0; i < kReferences; ++i)
-            if (refs[i].held && refs[i].frame == frame) return i;
-        return -1;
-    }
+    int slot_of(uint32_t frame) const { return held_slot(refs, frame); }
 
     // The reference for the next frame, or -1 for a key frame.
     int choose_reference() {

@@ -79,6 +79,8 @@ struct Workspace;
 void add_stats(StreamStats& total, const StreamStats& frame);
 // The slot a new picture goes to: a free one, else the one with the smallest frame number.
 int replacement_slot(const Picture (&refs)[kReferences]);
+// The slot holding frame `frame`, or -1.
+int held_slot(const Picture (&refs)[kReferences], uint32_t frame);
 
 // --- colour.cpp
 // Linear colour -> 8-bit sRGB -> YCoCg-R, chroma averaged 2x2 for 4:2:0.

@@ -32,6 +32,12 @@ int replacement_slot(const Picture (&refs)[kReferences]) {
     return slot;
 }
 
+int held_slot(const Picture (&refs)[kReferences], uint32_t frame) {
+    for (int i = 0; i < kReferences; ++i)
+        if (refs[i].held && refs[i].frame == frame) return i;
+    return -1;
+}
+
 int default_slices(int height) {
     const int mb_rows = (height + kMb - 1) / kMb;
     return std::clamp((mb_rows + 7) / 8, 1, kMaxSlices);
