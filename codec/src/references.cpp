@@ -1,0 +1,37 @@
+// What encoder and decoder keep alike: the held pictures' slots and the running counts.
+#include "internal.hpp"
+
+namespace reprise::codec {
+
+void add_stats(StreamStats& total, const StreamStats& f) {
+    total.frames += f.frames;
+    total.key_frames += f.key_frames;
+    total.older_reference += f.older_reference;
+    total.header_bits += f.header_bits;
+    total.camera_bits += f.camera_bits;
+    total.depth_bits += f.depth_bits;
+    total.motion_bits += f.motion_bits;
+    total.color_bits += f.color_bits;
+    total.blocks += f.blocks;
+    total.blocks_skipped += f.blocks_skipped;
+    total.intra_blocks += f.intra_blocks;
+    total.motion_residual_pixels += f.motion_residual_pixels;
+    total.depth_zero_blocks += f.depth_zero_blocks;
+}
+
+int replacement_slot(const Picture (&refs)[kReferences]) {
+    int slot = 0;
+    for (int i = 0; i < kReferences; ++i) {
+        if (!refs[i].held) return i;
+        if (refs[i].frame < refs[slot].frame) slot = i;
+    }
+    return slot;
+}
+
+int held_slot(const Picture (&refs)[kReferences], uint32_t frame) {
+    for (int i = 0; i < kReferences; ++i)
+        if (refs[i].held && refs[i].frame == frame) return i;
+    return -1;
+}
+
+}  // namespace reprise::codec
