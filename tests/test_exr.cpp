@@ -326,6 +326,33 @@ TEST_F(ExrTest, GarbageAndEmptyFilesAreErrors) {
     expect_error_naming(read_frame(path("magic.exr"), f), "magic.exr");
 }
 
+// Found by fuzz_exr: OpenEXR allocates an attribute at its declared size before reading it, so a
+// 556-byte file asking for a 1.8 GB "Software" string took 1.9 GB and seconds per open.
+TEST_F(ExrTest, HeaderAttributesLargerThanTheFileAreRefused) {
+    auto attribute = [](const std::string& name, const std::string& type, int32_t size) {
+        std::string bytes = name + '\0' + type + '\0';
+        bytes.append(reinterpret_cast<const char*>(&size), 4);
+        return bytes;
+    };
+    const std::string magic("\x76\x2f\x31\x01\x02\0\0\0", 8);
+    write_raw(path("huge.exr"), magic + attribute("Software", "string", 1828716733) + "oiio");
+    write_raw(path("negative.exr"), magic + attribute("owner", "string", -5) + "x");
+    const std::string multipart("\x76\x2f\x31\x01\x02\x10\0\0", 8);
+    write_raw(path("parts.exr"), multipart + attribute("name", "string", 1) + "a" + '\0' +
+                                     attribute("name", "string", 1 << 30) + "b");
+    FrameHeader header;
+    Frame f;
+    for (const char* name : {"huge.exr", "negative.exr", "parts.exr"}) {
+        const Status s = read_frame_header(path(name), header);
+        expect_error_naming(s, name);
+        EXPECT_NE(s.message().find("declares"), std::string::npos) << s.message();
+        expect_error_naming(read_frame(path(name), f), name);
+    }
+    // A real frame's header passes the same walk.
+    ASSERT_TRUE(write_frame(path("ok.exr"), full_frame(5, 4, 2)).ok());
+    ASSERT_TRUE(read_frame(path("ok.exr"), f).ok());
+}
+
 // Property: a damaged frame is read or refused, never a crash (run under ASan in CI).
 TEST_F(ExrTest, DamagedFilesAreReadOrRefused) {
     ASSERT_TRUE(write_frame(path("good.exr"), full_frame(24, 20, 16)).ok());
