@@ -1303,11 +1303,9 @@ struct FileAccess {
         if (joined.compare(0, prefix.size(), prefix) != 0) return false;
         std::error_code error;
         const std::filesystem::path target = std::filesystem::weakly_canonical(joined, error);
-        if (!error) {
-            auto [root_end, target_at] =
-                std::mismatch(root.begin(), root.end(), target.begin(), target.end());
-            if (root_end == root.end()) return true;
-        }
+        if (!error &&
+            std::mismatch(root.begin(), root.end(), target.begin(), target.end()).first == root.end())
+            return true;
         if (refused_uri.empty()) {
             refused_uri = joined.substr(prefix.size());
             refused_target = error ? joined : target.string();
