@@ -1019,6 +1019,19 @@ class GltfPaths : public GltfSynthetic {
     }
 };
 
+// Found by fuzz_gltf: tinygltf passed an image bufferView that ran past its buffer to stb_image,
+// which read beyond the allocation (heap-buffer-overflow under ASan).
+TEST_F(GltfSynthetic, ImageBufferViewPastItsBufferIsRefused) {
+    json doc = triangle_document();
+    doc["bufferViews"].push_back(json::parse(R"({"buffer": 0, "byteOffset": 200, "byteLength": 4000})"));
+    doc["images"] = json::parse(R"([{"bufferView": 8, "mimeType": "image/png"}])");
+    const Status status = load(write("view.glb", make_glb(doc, triangle_buffer())));
+    ASSERT_FALSE(status.ok());
+    EXPECT_NE(status.message().find("view.glb: "), std::string::npos) << status.message();
+    EXPECT_NE(status.message().find("bufferView runs past the end of its buffer"), std::string::npos)
+        << status.message();
+}
+
 TEST_F(GltfPaths, BuffersInsideTheFolderTreeLoad) {
     for (const std::string uri : {"tri.bin", "sub/tri.bin", "sub/../sub/tri.bin", "./sub/tri.bin"}) {
         const fs::path gltf = write_external(uri, dir_ / "scene" / uri);

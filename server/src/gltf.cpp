@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <exception>
 #include <filesystem>
@@ -1343,6 +1344,27 @@ Status check_file_access(const std::string& file, const FileAccess& access) {
                          "GltfOptions::allow_outside_paths)");
 }
 
+// tinygltf 2.7 hands an image's bufferView to stb_image without checking that it lies inside its
+// buffer (fuzz_gltf: a GLB whose image view ran 551 bytes past its 1636-byte buffer). Image bytes
+// that start inside a loaded buffer must end inside it; then tinygltf's own decoder runs.
+bool load_image_within_buffers(tg::Image* image, const int index, std::string* error,
+                               std::string* warning, int width, int height,
+                               const unsigned char* bytes, int size, void* model) {
+    const auto at = reinterpret_cast<std::uintptr_t>(bytes);
+    for (const tg::Buffer& buffer : static_cast<const tg::Model*>(model)->buffers) {
+        const auto begin = reinterpret_cast<std::uintptr_t>(buffer.data.data());
+        const auto end = begin + buffer.data.size();
+        if (buffer.data.empty() || at < begin || at > end) continue;
+        if (size < 0 || uint64_t(size) > end - at) {
+            if (error)
+                *error += "images[" + std::to_string(index) +
+                          "]: its bufferView runs past the end of its buffer\n";
+            return false;
+        }
+    }
+    return tg::LoadImageData(image, index, error, warning, width, height, bytes, size, nullptr);
+}
+
 // `access` null: tinygltf's own file access, unrestricted.
 Status parse(std::span<const unsigned char> bytes, const std::string& file, bool named_glb,
              FileAccess* access, const std::string& base_dir, tg::Model& model,
@@ -1356,6 +1378,7 @@ Status parse(std::span<const unsigned char> bytes, const std::string& file, bool
     uint32_t length = uint32_t(bytes.size());
     if (binary) REPRISE_TRY(check_glb_layout(file, bytes, length));
     tg::TinyGLTF loader;
+    loader.SetImageLoader(&load_image_within_buffers, &model);
     if (access)
         loader.SetFsCallbacks({.FileExists = &FileAccess::file_exists,
                                .ExpandFilePath = &tg::ExpandFilePath,
