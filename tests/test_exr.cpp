@@ -326,6 +326,51 @@ TEST_F(ExrTest, GarbageAndEmptyFilesAreErrors) {
     expect_error_naming(read_frame(path("magic.exr"), f), "magic.exr");
 }
 
+// Found by fuzz_exr: OpenEXR allocates an attribute at its declared size before reading it, so a
+// 556-byte file asking for a 1.8 GB "Software" string took 1.9 GB and seconds per open; and it
+// sizes buffers by the data window before reprise's size check (899 bytes without a dataWindow
+// came out 2818056 pixels wide and took 134 MB); a type name past OpenEXR's 31-byte limit put
+// the size field elsewhere for OpenEXR than for the check (1.7 GB).
+TEST_F(ExrTest, HeadersAskingForHugeAllocationsAreRefused) {
+    auto attribute = [](const std::string& name, const std::string& type, int32_t size) {
+        std::string bytes = name + '\0' + type + '\0';
+        bytes.append(reinterpret_cast<const char*>(&size), 4);
+        return bytes;
+    };
+    auto data_window = [&](int32_t width, int32_t height) {
+        const int32_t box[4] = {0, 0, width - 1, height - 1};
+        return attribute("dataWindow", "box2i", 16) +
+               std::string(reinterpret_cast<const char*>(box), 16);
+    };
+    const std::string magic("\x76\x2f\x31\x01\x02\0\0\0", 8);
+    const std::string multipart("\x76\x2f\x31\x01\x02\x10\0\0", 8);
+    const std::string end(1, '\0');
+    const std::vector<std::pair<std::string, std::string>> files = {
+        {"huge.exr", magic + data_window(4, 4) + attribute("Software", "string", 1828716733) + "oiio"},
+        {"negative.exr", magic + attribute("owner", "string", -5) + "x"},
+        {"parts.exr", multipart + data_window(4, 4) + end + data_window(4, 4) +
+                          attribute("name", "string", 1 << 30) + "b"},
+        {"no-window.exr", magic + attribute("capDate", "string", 1) + "x" + end + "pixels"},
+        {"no-window-part.exr", multipart + data_window(4, 4) + end + attribute("name", "string", 1) +
+                                   "b" + end + end},
+        {"wide.exr", magic + data_window(1 << 30, 6) + end + "pixels"},
+        {"long-type.exr", magic + data_window(4, 4) + attribute("Software", "string" + std::string(40, 'x'), 4) + "oiio" + end},
+        {"inverted.exr", magic + data_window(-3, 6) + end + "pixels"},
+    };
+    FrameHeader header;
+    Frame f;
+    for (const auto& [name, bytes] : files) {
+        write_raw(path(name), bytes);
+        const Status s = read_frame_header(path(name), header);
+        expect_error_naming(s, name);
+        EXPECT_NE(s.message().find("(header: "), std::string::npos) << s.message();
+        expect_error_naming(read_frame(path(name), f), name);
+    }
+    // Real frames pass the same walk (so does every other file read in this suite).
+    ASSERT_TRUE(write_frame(path("ok.exr"), full_frame(5, 4, 2)).ok());
+    ASSERT_TRUE(read_frame(path("ok.exr"), f).ok());
+}
+
 // Property: a damaged frame is read or refused, never a crash (run under ASan in CI).
 TEST_F(ExrTest, DamagedFilesAreReadOrRefused) {
     ASSERT_TRUE(write_frame(path("good.exr"), full_frame(24, 20, 16)).ok());

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <random>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -989,6 +990,140 @@ TEST_F(GltfSynthetic, BrokenImagesAreRejected) {
         },
         "meshes[0].primitives[0]: materials[0] is textured through TEXCOORD_0, which the primitive "
         "lacks");
+}
+
+
+// External files: only inside the glTF file's folder tree (canonical paths), unless allowed.
+class GltfPaths : public GltfSynthetic {
+  protected:
+    // dir_/scene/tri.gltf whose buffer is `uri`, and the buffer's bytes at `buffer_at`.
+    fs::path write_external(const std::string& uri, const fs::path& buffer_at) const {
+        fs::create_directories(dir_ / "scene");
+        fs::create_directories(buffer_at.parent_path());
+        const std::vector<uint8_t> bin = triangle_buffer();
+        std::ofstream(buffer_at, std::ios::binary)
+            .write(reinterpret_cast<const char*>(bin.data()), std::streamsize(bin.size()));
+        json doc = triangle_document();
+        doc["buffers"][0]["uri"] = uri;
+        const std::string text = doc.dump();
+        return write("scene/tri.gltf", std::vector<uint8_t>(text.begin(), text.end()));
+    }
+    void expect_refused(const Status& status, const std::string& uri) const {
+        ASSERT_FALSE(status.ok()) << uri;
+        EXPECT_NE(status.message().find("tri.gltf: uri \"" + uri + "\""), std::string::npos)
+            << status.message();
+        EXPECT_NE(status.message().find("outside the glTF file's folder"), std::string::npos)
+            << status.message();
+        EXPECT_NE(status.message().find("--allow-outside-paths"), std::string::npos)
+            << status.message();
+    }
+};
+
+// Found by fuzz_gltf: tinygltf passed an image bufferView that ran past its buffer to stb_image,
+// which read beyond the allocation (heap-buffer-overflow under ASan).
+TEST_F(GltfSynthetic, ImageBufferViewPastItsBufferIsRefused) {
+    json doc = triangle_document();
+    doc["bufferViews"].push_back(json::parse(R"({"buffer": 0, "byteOffset": 200, "byteLength": 4000})"));
+    doc["images"] = json::parse(R"([{"bufferView": 8, "mimeType": "image/png"}])");
+    const Status status = load(write("view.glb", make_glb(doc, triangle_buffer())));
+    ASSERT_FALSE(status.ok());
+    EXPECT_NE(status.message().find("view.glb: "), std::string::npos) << status.message();
+    EXPECT_NE(status.message().find("bufferView runs past the end of its buffer"), std::string::npos)
+        << status.message();
+}
+
+TEST_F(GltfPaths, BuffersInsideTheFolderTreeLoad) {
+    for (const std::string uri : {"tri.bin", "sub/tri.bin", "sub/../sub/tri.bin", "./sub/tri.bin"}) {
+        const fs::path gltf = write_external(uri, dir_ / "scene" / uri);
+        const Status status = load(gltf);
+        ASSERT_TRUE(status.ok()) << uri << ": " << status.message();
+        expect_scene_contract(scene_, uri);
+    }
+}
+
+TEST_F(GltfPaths, ParentFolderUrisAreRefusedUnlessAllowed) {
+    const fs::path gltf = write_external("../outside.bin", dir_ / "outside.bin");
+    expect_refused(load(gltf), "../outside.bin");
+    EXPECT_TRUE(scene_.meshes.empty());
+    // Percent-encoded dots are decoded by tinygltf before the path is joined.
+    write_external("%2E%2E/outside.bin", dir_ / "outside.bin");
+    expect_refused(load(gltf), "../outside.bin");
+    // Deep escapes and escapes that come back in through a sibling folder.
+    const std::string deep = "sub/../../scene2/x.bin";
+    write_external(deep, dir_ / "scene2/x.bin");
+    expect_refused(load(gltf), deep);
+
+    write_external("../outside.bin", dir_ / "outside.bin");
+    const Status allowed = load_gltf(gltf.string(), scene_, {.allow_outside_paths = true});
+    ASSERT_TRUE(allowed.ok()) << allowed.message();
+    expect_scene_contract(scene_, "allowed");
+}
+
+TEST_F(GltfPaths, AbsoluteUrisDoNotReachOutside) {
+    const fs::path outside = dir_ / "outside.bin";
+    const fs::path gltf = write_external(outside.string(), outside);
+    EXPECT_FALSE(load(gltf).ok());
+    EXPECT_TRUE(scene_.meshes.empty());
+}
+
+TEST_F(GltfPaths, SymlinksAreJudgedByWhereTheyLead) {
+    const fs::path gltf = write_external("link.bin", dir_ / "outside.bin");
+    fs::create_symlink(dir_ / "outside.bin", dir_ / "scene/link.bin");
+    expect_refused(load(gltf), "link.bin");
+    fs::create_directory_symlink(dir_, dir_ / "scene/up");
+    write_external("up/outside.bin", dir_ / "outside.bin");
+    expect_refused(load(gltf), "up/outside.bin");
+
+    // A link that stays inside the tree is fine, and so is a glTF file reached through a
+    // symlinked folder: its tree is where the link leads.
+    write_external("real/tri.bin", dir_ / "scene/real/tri.bin");
+    fs::create_directory_symlink(dir_ / "scene/real", dir_ / "scene/alias");
+    write_external("alias/tri.bin", dir_ / "scene/real/tri.bin");
+    Status status = load(gltf);
+    ASSERT_TRUE(status.ok()) << status.message();
+    fs::create_directory_symlink(dir_ / "scene", dir_ / "scene-link");
+    status = load(dir_ / "scene-link/tri.gltf");
+    ASSERT_TRUE(status.ok()) << status.message();
+}
+
+TEST_F(GltfPaths, ImagesOutsideTheTreeAreRefused) {
+    const cv::Mat pixels(4, 4, CV_8UC3, cv::Scalar(10, 200, 30));
+    ASSERT_TRUE(cv::imwrite((dir_ / "outside.png").string(), pixels));
+    fs::create_directories(dir_ / "scene");
+    json doc = triangle_document();
+    doc["images"] = json::parse(R"([{"uri": "../outside.png"}])");
+    doc["textures"] = json::parse(R"([{"source": 0}])");
+    doc["materials"] = json::parse(R"([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}])");
+    doc["meshes"][0]["primitives"][0]["material"] = 0;
+    doc["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = 6;
+    const fs::path gltf = write_gltf("scene/tri.gltf", doc, triangle_buffer());
+    expect_refused(load(gltf), "../outside.png");
+    const Status allowed = load_gltf(gltf.string(), scene_, {.allow_outside_paths = true});
+    ASSERT_TRUE(allowed.ok()) << allowed.message();
+}
+
+TEST_F(GltfPaths, MemoryLoadsReadNoFiles) {
+    json doc = triangle_document();
+    const std::vector<uint8_t> bin = triangle_buffer();
+    doc["buffers"][0]["uri"] = "data:application/octet-stream;base64," + base64(bin);
+    std::string text = doc.dump();
+    Status status = load_gltf(std::span(reinterpret_cast<const uint8_t*>(text.data()), text.size()),
+                              "memory.gltf", scene_);
+    ASSERT_TRUE(status.ok()) << status.message();
+    expect_scene_contract(scene_, "memory");
+
+    doc["buffers"][0]["uri"] = "tri.bin";
+    text = doc.dump();
+    status = load_gltf(std::span(reinterpret_cast<const uint8_t*>(text.data()), text.size()),
+                       "memory.gltf", scene_);
+    ASSERT_FALSE(status.ok());
+    EXPECT_NE(status.message().find("memory.gltf: uri \"tri.bin\": a glTF file loaded from memory"),
+              std::string::npos)
+        << status.message();
+
+    status = load_gltf(make_glb(triangle_document(), bin), "memory.glb", scene_);
+    ASSERT_TRUE(status.ok()) << status.message();
+    expect_scene_contract(scene_, "memory glb");
 }
 
 // Random byte flips of valid GLBs (one with a PNG inside): every result is a Scene that keeps

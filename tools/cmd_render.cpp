@@ -23,6 +23,7 @@ struct RenderJob {
     int start = 0;
     double fps = 30.0;
     bool unlit = false;
+    bool allow_outside_paths = false;
     double stereo = 0.0;       // IPD; > 0 renders both eyes into OUT/left and OUT/right
     double convergence = 0.0;  // > 0: off-axis rig converging there
 };
@@ -48,7 +49,8 @@ Status run_render(const RenderJob& job) {
 
     server::Scene scene;
     server::CameraPath path;
-    REPRISE_TRY(server::load_scene(job.scene, scene, path));
+    REPRISE_TRY(server::load_scene(job.scene, scene, path,
+                                    {.allow_outside_paths = job.allow_outside_paths}));
     if (!job.camera.empty()) {
         server::CameraPath fallback = path;
         REPRISE_TRY(server::parse_camera_spec(job.camera, scene, fallback, path));
@@ -121,6 +123,8 @@ int command_render(int argc, char** argv) {
                 "static|orbit|pan|dolly|shake|cut|gltf[:N] with ,key=value (speed, radius, "
                 "height, shake, time, angle)");
     args.flag("--unlit", &job.unlit, "base colour only (view-independent shading)");
+    args.flag("--allow-outside-paths", &job.allow_outside_paths,
+              "let a glTF file read buffers and images outside its own folder (trusted files only)");
     args.option("--stereo", &job.stereo,
                 "IPD: render both eyes (the camera is the rig's centre) into OUT/left and OUT/right");
     args.option("--convergence", &job.convergence, "with --stereo: off-axis rig converging at this distance");

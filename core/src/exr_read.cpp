@@ -6,8 +6,10 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <glm/gtc/type_ptr.hpp>
 #include <glm/mat4x4.hpp>
 #include <limits>
@@ -46,11 +48,81 @@ std::string type_name(TypeDesc type) {
     return type.c_str();
 }
 
+// OpenEXR allocates each header attribute at its declared size before reading it, and buffers
+// for the data window's width before the size check in open_exr, so a few hundred bytes can ask
+// for gigabytes. Every attribute must fit in the file and every header must hold a dataWindow
+// within kMaxImageSide (OpenEXR 2 layout: magic, version and flags, then headers of
+// `name\0 type\0 int32 size, value` ended by an empty name, names of at most 31 bytes or 255 with
+// the long-names flag; a multi-part file ends its list of headers with an empty header). A file
+// without the magic is left to OpenImageIO's own error.
+Status check_exr_header(const std::string& path) {
+    std::ifstream file(path, std::ios::binary);
+    std::error_code ec;
+    const uint64_t file_size = fs::file_size(path, ec);
+    unsigned char start[8];
+    if (!file || ec || !file.read(reinterpret_cast<char*>(start), 8)) return {};
+    if (std::memcmp(start, "\x76\x2f\x31\x01", 4) != 0) return {};
+    const bool multipart = (start[5] & 0x10) != 0;
+    // OpenEXR reads at most this many bytes of a name and goes on from there: longer names would
+    // put this walk and OpenEXR's out of step.
+    const std::size_t max_name = (start[5] & 0x04) != 0 ? 255 : 31;
+    auto fail = [&](const std::string& problem) {
+        return Status::error(path + ": not a readable OpenEXR file (header: " + problem + ")");
+    };
+    // A name or type: at most max_name bytes and a terminating 0; an empty name ends a header.
+    auto read_name = [&](std::string& name) {
+        name.clear();
+        for (char c; file.get(c);) {
+            if (c == 0) return true;
+            if (name.size() == max_name) return false;
+            name += c;
+        }
+        return false;
+    };
+    std::string name, type;
+    bool empty_header = true, data_window = false;
+    for (;;) {
+        if (!read_name(name)) return fail("truncated or overlong attribute name");
+        if (name.empty()) {
+            // A single-part file has one header, a multi-part list ends with an empty one.
+            if (empty_header && multipart) return {};
+            if (!data_window) return fail("no dataWindow");
+            if (!multipart) return {};
+            empty_header = true;
+            data_window = false;
+            continue;
+        }
+        empty_header = false;
+        if (!read_name(type)) return fail("attribute " + name + ": truncated type name");
+        unsigned char size_bytes[4];
+        if (!file.read(reinterpret_cast<char*>(size_bytes), 4))
+            return fail("attribute " + name + ": truncated size");
+        int32_t size;
+        std::memcpy(&size, size_bytes, 4);
+        const uint64_t at = uint64_t(file.tellg());
+        if (size < 0 || at + uint64_t(size) > file_size)
+            return fail("attribute " + name + " declares " + std::to_string(size) +
+                        " bytes, more than the " + std::to_string(file_size - at) + " left");
+        if (name == "dataWindow" && type == "box2i" && size == 16) {
+            int32_t box[4];
+            file.read(reinterpret_cast<char*>(box), 16);
+            const int64_t width = int64_t(box[2]) - box[0] + 1, height = int64_t(box[3]) - box[1] + 1;
+            if (width < 1 || height < 1 || width > kMaxImageSide || height > kMaxImageSide)
+                return fail("dataWindow " + std::to_string(width) + "x" + std::to_string(height) +
+                            " is outside 1.." + std::to_string(kMaxImageSide));
+            data_window = true;
+        } else {
+            file.seekg(size, std::ios::cur);
+        }
+    }
+}
+
 Status open_exr(const std::string& path, std::unique_ptr<OIIO::ImageInput>& in) {
     std::error_code ec;
     const fs::file_status status = fs::status(path, ec);
     if (!fs::exists(status)) return Status::error(path + ": no such file");
     if (fs::is_directory(status)) return Status::error(path + ": is a folder, not an EXR file");
+    REPRISE_TRY(check_exr_header(path));
     // Only the OpenEXR reader: a file that is not EXR must fail, whatever else it may be.
     in = OIIO::ImageInput::create("openexr");
     if (!in) return Status::error(path + ": " + OIIO::geterror());

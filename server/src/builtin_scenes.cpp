@@ -349,7 +349,8 @@ Scene cut_scene(CameraPath& camera) {
 
 }  // namespace
 
-Status load_scene(const std::string& name_or_file, Scene& scene, CameraPath& camera) {
+Status load_scene(const std::string& name_or_file, Scene& scene, CameraPath& camera,
+                  const GltfOptions& gltf) {
     const std::string& n = name_or_file;
     if (n == "pan") scene = pan_scene(camera, 1.5f);
     else if (n == "fast") scene = pan_scene(camera, 24.0f);
@@ -363,7 +364,7 @@ Status load_scene(const std::string& name_or_file, Scene& scene, CameraPath& cam
             return Status::error("scene '" + n +
                                  "' is neither a built-in scene (see `reprise scenes`) nor a "
                                  ".gltf/.glb file");
-        REPRISE_TRY(load_gltf(n, scene));
+        REPRISE_TRY(load_gltf(n, scene, gltf));
         camera = default_camera_path(scene);
     }
     return {};

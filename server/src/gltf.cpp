@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <exception>
 #include <filesystem>
@@ -17,6 +18,7 @@
 #include <limits>
 #include <numbers>
 #include <numeric>
+#include <span>
 #include <string_view>
 
 namespace reprise::server {
@@ -1236,7 +1238,7 @@ uint32_t load_u32(const unsigned char* p) {
 
 // The GLB container (header, JSON chunk, optional BIN chunk) fits in the file; tinygltf
 // 2.7 misses a BIN chunk that ends up to 8 bytes past it. `length` gets the GLB's length.
-Status check_glb_layout(const std::string& file, const std::vector<unsigned char>& bytes,
+Status check_glb_layout(const std::string& file, std::span<const unsigned char> bytes,
                         uint32_t& length) {
     auto fail = [&](const std::string& problem) {
         return Status::error(file + ": GLB: " + problem);
@@ -1284,17 +1286,105 @@ bool ends_with_glb(const std::string& path) {
     return extension == ".glb";
 }
 
-Status parse(const std::string& path, const std::string& file, tg::Model& model,
+// tinygltf's file access for external buffers and images. tinygltf joins each URI to base_dir
+// (and, failing that, to the working folder); a path is read only when it starts with base_dir
+// and its canonical form lies under the canonical root. Without a root nothing is read.
+struct FileAccess {
+    std::string base_dir;
+    std::filesystem::path root;
+    std::string refused_uri;     // the first URI that resolved outside the root
+    std::string refused_target;  // where it resolved to
+
+    bool permits(const std::string& joined) {
+        if (root.empty()) {
+            if (refused_uri.empty()) refused_uri = joined;
+            return false;
+        }
+        const std::string prefix = base_dir.ends_with('/') ? base_dir : base_dir + "/";
+        if (joined.compare(0, prefix.size(), prefix) != 0) return false;
+        std::error_code error;
+        const std::filesystem::path target = std::filesystem::weakly_canonical(joined, error);
+        if (!error &&
+            std::mismatch(root.begin(), root.end(), target.begin(), target.end()).first == root.end())
+            return true;
+        if (refused_uri.empty()) {
+            refused_uri = joined.substr(prefix.size());
+            refused_target = error ? joined : target.string();
+        }
+        return false;
+    }
+
+    static bool file_exists(const std::string& path, void* self) {
+        return static_cast<FileAccess*>(self)->permits(path) && tg::FileExists(path, nullptr);
+    }
+    static bool read_whole_file(std::vector<unsigned char>* out, std::string* error,
+                                const std::string& path, void* self) {
+        if (!static_cast<FileAccess*>(self)->permits(path)) {
+            if (error) *error += "outside the glTF file's folder";
+            return false;
+        }
+        return tg::ReadWholeFile(out, error, path, nullptr);
+    }
+    static bool write_whole_file(std::string* error, const std::string&,
+                                 const std::vector<unsigned char>&, void*) {
+        if (error) *error += "reprise writes no glTF files";
+        return false;
+    }
+};
+
+Status check_file_access(const std::string& file, const FileAccess& access) {
+    if (access.refused_uri.empty()) return ok();
+    if (access.root.empty())
+        return Status::error(file + ": uri \"" + access.refused_uri +
+                             "\": a glTF file loaded from memory reads no external files");
+    return Status::error(file + ": uri \"" + access.refused_uri + "\" resolves to " +
+                         access.refused_target + ", outside the glTF file's folder " +
+                         access.root.string() +
+                         " (for trusted files: --allow-outside-paths, "
+                         "GltfOptions::allow_outside_paths)");
+}
+
+// tinygltf 2.7 hands an image's bufferView to stb_image without checking that it lies inside its
+// buffer (fuzz_gltf: a GLB whose image view ran 551 bytes past its 1636-byte buffer). Image bytes
+// that start inside a loaded buffer must end inside it; then tinygltf's own decoder runs.
+bool load_image_within_buffers(tg::Image* image, const int index, std::string* error,
+                               std::string* warning, int width, int height,
+                               const unsigned char* bytes, int size, void* model) {
+    const auto at = reinterpret_cast<std::uintptr_t>(bytes);
+    for (const tg::Buffer& buffer : static_cast<const tg::Model*>(model)->buffers) {
+        const auto begin = reinterpret_cast<std::uintptr_t>(buffer.data.data());
+        const auto end = begin + buffer.data.size();
+        if (buffer.data.empty() || at < begin || at > end) continue;
+        if (size < 0 || uint64_t(size) > end - at) {
+            if (error)
+                *error += "images[" + std::to_string(index) +
+                          "]: its bufferView runs past the end of its buffer\n";
+            return false;
+        }
+    }
+    return tg::LoadImageData(image, index, error, warning, width, height, bytes, size, nullptr);
+}
+
+// `access` null: tinygltf's own file access, unrestricted.
+Status parse(std::span<const unsigned char> bytes, const std::string& file, bool named_glb,
+             FileAccess* access, const std::string& base_dir, tg::Model& model,
              std::string& warnings) {
-    std::vector<unsigned char> bytes;
-    REPRISE_TRY(read_file(path, file, bytes));
+    if (bytes.empty()) return Status::error(file + ": the file is empty");
+    if (bytes.size() > max_file_bytes)
+        return Status::error(file + ": " + std::to_string(bytes.size()) + " bytes is too large");
     const bool binary = bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0;
-    if (!binary && ends_with_glb(path))
+    if (!binary && named_glb)
         return Status::error(file + ": GLB: the file does not start with \"glTF\"");
     uint32_t length = uint32_t(bytes.size());
     if (binary) REPRISE_TRY(check_glb_layout(file, bytes, length));
-    const std::string base_dir = std::filesystem::path(path).parent_path().string();
     tg::TinyGLTF loader;
+    loader.SetImageLoader(&load_image_within_buffers, &model);
+    if (access)
+        loader.SetFsCallbacks({.FileExists = &FileAccess::file_exists,
+                               .ExpandFilePath = &tg::ExpandFilePath,
+                               .ReadWholeFile = &FileAccess::read_whole_file,
+                               .WriteWholeFile = &FileAccess::write_whole_file,
+                               .user_data = access});
     std::string error;
     const bool parsed =
         binary
@@ -1303,6 +1393,8 @@ Status parse(const std::string& path, const std::string& file, tg::Model& model,
                                          reinterpret_cast<const char*>(bytes.data()), length,
                                          base_dir);
     warnings = one_line(warnings);
+    // A refused image is only a tinygltf warning; a refused buffer is behind "File not found".
+    if (access) REPRISE_TRY(check_file_access(file, *access));
     // Before tinygltf's errors, which for a Draco file are about its missing bufferViews.
     REPRISE_TRY(check_required_extensions(file, model));
     // On success tinygltf's errors are about fields it skipped (e.g. a skin without the optional
@@ -1314,24 +1406,50 @@ Status parse(const std::string& path, const std::string& file, tg::Model& model,
     return Status::error(message);
 }
 
+Status convert(const std::string& file, const std::string& fallback_name, const tg::Model& model,
+               const std::string& warnings, Scene& scene) {
+    Gltf g{file, model, warnings};
+    g.quantized = std::find(model.extensionsUsed.begin(), model.extensionsUsed.end(),
+                            "KHR_mesh_quantization") != model.extensionsUsed.end();
+    Scene loaded;
+    REPRISE_TRY(convert_model(g, loaded));
+    if (loaded.name.empty()) loaded.name = fallback_name;
+    scene = std::move(loaded);
+    return ok();
+}
+
 }  // namespace
 
-Status load_gltf(const std::string& path, Scene& scene) {
+Status load_gltf(const std::string& path, Scene& scene, const GltfOptions& options) {
     const std::string file = std::filesystem::path(path).filename().string();
     try {
+        std::vector<unsigned char> bytes;
+        REPRISE_TRY(read_file(path, file, bytes));
+        std::error_code error;
+        FileAccess access;
+        access.base_dir = std::filesystem::absolute(path, error).parent_path().string();
+        if (!error) access.root = std::filesystem::canonical(access.base_dir, error);
+        if (error) return Status::error(file + ": its folder cannot be resolved: " + error.message());
         tg::Model model;
         std::string warnings;
-        REPRISE_TRY(parse(path, file, model, warnings));
-        Gltf g{file, model, warnings};
-        g.quantized = std::find(model.extensionsUsed.begin(), model.extensionsUsed.end(),
-                                "KHR_mesh_quantization") != model.extensionsUsed.end();
-        Scene loaded;
-        REPRISE_TRY(convert_model(g, loaded));
-        if (loaded.name.empty()) loaded.name = std::filesystem::path(path).stem().string();
-        scene = std::move(loaded);
-        return ok();
+        REPRISE_TRY(parse(bytes, file, ends_with_glb(path),
+                          options.allow_outside_paths ? nullptr : &access, access.base_dir, model,
+                          warnings));
+        return convert(file, std::filesystem::path(path).stem().string(), model, warnings, scene);
     } catch (const std::exception& e) {
         return Status::error(file + ": " + e.what());
+    }
+}
+
+Status load_gltf(std::span<const uint8_t> bytes, const std::string& name, Scene& scene) {
+    try {
+        FileAccess no_files;
+        tg::Model model;
+        std::string warnings;
+        REPRISE_TRY(parse(bytes, name, ends_with_glb(name), &no_files, "", model, warnings));
+        return convert(name, std::filesystem::path(name).stem().string(), model, warnings, scene);
+    } catch (const std::exception& e) {
+        return Status::error(name + ": " + e.what());
     }
 }
 

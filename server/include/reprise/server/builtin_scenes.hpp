@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "reprise/server/camera_path.hpp"
+#include "reprise/server/gltf.hpp"
 
 namespace reprise::server {
 
@@ -16,6 +17,7 @@ struct SceneInfo {
 const std::vector<SceneInfo>& builtin_scenes();
 
 // A built-in scene by name, or a .gltf/.glb file, with the camera path it comes with.
-Status load_scene(const std::string& name_or_file, Scene& scene, CameraPath& camera);
+Status load_scene(const std::string& name_or_file, Scene& scene, CameraPath& camera,
+                  const GltfOptions& gltf = {});
 
 }  // namespace reprise::server
