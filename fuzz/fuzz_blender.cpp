@@ -4,31 +4,14 @@
 // container, which fuzz_exr covers.
 // Input: channel names separated by '\n', then a 0 byte, then [width, height, one type byte per
 // channel (even: float, odd: half)], then pixel bytes, repeated to fill the image.
-#include <OpenImageIO/imageio.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <cstdint>
 #include <cstdio>
 #include <string>
 #include <vector>
 
+#include "oiio_scratch.hpp"
 #include "reprise/core/exr.hpp"
-
-namespace {
-
-std::string scratch_path() {
-    const char* shm = access("/dev/shm", W_OK) == 0 ? "/dev/shm" : "/tmp";
-    return std::string(shm) + "/reprise-fuzz-blender-" + std::to_string(getpid()) + ".exr";
-}
-
-}  // namespace
-
-extern "C" int LLVMFuzzerInitialize(int*, char***) {
-    OIIO::attribute("threads", 1);
-    OIIO::attribute("exr_threads", 1);
-    return 0;
-}
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const uint8_t* end = data + size;
@@ -54,7 +37,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         for (size_t b = 0; b < 4; ++b)
             reinterpret_cast<uint8_t*>(&pixels[i])[b] = rest[(4 * i + b) % available];
 
-    static const std::string path = scratch_path();
+    static const std::string path = fuzz_scratch_path("blender-");
     auto out = OIIO::ImageOutput::create(path);
     if (!out || !out->open(path, spec)) return 0;  // e.g. duplicate or empty channel names
     const bool written = out->write_image(OIIO::TypeFloat, pixels.data()) && out->close();

@@ -1,32 +1,15 @@
 // libFuzzer target: read_frame_header and read_frame on one whole EXR file (reprise frames and
 // Blender renders as seeds). read_frame takes a file name, so each input is written to a file in
 // /dev/shm (RAM) first.
-#include <OpenImageIO/imageio.h>
-#include <unistd.h>
-
 #include <cstdint>
 #include <cstdio>
 #include <string>
 
+#include "oiio_scratch.hpp"
 #include "reprise/core/exr.hpp"
 
-namespace {
-
-std::string scratch_path() {
-    const char* shm = access("/dev/shm", W_OK) == 0 ? "/dev/shm" : "/tmp";
-    return std::string(shm) + "/reprise-fuzz-" + std::to_string(getpid()) + ".exr";
-}
-
-}  // namespace
-
-extern "C" int LLVMFuzzerInitialize(int*, char***) {
-    OIIO::attribute("threads", 1);
-    OIIO::attribute("exr_threads", 1);
-    return 0;
-}
-
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-    static const std::string path = scratch_path();
+    static const std::string path = fuzz_scratch_path("");
     std::FILE* file = std::fopen(path.c_str(), "wb");
     if (!file) return 0;
     const bool written = std::fwrite(data, 1, size, file) == size;

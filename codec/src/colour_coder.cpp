@@ -170,6 +170,21 @@ int sad(const Block& a, const Block& b) {
     return s;
 }
 
+// The decoded block: prediction plus the dequantised, inverse-transformed levels (none: the
+// prediction alone, which counts as skipped for inter blocks).
+void reconstruct(SliceJob& j, int k, int bx, int by, const Block& pred, const Block* levels, bool intra,
+                 int32_t scale, int lo) {
+    if (!levels) {
+        store(j.out->p[k], bx, by, pred, nullptr, lo, 255);
+        j.skipped += !intra;
+        return;
+    }
+    Block coef, residual;
+    dequantize(*levels, scale, coef);
+    inverse_dct(coef, residual);
+    store(j.out->p[k], bx, by, pred, &residual, lo, 255);
+}
+
 // Calls f(plane, x, y) for the 8x8 blocks of macroblock (mx, my) in coding order.
 template <class F>
 void for_each_block(const SliceJob& j, int mx, int my, const F& f) {
@@ -292,15 +307,8 @@ bool code_slice(SliceJob& j, Coder& rc) {
                         }
                         rc.bit(m.cbf[type], nonzero > 0);
                         j.mark(k, bx, by, intra || nonzero);
-                        if (nonzero) {
-                            code_levels(rc, m, type, levels);
-                            dequantize(levels, scale, coef);
-                            inverse_dct(coef, residual);
-                            store(j.out->p[k], bx, by, pred, &residual, lo, 255);
-                        } else {
-                            store(j.out->p[k], bx, by, pred, nullptr, lo, 255);
-                            j.skipped += !intra;
-                        }
+                        if (nonzero) code_levels(rc, m, type, levels);
+                        reconstruct(j, k, bx, by, pred, nonzero ? &levels : nullptr, intra, scale, lo);
                     } else {
                         if (intra) {
                             mode = rc.bit(m.mode[k > 0][0]) << 1;
@@ -311,15 +319,8 @@ bool code_slice(SliceJob& j, Coder& rc) {
                         }
                         const bool cbf = rc.bit(m.cbf[type]);
                         j.mark(k, bx, by, intra || cbf);
-                        if (cbf) {
-                            if (!decode_levels(rc, m, type, levels)) return false;
-                            dequantize(levels, scale, coef);
-                            inverse_dct(coef, residual);
-                            store(j.out->p[k], bx, by, pred, &residual, lo, 255);
-                        } else {
-                            store(j.out->p[k], bx, by, pred, nullptr, lo, 255);
-                            j.skipped += !intra;
-                        }
+                        if (cbf && !decode_levels(rc, m, type, levels)) return false;
+                        reconstruct(j, k, bx, by, pred, cbf ? &levels : nullptr, intra, scale, lo);
                     }
                 }
             }
