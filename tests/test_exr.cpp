@@ -330,7 +330,8 @@ TEST_F(ExrTest, GarbageAndEmptyFilesAreErrors) {
 // 556-byte file asking for a 1.8 GB "Software" string took 1.9 GB and seconds per open; and it
 // sizes buffers by the data window before reprise's size check (899 bytes without a dataWindow
 // came out 2818056 pixels wide and took 134 MB); a type name past OpenEXR's 31-byte limit put
-// the size field elsewhere for OpenEXR than for the check (1.7 GB).
+// the size field elsewhere for OpenEXR than for the check (1.7 GB); a 4x4 image in one 8192x8192
+// tile took 1.4 GB and 19 s (CI's fuzz run, 2 GB limit).
 TEST_F(ExrTest, HeadersAskingForHugeAllocationsAreRefused) {
     auto attribute = [](const std::string& name, const std::string& type, int32_t size) {
         std::string bytes = name + '\0' + type + '\0';
@@ -356,6 +357,8 @@ TEST_F(ExrTest, HeadersAskingForHugeAllocationsAreRefused) {
         {"wide.exr", magic + data_window(1 << 30, 6) + end + "pixels"},
         {"long-type.exr", magic + data_window(4, 4) + attribute("Software", "string" + std::string(40, 'x'), 4) + "oiio" + end},
         {"inverted.exr", magic + data_window(-3, 6) + end + "pixels"},
+        {"tiles.exr", magic + data_window(4, 4) + attribute("tiles", "tiledesc", 9) +
+                          std::string("\0\x20\0\0\0\x20\0\0\0", 9) + end + "pixels"},
     };
     FrameHeader header;
     Frame f;
@@ -369,6 +372,16 @@ TEST_F(ExrTest, HeadersAskingForHugeAllocationsAreRefused) {
     // Real frames pass the same walk (so does every other file read in this suite).
     ASSERT_TRUE(write_frame(path("ok.exr"), full_frame(5, 4, 2)).ok());
     ASSERT_TRUE(read_frame(path("ok.exr"), f).ok());
+    // So do tiles of OpenEXR's usual 64 pixels on an image smaller than one tile.
+    OIIO::ImageSpec spec(5, 4, 4, OIIO::TypeFloat);
+    spec.tile_width = spec.tile_height = 64;
+    const std::vector<float> pixels(5 * 4 * 4, 0.25f);
+    auto out = OIIO::ImageOutput::create("openexr");
+    ASSERT_TRUE(out->open(path("tiled.exr"), spec));
+    ASSERT_TRUE(out->write_image(OIIO::TypeFloat, pixels.data()));
+    ASSERT_TRUE(out->close());
+    ASSERT_TRUE(read_frame(path("tiled.exr"), f).ok());
+    EXPECT_EQ(f.color(4, 3).x, 0.25f);
 }
 
 // Property: a damaged frame is read or refused, never a crash (run under ASan in CI).

@@ -81,15 +81,25 @@ Status check_exr_header(const std::string& path) {
     };
     std::string name, type;
     bool empty_header = true, data_window = false;
+    int64_t image[2] = {0, 0};
+    uint32_t tile[2] = {0, 0};  // 0 for scanline parts
     for (;;) {
         if (!read_name(name)) return fail("truncated or overlong attribute name");
         if (name.empty()) {
             // A single-part file has one header, a multi-part list ends with an empty one.
             if (empty_header && multipart) return {};
             if (!data_window) return fail("no dataWindow");
+            // OpenEXR decodes whole tiles: a 1x1 image in one 8192x8192 tile costs gigabytes.
+            // Real tiles are at most 64 pixels or as large as the image.
+            for (int axis = 0; axis < 2; ++axis)
+                if (tile[axis] > std::max<int64_t>(image[axis], 64))
+                    return fail("tile " + std::to_string(tile[0]) + "x" + std::to_string(tile[1]) +
+                                " is larger than the " + std::to_string(image[0]) + "x" +
+                                std::to_string(image[1]) + " image");
             if (!multipart) return {};
             empty_header = true;
             data_window = false;
+            tile[0] = tile[1] = 0;
             continue;
         }
         empty_header = false;
@@ -111,6 +121,11 @@ Status check_exr_header(const std::string& path) {
                 return fail("dataWindow " + std::to_string(width) + "x" + std::to_string(height) +
                             " is outside 1.." + std::to_string(kMaxImageSide));
             data_window = true;
+            image[0] = width;
+            image[1] = height;
+        } else if (name == "tiles" && type == "tiledesc" && size == 9) {
+            file.read(reinterpret_cast<char*>(tile), 8);
+            file.seekg(1, std::ios::cur);
         } else {
             file.seekg(size, std::ios::cur);
         }
