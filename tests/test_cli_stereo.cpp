@@ -1,6 +1,7 @@
 // `reprise render --stereo`, `reprise stereo` and `reprise export --stereo` end to end.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <opencv2/imgcodecs.hpp>
 #include <string>
@@ -69,4 +70,36 @@ TEST(CliStereo, BadArgumentsExitWithTwo) {
     EXPECT_EQ(run_command(cli::command_stereo, {"--in", "/nonexistent_reprise", "--out",
                                                 (fs::temp_directory_path() / "reprise_stereo_none").string()}),
               1);
+}
+
+// Blender renders carry no camera: without the focal length the eye would be wrong, so stereo
+// refuses until --fov gives it, and then matches the run that had the camera.
+TEST(CliStereo, InputWithoutACameraNeedsTheFieldOfView) {
+    const fs::path dir = fs::temp_directory_path() / ("reprise_cli_stereo_fov_" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    const std::string truth = (dir / "truth").string(), bare = (dir / "bare").string();
+    ASSERT_EQ(run_command(cli::command_render, {"--scene", "pan", "--frames", "1", "--size", "160x90",
+                                                "--stereo", "0.1", "--out", truth}),
+              0);
+    Frame frame;
+    ASSERT_TRUE(read_frame(frame_path(truth + "/left", 0), frame).ok());
+    const double fov_degrees = 2.0 * std::atan(1.0 / frame.camera.projection[1][1]) * 180.0 / M_PI;
+    frame.camera = Camera{};
+    fs::create_directories(bare);
+    ASSERT_TRUE(write_frame(frame_path(bare, 0), frame).ok());
+    const test::Outcome refused =
+        test::run_reprise("stereo --in " + bare + " --ipd 0.1 --out " + (dir / "none").string(), 60);
+    EXPECT_EQ(refused.status, 1) << refused.output;
+    EXPECT_NE(refused.output.find("has no camera"), std::string::npos) << refused.output;
+    EXPECT_NE(refused.output.find("--fov"), std::string::npos) << refused.output;
+    EXPECT_FALSE(fs::exists(frame_path((dir / "none/right").string(), 0)));
+    const std::string with_camera = (dir / "camera").string(), with_fov = (dir / "fov").string();
+    ASSERT_EQ(run_command(cli::command_stereo, {"--in", truth + "/left", "--ipd", "0.1", "--out", with_camera}), 0);
+    ASSERT_EQ(run_command(cli::command_stereo, {"--in", bare, "--ipd", "0.1", "--fov", std::to_string(fov_degrees), "--out", with_fov}), 0);
+    const std::string right = frame_path(truth + "/right", 0);
+    const double camera_psnr = psnr_of(right, frame_path(with_camera + "/right", 0));
+    const double fov_psnr = psnr_of(right, frame_path(with_fov + "/right", 0));
+    EXPECT_GT(fov_psnr, 28.0);
+    EXPECT_NEAR(fov_psnr, camera_psnr, 0.1);
+    fs::remove_all(dir);
 }

@@ -136,7 +136,7 @@ int command_bench(int argc, char** argv) {
     args.option("--sizes", &job.sizes, "comma-separated WxH list (default 640x360,1920x1080)");
     args.option("--dir", &job.dir, "exr: folder for the files (default: the temp folder)");
     args.option("--out", &job.out, "fruc, stereo, codec: report folder (default out/bench-WHAT)");
-    args.option("--scenes", &job.scenes, "fruc, stereo, codec: comma-separated scenes (default: every built-in scene)");
+    args.option("--scenes", &job.scenes, "fruc, stereo, codec: comma-separated scenes or glTF files (default: every built-in scene; fruc adds the held-out glTF models, also named by held-out)");
     args.option("--factor", &job.factor, "fruc: K, output frames per input frame (default 2)");
     args.option("--size", &job.size, "fruc, stereo: WxH (default 640x360); codec: default 1280x720");
     args.flag("--quick", &job.quick, "fruc: a few settings only (grid+pullpush, reverse+pullpush, splat+none, ...)");

@@ -7,6 +7,7 @@
 #include "commands.hpp"
 #include "reprise/core/exr.hpp"
 #include "reprise/warp/fruc.hpp"
+#include "flow_motion.hpp"
 #include "fruc_options.hpp"
 
 namespace reprise::cli {
@@ -31,6 +32,8 @@ Status run_fruc(const FrucJob& job) {
     if (ec) return Status::error(job.out + ": cannot create the folder: " + ec.message());
 
     warp::FrameRateConverter converter(job.factor, options);
+    FlowMotion flow;
+    bool estimating = false;
     Frame in, out;
     int written = 0;
     double busy_ms = 0.0;
@@ -38,6 +41,18 @@ Status run_fruc(const FrucJob& job) {
     for (std::size_t i = 0; i < n; ++i) {
         REPRISE_TRY(read_frame(sequence.files[i], in));
         if (in.fps <= 0) in.fps = sequence.fps;
+        if (i == 0 && (in.motion.empty() || in.depth.empty())) {
+            // Said once, before any work: what the input lacks and what stands in for it.
+            if (in.motion.empty())
+                std::fprintf(stderr, "[fruc] %s: no motion channels (motion.x, motion.y): motion is "
+                             "estimated by optical flow (OpenCV DIS) between consecutive frames\n",
+                             sequence.files[i].c_str());
+            if (in.depth.empty())
+                std::fprintf(stderr, "[fruc] %s: no depth channel (Z): every pixel is given one "
+                             "depth, so nothing occludes anything\n", sequence.files[i].c_str());
+            estimating = true;
+        }
+        if (estimating) flow.complete(in);
         auto start = std::chrono::steady_clock::now();
         REPRISE_TRY(converter.send(in));
         busy_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <filesystem>
 
+#include <glm/gtc/matrix_transform.hpp>
+
 #include "args.hpp"
 #include "commands.hpp"
 #include "reprise/core/exr.hpp"
@@ -18,6 +20,7 @@ struct StereoJob {
     std::string in, out, rig = "parallel", eye = "left", warp = "grid", fill = "pullpush";
     double ipd = 0.064;
     double convergence = 10.0;
+    double fov = 0.0;  // degrees, for inputs without a camera
     bool temporal = false;
 };
 
@@ -27,6 +30,8 @@ Status check(const StereoJob& j, stereo::StereoRig& rig, stereo::StereoOptions& 
     if (!(std::abs(j.ipd) <= 1e6)) return Status::error("--ipd must be a finite distance");
     if (!(j.convergence > 0.0 && j.convergence <= 1e30))
         return Status::error("--convergence must be a positive distance");
+    if (!(j.fov >= 0.0 && j.fov < 180.0))
+        return Status::error("--fov must be a vertical field of view in degrees, in (0, 180)");
     if (j.rig != "parallel" && j.rig != "offaxis")
         return Status::error("--rig: '" + j.rig + "' is not parallel or offaxis");
     if (j.eye != "left" && j.eye != "right")
@@ -66,6 +71,16 @@ Status run_stereo(const StereoJob& job, const stereo::StereoRig& rig, const ster
         REPRISE_TRY(read_frame(file, frame));
         if (frame.depth.width() != frame.width() || frame.depth.height() != frame.height())
             return Status::error(file + ": needs a depth channel (Z) of the colour's size");
+        // Disparity needs the focal length: from the file's camera, else from --fov.
+        if (!has_projection(frame.camera)) {
+            if (job.fov == 0.0)
+                return Status::error(file + ": has no camera (Blender renders carry none); give "
+                                            "--fov DEG, the camera's vertical field of view");
+            frame.camera.projection = glm::perspective(float(glm::radians(job.fov)),
+                                                       float(frame.width()) / float(frame.height()),
+                                                       frame.camera.near, frame.camera.far);
+            frame.camera.prev_projection = frame.camera.projection;
+        }
         const stereo::EyeCameras eyes = stereo::eye_cameras(
             frame.camera, rig, given_left ? stereo::Anchor::Left : stereo::Anchor::Right);
         // The file's camera is the rendered eye's as it was rendered; the rig only adds the other.
@@ -102,6 +117,7 @@ int command_stereo(int argc, char** argv) {
     args.option("--out", &job.out, "output folder (required)");
     args.option("--ipd", &job.ipd, "eye separation in scene units (default 0.064)");
     args.option("--convergence", &job.convergence, "zero-disparity distance, offaxis rig (default 10)");
+    args.option("--fov", &job.fov, "vertical field of view in degrees, for inputs without a camera");
     args.option("--rig", &job.rig, "parallel|offaxis (default parallel)");
     args.option("--eye", &job.eye, "which eye the input is: left|right (default left)");
     args.option("--warp", &job.warp, "grid|splat (default grid)");

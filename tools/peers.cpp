@@ -141,4 +141,48 @@ void inpaint_telea(ImageView<glm::vec3> display, ImageView<const uint8_t> holes)
             }
 }
 
+void RenderedVectorsInterpolator::interpolate(const Frame& a, const Frame& b, float s,
+                                              Image<glm::vec3>& display) {
+    const int w = b.width(), h = b.height();
+    const Frame* sides[2] = {&a, &b};
+    const float factors[2] = {-s, 1.0f - s};
+    for (int k = 0; k < 2; ++k) {
+        color_[k].assign(w, h, glm::vec3(0.0f));
+        depth_[k].assign(w, h, INFINITY);
+        covered_[k].assign(w, h, 0);
+        const Frame& f = *sides[k];
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                const float z = f.depth(x, y);
+                const glm::vec2 to = glm::vec2(x + 0.5f, y + 0.5f) + factors[k] * f.motion(x, y);
+                if (!(z == z) || !(to.x >= 0.0f && to.y >= 0.0f && to.x < float(w) && to.y < float(h)))
+                    continue;
+                const int tx = int(to.x), ty = int(to.y);
+                if (!covered_[k](tx, ty) || z < depth_[k](tx, ty)) {
+                    covered_[k](tx, ty) = 1;
+                    depth_[k](tx, ty) = z;
+                    color_[k](tx, ty) = glm::vec3(f.color(x, y));
+                }
+            }
+    }
+    display.resize(w, h);
+    holes_.resize(w, h);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const float za = depth_[0](x, y), zb = depth_[1](x, y);
+            const bool in_a = covered_[0](x, y), in_b = covered_[1](x, y);
+            glm::vec3 c(0.0f);
+            if (in_a && in_b && (za == zb || std::abs(za - zb) <= 0.02f * std::min(za, zb))) {
+                c = (1.0f - s) * color_[0](x, y) + s * color_[1](x, y);
+            } else if (in_a && in_b) {
+                c = za < zb ? color_[0](x, y) : color_[1](x, y);
+            } else if (in_a || in_b) {
+                c = in_a ? color_[0](x, y) : color_[1](x, y);
+            }
+            holes_(x, y) = !(in_a || in_b);
+            display(x, y) = glm::vec3(linear_to_srgb(c.r), linear_to_srgb(c.g), linear_to_srgb(c.b));
+        }
+    inpaint_telea(display.view(), holes_.view());
+}
+
 }  // namespace reprise::cli

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "reprise/core/frame.hpp"
 #include "reprise/core/visualize.hpp"
 
 namespace reprise::cli {
@@ -38,5 +39,19 @@ class DisInterpolator {
 // Fills the pixels where `holes` is nonzero by OpenCV's Telea inpainting (radius 3) of the
 // display values rounded to 8 bits; other pixels keep their exact values.
 void inpaint_telea(ImageView<glm::vec3> display, ImageView<const uint8_t> holes);
+
+// The plain use of rendered vectors that anyone could write: a and b splatted one pixel each to
+// instant s in (0, 1) (a along its backward motion negated, b along its own), the nearer surface
+// winning, the two blended where they land within 2 % in depth, holes by Telea inpainting;
+// display values out.
+class RenderedVectorsInterpolator {
+  public:
+    void interpolate(const Frame& a, const Frame& b, float s, Image<glm::vec3>& display);
+
+  private:
+    Image<glm::vec3> color_[2];
+    Image<float> depth_[2];
+    Image<uint8_t> covered_[2], holes_;
+};
 
 }  // namespace reprise::cli

@@ -93,11 +93,36 @@ std::size_t classify_row_axis_aligned(const GBufferView& f, int y,
     return dynamic;
 }
 
+// Without a camera nothing tells static from moving: every pixel goes along its own motion.
+void extrapolate_along_motion(const GBufferView& f, float s, float motion_scale,
+                              const FrucOptions& options, FrucScratch& scratch, Frame& out,
+                              FrucCounters& counters) {
+    const int w = f.width(), h = f.height();
+    out.color.resize(w, h);
+    out.depth.resize(w, h);
+    out.motion.resize(w, h);
+    scratch.valid.resize(w, h);
+    const WarpTarget target{out.color.view(), out.depth.view(), out.motion.view(), scratch.valid.view()};
+    const std::size_t covered = warp_into(f, -s, options, scratch, target, counters);
+    fill_holes(out.color.view(), scratch.valid.view(), out.depth.view(),
+               std::size_t(w) * std::size_t(h) - covered, options, scratch, counters);
+    parallel_for(0, h, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y) {
+            glm::vec2* m = out.motion.data() + std::size_t(y) * w;
+            for (int x = 0; x < w; ++x) m[x] *= motion_scale;
+        }
+    });
+}
+
 }  // namespace
 
 void extrapolate_frame(const GBufferView& f, float s, float motion_scale, const FrucOptions& options,
                        FrucScratch& scratch, Frame& out, FrucCounters& counters) {
     const int w = f.width(), h = f.height();
+    if (!has_projection(f.camera)) {
+        extrapolate_along_motion(f, s, motion_scale, options, scratch, out, counters);
+        return;
+    }
     const float nan = std::numeric_limits<float>::quiet_NaN();
     const Camera& c = f.camera;
     Camera previous = c;
@@ -171,7 +196,7 @@ void extrapolate_frame(const GBufferView& f, float s, float motion_scale, const 
         .color = f.color, .depth = scratch.layer_depth.view(), .motion = f.motion, .camera = c};
     WarpBuffers& moving = scratch.side_a;
     moving.resize(w, h);
-    splat(moving_layer, -s, moving.target(), options.splat);
+    warp_into(moving_layer, -s, options, scratch, moving.target(), counters);
     parallel_for(0, h, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y)
             for (int x = 0; x < w; ++x)

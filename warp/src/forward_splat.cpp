@@ -55,9 +55,12 @@ bool land(int x, int y, glm::vec2 m, float factor, int footprint, int w, int h, 
         const int ix = floor_small(dx + 0.5f), iy = floor_small(dy + 0.5f);
         out = {ix, iy, 1, 1, dx - float(ix), dy - float(iy)};
     } else {
-        const int ix = floor_small(dx), iy = floor_small(dy);
+        // A landing within kSnap of a pixel centre covers that pixel alone: otherwise rounding
+        // noise in the motion (1e-5 px) would spill a nearer surface one row or column over.
+        constexpr float kSnap = 1e-3f;
+        const int ix = floor_small(dx + kSnap), iy = floor_small(dy + kSnap);
         const float ox = dx - float(ix), oy = dy - float(iy);
-        out = {ix, iy, ox > 0.0f ? 2 : 1, oy > 0.0f ? 2 : 1, ox, oy};
+        out = {ix, iy, ox > kSnap ? 2 : 1, oy > kSnap ? 2 : 1, ox, oy};
     }
     return true;
 }

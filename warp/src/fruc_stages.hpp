@@ -22,6 +22,9 @@ struct FrucScratch {
     WarpBuffers side_b;       // interpolation: b's coverage (b is warped into the output)
     Image<float> layer_depth;        // extrapolation: the input's depth with some pixels left out
     Image<glm::vec2> layer_motion;   // and the static layer's displacement
+    Image<glm::vec2> true_a, true_b;  // interpolation: motion that lands where the frame goes
+    Image<glm::vec2> inverted;        // the later frame's moving pixels, at their earlier place
+    Image<float> inverted_depth;
     Image<uint8_t> valid;
     Image<glm::vec4> reprojected;
     GridWarper grid;
@@ -52,6 +55,19 @@ void interpolate_frame(const GBufferView& a, const GBufferView& b, float s, bool
 // its backward motion per input period times motion_scale.
 void extrapolate_frame(const GBufferView& f, float s, float motion_scale, const FrucOptions& options,
                        FrucScratch& scratch, Frame& out, FrucCounters& counters);
+
+// The motion m for which p + factor * m is where pixel p of `f` is seen by camera `to`: exact
+// for what f's camera explains (static pixels, from depth and both cameras); elsewhere the
+// `inverted` motion where it is finite (may be empty), else f's own. Returns the moving pixels.
+std::size_t motion_toward(const GBufferView& f, const Camera& to, float factor,
+                          ImageView<const glm::vec2> inverted, float tolerance,
+                          ImageView<glm::vec2> out);
+
+// The later frame's moving pixels splatted to where they were in the earlier frame, carrying
+// their backward motion (nearest wins; NaN where none lands): the earlier frame's true forward
+// motion is its negation.
+void invert_motion(const GBufferView& b, float tolerance, Image<glm::vec2>& inverted,
+                   Image<float>& depth);
 
 // True when every motion vector is exactly zero (and finite).
 bool motion_is_zero(const GBufferView& f);

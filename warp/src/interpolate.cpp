@@ -2,6 +2,7 @@
 #include <atomic>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include "fruc_stages.hpp"
 #include "reprise/core/parallel.hpp"
@@ -106,8 +107,23 @@ void interpolate_frame(const GBufferView& a, const GBufferView& b, float s, bool
     scratch.side_b.covered.resize(w, h);
     const WarpTarget into_out{out.color.view(), out.depth.view(), out.motion.view(),
                               scratch.side_b.covered.view()};
-    warp_into(b, 1.0f - s, options, scratch, into_out, counters);
-    if (use_a) warp_into(a, -s, options, scratch, wa.target(), counters);
+    GBufferView from_a = a, from_b = b;
+    if (options.true_motion && has_projection(a.camera) && has_projection(b.camera) &&
+        !a.depth.empty() && !b.depth.empty()) {
+        const Camera at = camera_between(a.camera, b.camera, s);
+        scratch.true_b.resize(w, h);
+        motion_toward(b, at, 1.0f - s, {}, options.static_tolerance, scratch.true_b.view());
+        from_b.motion = scratch.true_b.view();
+        if (use_a) {
+            invert_motion(b, options.static_tolerance, scratch.inverted, scratch.inverted_depth);
+            scratch.true_a.resize(w, h);
+            motion_toward(a, at, -s, std::as_const(scratch.inverted).view(),
+                          options.static_tolerance, scratch.true_a.view());
+            from_a.motion = scratch.true_a.view();
+        }
+    }
+    warp_into(from_b, 1.0f - s, options, scratch, into_out, counters);
+    if (use_a) warp_into(from_a, -s, options, scratch, wa.target(), counters);
     else wa.covered.fill(0);
     const float inf = std::numeric_limits<float>::infinity();
     std::atomic<std::size_t> holes{0};

@@ -17,4 +17,8 @@ struct Camera {
     double time = 0.0;                // seconds on the animation timeline
 };
 
+// False for a default Camera (identity projection): the input carried no camera (Blender's
+// render passes, plain video).
+inline bool has_projection(const Camera& camera) { return camera.projection != glm::mat4(1.0f); }
+
 }  // namespace reprise

@@ -30,9 +30,14 @@ struct FrucOptions {
     // starts a new shot: the history is dropped, nothing is blended across it.
     float cut_misses = 0.6f;
     float cut_color = 0.12f;
-    // Extrapolation: a pixel is static when its motion differs from the camera-only motion by
-    // less than this many pixels.
+    // A pixel is static when its motion differs from the camera-only motion by less than this
+    // many pixels.
     float static_tolerance = 0.25f;
+    // Interpolation with cameras: each side goes where it truly is at the in-between instant —
+    // static pixels along depth and the in-between camera (exact under rotation and acceleration),
+    // the earlier frame's moving pixels along the later frame's motion inverted. Off: the earlier
+    // frame follows its own backward motion negated, both sides linearly.
+    bool true_motion = true;
 };
 
 // What was done and what was left out because the frame did not need it.
