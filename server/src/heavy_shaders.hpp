@@ -2,15 +2,18 @@
 // GLSL ES 3.00 shaders of the heavy shading mode and its screen-space reuse cache, and of the
 // key light's shadow map. The heavy pass uses the G-buffer vertex shader (gbuffer_shaders.hpp).
 //
-// Cache layout (RGBA32F, ping-pong between frames, GL rows bottom-up like the framebuffer):
-//   term: procedural albedo (rgb), key-light visibility (a)       -- the expensive term
-//   meta: window depth of the unjittered image, object id, age in frames, temporal gradient of
-//         the display colour per frame (-1: unknown, the pixel was newly shaded on a miss)
-// A status target gives the CPU, per pixel: status code (renderer.hpp kReuse*), age.
+// Cache layout (ping-pong between frames, GL rows bottom-up like the framebuffer):
+//   term (RGBA16F, read filtered): procedural albedo (rgb), key-light visibility (a)
+//   meta (RGBA32F): window depth of the unjittered image, object id, age in frames (0 = shaded
+//         this frame), temporal gradient of the display colour per frame (-1: unknown, the pixel
+//         was shaded on a miss). The CPU reads the status of each pixel from it.
 
 namespace reprise::server::shaders {
 
+// Also the heavy pass's depth pre-pass (u_light_matrix = the camera's view-projection), so that
+// each pixel runs the heavy shader once: gl_Position is invariant in both programs.
 inline constexpr const char* kShadowVertex = R"(#version 300 es
+invariant gl_Position;
 uniform mat4 u_light_matrix;
 layout(location = 0) in vec3 a_position;
 void main() { gl_Position = u_light_matrix * vec4(a_position, 1.0); }
@@ -21,7 +24,8 @@ precision mediump float;
 void main() {}
 )";
 
-inline constexpr const char* kHeavyFragment = R"(#version 300 es
+// Compiled twice: with REUSE 0 (full shading, no cache code) and REUSE 1.
+inline constexpr const char* kHeavyFragment = R"(
 precision highp float;
 precision highp int;
 precision highp sampler2DShadow;
@@ -66,9 +70,10 @@ in float v_depth;
 layout(location = 0) out vec4 o_color;
 layout(location = 1) out vec4 o_depth_motion_id;
 layout(location = 2) out vec4 o_normal;
+#if REUSE
 layout(location = 3) out vec4 o_cache_term;
 layout(location = 4) out vec4 o_cache_meta;
-layout(location = 5) out vec4 o_status;
+#endif
 
 uint hash3(uvec3 v) {
     uint h = v.x * 0x8da6b343u ^ v.y * 0xd8163841u ^ v.z * 0xcb1ab31fu;
@@ -135,29 +140,42 @@ float visibility_jittered(vec3 n) {
     return 0.25 * (texture(u_shadow_map, vec3(s.xy + d, z)) + texture(u_shadow_map, vec3(s.xy - d, z)) +
                    texture(u_shadow_map, vec3(s.xy + e, z)) + texture(u_shadow_map, vec3(s.xy - e, z)));
 }
-// The cheap, view-dependent rest: every light, highlights, from the (cached or fresh) term.
-vec3 lighting(vec4 term, vec3 n) {
-    vec3 albedo = term.rgb;
-    float visibility = term.a;
+// The cheap, view-dependent rest, split so that a colour costs a few operations per term:
+// colour = albedo * (ambient_and_points + key * visibility) + specular + key_specular * visibility.
+struct Lights {
+    vec3 diffuse;       // ambient + point lights' diffuse irradiance
+    vec3 key;           // key light's irradiance when unshadowed
+    vec3 specular;      // point lights' highlights
+    vec3 key_specular;  // key light's highlight when unshadowed
+};
+Lights gather_lights(vec3 n) {
+    Lights L;
     vec3 v = normalize(u_eye - v_world);
     vec3 l = -normalize(u_light_direction);
     float diffuse = max(dot(n, l), 0.0);
     float highlight = diffuse > 0.0 ? pow(max(dot(n, normalize(l + v)), 0.0), u_shininess) : 0.0;
-    vec3 color = albedo * (u_ambient + u_light_color * diffuse * visibility) +
-                 u_light_color * u_specular * highlight * visibility;
+    L.diffuse = u_ambient;
+    L.key = u_light_color * diffuse;
+    L.specular = vec3(0.0);
+    L.key_specular = u_light_color * u_specular * highlight;
     for (int i = 0; i < u_point_count; ++i) {
         vec3 d = u_point_position[i] - v_world;
         float d2 = max(dot(d, d), 1e-4);
         vec3 li = d * inversesqrt(d2);
         float ndl = max(dot(n, li), 0.0);
         float spec = ndl > 0.0 ? pow(max(dot(n, normalize(li + v)), 0.0), u_shininess) : 0.0;
-        color += u_point_color[i] / d2 * (albedo * ndl + u_specular * spec);
+        L.diffuse += u_point_color[i] / d2 * ndl;
+        L.specular += u_point_color[i] / d2 * u_specular * spec;
     }
-    return color;
+    return L;
 }
-vec3 display(vec3 linear) {
+vec3 shade(Lights L, vec4 term) {
+    return term.rgb * (L.diffuse + L.key * term.a) + L.specular + L.key_specular * term.a;
+}
+// sRGB encoding within about 1 % (for the change estimate only).
+vec3 approximate_display(vec3 linear) {
     vec3 c = clamp(linear, 0.0, 1.0);
-    return mix(c * 12.92, 1.055 * pow(c, vec3(1.0 / 2.4)) - 0.055, step(vec3(0.0031308), c));
+    return 1.138 * sqrt(c) - 0.138 * c;
 }
 vec2 to_pixels(vec4 clip) {  // y down, origin at the top-left corner
     vec2 ndc = clip.xy / clip.w;
@@ -180,9 +198,7 @@ bool lookup(out vec4 term, out float age, out float gradient) {
     if (m00.y != u_id || m10.y != u_id || m01.y != u_id || m11.y != u_id) return false;
     float z = mix(mix(m00.x, m10.x, t.x), mix(m01.x, m11.x, t.x), t.y);
     if (abs(z - (ndc.z * 0.5 + 0.5)) > u_epsilon) return false;
-    vec4 c00 = texelFetch(u_cache_term, i0, 0), c10 = texelFetch(u_cache_term, ivec2(i1.x, i0.y), 0);
-    vec4 c01 = texelFetch(u_cache_term, ivec2(i0.x, i1.y), 0), c11 = texelFetch(u_cache_term, i1, 0);
-    term = mix(mix(c00, c10, t.x), mix(c01, c11, t.x), t.y);
+    term = texture(u_cache_term, (p + 0.5) / u_size);  // half floats, filtered: bilinear
     age = max(max(m00.z, m10.z), max(m01.z, m11.z));
     gradient = max(max(m00.w, m10.w), max(m01.w, m11.w));
     if (u_reuse == 2 && gradient >= 0.0) {  // spatial maximum filter of the gradients
@@ -207,9 +223,11 @@ int refresh_phase() {
 void main() {
     vec3 n = dot(v_normal, v_normal) > 0.0 ? normalize(gl_FrontFacing ? v_normal : -v_normal)
                                            : vec3(0.0, 0.0, 1.0);
+    Lights L = gather_lights(n);
+#if REUSE
     vec4 cached;
     float age, gradient;
-    bool hit = u_reuse != 0 && lookup(cached, age, gradient);
+    bool hit = lookup(cached, age, gradient);
     bool reshade = !hit;
     if (hit) {
         if (age + 1.0 >= float(u_period)) reshade = true;
@@ -218,28 +236,30 @@ void main() {
     }
     vec4 term = cached;
     float new_gradient = gradient;
+    // llvmpipe runs both sides of a branch under a mask but leaves a loop when no lane is left:
+    // the expensive term sits in loops (octaves, PCF taps) that cost one pass where nothing reshades.
     if (reshade) {
         term = vec4(procedural_albedo(), visibility_pcf(n));
-        if (hit) {
-            vec3 change = abs(display(lighting(term, n)) - display(lighting(cached, n)));
-            new_gradient = max(change.r, max(change.g, change.b)) / (age + 1.0);
-        } else {
-            new_gradient = -1.0;
-        }
+        vec3 change = abs(approximate_display(shade(L, term)) - approximate_display(shade(L, cached)));
+        new_gradient = hit ? max(change.r, max(change.g, change.b)) / (age + 1.0) : -1.0;
     } else if (u_smoothing > 0.0) {
         term.a = mix(term.a, visibility_jittered(n), u_smoothing);
     }
-    vec3 color = lighting(term, n);
+#else
+    vec4 term = vec4(procedural_albedo(), visibility_pcf(n));
+#endif
+    vec3 color = shade(L, term);
 
     vec2 motion = vec2(1e30);
     if (v_previous_clip.w > 0.0) motion = to_pixels(v_previous_clip) - to_pixels(v_clip);
     o_color = vec4(color, 1.0);
     o_depth_motion_id = vec4(v_depth, motion, u_id);
     o_normal = vec4(n, 0.0);
+#if REUSE
     float new_age = reshade ? 0.0 : age + 1.0;
     o_cache_term = term;
     o_cache_meta = vec4(v_clip.z / v_clip.w * 0.5 + 0.5, u_id, new_age, new_gradient);
-    o_status = vec4(!hit ? 1.0 : (reshade ? 3.0 : 2.0), new_age, 0.0, 0.0);
+#endif
 }
 )";
 

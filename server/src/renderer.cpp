@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <limits>
 #include <vector>
 
@@ -70,6 +71,14 @@ Status link(const char* vertex, const char* fragment, const char* what, GLuint& 
 }
 
 constexpr int kShadowMapSize = 1024;
+
+// CPU time of all threads of this process (llvmpipe shades on its own threads): on a shared
+// machine it varies far less than wall time.
+double process_cpu_ms() {
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return double(t.tv_sec) * 1e3 + double(t.tv_nsec) * 1e-6;
+}
 
 // Area-weighted vertex normals for primitives that come without them.
 void smooth_normals(const std::vector<glm::vec3>& positions, const std::vector<uint32_t>& indices,
@@ -152,9 +161,9 @@ struct Renderer::Gpu {
     GLuint program = 0;
     GLuint active = 0;  // the program uniform() looks names up in
     // Heavy shading: its program, the key light's shadow map and the ping-pong reuse cache.
-    GLuint heavy_program = 0, shadow_program = 0;
+    GLuint heavy_program[2] = {}, shadow_program = 0;  // heavy_program[reuse on]
     GLuint shadow_framebuffer = 0, shadow_map = 0;
-    GLuint cache_term[2] = {}, cache_meta[2] = {}, status_target = 0;
+    GLuint cache_term[2] = {}, cache_meta[2] = {};
     int cache_slot = 0;          // the slot written by the next reusing frame
     bool cache_valid = false;    // the other slot holds the frame rendered at cache_time/view
     double cache_time = 0.0;
@@ -193,13 +202,13 @@ struct Renderer::Gpu {
         glDeleteBuffers(1, &index_buffer);
         glDeleteVertexArrays(1, &vertex_array);
         glDeleteProgram(program);
-        glDeleteProgram(heavy_program);
+        glDeleteProgram(heavy_program[0]);
+        glDeleteProgram(heavy_program[1]);
         glDeleteProgram(shadow_program);
         glDeleteFramebuffers(1, &shadow_framebuffer);
         glDeleteTextures(1, &shadow_map);
         glDeleteTextures(2, cache_term);
         glDeleteTextures(2, cache_meta);
-        glDeleteTextures(1, &status_target);
     }
 
     GLint uniform(const char* name) const { return glGetUniformLocation(active, name); }
@@ -213,8 +222,14 @@ struct Renderer::Gpu {
 
     // Programs, shadow map and cache of the heavy mode, made on first use.
     Status prepare_heavy() {
-        if (heavy_program) return {};
-        REPRISE_TRY(link(shaders::kVertex, shaders::kHeavyFragment, "heavy shading", heavy_program));
+        if (heavy_program[0]) return {};
+        std::string vertex = shaders::kVertex;
+        vertex.insert(vertex.find("uniform"), "invariant gl_Position;\n");
+        for (int reuse = 0; reuse < 2; ++reuse) {
+            const std::string fragment = std::string("#version 300 es\n#define REUSE ") +
+                                         char('0' + reuse) + shaders::kHeavyFragment;
+            REPRISE_TRY(link(vertex.c_str(), fragment.c_str(), "heavy shading", heavy_program[reuse]));
+        }
         REPRISE_TRY(link(shaders::kShadowVertex, shaders::kShadowFragment, "shadow map", shadow_program));
         glGenTextures(1, &shadow_map);
         glBindTexture(GL_TEXTURE_2D, shadow_map);
@@ -235,12 +250,11 @@ struct Renderer::Gpu {
             return Status::error("OpenGL ES: the shadow map is not renderable on this device");
         GLint draw_buffers = 0;
         glGetIntegerv(GL_MAX_DRAW_BUFFERS, &draw_buffers);
-        if (draw_buffers < 6)
-            return Status::error("renderer: heavy shading needs 6 draw buffers, this device has " +
+        if (draw_buffers < 5)
+            return Status::error("renderer: heavy shading needs 5 draw buffers, this device has " +
                                  std::to_string(draw_buffers));
         glGenTextures(2, cache_term);
         glGenTextures(2, cache_meta);
-        glGenTextures(1, &status_target);
         return {};
     }
 
@@ -249,8 +263,15 @@ struct Renderer::Gpu {
     void read_reuse(bool reusing, const Image<uint32_t>& ids);
 
     void resize_cache(int w, int h) {
-        for (int i = 0; i < 2; ++i) float_target(cache_term[i], w, h), float_target(cache_meta[i], w, h);
-        float_target(status_target, w, h);
+        for (int i = 0; i < 2; ++i) {
+            float_target(cache_meta[i], w, h);
+            glBindTexture(GL_TEXTURE_2D, cache_term[i]);
+            glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA16F, w, h, 0, GL_RGBA, GL_HALF_FLOAT, nullptr);
+            glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+            glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+            glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+            glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+        }
         cache_valid = false;
     }
 
@@ -410,14 +431,18 @@ void Renderer::Gpu::read_reuse(bool reusing, const Image<uint32_t>& ids) {
         s.shaded = s.covered;
         return;
     }
-    glReadBuffer(GL_COLOR_ATTACHMENT5);
+    glReadBuffer(GL_COLOR_ATTACHMENT4);
     glReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, g.readback.data());
     for (int y = 0; y < h; ++y) {
         const glm::vec4* row = g.readback.data() + std::size_t(h - 1 - y) * w;
         for (int x = 0; x < w; ++x) {
-            const uint8_t status = uint8_t(row[x].x);
+            const glm::vec4 meta = row[x];  // depth, id, age, gradient (< 0: shaded on a miss)
+            const uint8_t status = meta.y == 0.0f ? kReuseBackground
+                                   : meta.z > 0.0f ? kReuseHit
+                                   : meta.w < 0.0f ? kReuseMiss
+                                                   : kReuseRefresh;
             g.maps.status(x, y) = status;
-            g.maps.age(x, y) = uint8_t(std::min(row[x].y, 255.0f));
+            g.maps.age(x, y) = uint8_t(std::min(meta.z, 255.0f));
             s.covered += status != kReuseBackground;
             s.hits += status == kReuseHit || status == kReuseRefresh;
             s.reused += status == kReuseHit;
@@ -535,14 +560,12 @@ Status Renderer::render(const Scene& scene, const Instant& current, const Instan
     if (reusing) {
         glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT3, GL_TEXTURE_2D, g.cache_term[slot], 0);
         glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT4, GL_TEXTURE_2D, g.cache_meta[slot], 0);
-        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT5, GL_TEXTURE_2D, g.status_target, 0);
-        const GLenum buffers[6] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2,
-                                   GL_COLOR_ATTACHMENT3, GL_COLOR_ATTACHMENT4, GL_COLOR_ATTACHMENT5};
-        glDrawBuffers(6, buffers);
+        const GLenum buffers[5] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2,
+                                   GL_COLOR_ATTACHMENT3, GL_COLOR_ATTACHMENT4};
+        glDrawBuffers(5, buffers);
         const glm::vec4 empty_meta(2.0f, 0.0f, 0.0f, 0.0f);
         glClearBufferfv(GL_COLOR, 3, glm::value_ptr(glm::vec4(0.0f)));
         glClearBufferfv(GL_COLOR, 4, glm::value_ptr(empty_meta));
-        glClearBufferfv(GL_COLOR, 5, glm::value_ptr(glm::vec4(0.0f)));
     } else {
         const GLenum buffers[3] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
         glDrawBuffers(3, buffers);
@@ -557,7 +580,7 @@ Status Renderer::render(const Scene& scene, const Instant& current, const Instan
     glDepthFunc(GL_LESS);
     glDisable(GL_BLEND);
 
-    g.active = heavy ? g.heavy_program : g.program;
+    g.active = heavy ? g.heavy_program[reusing] : g.program;
     glUseProgram(g.active);
     glUniformMatrix4fv(g.uniform("u_view_projection"), 1, GL_FALSE, glm::value_ptr(view_projection));
     const glm::mat4 unjittered = current.projection * current.view;
@@ -577,10 +600,29 @@ Status Renderer::render(const Scene& scene, const Instant& current, const Instan
     glActiveTexture(GL_TEXTURE0);
 
     const Material fallback;
+    const auto shading_start = std::chrono::steady_clock::now();
+    const double shading_cpu_start = process_cpu_ms();
+    if (heavy) {  // depth pre-pass: the heavy shader then runs once per pixel
+        glUseProgram(g.shadow_program);
+        glUniformMatrix4fv(glGetUniformLocation(g.shadow_program, "u_light_matrix"), 1, GL_FALSE,
+                           glm::value_ptr(view_projection));
+        glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+        for (const Draw& d : g.draws) {
+            const Material& m = d.material >= 0 ? scene.materials[d.material] : fallback;
+            if (m.double_sided) glDisable(GL_CULL_FACE);
+            else glEnable(GL_CULL_FACE);
+            glFrontFace(d.mirrored ? GL_CW : GL_CCW);
+            glDrawElements(GL_TRIANGLES, d.index_count, GL_UNSIGNED_INT,
+                           (void*)(std::size_t(d.first_index) * sizeof(uint32_t)));
+        }
+        glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+        glDepthFunc(GL_LEQUAL);
+        glDepthMask(GL_FALSE);
+        glUseProgram(g.active);
+    }
     const GLint base_color = g.uniform("u_base_color"), textured = g.uniform("u_textured"),
                 specular = g.uniform("u_specular"), shininess = g.uniform("u_shininess"),
                 id = g.uniform("u_id");
-    const auto shading_start = std::chrono::steady_clock::now();
     for (const Draw& d : g.draws) {
         const Material& m = d.material >= 0 ? scene.materials[d.material] : fallback;
         glUniform4fv(base_color, 1, glm::value_ptr(m.base_color));
@@ -596,9 +638,12 @@ Status Renderer::render(const Scene& scene, const Instant& current, const Instan
                        (void*)(std::size_t(d.first_index) * sizeof(uint32_t)));
     }
     if (heavy) {
+        glDepthMask(GL_TRUE);
+        glDepthFunc(GL_LESS);
         glFinish();
         g.stats.shading_ms = std::chrono::duration<double, std::milli>(
                                  std::chrono::steady_clock::now() - shading_start).count();
+        g.stats.shading_cpu_ms = process_cpu_ms() - shading_cpu_start;
     }
 
     // Read back, turning GL's bottom-up rows into top-down images.

@@ -54,8 +54,8 @@ struct RenderSettings {
     int height = 360;
     Shading shading = Shading::Lit;
     ReuseSettings reuse;
-    int heavy_octaves = 6;     // per noise layer (three layers)
-    int heavy_pcf_radius = 3;  // (2r+1)^2 shadow-map comparisons
+    int heavy_octaves = 8;     // per noise layer (three layers)
+    int heavy_pcf_radius = 5;  // (2r+1)^2 shadow-map comparisons
 
 };
 
@@ -65,7 +65,8 @@ struct ReuseStats {
     int64_t hits = 0;       // covered pixels whose reprojection passed the depth and id test
     int64_t reused = 0;     // hits that reused the cache (not reshaded)
     int64_t shaded = 0;     // covered pixels that ran the expensive term
-    double shading_ms = 0;  // the main pass, draw to finish (without shadow map and read-back)
+    double shading_ms = 0;      // the main pass, draw to finish (without shadow map and read-back)
+    double shading_cpu_ms = 0;  // the same pass in CPU time of the whole process (software GL)
     double hit_rate() const { return covered ? double(hits) / double(covered) : 0.0; }
     double shaded_fraction() const { return covered ? double(shaded) / double(covered) : 0.0; }
 };
