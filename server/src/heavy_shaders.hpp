@@ -195,12 +195,20 @@ bool lookup(out vec4 term, out float age, out float gradient) {
     ivec2 i0 = clamp(ivec2(f), ivec2(0), last), i1 = clamp(ivec2(f) + 1, ivec2(0), last);
     vec4 m00 = texelFetch(u_cache_meta, i0, 0), m10 = texelFetch(u_cache_meta, ivec2(i1.x, i0.y), 0);
     vec4 m01 = texelFetch(u_cache_meta, ivec2(i0.x, i1.y), 0), m11 = texelFetch(u_cache_meta, i1, 0);
-    if (m00.y != u_id || m10.y != u_id || m01.y != u_id || m11.y != u_id) return false;
-    float z = mix(mix(m00.x, m10.x, t.x), mix(m01.x, m11.x, t.x), t.y);
+    // Texels that carry bilinear weight must show this object; their oldest entry counts.
+    vec4 weight = vec4((1.0 - t.x) * (1.0 - t.y), t.x * (1.0 - t.y), (1.0 - t.x) * t.y, t.x * t.y);
+    bvec4 counted = greaterThan(weight, vec4(1.0 / 256.0));
+    bvec4 same = equal(vec4(m00.y, m10.y, m01.y, m11.y), vec4(u_id));
+    if (any(bvec4(counted.x && !same.x, counted.y && !same.y, counted.z && !same.z, counted.w && !same.w)))
+        return false;
+    float z = dot(weight, vec4(m00.x, m10.x, m01.x, m11.x));
     if (abs(z - (ndc.z * 0.5 + 0.5)) > u_epsilon) return false;
     term = texture(u_cache_term, (p + 0.5) / u_size);  // half floats, filtered: bilinear
-    age = max(max(m00.z, m10.z), max(m01.z, m11.z));
-    gradient = max(max(m00.w, m10.w), max(m01.w, m11.w));
+    vec4 ages = mix(vec4(0.0), vec4(m00.z, m10.z, m01.z, m11.z), vec4(counted));
+    vec4 gradients = mix(vec4(-2.0), vec4(m00.w, m10.w, m01.w, m11.w), vec4(counted));
+    age = max(max(ages.x, ages.y), max(ages.z, ages.w));
+    gradient = max(max(gradients.x, gradients.y), max(gradients.z, gradients.w));
+    if (min(min(gradients.x, gradients.y), min(gradients.z, gradients.w)) == -1.0) gradient = -1.0;
     if (u_reuse == 2 && gradient >= 0.0) {  // spatial maximum filter of the gradients
         ivec2 c = clamp(ivec2(floor(p + 0.5)), ivec2(0), last);
         int r = u_filter_radius;
@@ -230,9 +238,14 @@ void main() {
     bool hit = lookup(cached, age, gradient);
     bool reshade = !hit;
     if (hit) {
-        if (age + 1.0 >= float(u_period)) reshade = true;
-        else if (u_reuse == 1) reshade = (u_frame + refresh_phase()) % u_period == 0;
-        else reshade = gradient < 0.0 || gradient * (age + 1.0) > u_threshold;
+        if (u_reuse == 1) {
+            reshade = age + 1.0 >= float(u_period) || (u_frame + refresh_phase()) % u_period == 0;
+        } else {
+            // The period caps each deadline, staggered per 8x8 block so that caps do not align.
+            float cap = float(u_period - int(hash3(uvec3(uvec2(ivec2(gl_FragCoord.xy) / 8), 31u)) %
+                                             uint(max(u_period / 2, 1))));
+            reshade = age + 1.0 >= cap || gradient < 0.0 || gradient * (age + 1.0) > u_threshold;
+        }
     }
     vec4 term = cached;
     float new_gradient = gradient;
