@@ -29,6 +29,7 @@ struct RenderJob {
     std::string refresh;
     double threshold = 8.0;  // adaptive: in 1/255 display steps
     double smoothing = 0.0;
+    double depth_epsilon = 1024.0;
     int octaves = 8;
     int pcf_radius = 5;
     bool allow_outside_paths = false;
@@ -66,6 +67,9 @@ Status parse_shading(const RenderJob& job, const server::Scene& scene, server::R
     if (!(job.smoothing >= 0.0 && job.smoothing <= 1.0))
         return Status::error("--smoothing must be in [0, 1]");
     reuse.smoothing = float(job.smoothing);
+    if (!(job.depth_epsilon >= 0.0 && job.depth_epsilon <= 1e6))
+        return Status::error("--depth-epsilon must be in [0, 1e6]");
+    reuse.depth_epsilon = float(job.depth_epsilon);
     if (job.octaves < 1 || job.octaves > 16) return Status::error("--octaves must be in 1..16");
     if (job.pcf_radius < 0 || job.pcf_radius > 8) return Status::error("--pcf must be in 0..8");
     settings.heavy_octaves = job.octaves;
@@ -191,6 +195,8 @@ int command_render(int argc, char** argv) {
     args.option("--octaves", &job.octaves, "heavy: noise octaves per layer, three layers (default 8)");
     args.option("--pcf", &job.pcf_radius, "heavy: PCF radius r, (2r+1)^2 shadow taps (default 5)");
     args.option("--threshold", &job.threshold, "adaptive: allowed change per channel in 1/255 (default 8)");
+    args.option("--depth-epsilon", &job.depth_epsilon,
+                "cache hit test: depth tolerance in 24-bit Z-buffer steps (default 1024)");
     args.option("--smoothing", &job.smoothing,
                 "amortized shadow supersampling alpha on cache hits (0 = off, default)");
     args.flag("--allow-outside-paths", &job.allow_outside_paths,

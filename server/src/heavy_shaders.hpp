@@ -4,7 +4,7 @@
 //
 // Cache layout (ping-pong between frames, GL rows bottom-up like the framebuffer):
 //   term (RGBA16F, read filtered): procedural albedo (rgb), key-light visibility (a)
-//   meta (RGBA32F): window depth of the unjittered image, object id, age in frames (0 = shaded
+//   meta (RGBA32F): depth key (depth_key below) of the unjittered image, object id, age in frames (0 = shaded
 //         this frame), temporal gradient of the display colour per frame (-1: unknown, the pixel
 //         was shaded on a miss). The CPU reads the status of each pixel from it.
 
@@ -24,7 +24,8 @@ precision mediump float;
 void main() {}
 )";
 
-// Compiled twice: with REUSE 0 (full shading, no cache code) and REUSE 1.
+// Compiled three times: REUSE 0 (full shading, no cache code); REUSE 1 with PASS 1 (the hit
+// pass: reuse or discard) and PASS 2 (the miss pass: full shading where the hit pass discarded).
 inline constexpr const char* kHeavyFragment = R"(
 precision highp float;
 precision highp int;
@@ -60,6 +61,7 @@ uniform int u_interleave_step;
 uniform float u_threshold;
 uniform int u_filter_radius;
 uniform float u_epsilon;
+uniform bool u_orthographic;
 uniform float u_smoothing;
 in vec4 v_clip;
 in vec4 v_previous_clip;
@@ -181,6 +183,12 @@ vec2 to_pixels(vec4 clip) {  // y down, origin at the top-left corner
     vec2 ndc = clip.xy / clip.w;
     return vec2((ndc.x * 0.5 + 0.5) * u_size.x, (0.5 - ndc.y * 0.5) * u_size.y);
 }
+// What the cache stores as depth: window depth is affine in screen space but crowds against 1
+// in floats; 1/w is affine too, keeps full precision, and a step of a 24-bit Z-buffer is a
+// constant step in it (2^-24 (1/near - 1/far)).
+float depth_key(vec4 clip) {
+    return u_orthographic ? clip.z / clip.w * 0.5 + 0.5 : 1.0 / clip.w;
+}
 // Reverse reprojection into the previous frame's cache: bilinear depth within epsilon, the same
 // object id on all four texels.
 bool lookup(out vec4 term, out float age, out float gradient) {
@@ -202,7 +210,7 @@ bool lookup(out vec4 term, out float age, out float gradient) {
     if (any(bvec4(counted.x && !same.x, counted.y && !same.y, counted.z && !same.z, counted.w && !same.w)))
         return false;
     float z = dot(weight, vec4(m00.x, m10.x, m01.x, m11.x));
-    if (abs(z - (ndc.z * 0.5 + 0.5)) > u_epsilon) return false;
+    if (abs(z - depth_key(v_previous_clip)) > u_epsilon) return false;
     term = texture(u_cache_term, (p + 0.5) / u_size);  // half floats, filtered: bilinear
     vec4 ages = mix(vec4(0.0), vec4(m00.z, m10.z, m01.z, m11.z), vec4(counted));
     vec4 gradients = mix(vec4(-2.0), vec4(m00.w, m10.w, m01.w, m11.w), vec4(counted));
@@ -249,15 +257,17 @@ void main() {
     }
     vec4 term = cached;
     float new_gradient = gradient;
-    // llvmpipe runs both sides of a branch under a mask but leaves a loop when no lane is left:
-    // the expensive term sits in loops (octaves, PCF taps) that cost one pass where nothing reshades.
-    if (reshade) {
-        term = vec4(procedural_albedo(), visibility_pcf(n));
-        vec3 change = abs(approximate_display(shade(L, term)) - approximate_display(shade(L, cached)));
-        new_gradient = hit ? max(change.r, max(change.g, change.b)) / (age + 1.0) : -1.0;
-    } else if (u_smoothing > 0.0) {
-        term.a = mix(term.a, visibility_jittered(n), u_smoothing);
-    }
+#if PASS == 1
+    // The hit pass: what reshades is left to the miss pass (stencil 0 there), so that llvmpipe
+    // never runs the expensive term for blocks without a reshaded pixel.
+    if (reshade) discard;
+    if (u_smoothing > 0.0) term.a = mix(term.a, visibility_jittered(n), u_smoothing);
+#else
+    reshade = true;  // the miss pass sees only pixels the hit pass discarded
+    term = vec4(procedural_albedo(), visibility_pcf(n));
+    vec3 change = abs(approximate_display(shade(L, term)) - approximate_display(shade(L, cached)));
+    new_gradient = hit ? max(change.r, max(change.g, change.b)) / (age + 1.0) : -1.0;
+#endif
 #else
     vec4 term = vec4(procedural_albedo(), visibility_pcf(n));
 #endif
@@ -271,7 +281,7 @@ void main() {
 #if REUSE
     float new_age = reshade ? 0.0 : age + 1.0;
     o_cache_term = term;
-    o_cache_meta = vec4(v_clip.z / v_clip.w * 0.5 + 0.5, u_id, new_age, new_gradient);
+    o_cache_meta = vec4(depth_key(v_clip), u_id, new_age, new_gradient);
 #endif
 }
 )";

@@ -161,7 +161,8 @@ struct Renderer::Gpu {
     GLuint program = 0;
     GLuint active = 0;  // the program uniform() looks names up in
     // Heavy shading: its program, the key light's shadow map and the ping-pong reuse cache.
-    GLuint heavy_program[2] = {}, shadow_program = 0;  // heavy_program[reuse on]
+    // Full shading, the hit pass and the miss pass of reuse (heavy_shaders.hpp).
+    GLuint heavy_program[3] = {}, shadow_program = 0;
     GLuint shadow_framebuffer = 0, shadow_map = 0;
     GLuint cache_term[2] = {}, cache_meta[2] = {};
     int cache_slot = 0;          // the slot written by the next reusing frame
@@ -202,8 +203,7 @@ struct Renderer::Gpu {
         glDeleteBuffers(1, &index_buffer);
         glDeleteVertexArrays(1, &vertex_array);
         glDeleteProgram(program);
-        glDeleteProgram(heavy_program[0]);
-        glDeleteProgram(heavy_program[1]);
+        for (GLuint p : heavy_program) glDeleteProgram(p);
         glDeleteProgram(shadow_program);
         glDeleteFramebuffers(1, &shadow_framebuffer);
         glDeleteTextures(1, &shadow_map);
@@ -225,10 +225,11 @@ struct Renderer::Gpu {
         if (heavy_program[0]) return {};
         std::string vertex = shaders::kVertex;
         vertex.insert(vertex.find("uniform"), "invariant gl_Position;\n");
-        for (int reuse = 0; reuse < 2; ++reuse) {
+        for (int pass = 0; pass < 3; ++pass) {
             const std::string fragment = std::string("#version 300 es\n#define REUSE ") +
-                                         char('0' + reuse) + shaders::kHeavyFragment;
-            REPRISE_TRY(link(vertex.c_str(), fragment.c_str(), "heavy shading", heavy_program[reuse]));
+                                         (pass ? "1" : "0") + "\n#define PASS " + char('0' + pass) +
+                                         "\n" + shaders::kHeavyFragment;
+            REPRISE_TRY(link(vertex.c_str(), fragment.c_str(), "heavy shading", heavy_program[pass]));
         }
         REPRISE_TRY(link(shaders::kShadowVertex, shaders::kShadowFragment, "shadow map", shadow_program));
         glGenTextures(1, &shadow_map);
@@ -258,7 +259,7 @@ struct Renderer::Gpu {
         return {};
     }
 
-    void set_heavy_uniforms(const Scene& s, const RenderSettings& settings,
+    void set_heavy_uniforms(const Scene& s, const Instant& current, const RenderSettings& settings,
                             const glm::mat4& light_matrix, bool cache_usable);
     void read_reuse(bool reusing, const Image<uint32_t>& ids);
 
@@ -298,8 +299,8 @@ struct Renderer::Gpu {
                                    targets[i], 0);
         }
         glBindRenderbuffer(GL_RENDERBUFFER, depth_buffer);
-        glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, w, h);
-        glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth_buffer);
+        glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH32F_STENCIL8, w, h);  // stencil: reuse's passes
+        glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, depth_buffer);
         const GLenum buffers[3] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
         glDrawBuffers(3, buffers);
         if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
@@ -369,7 +370,8 @@ struct Renderer::Gpu {
     }
 };
 
-void Renderer::Gpu::set_heavy_uniforms(const Scene& drawn, const RenderSettings& settings,
+void Renderer::Gpu::set_heavy_uniforms(const Scene& drawn, const Instant& current,
+                                       const RenderSettings& settings,
                                        const glm::mat4& light_matrix, bool cache_usable) {
     Gpu& g = *this;
     const ReuseSettings& r = settings.reuse;
@@ -398,7 +400,12 @@ void Renderer::Gpu::set_heavy_uniforms(const Scene& drawn, const RenderSettings&
     glUniform1i(g.uniform("u_interleave_step"), std::max(1, int(std::lround(std::sqrt(double(r.period))))));
     glUniform1f(g.uniform("u_threshold"), r.threshold);
     glUniform1i(g.uniform("u_filter_radius"), r.filter_radius);
-    glUniform1f(g.uniform("u_epsilon"), r.depth_epsilon / 16777215.0f);
+    // One step of a 24-bit Z-buffer, in the cache's depth key (heavy_shaders.hpp).
+    const bool orthographic = current.projection[3][3] == 1.0f;
+    const float inverse_range = orthographic ? 1.0f
+                                             : 1.0f / current.near - (std::isfinite(current.far) ? 1.0f / current.far : 0.0f);
+    glUniform1i(g.uniform("u_orthographic"), orthographic);
+    glUniform1f(g.uniform("u_epsilon"), r.depth_epsilon / 16777215.0f * inverse_range);
     glUniform1f(g.uniform("u_smoothing"), r.smoothing);
     glUniform1i(g.uniform("u_shadow_map"), 1);
     glUniform1i(g.uniform("u_cache_term"), 2);
@@ -563,7 +570,7 @@ Status Renderer::render(const Scene& scene, const Instant& current, const Instan
         const GLenum buffers[5] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2,
                                    GL_COLOR_ATTACHMENT3, GL_COLOR_ATTACHMENT4};
         glDrawBuffers(5, buffers);
-        const glm::vec4 empty_meta(2.0f, 0.0f, 0.0f, 0.0f);
+        const glm::vec4 empty_meta(-1.0f, 0.0f, 0.0f, 0.0f);
         glClearBufferfv(GL_COLOR, 3, glm::value_ptr(glm::vec4(0.0f)));
         glClearBufferfv(GL_COLOR, 4, glm::value_ptr(empty_meta));
     } else {
@@ -575,67 +582,89 @@ Status Renderer::render(const Scene& scene, const Instant& current, const Instan
     glClearBufferfv(GL_COLOR, 1, glm::value_ptr(zero));
     glClearBufferfv(GL_COLOR, 2, glm::value_ptr(zero));
     glClearDepthf(1.0f);
-    glClear(GL_DEPTH_BUFFER_BIT);
+    glClearStencil(0);
+    glClear(GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
     glEnable(GL_DEPTH_TEST);
     glDepthFunc(GL_LESS);
     glDisable(GL_BLEND);
 
-    g.active = heavy ? g.heavy_program[reusing] : g.program;
-    glUseProgram(g.active);
-    glUniformMatrix4fv(g.uniform("u_view_projection"), 1, GL_FALSE, glm::value_ptr(view_projection));
     const glm::mat4 unjittered = current.projection * current.view;
-    glUniformMatrix4fv(g.uniform("u_unjittered_view_projection"), 1, GL_FALSE,
-                       glm::value_ptr(unjittered));
-    glUniformMatrix4fv(g.uniform("u_view"), 1, GL_FALSE, glm::value_ptr(current.view));
-    glUniformMatrix4fv(g.uniform("u_previous_view_projection"), 1, GL_FALSE,
-                       glm::value_ptr(previous_view_projection));
-    glUniform2f(g.uniform("u_size"), float(w), float(h));
-    glUniform3fv(g.uniform("u_eye"), 1, glm::value_ptr(eye));
-    glUniform3fv(g.uniform("u_light_direction"), 1, glm::value_ptr(scene.light.direction));
-    glUniform3fv(g.uniform("u_light_color"), 1, glm::value_ptr(scene.light.color));
-    glUniform3fv(g.uniform("u_ambient"), 1, glm::value_ptr(scene.light.ambient));
-    glUniform1i(g.uniform("u_lit"), settings.shading == Shading::Lit);
-    glUniform1i(g.uniform("u_texture"), 0);
-    if (heavy) g.set_heavy_uniforms(scene, settings, light_matrix, cache_usable);
-    glActiveTexture(GL_TEXTURE0);
-
+    // Everything a program of the main pass needs besides the per-draw material.
+    auto use = [&](GLuint program) {
+        g.active = program;
+        glUseProgram(program);
+        glUniformMatrix4fv(g.uniform("u_view_projection"), 1, GL_FALSE, glm::value_ptr(view_projection));
+        glUniformMatrix4fv(g.uniform("u_unjittered_view_projection"), 1, GL_FALSE,
+                           glm::value_ptr(unjittered));
+        glUniformMatrix4fv(g.uniform("u_view"), 1, GL_FALSE, glm::value_ptr(current.view));
+        glUniformMatrix4fv(g.uniform("u_previous_view_projection"), 1, GL_FALSE,
+                           glm::value_ptr(previous_view_projection));
+        glUniform2f(g.uniform("u_size"), float(w), float(h));
+        glUniform3fv(g.uniform("u_eye"), 1, glm::value_ptr(eye));
+        glUniform3fv(g.uniform("u_light_direction"), 1, glm::value_ptr(scene.light.direction));
+        glUniform3fv(g.uniform("u_light_color"), 1, glm::value_ptr(scene.light.color));
+        glUniform3fv(g.uniform("u_ambient"), 1, glm::value_ptr(scene.light.ambient));
+        glUniform1i(g.uniform("u_lit"), settings.shading == Shading::Lit);
+        glUniform1i(g.uniform("u_texture"), 0);
+        if (heavy) g.set_heavy_uniforms(scene, current, settings, light_matrix, cache_usable);
+        glActiveTexture(GL_TEXTURE0);
+    };
     const Material fallback;
-    const auto shading_start = std::chrono::steady_clock::now();
-    const double shading_cpu_start = process_cpu_ms();
-    if (heavy) {  // depth pre-pass: the heavy shader then runs once per pixel
-        glUseProgram(g.shadow_program);
-        glUniformMatrix4fv(glGetUniformLocation(g.shadow_program, "u_light_matrix"), 1, GL_FALSE,
-                           glm::value_ptr(view_projection));
-        glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+    auto draw_all = [&](bool materials) {
+        const GLint base_color = g.uniform("u_base_color"), textured = g.uniform("u_textured"),
+                    specular = g.uniform("u_specular"), shininess = g.uniform("u_shininess"),
+                    id = g.uniform("u_id");
         for (const Draw& d : g.draws) {
             const Material& m = d.material >= 0 ? scene.materials[d.material] : fallback;
+            if (materials) {
+                glUniform4fv(base_color, 1, glm::value_ptr(m.base_color));
+                glUniform1i(textured, m.base_color_texture >= 0);
+                if (m.base_color_texture >= 0) glBindTexture(GL_TEXTURE_2D, g.textures[m.base_color_texture]);
+                glUniform1f(specular, m.specular);
+                glUniform1f(shininess, m.shininess);
+                glUniform1f(id, d.id);
+            }
             if (m.double_sided) glDisable(GL_CULL_FACE);
             else glEnable(GL_CULL_FACE);
             glFrontFace(d.mirrored ? GL_CW : GL_CCW);
             glDrawElements(GL_TRIANGLES, d.index_count, GL_UNSIGNED_INT,
                            (void*)(std::size_t(d.first_index) * sizeof(uint32_t)));
         }
+    };
+    const auto shading_start = std::chrono::steady_clock::now();
+    const double shading_cpu_start = process_cpu_ms();
+    if (!heavy) {
+        use(g.program);
+        draw_all(true);
+    } else {
+        // Depth pre-pass: each pixel then runs the heavy shader once.
+        g.active = g.shadow_program;
+        glUseProgram(g.shadow_program);
+        glUniformMatrix4fv(g.uniform("u_light_matrix"), 1, GL_FALSE, glm::value_ptr(view_projection));
+        glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+        draw_all(false);
         glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
         glDepthFunc(GL_LEQUAL);
         glDepthMask(GL_FALSE);
-        glUseProgram(g.active);
-    }
-    const GLint base_color = g.uniform("u_base_color"), textured = g.uniform("u_textured"),
-                specular = g.uniform("u_specular"), shininess = g.uniform("u_shininess"),
-                id = g.uniform("u_id");
-    for (const Draw& d : g.draws) {
-        const Material& m = d.material >= 0 ? scene.materials[d.material] : fallback;
-        glUniform4fv(base_color, 1, glm::value_ptr(m.base_color));
-        glUniform1i(textured, m.base_color_texture >= 0);
-        if (m.base_color_texture >= 0) glBindTexture(GL_TEXTURE_2D, g.textures[m.base_color_texture]);
-        glUniform1f(specular, m.specular);
-        glUniform1f(shininess, m.shininess);
-        glUniform1f(id, d.id);
-        if (m.double_sided) glDisable(GL_CULL_FACE);
-        else glEnable(GL_CULL_FACE);
-        glFrontFace(d.mirrored ? GL_CW : GL_CCW);
-        glDrawElements(GL_TRIANGLES, d.index_count, GL_UNSIGNED_INT,
-                       (void*)(std::size_t(d.first_index) * sizeof(uint32_t)));
+        if (!reusing) {
+            use(g.heavy_program[0]);
+            draw_all(true);
+        } else {
+            // Nehab's two-pass control flow with the stencil in place of a depth shift: the hit
+            // pass marks what it reused; the miss pass shades the rest and is culled early
+            // wherever the hit pass covered a whole block.
+            glEnable(GL_STENCIL_TEST);
+            glStencilMask(0xff);
+            glStencilFunc(GL_ALWAYS, 1, 0xff);
+            glStencilOp(GL_KEEP, GL_KEEP, GL_REPLACE);
+            use(g.heavy_program[1]);
+            draw_all(true);
+            glStencilFunc(GL_EQUAL, 0, 0xff);
+            glStencilOp(GL_KEEP, GL_KEEP, GL_KEEP);
+            use(g.heavy_program[2]);
+            draw_all(true);
+            glDisable(GL_STENCIL_TEST);
+        }
     }
     if (heavy) {
         glDepthMask(GL_TRUE);

@@ -43,7 +43,7 @@ struct ReuseSettings {
     int period = 4;                   // every covered pixel is reshaded at least this often (1..255)
     float threshold = 8.0f / 255.0f;  // Adaptive: allowed change per display channel
     int filter_radius = 1;            // Adaptive: spatial max filter of gradients, (2r+1)^2 (0..3)
-    float depth_epsilon = 64.0f;      // hit test: in increments of a 24-bit Z-buffer
+    float depth_epsilon = 1024.0f;    // hit test: in steps of a 24-bit Z-buffer (curved, faceted surfaces need room)
     // Amortized supersampling of the key light's shadow (Nehab §6): on a hit, a few jittered
     // PCF taps are blended into the cached visibility with this weight; 0 = off.
     float smoothing = 0.0f;
