@@ -363,7 +363,7 @@ Scene courtyard_scene(CameraPath& camera) {
     Builder b;
     b.scene.name = "courtyard";
     b.scene.heavy_shading = true;
-    b.scene.light.direction = {-0.5f, -1.0f, -0.35f};
+    b.scene.light = {.direction = {-0.5f, -1.0f, -0.35f}, .color = {1.0f, 0.95f, 0.85f}, .ambient = {0.1f, 0.11f, 0.14f}};
     int stone = b.material({0.85f, 0.82f, 0.78f}, -1, 0.2f, 24.0f);
     int brick = b.material({0.8f, 0.5f, 0.4f}, -1, 0.1f, 16.0f);
     int marble = b.material({0.9f, 0.9f, 0.95f}, -1, 0.6f, 64.0f);
@@ -380,7 +380,7 @@ Scene courtyard_scene(CameraPath& camera) {
     b.spin(ball, {0, 0, 1}, 1.4f / 0.7f);
     int slab = b.add("slab", box({0.4f, 2.4f, 1.6f}, 0.8f), brick, {1.5f, 1.2f, 0.5f});
     b.spin(slab, {0, 1, 0}, 0.6f);
-    ring_of_lights(b.scene, {0, 0, -2.5f}, 5.0f, 2.2f, 3.0f);
+    ring_of_lights(b.scene, {0, 0, -2.5f}, 5.0f, 2.2f, 1.5f);
     camera = {.motion = CameraMotion::Static,
               .target = {0, 1.0f, -3},
               .eye = {0, 3.0f, 6},
@@ -392,7 +392,7 @@ Scene stroll_scene(CameraPath& camera) {
     Builder b;
     b.scene.name = "stroll";
     b.scene.heavy_shading = true;
-    b.scene.light.direction = {-0.6f, -0.9f, -0.4f};
+    b.scene.light = {.direction = {-0.6f, -0.9f, -0.4f}, .color = {1.0f, 0.95f, 0.85f}, .ambient = {0.1f, 0.11f, 0.14f}};
     int stone = b.material({0.8f, 0.78f, 0.72f}, -1, 0.2f, 24.0f);
     int marble = b.material({0.92f, 0.9f, 0.88f}, -1, 0.7f, 80.0f);
     int moss = b.material({0.45f, 0.6f, 0.35f}, -1, 0.05f, 8.0f);
@@ -407,7 +407,7 @@ Scene stroll_scene(CameraPath& camera) {
     b.add("statue", sphere(0.7f, 24, 48), bronze, {0, 1.5f, 0});
     b.add("bench", box({2.5f, 0.5f, 0.7f}, 1.0f), moss, {-1.5f, 0.25f, 5.5f},
           glm::angleAxis(0.3f, glm::vec3(0, 1, 0)));
-    ring_of_lights(b.scene, {0, 0, 0}, 6.0f, 2.5f, 4.0f);
+    ring_of_lights(b.scene, {0, 0, 0}, 6.0f, 2.5f, 2.0f);
     camera = {.motion = CameraMotion::Orbit,
               .target = {0, 1.0f, 0},
               .eye = {0, 3.0f, 8.5f},

@@ -150,12 +150,16 @@ struct Lights {
     vec3 specular;      // point lights' highlights
     vec3 key_specular;  // key light's highlight when unshadowed
 };
+// Schlick's rational stand-in for pow(x, shininess): one division instead of exp2 and log2.
+float lobe(float x) {
+    return x / (u_shininess - u_shininess * x + x);
+}
 Lights gather_lights(vec3 n) {
     Lights L;
     vec3 v = normalize(u_eye - v_world);
     vec3 l = -normalize(u_light_direction);
     float diffuse = max(dot(n, l), 0.0);
-    float highlight = diffuse > 0.0 ? pow(max(dot(n, normalize(l + v)), 0.0), u_shininess) : 0.0;
+    float highlight = diffuse > 0.0 ? lobe(max(dot(n, normalize(l + v)), 0.0)) : 0.0;
     L.diffuse = u_ambient;
     L.key = u_light_color * diffuse;
     L.specular = vec3(0.0);
@@ -165,7 +169,7 @@ Lights gather_lights(vec3 n) {
         float d2 = max(dot(d, d), 1e-4);
         vec3 li = d * inversesqrt(d2);
         float ndl = max(dot(n, li), 0.0);
-        float spec = ndl > 0.0 ? pow(max(dot(n, normalize(li + v)), 0.0), u_shininess) : 0.0;
+        float spec = ndl > 0.0 ? lobe(max(dot(n, normalize(li + v)), 0.0)) : 0.0;
         L.diffuse += u_point_color[i] / d2 * ndl;
         L.specular += u_point_color[i] / d2 * u_specular * spec;
     }
