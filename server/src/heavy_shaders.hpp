@@ -243,7 +243,6 @@ int refresh_phase() {
 void main() {
     vec3 n = dot(v_normal, v_normal) > 0.0 ? normalize(gl_FrontFacing ? v_normal : -v_normal)
                                            : vec3(0.0, 0.0, 1.0);
-    Lights L = gather_lights(n);
 #if REUSE
     vec4 cached;
     float age, gradient;
@@ -265,14 +264,17 @@ void main() {
     // The hit pass: what reshades is left to the miss pass (stencil 0 there), so that llvmpipe
     // never runs the expensive term for blocks without a reshaded pixel.
     if (reshade) discard;
+    Lights L = gather_lights(n);
     if (u_smoothing > 0.0) term.a = mix(term.a, visibility_jittered(n), u_smoothing);
 #else
     reshade = true;  // the miss pass sees only pixels the hit pass discarded
+    Lights L = gather_lights(n);
     term = vec4(procedural_albedo(), visibility_pcf(n));
     vec3 change = abs(approximate_display(shade(L, term)) - approximate_display(shade(L, cached)));
     new_gradient = hit ? max(change.r, max(change.g, change.b)) / (age + 1.0) : -1.0;
 #endif
 #else
+    Lights L = gather_lights(n);
     vec4 term = vec4(procedural_albedo(), visibility_pcf(n));
 #endif
     vec3 color = shade(L, term);
