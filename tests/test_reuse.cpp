@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 
 #include "reprise/core/metrics.hpp"
@@ -181,11 +182,13 @@ TEST(Reuse, ErrorStaysBoundedOnTheHeavyScenes) {
     for (const char* name : {"courtyard", "stroll"}) {
         double shaded = 0.0;
         const double uniform = mean_above(name, {.mode = Reuse::Cache, .refresh = Refresh::Blocks, .period = 4}, 10, shaded);
-        EXPECT_LE(uniform, 0.02) << name << ": blocks:4";
-        EXPECT_LT(shaded, 0.6) << name;
+        std::printf("%s blocks:4: %.3f %% above T, %.1f %% shaded\n", name, 100 * uniform, 100 * shaded);
+        EXPECT_LE(uniform, 0.01) << name << ": blocks:4";  // measured 0.5 % at 128x72
+        EXPECT_LT(shaded, 0.45) << name;
         const double adaptive = mean_above(name, {.mode = Reuse::Adaptive, .period = 16}, 10, shaded);
-        EXPECT_LE(adaptive, 0.01) << name << ": adaptive";
-        EXPECT_LT(shaded, 0.7) << name;
+        std::printf("%s adaptive: %.3f %% above T, %.1f %% shaded\n", name, 100 * adaptive, 100 * shaded);
+        EXPECT_LE(adaptive, 0.005) << name << ": adaptive";  // measured 0.1 %
+        EXPECT_LT(shaded, 0.65) << name;
     }
 }
 
