@@ -65,6 +65,7 @@ std::vector<ReuseCase> reuse_cases(bool quick) {
     if (quick) {
         cache("tiled", Refresh::Tiled, 4);
         for (int n : {2, 4, 8}) cache("blocks", Refresh::Blocks, n);
+        cache("blocks+smooth", Refresh::Blocks, 8, 0.1f);
         adaptive(8);
         return cases;
     }
@@ -72,8 +73,8 @@ std::vector<ReuseCase> reuse_cases(bool quick) {
     cache("random", Refresh::Random, 4);
     cache("interleaved", Refresh::Interleaved, 4);
     for (int n : {2, 3, 4, 6, 8, 12, 16}) cache("blocks", Refresh::Blocks, n);
-    cache("blocks+smooth", Refresh::Blocks, 4, 0.3f);
-    cache("blocks+smooth", Refresh::Blocks, 8, 0.3f);
+    cache("blocks+smooth", Refresh::Blocks, 8, 0.1f);
+    cache("blocks+smooth", Refresh::Blocks, 16, 0.1f);
     for (int t : {4, 8, 16}) adaptive(t);
     return cases;
 }

@@ -130,17 +130,19 @@ float visibility_pcf(vec3 n) {
     float taps = float((2 * r + 1) * (2 * r + 1));
     return sum / taps;
 }
-// Four taps of the same footprint, rotated and scaled per frame (amortized supersampling).
+// Four taps drawn per pixel and frame from the PCF grid (amortized supersampling, Nehab §6):
+// an unbiased estimate of visibility_pcf that exponential smoothing averages over frames.
 float visibility_jittered(vec3 n) {
     vec3 s = shadow_coord(n);
-    uint h = hash3(uvec3(uint(u_frame), 3u, 7u));
-    float angle = float(h & 0xffffu) * (6.2831853 / 65535.0);
-    float radius = (0.25 + 0.75 * float((h >> 16) & 0xffffu) / 65535.0) * 1.5 * float(u_pcf_radius);
-    vec2 d = radius * vec2(cos(angle), sin(angle)) * u_shadow_texel;
-    vec2 e = vec2(-d.y, d.x);
     float z = s.z - 0.0015;
-    return 0.25 * (texture(u_shadow_map, vec3(s.xy + d, z)) + texture(u_shadow_map, vec3(s.xy - d, z)) +
-                   texture(u_shadow_map, vec3(s.xy + e, z)) + texture(u_shadow_map, vec3(s.xy - e, z)));
+    uint side = uint(2 * u_pcf_radius + 1);
+    float sum = 0.0;
+    for (int k = 0; k < 4; ++k) {
+        uint h = hash3(uvec3(uvec2(gl_FragCoord.xy), uint(u_frame * 4 + k)));
+        vec2 tap = vec2(float(h % side), float((h >> 16) % side)) - float(u_pcf_radius);
+        sum += texture(u_shadow_map, vec3(s.xy + 1.5 * u_shadow_texel * tap, z));
+    }
+    return 0.25 * sum;
 }
 // The cheap, view-dependent rest, split so that a colour costs a few operations per term:
 // colour = albedo * (ambient_and_points + key * visibility) + specular + key_specular * visibility.
