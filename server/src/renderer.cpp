@@ -91,7 +91,12 @@ void smooth_normals(const std::vector<glm::vec3>& positions, const std::vector<u
     }
 }
 
-Status check_reuse_settings(const ReuseSettings& r) {
+Status check_heavy_settings(const RenderSettings& settings) {
+    if (settings.heavy_octaves < 1 || settings.heavy_octaves > 16)
+        return Status::error("heavy shading: octaves must be in 1..16");
+    if (settings.heavy_pcf_radius < 0 || settings.heavy_pcf_radius > 8)
+        return Status::error("heavy shading: PCF radius must be in 0..8");
+    const ReuseSettings& r = settings.reuse;
     if (r.period < 1 || r.period > 255)
         return Status::error("reuse: refresh period " + std::to_string(r.period) + " must be in 1..255");
     if (!(r.threshold > 0.0f && r.threshold <= 1.0f))
@@ -525,7 +530,7 @@ Status Renderer::render(const Scene& scene, const Instant& current, const Instan
     const ReuseSettings& reuse = settings.reuse;
     const bool reusing = heavy && reuse.mode != Reuse::Off;
     if (heavy) {
-        REPRISE_TRY(check_reuse_settings(reuse));
+        REPRISE_TRY(check_heavy_settings(settings));
         REPRISE_TRY(g.prepare_heavy());
         if (g.cache_width != w || g.cache_height != h) {
             g.resize_cache(w, h);

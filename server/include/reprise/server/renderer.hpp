@@ -43,7 +43,9 @@ struct ReuseSettings {
     int period = 4;                   // every covered pixel is reshaded at least this often (1..255)
     float threshold = 8.0f / 255.0f;  // Adaptive: allowed change per display channel
     int filter_radius = 1;            // Adaptive: spatial max filter of gradients, (2r+1)^2 (0..3)
-    float depth_epsilon = 1024.0f;    // hit test: in steps of a 24-bit Z-buffer (curved, faceted surfaces need room)
+    // Hit test: bilinear depth within this many steps of a 24-bit Z-buffer (Nehab's ε is one
+    // step; faceted curved surfaces need room).
+    float depth_epsilon = 1024.0f;
     // Amortized supersampling of the key light's shadow (Nehab §6): on a hit, a few jittered
     // PCF taps are blended into the cached visibility with this weight; 0 = off.
     float smoothing = 0.0f;
@@ -56,7 +58,6 @@ struct RenderSettings {
     ReuseSettings reuse;
     int heavy_octaves = 8;     // per noise layer (three layers)
     int heavy_pcf_radius = 5;  // (2r+1)^2 shadow-map comparisons
-
 };
 
 // What reuse did in the last frame rendered with Shading::Heavy.
@@ -65,7 +66,7 @@ struct ReuseStats {
     int64_t hits = 0;       // covered pixels whose reprojection passed the depth and id test
     int64_t reused = 0;     // hits that reused the cache (not reshaded)
     int64_t shaded = 0;     // covered pixels that ran the expensive term
-    double shading_ms = 0;      // the main pass, draw to finish (without shadow map and read-back)
+    double shading_ms = 0;      // depth pre-pass and shading passes to glFinish (no shadow map, no read-back)
     double shading_cpu_ms = 0;  // the same pass in CPU time of the whole process (software GL)
     double hit_rate() const { return covered ? double(hits) / double(covered) : 0.0; }
     double shaded_fraction() const { return covered ? double(shaded) / double(covered) : 0.0; }
