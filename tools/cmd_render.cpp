@@ -104,6 +104,10 @@ Status run_render(const RenderJob& job) {
         server::CameraPath fallback = path;
         REPRISE_TRY(server::parse_camera_spec(job.camera, scene, fallback, path));
     }
+    server::RenderSettings settings{.width = width, .height = height};
+    REPRISE_TRY(parse_shading(job, scene, settings));
+    if (settings.reuse.mode != server::Reuse::Off && stereo)
+        return Status::error("--reuse works on one eye only (no --stereo)");
     std::error_code ec;
     for (const std::string& dir : {left_dir, stereo ? right_dir : left_dir}) {
         std::filesystem::create_directories(dir, ec);
@@ -114,13 +118,6 @@ Status run_render(const RenderJob& job) {
     REPRISE_TRY(server::Renderer::create(renderer));
     std::fprintf(stderr, "[render] %s, %dx%d, %d frames at %g Hz on %s\n", job.scene.c_str(),
                  width, height, job.frames, job.fps, renderer->device().c_str());
-    server::RenderSettings settings{
-        .width = width,
-        .height = height,
-        .shading = job.unlit ? server::Shading::Unlit : server::Shading::Lit};
-    REPRISE_TRY(parse_shading(job, scene, settings));
-    const bool reusing = settings.reuse.mode != server::Reuse::Off;
-    if (reusing && stereo) return Status::error("--reuse works on one eye only (no --stereo)");
     ReuseTotals totals;
     Frame frame;
     auto begin = std::chrono::steady_clock::now();
