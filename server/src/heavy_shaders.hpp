@@ -196,7 +196,7 @@ float depth_key(vec4 clip) {
     return u_orthographic ? clip.z / clip.w * 0.5 + 0.5 : 1.0 / clip.w;
 }
 // Reverse reprojection into the previous frame's cache: bilinear depth within epsilon, the same
-// object id on all four texels.
+// object id on every texel that carries bilinear weight.
 bool lookup(out vec4 term, out float age, out float gradient) {
     term = vec4(0.0); age = 0.0; gradient = 0.0;
     if (!u_cache_valid || v_previous_clip.w <= 0.0) return false;
