@@ -63,8 +63,8 @@ std::vector<ReuseCase> reuse_cases(bool quick) {
                          {.mode = Reuse::Adaptive, .period = cap, .threshold = float(steps) / 255.0f}});
     };
     if (quick) {
-        cache("tiled", Refresh::Tiled, 4);
-        for (int n : {2, 4, 8}) cache("blocks", Refresh::Blocks, n);
+        cache("tiled", Refresh::Tiled, 8);
+        for (int n : {4, 8, 16}) cache("blocks", Refresh::Blocks, n);
         cache("blocks+smooth", Refresh::Blocks, 8, 0.1f);
         adaptive(8);
         return cases;
