@@ -27,10 +27,12 @@ std::vector<std::string> fields(const std::string& line) {
 }
 
 TEST(CliBenchReuse, WritesRowsSummaryAndReport) {
-    const fs::path dir = fs::temp_directory_path() / ("reprise-cli-bench-reuse-" + std::to_string(getpid()));
+    const fs::path dir =
+        fs::temp_directory_path() / ("reprise-cli-bench-reuse-" + std::to_string(getpid()));
     fs::remove_all(dir);
-    const Outcome r = run_reprise("bench reuse --quick --scenes courtyard --size 64x36 --frames 3 --out " +
-                                      dir.string(), 300);
+    const Outcome r = run_reprise(
+        "bench reuse --quick --scenes courtyard --size 64x36 --frames 3 --out " + dir.string(),
+        300);
     ASSERT_EQ(r.status, 0) << r.output;
     EXPECT_NE(r.output.find("Targets (issue 11)"), std::string::npos) << r.output;
     EXPECT_NE(r.output.find("uniform at equal pixels shaded"), std::string::npos) << r.output;
@@ -47,7 +49,8 @@ TEST(CliBenchReuse, WritesRowsSummaryAndReport) {
         const std::vector<std::string> f = fields(line);
         ASSERT_EQ(f.size(), header.size()) << line;
         methods.insert(f[1]);
-        const double hit_rate = std::stod(f[header.size() - 3]), shaded = std::stod(f[header.size() - 2]);
+        const double hit_rate = std::stod(f[header.size() - 3]),
+                     shaded = std::stod(f[header.size() - 2]);
         const double above = std::stod(f[header.size() - 1]);
         EXPECT_TRUE(hit_rate >= 0 && hit_rate <= 1 && shaded >= 0 && shaded <= 1) << line;
         EXPECT_TRUE(above >= 0 && above <= 1) << line;

@@ -72,11 +72,13 @@ TEST(Reuse, NewlyVisiblePixelsAreMisses) {
                 if (now.id(x, y) == 0) continue;
                 // Where this surface point was: another object (or nothing) covered it then.
                 const glm::vec2 m = now.motion(x, y);
-                const int px = int(std::floor(x + 0.5f + m.x)), py = int(std::floor(y + 0.5f + m.y));
+                const int px = int(std::floor(x + 0.5f + m.x)),
+                          py = int(std::floor(y + 0.5f + m.y));
                 const bool outside = !(px >= 0 && py >= 0 && px < kWidth && py < kHeight);
                 if (!outside && before.id(px, py) == now.id(x, y)) continue;
                 ++disoccluded;
-                EXPECT_EQ(maps.status(x, y), kReuseMiss) << "frame " << f << " pixel " << x << "," << y;
+                EXPECT_EQ(maps.status(x, y), kReuseMiss)
+                    << "frame " << f << " pixel " << x << "," << y;
             }
         EXPECT_GT(r.reuse_stats().reused, r.reuse_stats().covered / 2) << "frame " << f;
     }
@@ -117,13 +119,16 @@ TEST(Reuse, EveryPixelIsReshadedWithinItsPeriod) {
     for (Refresh kind : {Refresh::Tiled, Refresh::Random, Refresh::Blocks, Refresh::Interleaved})
         for (int period : {3, 4}) {
             r.drop_reuse_cache();
-            const RenderSettings settings = heavy({.mode = Reuse::Cache, .refresh = kind, .period = period});
+            const RenderSettings settings =
+                heavy({.mode = Reuse::Cache, .refresh = kind, .period = period});
             int64_t reused = 0;
             for (int f = 0; f < 2 * period + 2; ++f) {
                 ASSERT_TRUE(r.render_frame(scene, path, f, kFps, settings, frame).ok());
                 const ReuseMaps& maps = r.reuse_maps();
-                const uint8_t oldest = *std::max_element(maps.age.data(), maps.age.data() + maps.age.pixel_count());
-                EXPECT_LT(int(oldest), period) << to_string(kind) << ":" << period << " frame " << f;
+                const uint8_t oldest =
+                    *std::max_element(maps.age.data(), maps.age.data() + maps.age.pixel_count());
+                EXPECT_LT(int(oldest), period)
+                    << to_string(kind) << ":" << period << " frame " << f;
                 reused += r.reuse_stats().reused;
             }
             EXPECT_GT(reused, 0) << to_string(kind);
@@ -131,9 +136,12 @@ TEST(Reuse, EveryPixelIsReshadedWithinItsPeriod) {
     // Adaptive reshading keeps its cap too.
     r.drop_reuse_cache();
     for (int f = 0; f < 10; ++f) {
-        ASSERT_TRUE(r.render_frame(scene, path, f, kFps, heavy({.mode = Reuse::Adaptive, .period = 5}), frame).ok());
+        ASSERT_TRUE(r.render_frame(scene, path, f, kFps,
+                                   heavy({.mode = Reuse::Adaptive, .period = 5}), frame)
+                        .ok());
         const ReuseMaps& maps = r.reuse_maps();
-        EXPECT_LT(int(*std::max_element(maps.age.data(), maps.age.data() + maps.age.pixel_count())), 5);
+        EXPECT_LT(int(*std::max_element(maps.age.data(), maps.age.data() + maps.age.pixel_count())),
+                  5);
     }
 }
 
@@ -148,7 +156,8 @@ TEST(Reuse, AStillSceneConvergesToFullShading) {
     for (Reuse mode : {Reuse::Cache, Reuse::Adaptive}) {
         r.drop_reuse_cache();
         const RenderSettings settings = heavy({.mode = mode, .period = 6});
-        for (int f = 0; f < 8; ++f) ASSERT_TRUE(r.render(scene, still, still, settings, reused).ok());
+        for (int f = 0; f < 8; ++f)
+            ASSERT_TRUE(r.render(scene, still, still, settings, reused).ok());
         EXPECT_GT(r.reuse_stats().hit_rate(), 0.99);
         EXPECT_LT(r.reuse_stats().shaded_fraction(), 0.5);  // it reuses, and still matches:
         const DisplayError e = display_error(full, reused);
@@ -181,12 +190,16 @@ double mean_above(const std::string& name, ReuseSettings reuse, int frames, doub
 TEST(Reuse, ErrorStaysBoundedOnTheHeavyScenes) {
     for (const char* name : {"courtyard", "stroll"}) {
         double shaded = 0.0;
-        const double uniform = mean_above(name, {.mode = Reuse::Cache, .refresh = Refresh::Blocks, .period = 4}, 10, shaded);
-        std::printf("%s blocks:4: %.3f %% above T, %.1f %% shaded\n", name, 100 * uniform, 100 * shaded);
+        const double uniform = mean_above(
+            name, {.mode = Reuse::Cache, .refresh = Refresh::Blocks, .period = 4}, 10, shaded);
+        std::printf("%s blocks:4: %.3f %% above T, %.1f %% shaded\n", name, 100 * uniform,
+                    100 * shaded);
         EXPECT_LE(uniform, 0.01) << name << ": blocks:4";  // measured 0.5 % at 128x72
         EXPECT_LT(shaded, 0.45) << name;
-        const double adaptive = mean_above(name, {.mode = Reuse::Adaptive, .period = 16}, 10, shaded);
-        std::printf("%s adaptive: %.3f %% above T, %.1f %% shaded\n", name, 100 * adaptive, 100 * shaded);
+        const double adaptive =
+            mean_above(name, {.mode = Reuse::Adaptive, .period = 16}, 10, shaded);
+        std::printf("%s adaptive: %.3f %% above T, %.1f %% shaded\n", name, 100 * adaptive,
+                    100 * shaded);
         EXPECT_LE(adaptive, 0.005) << name << ": adaptive";  // measured 0.1 %
         EXPECT_LT(shaded, 0.65) << name;
     }
@@ -198,9 +211,15 @@ TEST(Reuse, BadSettingsAreStatuses) {
     CameraPath path;
     load("courtyard", scene, path);
     Frame frame;
-    EXPECT_FALSE(r.render_frame(scene, path, 0, kFps, heavy({.mode = Reuse::Cache, .period = 0}), frame).ok());
-    EXPECT_FALSE(r.render_frame(scene, path, 0, kFps, heavy({.mode = Reuse::Adaptive, .threshold = -1.0f}), frame).ok());
-    EXPECT_FALSE(r.render_frame(scene, path, 0, kFps, heavy({.mode = Reuse::Cache, .smoothing = NAN}), frame).ok());
+    EXPECT_FALSE(
+        r.render_frame(scene, path, 0, kFps, heavy({.mode = Reuse::Cache, .period = 0}), frame)
+            .ok());
+    EXPECT_FALSE(r.render_frame(scene, path, 0, kFps,
+                                heavy({.mode = Reuse::Adaptive, .threshold = -1.0f}), frame)
+                     .ok());
+    EXPECT_FALSE(
+        r.render_frame(scene, path, 0, kFps, heavy({.mode = Reuse::Cache, .smoothing = NAN}), frame)
+            .ok());
     ReuseSettings reuse;
     EXPECT_TRUE(parse_refresh("tiled:8", reuse).ok());
     EXPECT_EQ(reuse.refresh, Refresh::Tiled);
