@@ -4,9 +4,9 @@
 //
 // Cache layout (ping-pong between frames, GL rows bottom-up like the framebuffer):
 //   term (RGBA16F, read filtered): procedural albedo (rgb), key-light visibility (a)
-//   meta (RGBA32F): depth key (depth_key below) of the unjittered image, object id, age in frames (0 = shaded
-//         this frame), temporal gradient of the display colour per frame (-1: unknown, the pixel
-//         was shaded on a miss). The CPU reads the status of each pixel from it.
+//   meta (RGBA32F): depth key (depth_key below) of the unjittered image, object id, age in
+//         frames (0 = shaded this frame), temporal gradient of the display colour per frame
+//         (-1: unknown, the pixel was shaded on a miss). The CPU reads each pixel's status from it.
 
 namespace reprise::server::shaders {
 
