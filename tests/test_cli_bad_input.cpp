@@ -46,6 +46,16 @@ TEST(CliBadInput, ArgumentsGetOneMessageAndStatusTwo) {
     expect_clean_failure(run("render --camera spiral --out " + out.string()), "spiral", "bad camera");
     expect_clean_failure(run("render --camera orbit:speed=x --out " + out.string()), "'x'", "bad param");
     expect_clean_failure(run("render"), "--out", "no output");
+    expect_clean_failure(run("render --reuse always --scene courtyard --out " + out.string()), "always", "bad reuse");
+    expect_clean_failure(run("render --reuse cache --scene pan --out " + out.string()), "heavy", "reuse needs heavy");
+    expect_clean_failure(run("render --shading glossy --out " + out.string()), "glossy", "bad shading");
+    expect_clean_failure(run("render --scene courtyard --reuse cache --refresh tiles:4 --out " + out.string()),
+                         "tiles:4", "bad refresh kind");
+    expect_clean_failure(run("render --scene courtyard --reuse cache --refresh tiled:0 --out " + out.string()),
+                         "tiled:0", "bad refresh period");
+    expect_clean_failure(run("render --scene courtyard --reuse adaptive --threshold nan --out " + out.string()),
+                         "--threshold", "NaN threshold");
+    expect_clean_failure(run("render --scene courtyard --pcf 99 --out " + out.string()), "--pcf", "huge PCF");
     EXPECT_EQ(run("render --help").status, 0);
     EXPECT_EQ(run("--help").status, 0);
 }

@@ -58,5 +58,10 @@ Status bench_stereo(const BenchOptions& options);
 // 1080p; issue 8's targets as met / not met: OUT/codec.csv, bd_rate.csv, depth.csv, speed.csv,
 // index.html.
 Status bench_codec(const BenchOptions& options);
+// Shading reuse in the heavy renderer (reprojection cache, refresh policies, adaptive reshading)
+// per heavy scene (--scenes, default courtyard,stroll; --size, --frames, --quick): shading-pass
+// speed-up against full shading in the same run, hit rate, pixels shaded, error against full
+// shading every frame: OUT/reuse.csv, OUT/reuse_summary.csv, OUT/index.html.
+Status bench_reuse(const BenchOptions& options);
 
 }  // namespace reprise::cli

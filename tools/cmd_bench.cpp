@@ -129,8 +129,8 @@ int command_bench(int argc, char** argv) {
               "error against run time\nfor every setting beside ffmpeg minterpolate and OpenCV DIS flow "
               "(CSV + HTML report in --out).\nstereo: the synthesized second eye against the rendered one, naive DIBR peers and the "
               "renderer's\nsecond-eye time (CSV + HTML report in --out). paths: whole made frames at display "
-              "rate against cv::remap.\ncodec: reprise's codec beside x264, x265 and SVT-AV1\n(bits, PSNR/SSIM/FLIP, ms, BD-rates, depth coders, 1080p speed; CSV + HTML report in --out).");
-    args.positional("WHAT", &job.what, "render | exr | reproject | grid | fill | paths | fruc | stereo | codec");
+              "rate against cv::remap.\nreuse: shading reuse in the heavy renderer against full shading in the same run (speed-up, hit rate,\npixels shaded, error; CSV + HTML report in --out).\ncodec: reprise's codec beside x264, x265 and SVT-AV1\n(bits, PSNR/SSIM/FLIP, ms, BD-rates, depth coders, 1080p speed; CSV + HTML report in --out).");
+    args.positional("WHAT", &job.what, "render | exr | reproject | grid | fill | paths | fruc | stereo | codec | reuse");
     args.option("--scene", &job.scene, "scene to render (default pan)");
     args.option("--frames", &job.frames, "frames per size (default 10); fruc: input frames (default 20); stereo: frames per scene (at most 5)");
     args.option("--sizes", &job.sizes, "comma-separated WxH list (default 640x360,1920x1080)");
@@ -153,6 +153,8 @@ int command_bench(int argc, char** argv) {
     if (job.what == "fruc" && !args.given("--frames")) job.frames = 20;  // reaches the cut at 0.5 s
     if (job.what == "codec" && !args.given("--frames")) job.frames = 30;
     if (job.what == "codec" && !args.given("--size")) job.size = "1280x720";
+    if (job.what == "reuse" && !args.given("--frames")) job.frames = 24;
+    if (job.what == "reuse" && !args.given("--size")) job.size = "256x144";
     Status result;
     if (job.frames < 1 || job.frames > 100000) result = Status::error("bench: --frames must be in 1..100000");
     else if (job.what == "render") result = bench_render(job);
@@ -164,8 +166,9 @@ int command_bench(int argc, char** argv) {
     else if (job.what == "fruc") result = bench_fruc(job);
     else if (job.what == "stereo") result = bench_stereo(job);
     else if (job.what == "codec") result = bench_codec(job);
+    else if (job.what == "reuse") result = bench_reuse(job);
     else result = Status::error("bench: unknown benchmark '" + job.what +
-                                "' (render, exr, reproject, grid, fill, paths, fruc, stereo, codec)");
+                                "' (render, exr, reproject, grid, fill, paths, fruc, stereo, codec, reuse)");
     return report(args, parsed, result);
 }
 

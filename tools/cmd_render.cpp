@@ -1,4 +1,5 @@
 // reprise render / reprise scenes
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -23,10 +24,58 @@ struct RenderJob {
     int start = 0;
     double fps = 30.0;
     bool unlit = false;
+    std::string shading;  // lit | unlit | heavy; default: heavy for scenes built for it, else lit
+    std::string reuse = "off";
+    std::string refresh;
+    double threshold = 8.0;  // adaptive: in 1/255 display steps
+    double smoothing = 0.0;
+    double depth_epsilon = 1024.0;
+    int octaves = 8;
+    int pcf_radius = 5;
     bool allow_outside_paths = false;
     double stereo = 0.0;       // IPD; > 0 renders both eyes into OUT/left and OUT/right
     double convergence = 0.0;  // > 0: off-axis rig converging there
 };
+
+struct ReuseTotals : server::ReuseStats {
+    void add(const server::ReuseStats& s) {
+        covered += s.covered, hits += s.hits, reused += s.reused, shaded += s.shaded;
+        shading_ms += s.shading_ms, shading_cpu_ms += s.shading_cpu_ms;
+    }
+};
+
+Status parse_shading(const RenderJob& job, const server::Scene& scene, server::RenderSettings& settings) {
+    const std::string shading =
+        !job.shading.empty() ? job.shading : job.unlit ? "unlit" : scene.heavy_shading ? "heavy" : "lit";
+    if (shading == "lit") settings.shading = server::Shading::Lit;
+    else if (shading == "unlit") settings.shading = server::Shading::Unlit;
+    else if (shading == "heavy") settings.shading = server::Shading::Heavy;
+    else return Status::error("--shading '" + shading + "' must be lit, unlit or heavy");
+    if (job.unlit && settings.shading != server::Shading::Unlit)
+        return Status::error("--unlit contradicts --shading " + shading);
+    server::ReuseSettings& reuse = settings.reuse;
+    if (job.reuse == "off") reuse.mode = server::Reuse::Off;
+    else if (job.reuse == "cache") reuse.mode = server::Reuse::Cache;
+    else if (job.reuse == "adaptive") reuse.mode = server::Reuse::Adaptive, reuse.period = 16;
+    else return Status::error("--reuse '" + job.reuse + "' must be off, cache or adaptive");
+    if (reuse.mode != server::Reuse::Off && settings.shading != server::Shading::Heavy)
+        return Status::error("--reuse " + job.reuse + " needs --shading heavy");
+    if (!job.refresh.empty()) REPRISE_TRY(server::parse_refresh(job.refresh, reuse));
+    if (!(job.threshold > 0.0 && job.threshold <= 255.0))
+        return Status::error("--threshold must be in (0, 255] display steps");
+    reuse.threshold = float(job.threshold / 255.0);
+    if (!(job.smoothing >= 0.0 && job.smoothing <= 1.0))
+        return Status::error("--smoothing must be in [0, 1]");
+    reuse.smoothing = float(job.smoothing);
+    if (!(job.depth_epsilon >= 0.0 && job.depth_epsilon <= 1e6))
+        return Status::error("--depth-epsilon must be in [0, 1e6]");
+    reuse.depth_epsilon = float(job.depth_epsilon);
+    if (job.octaves < 1 || job.octaves > 16) return Status::error("--octaves must be in 1..16");
+    if (job.pcf_radius < 0 || job.pcf_radius > 8) return Status::error("--pcf must be in 0..8");
+    settings.heavy_octaves = job.octaves;
+    settings.heavy_pcf_radius = job.pcf_radius;
+    return {};
+}
 
 Status run_render(const RenderJob& job) {
     int width = 0, height = 0;
@@ -55,6 +104,10 @@ Status run_render(const RenderJob& job) {
         server::CameraPath fallback = path;
         REPRISE_TRY(server::parse_camera_spec(job.camera, scene, fallback, path));
     }
+    server::RenderSettings settings{.width = width, .height = height};
+    REPRISE_TRY(parse_shading(job, scene, settings));
+    if (settings.reuse.mode != server::Reuse::Off && stereo)
+        return Status::error("--reuse works on one eye only (no --stereo)");
     std::error_code ec;
     for (const std::string& dir : {left_dir, stereo ? right_dir : left_dir}) {
         std::filesystem::create_directories(dir, ec);
@@ -65,15 +118,14 @@ Status run_render(const RenderJob& job) {
     REPRISE_TRY(server::Renderer::create(renderer));
     std::fprintf(stderr, "[render] %s, %dx%d, %d frames at %g Hz on %s\n", job.scene.c_str(),
                  width, height, job.frames, job.fps, renderer->device().c_str());
-    const server::RenderSettings settings{
-        .width = width,
-        .height = height,
-        .shading = job.unlit ? server::Shading::Unlit : server::Shading::Lit};
+    ReuseTotals totals;
     Frame frame;
     auto begin = std::chrono::steady_clock::now();
     for (int i = 0; i < job.frames; ++i) {
         if (!stereo) {
             REPRISE_TRY(renderer->render_frame(scene, path, job.start + i, job.fps, settings, frame));
+            // Frame 0 has no cache and pays llvmpipe's shader compilation: left out.
+            if (settings.shading == server::Shading::Heavy && i > 0) totals.add(renderer->reuse_stats());
             REPRISE_TRY(write_frame(frame_path(job.out, i), frame));
         } else {
             // The path's camera is the rig's centre; each eye renders with its own view.
@@ -104,6 +156,12 @@ Status run_render(const RenderJob& job) {
         std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
     std::fprintf(stderr, "\n[render] %.2f s (%.1f frames/s with EXR writing) -> %s\n", seconds,
                  job.frames / seconds, job.out.c_str());
+    const double frames = std::max(job.frames - 1, 1);
+    if (settings.shading == server::Shading::Heavy)
+        std::printf("reuse %s: hit rate %.1f %%, pixels shaded %.1f %% (%.0f per frame), shading pass "
+                    "%.1f ms/frame (CPU %.1f ms), frames 1..\n",
+                    job.reuse.c_str(), 100.0 * totals.hit_rate(), 100.0 * totals.shaded_fraction(),
+                    double(totals.shaded) / frames, totals.shading_ms / frames, totals.shading_cpu_ms / frames);
     return {};
 }
 
@@ -123,6 +181,21 @@ int command_render(int argc, char** argv) {
                 "static|orbit|pan|dolly|shake|cut|gltf[:N] with ,key=value (speed, radius, "
                 "height, shake, time, angle)");
     args.flag("--unlit", &job.unlit, "base colour only (view-independent shading)");
+    args.option("--shading", &job.shading,
+                "lit|unlit|heavy (default: heavy for courtyard and stroll, else lit)");
+    args.option("--reuse", &job.reuse,
+                "off|cache|adaptive: heavy shading reuses its expensive term through a "
+                "reprojection cache (default off)");
+    args.option("--refresh", &job.refresh,
+                "KIND:N with --reuse: tiled|random|blocks|interleaved, each pixel reshaded at "
+                "least every N frames (default blocks:4; adaptive: N caps the deadline, default 16)");
+    args.option("--octaves", &job.octaves, "heavy: noise octaves per layer, three layers (default 8)");
+    args.option("--pcf", &job.pcf_radius, "heavy: PCF radius r, (2r+1)^2 shadow taps (default 5)");
+    args.option("--threshold", &job.threshold, "adaptive: allowed change per channel in 1/255 (default 8)");
+    args.option("--depth-epsilon", &job.depth_epsilon,
+                "cache hit test: depth tolerance in 24-bit Z-buffer steps (default 1024)");
+    args.option("--smoothing", &job.smoothing,
+                "amortized shadow supersampling alpha on cache hits (0 = off, default)");
     args.flag("--allow-outside-paths", &job.allow_outside_paths,
               "let a glTF file read buffers and images outside its own folder (trusted files only)");
     args.option("--stereo", &job.stereo,

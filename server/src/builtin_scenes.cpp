@@ -18,6 +18,8 @@ const std::vector<SceneInfo>& builtin_scenes() {
         {"specular", "view-dependent highlights on shiny objects under an orbit"},
         {"fast", "a camera pan and an object moving over 100 px/frame at 1080p, 30 Hz"},
         {"cut", "an orbit with a hard camera cut at 0.5 s"},
+        {"courtyard", "heavy shading: still camera, objects moving through soft shadows, 8 lights"},
+        {"stroll", "heavy shading: a camera orbiting a plaza of marbled objects, 8 lights"},
     };
     return scenes;
 }
@@ -347,6 +349,73 @@ Scene cut_scene(CameraPath& camera) {
     return scene;
 }
 
+// Eight coloured point lights on a ring `radius` around `centre`, `height` above the ground.
+void ring_of_lights(Scene& scene, glm::vec3 centre, float radius, float height, float power) {
+    const glm::vec3 tints[4] = {{1.0f, 0.75f, 0.5f}, {0.55f, 0.7f, 1.0f}, {1.0f, 0.55f, 0.7f}, {0.6f, 1.0f, 0.7f}};
+    for (int i = 0; i < 8; ++i) {
+        float a = glm::two_pi<float>() * (float(i) + 0.5f) / 8.0f;
+        scene.point_lights.push_back({.position = centre + glm::vec3(radius * std::cos(a), height, radius * std::sin(a)),
+                                      .color = power * tints[i % 4]});
+    }
+}
+
+Scene courtyard_scene(CameraPath& camera) {
+    Builder b;
+    b.scene.name = "courtyard";
+    b.scene.heavy_shading = true;
+    b.scene.light = {.direction = {-0.5f, -1.0f, -0.35f}, .color = {1.0f, 0.95f, 0.85f}, .ambient = {0.1f, 0.11f, 0.14f}};
+    int stone = b.material({0.85f, 0.82f, 0.78f}, -1, 0.2f, 24.0f);
+    int brick = b.material({0.8f, 0.5f, 0.4f}, -1, 0.1f, 16.0f);
+    int marble = b.material({0.9f, 0.9f, 0.95f}, -1, 0.6f, 64.0f);
+    int bronze = b.material({0.75f, 0.55f, 0.3f}, -1, 0.8f, 48.0f);
+    b.add("ground", ground(30, 24, 4), stone, {0, 0, -2});
+    b.add("wall", wall(30, 8, 3), brick, {0, 0, -8});
+    for (int i = 0; i < 4; ++i)
+        b.add("pillar" + std::to_string(i), cylinder(0.35f, 4.0f, 24), marble, {-4.5f + 3.0f * i, 0, -5.5f});
+    int cube = b.add("cube", box({1.2f, 1.2f, 1.2f}, 0.6f), bronze, {-4, 0.6f, -1});
+    b.move(cube, {1.6f, 0, 0});
+    b.spin(cube, {0, 1, 0}, 0.9f);
+    int ball = b.add("ball", sphere(0.7f, 24, 48), marble, {4, 0.7f, -3});
+    b.move(ball, {-1.4f, 0, 0});
+    b.spin(ball, {0, 0, 1}, 1.4f / 0.7f);
+    int slab = b.add("slab", box({0.4f, 2.4f, 1.6f}, 0.8f), brick, {1.5f, 1.2f, 0.5f});
+    b.spin(slab, {0, 1, 0}, 0.6f);
+    ring_of_lights(b.scene, {0, 0, -2.5f}, 5.0f, 2.2f, 1.5f);
+    camera = {.motion = CameraMotion::Static,
+              .target = {0, 1.0f, -3},
+              .eye = {0, 3.0f, 6},
+              .model = builtin_lens()};
+    return std::move(b.scene);
+}
+
+Scene stroll_scene(CameraPath& camera) {
+    Builder b;
+    b.scene.name = "stroll";
+    b.scene.heavy_shading = true;
+    b.scene.light = {.direction = {-0.6f, -0.9f, -0.4f}, .color = {1.0f, 0.95f, 0.85f}, .ambient = {0.1f, 0.11f, 0.14f}};
+    int stone = b.material({0.8f, 0.78f, 0.72f}, -1, 0.2f, 24.0f);
+    int marble = b.material({0.92f, 0.9f, 0.88f}, -1, 0.7f, 80.0f);
+    int moss = b.material({0.45f, 0.6f, 0.35f}, -1, 0.05f, 8.0f);
+    int bronze = b.material({0.75f, 0.55f, 0.3f}, -1, 0.8f, 48.0f);
+    b.add("ground", ground(40, 40, 4), stone, {0, 0, 0});
+    for (int i = 0; i < 6; ++i) {
+        float a = glm::two_pi<float>() * float(i) / 6.0f;
+        glm::vec3 at(3.5f * std::cos(a), 0, 3.5f * std::sin(a));
+        b.add("column" + std::to_string(i), cylinder(0.3f, 2.5f + 0.4f * float(i % 3), 24), marble, at);
+    }
+    b.add("plinth", box({2.0f, 0.8f, 2.0f}, 1.0f), moss, {0, 0.4f, 0});
+    b.add("statue", sphere(0.7f, 24, 48), bronze, {0, 1.5f, 0});
+    b.add("bench", box({2.5f, 0.5f, 0.7f}, 1.0f), moss, {-1.5f, 0.25f, 5.5f},
+          glm::angleAxis(0.3f, glm::vec3(0, 1, 0)));
+    ring_of_lights(b.scene, {0, 0, 0}, 6.0f, 2.5f, 2.0f);
+    camera = {.motion = CameraMotion::Orbit,
+              .target = {0, 1.0f, 0},
+              .eye = {0, 3.0f, 8.5f},
+              .speed = 0.25f,
+              .model = builtin_lens()};
+    return std::move(b.scene);
+}
+
 }  // namespace
 
 Status load_scene(const std::string& name_or_file, Scene& scene, CameraPath& camera,
@@ -358,6 +427,8 @@ Status load_scene(const std::string& name_or_file, Scene& scene, CameraPath& cam
     else if (n == "crossing") scene = crossing_scene(camera);
     else if (n == "specular") scene = specular_scene(camera);
     else if (n == "cut") scene = cut_scene(camera);
+    else if (n == "courtyard") scene = courtyard_scene(camera);
+    else if (n == "stroll") scene = stroll_scene(camera);
     else {
         auto ext = std::filesystem::path(n).extension().string();
         if (ext != ".gltf" && ext != ".glb")

@@ -1,6 +1,8 @@
 #include "reprise/server/renderer.hpp"
 
+#include <chrono>
 #include <cmath>
+#include <ctime>
 #include <limits>
 #include <vector>
 
@@ -9,6 +11,7 @@
 #include <glm/gtc/type_ptr.hpp>
 
 #include "gbuffer_shaders.hpp"
+#include "heavy_shaders.hpp"
 #include "reprise/server/animation.hpp"
 #include "reprise/server/gl_context.hpp"
 
@@ -45,6 +48,38 @@ Status compile(GLenum type, const char* source, GLuint& shader) {
     return Status::error(std::string("OpenGL ES: shader does not compile: ") + log);
 }
 
+Status link(const char* vertex, const char* fragment, const char* what, GLuint& program) {
+    GLuint vs = 0, fs = 0;
+    Status status = compile(GL_VERTEX_SHADER, vertex, vs);
+    if (status.ok()) status = compile(GL_FRAGMENT_SHADER, fragment, fs);
+    if (status.ok()) {
+        program = glCreateProgram();
+        glAttachShader(program, vs);
+        glAttachShader(program, fs);
+        glLinkProgram(program);
+        GLint linked = 0;
+        glGetProgramiv(program, GL_LINK_STATUS, &linked);
+        if (!linked) {
+            char log[2048] = {};
+            glGetProgramInfoLog(program, sizeof log, nullptr, log);
+            status = Status::error(std::string("OpenGL ES: the ") + what + " program does not link: " + log);
+        }
+    }
+    glDeleteShader(vs);
+    glDeleteShader(fs);
+    return status;
+}
+
+constexpr int kShadowMapSize = 1024;
+
+// CPU time of all threads of this process (llvmpipe shades on its own threads): on a shared
+// machine it varies far less than wall time.
+double process_cpu_ms() {
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return double(t.tv_sec) * 1e3 + double(t.tv_nsec) * 1e-6;
+}
+
 // Area-weighted vertex normals for primitives that come without them.
 void smooth_normals(const std::vector<glm::vec3>& positions, const std::vector<uint32_t>& indices,
                     std::vector<glm::vec3>& normals) {
@@ -56,16 +91,99 @@ void smooth_normals(const std::vector<glm::vec3>& positions, const std::vector<u
     }
 }
 
+Status check_heavy_settings(const RenderSettings& settings) {
+    if (settings.heavy_octaves < 1 || settings.heavy_octaves > 16)
+        return Status::error("heavy shading: octaves must be in 1..16");
+    if (settings.heavy_pcf_radius < 0 || settings.heavy_pcf_radius > 8)
+        return Status::error("heavy shading: PCF radius must be in 0..8");
+    const ReuseSettings& r = settings.reuse;
+    if (r.period < 1 || r.period > 255)
+        return Status::error("reuse: refresh period " + std::to_string(r.period) + " must be in 1..255");
+    if (!(r.threshold > 0.0f && r.threshold <= 1.0f))
+        return Status::error("reuse: threshold must be in (0, 1]");
+    if (r.filter_radius < 0 || r.filter_radius > 3)
+        return Status::error("reuse: filter radius must be in 0..3");
+    if (!(r.depth_epsilon >= 0.0f && r.depth_epsilon <= 1e6f))
+        return Status::error("reuse: depth epsilon must be in [0, 1e6] Z-buffer increments");
+    if (!(r.smoothing >= 0.0f && r.smoothing <= 1.0f))
+        return Status::error("reuse: smoothing alpha must be in [0, 1]");
+    return {};
+}
+
+// Orthographic light view around the bounding sphere of everything drawn.
+template <class Vertices>
+glm::mat4 shadow_light_matrix(const Vertices& vertices, glm::vec3 direction) {
+    glm::vec3 lo(std::numeric_limits<float>::max()), hi(-std::numeric_limits<float>::max());
+    for (const auto& v : vertices) lo = glm::min(lo, v.position), hi = glm::max(hi, v.position);
+    if (vertices.empty()) lo = hi = glm::vec3(0.0f);
+    const glm::vec3 centre = 0.5f * (lo + hi);
+    const float radius = std::max(0.5f * glm::length(hi - lo), 1e-3f);
+    glm::vec3 d = glm::length(direction) > 0.0f ? glm::normalize(direction) : glm::vec3(0, -1, 0);
+    glm::vec3 up = std::abs(d.y) > 0.99f ? glm::vec3(1, 0, 0) : glm::vec3(0, 1, 0);
+    glm::mat4 view = glm::lookAt(centre - 2.0f * radius * d, centre, up);
+    return glm::ortho(-radius, radius, -radius, radius, radius, 3.0f * radius) * view;
+}
+
+}  // namespace
+
+const char* to_string(Refresh refresh) {
+    switch (refresh) {
+    case Refresh::Tiled: return "tiled";
+    case Refresh::Random: return "random";
+    case Refresh::Blocks: return "blocks";
+    case Refresh::Interleaved: return "interleaved";
+    }
+    return "?";
+}
+
+Status parse_refresh(const std::string& spec, ReuseSettings& reuse) {
+    const std::size_t colon = spec.find(':');
+    const std::string kind = spec.substr(0, colon);
+    if (kind == "tiled") reuse.refresh = Refresh::Tiled;
+    else if (kind == "random") reuse.refresh = Refresh::Random;
+    else if (kind == "blocks") reuse.refresh = Refresh::Blocks;
+    else if (kind == "interleaved") reuse.refresh = Refresh::Interleaved;
+    else
+        return Status::error("--refresh '" + spec +
+                             "': the kind must be tiled, random, blocks or interleaved");
+    if (colon != std::string::npos) {
+        const std::string n = spec.substr(colon + 1);
+        char* end = nullptr;
+        long period = std::strtol(n.c_str(), &end, 10);
+        if (n.empty() || *end != '\0' || period < 1 || period > 255)
+            return Status::error("--refresh '" + spec + "': the period must be an integer in 1..255");
+        reuse.period = int(period);
+    }
+    return {};
+}
+
+namespace {
+
 }  // namespace
 
 struct Renderer::Gpu {
     std::unique_ptr<GlContext> context;
     GLuint program = 0;
+    GLuint active = 0;  // the program uniform() looks names up in
+    // Heavy shading: its program, the key light's shadow map and the ping-pong reuse cache.
+    // Full shading, the hit pass and the miss pass of reuse (heavy_shaders.hpp).
+    GLuint heavy_program[3] = {}, shadow_program = 0;
+    GLuint shadow_framebuffer = 0, shadow_map = 0;
+    GLuint cache_term[2] = {}, cache_meta[2] = {};
+    int cache_slot = 0;          // the slot written by the next reusing frame
+    bool cache_valid = false;    // the other slot holds the frame rendered at cache_time/view
+    double cache_time = 0.0;
+    glm::mat4 cache_view{0.0f};
+    const Scene* cache_scene = nullptr;
+    int reuse_frame = 0;
+    ReuseStats stats;
+    ReuseMaps maps;
     GLuint framebuffer = 0;
     GLuint targets[3] = {};  // colour, (depth, motion, id), normal
     GLuint depth_buffer = 0;
     GLuint vertex_array = 0, vertex_buffer = 0, index_buffer = 0;
     int width = 0, height = 0;
+    int cache_width = 0, cache_height = 0;
     float max_anisotropy = 0.0f;
     // Textures of the scene last drawn, recognised by its address and its texture storage.
     const Scene* scene = nullptr;
@@ -90,9 +208,78 @@ struct Renderer::Gpu {
         glDeleteBuffers(1, &index_buffer);
         glDeleteVertexArrays(1, &vertex_array);
         glDeleteProgram(program);
+        for (GLuint p : heavy_program) glDeleteProgram(p);
+        glDeleteProgram(shadow_program);
+        glDeleteFramebuffers(1, &shadow_framebuffer);
+        glDeleteTextures(1, &shadow_map);
+        glDeleteTextures(2, cache_term);
+        glDeleteTextures(2, cache_meta);
     }
 
-    GLint uniform(const char* name) const { return glGetUniformLocation(program, name); }
+    GLint uniform(const char* name) const { return glGetUniformLocation(active, name); }
+
+    static void float_target(GLuint texture, int w, int h) {
+        glBindTexture(GL_TEXTURE_2D, texture);
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, w, h, 0, GL_RGBA, GL_FLOAT, nullptr);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    }
+
+    // Programs, shadow map and cache of the heavy mode, made on first use.
+    Status prepare_heavy() {
+        if (heavy_program[0]) return {};
+        std::string vertex = shaders::kVertex;
+        vertex.insert(vertex.find("uniform"), "invariant gl_Position;\n");
+        for (int pass = 0; pass < 3; ++pass) {
+            const std::string fragment = std::string("#version 300 es\n#define REUSE ") +
+                                         (pass ? "1" : "0") + "\n#define PASS " + char('0' + pass) +
+                                         "\n" + shaders::kHeavyFragment;
+            REPRISE_TRY(link(vertex.c_str(), fragment.c_str(), "heavy shading", heavy_program[pass]));
+        }
+        REPRISE_TRY(link(shaders::kShadowVertex, shaders::kShadowFragment, "shadow map", shadow_program));
+        glGenTextures(1, &shadow_map);
+        glBindTexture(GL_TEXTURE_2D, shadow_map);
+        glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT32F, kShadowMapSize, kShadowMapSize, 0,
+                     GL_DEPTH_COMPONENT, GL_FLOAT, nullptr);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_MODE, GL_COMPARE_REF_TO_TEXTURE);
+        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_COMPARE_FUNC, GL_LEQUAL);
+        glGenFramebuffers(1, &shadow_framebuffer);
+        glBindFramebuffer(GL_FRAMEBUFFER, shadow_framebuffer);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_TEXTURE_2D, shadow_map, 0);
+        const GLenum none = GL_NONE;
+        glDrawBuffers(1, &none);
+        if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+            return Status::error("OpenGL ES: the shadow map is not renderable on this device");
+        GLint draw_buffers = 0;
+        glGetIntegerv(GL_MAX_DRAW_BUFFERS, &draw_buffers);
+        if (draw_buffers < 5)
+            return Status::error("renderer: heavy shading needs 5 draw buffers, this device has " +
+                                 std::to_string(draw_buffers));
+        glGenTextures(2, cache_term);
+        glGenTextures(2, cache_meta);
+        return {};
+    }
+
+    void set_heavy_uniforms(const Scene& s, const Instant& current, const RenderSettings& settings,
+                            const glm::mat4& light_matrix, bool cache_usable);
+    void read_reuse(bool reusing, const Image<uint32_t>& ids);
+
+    void resize_cache(int w, int h) {
+        for (int i = 0; i < 2; ++i) {
+            float_target(cache_meta[i], w, h);
+            glBindTexture(GL_TEXTURE_2D, cache_term[i]);
+            glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA16F, w, h, 0, GL_RGBA, GL_HALF_FLOAT, nullptr);
+            glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
+            glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+            glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_CLAMP_TO_EDGE);
+            glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_CLAMP_TO_EDGE);
+        }
+        cache_valid = false;
+    }
 
     Status resize(int w, int h) {
         if (w == width && h == height) return {};
@@ -117,8 +304,8 @@ struct Renderer::Gpu {
                                    targets[i], 0);
         }
         glBindRenderbuffer(GL_RENDERBUFFER, depth_buffer);
-        glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT32F, w, h);
-        glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth_buffer);
+        glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH32F_STENCIL8, w, h);  // stencil: reuse's passes
+        glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, depth_buffer);
         const GLenum buffers[3] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
         glDrawBuffers(3, buffers);
         if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
@@ -188,6 +375,94 @@ struct Renderer::Gpu {
     }
 };
 
+void Renderer::Gpu::set_heavy_uniforms(const Scene& drawn, const Instant& current,
+                                       const RenderSettings& settings,
+                                       const glm::mat4& light_matrix, bool cache_usable) {
+    Gpu& g = *this;
+    const ReuseSettings& r = settings.reuse;
+    glUniformMatrix4fv(g.uniform("u_light_matrix"), 1, GL_FALSE, glm::value_ptr(light_matrix));
+    glUniform1f(g.uniform("u_shadow_texel"), 1.0f / float(kShadowMapSize));
+    glUniform1i(g.uniform("u_pcf_radius"), settings.heavy_pcf_radius);
+    glUniform1i(g.uniform("u_octaves"), settings.heavy_octaves);
+    const int lights = int(std::min<std::size_t>(drawn.point_lights.size(), 16));
+    glm::vec3 light_positions[16], light_colors[16];
+    for (int i = 0; i < lights; ++i)
+        light_positions[i] = drawn.point_lights[i].position, light_colors[i] = drawn.point_lights[i].color;
+    glUniform1i(g.uniform("u_point_count"), lights);
+    if (lights > 0) {
+        glUniform3fv(g.uniform("u_point_position"), lights, glm::value_ptr(light_positions[0]));
+        glUniform3fv(g.uniform("u_point_color"), lights, glm::value_ptr(light_colors[0]));
+    }
+    glUniform1i(g.uniform("u_reuse"), int(r.mode));
+    glUniform1i(g.uniform("u_cache_valid"), cache_usable);
+    glUniform1i(g.uniform("u_frame"), g.reuse_frame);
+    glUniform1i(g.uniform("u_refresh"), int(r.refresh));
+    glUniform1i(g.uniform("u_period"), r.period);
+    int rows = 1;
+    for (int d = 1; d * d <= r.period; ++d)
+        if (r.period % d == 0) rows = d;
+    glUniform2i(g.uniform("u_tiles"), r.period / rows, rows);
+    glUniform1i(g.uniform("u_interleave_step"), std::max(1, int(std::lround(std::sqrt(double(r.period))))));
+    glUniform1f(g.uniform("u_threshold"), r.threshold);
+    glUniform1i(g.uniform("u_filter_radius"), r.filter_radius);
+    // One step of a 24-bit Z-buffer, in the cache's depth key (heavy_shaders.hpp).
+    const bool orthographic = current.projection[3][3] == 1.0f;
+    const float inverse_range = orthographic ? 1.0f
+                                             : 1.0f / current.near - (std::isfinite(current.far) ? 1.0f / current.far : 0.0f);
+    glUniform1i(g.uniform("u_orthographic"), orthographic);
+    glUniform1f(g.uniform("u_epsilon"), r.depth_epsilon / 16777215.0f * inverse_range);
+    glUniform1f(g.uniform("u_smoothing"), r.smoothing);
+    glUniform1i(g.uniform("u_shadow_map"), 1);
+    glUniform1i(g.uniform("u_cache_term"), 2);
+    glUniform1i(g.uniform("u_cache_meta"), 3);
+    const int previous = g.cache_slot ^ 1;
+    glActiveTexture(GL_TEXTURE1);
+    glBindTexture(GL_TEXTURE_2D, g.shadow_map);
+    glActiveTexture(GL_TEXTURE2);
+    glBindTexture(GL_TEXTURE_2D, g.cache_term[previous]);
+    glActiveTexture(GL_TEXTURE3);
+    glBindTexture(GL_TEXTURE_2D, g.cache_meta[previous]);
+}
+
+// Statistics and per-pixel maps of reuse (everything is shaded without it).
+void Renderer::Gpu::read_reuse(bool reusing, const Image<uint32_t>& ids) {
+    Gpu& g = *this;
+    const int w = ids.width(), h = ids.height();
+    ReuseStats& s = g.stats;
+    s.covered = s.hits = s.reused = s.shaded = 0;
+    g.maps.status.resize(w, h);
+    g.maps.age.resize(w, h);
+    if (!reusing) {
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                const bool covered = ids(x, y) != 0;
+                g.maps.status(x, y) = covered ? kReuseMiss : kReuseBackground;
+                g.maps.age(x, y) = 0;
+                s.covered += covered;
+            }
+        s.shaded = s.covered;
+        return;
+    }
+    glReadBuffer(GL_COLOR_ATTACHMENT4);
+    glReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, g.readback.data());
+    for (int y = 0; y < h; ++y) {
+        const glm::vec4* row = g.readback.data() + std::size_t(h - 1 - y) * w;
+        for (int x = 0; x < w; ++x) {
+            const glm::vec4 meta = row[x];  // depth, id, age, gradient (< 0: shaded on a miss)
+            const uint8_t status = meta.y == 0.0f ? kReuseBackground
+                                   : meta.z > 0.0f ? kReuseHit
+                                   : meta.w < 0.0f ? kReuseMiss
+                                                   : kReuseRefresh;
+            g.maps.status(x, y) = status;
+            g.maps.age(x, y) = uint8_t(std::min(meta.z, 255.0f));
+            s.covered += status != kReuseBackground;
+            s.hits += status == kReuseHit || status == kReuseRefresh;
+            s.reused += status == kReuseHit;
+            s.shaded += status == kReuseMiss || status == kReuseRefresh;
+        }
+    }
+}
+
 Instant instant_on_path(const CameraPath& path, const Scene& scene, double time, int width,
                         int height) {
     return {.time = time,
@@ -201,26 +476,15 @@ Renderer::Renderer() : gpu_(std::make_unique<Gpu>()) {}
 Renderer::~Renderer() = default;
 
 const std::string& Renderer::device() const { return gpu_->context->description(); }
+const ReuseStats& Renderer::reuse_stats() const { return gpu_->stats; }
+const ReuseMaps& Renderer::reuse_maps() const { return gpu_->maps; }
+void Renderer::drop_reuse_cache() { gpu_->cache_valid = false; }
 
 Status Renderer::create(std::unique_ptr<Renderer>& renderer) {
     std::unique_ptr<Renderer> r(new Renderer());
     Gpu& g = *r->gpu_;
     REPRISE_TRY(GlContext::create(g.context));
-    GLuint vs = 0, fs = 0;
-    Status status = compile(GL_VERTEX_SHADER, shaders::kVertex, vs);
-    if (status.ok()) status = compile(GL_FRAGMENT_SHADER, shaders::kFragment, fs);
-    if (status.ok()) {
-        g.program = glCreateProgram();
-        glAttachShader(g.program, vs);
-        glAttachShader(g.program, fs);
-        glLinkProgram(g.program);
-        GLint linked = 0;
-        glGetProgramiv(g.program, GL_LINK_STATUS, &linked);
-        if (!linked) status = Status::error("OpenGL ES: the G-buffer program does not link");
-    }
-    glDeleteShader(vs);
-    glDeleteShader(fs);
-    REPRISE_TRY(status);
+    REPRISE_TRY(link(shaders::kVertex, shaders::kFragment, "G-buffer", g.program));
     glGenVertexArrays(1, &g.vertex_array);
     glGenBuffers(1, &g.vertex_buffer);
     glGenBuffers(1, &g.index_buffer);
@@ -262,34 +526,19 @@ Status Renderer::render(const Scene& scene, const Instant& current, const Instan
     glm::mat4 previous_view_projection = previous.projection * previous.view;
     glm::vec3 eye = glm::vec3(glm::inverse(current.view)[3]);
 
-    glBindFramebuffer(GL_FRAMEBUFFER, g.framebuffer);
-    glViewport(0, 0, w, h);
-    const glm::vec4 sky(scene.background, 0.0f), zero(0.0f);
-    glClearBufferfv(GL_COLOR, 0, glm::value_ptr(sky));
-    glClearBufferfv(GL_COLOR, 1, glm::value_ptr(zero));
-    glClearBufferfv(GL_COLOR, 2, glm::value_ptr(zero));
-    glClearDepthf(1.0f);
-    glClear(GL_DEPTH_BUFFER_BIT);
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_LESS);
-    glDisable(GL_BLEND);
-
-    glUseProgram(g.program);
-    glUniformMatrix4fv(g.uniform("u_view_projection"), 1, GL_FALSE, glm::value_ptr(view_projection));
-    const glm::mat4 unjittered = current.projection * current.view;
-    glUniformMatrix4fv(g.uniform("u_unjittered_view_projection"), 1, GL_FALSE,
-                       glm::value_ptr(unjittered));
-    glUniformMatrix4fv(g.uniform("u_view"), 1, GL_FALSE, glm::value_ptr(current.view));
-    glUniformMatrix4fv(g.uniform("u_previous_view_projection"), 1, GL_FALSE,
-                       glm::value_ptr(previous_view_projection));
-    glUniform2f(g.uniform("u_size"), float(w), float(h));
-    glUniform3fv(g.uniform("u_eye"), 1, glm::value_ptr(eye));
-    glUniform3fv(g.uniform("u_light_direction"), 1, glm::value_ptr(scene.light.direction));
-    glUniform3fv(g.uniform("u_light_color"), 1, glm::value_ptr(scene.light.color));
-    glUniform3fv(g.uniform("u_ambient"), 1, glm::value_ptr(scene.light.ambient));
-    glUniform1i(g.uniform("u_lit"), settings.shading == Shading::Lit);
-    glUniform1i(g.uniform("u_texture"), 0);
-    glActiveTexture(GL_TEXTURE0);
+    const bool heavy = settings.shading == Shading::Heavy;
+    const ReuseSettings& reuse = settings.reuse;
+    const bool reusing = heavy && reuse.mode != Reuse::Off;
+    if (heavy) {
+        REPRISE_TRY(check_heavy_settings(settings));
+        REPRISE_TRY(g.prepare_heavy());
+        if (g.cache_width != w || g.cache_height != h) {
+            g.resize_cache(w, h);
+            g.cache_width = w, g.cache_height = h;
+        }
+    }
+    const bool cache_usable = reusing && g.cache_valid && !current.cut && g.cache_scene == &scene &&
+                              previous.time == g.cache_time && previous.view == g.cache_view;
 
     glBindVertexArray(g.vertex_array);
     glBindBuffer(GL_ARRAY_BUFFER, g.vertex_buffer);
@@ -298,23 +547,137 @@ Status Renderer::render(const Scene& scene, const Instant& current, const Instan
     glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, g.index_buffer);
     glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(g.indices.size() * sizeof(uint32_t)),
                  g.indices.data(), GL_STREAM_DRAW);
+
+    glm::mat4 light_matrix(1.0f);
+    if (heavy) {
+        light_matrix = shadow_light_matrix(g.vertices, scene.light.direction);
+        glBindFramebuffer(GL_FRAMEBUFFER, g.shadow_framebuffer);
+        glViewport(0, 0, kShadowMapSize, kShadowMapSize);
+        glClearDepthf(1.0f);
+        glClear(GL_DEPTH_BUFFER_BIT);
+        glEnable(GL_DEPTH_TEST);
+        glDepthFunc(GL_LESS);
+        glDisable(GL_CULL_FACE);
+        glUseProgram(g.shadow_program);
+        glUniformMatrix4fv(glGetUniformLocation(g.shadow_program, "u_light_matrix"), 1, GL_FALSE,
+                           glm::value_ptr(light_matrix));
+        for (const Draw& d : g.draws)
+            glDrawElements(GL_TRIANGLES, d.index_count, GL_UNSIGNED_INT,
+                           (void*)(std::size_t(d.first_index) * sizeof(uint32_t)));
+    }
+
+    glBindFramebuffer(GL_FRAMEBUFFER, g.framebuffer);
+    glViewport(0, 0, w, h);
+    const int slot = g.cache_slot;
+    if (reusing) {
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT3, GL_TEXTURE_2D, g.cache_term[slot], 0);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT4, GL_TEXTURE_2D, g.cache_meta[slot], 0);
+        const GLenum buffers[5] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2,
+                                   GL_COLOR_ATTACHMENT3, GL_COLOR_ATTACHMENT4};
+        glDrawBuffers(5, buffers);
+        const glm::vec4 empty_meta(-1.0f, 0.0f, 0.0f, 0.0f);
+        glClearBufferfv(GL_COLOR, 3, glm::value_ptr(glm::vec4(0.0f)));
+        glClearBufferfv(GL_COLOR, 4, glm::value_ptr(empty_meta));
+    } else {
+        const GLenum buffers[3] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
+        glDrawBuffers(3, buffers);
+    }
+    const glm::vec4 sky(scene.background, 0.0f), zero(0.0f);
+    glClearBufferfv(GL_COLOR, 0, glm::value_ptr(sky));
+    glClearBufferfv(GL_COLOR, 1, glm::value_ptr(zero));
+    glClearBufferfv(GL_COLOR, 2, glm::value_ptr(zero));
+    glClearDepthf(1.0f);
+    glClearStencil(0);
+    glClear(GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDisable(GL_BLEND);
+
+    const glm::mat4 unjittered = current.projection * current.view;
+    // Everything a program of the main pass needs besides the per-draw material.
+    auto use = [&](GLuint program) {
+        g.active = program;
+        glUseProgram(program);
+        glUniformMatrix4fv(g.uniform("u_view_projection"), 1, GL_FALSE, glm::value_ptr(view_projection));
+        glUniformMatrix4fv(g.uniform("u_unjittered_view_projection"), 1, GL_FALSE,
+                           glm::value_ptr(unjittered));
+        glUniformMatrix4fv(g.uniform("u_view"), 1, GL_FALSE, glm::value_ptr(current.view));
+        glUniformMatrix4fv(g.uniform("u_previous_view_projection"), 1, GL_FALSE,
+                           glm::value_ptr(previous_view_projection));
+        glUniform2f(g.uniform("u_size"), float(w), float(h));
+        glUniform3fv(g.uniform("u_eye"), 1, glm::value_ptr(eye));
+        glUniform3fv(g.uniform("u_light_direction"), 1, glm::value_ptr(scene.light.direction));
+        glUniform3fv(g.uniform("u_light_color"), 1, glm::value_ptr(scene.light.color));
+        glUniform3fv(g.uniform("u_ambient"), 1, glm::value_ptr(scene.light.ambient));
+        glUniform1i(g.uniform("u_lit"), settings.shading == Shading::Lit);
+        glUniform1i(g.uniform("u_texture"), 0);
+        if (heavy) g.set_heavy_uniforms(scene, current, settings, light_matrix, cache_usable);
+        glActiveTexture(GL_TEXTURE0);
+    };
     const Material fallback;
-    const GLint base_color = g.uniform("u_base_color"), textured = g.uniform("u_textured"),
-                specular = g.uniform("u_specular"), shininess = g.uniform("u_shininess"),
-                id = g.uniform("u_id");
-    for (const Draw& d : g.draws) {
-        const Material& m = d.material >= 0 ? scene.materials[d.material] : fallback;
-        glUniform4fv(base_color, 1, glm::value_ptr(m.base_color));
-        glUniform1i(textured, m.base_color_texture >= 0);
-        if (m.base_color_texture >= 0) glBindTexture(GL_TEXTURE_2D, g.textures[m.base_color_texture]);
-        glUniform1f(specular, m.specular);
-        glUniform1f(shininess, m.shininess);
-        glUniform1f(id, d.id);
-        if (m.double_sided) glDisable(GL_CULL_FACE);
-        else glEnable(GL_CULL_FACE);
-        glFrontFace(d.mirrored ? GL_CW : GL_CCW);
-        glDrawElements(GL_TRIANGLES, d.index_count, GL_UNSIGNED_INT,
-                       (void*)(std::size_t(d.first_index) * sizeof(uint32_t)));
+    auto draw_all = [&](bool materials) {
+        const GLint base_color = g.uniform("u_base_color"), textured = g.uniform("u_textured"),
+                    specular = g.uniform("u_specular"), shininess = g.uniform("u_shininess"),
+                    id = g.uniform("u_id");
+        for (const Draw& d : g.draws) {
+            const Material& m = d.material >= 0 ? scene.materials[d.material] : fallback;
+            if (materials) {
+                glUniform4fv(base_color, 1, glm::value_ptr(m.base_color));
+                glUniform1i(textured, m.base_color_texture >= 0);
+                if (m.base_color_texture >= 0) glBindTexture(GL_TEXTURE_2D, g.textures[m.base_color_texture]);
+                glUniform1f(specular, m.specular);
+                glUniform1f(shininess, m.shininess);
+                glUniform1f(id, d.id);
+            }
+            if (m.double_sided) glDisable(GL_CULL_FACE);
+            else glEnable(GL_CULL_FACE);
+            glFrontFace(d.mirrored ? GL_CW : GL_CCW);
+            glDrawElements(GL_TRIANGLES, d.index_count, GL_UNSIGNED_INT,
+                           (void*)(std::size_t(d.first_index) * sizeof(uint32_t)));
+        }
+    };
+    const auto shading_start = std::chrono::steady_clock::now();
+    const double shading_cpu_start = process_cpu_ms();
+    if (!heavy) {
+        use(g.program);
+        draw_all(true);
+    } else {
+        // Depth pre-pass: each pixel then runs the heavy shader once.
+        g.active = g.shadow_program;
+        glUseProgram(g.shadow_program);
+        glUniformMatrix4fv(g.uniform("u_light_matrix"), 1, GL_FALSE, glm::value_ptr(view_projection));
+        glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+        draw_all(false);
+        glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+        glDepthFunc(GL_LEQUAL);
+        glDepthMask(GL_FALSE);
+        if (!reusing) {
+            use(g.heavy_program[0]);
+            draw_all(true);
+        } else {
+            // Nehab's two-pass control flow with the stencil in place of a depth shift: the hit
+            // pass marks what it reused; the miss pass shades the rest and is culled early
+            // wherever the hit pass covered a whole block.
+            glEnable(GL_STENCIL_TEST);
+            glStencilMask(0xff);
+            glStencilFunc(GL_ALWAYS, 1, 0xff);
+            glStencilOp(GL_KEEP, GL_KEEP, GL_REPLACE);
+            use(g.heavy_program[1]);
+            draw_all(true);
+            glStencilFunc(GL_EQUAL, 0, 0xff);
+            glStencilOp(GL_KEEP, GL_KEEP, GL_KEEP);
+            use(g.heavy_program[2]);
+            draw_all(true);
+            glDisable(GL_STENCIL_TEST);
+        }
+    }
+    if (heavy) {
+        glDepthMask(GL_TRUE);
+        glDepthFunc(GL_LESS);
+        glFinish();
+        g.stats.shading_ms = std::chrono::duration<double, std::milli>(
+                                 std::chrono::steady_clock::now() - shading_start).count();
+        g.stats.shading_cpu_ms = process_cpu_ms() - shading_cpu_start;
     }
 
     // Read back, turning GL's bottom-up rows into top-down images.
@@ -365,6 +728,15 @@ Status Renderer::render(const Scene& scene, const Instant& current, const Instan
                        to_pixels(previous_view_projection, world, there);
         frame.motion(x, y) = visible ? glm::vec2(there - here) : glm::vec2(nan);
     });
+    if (heavy) g.read_reuse(reusing, frame.id);
+    if (reusing) {
+        g.cache_valid = true;
+        g.cache_time = current.time;
+        g.cache_view = current.view;
+        g.cache_scene = &scene;
+        g.cache_slot ^= 1;
+        ++g.reuse_frame;
+    }
     GLenum error = glGetError();
     if (error != GL_NO_ERROR)
         return Status::error("OpenGL ES error 0x" + std::to_string(error) + " while rendering");
@@ -387,6 +759,7 @@ Status Renderer::render_frame(const Scene& scene, const CameraPath& path, int in
     const int w = settings.width, h = settings.height;
     Instant now = instant_on_path(path, scene, index / fps, w, h);
     Instant before = instant_on_path(path, scene, (index - 1) / fps, w, h);
+    now.cut = path.motion == CameraMotion::Cut && before.time < path.cut_time && now.time >= path.cut_time;
     REPRISE_TRY(render(scene, now, before, settings, frame));
     frame.fps = fps;
     return {};

@@ -1,6 +1,7 @@
 #pragma once
 // The headless G-buffer renderer: colour, linear depth, exact backward motion, world normals and
 // object ids of a Scene, through OpenGL ES 3 on EGL.
+#include <cstdint>
 #include <memory>
 #include <string>
 
@@ -13,13 +14,76 @@ namespace reprise::server {
 enum class Shading {
     Lit,    // base colour x (ambient + directional diffuse) + Blinn-Phong specular
     Unlit,  // base colour only: view-independent, for checking motion against colour
+    // Procedural albedo (octaves of value noise), the key light's shadow map filtered by wide
+    // PCF, the scene's point lights: shading dominates the frame. The only mode with reuse.
+    Heavy,
+};
+
+// Shading reuse of the heavy mode (Nehab et al. 2007, Mueller et al. 2021): the expensive, slowly
+// varying term (albedo and key-light visibility) is cached in screen space and reused through
+// reverse reprojection; the view-dependent rest (lights, highlights) is computed every frame.
+enum class Reuse {
+    Off,       // full shading everywhere, the cache is neither read nor written
+    Cache,     // reuse on a cache hit unless the refresh pattern or the period says reshade
+    Adaptive,  // reuse until the predicted change (temporal gradient x age) reaches threshold
+};
+
+// Where the forced refreshes of Reuse::Cache fall; each pixel's phase d refreshes it when
+// (frame + d) mod period == 0.
+enum class Refresh {
+    Tiled,        // the screen in `period` tiles, one refreshed per frame
+    Random,       // random phase per 2x2 block
+    Blocks,       // random phase per 8x8 block (coarse enough for lock-step SIMD shading)
+    Interleaved,  // phase (x + k y) mod period: refreshed pixels spread evenly
+};
+
+struct ReuseSettings {
+    Reuse mode = Reuse::Off;
+    Refresh refresh = Refresh::Blocks;
+    int period = 4;                   // every covered pixel is reshaded at least this often (1..255)
+    float threshold = 8.0f / 255.0f;  // Adaptive: allowed change per display channel
+    int filter_radius = 1;            // Adaptive: spatial max filter of gradients, (2r+1)^2 (0..3)
+    // Hit test: bilinear depth within this many steps of a 24-bit Z-buffer (Nehab's ε is one
+    // step; faceted curved surfaces need room).
+    float depth_epsilon = 1024.0f;
+    // Amortized supersampling of the key light's shadow (Nehab §6): on a hit, a few jittered
+    // PCF taps are blended into the cached visibility with this weight; 0 = off.
+    float smoothing = 0.0f;
 };
 
 struct RenderSettings {
     int width = 640;
     int height = 360;
     Shading shading = Shading::Lit;
+    ReuseSettings reuse;
+    int heavy_octaves = 8;     // per noise layer (three layers)
+    int heavy_pcf_radius = 5;  // (2r+1)^2 shadow-map comparisons
 };
+
+// What reuse did in the last frame rendered with Shading::Heavy.
+struct ReuseStats {
+    int64_t covered = 0;    // pixels with geometry
+    int64_t hits = 0;       // covered pixels whose reprojection passed the depth and id test
+    int64_t reused = 0;     // hits that reused the cache (not reshaded)
+    int64_t shaded = 0;     // covered pixels that ran the expensive term
+    double shading_ms = 0;      // depth pre-pass and shading passes to glFinish (no shadow map, no read-back)
+    double shading_cpu_ms = 0;  // the same pass in CPU time of the whole process (software GL)
+    double hit_rate() const { return covered ? double(hits) / double(covered) : 0.0; }
+    double shaded_fraction() const { return covered ? double(shaded) / double(covered) : 0.0; }
+};
+
+// Per pixel of the last heavy frame: kReuseBackground, kReuseMiss, kReuseHit (reused) or
+// kReuseRefresh (a hit reshaded by the policy), and frames since the pixel's expensive term was
+// last computed (0 = this frame).
+inline constexpr uint8_t kReuseBackground = 0, kReuseMiss = 1, kReuseHit = 2, kReuseRefresh = 3;
+struct ReuseMaps {
+    Image<uint8_t> status;
+    Image<uint8_t> age;
+};
+
+const char* to_string(Refresh refresh);
+// "tiled:4", "random:8", "blocks:4", "interleaved:2"
+Status parse_refresh(const std::string& spec, ReuseSettings& reuse);
 
 // The camera and the animation timeline at one instant.
 struct Instant {
@@ -29,6 +93,7 @@ struct Instant {
     glm::vec2 jitter{0.0f};      // pixel p samples the unjittered image at p + jitter
     float near = 0.1f;
     float far = 1000.0f;
+    bool cut = false;  // a camera cut lies between `previous` and this instant: nothing is reused
 };
 
 Instant instant_on_path(const CameraPath& path, const Scene& scene, double time, int width,
@@ -50,6 +115,12 @@ public:
                         const RenderSettings& settings, Frame& frame);
 
     const std::string& device() const;
+
+    // Reuse of the last heavy frame. The cache survives between frames of one sequence; it is
+    // dropped at a cut, a size change, or when `previous` is not the instant rendered last.
+    const ReuseStats& reuse_stats() const;
+    const ReuseMaps& reuse_maps() const;
+    void drop_reuse_cache();
 
 private:
     Renderer();

@@ -106,6 +106,12 @@ struct Light {
     glm::vec3 ambient{0.25f, 0.27f, 0.32f};
 };
 
+// A point light of the heavy shading mode (no shadow; quadratic falloff).
+struct PointLight {
+    glm::vec3 position{0.0f};
+    glm::vec3 color{1.0f};
+};
+
 struct Scene {
     std::string name;
     std::vector<Node> nodes;
@@ -117,6 +123,8 @@ struct Scene {
     std::vector<Animation> animations;
     std::vector<CameraModel> cameras;
     Light light;
+    std::vector<PointLight> point_lights;  // used by Shading::Heavy only (at most 16)
+    bool heavy_shading = false;            // built for Shading::Heavy (the CLI's default for it)
     glm::vec3 background{0.55f, 0.70f, 0.90f};  // linear RGB of the sky (id 0)
 };
 
