@@ -39,6 +39,8 @@ struct UpsampleOptions {
     float depth_sigma = 0.03f;         // sigma_d as a fraction of the pixel's depth
     float gamma_max = 4.0f;            // largest fall-off of the image-space filter k
     float gamma_unsteered = 3.0f;      // fall-off of k without steering and for the gradient estimate
+    float gamma_min = 1.0f;            // floor of the steered fall-off (1: a hat, as plain joint
+                                       // bilateral upsampling; the paper's 0 is a box)
     float epsilon = 0.01f;             // weight floor of g (eq. 3)
     bool gradient_steering = true;     // temporal gradients steer w_f and gamma_k (section 3.5)
     bool id_test = true;               // history and spatial samples must carry the pixel's id
@@ -46,10 +48,11 @@ struct UpsampleOptions {
     int gradient_radius = 0;           // box radius of the gradient low-pass; 0 = one low pixel + 1
 };
 
+// Counts of one upsample() call (overwritten by each call).
 struct UpsampleStats {
     int64_t history_rejected = 0;   // pixels whose history existed but was disoccluded or off-screen
     int64_t history_used = 0;       // pixels blended with their history
-    int64_t nonfinite_samples = 0;  // low-resolution samples or guide pixels skipped for NaN/Inf
+    int64_t nonfinite_samples = 0;  // low-resolution sample reads skipped for NaN/Inf colour
     int64_t unresolved = 0;         // pixels with neither a finite sample nor history (written 0)
 };
 
