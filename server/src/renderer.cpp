@@ -432,9 +432,11 @@ Status Renderer::render_frame_lowres(const Scene& scene, const CameraPath& path,
     RenderSettings low_settings = settings;
     low_settings.width = low.x;
     low_settings.height = low.y;
-    // Texture detail as the full resolution would pick it.
+    // Texture detail about as the full resolution picks it. (Scaling the screen derivatives
+    // through textureGrad would be exact but matched the full render worse on llvmpipe: 34.3
+    // against 35.4 dB for the composed 2x2 cycle of a still camera, probably anisotropy.)
     low_settings.texture_lod_bias =
-        settings.texture_lod_bias - std::log2(std::max(footprint.x, footprint.y)) * (factor == 4 ? 1.0f : 0.5f);
+        settings.texture_lod_bias - 0.5f * std::log2(footprint.x * footprint.y);
     Frame& scratch = gpu_->lowres_scratch;
     REPRISE_TRY(render(scene, now, before, low_settings, scratch));
     low_color.resize(low.x, low.y);

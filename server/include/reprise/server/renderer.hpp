@@ -62,8 +62,8 @@ public:
                         const RenderSettings& settings, Frame& frame);
 
     // Frame `index` as render_frame() at full resolution, unjittered, plus its colour at 1/factor of
-    // the pixels with lowres_jitter(index) into `low_color` (texture detail chosen for the full
-    // resolution, so low samples equal full-resolution ones at the same positions). `jitter`
+    // the pixels with lowres_jitter(index) into `low_color` (texture level of detail biased
+    // towards the full resolution's, so low samples about equal full-resolution ones). `jitter`
     // receives the jitter used, in full-resolution pixels.
     Status render_frame_lowres(const Scene& scene, const CameraPath& path, int index, double fps,
                                const RenderSettings& settings, int factor, Frame& frame,
