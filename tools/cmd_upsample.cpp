@@ -19,7 +19,7 @@ struct UpsampleJob {
     std::string in, low, out;
     bool spatial_only = false, no_steering = false, no_id_test = false;
     double history_weight = 1.0;
-    double gamma_max = 4.0, max_history_weight = 16.0;
+    double gamma_max = 4.0, max_history_weight = 16.0, gradient_gain = 1.0, history_clamp = 0.25;
 };
 
 Status run_upsample(const UpsampleJob& job) {
@@ -28,6 +28,8 @@ Status run_upsample(const UpsampleJob& job) {
     if (!(job.gamma_max >= 0.0 && job.gamma_max <= 1000.0)) return Status::error("--gamma-max must be in [0, 1000]");
     if (!(job.max_history_weight > 0.0 && job.max_history_weight <= 1e6))
         return Status::error("--max-history-weight must be in (0, 1e6]");
+    if (!(job.gradient_gain >= 0.0 && job.gradient_gain <= 1e3)) return Status::error("--gradient-gain must be in [0, 1000]");
+    if (!(job.history_clamp <= 1e3)) return Status::error("--history-clamp must be at most 1000");
     if (!(job.history_weight >= 0.0 && job.history_weight <= 1.0))
         return Status::error("--history-weight must be in [0, 1]");
     const std::string low_dir = job.low.empty() ? job.in + "/lowres" : job.low;
@@ -48,6 +50,8 @@ Status run_upsample(const UpsampleJob& job) {
         .gamma_max = float(job.gamma_max),
         .gradient_steering = !job.no_steering,
         .id_test = !job.no_id_test,
+        .gradient_gain = float(job.gradient_gain),
+        .history_clamp = float(job.history_clamp),
     });
     Frame full, low;
     Image<glm::vec4> out;
@@ -125,6 +129,8 @@ int command_upsample(int argc, char** argv) {
     args.option("--history-weight", &job.history_weight, "a of the temporal weight, 0..1 (default 1)");
     args.option("--gamma-max", &job.gamma_max, "largest fall-off of the image-space filter (default 4, the paper's)");
     args.option("--max-history-weight", &job.max_history_weight, "cap on the history weight (default 16)");
+    args.option("--gradient-gain", &job.gradient_gain, "factor on the temporal gradient (default 1)");
+    args.option("--history-clamp", &job.history_clamp, "clamp the history to the samples' colour box widened by this fraction (default 0.25; < 0: off, as the paper)");
     args.flag("--spatial-only", &job.spatial_only, "joint bilateral upsampling without history");
     args.flag("--no-steering", &job.no_steering, "a fixed history fall-off (0.9) instead of temporal gradients");
     args.flag("--no-id-test", &job.no_id_test, "ignore object ids (depth and normals only)");

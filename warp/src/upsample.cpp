@@ -22,13 +22,35 @@ bool finite3(const glm::vec4& c) {
 
 float luminance(const glm::vec4& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 
+// base^gamma for base in [eps, 1], gamma >= 0, to about 1e-4 relative: exp2(gamma log2 base) with
+// short polynomials (powf dominated the filter).
+float fast_pow(float base, float gamma) {
+    uint32_t bits;
+    std::memcpy(&bits, &base, sizeof bits);
+    const float exponent = float(int((bits >> 23) & 0xff) - 127);
+    bits = (bits & 0x007fffffu) | 0x3f800000u;  // mantissa in [1, 2)
+    float m;
+    std::memcpy(&m, &bits, sizeof m);
+    const float t = (m - 1.0f) / (m + 1.0f), t2 = t * t;  // log2 m = 2 atanh(t) / ln 2
+    const float log2_base = exponent + t * (2.8853900818f + t2 * (0.9617966939f + t2 * (0.5770780164f + t2 * 0.4121985232f)));
+    float e = gamma * log2_base;
+    if (e < -126.0f) return 0.0f;
+    const float whole = std::floor(e), frac = e - whole;
+    // 2^frac on [0, 1)
+    const float p = 1.0f + frac * (0.6931471806f + frac * (0.2402265070f + frac * (0.0555041087f + frac * (0.0096181291f + frac * 0.0013333558f))));
+    uint32_t scale_bits = uint32_t(int(whole) + 127) << 23;
+    float scale;
+    std::memcpy(&scale, &scale_bits, sizeof scale);
+    return p * scale;
+}
+
 // g(x, sigma, gamma) of eq. 3 with x and sigma already divided: max(eps, 1 - ratio)^gamma.
 float falloff(float ratio, float epsilon, float gamma) {
     const float base = std::max(epsilon, 1.0f - ratio);
     if (gamma == 3.0f) return base * base * base;
     if (gamma == 1.0f) return base;
     if (gamma <= 0.0f) return 1.0f;
-    return std::pow(base, gamma);
+    return fast_pow(base, gamma);
 }
 
 enum class DepthKind { Surface, Background, Invalid };
@@ -83,6 +105,7 @@ struct SpatialResult {
     glm::vec4 color{0.0f};  // normalized
     float weight = 0.0f;    // w~ = sum w_s
     int nonfinite = 0;
+    glm::vec3 lo{INFINITY}, hi{-INFINITY};  // colour box of the samples on the same surface
 };
 
 // Eq. 6 over the 2x2 nearest low samples with image-space fall-off gamma_k.
@@ -108,9 +131,14 @@ SpatialResult spatial(const FrameContext& f, int x, int y, float gamma_k) {
             const int gx = std::clamp(int(std::floor(sx)), 0, f.width - 1);
             const float dx = sx - p.x, dy = sy - p.y;
             const float k = falloff(std::sqrt(dx * dx + dy * dy) / f.diagonal, eps, gamma_k);
-            const float w = geometric_weight(f, x, y, gx, gy) * k;
+            const float geometric = geometric_weight(f, x, y, gx, gy);
+            const float w = geometric * k;
             sum += w * glm::vec4(c.x, c.y, c.z, 0.0f);
             r.weight += w;
+            if (geometric > f.floor3) {
+                r.lo = glm::min(r.lo, glm::vec3(c));
+                r.hi = glm::max(r.hi, glm::vec3(c));
+            }
         }
     }
     if (r.weight > 0.0f) r.color = sum / r.weight;
@@ -284,12 +312,12 @@ void SpatioTemporalUpsampler::upsample(ImageView<const glm::vec4> low_color, glm
         int64_t used = 0, nonfinite = 0, unresolved = 0;
         for (int y = y0; y < y1; ++y) {
             for (int x = 0; x < width; ++x) {
-                const glm::vec4 h = temporal ? reprojected_(x, y) : glm::vec4(0.0f);
-                const bool history = h.w > 0.0f;
+                const glm::vec4 history_color = temporal ? reprojected_(x, y) : glm::vec4(0.0f);
+                const bool history = history_color.w > 0.0f;
                 float fade = 0.0f, gamma_k = o.gamma_unsteered;
                 if (history) {
                     if (o.gradient_steering) {
-                        const float c = 1.0f - std::clamp(gradient_(x, y), 0.0f, 1.0f);
+                        const float c = 1.0f - std::clamp(o.gradient_gain * gradient_(x, y), 0.0f, 1.0f);
                         fade = std::min(1.0f, o.history_weight * c * c);
                         gamma_k = std::max(o.gamma_min, o.gamma_max * fade);
                     } else {
@@ -302,6 +330,12 @@ void SpatioTemporalUpsampler::upsample(ImageView<const glm::vec4> low_color, glm
                 nonfinite += s.nonfinite;
                 glm::vec4 result(s.color.x, s.color.y, s.color.z, 0.0f);
                 float weight = s.weight;
+                glm::vec4 h = history_color;
+                if (history && o.history_clamp >= 0.0f && s.lo.x <= s.hi.x) {
+                    const glm::vec3 margin = o.history_clamp * (s.hi - s.lo);
+                    const glm::vec3 c = glm::clamp(glm::vec3(h), s.lo - margin, s.hi + margin);
+                    h = glm::vec4(c, h.w);
+                }
                 if (history && fade > 0.0f) {
                     const float hw = fade * h.w;
                     const float total = s.weight + hw;

@@ -46,6 +46,11 @@ struct UpsampleOptions {
     bool id_test = true;               // history and spatial samples must carry the pixel's id
     float history_depth_tolerance = 0.05f;  // relative depth difference that still counts as the same surface
     int gradient_radius = 0;           // box radius of the gradient low-pass; 0 = one low pixel + 1
+    float gradient_gain = 1.0f;        // |grad| is multiplied by this before eq. 8 (the paper: 1)
+    // Beyond the paper: < 0 leaves the history as it is; >= 0 clamps it to the colour box of this
+    // frame's 2x2 samples on the same surface, widened by this fraction of the box's size on each
+    // side (as temporal anti-aliasing does), so changed shading cannot linger.
+    float history_clamp = 0.25f;
 };
 
 // Counts of one upsample() call (overwritten by each call).
