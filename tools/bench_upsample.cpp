@@ -89,6 +89,7 @@ std::vector<Method> methods() {
     };
     return {
         {"herzog", "steered", herzog({})},
+        {"herzog", "paper (no clamp)", herzog({.history_clamp = -1.0f})},
         {"herzog", "fixed 0.9", herzog({.gradient_steering = false})},
         {"jbu", "no history", herzog({.history_weight = 0.0f})},
         {"cv::resize", "bilinear", resize(cv::INTER_LINEAR)},
@@ -96,6 +97,9 @@ std::vector<Method> methods() {
         {"cv::warpAffine", "bicubic, jitter-aware", jitter_aware},
     };
 }
+
+// Indices into methods() of the peers the report singles out.
+constexpr std::size_t kJbu = 3, kBilinear = 4, kJitterAware = 6;
 
 struct Summary {
     double psnr = 0, ssim = 0, flip = 0, ms = 0;
@@ -186,7 +190,9 @@ Status bench_upsample(const BenchOptions& options) {
         "cycling over the full pixels of each low pixel, upsampled to %dx%d with the full-resolution "
         "G-buffer and compared with the full-resolution render of the same frames (display values). "
         "%d frames per scene from t = 0, each frame's fastest of %d runs. herzog: Herzog et al. 2010 "
-        "(steered: temporal gradients steer the history; fixed 0.9: a constant fall-off); jbu: the "
+        "(steered: temporal gradients steer the history, which is clamped to the colour box of the "
+        "current samples on the same surface; paper: without that clamp; fixed 0.9: a constant "
+        "fall-off, with the clamp); jbu: the "
         "same tri-weight joint bilateral filter without history; cv::resize ignores the jitter; "
         "cv::warpAffine places the low samples where they were taken.",
         width, height, options.frames, options.repeat));
@@ -225,7 +231,7 @@ Status bench_upsample(const BenchOptions& options) {
                     s.flip += e.flip;
                     s.ms += fastest[run_frame];
                     ++s.frames;
-                    if (run_frame == options.frames - 1 && (m == 0 || m == 2 || m == 3 || m == 5)) {
+                    if (run_frame == options.frames - 1 && (m == 0 || m == kJbu || m == kBilinear || m == kJitterAware)) {
                         Image<Rgb8> picture;
                         to_rgb8(test_display.view(), picture);
                         last_pictures.push_back(std::move(picture));
@@ -257,7 +263,7 @@ Status bench_upsample(const BenchOptions& options) {
         section.time_label = "ms per upsampled frame (log scale)";
         std::vector<Summary> means(all.size());
         for (const std::string& scene_name : scenes) {
-            const Summary& bilinear = summaries[{factor, scene_name, 3}];
+            const Summary& bilinear = summaries[{factor, scene_name, kBilinear}];
             for (std::size_t m = 0; m < all.size(); ++m) {
                 const Summary& s = summaries[{factor, scene_name, m}];
                 const double n = std::max(1, s.frames);
@@ -275,7 +281,7 @@ Status bench_upsample(const BenchOptions& options) {
                                       means[m].flip, means[m].ms});
             table += strf("%-9s 1/%-4d %-16s %-22s %8.2f %7.4f %7.4f %9.2f %+9.2f\n", "MEAN", factor,
                           all[m].method.c_str(), all[m].setting.c_str(), means[m].psnr, means[m].ssim,
-                          means[m].flip, means[m].ms, means[m].psnr - means[3].psnr);
+                          means[m].flip, means[m].ms, means[m].psnr - means[kBilinear].psnr);
         }
         for (const ReportImage& image : images)
             if (image.file.find(strf("_1of%d", factor)) != std::string::npos) section.images.push_back(image);

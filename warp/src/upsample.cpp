@@ -22,35 +22,41 @@ bool finite3(const glm::vec4& c) {
 
 float luminance(const glm::vec4& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 
-// base^gamma for base in [eps, 1], gamma >= 0, to about 1e-4 relative: exp2(gamma log2 base) with
-// short polynomials (powf dominated the filter).
-float fast_pow(float base, float gamma) {
+// log2 and exp2 to about 1e-4 relative with short polynomials (powf dominated the filter).
+float fast_log2(float x) {  // x > 0, finite
     uint32_t bits;
-    std::memcpy(&bits, &base, sizeof bits);
+    std::memcpy(&bits, &x, sizeof bits);
     const float exponent = float(int((bits >> 23) & 0xff) - 127);
     bits = (bits & 0x007fffffu) | 0x3f800000u;  // mantissa in [1, 2)
     float m;
     std::memcpy(&m, &bits, sizeof m);
     const float t = (m - 1.0f) / (m + 1.0f), t2 = t * t;  // log2 m = 2 atanh(t) / ln 2
-    const float log2_base = exponent + t * (2.8853900818f + t2 * (0.9617966939f + t2 * (0.5770780164f + t2 * 0.4121985232f)));
-    float e = gamma * log2_base;
+    return exponent + t * (2.8853900818f + t2 * (0.9617966939f + t2 * (0.5770780164f + t2 * 0.4121985232f)));
+}
+
+float fast_exp2(float e) {  // e <= 0
     if (e < -126.0f) return 0.0f;
     const float whole = std::floor(e), frac = e - whole;
-    // 2^frac on [0, 1)
     const float p = 1.0f + frac * (0.6931471806f + frac * (0.2402265070f + frac * (0.0555041087f + frac * (0.0096181291f + frac * 0.0013333558f))));
-    uint32_t scale_bits = uint32_t(int(whole) + 127) << 23;
+    const uint32_t scale_bits = uint32_t(int(whole) + 127) << 23;
     float scale;
     std::memcpy(&scale, &scale_bits, sizeof scale);
     return p * scale;
 }
 
-// g(x, sigma, gamma) of eq. 3 with x and sigma already divided: max(eps, 1 - ratio)^gamma.
-float falloff(float ratio, float epsilon, float gamma) {
-    const float base = std::max(epsilon, 1.0f - ratio);
+float fast_pow(float base, float gamma) { return fast_exp2(gamma * fast_log2(base)); }
+
+// base^gamma of eq. 3 for base = max(eps, 1 - x / sigma).
+float falloff_of_base(float base, float gamma) {
     if (gamma == 3.0f) return base * base * base;
     if (gamma == 1.0f) return base;
     if (gamma <= 0.0f) return 1.0f;
     return fast_pow(base, gamma);
+}
+
+// g(x, sigma, gamma) of eq. 3 with x and sigma already divided: max(eps, 1 - ratio)^gamma.
+float falloff(float ratio, float epsilon, float gamma) {
+    return falloff_of_base(std::max(epsilon, 1.0f - ratio), gamma);
 }
 
 enum class DepthKind { Surface, Background, Invalid };
@@ -70,26 +76,37 @@ struct FrameContext {
     int width = 0, height = 0;
     const UpsampleOptions* options = nullptr;
     float floor3 = 0.0f;  // eps^3: the weight of a failed geometric test
+    bool ids = false;     // the id test applies
 };
 
+// What the geometric weights read of one full pixel.
+struct Guide {
+    float depth;
+    DepthKind kind;
+    glm::vec3 normal;
+    uint32_t id;
+};
+
+Guide guide_at(const GBufferView& g, int x, int y) {
+    const float z = g.depth(x, y);
+    return {z, depth_kind(z), g.normal.empty() ? glm::vec3(0.0f) : g.normal(x, y),
+            g.id.empty() ? 0u : g.id(x, y)};
+}
+
 // Geometric part of w_s (eq. 2) between full pixels i and j, and the id test.
-float geometric_weight(const FrameContext& f, int xi, int yi, int xj, int yj) {
+float geometric_weight(const FrameContext& f, const Guide& i, const Guide& j) {
     const UpsampleOptions& o = *f.options;
-    const GBufferView& g = *f.full;
     float w = 1.0f;
-    const float zi = g.depth(xi, yi), zj = g.depth(xj, yj);
-    const DepthKind ki = depth_kind(zi), kj = depth_kind(zj);
-    if (ki == DepthKind::Surface && kj == DepthKind::Surface) {
-        const float dz = (zi - zj) / (o.depth_sigma * zi);
+    if (i.kind == DepthKind::Surface && j.kind == DepthKind::Surface) {
+        const float dz = (i.depth - j.depth) / (o.depth_sigma * i.depth);
         w *= falloff(dz * dz, o.epsilon, 3.0f);
-    } else if (!(ki == DepthKind::Background && kj == DepthKind::Background)) {
+    } else if (!(i.kind == DepthKind::Background && j.kind == DepthKind::Background)) {
         return f.floor3;
     }
-    if (!g.normal.empty()) {
-        const glm::vec3 ni = g.normal(xi, yi), nj = g.normal(xj, yj);
-        const float d = ni.x * nj.x + ni.y * nj.y + ni.z * nj.z;
+    if (!f.full->normal.empty()) {
+        const float d = i.normal.x * j.normal.x + i.normal.y * j.normal.y + i.normal.z * j.normal.z;
         if (!std::isfinite(d)) return f.floor3 * w;
-        const bool zero_i = ni == glm::vec3(0.0f), zero_j = nj == glm::vec3(0.0f);
+        const bool zero_i = i.normal == glm::vec3(0.0f), zero_j = j.normal == glm::vec3(0.0f);
         if (zero_i != zero_j) {
             w *= f.floor3;
         } else if (!zero_i) {
@@ -97,8 +114,47 @@ float geometric_weight(const FrameContext& f, int xi, int yi, int xj, int yj) {
             w *= falloff(a * a / (o.normal_sigma * o.normal_sigma), o.epsilon, 3.0f);
         }
     }
-    if (o.id_test && !g.id.empty() && g.id(xi, yi) != g.id(xj, yj)) w *= f.floor3;
+    if (f.ids && i.id != j.id) w *= f.floor3;
     return w;
+}
+
+// The 2x2 nearest low samples of full pixel (x, y): their geometric weights and the base of the
+// image-space filter as log2 max(eps, 1 - distance / r); k = 2^(gamma_k log_base). Fixed for a
+// frame, so the gradient pass computes them once for the final pass.
+struct Taps {
+    glm::vec4 geometric{0.0f};
+    glm::vec4 log_base{0.0f};
+};
+
+struct TapOrigin {
+    int u0, v0;
+};
+
+TapOrigin tap_origin(const FrameContext& f, int x, int y) {
+    const glm::vec2 q = (glm::vec2(float(x) + 0.5f, float(y) + 0.5f) - f.jitter) / f.scale - 0.5f;
+    return {int(std::floor(q.x)), int(std::floor(q.y))};
+}
+
+Taps compute_taps(const FrameContext& f, int x, int y) {
+    const TapOrigin o = tap_origin(f, x, y);
+    const Guide here = guide_at(*f.full, x, y);
+    const float px = float(x) + 0.5f, py = float(y) + 0.5f;
+    Taps t;
+    for (int dv = 0; dv < 2; ++dv) {
+        const int v = std::clamp(o.v0 + dv, 0, f.low.height - 1);
+        const float sy = (float(v) + 0.5f) * f.scale.y + f.jitter.y;
+        const int gy = std::clamp(int(std::floor(sy)), 0, f.height - 1);
+        for (int du = 0; du < 2; ++du) {
+            const int u = std::clamp(o.u0 + du, 0, f.low.width - 1);
+            const float sx = (float(u) + 0.5f) * f.scale.x + f.jitter.x;
+            const int gx = std::clamp(int(std::floor(sx)), 0, f.width - 1);
+            const float dx = sx - px, dy = sy - py;
+            t.log_base[dv * 2 + du] =
+                fast_log2(std::max(f.options->epsilon, 1.0f - std::sqrt(dx * dx + dy * dy) / f.diagonal));
+            t.geometric[dv * 2 + du] = geometric_weight(f, here, guide_at(*f.full, gx, gy));
+        }
+    }
+    return t;
 }
 
 struct SpatialResult {
@@ -109,30 +165,22 @@ struct SpatialResult {
 };
 
 // Eq. 6 over the 2x2 nearest low samples with image-space fall-off gamma_k.
-SpatialResult spatial(const FrameContext& f, int x, int y, float gamma_k) {
-    const glm::vec2 p(float(x) + 0.5f, float(y) + 0.5f);
-    const glm::vec2 q = (p - f.jitter) / f.scale - 0.5f;
-    const int u0 = int(std::floor(q.x)), v0 = int(std::floor(q.y));
-    const float eps = f.options->epsilon;
+SpatialResult combine(const FrameContext& f, int x, int y, const Taps& t, float gamma_k) {
+    const TapOrigin o = tap_origin(f, x, y);
     SpatialResult r;
     glm::vec4 sum(0.0f);
     for (int dv = 0; dv < 2; ++dv) {
-        const int v = std::clamp(v0 + dv, 0, f.low.height - 1);
-        const float sy = (float(v) + 0.5f) * f.scale.y + f.jitter.y;
-        const int gy = std::clamp(int(std::floor(sy)), 0, f.height - 1);
+        const int v = std::clamp(o.v0 + dv, 0, f.low.height - 1);
         for (int du = 0; du < 2; ++du) {
-            const int u = std::clamp(u0 + du, 0, f.low.width - 1);
+            const int u = std::clamp(o.u0 + du, 0, f.low.width - 1);
             const glm::vec4 c = f.low(u, v);
             if (!finite3(c)) {
                 ++r.nonfinite;
                 continue;
             }
-            const float sx = (float(u) + 0.5f) * f.scale.x + f.jitter.x;
-            const int gx = std::clamp(int(std::floor(sx)), 0, f.width - 1);
-            const float dx = sx - p.x, dy = sy - p.y;
-            const float k = falloff(std::sqrt(dx * dx + dy * dy) / f.diagonal, eps, gamma_k);
-            const float geometric = geometric_weight(f, x, y, gx, gy);
-            const float w = geometric * k;
+            const int tap = dv * 2 + du;
+            const float geometric = t.geometric[tap];
+            const float w = gamma_k > 0.0f ? geometric * fast_exp2(gamma_k * t.log_base[tap]) : geometric;
             sum += w * glm::vec4(c.x, c.y, c.z, 0.0f);
             r.weight += w;
             if (geometric > f.floor3) {
@@ -178,6 +226,8 @@ void SpatioTemporalUpsampler::upsample(ImageView<const glm::vec4> low_color, glm
         reprojected_.resize(width, height);
         gradient_.resize(width, height);
         gradient_tmp_.resize(width, height);
+        tap_geometric_.resize(width, height);
+        tap_base_.resize(width, height);
         has_history_ = false;
     }
     if (!std::isfinite(jitter_px.x) || !std::isfinite(jitter_px.y)) jitter_px = glm::vec2(0.0f);
@@ -192,6 +242,7 @@ void SpatioTemporalUpsampler::upsample(ImageView<const glm::vec4> low_color, glm
     f.height = height;
     f.options = &o;
     f.floor3 = o.epsilon * o.epsilon * o.epsilon;
+    f.ids = o.id_test && !full.id.empty();
 
     const bool temporal = has_history_ && !full.motion.empty() && o.history_weight > 0.0f;
     const bool ids = o.id_test && !full.id.empty();
@@ -267,8 +318,11 @@ void SpatioTemporalUpsampler::upsample(ImageView<const glm::vec4> low_color, glm
                     const glm::vec4 h = reprojected_(x, y);
                     glm::vec4& d = next_deltas_(x, y);
                     float current = 1.0f;
+                    const Taps taps = compute_taps(f, x, y);
+                    tap_geometric_(x, y) = taps.geometric;
+                    tap_base_(x, y) = taps.log_base;
                     if (h.w > 0.0f) {
-                        const SpatialResult s = spatial(f, x, y, o.gamma_unsteered);
+                        const SpatialResult s = combine(f, x, y, taps, o.gamma_unsteered);
                         const float a = luminance(s.color), b = luminance(h);
                         const float scale = std::max(std::abs(a), std::abs(b));
                         current = s.weight > 0.0f && scale > 0.0f ? std::clamp((a - b) / scale, -1.0f, 1.0f) : 0.0f;
@@ -308,6 +362,7 @@ void SpatioTemporalUpsampler::upsample(ImageView<const glm::vec4> low_color, glm
     }
 
     // (C) Steered spatial filter blended with the history (eq. 7).
+    const bool cached_taps = temporal && o.gradient_steering && !o.recompute_taps;
     parallel_for(0, height, [&](int y0, int y1) {
         int64_t used = 0, nonfinite = 0, unresolved = 0;
         for (int y = y0; y < y1; ++y) {
@@ -326,7 +381,8 @@ void SpatioTemporalUpsampler::upsample(ImageView<const glm::vec4> low_color, glm
                 } else if (o.gradient_steering) {
                     gamma_k = o.gamma_min;
                 }
-                const SpatialResult s = spatial(f, x, y, gamma_k);
+                const SpatialResult s =
+                    combine(f, x, y, cached_taps ? Taps{tap_geometric_(x, y), tap_base_(x, y)} : compute_taps(f, x, y), gamma_k);
                 nonfinite += s.nonfinite;
                 glm::vec4 result(s.color.x, s.color.y, s.color.z, 0.0f);
                 float weight = s.weight;

@@ -51,6 +51,9 @@ struct UpsampleOptions {
     // frame's 2x2 samples on the same surface, widened by this fraction of the box's size on each
     // side (as temporal anti-aliasing does), so changed shading cannot linger.
     float history_clamp = 0.25f;
+    // Recompute the spatial taps in the final pass instead of reusing the gradient pass's (the
+    // reference the tests compare the cached path with; the results are identical).
+    bool recompute_taps = false;
 };
 
 // Counts of one upsample() call (overwritten by each call).
@@ -87,6 +90,9 @@ private:
     // Per-frame scratch, sized once.
     Image<glm::vec4> reprojected_;  // h_r at p + motion, a = h_w (0: no history)
     Image<float> gradient_, gradient_tmp_;
+    // The 2x2 spatial taps of each pixel (geometric weights, filter bases), shared by the gradient
+    // and the final pass.
+    Image<glm::vec4> tap_geometric_, tap_base_;
     bool has_history_ = false;
 };
 
