@@ -70,7 +70,8 @@ DepthKind depth_kind(float z) {
 struct FrameContext {
     ImageView<const glm::vec4> low;
     const GBufferView* full = nullptr;
-    glm::vec2 jitter{0.0f};
+    glm::vec2 jitter{0.0f};       // of the low samples, full-resolution pixels
+    glm::vec2 full_jitter{0.0f};  // of the full G-buffer (0 as reprise renders it)
     glm::vec2 scale{1.0f};  // full pixels per low pixel
     float diagonal = 1.0f;  // r: the low pixel's diagonal in full pixels
     int width = 0, height = 0;
@@ -131,23 +132,24 @@ struct TapOrigin {
 };
 
 TapOrigin tap_origin(const FrameContext& f, int x, int y) {
-    const glm::vec2 q = (glm::vec2(float(x) + 0.5f, float(y) + 0.5f) - f.jitter) / f.scale - 0.5f;
+    const glm::vec2 q = (glm::vec2(float(x) + 0.5f, float(y) + 0.5f) + f.full_jitter - f.jitter) / f.scale - 0.5f;
     return {int(std::floor(q.x)), int(std::floor(q.y))};
 }
 
 Taps compute_taps(const FrameContext& f, int x, int y) {
     const TapOrigin o = tap_origin(f, x, y);
     const Guide here = guide_at(*f.full, x, y);
-    const float px = float(x) + 0.5f, py = float(y) + 0.5f;
+    // Positions in the unjittered full image: pixel (x, y) saw x + 0.5 + full jitter.
+    const float px = float(x) + 0.5f + f.full_jitter.x, py = float(y) + 0.5f + f.full_jitter.y;
     Taps t;
     for (int dv = 0; dv < 2; ++dv) {
         const int v = std::clamp(o.v0 + dv, 0, f.low.height - 1);
         const float sy = (float(v) + 0.5f) * f.scale.y + f.jitter.y;
-        const int gy = std::clamp(int(std::floor(sy)), 0, f.height - 1);
+        const int gy = std::clamp(int(std::floor(sy - f.full_jitter.y)), 0, f.height - 1);
         for (int du = 0; du < 2; ++du) {
             const int u = std::clamp(o.u0 + du, 0, f.low.width - 1);
             const float sx = (float(u) + 0.5f) * f.scale.x + f.jitter.x;
-            const int gx = std::clamp(int(std::floor(sx)), 0, f.width - 1);
+            const int gx = std::clamp(int(std::floor(sx - f.full_jitter.x)), 0, f.width - 1);
             const float dx = sx - px, dy = sy - py;
             t.log_base[dv * 2 + du] =
                 fast_log2(std::max(f.options->epsilon, 1.0f - std::sqrt(dx * dx + dy * dy) / f.diagonal));
@@ -231,11 +233,14 @@ void SpatioTemporalUpsampler::upsample(ImageView<const glm::vec4> low_color, glm
         has_history_ = false;
     }
     if (!std::isfinite(jitter_px.x) || !std::isfinite(jitter_px.y)) jitter_px = glm::vec2(0.0f);
+    glm::vec2 full_jitter = full.camera.jitter;
+    if (!std::isfinite(full_jitter.x) || !std::isfinite(full_jitter.y)) full_jitter = glm::vec2(0.0f);
 
     FrameContext f;
     f.low = low_color;
     f.full = &full;
     f.jitter = jitter_px;
+    f.full_jitter = full_jitter;
     f.scale = glm::vec2(float(width) / float(low_color.width), float(height) / float(low_color.height));
     f.diagonal = std::sqrt(f.scale.x * f.scale.x + f.scale.y * f.scale.y);
     f.width = width;
@@ -266,11 +271,13 @@ void SpatioTemporalUpsampler::upsample(ImageView<const glm::vec4> low_color, glm
                         float expected = INFINITY;
                         if (kind == DepthKind::Surface) {
                             const glm::vec4 point = camera.unprojector().point(
-                                float(x) + 0.5f - full.camera.jitter.x,
-                                float(y) + 0.5f - full.camera.jitter.y, z);
+                                float(x) + 0.5f + full_jitter.x, float(y) + 0.5f + full_jitter.y, z);
                             expected = -(to_previous_view * point).z;
                         }
-                        const float fx = float(x) + m.x, fy = float(y) + m.y;
+                        // p + jitter + motion in the previous unjittered image; its pixels saw
+                        // their centre + the previous jitter.
+                        const float fx = float(x) + m.x + full_jitter.x - history_jitter_.x;
+                        const float fy = float(y) + m.y + full_jitter.y - history_jitter_.y;
                         const int x0 = int(std::floor(fx)), y0b = int(std::floor(fy));
                         const float ax = fx - float(x0), ay = fy - float(y0b);
                         const uint32_t id = ids ? full.id(x, y) : 0u;
@@ -419,6 +426,7 @@ void SpatioTemporalUpsampler::upsample(ImageView<const glm::vec4> low_color, glm
         if (!full.id.empty())
             std::memcpy(&history_id_(0, y), full.id.row(y), sizeof(uint32_t) * std::size_t(width));
     }
+    history_jitter_ = full_jitter;
     has_history_ = true;
 
     if (stats) {

@@ -9,7 +9,8 @@
 // (u, v) holds the scene sampled at the full-resolution position
 //     ((u + 0.5) * s.x + jitter.x, (v + 0.5) * s.y + jitter.y)
 // (the renderer's convention: a pixel samples the unjittered image at its centre + jitter, with
-// the jitter given in full-resolution pixels). With a jitter cycle that visits every full pixel
+// the jitter given in full-resolution pixels). A full G-buffer with its own jitter
+// (full.camera.jitter, 0 as reprise renders it) is accounted for the same way. With a jitter cycle that visits every full pixel
 // centre of a low pixel's footprint (server::lowres_jitter), a still scene converges.
 //
 // Per pixel i (equations of the paper):
@@ -93,6 +94,7 @@ private:
     // The 2x2 spatial taps of each pixel (geometric weights, filter bases), shared by the gradient
     // and the final pass.
     Image<glm::vec4> tap_geometric_, tap_base_;
+    glm::vec2 history_jitter_{0.0f};  // the full G-buffer's jitter of the history's frame
     bool has_history_ = false;
 };
 
