@@ -419,15 +419,27 @@ Status Renderer::render_frame(const Scene& scene, const CameraPath& path, int in
 Status Renderer::render_frame_lowres(const Scene& scene, const CameraPath& path, int index,
                                      double fps, const RenderSettings& settings, int factor,
                                      Frame& frame, Image<glm::vec4>& low_color, glm::vec2& jitter) {
+    REPRISE_ASSERT(fps > 0);
+    REPRISE_TRY(check_image_size(settings.width, settings.height, "renderer"));
+    const Instant now = instant_on_path(path, scene, index / fps, settings.width, settings.height);
+    const Instant before = instant_on_path(path, scene, (index - 1) / fps, settings.width, settings.height);
+    REPRISE_TRY(render_lowres(scene, now, before, settings, factor, index, frame, low_color, jitter));
+    frame.fps = fps;
+    return {};
+}
+
+Status Renderer::render_lowres(const Scene& scene, const Instant& current, const Instant& previous,
+                               const RenderSettings& settings, int factor, int64_t jitter_index,
+                               Frame& frame, Image<glm::vec4>& low_color, glm::vec2& jitter) {
     REPRISE_ASSERT(lowres_factor_valid(factor));
     REPRISE_TRY(check_image_size(settings.width, settings.height, "renderer"));
-    REPRISE_TRY(render_frame(scene, path, index, fps, settings, frame));
+    REPRISE_TRY(render(scene, current, previous, settings, frame));
     const glm::ivec2 low = lowres_size(settings.width, settings.height, factor);
-    jitter = lowres_jitter(settings.width, settings.height, factor, index);
+    // Relative to the unjittered full image (the full frame's own jitter, usually 0, included).
+    jitter = current.jitter + lowres_jitter(settings.width, settings.height, factor, jitter_index);
     const glm::vec2 footprint(float(settings.width) / float(low.x), float(settings.height) / float(low.y));
     // The same frustum (projection of the full size) at the low size; the jitter in low pixels.
-    Instant now = instant_on_path(path, scene, index / fps, settings.width, settings.height);
-    Instant before = instant_on_path(path, scene, (index - 1) / fps, settings.width, settings.height);
+    Instant now = current;
     now.jitter = jitter / footprint;
     RenderSettings low_settings = settings;
     low_settings.width = low.x;
@@ -438,7 +450,7 @@ Status Renderer::render_frame_lowres(const Scene& scene, const CameraPath& path,
     low_settings.texture_lod_bias =
         settings.texture_lod_bias - 0.5f * std::log2(footprint.x * footprint.y);
     Frame& scratch = gpu_->lowres_scratch;
-    REPRISE_TRY(render(scene, now, before, low_settings, scratch));
+    REPRISE_TRY(render(scene, now, previous, low_settings, scratch));
     low_color.resize(low.x, low.y);
     std::copy(scratch.color.data(), scratch.color.data() + scratch.color.pixel_count(), low_color.data());
     return {};

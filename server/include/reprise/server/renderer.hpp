@@ -68,6 +68,12 @@ public:
     Status render_frame_lowres(const Scene& scene, const CameraPath& path, int index, double fps,
                                const RenderSettings& settings, int factor, Frame& frame,
                                Image<glm::vec4>& low_color, glm::vec2& jitter);
+    // The same from explicit instants (a streaming session's poses): `current` and `previous`
+    // without jitter, their projections made for the full size; `jitter_index` picks
+    // lowres_jitter's phase (a frame counter).
+    Status render_lowres(const Scene& scene, const Instant& current, const Instant& previous,
+                         const RenderSettings& settings, int factor, int64_t jitter_index,
+                         Frame& frame, Image<glm::vec4>& low_color, glm::vec2& jitter);
 
     const std::string& device() const;
 
