@@ -112,7 +112,7 @@ TEST(LowresRender, SamplesLandOnFullResolutionPixelCentres) {
     }
 }
 
-// Measured 2026-12-01 (pan, 256x144, 1/4 of the pixels, mean of frames 4..9): upsampled 33.20 dB,
+// Measured 2026-12-01 (pan, 256x144, 1/4 of the pixels, mean of frames 4..9): upsampled 33.54 dB,
 // bilinear cv::resize 28.07 dB; the floors sit about 1 dB below.
 TEST(Upsample, RenderedScenePsnrFloorAndMarginOverBilinear) {
     const int w = 256, h = 144, frames = 10;
@@ -133,12 +133,12 @@ TEST(Upsample, RenderedScenePsnrFloorAndMarginOverBilinear) {
     ours /= counted;
     bilinear /= counted;
     std::printf("pan 256x144 1/4: upsampled %.2f dB, bilinear %.2f dB\n", ours, bilinear);
-    EXPECT_GT(ours, 32.2);
-    EXPECT_GT(ours, bilinear + 4.0);
+    EXPECT_GT(ours, 32.5);
+    EXPECT_GT(ours, bilinear + 4.5);
 }
 
 // A still camera: the history gathers every full pixel over the jitter cycle, and the error falls
-// well below the spatial-only first frame (measured: 30.14 -> 33.63 dB at 192x108 over 12 frames).
+// well below the spatial-only first frame (measured: 30.35 -> 33.89 dB at 192x108 over 12 frames).
 TEST(Upsample, StillCameraConvergesTowardsTheFullRender) {
     const int w = 192, h = 108, frames = 12;
     const Rendered r = render_lowres("pan", "static", frames, w, h, 4);

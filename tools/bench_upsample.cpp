@@ -89,7 +89,7 @@ std::vector<Method> methods() {
     };
     return {
         {"herzog", "steered", herzog({})},
-        {"herzog", "paper (no clamp)", herzog({.history_clamp = -1.0f})},
+        {"herzog", "paper (no clamp, radial)", herzog({.history_clamp = -1.0f, .separable_filter = false})},
         {"herzog", "fixed 0.9", herzog({.gradient_steering = false})},
         {"jbu", "no history", herzog({.history_weight = 0.0f})},
         {"cv::resize", "bilinear", resize(cv::INTER_LINEAR)},
@@ -191,8 +191,9 @@ Status bench_upsample(const BenchOptions& options) {
         "G-buffer and compared with the full-resolution render of the same frames (display values). "
         "%d frames per scene from t = 0, each frame's fastest of %d runs. herzog: Herzog et al. 2010 "
         "(steered: temporal gradients steer the history, which is clamped to the colour box of the "
-        "current samples on the same surface; paper: without that clamp; fixed 0.9: a constant "
-        "fall-off, with the clamp); jbu: the "
+        "current samples on the same surface, and whose image-space filter is a separable tent; "
+        "paper: without the clamp, with the paper's radial filter over the low pixel diagonal; "
+        "fixed 0.9: a constant fall-off instead of steering); jbu: the "
         "same tri-weight joint bilateral filter without history; cv::resize ignores the jitter; "
         "cv::warpAffine places the low samples where they were taken.",
         width, height, options.frames, options.repeat));

@@ -17,7 +17,7 @@ namespace {
 
 struct UpsampleJob {
     std::string in, low, out;
-    bool spatial_only = false, no_steering = false, no_id_test = false;
+    bool spatial_only = false, no_steering = false, no_id_test = false, radial = false;
     double history_weight = 1.0;
     double gamma_max = 4.0, max_history_weight = 16.0, gradient_gain = 1.0, history_clamp = 0.25;
 };
@@ -52,6 +52,7 @@ Status run_upsample(const UpsampleJob& job) {
         .id_test = !job.no_id_test,
         .gradient_gain = float(job.gradient_gain),
         .history_clamp = float(job.history_clamp),
+        .separable_filter = !job.radial,
     });
     Frame full, low;
     Image<glm::vec4> out;
@@ -133,6 +134,7 @@ int command_upsample(int argc, char** argv) {
     args.option("--history-clamp", &job.history_clamp, "clamp the history to the samples' colour box widened by this fraction (default 0.25; < 0: off, as the paper)");
     args.flag("--spatial-only", &job.spatial_only, "joint bilateral upsampling without history");
     args.flag("--no-steering", &job.no_steering, "a fixed history fall-off (0.9) instead of temporal gradients");
+    args.flag("--radial", &job.radial, "the paper's radial image-space filter over the low pixel's diagonal (default: a separable tent)");
     args.flag("--no-id-test", &job.no_id_test, "ignore object ids (depth and normals only)");
     Status parsed = args.parse(argc, argv);
     if (!parsed.ok() || args.help_requested()) return report(args, parsed, {});

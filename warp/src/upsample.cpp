@@ -151,8 +151,11 @@ Taps compute_taps(const FrameContext& f, int x, int y) {
             const float sx = (float(u) + 0.5f) * f.scale.x + f.jitter.x;
             const int gx = std::clamp(int(std::floor(sx - f.full_jitter.x)), 0, f.width - 1);
             const float dx = sx - px, dy = sy - py;
+            const float eps = f.options->epsilon;
             t.log_base[dv * 2 + du] =
-                fast_log2(std::max(f.options->epsilon, 1.0f - std::sqrt(dx * dx + dy * dy) / f.diagonal));
+                f.options->separable_filter
+                    ? fast_log2(std::max(eps, 1.0f - std::abs(dx) / f.scale.x) * std::max(eps, 1.0f - std::abs(dy) / f.scale.y))
+                    : fast_log2(std::max(eps, 1.0f - std::sqrt(dx * dx + dy * dy) / f.diagonal));
             t.geometric[dv * 2 + du] = geometric_weight(f, here, guide_at(*f.full, gx, gy));
         }
     }
