@@ -54,6 +54,18 @@ float falloff_of_base(float base, float gamma) {
     return fast_pow(base, gamma);
 }
 
+// base^gamma for the steered fall-off of k (gamma in [0, 8]): exact at whole gammas, linear in
+// gamma between them (multiplications only; the per-tap powf dominated the filter).
+float steered_power(float base, float gamma) {
+    if (!(gamma > 0.0f)) return 1.0f;
+    if (gamma > 8.0f) return fast_pow(base, gamma);
+    const int whole = int(gamma);
+    float lower = 1.0f;
+    for (int i = 0; i < whole; ++i) lower *= base;
+    const float frac = gamma - float(whole);
+    return frac > 0.0f ? lower * (1.0f - frac + frac * base) : lower;
+}
+
 // g(x, sigma, gamma) of eq. 3 with x and sigma already divided: max(eps, 1 - ratio)^gamma.
 float falloff(float ratio, float epsilon, float gamma) {
     return falloff_of_base(std::max(epsilon, 1.0f - ratio), gamma);
@@ -120,11 +132,11 @@ float geometric_weight(const FrameContext& f, const Guide& i, const Guide& j) {
 }
 
 // The 2x2 nearest low samples of full pixel (x, y): their geometric weights and the base of the
-// image-space filter as log2 max(eps, 1 - distance / r); k = 2^(gamma_k log_base). Fixed for a
+// image-space filter, max(eps, 1 - distance / r); k = base^gamma_k. Fixed for a
 // frame, so the gradient pass computes them once for the final pass.
 struct Taps {
     glm::vec4 geometric{0.0f};
-    glm::vec4 log_base{0.0f};
+    glm::vec4 base{0.0f};
 };
 
 struct TapOrigin {
@@ -152,10 +164,10 @@ Taps compute_taps(const FrameContext& f, int x, int y) {
             const int gx = std::clamp(int(std::floor(sx - f.full_jitter.x)), 0, f.width - 1);
             const float dx = sx - px, dy = sy - py;
             const float eps = f.options->epsilon;
-            t.log_base[dv * 2 + du] =
+            t.base[dv * 2 + du] =
                 f.options->separable_filter
-                    ? fast_log2(std::max(eps, 1.0f - std::abs(dx) / f.scale.x) * std::max(eps, 1.0f - std::abs(dy) / f.scale.y))
-                    : fast_log2(std::max(eps, 1.0f - std::sqrt(dx * dx + dy * dy) / f.diagonal));
+                    ? std::max(eps, 1.0f - std::abs(dx) / f.scale.x) * std::max(eps, 1.0f - std::abs(dy) / f.scale.y)
+                    : std::max(eps, 1.0f - std::sqrt(dx * dx + dy * dy) / f.diagonal);
             t.geometric[dv * 2 + du] = geometric_weight(f, here, guide_at(*f.full, gx, gy));
         }
     }
@@ -185,7 +197,7 @@ SpatialResult combine(const FrameContext& f, int x, int y, const Taps& t, float 
             }
             const int tap = dv * 2 + du;
             const float geometric = t.geometric[tap];
-            const float w = gamma_k > 0.0f ? geometric * fast_exp2(gamma_k * t.log_base[tap]) : geometric;
+            const float w = geometric * steered_power(t.base[tap], gamma_k);
             sum += w * glm::vec4(c.x, c.y, c.z, 0.0f);
             r.weight += w;
             if (geometric > f.floor3) {
@@ -330,7 +342,7 @@ void SpatioTemporalUpsampler::upsample(ImageView<const glm::vec4> low_color, glm
                     float current = 1.0f;
                     const Taps taps = compute_taps(f, x, y);
                     tap_geometric_(x, y) = taps.geometric;
-                    tap_base_(x, y) = taps.log_base;
+                    tap_base_(x, y) = taps.base;
                     if (h.w > 0.0f) {
                         const SpatialResult s = combine(f, x, y, taps, o.gamma_unsteered);
                         const float a = luminance(s.color), b = luminance(h);
