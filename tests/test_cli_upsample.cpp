@@ -1,6 +1,5 @@
 // `reprise render --lowres`, `reprise upsample` and `reprise bench upsample` end to end.
 #include <gtest/gtest.h>
-
 #include <unistd.h>
 
 #include <filesystem>
@@ -21,7 +20,8 @@ using test::display_psnr;
 using test::run_command;
 
 fs::path scratch(const std::string& name) {
-    const fs::path dir = fs::temp_directory_path() / ("reprise_cli_upsample_" + name + "_" + std::to_string(::getpid()));
+    const fs::path dir = fs::temp_directory_path() /
+                         ("reprise_cli_upsample_" + name + "_" + std::to_string(::getpid()));
     fs::remove_all(dir);
     return dir;
 }
@@ -31,8 +31,8 @@ fs::path scratch(const std::string& name) {
 TEST(CliUpsample, RenderLowresThenUpsample) {
     const fs::path dir = scratch("run");
     const std::string rendered = (dir / "in").string(), made = (dir / "out").string();
-    ASSERT_EQ(run_command(cli::command_render, {"--scene", "pan", "--frames", "6", "--size", "128x72",
-                                                "--lowres", "4", "--out", rendered}),
+    ASSERT_EQ(run_command(cli::command_render, {"--scene", "pan", "--frames", "6", "--size",
+                                                "128x72", "--lowres", "4", "--out", rendered}),
               0);
     Frame full, low;
     ASSERT_TRUE(read_frame(frame_path(rendered, 5), full).ok());
@@ -53,27 +53,34 @@ TEST(CliUpsample, RenderLowresThenUpsample) {
 
 TEST(CliUpsample, BadArguments) {
     const fs::path dir = scratch("bad");
-    EXPECT_NE(run_command(cli::command_render, {"--scene", "pan", "--frames", "1", "--size", "32x18",
-                                                "--lowres", "3", "--out", (dir / "a").string()}),
+    EXPECT_NE(
+        run_command(cli::command_render, {"--scene", "pan", "--frames", "1", "--size", "32x18",
+                                          "--lowres", "3", "--out", (dir / "a").string()}),
+        0);
+    EXPECT_NE(run_command(cli::command_upsample,
+                          {"--in", (dir / "missing").string(), "--out", (dir / "b").string()}),
               0);
-    EXPECT_NE(run_command(cli::command_upsample, {"--in", (dir / "missing").string(), "--out", (dir / "b").string()}), 0);
     // A full-resolution sequence without its low-resolution colour.
-    ASSERT_EQ(run_command(cli::command_render, {"--scene", "pan", "--frames", "1", "--size", "32x18",
-                                                "--out", (dir / "c").string()}),
+    ASSERT_EQ(run_command(cli::command_render, {"--scene", "pan", "--frames", "1", "--size",
+                                                "32x18", "--out", (dir / "c").string()}),
               0);
-    EXPECT_NE(run_command(cli::command_upsample, {"--in", (dir / "c").string(), "--out", (dir / "d").string()}), 0);
+    EXPECT_NE(run_command(cli::command_upsample,
+                          {"--in", (dir / "c").string(), "--out", (dir / "d").string()}),
+              0);
     // Low colour larger than the full frame.
-    EXPECT_NE(run_command(cli::command_upsample, {"--in", (dir / "c").string(), "--low", (dir / "c").string(),
-                                                  "--out", (dir / "d").string(), "--history-weight", "2"}),
+    EXPECT_NE(run_command(cli::command_upsample,
+                          {"--in", (dir / "c").string(), "--low", (dir / "c").string(), "--out",
+                           (dir / "d").string(), "--history-weight", "2"}),
               0);
     fs::remove_all(dir);
 }
 
 TEST(CliUpsample, BenchWritesItsReport) {
     const fs::path dir = scratch("bench");
-    ASSERT_EQ(run_command(cli::command_bench, {"upsample", "--scenes", "pan", "--size", "64x36", "--frames", "3",
-                                               "--factor", "4", "--repeat", "1", "--speed-size", "64x36",
-                                               "--speed-frames", "2", "--out", dir.string()}),
+    ASSERT_EQ(run_command(cli::command_bench,
+                          {"upsample", "--scenes", "pan", "--size", "64x36", "--frames", "3",
+                           "--factor", "4", "--repeat", "1", "--speed-size", "64x36",
+                           "--speed-frames", "2", "--out", dir.string()}),
               0);
     const std::string csv = test::read_text(dir / "upsample.csv");
     EXPECT_NE(csv.find("pan,herzog,steered,2,"), std::string::npos);

@@ -41,13 +41,15 @@ Rendered render_lowres(const std::string& name, const std::string& camera, int f
     }
     EXPECT_TRUE(status.ok()) << status.message();
     const server::RenderSettings settings{
-        .width = width, .height = height, .shading = unlit ? server::Shading::Unlit : server::Shading::Lit};
+        .width = width,
+        .height = height,
+        .shading = unlit ? server::Shading::Unlit : server::Shading::Lit};
     r.full.resize(frames);
     r.low.resize(frames);
     r.jitter.resize(frames);
     for (int i = 0; i < frames; ++i) {
-        status = shared_renderer().render_frame_lowres(scene, path, i, 30.0, settings, factor, r.full[i],
-                                                       r.low[i], r.jitter[i]);
+        status = shared_renderer().render_frame_lowres(scene, path, i, 30.0, settings, factor,
+                                                       r.full[i], r.low[i], r.jitter[i]);
         EXPECT_TRUE(status.ok()) << status.message();
     }
     return r;
@@ -65,7 +67,8 @@ bool all_finite(const Image<glm::vec4>& image) {
     for (int y = 0; y < image.height(); ++y)
         for (int x = 0; x < image.width(); ++x) {
             const glm::vec4 c = image(x, y);
-            if (!std::isfinite(c.x) || !std::isfinite(c.y) || !std::isfinite(c.z) || !std::isfinite(c.w))
+            if (!std::isfinite(c.x) || !std::isfinite(c.y) || !std::isfinite(c.z) ||
+                !std::isfinite(c.w))
                 return false;
         }
     return true;
@@ -79,7 +82,8 @@ TEST(LowresRender, SizesAndJitterCycle) {
     // 2x2: every full pixel centre of a low pixel once per four frames, then again.
     std::vector<glm::vec2> seen;
     for (int i = 0; i < 4; ++i) seen.push_back(server::lowres_jitter(64, 36, 4, i));
-    for (glm::vec2 corner : {glm::vec2(-0.5f, -0.5f), glm::vec2(0.5f, -0.5f), glm::vec2(-0.5f, 0.5f), glm::vec2(0.5f, 0.5f)})
+    for (glm::vec2 corner : {glm::vec2(-0.5f, -0.5f), glm::vec2(0.5f, -0.5f),
+                             glm::vec2(-0.5f, 0.5f), glm::vec2(0.5f, 0.5f)})
         EXPECT_EQ(std::count(seen.begin(), seen.end(), corner), 1);
     EXPECT_EQ(server::lowres_jitter(64, 36, 4, 5), seen[1]);
     EXPECT_EQ(server::lowres_jitter(64, 36, 2, 0), glm::vec2(-0.5f, 0.0f));
@@ -107,7 +111,8 @@ TEST(LowresRender, SamplesLandOnFullResolutionPixelCentres) {
         for (int oy = 0; oy < 3; ++oy)
             for (int ox = 0; ox < 3; ++ox)
                 if (ox != 1 || oy != 1) {
-                    EXPECT_LT(2.0 * error[1][1], error[oy][ox]) << "frame " << i << " offset " << ox - 1 << "," << oy - 1;
+                    EXPECT_LT(2.0 * error[1][1], error[oy][ox])
+                        << "frame " << i << " offset " << ox - 1 << "," << oy - 1;
                 }
     }
 }
@@ -138,7 +143,8 @@ TEST(Upsample, RenderedScenePsnrFloorAndMarginOverBilinear) {
         }
         ours /= counted;
         bilinear /= counted;
-        std::printf("pan 256x144 1/%d: upsampled %.2f dB, bilinear %.2f dB\n", c.factor, ours, bilinear);
+        std::printf("pan 256x144 1/%d: upsampled %.2f dB, bilinear %.2f dB\n", c.factor, ours,
+                    bilinear);
         EXPECT_GT(ours, c.floor) << "1/" << c.factor;
         EXPECT_GT(ours, bilinear + c.margin) << "1/" << c.factor;
     }
@@ -156,8 +162,8 @@ TEST(Upsample, StillCameraConvergesTowardsTheFullRender) {
         upsampler.upsample(r.low[i].view(), r.jitter[i], r.full[i], out.view());
         psnr.push_back(display_psnr(r.full[i].color, out));
     }
-    std::printf("still camera: frame 0 %.2f dB, frame 3 %.2f dB, frame %d %.2f dB\n", psnr[0], psnr[3],
-                frames - 1, psnr.back());
+    std::printf("still camera: frame 0 %.2f dB, frame 3 %.2f dB, frame %d %.2f dB\n", psnr[0],
+                psnr[3], frames - 1, psnr.back());
     EXPECT_GT(psnr.back(), psnr[0] + 2.5);
     EXPECT_GE(psnr.back(), psnr[3] - 0.1);
 }
@@ -180,7 +186,9 @@ TwoFrames two_frames(int w, int h, glm::vec4 a, glm::vec4 b) {
     return t;
 }
 
-bool inside(int x, int y) { return x >= 8 && x < 16 && y >= 4 && y < 12; }
+bool inside(int x, int y) {
+    return x >= 8 && x < 16 && y >= 4 && y < 12;
+}
 
 TEST(Upsample, NewIdOrDisocclusionTakesNoHistory) {
     const int w = 32, h = 16;
@@ -190,8 +198,10 @@ TEST(Upsample, NewIdOrDisocclusionTakesNoHistory) {
         for (int y = 0; y < h; ++y)
             for (int x = 0; x < w; ++x)
                 if (inside(x, y)) {
-                    if (by_id) t.current.id(x, y) = 2u;
-                    else t.current.depth(x, y) = 5.0f;  // a surface in front of the old one
+                    if (by_id)
+                        t.current.id(x, y) = 2u;
+                    else
+                        t.current.depth(x, y) = 5.0f;  // a surface in front of the old one
                 }
         SpatioTemporalUpsampler upsampler({.history_clamp = -1.0f});
         Image<glm::vec4> out(w, h);
@@ -206,7 +216,8 @@ TEST(Upsample, NewIdOrDisocclusionTakesNoHistory) {
                     EXPECT_NEAR(out(x, y).x, b.x, 1e-5f) << x << "," << y;
                     EXPECT_NEAR(out(x, y).z, b.z, 1e-5f) << x << "," << y;
                 } else {
-                    EXPECT_GT(out(x, y).x, b.x + 0.05f) << x << "," << y;  // history of A blended in
+                    EXPECT_GT(out(x, y).x, b.x + 0.05f)
+                        << x << "," << y;  // history of A blended in
                 }
             }
     }
@@ -297,9 +308,11 @@ TEST(Upsample, NonFiniteColourOrDepthDoesNotSpread) {
                 const bool near_inf = std::abs(x - 29) <= 5 && std::abs(y - 13) <= 5;
                 const bool near_depth = std::abs(x - 30) <= 5 && std::abs(y - 3) <= 5;
                 const bool near_normal = std::abs(x - 2) <= 5 && std::abs(y - 20) <= 5;
-                if (near_nan || near_inf || near_depth || near_normal || (x == 20 && y == 20)) continue;
+                if (near_nan || near_inf || near_depth || near_normal || (x == 20 && y == 20))
+                    continue;
                 // The gradient low-pass reaches 3 pixels further; the result stays close.
-                EXPECT_NEAR(out(x, y).x, reference(x, y).x, 0.02f) << x << "," << y << " frame " << i;
+                EXPECT_NEAR(out(x, y).x, reference(x, y).x, 0.02f)
+                    << x << "," << y << " frame " << i;
             }
     }
 }
@@ -333,7 +346,8 @@ TEST(Upsample, TinyAndOddSizes) {
         SpatioTemporalUpsampler upsampler;
         for (int i = 0; i < 4; ++i) {
             UpsampleStats stats;
-            upsampler.upsample(low.view(), {0.25f * i - 0.5f, 0.5f - 0.25f * i}, f, out.view(), &stats);
+            upsampler.upsample(low.view(), {0.25f * i - 0.5f, 0.5f - 0.25f * i}, f, out.view(),
+                               &stats);
             EXPECT_EQ(stats.unresolved, 0);
             ASSERT_TRUE(all_finite(out)) << c.w << "x" << c.h << " from " << c.lw << "x" << c.lh;
         }

@@ -38,10 +38,9 @@ Status render_sequence(BenchScene& bench, int width, int height, int factor, int
     seq.low.resize(std::size_t(frames));
     seq.jitter.resize(std::size_t(frames));
     for (int i = 0; i < frames; ++i) {
-        REPRISE_TRY(bench.renderer->render_frame_lowres(bench.scene, bench.path, i, 30.0,
-                                                        {.width = width, .height = height}, factor,
-                                                        seq.full[std::size_t(i)], seq.low[std::size_t(i)],
-                                                        seq.jitter[std::size_t(i)]));
+        REPRISE_TRY(bench.renderer->render_frame_lowres(
+            bench.scene, bench.path, i, 30.0, {.width = width, .height = height}, factor,
+            seq.full[std::size_t(i)], seq.low[std::size_t(i)], seq.jitter[std::size_t(i)]));
         std::fprintf(stderr, "\r[bench] rendering %d/%d", i + 1, frames);
     }
     std::fprintf(stderr, "\r%40s\r", "");
@@ -81,15 +80,18 @@ std::vector<Method> methods() {
     auto jitter_aware = [](const LowresSequence& s, int i, bool, Image<glm::vec4>& out) {
         const Image<glm::vec4>& low = s.low[std::size_t(i)];
         const glm::vec2 j = s.jitter[std::size_t(i)];
-        const double sx = double(out.width()) / low.width(), sy = double(out.height()) / low.height();
-        const cv::Matx23d to_low(1.0 / sx, 0.0, (0.5 - j.x) / sx - 0.5, 0.0, 1.0 / sy, (0.5 - j.y) / sy - 0.5);
+        const double sx = double(out.width()) / low.width(),
+                     sy = double(out.height()) / low.height();
+        const cv::Matx23d to_low(1.0 / sx, 0.0, (0.5 - j.x) / sx - 0.5, 0.0, 1.0 / sy,
+                                 (0.5 - j.y) / sy - 0.5);
         cv::Mat dst = as_mat(out);
         cv::warpAffine(as_mat(low), dst, to_low, dst.size(), cv::INTER_CUBIC | cv::WARP_INVERSE_MAP,
                        cv::BORDER_REPLICATE);
     };
     return {
         {"herzog", "steered", herzog({})},
-        {"herzog", "paper (no clamp, radial)", herzog({.history_clamp = -1.0f, .separable_filter = false})},
+        {"herzog", "paper (no clamp, radial)",
+         herzog({.history_clamp = -1.0f, .separable_filter = false})},
         {"herzog", "fixed 0.9", herzog({.gradient_steering = false})},
         {"jbu", "no history", herzog({.history_weight = 0.0f})},
         {"cv::resize", "bilinear", resize(cv::INTER_LINEAR)},
@@ -123,8 +125,10 @@ Status speed_run(const BenchOptions& options, CsvFile& csv, std::string& text) {
         const Frame& f = seq.full[std::size_t(i)];
         for (std::size_t m = 0; m < all.size(); ++m) {
             auto run = [&] { all[m].run(seq, i, i == 0, out); };
-            if (i > 0) time_once(times[m], run);  // the first frame has no history: untimed
-            else run();
+            if (i > 0)
+                time_once(times[m], run);  // the first frame has no history: untimed
+            else
+                run();
         }
         // The peer: cv::remap of this frame's full-resolution colour along its motion.
         for (int y = 0; y < h; ++y)
@@ -138,21 +142,26 @@ Status speed_run(const BenchOptions& options, CsvFile& csv, std::string& text) {
         auto remap = [&] {
             cv::remap(as_mat(f.color), dst, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT);
         };
-        if (i > 0) time_once(remap_times, remap);
-        else remap();
+        if (i > 0)
+            time_once(remap_times, remap);
+        else
+            remap();
         std::fprintf(stderr, "\r[bench] speed %dx%d %d/%d", w, h, i + 1, frames);
     }
     std::fprintf(stderr, "\r%40s\r", "");
-    text += strf("\nms per %dx%d frame (%s, 1/4 of the pixels, %d timed frames, %d threads) against "
-                 "cv::remap (INTER_LINEAR, CV_32FC4, float maps) of the same frame:\n",
-                 w, h, options.speed_scene.c_str(), frames - 1, thread_count());
+    text += strf(
+        "\nms per %dx%d frame (%s, 1/4 of the pixels, %d timed frames, %d threads) against "
+        "cv::remap (INTER_LINEAR, CV_32FC4, float maps) of the same frame:\n",
+        w, h, options.speed_scene.c_str(), frames - 1, thread_count());
     text += strf("%-16s %-22s %9s %9s %10s %10s\n", "method", "setting", "best ms", "median ms",
                  "best/remap", "med/remap");
     auto line = [&](const std::string& method, const std::string& setting, const Timing& t) {
         text += strf("%-16s %-22s %9.2f %9.2f %9.2fx %9.2fx\n", method.c_str(), setting.c_str(),
-                     t.best(), t.median(), t.best() / remap_times.best(), t.median() / remap_times.median());
-        csv.row({strf("%dx%d", w, h), method, setting, strf("%.4f", t.best()), strf("%.4f", t.median()),
-                 strf("%.4f", t.best() / remap_times.best()), strf("%.4f", t.median() / remap_times.median())});
+                     t.best(), t.median(), t.best() / remap_times.best(),
+                     t.median() / remap_times.median());
+        csv.row({strf("%dx%d", w, h), method, setting, strf("%.4f", t.best()),
+                 strf("%.4f", t.median()), strf("%.4f", t.best() / remap_times.best()),
+                 strf("%.4f", t.median() / remap_times.median())});
     };
     for (std::size_t m = 0; m < all.size(); ++m) line(all[m].method, all[m].setting, times[m]);
     line("cv::remap", "peer", remap_times);
@@ -168,9 +177,13 @@ Status bench_upsample(const BenchOptions& options) {
     if (scenes.empty())
         for (const server::SceneInfo& s : server::builtin_scenes()) scenes.push_back(s.name);
     std::vector<int> factors;
-    if (options.factor == 0) factors = {4, 2};
-    else if (options.factor == 2 || options.factor == 4) factors = {options.factor};
-    else return Status::error("bench upsample: --factor must be 2 or 4 (pixels per low-resolution sample)");
+    if (options.factor == 0)
+        factors = {4, 2};
+    else if (options.factor == 2 || options.factor == 4)
+        factors = {options.factor};
+    else
+        return Status::error(
+            "bench upsample: --factor must be 2 or 4 (pixels per low-resolution sample)");
     const std::string out_dir = options.out.empty() ? "out/bench-upsample" : options.out;
     std::error_code ec;
     std::filesystem::create_directories(out_dir, ec);
@@ -179,7 +192,9 @@ Status bench_upsample(const BenchOptions& options) {
 
     CsvFile csv, speed_csv;
     REPRISE_TRY(csv.open(out_dir + "/upsample.csv", std::string(kErrorTimeColumns) + ",factor"));
-    REPRISE_TRY(speed_csv.open(out_dir + "/speed.csv", "size,method,setting,best_ms,median_ms,best_over_remap,median_over_remap"));
+    REPRISE_TRY(
+        speed_csv.open(out_dir + "/speed.csv",
+                       "size,method,setting,best_ms,median_ms,best_over_remap,median_over_remap"));
     const std::vector<Method> all = methods();
     // (factor, scene, method index) -> summary
     std::map<std::tuple<int, std::string, std::size_t>, Summary> summaries;
@@ -187,9 +202,12 @@ Status bench_upsample(const BenchOptions& options) {
     report.title = "reprise bench upsample";
     report.paragraphs.push_back(strf(
         "Colour rendered at 1/2 (W/2 x H) or 1/4 (W/2 x H/2) of the pixels with a per-frame jitter "
-        "cycling over the full pixels of each low pixel, upsampled to %dx%d with the full-resolution "
-        "G-buffer and compared with the full-resolution render of the same frames (display values). "
-        "%d frames per scene from t = 0, each frame's fastest of %d runs. herzog: Herzog et al. 2010 "
+        "cycling over the full pixels of each low pixel, upsampled to %dx%d with the "
+        "full-resolution "
+        "G-buffer and compared with the full-resolution render of the same frames (display "
+        "values). "
+        "%d frames per scene from t = 0, each frame's fastest of %d runs. herzog: Herzog et al. "
+        "2010 "
         "(steered: temporal gradients steer the history, which is clamped to the colour box of the "
         "current samples on the same surface, and whose image-space filter is a separable tent; "
         "paper: without the clamp, with the paper's radial filter over the low pixel diagonal; "
@@ -232,7 +250,8 @@ Status bench_upsample(const BenchOptions& options) {
                     s.flip += e.flip;
                     s.ms += fastest[run_frame];
                     ++s.frames;
-                    if (run_frame == options.frames - 1 && (m == 0 || m == kJbu || m == kBilinear || m == kJitterAware)) {
+                    if (run_frame == options.frames - 1 &&
+                        (m == 0 || m == kJbu || m == kBilinear || m == kJitterAware)) {
                         Image<Rgb8> picture;
                         to_rgb8(test_display.view(), picture);
                         last_pictures.push_back(std::move(picture));
@@ -249,8 +268,9 @@ Status bench_upsample(const BenchOptions& options) {
             const std::string picture = strf("%s_1of%d.png", scene_name.c_str(), factor);
             REPRISE_TRY(write_worst_window_sheet(out_dir + "/" + picture, std::move(last_pictures),
                                                  labels, truth, 640));
-            images.push_back({picture, strf("%s, 1/%d of the pixels, last frame: %s (worst window of herzog)",
-                                            scene_name.c_str(), factor, "herzog, jbu, bilinear, warpAffine")});
+            images.push_back(
+                {picture, strf("%s, 1/%d of the pixels, last frame: %s (worst window of herzog)",
+                               scene_name.c_str(), factor, "herzog, jbu, bilinear, warpAffine")});
             csv.flush();
         }
     }
@@ -260,7 +280,8 @@ Status bench_upsample(const BenchOptions& options) {
     for (int factor : factors) {
         ReportSection section;
         section.title = strf("1/%d of the pixels (mean over scenes)", factor);
-        section.note = "Mean PSNR over every scene and frame against the mean ms per frame at the bench size.";
+        section.note =
+            "Mean PSNR over every scene and frame against the mean ms per frame at the bench size.";
         section.time_label = "ms per upsampled frame (log scale)";
         std::vector<Summary> means(all.size());
         for (const std::string& scene_name : scenes) {
@@ -268,9 +289,10 @@ Status bench_upsample(const BenchOptions& options) {
             for (std::size_t m = 0; m < all.size(); ++m) {
                 const Summary& s = summaries[{factor, scene_name, m}];
                 const double n = std::max(1, s.frames);
-                table += strf("%-9s 1/%-4d %-16s %-22s %8.2f %7.4f %7.4f %9.2f %+9.2f\n", scene_name.c_str(),
-                              factor, all[m].method.c_str(), all[m].setting.c_str(), s.psnr / n, s.ssim / n,
-                              s.flip / n, s.ms / n, (s.psnr - bilinear.psnr) / n);
+                table += strf("%-9s 1/%-4d %-16s %-22s %8.2f %7.4f %7.4f %9.2f %+9.2f\n",
+                              scene_name.c_str(), factor, all[m].method.c_str(),
+                              all[m].setting.c_str(), s.psnr / n, s.ssim / n, s.flip / n, s.ms / n,
+                              (s.psnr - bilinear.psnr) / n);
                 means[m].psnr += s.psnr / n / double(scenes.size());
                 means[m].ssim += s.ssim / n / double(scenes.size());
                 means[m].flip += s.flip / n / double(scenes.size());
@@ -280,12 +302,14 @@ Status bench_upsample(const BenchOptions& options) {
         for (std::size_t m = 0; m < all.size(); ++m) {
             section.points.push_back({all[m].method, all[m].setting, means[m].psnr, means[m].ssim,
                                       means[m].flip, means[m].ms});
-            table += strf("%-9s 1/%-4d %-16s %-22s %8.2f %7.4f %7.4f %9.2f %+9.2f\n", "MEAN", factor,
-                          all[m].method.c_str(), all[m].setting.c_str(), means[m].psnr, means[m].ssim,
-                          means[m].flip, means[m].ms, means[m].psnr - means[kBilinear].psnr);
+            table +=
+                strf("%-9s 1/%-4d %-16s %-22s %8.2f %7.4f %7.4f %9.2f %+9.2f\n", "MEAN", factor,
+                     all[m].method.c_str(), all[m].setting.c_str(), means[m].psnr, means[m].ssim,
+                     means[m].flip, means[m].ms, means[m].psnr - means[kBilinear].psnr);
         }
         for (const ReportImage& image : images)
-            if (image.file.find(strf("_1of%d", factor)) != std::string::npos) section.images.push_back(image);
+            if (image.file.find(strf("_1of%d", factor)) != std::string::npos)
+                section.images.push_back(image);
         report.sections.push_back(std::move(section));
     }
     std::string speed_text;

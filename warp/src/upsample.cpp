@@ -20,7 +20,9 @@ bool finite3(const glm::vec4& c) {
     return std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z);
 }
 
-float luminance(const glm::vec4& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
+float luminance(const glm::vec4& c) {
+    return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z;
+}
 
 // log2 and exp2 to about 1e-4 relative with short polynomials (powf dominated the filter).
 float fast_log2(float x) {  // x > 0, finite
@@ -31,20 +33,27 @@ float fast_log2(float x) {  // x > 0, finite
     float m;
     std::memcpy(&m, &bits, sizeof m);
     const float t = (m - 1.0f) / (m + 1.0f), t2 = t * t;  // log2 m = 2 atanh(t) / ln 2
-    return exponent + t * (2.8853900818f + t2 * (0.9617966939f + t2 * (0.5770780164f + t2 * 0.4121985232f)));
+    return exponent +
+           t * (2.8853900818f + t2 * (0.9617966939f + t2 * (0.5770780164f + t2 * 0.4121985232f)));
 }
 
 float fast_exp2(float e) {  // e <= 0
     if (e < -126.0f) return 0.0f;
     const float whole = std::floor(e), frac = e - whole;
-    const float p = 1.0f + frac * (0.6931471806f + frac * (0.2402265070f + frac * (0.0555041087f + frac * (0.0096181291f + frac * 0.0013333558f))));
+    const float p =
+        1.0f +
+        frac * (0.6931471806f +
+                frac * (0.2402265070f +
+                        frac * (0.0555041087f + frac * (0.0096181291f + frac * 0.0013333558f))));
     const uint32_t scale_bits = uint32_t(int(whole) + 127) << 23;
     float scale;
     std::memcpy(&scale, &scale_bits, sizeof scale);
     return p * scale;
 }
 
-float fast_pow(float base, float gamma) { return fast_exp2(gamma * fast_log2(base)); }
+float fast_pow(float base, float gamma) {
+    return fast_exp2(gamma * fast_log2(base));
+}
 
 // base^gamma of eq. 3 for base = max(eps, 1 - x / sigma).
 float falloff_of_base(float base, float gamma) {
@@ -84,8 +93,8 @@ struct FrameContext {
     const GBufferView* full = nullptr;
     glm::vec2 jitter{0.0f};       // of the low samples, full-resolution pixels
     glm::vec2 full_jitter{0.0f};  // of the full G-buffer (0 as reprise renders it)
-    glm::vec2 scale{1.0f};  // full pixels per low pixel
-    float diagonal = 1.0f;  // r: the low pixel's diagonal in full pixels
+    glm::vec2 scale{1.0f};        // full pixels per low pixel
+    float diagonal = 1.0f;        // r: the low pixel's diagonal in full pixels
     int width = 0, height = 0;
     const UpsampleOptions* options = nullptr;
     float floor3 = 0.0f;  // eps^3: the weight of a failed geometric test
@@ -144,7 +153,8 @@ struct TapOrigin {
 };
 
 TapOrigin tap_origin(const FrameContext& f, int x, int y) {
-    const glm::vec2 q = (glm::vec2(float(x) + 0.5f, float(y) + 0.5f) + f.full_jitter - f.jitter) / f.scale - 0.5f;
+    const glm::vec2 q =
+        (glm::vec2(float(x) + 0.5f, float(y) + 0.5f) + f.full_jitter - f.jitter) / f.scale - 0.5f;
     return {int(std::floor(q.x)), int(std::floor(q.y))};
 }
 
@@ -166,7 +176,8 @@ Taps compute_taps(const FrameContext& f, int x, int y) {
             const float eps = f.options->epsilon;
             t.base[dv * 2 + du] =
                 f.options->separable_filter
-                    ? std::max(eps, 1.0f - std::abs(dx) / f.scale.x) * std::max(eps, 1.0f - std::abs(dy) / f.scale.y)
+                    ? std::max(eps, 1.0f - std::abs(dx) / f.scale.x) *
+                          std::max(eps, 1.0f - std::abs(dy) / f.scale.y)
                     : std::max(eps, 1.0f - std::sqrt(dx * dx + dy * dy) / f.diagonal);
             t.geometric[dv * 2 + du] = geometric_weight(f, here, guide_at(*f.full, gx, gy));
         }
@@ -218,7 +229,9 @@ struct Counters {
 
 SpatioTemporalUpsampler::SpatioTemporalUpsampler(UpsampleOptions options) : options_(options) {}
 
-void SpatioTemporalUpsampler::reset() { has_history_ = false; }
+void SpatioTemporalUpsampler::reset() {
+    has_history_ = false;
+}
 
 void SpatioTemporalUpsampler::upsample(ImageView<const glm::vec4> low_color, glm::vec2 jitter_px,
                                        const GBufferView& full, ImageView<glm::vec4> out,
@@ -228,10 +241,13 @@ void SpatioTemporalUpsampler::upsample(ImageView<const glm::vec4> low_color, glm
     REPRISE_ASSERT(!full.depth.empty() && !low_color.empty());
     REPRISE_ASSERT(out.width == width && out.height == height);
     REPRISE_ASSERT(low_color.width <= width && low_color.height <= height);
-    REPRISE_ASSERT(full.normal.empty() || (full.normal.width == width && full.normal.height == height));
+    REPRISE_ASSERT(full.normal.empty() ||
+                   (full.normal.width == width && full.normal.height == height));
     REPRISE_ASSERT(full.id.empty() || (full.id.width == width && full.id.height == height));
-    REPRISE_ASSERT(full.motion.empty() || (full.motion.width == width && full.motion.height == height));
-    REPRISE_ASSERT(o.depth_sigma > 0.0f && o.normal_sigma > 0.0f && o.epsilon > 0.0f && o.epsilon < 1.0f);
+    REPRISE_ASSERT(full.motion.empty() ||
+                   (full.motion.width == width && full.motion.height == height));
+    REPRISE_ASSERT(o.depth_sigma > 0.0f && o.normal_sigma > 0.0f && o.epsilon > 0.0f &&
+                   o.epsilon < 1.0f);
 
     if (history_.width() != width || history_.height() != height) {
         history_.resize(width, height);
@@ -249,14 +265,16 @@ void SpatioTemporalUpsampler::upsample(ImageView<const glm::vec4> low_color, glm
     }
     if (!std::isfinite(jitter_px.x) || !std::isfinite(jitter_px.y)) jitter_px = glm::vec2(0.0f);
     glm::vec2 full_jitter = full.camera.jitter;
-    if (!std::isfinite(full_jitter.x) || !std::isfinite(full_jitter.y)) full_jitter = glm::vec2(0.0f);
+    if (!std::isfinite(full_jitter.x) || !std::isfinite(full_jitter.y))
+        full_jitter = glm::vec2(0.0f);
 
     FrameContext f;
     f.low = low_color;
     f.full = &full;
     f.jitter = jitter_px;
     f.full_jitter = full_jitter;
-    f.scale = glm::vec2(float(width) / float(low_color.width), float(height) / float(low_color.height));
+    f.scale =
+        glm::vec2(float(width) / float(low_color.width), float(height) / float(low_color.height));
     f.diagonal = std::sqrt(f.scale.x * f.scale.x + f.scale.y * f.scale.y);
     f.width = width;
     f.height = height;
@@ -285,8 +303,9 @@ void SpatioTemporalUpsampler::upsample(ImageView<const glm::vec4> low_color, glm
                     if (kind != DepthKind::Invalid && std::isfinite(m.x) && std::isfinite(m.y)) {
                         float expected = INFINITY;
                         if (kind == DepthKind::Surface) {
-                            const glm::vec4 point = camera.unprojector().point(
-                                float(x) + 0.5f + full_jitter.x, float(y) + 0.5f + full_jitter.y, z);
+                            const glm::vec4 point =
+                                camera.unprojector().point(float(x) + 0.5f + full_jitter.x,
+                                                           float(y) + 0.5f + full_jitter.y, z);
                             expected = -(to_previous_view * point).z;
                         }
                         // p + jitter + motion in the previous unjittered image; its pixels saw
@@ -309,7 +328,8 @@ void SpatioTemporalUpsampler::upsample(ImageView<const glm::vec4> low_color, glm
                                 } else {
                                     const float tolerance =
                                         o.history_depth_tolerance * (ids ? 4.0f : 1.0f);
-                                    if (!(std::abs(zp - expected) <= tolerance * expected)) continue;
+                                    if (!(std::abs(zp - expected) <= tolerance * expected))
+                                        continue;
                                 }
                                 const glm::vec4 h = history_(px, py);
                                 if (!(h.w > 0.0f)) continue;
@@ -321,7 +341,8 @@ void SpatioTemporalUpsampler::upsample(ImageView<const glm::vec4> low_color, glm
                     }
                     if (accepted > 1e-3f) {
                         reprojected_(x, y) = color / accepted;
-                        next_deltas_(x, y) = delta / accepted;  // rotated below, after the spatial estimate
+                        next_deltas_(x, y) =
+                            delta / accepted;  // rotated below, after the spatial estimate
                     } else {
                         reprojected_(x, y) = glm::vec4(0.0f);
                         next_deltas_(x, y) = glm::vec4(1.0f);
@@ -347,7 +368,9 @@ void SpatioTemporalUpsampler::upsample(ImageView<const glm::vec4> low_color, glm
                         const SpatialResult s = combine(f, x, y, taps, o.gamma_unsteered);
                         const float a = luminance(s.color), b = luminance(h);
                         const float scale = std::max(std::abs(a), std::abs(b));
-                        current = s.weight > 0.0f && scale > 0.0f ? std::clamp((a - b) / scale, -1.0f, 1.0f) : 0.0f;
+                        current = s.weight > 0.0f && scale > 0.0f
+                                      ? std::clamp((a - b) / scale, -1.0f, 1.0f)
+                                      : 0.0f;
                         gradient_(x, y) = std::min(
                             1.0f, std::abs(0.4f * current + 0.3f * d.x + 0.2f * d.y + 0.1f * d.z));
                     } else {
@@ -394,7 +417,8 @@ void SpatioTemporalUpsampler::upsample(ImageView<const glm::vec4> low_color, glm
                 float fade = 0.0f, gamma_k = o.gamma_unsteered;
                 if (history) {
                     if (o.gradient_steering) {
-                        const float c = 1.0f - std::clamp(o.gradient_gain * gradient_(x, y), 0.0f, 1.0f);
+                        const float c =
+                            1.0f - std::clamp(o.gradient_gain * gradient_(x, y), 0.0f, 1.0f);
                         fade = std::min(1.0f, o.history_weight * c * c);
                         gamma_k = std::max(o.gamma_min, o.gamma_max * fade);
                     } else {
@@ -404,7 +428,10 @@ void SpatioTemporalUpsampler::upsample(ImageView<const glm::vec4> low_color, glm
                     gamma_k = o.gamma_min;
                 }
                 const SpatialResult s =
-                    combine(f, x, y, cached_taps ? Taps{tap_geometric_(x, y), tap_base_(x, y)} : compute_taps(f, x, y), gamma_k);
+                    combine(f, x, y,
+                            cached_taps ? Taps{tap_geometric_(x, y), tap_base_(x, y)}
+                                        : compute_taps(f, x, y),
+                            gamma_k);
                 nonfinite += s.nonfinite;
                 glm::vec4 result(s.color.x, s.color.y, s.color.z, 0.0f);
                 float weight = s.weight;

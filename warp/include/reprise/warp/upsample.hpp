@@ -10,8 +10,9 @@
 //     ((u + 0.5) * s.x + jitter.x, (v + 0.5) * s.y + jitter.y)
 // (the renderer's convention: a pixel samples the unjittered image at its centre + jitter, with
 // the jitter given in full-resolution pixels). A full G-buffer with its own jitter
-// (full.camera.jitter, 0 as reprise renders it) is accounted for the same way. With a jitter cycle that visits every full pixel
-// centre of a low pixel's footprint (server::lowres_jitter), a still scene converges.
+// (full.camera.jitter, 0 as reprise renders it) is accounted for the same way. With a jitter cycle
+// that visits every full pixel centre of a low pixel's footprint (server::lowres_jitter), a still
+// scene converges.
 //
 // Per pixel i (equations of the paper):
 //   w_s(i, j) = g(max(0, 1 - n_i.n_j)^2, sigma_n^2, 3) * g(dz^2, sigma_d^2, 3) * k(i, j)   (2)
@@ -40,15 +41,16 @@ struct UpsampleOptions {
     float normal_sigma = 0.2f;         // sigma_n of eq. 2
     float depth_sigma = 0.03f;         // sigma_d as a fraction of the pixel's depth
     float gamma_max = 4.0f;            // largest fall-off of the image-space filter k
-    float gamma_unsteered = 3.0f;      // fall-off of k without steering and for the gradient estimate
-    float gamma_min = 1.0f;            // floor of the steered fall-off (1: a hat, as plain joint
-                                       // bilateral upsampling; the paper's 0 is a box)
-    float epsilon = 0.01f;             // weight floor of g (eq. 3)
-    bool gradient_steering = true;     // temporal gradients steer w_f and gamma_k (section 3.5)
-    bool id_test = true;               // history and spatial samples must carry the pixel's id
-    float history_depth_tolerance = 0.05f;  // relative depth difference that still counts as the same surface
-    int gradient_radius = 0;           // box radius of the gradient low-pass; 0 = one low pixel + 1
-    float gradient_gain = 1.0f;        // |grad| is multiplied by this before eq. 8 (the paper: 1)
+    float gamma_unsteered = 3.0f;   // fall-off of k without steering and for the gradient estimate
+    float gamma_min = 1.0f;         // floor of the steered fall-off (1: a hat, as plain joint
+                                    // bilateral upsampling; the paper's 0 is a box)
+    float epsilon = 0.01f;          // weight floor of g (eq. 3)
+    bool gradient_steering = true;  // temporal gradients steer w_f and gamma_k (section 3.5)
+    bool id_test = true;            // history and spatial samples must carry the pixel's id
+    float history_depth_tolerance =
+        0.05f;                   // relative depth difference that still counts as the same surface
+    int gradient_radius = 0;     // box radius of the gradient low-pass; 0 = one low pixel + 1
+    float gradient_gain = 1.0f;  // |grad| is multiplied by this before eq. 8 (the paper: 1)
     // Beyond the paper: < 0 leaves the history as it is; >= 0 clamps it to the colour box of this
     // frame's 2x2 samples on the same surface, widened by this fraction of the box's size on each
     // side (as temporal anti-aliasing does), so changed shading cannot linger.
@@ -58,20 +60,21 @@ struct UpsampleOptions {
     bool recompute_taps = false;
     // Beyond the paper: k as a separable tent over one low pixel per axis (gamma_k = 1: bilinear
     // weights); false: the paper's radial fall-off over the low pixel's diagonal, which blurs
-    // across the full-resolution rows of ½-pixel colour (measured +0.3..0.8 dB at ¼, +1..1.4 dB at ½).
+    // across the full-resolution rows of ½-pixel colour (measured +0.3..0.8 dB at ¼, +1..1.4 dB at
+    // ½).
     bool separable_filter = true;
 };
 
 // Counts of one upsample() call (overwritten by each call).
 struct UpsampleStats {
-    int64_t history_rejected = 0;   // pixels whose history existed but was disoccluded or off-screen
-    int64_t history_used = 0;       // pixels blended with their history
+    int64_t history_rejected = 0;  // pixels whose history existed but was disoccluded or off-screen
+    int64_t history_used = 0;      // pixels blended with their history
     int64_t nonfinite_samples = 0;  // low-resolution sample reads skipped for NaN/Inf colour
     int64_t unresolved = 0;         // pixels with neither a finite sample nor history (written 0)
 };
 
 class SpatioTemporalUpsampler {
-public:
+  public:
     explicit SpatioTemporalUpsampler(UpsampleOptions options = {});
 
     // `low_color`: linear RGBA at lw x lh (see above), rendered with `jitter_px` (full-resolution
@@ -79,14 +82,15 @@ public:
     // normal, id and motion may be empty (their tests and the history are then skipped).
     // `out`: the full size, caller-owned, must not alias the inputs. The first frame, a new size
     // and the frame after reset() are spatial only. Threaded; allocates only on a size change.
-    void upsample(ImageView<const glm::vec4> low_color, glm::vec2 jitter_px, const GBufferView& full,
-                  ImageView<glm::vec4> out, UpsampleStats* stats = nullptr);
+    void upsample(ImageView<const glm::vec4> low_color, glm::vec2 jitter_px,
+                  const GBufferView& full, ImageView<glm::vec4> out,
+                  UpsampleStats* stats = nullptr);
     // Forgets the history (a cut, a new stream).
     void reset();
 
     const UpsampleOptions& options() const { return options_; }
 
-private:
+  private:
     UpsampleOptions options_;
     // History, double-buffered (read at p + motion while the next one is written).
     Image<glm::vec4> history_, next_history_;  // h_r rgb, a = h_w
