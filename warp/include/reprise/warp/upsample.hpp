@@ -47,8 +47,8 @@ struct UpsampleOptions {
     float epsilon = 0.01f;          // weight floor of g (eq. 3)
     bool gradient_steering = true;  // temporal gradients steer w_f and gamma_k (section 3.5)
     bool id_test = true;            // history and spatial samples must carry the pixel's id
-    float history_depth_tolerance =
-        0.05f;                   // relative depth difference that still counts as the same surface
+    // Relative depth difference that still counts as the same surface (x4 where ids match).
+    float history_depth_tolerance = 0.05f;
     int gradient_radius = 0;     // box radius of the gradient low-pass; 0 = one low pixel + 1
     float gradient_gain = 1.0f;  // |grad| is multiplied by this before eq. 8 (the paper: 1)
     // Beyond the paper: < 0 leaves the history as it is; >= 0 clamps it to the colour box of this
@@ -82,6 +82,9 @@ class SpatioTemporalUpsampler {
     // normal, id and motion may be empty (their tests and the history are then skipped).
     // `out`: the full size, caller-owned, must not alias the inputs. The first frame, a new size
     // and the frame after reset() are spatial only. Threaded; allocates only on a size change.
+    // Frames must come in order: the history moves by one frame's motion, so after a skipped or
+    // lost frame call reset() (otherwise only the depth and id tests stand between the stale
+    // history and the picture).
     void upsample(ImageView<const glm::vec4> low_color, glm::vec2 jitter_px,
                   const GBufferView& full, ImageView<glm::vec4> out,
                   UpsampleStats* stats = nullptr);
