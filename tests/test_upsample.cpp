@@ -290,6 +290,7 @@ TEST(Upsample, NonFiniteColourOrDepthDoesNotSpread) {
     bad.depth(30, 3) = kNaN;
     bad.depth(31, 3) = -kInf;
     bad.motion(20, 20) = glm::vec2(kNaN, 1.0f);
+    bad.motion(21, 20) = glm::vec2(3e38f, -3e38f);
     bad.normal.assign(w, h, glm::vec3(0.0f, 0.0f, 1.0f));
     f.normal = bad.normal;
     bad.normal(2, 20) = glm::vec3(kNaN);
@@ -353,6 +354,12 @@ TEST(Upsample, TinyAndOddSizes) {
         }
         upsampler.reset();
         upsampler.upsample(low.view(), {0.0f, 0.0f}, f, out.view());
+        ASSERT_TRUE(all_finite(out));
+        // Absurd jitter and motion are bounded, not undefined.
+        f.camera.jitter = glm::vec2(1e30f, -kInf);
+        f.motion.assign(c.w, c.h, glm::vec2(-1e30f, 1e20f));
+        upsampler.upsample(low.view(), {1e30f, kNaN}, f, out.view());
+        upsampler.upsample(low.view(), {-1e30f, 5.0f}, f, out.view());
         ASSERT_TRUE(all_finite(out));
     }
 }

@@ -263,10 +263,14 @@ void SpatioTemporalUpsampler::upsample(ImageView<const glm::vec4> low_color, glm
         tap_base_.resize(width, height);
         has_history_ = false;
     }
-    if (!std::isfinite(jitter_px.x) || !std::isfinite(jitter_px.y)) jitter_px = glm::vec2(0.0f);
-    glm::vec2 full_jitter = full.camera.jitter;
-    if (!std::isfinite(full_jitter.x) || !std::isfinite(full_jitter.y))
-        full_jitter = glm::vec2(0.0f);
+    // Offsets beyond any image are nonsense; bounding them keeps every index computation in range.
+    auto bounded = [](glm::vec2 v) {
+        const float limit = float(kMaxImageSide);
+        if (!std::isfinite(v.x) || !std::isfinite(v.y)) return glm::vec2(0.0f);
+        return glm::clamp(v, glm::vec2(-limit), glm::vec2(limit));
+    };
+    jitter_px = bounded(jitter_px);
+    const glm::vec2 full_jitter = bounded(full.camera.jitter);
 
     FrameContext f;
     f.low = low_color;
@@ -283,7 +287,7 @@ void SpatioTemporalUpsampler::upsample(ImageView<const glm::vec4> low_color, glm
     f.ids = o.id_test && !full.id.empty();
 
     const bool temporal = has_history_ && !full.motion.empty() && o.history_weight > 0.0f;
-    const bool ids = o.id_test && !full.id.empty();
+    const bool ids = o.id_test && !full.id.empty() && history_has_ids_;
     const StaticReprojection camera(full.camera, full.camera.prev_view, full.camera.prev_projection,
                                     width, height);
     const glm::mat4 to_previous_view = camera.to_view();
@@ -300,7 +304,9 @@ void SpatioTemporalUpsampler::upsample(ImageView<const glm::vec4> low_color, glm
                     const glm::vec2 m = full.motion(x, y);
                     glm::vec4 color(0.0f), delta(0.0f);
                     float accepted = 0.0f;
-                    if (kind != DepthKind::Invalid && std::isfinite(m.x) && std::isfinite(m.y)) {
+                    const float limit = float(kMaxImageSide);
+                    if (kind != DepthKind::Invalid && std::abs(m.x) < limit &&
+                        std::abs(m.y) < limit) {
                         float expected = INFINITY;
                         if (kind == DepthKind::Surface) {
                             const glm::vec4 point =
@@ -469,6 +475,7 @@ void SpatioTemporalUpsampler::upsample(ImageView<const glm::vec4> low_color, glm
             std::memcpy(&history_id_(0, y), full.id.row(y), sizeof(uint32_t) * std::size_t(width));
     }
     history_jitter_ = full_jitter;
+    history_has_ids_ = !full.id.empty();
     has_history_ = true;
 
     if (stats) {

@@ -107,6 +107,7 @@ class SpatioTemporalUpsampler {
     // and the final pass.
     Image<glm::vec4> tap_geometric_, tap_base_;
     glm::vec2 history_jitter_{0.0f};  // the full G-buffer's jitter of the history's frame
+    bool history_has_ids_ = false;
     bool has_history_ = false;
 };
 
