@@ -309,8 +309,10 @@ TEST(Upsample, NonFiniteColourOrDepthDoesNotSpread) {
                 const bool near_inf = std::abs(x - 29) <= 5 && std::abs(y - 13) <= 5;
                 const bool near_depth = std::abs(x - 30) <= 5 && std::abs(y - 3) <= 5;
                 const bool near_normal = std::abs(x - 2) <= 5 && std::abs(y - 20) <= 5;
-                if (near_nan || near_inf || near_depth || near_normal || (x == 20 && y == 20))
-                    continue;
+                // A pixel without history has the largest temporal gradient, which the gradient's
+                // low-pass (radius 3) spreads a little.
+                const bool near_motion = x >= 17 && x <= 24 && std::abs(y - 20) <= 3;
+                if (near_nan || near_inf || near_depth || near_normal || near_motion) continue;
                 // The gradient low-pass reaches 3 pixels further; the result stays close.
                 EXPECT_NEAR(out(x, y).x, reference(x, y).x, 0.02f)
                     << x << "," << y << " frame " << i;
