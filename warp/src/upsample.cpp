@@ -293,6 +293,29 @@ void SpatioTemporalUpsampler::upsample(ImageView<const glm::vec4> low_color, glm
     const glm::mat4 to_previous_view = camera.to_view();
     Counters counters;
 
+    // The spatial taps (kept for the final pass) and the relative temporal gradient of a pixel
+    // whose history has just been fetched; the differences rotate for the next frame.
+    auto temporal_gradient = [&](int x, int y) {
+        const glm::vec4 h = reprojected_(x, y);
+        glm::vec4& d = next_deltas_(x, y);
+        float current = 1.0f;
+        const Taps taps = compute_taps(f, x, y);
+        tap_geometric_(x, y) = taps.geometric;
+        tap_base_(x, y) = taps.base;
+        if (h.w > 0.0f) {
+            const SpatialResult s = combine(f, x, y, taps, o.gamma_unsteered);
+            const float a = luminance(s.color), b = luminance(h);
+            const float scale = std::max(std::abs(a), std::abs(b));
+            current =
+                s.weight > 0.0f && scale > 0.0f ? std::clamp((a - b) / scale, -1.0f, 1.0f) : 0.0f;
+            gradient_(x, y) =
+                std::min(1.0f, std::abs(0.4f * current + 0.3f * d.x + 0.2f * d.y + 0.1f * d.z));
+        } else {
+            gradient_(x, y) = 1.0f;
+        }
+        d = glm::vec4(current, d.x, d.y, 0.0f);
+    };
+
     // (A) History at p + motion, disocclusion test, raw temporal gradient.
     if (temporal) {
         parallel_for(0, height, [&](int y0, int y1) {
@@ -354,6 +377,7 @@ void SpatioTemporalUpsampler::upsample(ImageView<const glm::vec4> low_color, glm
                         next_deltas_(x, y) = glm::vec4(1.0f);
                         ++rejected;
                     }
+                    if (o.gradient_steering) temporal_gradient(x, y);
                 }
             }
             counters.rejected += rejected;
@@ -361,31 +385,6 @@ void SpatioTemporalUpsampler::upsample(ImageView<const glm::vec4> low_color, glm
     }
 
     if (temporal && o.gradient_steering) {
-        parallel_for(0, height, [&](int y0, int y1) {
-            for (int y = y0; y < y1; ++y) {
-                for (int x = 0; x < width; ++x) {
-                    const glm::vec4 h = reprojected_(x, y);
-                    glm::vec4& d = next_deltas_(x, y);
-                    float current = 1.0f;
-                    const Taps taps = compute_taps(f, x, y);
-                    tap_geometric_(x, y) = taps.geometric;
-                    tap_base_(x, y) = taps.base;
-                    if (h.w > 0.0f) {
-                        const SpatialResult s = combine(f, x, y, taps, o.gamma_unsteered);
-                        const float a = luminance(s.color), b = luminance(h);
-                        const float scale = std::max(std::abs(a), std::abs(b));
-                        current = s.weight > 0.0f && scale > 0.0f
-                                      ? std::clamp((a - b) / scale, -1.0f, 1.0f)
-                                      : 0.0f;
-                        gradient_(x, y) = std::min(
-                            1.0f, std::abs(0.4f * current + 0.3f * d.x + 0.2f * d.y + 0.1f * d.z));
-                    } else {
-                        gradient_(x, y) = 1.0f;
-                    }
-                    d = glm::vec4(current, d.x, d.y, 0.0f);
-                }
-            }
-        });
         // (B) Box low-pass, slightly wider than a low pixel.
         const int radius = o.gradient_radius > 0
                                ? o.gradient_radius
