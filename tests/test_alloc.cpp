@@ -14,6 +14,7 @@
 
 #include "reprise/stereo/synthesize.hpp"
 #include "reprise/warp/fruc.hpp"
+#include "reprise/warp/upsample.hpp"
 
 namespace {
 
@@ -186,4 +187,21 @@ TEST(Allocations, StereoSynthesisSteadyStateAllocatesNothing) {
         EXPECT_EQ(counted, 0) << "allocations in 6 steady-state syntheses, fill " << int(fill);
     }
     EXPECT_GT(covered, 0u);
+}
+
+TEST(Allocations, UpsamplingSteadyStateAllocatesNothing) {
+    std::vector<Frame> frames;
+    for (int i = 0; i < 4; ++i) frames.push_back(make_frame(i));
+    Image<glm::vec4> low(kW / 2, kH / 2), out(kW, kH);
+    for (int y = 0; y < kH / 2; ++y)
+        for (int x = 0; x < kW / 2; ++x) low(x, y) = frames[0].color(2 * x, 2 * y);
+    warp::SpatioTemporalUpsampler upsampler;
+    warp::UpsampleStats stats;
+    upsampler.upsample(low.view(), {-0.5f, -0.5f}, frames[0], out.view(), &stats);
+    const long counted = allocations_during([&] {
+        for (int i = 1; i < 4; ++i)
+            upsampler.upsample(low.view(), {0.5f * (i & 1) - 0.25f, 0.25f}, frames[std::size_t(i)], out.view(), &stats);
+    });
+    EXPECT_GT(stats.history_used, 0);
+    EXPECT_EQ(counted, 0) << "allocations in 3 steady-state upsampled frames";
 }
