@@ -1,0 +1,330 @@
+#include "reprise/warp/kernel_registry.hpp"
+
+#include <atomic>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <optional>
+#include <random>
+#include <utility>
+#include <vector>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "kernels.hpp"
+#include "reprise/core/camera_math.hpp"
+#include "reprise/core/frame.hpp"
+#include "reprise/core/parallel.hpp"
+#include "reprise/warp/reproject.hpp"
+
+namespace reprise::warp {
+
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+
+float uniform(std::mt19937& rng, float a, float b) {
+    return a + (b - a) * float(rng() >> 8) * (1.0f / 16777216.0f);
+}
+
+// The worst values a float input can hold, picked at random.
+float worst_value(std::mt19937& rng) {
+    constexpr float values[] = {kNaN, kInf, -kInf, 0.0f, -0.0f, 1e30f, -1e30f, 1e-30f, -1.0f,
+                                std::numeric_limits<float>::denorm_min()};
+    return values[rng() % std::size(values)];
+}
+
+// Bitwise equality of two float arrays (NaN payloads included); names the first difference.
+template <class T>
+std::string compare_bits(const char* what, const std::vector<T>& a, const std::vector<T>& b) {
+    const std::size_t floats = a.size() * sizeof(T) / sizeof(float);
+    const auto* fa = reinterpret_cast<const uint32_t*>(a.data());
+    const auto* fb = reinterpret_cast<const uint32_t*>(b.data());
+    for (std::size_t i = 0; i < floats; ++i)
+        if (fa[i] != fb[i]) {
+            float va, vb;
+            std::memcpy(&va, fa + i, 4);
+            std::memcpy(&vb, fb + i, 4);
+            return std::string(what) + ": float " + std::to_string(i) + " is " + std::to_string(va) +
+                   ", reference " + std::to_string(vb);
+        }
+    return {};
+}
+
+// Two cameras a little apart (a translation and a turn), perspective or orthographic.
+Camera random_camera(std::mt19937& rng, int w, int h, bool ortho, float move) {
+    Camera c;
+    c.projection = ortho ? glm::ortho(-4.0f, 4.0f, -3.0f, 3.0f, 0.1f, 50.0f)
+                         : glm::perspective(uniform(rng, 0.5f, 1.5f), float(w) / float(h), 0.1f, 100.0f);
+    c.view = glm::translate(glm::mat4(1.0f), glm::vec3(uniform(rng, -1, 1), 0, uniform(rng, -1, 1)));
+    c.prev_view = glm::rotate(glm::translate(c.view, move * glm::vec3(0.05f, -0.02f, 0.1f)),
+                              uniform(rng, -0.05f, 0.05f), glm::vec3(0, 1, 0));
+    c.prev_projection = c.projection;
+    return c;
+}
+
+// ---------------------------------------------------------------------------------------------
+
+class BlendCase final : public KernelCase {
+public:
+    void generate(int w, int h, KernelInputs inputs, uint32_t seed) override {
+        std::mt19937 rng(seed);
+        width_ = w, height_ = h;
+        const std::size_t n = std::size_t(w) * std::size_t(h);
+        covered_a_.resize(n), covered_b_.resize(n), depth_a_.resize(n), color_a_.resize(n);
+        motion_a_.resize(n), depth_b_.resize(n), color_b_.resize(n), motion_b_.resize(n);
+        const bool worst = inputs == KernelInputs::WorstCase;
+        s_ = uniform(rng, 0.05f, 0.95f);
+        scale_ = worst ? -1e30f : uniform(rng, 0.5f, 2.0f);
+        for (std::size_t i = 0; i < n; ++i) {
+            covered_a_[i] = uint8_t(rng() % 8 ? (worst ? 1 + rng() % 255 : 1) : 0);
+            covered_b_[i] = uint8_t(rng() % 8 ? 1 : 0);
+            const float z = uniform(rng, 0.5f, 50.0f);
+            depth_a_[i] = z;
+            switch (rng() % 4) {  // same surface, nearer, farther, background on both
+                case 0: depth_b_[i] = z * uniform(rng, 0.97f, 1.03f); break;  // about the 2 % line
+                case 1: depth_b_[i] = z * 0.5f; break;
+                case 2: depth_b_[i] = z * 2.0f; break;
+                default: depth_a_[i] = depth_b_[i] = kInf; break;
+            }
+            for (int c = 0; c < 4; ++c) {
+                color_a_[i][c] = uniform(rng, 0.0f, 4.0f);
+                color_b_[i][c] = uniform(rng, 0.0f, 4.0f);
+            }
+            motion_a_[i] = {uniform(rng, -20, 20), uniform(rng, -20, 20)};
+            motion_b_[i] = {uniform(rng, -20, 20), uniform(rng, -20, 20)};
+            if (!worst || rng() % 3) continue;
+            switch (rng() % 5) {
+                case 0: depth_a_[i] = worst_value(rng); break;
+                case 1: depth_b_[i] = worst_value(rng); break;
+                case 2: color_a_[i][int(rng() % 4)] = worst_value(rng); break;
+                case 3: motion_a_[i][int(rng() % 2)] = worst_value(rng); break;
+                default:
+                    depth_a_[i] = rng() % 2 ? 0.0f : -0.0f;
+                    depth_b_[i] = rng() % 2 ? 0.0f : -0.0f;
+            }
+        }
+    }
+    void run_reference() override { run_into(reference_, blend_row_reference); }
+    void run() override { run_into(optimized_, blend_row); }
+    std::string compare() const override {
+        if (optimized_.holes != reference_.holes)
+            return "holes " + std::to_string(optimized_.holes) + ", reference " +
+                   std::to_string(reference_.holes);
+        if (optimized_.valid != reference_.valid) return "valid differs";
+        std::string d = compare_bits("colour", optimized_.color, reference_.color);
+        if (d.empty()) d = compare_bits("depth", optimized_.depth, reference_.depth);
+        if (d.empty()) d = compare_bits("motion", optimized_.motion, reference_.motion);
+        return d;
+    }
+
+private:
+    struct Output {
+        std::vector<float> depth;
+        std::vector<glm::vec4> color;
+        std::vector<glm::vec2> motion;
+        std::vector<uint8_t> valid;
+        std::size_t holes = 0;
+    };
+    template <class Kernel>
+    void run_into(Output& out, Kernel kernel) {
+        // b is blended in place: start from its inputs (untimed work is small beside the blend).
+        out.depth = depth_b_, out.color = color_b_, out.motion = motion_b_;
+        out.valid.resize(depth_b_.size());
+        std::atomic<std::size_t> holes{0};
+        const int w = width_;
+        parallel_for(0, height_, [&](int y0, int y1) {
+            std::size_t local = 0;
+            for (int y = y0; y < y1; ++y) {
+                const std::size_t o = std::size_t(y) * std::size_t(w);
+                local += kernel({.covered_a = covered_a_.data() + o,
+                                 .covered_b = covered_b_.data() + o,
+                                 .depth_a = depth_a_.data() + o,
+                                 .color_a = color_a_.data() + o,
+                                 .motion_a = motion_a_.data() + o,
+                                 .depth = out.depth.data() + o,
+                                 .color = out.color.data() + o,
+                                 .motion = out.motion.data() + o,
+                                 .valid = out.valid.data() + o,
+                                 .width = w,
+                                 .s = s_,
+                                 .motion_scale = scale_});
+            }
+            holes += local;
+        });
+        out.holes = holes.load();
+    }
+
+    int width_ = 0, height_ = 0;
+    float s_ = 0.5f, scale_ = 1.0f;
+    std::vector<uint8_t> covered_a_, covered_b_;
+    std::vector<float> depth_a_, depth_b_;
+    std::vector<glm::vec4> color_a_, color_b_;
+    std::vector<glm::vec2> motion_a_, motion_b_;
+    Output reference_, optimized_;
+};
+
+// ---------------------------------------------------------------------------------------------
+
+class StaticLayerCase final : public KernelCase {
+public:
+    void generate(int w, int h, KernelInputs inputs, uint32_t seed) override {
+        std::mt19937 rng(seed);
+        width_ = w, height_ = h;
+        const bool worst = inputs == KernelInputs::WorstCase;
+        // Worst case: the previous camera moved far forward, so near points are behind it.
+        const Camera c = random_camera(rng, w, h, seed % 3 == 2, worst ? 60.0f : 1.0f);
+        const StaticReprojection previous = camera_only_motion(c, w, h);
+        const glm::mat4 future_view =
+            glm::translate(c.view, glm::vec3(uniform(rng, -0.1f, 0.1f), 0.0f, uniform(rng, -0.1f, 0.1f)));
+        const StaticReprojection future(c, future_view, c.projection, w, h);
+        test_.emplace(previous, future, w, h, uniform(rng, 0.25f, 1.0f));
+        const std::size_t n = std::size_t(w) * std::size_t(h);
+        depth_.resize(n), motion_.resize(n);
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x);
+                float z = rng() % 10 == 0 ? kInf : uniform(rng, 0.2f, 60.0f);
+                const glm::vec2 p(float(x) + 0.5f, float(y) + 0.5f);
+                glm::vec2 before(0.0f);
+                const bool lands = previous.land(p.x, p.y, z, before);
+                // Most pixels static (their motion is the camera's, give or take), some moving.
+                glm::vec2 m = lands && rng() % 4 ? before - p : glm::vec2(uniform(rng, -30, 30), uniform(rng, -30, 30));
+                m += glm::vec2(uniform(rng, -0.3f, 0.3f), uniform(rng, -0.3f, 0.3f));
+                if (worst && rng() % 3 == 0) {
+                    switch (rng() % 4) {
+                        case 0: z = worst_value(rng); break;
+                        case 1: m[int(rng() % 2)] = worst_value(rng); break;
+                        case 2: m = {1e30f, -1e30f}; break;
+                        default: z = -uniform(rng, 0.1f, 10.0f); break;  // behind this camera
+                    }
+                }
+                depth_[i] = z, motion_[i] = m;
+            }
+    }
+    void run_reference() override {
+        run_into(reference_, [](const StaticLayerTest& t, int y, int width, const float* d,
+                                const glm::vec2* m, float* d_out, glm::vec2* m_out) {
+            return static_layer_row_reference(t, y, 0, width, d, m, d_out, m_out);
+        });
+    }
+    void run() override { run_into(optimized_, static_layer_row); }
+    std::string compare() const override {
+        if (optimized_.dynamic != reference_.dynamic)
+            return "moving pixels " + std::to_string(optimized_.dynamic) + ", reference " +
+                   std::to_string(reference_.dynamic);
+        std::string d = compare_bits("depth", optimized_.depth, reference_.depth);
+        if (d.empty()) d = compare_bits("motion", optimized_.motion, reference_.motion);
+        return d;
+    }
+
+private:
+    struct Output {
+        std::vector<float> depth;
+        std::vector<glm::vec2> motion;
+        std::size_t dynamic = 0;
+    };
+    template <class Kernel>
+    void run_into(Output& out, Kernel kernel) {
+        out.depth.resize(depth_.size()), out.motion.resize(motion_.size());
+        std::atomic<std::size_t> dynamic{0};
+        const int w = width_;
+        parallel_for(0, height_, [&](int y0, int y1) {
+            std::size_t local = 0;
+            for (int y = y0; y < y1; ++y) {
+                const std::size_t o = std::size_t(y) * std::size_t(w);
+                local += kernel(*test_, y, w, depth_.data() + o, motion_.data() + o,
+                                out.depth.data() + o, out.motion.data() + o);
+            }
+            dynamic += local;
+        });
+        out.dynamic = dynamic.load();
+    }
+
+    int width_ = 0, height_ = 0;
+    std::optional<StaticLayerTest> test_;
+    std::vector<float> depth_;
+    std::vector<glm::vec2> motion_;
+    Output reference_, optimized_;
+};
+
+// ---------------------------------------------------------------------------------------------
+
+// Reverse reprojection of an RGBA payload: the SSE2 path (threaded) against the scalar reference.
+class ReprojectCase final : public KernelCase {
+public:
+    void generate(int w, int h, KernelInputs inputs, uint32_t seed) override {
+        std::mt19937 rng(seed);
+        const bool worst = inputs == KernelInputs::WorstCase;
+        for (Frame* f : {&current_, &previous_}) {
+            f->depth.assign(w, h, 1.0f);
+            f->motion.assign(w, h, glm::vec2(0.0f));
+            f->id.assign(w, h, 1u);
+        }
+        current_.camera = random_camera(rng, w, h, seed % 3 == 2, worst ? 60.0f : 1.0f);
+        payload_.assign(w, h, glm::vec4(0.0f));
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                const float z = 5.0f + 2.0f * std::sin(float(x) * 0.1f) * std::cos(float(y) * 0.13f);
+                const bool block = (x / 7 + y / 5) % 4 == 0;
+                current_.depth(x, y) = block ? z * 0.5f : z;
+                previous_.depth(x, y) = z * uniform(rng, 0.97f, 1.03f);
+                current_.id(x, y) = block ? 2 : 1;
+                previous_.id(x, y) = (x / 6 + y / 6) % 5 == 0 ? 2 : 1;
+                current_.motion(x, y) = {1.5f * std::sin(float(y) * 0.07f) + uniform(rng, -0.5f, 0.5f),
+                                         std::cos(float(x) * 0.05f) + uniform(rng, -0.5f, 0.5f)};
+                for (int c = 0; c < 4; ++c) payload_(x, y)[c] = uniform(rng, -4.0f, 4.0f);
+                if (!worst || rng() % 3) continue;
+                switch (rng() % 6) {
+                    case 0: current_.depth(x, y) = worst_value(rng); break;
+                    case 1: previous_.depth(x, y) = worst_value(rng); break;
+                    case 2: current_.motion(x, y)[int(rng() % 2)] = worst_value(rng); break;
+                    case 3: current_.motion(x, y) = {1e30f, -1e30f}; break;
+                    case 4: payload_(x, y)[int(rng() % 4)] = worst_value(rng); break;
+                    default: current_.depth(x, y) = kInf, previous_.depth(x, y) = kInf;
+                }
+            }
+    }
+    void run_reference() override { reference_ = run_into(reference_out_, reproject_reference); }
+    void run() override { optimized_ = run_into(optimized_out_, reproject); }
+    std::string compare() const override {
+        if (!(optimized_ == reference_)) return "counts differ";
+        if (!(optimized_hit_ == reference_hit_)) return "hits differ";
+        std::vector<glm::vec4> a(optimized_out_.data(), optimized_out_.data() + optimized_out_.pixel_count());
+        std::vector<glm::vec4> b(reference_out_.data(), reference_out_.data() + reference_out_.pixel_count());
+        return compare_bits("payload", a, b);
+    }
+
+private:
+    template <class Kernel>
+    ReprojectCounts run_into(Image<glm::vec4>& out, Kernel kernel) {
+        Image<uint8_t>& hit = &out == &optimized_out_ ? optimized_hit_ : reference_hit_;
+        out.assign(payload_.width(), payload_.height(), glm::vec4(-3.0f));
+        hit.assign(payload_.width(), payload_.height(), 0);
+        return kernel(current_, previous_, payload_of(std::as_const(payload_).view()),
+                      payload_of(out.view()), hit.view(), {});
+    }
+
+    Frame current_, previous_;
+    Image<glm::vec4> payload_, optimized_out_, reference_out_;
+    Image<uint8_t> optimized_hit_, reference_hit_;
+    ReprojectCounts optimized_, reference_;
+};
+
+template <class T>
+std::unique_ptr<KernelCase> make() {
+    return std::make_unique<T>();
+}
+
+constexpr KernelEntry kEntries[] = {
+    {"interpolate blend", "bit-exact", true, make<BlendCase>},
+    {"extrapolate static layer", "bit-exact", true, make<StaticLayerCase>},
+    {"reverse reprojection", "bit-exact", false, make<ReprojectCase>},
+};
+
+}  // namespace
+
+std::span<const KernelEntry> kernel_registry() { return kEntries; }
+
+}  // namespace reprise::warp
