@@ -39,9 +39,11 @@ TEST(Kernels, EveryLevelAgreesWithTheReference) {
         for (const KernelInputs inputs : {KernelInputs::Random, KernelInputs::WorstCase})
             for (const auto& [w, h] : kSizes) {
                 k->generate(w, h, inputs, seed++);
+                k->reset_reference();
                 k->run_reference();
                 for (const simd::Target& target : targets) {
                     simd::force_target(target.bits);
+                    k->reset();
                     k->run();
                     const std::string difference = k->compare();
                     EXPECT_TRUE(difference.empty())

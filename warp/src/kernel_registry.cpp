@@ -106,6 +106,9 @@ public:
             }
         }
     }
+    // b is blended in place: the outputs start as b.
+    void reset() override { start(optimized_); }
+    void reset_reference() override { start(reference_); }
     void run_reference() override { run_into(reference_, blend_row_reference); }
     void run() override { run_into(optimized_, blend_row); }
     std::string compare() const override {
@@ -127,11 +130,12 @@ private:
         std::vector<uint8_t> valid;
         std::size_t holes = 0;
     };
-    template <class Kernel>
-    void run_into(Output& out, Kernel kernel) {
-        // b is blended in place: start from its inputs (untimed work is small beside the blend).
+    void start(Output& out) const {
         out.depth = depth_b_, out.color = color_b_, out.motion = motion_b_;
         out.valid.resize(depth_b_.size());
+    }
+    template <class Kernel>
+    void run_into(Output& out, Kernel kernel) {
         std::atomic<std::size_t> holes{0};
         const int w = width_;
         parallel_for(0, height_, [&](int y0, int y1) {
@@ -286,6 +290,9 @@ public:
                 }
             }
     }
+    // A miss leaves its pixel as it was.
+    void reset() override { start(optimized_out_, optimized_hit_); }
+    void reset_reference() override { start(reference_out_, reference_hit_); }
     void run_reference() override { reference_ = run_into(reference_out_, reproject_reference); }
     void run() override { optimized_ = run_into(optimized_out_, reproject); }
     std::string compare() const override {
@@ -297,11 +304,13 @@ public:
     }
 
 private:
+    void start(Image<glm::vec4>& out, Image<uint8_t>& hit) const {
+        out.assign(payload_.width(), payload_.height(), glm::vec4(-3.0f));
+        hit.assign(payload_.width(), payload_.height(), 0);
+    }
     template <class Kernel>
     ReprojectCounts run_into(Image<glm::vec4>& out, Kernel kernel) {
         Image<uint8_t>& hit = &out == &optimized_out_ ? optimized_hit_ : reference_hit_;
-        out.assign(payload_.width(), payload_.height(), glm::vec4(-3.0f));
-        hit.assign(payload_.width(), payload_.height(), 0);
         return kernel(current_, previous_, payload_of(std::as_const(payload_).view()),
                       payload_of(out.view()), hit.view(), {});
     }

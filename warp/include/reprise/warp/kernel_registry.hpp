@@ -19,6 +19,10 @@ class KernelCase {
 public:
     virtual ~KernelCase() = default;
     virtual void generate(int width, int height, KernelInputs inputs, uint32_t seed) = 0;
+    // Put back what the kernel (reset) or the reference (reset_reference) changes in place: call
+    // before each run (benchmarks leave it out of the time).
+    virtual void reset() {}
+    virtual void reset_reference() {}
     virtual void run_reference() = 0;  // the scalar reference, into its own outputs
     virtual void run() = 0;            // the optimized kernel (at the current SIMD level)
     // Empty when the two outputs agree as the kernel promises, else the first difference.
