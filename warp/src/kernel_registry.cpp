@@ -1,5 +1,6 @@
 #include "reprise/warp/kernel_registry.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <cstring>
@@ -255,6 +256,92 @@ private:
 
 // ---------------------------------------------------------------------------------------------
 
+// Pull-push's first pull (image -> level 1), every coarse row, with and without depth.
+class PullCase final : public KernelCase {
+public:
+    void generate(int w, int h, KernelInputs inputs, uint32_t seed) override {
+        std::mt19937 rng(seed);
+        const bool worst = inputs == KernelInputs::WorstCase;
+        width_ = w, height_ = h;
+        use_depth_ = seed % 4 != 3;
+        const std::size_t n = std::size_t(w) * std::size_t(h);
+        color_.resize(n), valid_.resize(n), depth_.resize(n);
+        for (std::size_t i = 0; i < n; ++i) {
+            // Holes in runs (disocclusions) and alone; layers within and beyond the depth ratio.
+            valid_[i] = uint8_t((i / 5 + i / 97) % 6 == 0 || rng() % 16 == 0 ? 0 : worst ? 1 + rng() % 255 : 1);
+            for (int c = 0; c < 4; ++c) color_[i][c] = uniform(rng, 0.0f, 4.0f);
+            const float base = (i / 13) % 3 == 0 ? 2.0f : 20.0f;
+            depth_[i] = rng() % 12 == 0 ? kInf : base * uniform(rng, 0.95f, 1.15f);
+            if (!worst || rng() % 3) continue;
+            switch (rng() % 3) {
+                case 0: color_[i][int(rng() % 4)] = worst_value(rng); break;
+                case 1: depth_[i] = worst_value(rng); break;
+                default: color_[i] = glm::vec4(3e38f); break;  // finite, the sum of four is not
+            }
+        }
+    }
+    void run_reference() override {
+        run_into(reference_, [](const PullRow& r) {
+            return pull_row_reference(r, 0, (r.fine_width + 1) / 2);
+        });
+    }
+    void run() override { run_into(optimized_, pull_row); }
+    std::string compare() const override {
+        if (optimized_.holes != reference_.holes || optimized_.empty != reference_.empty)
+            return "counts differ";
+        if (optimized_.bits != reference_.bits) return "hole bits differ";
+        std::string d = compare_bits("level 1", optimized_.color, reference_.color);
+        if (d.empty()) d = compare_bits("level 1 depth", optimized_.depth, reference_.depth);
+        return d;
+    }
+
+private:
+    struct Output {
+        std::vector<glm::vec4> color;
+        std::vector<float> depth;
+        std::vector<uint8_t> bits;
+        std::size_t holes = 0, empty = 0;
+    };
+    template <class Kernel>
+    void run_into(Output& out, Kernel kernel) {
+        const int w = width_, h = height_, cw = (w + 1) / 2, ch = (h + 1) / 2;
+        const std::size_t cn = std::size_t(cw) * std::size_t(ch);
+        out.color.resize(cn), out.depth.resize(use_depth_ ? cn : 0), out.bits.resize(cn);
+        std::atomic<std::size_t> holes{0}, empty{0};
+        parallel_for(0, ch, [&](int j0, int j1) {
+            PullCounts local;
+            for (int j = j0; j < j1; ++j) {
+                const int y0 = 2 * j, y1 = std::min(y0 + 1, h - 1);
+                const std::size_t o0 = std::size_t(y0) * std::size_t(w), o1 = std::size_t(y1) * std::size_t(w);
+                const std::size_t oc = std::size_t(j) * std::size_t(cw);
+                const PullCounts c = kernel({.row0 = color_.data() + o0,
+                                             .row1 = color_.data() + o1,
+                                             .valid0 = valid_.data() + o0,
+                                             .valid1 = valid_.data() + o1,
+                                             .depth0 = use_depth_ ? depth_.data() + o0 : nullptr,
+                                             .depth1 = use_depth_ ? depth_.data() + o1 : nullptr,
+                                             .fine_width = w,
+                                             .rows = y1 - y0 + 1,
+                                             .out = out.color.data() + oc,
+                                             .out_depth = use_depth_ ? out.depth.data() + oc : nullptr,
+                                             .hole_bits = out.bits.data() + oc});
+                local.holes += c.holes, local.empty += c.empty;
+            }
+            holes += local.holes, empty += local.empty;
+        });
+        out.holes = holes.load(), out.empty = empty.load();
+    }
+
+    int width_ = 0, height_ = 0;
+    bool use_depth_ = true;
+    std::vector<glm::vec4> color_;
+    std::vector<uint8_t> valid_;
+    std::vector<float> depth_;
+    Output reference_, optimized_;
+};
+
+// ---------------------------------------------------------------------------------------------
+
 // Reverse reprojection of an RGBA payload: the SSE2 path (threaded) against the scalar reference.
 class ReprojectCase final : public KernelCase {
 public:
@@ -329,6 +416,7 @@ std::unique_ptr<KernelCase> make() {
 constexpr KernelEntry kEntries[] = {
     {"interpolate blend", "bit-exact", true, make<BlendCase>},
     {"extrapolate static layer", "bit-exact", true, make<StaticLayerCase>},
+    {"pull-push first pull", "bit-exact", true, make<PullCase>},
     {"reverse reprojection", "bit-exact", false, make<ReprojectCase>},
 };
 

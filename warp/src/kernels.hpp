@@ -56,3 +56,31 @@ std::size_t static_layer_row(const StaticLayerTest& test, int y, int width, cons
                              const glm::vec2* motion, float* depth_out, glm::vec2* motion_out);
 
 }  // namespace reprise::warp
+
+namespace reprise::warp {
+
+// Pull-push's first pull, one coarse row: each coarse pixel from its (up to) 2x2 children in fine
+// rows row0 and row1 (the same row when the image ends after row0). Writes the premultiplied
+// colour and weight, the farthest kept depth (with depth) and which children are holes.
+struct PullRow {
+    const glm::vec4* row0;
+    const glm::vec4* row1;
+    const uint8_t* valid0;
+    const uint8_t* valid1;
+    const float* depth0;  // null without depth
+    const float* depth1;
+    int fine_width;
+    int rows;  // 2, or 1 for the last row of an odd height
+    glm::vec4* out;  // (fine_width + 1) / 2 pixels
+    float* out_depth;
+    uint8_t* hole_bits;
+};
+struct PullCounts {
+    std::size_t holes = 0;  // fine pixels that are holes
+    std::size_t empty = 0;  // coarse pixels of weight below 1
+};
+// The reference does coarse pixels [i_begin, i_end).
+PullCounts pull_row_reference(const PullRow& row, int i_begin, int i_end);
+PullCounts pull_row(const PullRow& row);
+
+}  // namespace reprise::warp

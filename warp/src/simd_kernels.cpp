@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "kernels.hpp"
+#include "reprise/warp/fill.hpp"
 
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "simd_kernels.cpp"
@@ -127,6 +128,80 @@ std::size_t StaticLayerRowSimd(const StaticLayerTest& t, int y, int width, const
     return dynamic;
 }
 
+
+PullCounts PullRowSimd(const PullRow& r) {
+    const int coarse = (r.fine_width + 1) / 2;
+#if HWY_TARGET == HWY_SCALAR
+    return pull_row_reference(r, 0, coarse);
+#else
+    if (r.rows != 2) return pull_row_reference(r, 0, coarse);
+    const hn::ScalableTag<float> df;
+    const hn::RebindToUnsigned<decltype(df)> du32;
+    const hn::Rebind<uint16_t, decltype(df)> du16;
+    const hn::Rebind<uint8_t, decltype(df)> du8;
+    using VF = hn::Vec<decltype(df)>;
+    const int n = int(hn::Lanes(df));
+    const VF zero = hn::Zero(df), one = hn::Set(df, 1.0f), four = hn::Set(df, 4.0f);
+    const VF inf = hn::Set(df, std::numeric_limits<float>::infinity());
+    const VF ratio = hn::Set(df, kBackgroundDepthRatio);
+    const auto low_byte = hn::Set(du32, 0x00FFu), high_byte = hn::Set(du32, 0xFF00u);
+    const auto zero_u = hn::Zero(du32);
+    // Both children of each pair valid (a pair of bytes read as one 16-bit lane).
+    auto pair_valid = [&](const uint8_t* m) {
+        const auto v = hn::PromoteTo(du32, hn::LoadU(du16, reinterpret_cast<const uint16_t*>(m)));
+        return hn::RebindMask(df, hn::And((v & low_byte) != zero_u, (v & high_byte) != zero_u));
+    };
+    auto sane = [&](VF d) {  // sane_depth: NaN -> +inf, below 0 -> 0
+        return hn::IfThenElse(d != d, inf, hn::IfThenElse(d < zero, zero, d));
+    };
+    auto larger = [](VF a, VF b) { return hn::IfThenElse(a < b, b, a); };  // std::max(a, b)
+    PullCounts counts;
+    const int pairs = r.fine_width / 2;
+    int i = 0;
+    for (; i + n <= pairs; i += n) {
+        const int x0 = 2 * i;
+        VF sum[3];
+        {
+            VF c0[4], c1[4], c2[4], c3[4];  // row 0 pixels x0.., x0 + n..; row 1 the same
+            hn::LoadInterleaved4(df, &r.row0[x0].x, c0[0], c0[1], c0[2], c0[3]);
+            hn::LoadInterleaved4(df, &r.row0[x0 + n].x, c1[0], c1[1], c1[2], c1[3]);
+            hn::LoadInterleaved4(df, &r.row1[x0].x, c2[0], c2[1], c2[2], c2[3]);
+            hn::LoadInterleaved4(df, &r.row1[x0 + n].x, c3[0], c3[1], c3[2], c3[3]);
+            for (int c = 0; c < 3; ++c)  // (((0 + a) + b) + e) + g, children in raster order
+                sum[c] = zero + hn::ConcatEven(df, c1[c], c0[c]) + hn::ConcatOdd(df, c1[c], c0[c]) +
+                         hn::ConcatEven(df, c3[c], c2[c]) + hn::ConcatOdd(df, c3[c], c2[c]);
+        }
+        auto fast = hn::And(hn::And(pair_valid(r.valid0 + x0), pair_valid(r.valid1 + x0)),
+                            hn::And(hn::And((sum[0] - sum[0]) == zero, (sum[1] - sum[1]) == zero),
+                                    (sum[2] - sum[2]) == zero));
+        VF dmax = zero;
+        if (r.depth0) {
+            VF a, b, e, g;
+            hn::LoadInterleaved2(df, r.depth0 + x0, a, b);
+            hn::LoadInterleaved2(df, r.depth1 + x0, e, g);
+            a = sane(a), b = sane(b), e = sane(e), g = sane(g);
+            dmax = larger(larger(a, b), larger(e, g));
+            fast = hn::And(fast, hn::And(hn::And(a * ratio >= dmax, b * ratio >= dmax),
+                                         hn::And(e * ratio >= dmax, g * ratio >= dmax)));
+            hn::StoreU(dmax, df, r.out_depth + i);
+        }
+        hn::StoreInterleaved4(sum[0] / four, sum[1] / four, sum[2] / four, one, df, &r.out[i].x);
+        hn::StoreU(hn::Zero(du8), du8, r.hole_bits + i);
+        if (hn::CountTrue(df, fast) == size_t(n)) continue;
+        alignas(64) float done[HWY_MAX_BYTES / sizeof(float)];
+        hn::Store(hn::IfThenElseZero(fast, one), df, done);
+        for (int k = 0; k < n; ++k)
+            if (done[k] == 0.0f) {
+                const PullCounts c = pull_row_reference(r, i + k, i + k + 1);
+                counts.holes += c.holes, counts.empty += c.empty;
+            }
+    }
+    const PullCounts tail = pull_row_reference(r, i, coarse);
+    counts.holes += tail.holes, counts.empty += tail.empty;
+    return counts;
+#endif
+}
+
 }  // namespace reprise::warp::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
 
@@ -135,6 +210,9 @@ namespace reprise::warp {
 
 HWY_EXPORT(BlendRowSimd);
 HWY_EXPORT(StaticLayerRowSimd);
+HWY_EXPORT(PullRowSimd);
+
+PullCounts pull_row(const PullRow& row) { return HWY_DYNAMIC_DISPATCH(PullRowSimd)(row); }
 
 std::size_t blend_row(const BlendRow& row) { return HWY_DYNAMIC_DISPATCH(BlendRowSimd)(row); }
 
