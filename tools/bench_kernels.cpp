@@ -102,7 +102,7 @@ Status bench_kernels(const BenchOptions& options) {
         "reference and cv::remap (INTER_LINEAR, CV_32FC4, float maps) of an image of the same size;\n"
         "%d threads (reprise) / %d (OpenCV), best and median of %d runs, ms; random inputs.\n"
         "x ref = reference best / best; x remap = best / remap best; the reverse reprojection's\n"
-        "reference is single-threaded, its vector path (SSE2) fixed when compiled.\n",
+        "reference is single-threaded (the others run on the same threads as their kernels).\n",
         thread_count(), cv::getNumThreads(), options.frames);
     for (const std::string& size : split_list(options.sizes)) {
         int w = 0, h = 0;

@@ -267,11 +267,14 @@ public:
         const std::size_t n = std::size_t(w) * std::size_t(h);
         color_.resize(n), valid_.resize(n), depth_.resize(n);
         for (std::size_t i = 0; i < n; ++i) {
-            // Holes in runs (disocclusions) and alone; layers within and beyond the depth ratio.
-            valid_[i] = uint8_t((i / 5 + i / 97) % 6 == 0 || rng() % 16 == 0 ? 0 : worst ? 1 + rng() % 255 : 1);
+            const int x = int(i % std::size_t(w)), y = int(i / std::size_t(w));
+            // A few percent holes: disocclusion strips beside depth edges, and single pixels;
+            // worst case: a third of the pixels, and depth edges everywhere.
+            const bool strip = worst ? (x / 3 + y / 2) % 3 == 0 : (x / 48 + y / 32) % 11 == 0 && x % 48 < 6;
+            valid_[i] = uint8_t(strip || rng() % 64 == 0 ? 0 : worst ? 1 + rng() % 255 : 1);
             for (int c = 0; c < 4; ++c) color_[i][c] = uniform(rng, 0.0f, 4.0f);
-            const float base = (i / 13) % 3 == 0 ? 2.0f : 20.0f;
-            depth_[i] = rng() % 12 == 0 ? kInf : base * uniform(rng, 0.95f, 1.15f);
+            const float base = ((worst ? x / 2 : x / 48) + y / 32) % 3 == 0 ? 2.0f : 20.0f;
+            depth_[i] = y < h / 8 ? kInf : base * uniform(rng, 0.95f, 1.15f);
             if (!worst || rng() % 3) continue;
             switch (rng() % 3) {
                 case 0: color_[i][int(rng() % 4)] = worst_value(rng); break;

@@ -183,18 +183,15 @@ PullCounts PullRowSimd(const PullRow& r) {
             dmax = larger(larger(a, b), larger(e, g));
             fast = hn::And(fast, hn::And(hn::And(a * ratio >= dmax, b * ratio >= dmax),
                                          hn::And(e * ratio >= dmax, g * ratio >= dmax)));
-            hn::StoreU(dmax, df, r.out_depth + i);
         }
+        if (!hn::AllTrue(df, fast)) {  // a hole or a depth edge among them: the general code
+            const PullCounts c = pull_row_reference(r, i, i + n);
+            counts.holes += c.holes, counts.empty += c.empty;
+            continue;
+        }
+        if (r.depth0) hn::StoreU(dmax, df, r.out_depth + i);
         hn::StoreInterleaved4(sum[0] / four, sum[1] / four, sum[2] / four, one, df, &r.out[i].x);
         hn::StoreU(hn::Zero(du8), du8, r.hole_bits + i);
-        if (hn::CountTrue(df, fast) == size_t(n)) continue;
-        alignas(64) float done[HWY_MAX_BYTES / sizeof(float)];
-        hn::Store(hn::IfThenElseZero(fast, one), df, done);
-        for (int k = 0; k < n; ++k)
-            if (done[k] == 0.0f) {
-                const PullCounts c = pull_row_reference(r, i + k, i + k + 1);
-                counts.holes += c.holes, counts.empty += c.empty;
-            }
     }
     const PullCounts tail = pull_row_reference(r, i, coarse);
     counts.holes += tail.holes, counts.empty += tail.empty;
