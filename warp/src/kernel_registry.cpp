@@ -345,6 +345,83 @@ private:
 
 // ---------------------------------------------------------------------------------------------
 
+// Pull-push's coarser pulls: one level from the one below (weights in alpha, depth sanitised).
+class PullLevelCase final : public KernelCase {
+public:
+    void generate(int w, int h, KernelInputs inputs, uint32_t seed) override {
+        std::mt19937 rng(seed);
+        const bool worst = inputs == KernelInputs::WorstCase;
+        width_ = w, height_ = h;
+        use_depth_ = seed % 4 != 3;
+        const std::size_t n = std::size_t(w) * std::size_t(h);
+        level_.resize(n), depth_.resize(n);
+        for (std::size_t i = 0; i < n; ++i) {
+            const int x = int(i % std::size_t(w)), y = int(i / std::size_t(w));
+            const bool partial =
+                worst ? rng() % 3 == 0 : ((x / 24 + y / 16) % 11 == 0 && x % 24 < 4) || rng() % 97 == 0;
+            const float weight = !partial ? 1.0f : rng() % 2 ? 0.0f : uniform(rng, 0.25f, 1.0f);
+            for (int c = 0; c < 3; ++c) level_[i][c] = weight * uniform(rng, 0.0f, 4.0f);
+            level_[i].a = weight;
+            const float base = ((worst ? x / 2 : x / 24) + y / 16) % 3 == 0 ? 2.0f : 20.0f;
+            depth_[i] = y < h / 8 ? kInf : weight == 0.0f ? 0.0f : base * uniform(rng, 0.95f, 1.15f);
+            if (worst && rng() % 5 == 0) level_[i][int(rng() % 3)] = rng() % 2 ? 3e38f : -0.0f;
+            if (worst && rng() % 7 == 0) level_[i].a = std::nextafter(1.0f, 0.0f);
+        }
+    }
+    void run_reference() override {
+        run_into(reference_, [](const PullLevelRow& r) {
+            return pull_level_row_reference(r, 0, (r.fine_width + 1) / 2);
+        });
+    }
+    void run() override { run_into(optimized_, pull_level_row); }
+    std::string compare() const override {
+        if (optimized_.empty != reference_.empty) return "empty counts differ";
+        std::string d = compare_bits("level", optimized_.color, reference_.color);
+        if (d.empty()) d = compare_bits("level depth", optimized_.depth, reference_.depth);
+        return d;
+    }
+
+private:
+    struct Output {
+        std::vector<glm::vec4> color;
+        std::vector<float> depth;
+        std::size_t empty = 0;
+    };
+    template <class Kernel>
+    void run_into(Output& out, Kernel kernel) {
+        const int w = width_, h = height_, cw = (w + 1) / 2, ch = (h + 1) / 2;
+        const std::size_t cn = std::size_t(cw) * std::size_t(ch);
+        out.color.resize(cn), out.depth.resize(use_depth_ ? cn : 0);
+        std::atomic<std::size_t> empty{0};
+        parallel_for(0, ch, [&](int j0, int j1) {
+            std::size_t local = 0;
+            for (int j = j0; j < j1; ++j) {
+                const int y0 = 2 * j, y1 = std::min(y0 + 1, h - 1);
+                const std::size_t o0 = std::size_t(y0) * std::size_t(w), o1 = std::size_t(y1) * std::size_t(w);
+                const std::size_t oc = std::size_t(j) * std::size_t(cw);
+                local += kernel({.row0 = level_.data() + o0,
+                                 .row1 = level_.data() + o1,
+                                 .depth0 = use_depth_ ? depth_.data() + o0 : nullptr,
+                                 .depth1 = use_depth_ ? depth_.data() + o1 : nullptr,
+                                 .fine_width = w,
+                                 .rows = y1 - y0 + 1,
+                                 .out = out.color.data() + oc,
+                                 .out_depth = use_depth_ ? out.depth.data() + oc : nullptr});
+            }
+            empty += local;
+        });
+        out.empty = empty.load();
+    }
+
+    int width_ = 0, height_ = 0;
+    bool use_depth_ = true;
+    std::vector<glm::vec4> level_;
+    std::vector<float> depth_;
+    Output reference_, optimized_;
+};
+
+// ---------------------------------------------------------------------------------------------
+
 // Reverse reprojection of an RGBA payload: the SSE2 path (threaded) against the scalar reference.
 class ReprojectCase final : public KernelCase {
 public:
@@ -422,6 +499,7 @@ constexpr KernelEntry kEntries[] = {
     {"interpolate blend", "bit-exact", true, make<BlendCase>},
     {"extrapolate static layer", "bit-exact", true, make<StaticLayerCase>},
     {"pull-push first pull", "bit-exact", true, make<PullCase>},
+    {"pull-push coarser pull", "bit-exact", true, make<PullLevelCase>},
     {"reverse reprojection", "bit-exact", true, make<ReprojectCase>},
 };
 

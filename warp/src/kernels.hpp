@@ -83,4 +83,20 @@ struct PullCounts {
 PullCounts pull_row_reference(const PullRow& row, int i_begin, int i_end);
 PullCounts pull_row(const PullRow& row);
 
+// Pull-push's coarser pulls, one row of level s + 1 from level s (premultiplied rgb, weight in
+// a, farthest kept depth): four children of weight 1 within the depth ratio give their plain
+// mean, the others go through the general pull. Returns the pixels of weight below 1.
+struct PullLevelRow {
+    const glm::vec4* row0;
+    const glm::vec4* row1;  // the same row when the level ends after row0
+    const float* depth0;    // null without depth
+    const float* depth1;
+    int fine_width;
+    int rows;  // 2, or 1
+    glm::vec4* out;  // (fine_width + 1) / 2 pixels
+    float* out_depth;
+};
+std::size_t pull_level_row_reference(const PullLevelRow& row, int i_begin, int i_end);
+std::size_t pull_level_row(const PullLevelRow& row);
+
 }  // namespace reprise::warp

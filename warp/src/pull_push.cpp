@@ -132,6 +132,43 @@ void check_inputs(ImageView<glm::vec4> color, ImageView<const uint8_t> valid,
 
 }  // namespace
 
+std::size_t pull_level_row_reference(const PullLevelRow& r, int i_begin, int i_end) {
+    const bool use_depth = r.depth0 != nullptr;
+    std::size_t empty = 0;
+    for (int i = i_begin; i < i_end; ++i) {
+        const int x0 = 2 * i;
+        if (x0 + 1 < r.fine_width && r.rows == 2) {
+            const vec4 &a = r.row0[x0], &b = r.row0[x0 + 1], &e = r.row1[x0], &g = r.row1[x0 + 1];
+            if (a.a == 1.0f && b.a == 1.0f && e.a == 1.0f && g.a == 1.0f) {
+                float dmax = 0.0f;
+                bool same_layer = true;
+                if (use_depth) {
+                    const float d[4] = {r.depth0[x0], r.depth0[x0 + 1], r.depth1[x0], r.depth1[x0 + 1]};
+                    dmax = std::max(std::max(d[0], d[1]), std::max(d[2], d[3]));
+                    for (float dk : d) same_layer &= dk * kBackgroundDepthRatio >= dmax;
+                }
+                if (same_layer) {  // pull_pixel's arithmetic, in its order
+                    r.out[i] = vec4(vec3(vec4(0.0f) + a + b + e + g) / 4.0f, 1.0f);
+                    if (use_depth) r.out_depth[i] = dmax;
+                    continue;
+                }
+            }
+        }
+        Child child[4];
+        int n = 0;
+        for (int dy = 0; dy < r.rows; ++dy)
+            for (int dx = 0; dx < 2 && x0 + dx < r.fine_width; ++dx) {
+                const vec4& p = (dy ? r.row1 : r.row0)[x0 + dx];
+                child[n++] = {vec3(p), p.a, use_depth ? (dy ? r.depth1 : r.depth0)[x0 + dx] : 0.0f};
+            }
+        float d;
+        pull_pixel(child, n, use_depth, r.out[i], d);
+        if (use_depth) r.out_depth[i] = d;
+        empty += r.out[i].a < 1.0f;
+    }
+    return empty;
+}
+
 PullCounts pull_row_reference(const PullRow& r, int i_begin, int i_end) {
     const bool use_depth = r.depth0 != nullptr;
     const int width = r.fine_width, ny = r.rows;
@@ -339,41 +376,17 @@ FillStats PullPush::fill(ImageView<glm::vec4> color, ImageView<const uint8_t> va
         Image<float>* cd = depth_at(top + 1);
         parallel_for(0, c.height(), [&](int j0, int j1) {
             std::size_t empty_count = 0;
-            for (int j = j0; j < j1; ++j)
-                for (int i = 0; i < c.width(); ++i) {
-                    const int x0 = 2 * i, y0 = 2 * j;
-                    if (x0 + 1 < f.width() && y0 + 1 < f.height()) {
-                        const vec4 &a = f(x0, y0), &b = f(x0 + 1, y0), &e = f(x0, y0 + 1),
-                                   &g = f(x0 + 1, y0 + 1);
-                        if (a.a == 1.0f && b.a == 1.0f && e.a == 1.0f && g.a == 1.0f) {
-                            float dmax = 0.0f;
-                            bool same_layer = true;
-                            if (fd) {
-                                const float d[4] = {(*fd)(x0, y0), (*fd)(x0 + 1, y0),
-                                                    (*fd)(x0, y0 + 1), (*fd)(x0 + 1, y0 + 1)};
-                                dmax = std::max(std::max(d[0], d[1]), std::max(d[2], d[3]));
-                                for (float dk : d) same_layer &= dk * kBackgroundDepthRatio >= dmax;
-                            }
-                            if (same_layer) {  // pull_pixel's arithmetic, in its order
-                                c(i, j) = vec4(vec3(vec4(0.0f) + a + b + e + g) / 4.0f, 1.0f);
-                                if (cd) (*cd)(i, j) = dmax;
-                                continue;
-                            }
-                        }
-                    }
-                    Child child[4];
-                    int n = 0;
-                    for (int dy = 0; dy < 2; ++dy)
-                        for (int dx = 0; dx < 2; ++dx) {
-                            const int x = x0 + dx, y = y0 + dy;
-                            if (x < f.width() && y < f.height())
-                                child[n++] = {vec3(f(x, y)), f(x, y).a, fd ? (*fd)(x, y) : 0.0f};
-                        }
-                    float d;
-                    pull_pixel(child, n, use_depth, c(i, j), d);
-                    if (cd) (*cd)(i, j) = d;
-                    empty_count += c(i, j).a < 1.0f;
-                }
+            for (int j = j0; j < j1; ++j) {
+                const int y0 = 2 * j, y1 = std::min(y0 + 1, f.height() - 1);
+                empty_count += pull_level_row({.row0 = &f(0, y0),
+                                               .row1 = &f(0, y1),
+                                               .depth0 = fd ? &(*fd)(0, y0) : nullptr,
+                                               .depth1 = fd ? &(*fd)(0, y1) : nullptr,
+                                               .fine_width = f.width(),
+                                               .rows = y1 - y0 + 1,
+                                               .out = &c(0, j),
+                                               .out_depth = cd ? &(*cd)(0, j) : nullptr});
+            }
             empty += empty_count;
         }, grain_rows(c.width()));
         ++top;

@@ -199,6 +199,57 @@ PullCounts PullRowSimd(const PullRow& r) {
 #endif
 }
 
+std::size_t PullLevelRowSimd(const PullLevelRow& r) {
+    const int coarse = (r.fine_width + 1) / 2;
+#if HWY_TARGET == HWY_SCALAR
+    return pull_level_row_reference(r, 0, coarse);
+#else
+    if (r.rows != 2) return pull_level_row_reference(r, 0, coarse);
+    const hn::ScalableTag<float> df;
+    using VF = hn::Vec<decltype(df)>;
+    const int n = int(hn::Lanes(df));
+    const VF zero = hn::Zero(df), one = hn::Set(df, 1.0f), four = hn::Set(df, 4.0f);
+    const VF ratio = hn::Set(df, kBackgroundDepthRatio);
+    auto larger = [](VF a, VF b) { return hn::IfThenElse(a < b, b, a); };  // std::max(a, b)
+    std::size_t empty = 0;
+    const int pairs = r.fine_width / 2;
+    int i = 0;
+    for (; i + n <= pairs; i += n) {
+        const int x0 = 2 * i;
+        VF c0[4], c1[4], c2[4], c3[4];
+        hn::LoadInterleaved4(df, &r.row0[x0].x, c0[0], c0[1], c0[2], c0[3]);
+        hn::LoadInterleaved4(df, &r.row0[x0 + n].x, c1[0], c1[1], c1[2], c1[3]);
+        hn::LoadInterleaved4(df, &r.row1[x0].x, c2[0], c2[1], c2[2], c2[3]);
+        hn::LoadInterleaved4(df, &r.row1[x0 + n].x, c3[0], c3[1], c3[2], c3[3]);
+        VF even[4][2], odd[4][2];  // [channel][row]: children (0,0) (0,1) in even, (1,0) (1,1) in odd
+        VF sum[3];
+        for (int c = 0; c < 4; ++c) {
+            even[c][0] = hn::ConcatEven(df, c1[c], c0[c]), odd[c][0] = hn::ConcatOdd(df, c1[c], c0[c]);
+            even[c][1] = hn::ConcatEven(df, c3[c], c2[c]), odd[c][1] = hn::ConcatOdd(df, c3[c], c2[c]);
+            if (c < 3) sum[c] = zero + even[c][0] + odd[c][0] + even[c][1] + odd[c][1];
+        }
+        auto fast = hn::And(hn::And(even[3][0] == one, odd[3][0] == one),
+                            hn::And(even[3][1] == one, odd[3][1] == one));
+        VF dmax = zero;
+        if (r.depth0) {
+            VF a, b, e, g;
+            hn::LoadInterleaved2(df, r.depth0 + x0, a, b);
+            hn::LoadInterleaved2(df, r.depth1 + x0, e, g);
+            dmax = larger(larger(a, b), larger(e, g));
+            fast = hn::And(fast, hn::And(hn::And(a * ratio >= dmax, b * ratio >= dmax),
+                                         hn::And(e * ratio >= dmax, g * ratio >= dmax)));
+        }
+        if (!hn::AllTrue(df, fast)) {
+            empty += pull_level_row_reference(r, i, i + n);
+            continue;
+        }
+        if (r.depth0) hn::StoreU(dmax, df, r.out_depth + i);
+        hn::StoreInterleaved4(sum[0] / four, sum[1] / four, sum[2] / four, one, df, &r.out[i].x);
+    }
+    return empty + pull_level_row_reference(r, i, coarse);
+#endif
+}
+
 }  // namespace reprise::warp::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
 
@@ -208,6 +259,11 @@ namespace reprise::warp {
 HWY_EXPORT(BlendRowSimd);
 HWY_EXPORT(StaticLayerRowSimd);
 HWY_EXPORT(PullRowSimd);
+HWY_EXPORT(PullLevelRowSimd);
+
+std::size_t pull_level_row(const PullLevelRow& row) {
+    return HWY_DYNAMIC_DISPATCH(PullLevelRowSimd)(row);
+}
 
 PullCounts pull_row(const PullRow& row) { return HWY_DYNAMIC_DISPATCH(PullRowSimd)(row); }
 
