@@ -44,6 +44,9 @@ Status open_bench_scene(const std::string& name, BenchScene& bench);
 Status bench_reproject(const BenchOptions& options);  // reverse reprojection vs cv::remap
 Status bench_grid(const BenchOptions& options);       // splat and adaptive grid warp
 Status bench_fill(const BenchOptions& options);       // pull-push, Andreev vs cv::inpaint (Telea)
+// Every (kernel, reference) pair of the warp kernel registry at every SIMD level, against the
+// reference and cv::remap, after checking each level agrees: OUT/kernels.csv.
+Status bench_kernels(const BenchOptions& options);
 // Whole made frames (interpolation, extrapolation, the second eye) against cv::remap, one run.
 Status bench_paths(const BenchOptions& options);
 // Upconversion error against run time, every setting and the peers (ffmpeg minterpolate,

@@ -129,13 +129,13 @@ int command_bench(int argc, char** argv) {
               "error against run time\nfor every setting beside ffmpeg minterpolate and OpenCV DIS flow "
               "(CSV + HTML report in --out).\nstereo: the synthesized second eye against the rendered one, naive DIBR peers and the "
               "renderer's\nsecond-eye time (CSV + HTML report in --out). paths: whole made frames at display "
-              "rate against cv::remap.\nreuse: shading reuse in the heavy renderer against full shading in the same run (speed-up, hit rate,\npixels shaded, error; CSV + HTML report in --out).\ncodec: reprise's codec beside x264, x265 and SVT-AV1\n(bits, PSNR/SSIM/FLIP, ms, BD-rates, depth coders, 1080p speed; CSV + HTML report in --out).\nupsample: Herzog spatio-temporal upsampling of 1/2 or 1/4 of the pixels against the full render,\nbeside cv::resize, warpAffine and joint bilateral peers; ms per 1080p frame against cv::remap (CSV + HTML).");
-    args.positional("WHAT", &job.what, "render | exr | reproject | grid | fill | paths | fruc | stereo | codec | reuse | upsample");
+              "rate against cv::remap.\nkernels: each SIMD kernel at every level the CPU runs against its scalar reference and cv::remap (CSV in --out).\nreuse: shading reuse in the heavy renderer against full shading in the same run (speed-up, hit rate,\npixels shaded, error; CSV + HTML report in --out).\ncodec: reprise's codec beside x264, x265 and SVT-AV1\n(bits, PSNR/SSIM/FLIP, ms, BD-rates, depth coders, 1080p speed; CSV + HTML report in --out).\nupsample: Herzog spatio-temporal upsampling of 1/2 or 1/4 of the pixels against the full render,\nbeside cv::resize, warpAffine and joint bilateral peers; ms per 1080p frame against cv::remap (CSV + HTML).");
+    args.positional("WHAT", &job.what, "render | exr | reproject | grid | fill | paths | kernels | fruc | stereo | codec | reuse | upsample");
     args.option("--scene", &job.scene, "scene to render (default pan)");
     args.option("--frames", &job.frames, "frames per size (default 10); fruc: input frames (default 20); stereo: frames per scene (at most 5); upsample: frames per scene (default 12)");
     args.option("--sizes", &job.sizes, "comma-separated WxH list (default 640x360,1920x1080)");
     args.option("--dir", &job.dir, "exr: folder for the files (default: the temp folder)");
-    args.option("--out", &job.out, "fruc, stereo, codec, reuse, upsample: report folder (default out/bench-WHAT)");
+    args.option("--out", &job.out, "fruc, stereo, codec, kernels, reuse, upsample: report folder (default out/bench-WHAT)");
     args.option("--scenes", &job.scenes, "fruc, stereo, codec, reuse, upsample: comma-separated scenes or glTF files (default: every built-in scene; fruc adds the held-out glTF models, also named by held-out)");
     args.option("--factor", &job.factor, "fruc: K, output frames per input frame (default 2); upsample: 2 or 4 pixels per sample (default both)");
     args.option("--size", &job.size, "fruc, stereo, upsample: WxH (default 640x360); codec: default 1280x720");
@@ -166,13 +166,14 @@ int command_bench(int argc, char** argv) {
     else if (job.what == "grid") result = bench_grid(job);
     else if (job.what == "fill") result = bench_fill(job);
     else if (job.what == "paths") result = bench_paths(job);
+    else if (job.what == "kernels") result = bench_kernels(job);
     else if (job.what == "fruc") result = bench_fruc(job);
     else if (job.what == "stereo") result = bench_stereo(job);
     else if (job.what == "codec") result = bench_codec(job);
     else if (job.what == "reuse") result = bench_reuse(job);
     else if (job.what == "upsample") result = bench_upsample(job);
     else result = Status::error("bench: unknown benchmark '" + job.what +
-                                "' (render, exr, reproject, grid, fill, paths, fruc, stereo, codec, reuse, upsample)");
+                                "' (render, exr, reproject, grid, fill, paths, kernels, fruc, stereo, codec, reuse, upsample)");
     return report(args, parsed, result);
 }
 

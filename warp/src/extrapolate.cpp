@@ -3,6 +3,7 @@
 #include <limits>
 
 #include "fruc_stages.hpp"
+#include "kernels.hpp"
 #include "reprise/core/camera_math.hpp"
 #include "reprise/core/parallel.hpp"
 
@@ -45,31 +46,39 @@ std::size_t classify_row(const GBufferView& f, int y, const StaticReprojection& 
     return dynamic;
 }
 
-// The same for an axis-aligned projection, written without branches so that it vectorises:
+}  // namespace
+
+StaticLayerTest::StaticLayerTest(const StaticReprojection& previous,
+                                 const StaticReprojection& future, int image_width,
+                                 int image_height, float tolerance)
+    : projection(previous.unprojector().projection()),
+      to_previous(previous.to_clip()),
+      to_future(future.to_clip()),
+      background_zv(previous.unprojector().perspective() ? -1.0f
+                                                         : -previous.unprojector().far_plane()),
+      background_w(previous.unprojector().perspective() ? 0.0f : 1.0f),
+      width(float(image_width)),
+      height(float(image_height)),
+      tolerance2(tolerance * tolerance) {}
+
+// classify_row for an axis-aligned projection, written without branches (it vectorises):
 // Unprojector::point_ndc and StaticReprojection::land spelled out.
-std::size_t classify_row_axis_aligned(const GBufferView& f, int y,
-                                      const StaticReprojection& to_previous,
-                                      const StaticReprojection& to_future, float tolerance2,
-                                      float* depth_out, glm::vec2* motion_out) {
-    const Unprojector& unproject = to_previous.unprojector();
+std::size_t static_layer_row_reference(const StaticLayerTest& t, int y, int x_begin, int x_end,
+                                       const float* __restrict depth,
+                                       const glm::vec2* __restrict motion,
+                                       float* __restrict depth_out, glm::vec2* __restrict motion_out) {
     // Copies: the stores below could otherwise alias the matrices and the loop would not vectorise.
-    const glm::mat4 P = unproject.projection();
-    const glm::mat4 A = to_previous.to_clip(), B = to_future.to_clip();
-    const bool perspective = unproject.perspective();
-    const float background_zv = perspective ? -1.0f : -unproject.far_plane();
-    const float background_w = perspective ? 0.0f : 1.0f;
-    const float fw = float(f.depth.width), fh = float(f.depth.height);
-    const float* __restrict z_row = f.depth.row(y);
-    const float* __restrict m_row = &f.motion.row(y)->x;
+    const glm::mat4 P = t.projection, A = t.to_previous, B = t.to_future;
+    const float background_zv = t.background_zv, background_w = t.background_w;
+    const float fw = t.width, fh = t.height, tolerance2 = t.tolerance2;
+    const float* __restrict m_row = &motion->x;
     float* __restrict m_out = &motion_out->x;
-    float* __restrict d_out = depth_out;
-    const float py = float(y) + 0.5f, ny = unproject.ndc_y(py);
+    const float py = float(y) + 0.5f, ny = 1.0f - 2.0f * py / fh;
     const float inf = std::numeric_limits<float>::infinity();
-    const int width = f.depth.width;
     unsigned dynamic = 0;
-    for (int x = 0; x < width; ++x) {
-        const float z = z_row[x], mx = m_row[2 * x], my = m_row[2 * x + 1];
-        const float px = float(x) + 0.5f, nx = unproject.ndc_x(px);
+    for (int x = x_begin; x < x_end; ++x) {
+        const float z = depth[x], mx = m_row[2 * x], my = m_row[2 * x + 1];
+        const float px = float(x) + 0.5f, nx = 2.0f * px / fw - 1.0f;
         const bool background = z == inf;
         const float zv = background ? background_zv : -z;
         const float w = background ? background_w : 1.0f;
@@ -85,13 +94,15 @@ std::size_t classify_row_axis_aligned(const GBufferView& f, int y,
         const float ex = bx - px - mx, ey = by - py - my;
         const bool still = (z == z) & (mx - mx == 0.0f) & (my - my == 0.0f) & (aw > 0.0f) &
                            (bw > 0.0f) & (ex * ex + ey * ey <= tolerance2);
-        d_out[x] = still ? z : kNaN;
+        depth_out[x] = still ? z : kNaN;
         m_out[2 * x] = still ? lx - px : kNaN;
         m_out[2 * x + 1] = still ? ly - py : kNaN;
         dynamic += !still;
     }
     return dynamic;
 }
+
+namespace {
 
 // Without a camera nothing tells static from moving: every pixel goes along its own motion.
 void extrapolate_along_motion(const GBufferView& f, float s, float motion_scale,
@@ -144,12 +155,14 @@ void extrapolate_frame(const GBufferView& f, float s, float motion_scale, const 
     const ImageView<glm::vec2> layer_motion = scratch.layer_motion.view();
     std::atomic<std::size_t> dynamic{0};
     const float tolerance2 = options.static_tolerance * options.static_tolerance;
+    const StaticLayerTest axis_aligned_test(to_previous, to_future, w, h,
+                                            options.static_tolerance);
     parallel_for(0, h, [&](int y0, int y1) {
         std::size_t local = 0;
         for (int y = y0; y < y1; ++y) {
             if (unproject.axis_aligned())
-                local += classify_row_axis_aligned(f, y, to_previous, to_future, tolerance2,
-                                                   layer_depth.row(y), layer_motion.row(y));
+                local += static_layer_row(axis_aligned_test, y, w, f.depth.row(y), f.motion.row(y),
+                                          layer_depth.row(y), layer_motion.row(y));
             else
                 local += classify_row(f, y, to_previous, to_future, tolerance2, layer_depth.row(y),
                                       layer_motion.row(y));

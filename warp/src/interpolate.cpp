@@ -5,6 +5,7 @@
 #include <utility>
 
 #include "fruc_stages.hpp"
+#include "kernels.hpp"
 #include "reprise/core/parallel.hpp"
 #include "reprise/warp/sample.hpp"
 
@@ -93,6 +94,33 @@ void fill_holes(ImageView<glm::vec4> color, ImageView<const uint8_t> valid,
     else scratch.andreev.fill(color, valid, depth);
 }
 
+std::size_t blend_row_reference(const BlendRow& r) {
+    const float inf = std::numeric_limits<float>::infinity();
+    const float s = r.s;
+    std::size_t holes = 0;
+    for (int x = 0; x < r.width; ++x) {
+        const bool ca = r.covered_a[x], cb = r.covered_b[x];
+        const float za = r.depth_a[x], zb = r.depth[x];
+        r.valid[x] = ca || cb;
+        if (!ca) {  // b alone (or nothing: colour 0, depth +inf, motion 0 already)
+            holes += !cb;
+            r.motion[x] *= r.motion_scale;
+            continue;
+        }
+        if (cb && std::abs(za - zb) <= 0.02f * std::min(za, zb)) {
+            r.color[x] = (1.0f - s) * r.color_a[x] + s * r.color[x];
+            r.depth[x] = std::min(za, zb);
+        } else if (cb && std::isinf(za) && std::isinf(zb)) {
+            r.color[x] = (1.0f - s) * r.color_a[x] + s * r.color[x];
+            r.depth[x] = inf;
+        } else if (!cb || !(zb < za)) {
+            r.color[x] = r.color_a[x], r.depth[x] = za, r.motion[x] = r.motion_a[x];
+        }
+        r.motion[x] *= r.motion_scale;
+    }
+    return holes;
+}
+
 void interpolate_frame(const GBufferView& a, const GBufferView& b, float s, bool use_a,
                        float motion_scale, const FrucOptions& options, FrucScratch& scratch,
                        Frame& out, FrucCounters& counters) {
@@ -125,41 +153,22 @@ void interpolate_frame(const GBufferView& a, const GBufferView& b, float s, bool
     warp_into(from_b, 1.0f - s, options, scratch, into_out, counters);
     if (use_a) warp_into(from_a, -s, options, scratch, wa.target(), counters);
     else wa.covered.fill(0);
-    const float inf = std::numeric_limits<float>::infinity();
     std::atomic<std::size_t> holes{0};
     parallel_for(0, h, [&](int y0, int y1) {
         std::size_t local_holes = 0;
-        for (int y = y0; y < y1; ++y) {
-            const uint8_t* cov_a = &wa.covered(0, y);
-            const uint8_t* cov_b = &scratch.side_b.covered(0, y);
-            const float* depth_a = &wa.depth(0, y);
-            const glm::vec4* color_a = &wa.color(0, y);
-            const glm::vec2* motion_a = &wa.motion(0, y);
-            float* depth = &out.depth(0, y);
-            glm::vec4* color = &out.color(0, y);
-            glm::vec2* motion = &out.motion(0, y);
-            uint8_t* valid = &scratch.valid(0, y);
-            for (int x = 0; x < w; ++x) {
-                const bool ca = cov_a[x], cb = cov_b[x];
-                const float za = depth_a[x], zb = depth[x];
-                valid[x] = ca || cb;
-                if (!ca) {  // b alone (or nothing: colour 0, depth +inf, motion 0 already)
-                    local_holes += !cb;
-                    motion[x] *= motion_scale;
-                    continue;
-                }
-                if (cb && std::abs(za - zb) <= 0.02f * std::min(za, zb)) {
-                    color[x] = (1.0f - s) * color_a[x] + s * color[x];
-                    depth[x] = std::min(za, zb);
-                } else if (cb && std::isinf(za) && std::isinf(zb)) {
-                    color[x] = (1.0f - s) * color_a[x] + s * color[x];
-                    depth[x] = inf;
-                } else if (!cb || !(zb < za)) {
-                    color[x] = color_a[x], depth[x] = za, motion[x] = motion_a[x];
-                }
-                motion[x] *= motion_scale;
-            }
-        }
+        for (int y = y0; y < y1; ++y)
+            local_holes += blend_row({.covered_a = &wa.covered(0, y),
+                                      .covered_b = &scratch.side_b.covered(0, y),
+                                      .depth_a = &wa.depth(0, y),
+                                      .color_a = &wa.color(0, y),
+                                      .motion_a = &wa.motion(0, y),
+                                      .depth = &out.depth(0, y),
+                                      .color = &out.color(0, y),
+                                      .motion = &out.motion(0, y),
+                                      .valid = &scratch.valid(0, y),
+                                      .width = w,
+                                      .s = s,
+                                      .motion_scale = motion_scale});
         holes += local_holes;
     });
     fill_holes(out.color.view(), scratch.valid.view(), out.depth.view(), holes.load(), options,

@@ -11,6 +11,7 @@
 #include <cstring>
 
 #include "reprise/core/parallel.hpp"
+#include "kernels.hpp"
 #include "reprise/warp/fill.hpp"
 
 namespace reprise::warp {
@@ -130,6 +131,93 @@ void check_inputs(ImageView<glm::vec4> color, ImageView<const uint8_t> valid,
 }
 
 }  // namespace
+
+std::size_t pull_level_row_reference(const PullLevelRow& r, int i_begin, int i_end) {
+    const bool use_depth = r.depth0 != nullptr;
+    std::size_t empty = 0;
+    for (int i = i_begin; i < i_end; ++i) {
+        const int x0 = 2 * i;
+        if (x0 + 1 < r.fine_width && r.rows == 2) {
+            const vec4 &a = r.row0[x0], &b = r.row0[x0 + 1], &e = r.row1[x0], &g = r.row1[x0 + 1];
+            if (a.a == 1.0f && b.a == 1.0f && e.a == 1.0f && g.a == 1.0f) {
+                float dmax = 0.0f;
+                bool same_layer = true;
+                if (use_depth) {
+                    const float d[4] = {r.depth0[x0], r.depth0[x0 + 1], r.depth1[x0], r.depth1[x0 + 1]};
+                    dmax = std::max(std::max(d[0], d[1]), std::max(d[2], d[3]));
+                    for (float dk : d) same_layer &= dk * kBackgroundDepthRatio >= dmax;
+                }
+                if (same_layer) {  // pull_pixel's arithmetic, in its order
+                    r.out[i] = vec4(vec3(vec4(0.0f) + a + b + e + g) / 4.0f, 1.0f);
+                    if (use_depth) r.out_depth[i] = dmax;
+                    continue;
+                }
+            }
+        }
+        Child child[4];
+        int n = 0;
+        for (int dy = 0; dy < r.rows; ++dy)
+            for (int dx = 0; dx < 2 && x0 + dx < r.fine_width; ++dx) {
+                const vec4& p = (dy ? r.row1 : r.row0)[x0 + dx];
+                child[n++] = {vec3(p), p.a, use_depth ? (dy ? r.depth1 : r.depth0)[x0 + dx] : 0.0f};
+            }
+        float d;
+        pull_pixel(child, n, use_depth, r.out[i], d);
+        if (use_depth) r.out_depth[i] = d;
+        empty += r.out[i].a < 1.0f;
+    }
+    return empty;
+}
+
+PullCounts pull_row_reference(const PullRow& r, int i_begin, int i_end) {
+    const bool use_depth = r.depth0 != nullptr;
+    const int width = r.fine_width, ny = r.rows;
+    const vec4* row0 = r.row0;
+    const vec4* row1 = r.row1;
+    const uint8_t* m0 = r.valid0;
+    const uint8_t* m1 = r.valid1;
+    PullCounts counts;
+    for (int i = i_begin; i < i_end; ++i) {
+        const int x0 = 2 * i, nx = std::min(2, width - x0);
+        // Four valid children (within the depth ratio): the plain mean, in the same order and
+        // arithmetic as pull_pixel; alpha of the sum is ignored.
+        if (nx == 2 && ny == 2 && m0[x0] && m0[x0 + 1] && m1[x0] && m1[x0 + 1]) {
+            const vec4 s = vec4(0.0f) + row0[x0] + row0[x0 + 1] + row1[x0] + row1[x0 + 1];
+            float dmax = 0.0f;
+            bool same_layer = true;
+            if (use_depth) {
+                const float d[4] = {sane_depth(r.depth0[x0]), sane_depth(r.depth0[x0 + 1]),
+                                    sane_depth(r.depth1[x0]), sane_depth(r.depth1[x0 + 1])};
+                dmax = std::max(std::max(d[0], d[1]), std::max(d[2], d[3]));
+                for (float dk : d) same_layer &= dk * kBackgroundDepthRatio >= dmax;
+            }
+            if (same_layer && std::isfinite(s.r) && std::isfinite(s.g) && std::isfinite(s.b)) {
+                r.out[i] = vec4(vec3(s) / 4.0f, 1.0f);
+                if (use_depth) r.out_depth[i] = dmax;
+                r.hole_bits[i] = 0;
+                continue;
+            }
+        }
+        Child child[4];
+        int n = 0;
+        uint8_t hole_mask = 0;
+        for (int dy = 0; dy < ny; ++dy)
+            for (int dx = 0; dx < nx; ++dx) {
+                const vec4& c = (dy ? row1 : row0)[x0 + dx];
+                const bool ok = (dy ? m1 : m0)[x0 + dx] != 0 && finite_rgb(c);
+                if (!ok) hole_mask |= uint8_t(1u << (2 * dy + dx));
+                const float d = use_depth ? sane_depth((dy ? r.depth1 : r.depth0)[x0 + dx]) : 0.0f;
+                child[n++] = {ok ? vec3(c) : vec3(0.0f), ok ? 1.0f : 0.0f, d};
+            }
+        float d;
+        pull_pixel(child, n, use_depth, r.out[i], d);
+        if (use_depth) r.out_depth[i] = d;
+        r.hole_bits[i] = hole_mask;
+        counts.holes += std::size_t(std::popcount(hole_mask));
+        counts.empty += r.out[i].a < 1.0f;
+    }
+    return counts;
+}
 
 FillStats PullPush::fill_reference(ImageView<glm::vec4> color, ImageView<const uint8_t> valid,
                                    ImageView<const float> depth) {
@@ -252,49 +340,20 @@ FillStats PullPush::fill(ImageView<glm::vec4> color, ImageView<const uint8_t> va
                 vec4* out = &c1(0, j);
                 uint8_t* bits = &hole_bits_(0, j);
                 float* out_d = use_depth ? &depth_levels_[0](0, j) : nullptr;
-                for (int i = 0; i < c1.width(); ++i) {
-                    const int x0 = 2 * i, nx = std::min(2, width - x0);
-                    // Four valid children (within the depth ratio): the plain mean, in the
-                    // same order and arithmetic as pull_pixel; alpha of the sum is ignored.
-                    if (nx == 2 && ny == 2 && m0[x0] && m0[x0 + 1] && m1[x0] && m1[x0 + 1]) {
-                        const vec4 s =
-                            vec4(0.0f) + row0[x0] + row0[x0 + 1] + row1[x0] + row1[x0 + 1];
-                        float dmax = 0.0f;
-                        bool same_layer = true;
-                        if (use_depth) {
-                            const float* d0 = depth.row(y0) + x0;
-                            const float* d1 = depth.row(y0 + 1) + x0;
-                            const float d[4] = {sane_depth(d0[0]), sane_depth(d0[1]),
-                                                sane_depth(d1[0]), sane_depth(d1[1])};
-                            dmax = std::max(std::max(d[0], d[1]), std::max(d[2], d[3]));
-                            for (float dk : d) same_layer &= dk * kBackgroundDepthRatio >= dmax;
-                        }
-                        if (same_layer && std::isfinite(s.r) && std::isfinite(s.g) &&
-                            std::isfinite(s.b)) {
-                            out[i] = vec4(vec3(s) / 4.0f, 1.0f);
-                            if (out_d) out_d[i] = dmax;
-                            bits[i] = 0;
-                            continue;
-                        }
-                    }
-                    Child child[4];
-                    int n = 0;
-                    uint8_t hole_mask = 0;
-                    for (int dy = 0; dy < ny; ++dy)
-                        for (int dx = 0; dx < nx; ++dx) {
-                            const vec4& c = (dy ? row1 : row0)[x0 + dx];
-                            const bool ok = (dy ? m1 : m0)[x0 + dx] != 0 && finite_rgb(c);
-                            if (!ok) hole_mask |= uint8_t(1u << (2 * dy + dx));
-                            const float d = use_depth ? sane_depth(depth(x0 + dx, y0 + dy)) : 0.0f;
-                            child[n++] = {ok ? vec3(c) : vec3(0.0f), ok ? 1.0f : 0.0f, d};
-                        }
-                    float d;
-                    pull_pixel(child, n, use_depth, out[i], d);
-                    if (out_d) out_d[i] = d;
-                    bits[i] = hole_mask;
-                    count += std::size_t(std::popcount(hole_mask));
-                    empty_count += out[i].a < 1.0f;
-                }
+                const PullCounts counts =
+                    pull_row({.row0 = row0,
+                              .row1 = row1,
+                              .valid0 = m0,
+                              .valid1 = m1,
+                              .depth0 = use_depth ? depth.row(y0) : nullptr,
+                              .depth1 = use_depth ? depth.row(y0 + ny - 1) : nullptr,
+                              .fine_width = width,
+                              .rows = ny,
+                              .out = out,
+                              .out_depth = out_d,
+                              .hole_bits = bits});
+                count += counts.holes;
+                empty_count += counts.empty;
             }
             holes += count;
             empty += empty_count;
@@ -317,41 +376,17 @@ FillStats PullPush::fill(ImageView<glm::vec4> color, ImageView<const uint8_t> va
         Image<float>* cd = depth_at(top + 1);
         parallel_for(0, c.height(), [&](int j0, int j1) {
             std::size_t empty_count = 0;
-            for (int j = j0; j < j1; ++j)
-                for (int i = 0; i < c.width(); ++i) {
-                    const int x0 = 2 * i, y0 = 2 * j;
-                    if (x0 + 1 < f.width() && y0 + 1 < f.height()) {
-                        const vec4 &a = f(x0, y0), &b = f(x0 + 1, y0), &e = f(x0, y0 + 1),
-                                   &g = f(x0 + 1, y0 + 1);
-                        if (a.a == 1.0f && b.a == 1.0f && e.a == 1.0f && g.a == 1.0f) {
-                            float dmax = 0.0f;
-                            bool same_layer = true;
-                            if (fd) {
-                                const float d[4] = {(*fd)(x0, y0), (*fd)(x0 + 1, y0),
-                                                    (*fd)(x0, y0 + 1), (*fd)(x0 + 1, y0 + 1)};
-                                dmax = std::max(std::max(d[0], d[1]), std::max(d[2], d[3]));
-                                for (float dk : d) same_layer &= dk * kBackgroundDepthRatio >= dmax;
-                            }
-                            if (same_layer) {  // pull_pixel's arithmetic, in its order
-                                c(i, j) = vec4(vec3(vec4(0.0f) + a + b + e + g) / 4.0f, 1.0f);
-                                if (cd) (*cd)(i, j) = dmax;
-                                continue;
-                            }
-                        }
-                    }
-                    Child child[4];
-                    int n = 0;
-                    for (int dy = 0; dy < 2; ++dy)
-                        for (int dx = 0; dx < 2; ++dx) {
-                            const int x = x0 + dx, y = y0 + dy;
-                            if (x < f.width() && y < f.height())
-                                child[n++] = {vec3(f(x, y)), f(x, y).a, fd ? (*fd)(x, y) : 0.0f};
-                        }
-                    float d;
-                    pull_pixel(child, n, use_depth, c(i, j), d);
-                    if (cd) (*cd)(i, j) = d;
-                    empty_count += c(i, j).a < 1.0f;
-                }
+            for (int j = j0; j < j1; ++j) {
+                const int y0 = 2 * j, y1 = std::min(y0 + 1, f.height() - 1);
+                empty_count += pull_level_row({.row0 = &f(0, y0),
+                                               .row1 = &f(0, y1),
+                                               .depth0 = fd ? &(*fd)(0, y0) : nullptr,
+                                               .depth1 = fd ? &(*fd)(0, y1) : nullptr,
+                                               .fine_width = f.width(),
+                                               .rows = y1 - y0 + 1,
+                                               .out = &c(0, j),
+                                               .out_depth = cd ? &(*cd)(0, j) : nullptr});
+            }
             empty += empty_count;
         }, grain_rows(c.width()));
         ++top;

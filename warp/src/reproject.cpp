@@ -16,6 +16,11 @@
 #include <emmintrin.h>
 #endif
 
+// Compiled once per Highway target (foreach_target.h includes this file again): the shared
+// scalar part once, the row loop per target, the public functions once.
+#ifndef REPRISE_WARP_REPROJECT_SHARED
+#define REPRISE_WARP_REPROJECT_SHARED
+
 namespace reprise::warp {
 
 namespace {
@@ -139,19 +144,6 @@ inline bool finite(float v) {
     return v - v == 0.0f;
 }
 
-#if defined(__SSE2__)
-// Byte i is 1 where bit i is set.
-constexpr uint8_t kLaneBytes[16][4] = {{0, 0, 0, 0}, {1, 0, 0, 0}, {0, 1, 0, 0}, {1, 1, 0, 0},
-                                       {0, 0, 1, 0}, {1, 0, 1, 0}, {0, 1, 1, 0}, {1, 1, 1, 0},
-                                       {0, 0, 0, 1}, {1, 0, 0, 1}, {0, 1, 0, 1}, {1, 1, 0, 1},
-                                       {0, 0, 1, 1}, {1, 0, 1, 1}, {0, 1, 1, 1}, {1, 1, 1, 1}};
-// Lane i is all ones where bit i is set.
-alignas(16) constexpr int32_t kLaneMasks[16][4] = {
-    {0, 0, 0, 0},   {-1, 0, 0, 0},   {0, -1, 0, 0},   {-1, -1, 0, 0},
-    {0, 0, -1, 0},  {-1, 0, -1, 0},  {0, -1, -1, 0},  {-1, -1, -1, 0},
-    {0, 0, 0, -1},  {-1, 0, 0, -1},  {0, -1, 0, -1},  {-1, -1, 0, -1},
-    {0, 0, -1, -1}, {-1, 0, -1, -1}, {0, -1, -1, -1}, {-1, -1, -1, -1}};
-#endif
 
 // Bilinear over taps a, b (row 0) and c, d (row 1) of n channels; writes `dst` only when every
 // channel is finite.
@@ -186,6 +178,20 @@ inline bool fetch(const float* a, const float* b, const float* c, const float* d
     }
     return true;
 }
+
+}  // namespace
+
+}  // namespace reprise::warp
+#endif  // REPRISE_WARP_REPROJECT_SHARED
+
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "reproject.cpp"
+#include <hwy/foreach_target.h>  // IWYU pragma: keep
+#include <hwy/highway.h>
+
+HWY_BEFORE_NAMESPACE();
+namespace reprise::warp::HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
 
 // Rows [y_begin, y_end) with C payload channels (0: any). Everything the loop reads is copied
 // into locals first: the float stores to `out` could otherwise alias them.
@@ -284,142 +290,108 @@ void reproject_rows(const Kernel& kernel, int y_begin, int y_end, int step, std:
             for (; x < width; x += step) record(x, classify(x), hrow);
             continue;
         }
-#if defined(__SSE2__)
-        // Four pixels at a time: the same arithmetic lane by lane (so the same bits as the scalar
-        // code), with the taps gathered per lane. Blocks with any pixel that is invalid, behind or
+#if HWY_TARGET != HWY_SCALAR
+        // Lanes() pixels at a time: the same arithmetic lane by lane (so the same bits as the
+        // scalar code), the taps gathered. Blocks with any pixel that is invalid, behind or
         // offscreen go to the scalar code.
-        const __m128 zero = _mm_setzero_ps(), inf = _mm_set1_ps(kInf);
-        const __m128 v_kx = _mm_set1_ps(s.kx), v_kz = _mm_set1_ps(s.kz), v_k1 = _mm_set1_ps(s.k1);
-        const __m128 v_wz = _mm_set1_ps(s.wz), v_w1 = _mm_set1_ps(s.w1), v_row = _mm_set1_ps(row);
-        const __m128 v_px0 = _mm_set1_ps(s.px0), v_qx0 = _mm_set1_ps(s.qx0);
-        const __m128 v_qy = _mm_set1_ps(qy_row), v_half = _mm_set1_ps(0.5f);
-        const __m128 v_fpw = _mm_set1_ps(fpw), v_fph = _mm_set1_ps(fph);
-        const __m128 v_tol = _mm_set1_ps(s.tolerance), v_id_tol = _mm_set1_ps(s.id_tolerance);
-        const __m128 v_background = _mm_castsi128_ps(_mm_set1_epi32(background_hits ? -1 : 0));
-        const __m128 v_abs = _mm_castsi128_ps(_mm_set1_epi32(0x7fffffff));
-        const __m128i v_pw1 = _mm_set1_epi32(pw - 1), v_ph1 = _mm_set1_epi32(ph - 1);
-        const __m128i v_one = _mm_set1_epi32(1), izero = _mm_setzero_si128();
-        auto min_i = [](__m128i a, __m128i b) {  // SSE2 has no pminsd
-            const __m128i greater = _mm_cmpgt_epi32(a, b);
-            return _mm_or_si128(_mm_and_si128(greater, b), _mm_andnot_si128(greater, a));
+        const hn::ScalableTag<float> df;
+        const hn::RebindToSigned<decltype(df)> di;
+        using VF = hn::Vec<decltype(df)>;
+        using VI = hn::Vec<decltype(di)>;
+        const int lanes = int(hn::Lanes(df));
+        const VF zero = hn::Zero(df), inf = hn::Set(df, kInf), half = hn::Set(df, 0.5f);
+        const VF v_kx = hn::Set(df, s.kx), v_kz = hn::Set(df, s.kz), v_k1 = hn::Set(df, s.k1);
+        const VF v_wz = hn::Set(df, s.wz), v_w1 = hn::Set(df, s.w1), v_row = hn::Set(df, row);
+        const VF v_px0 = hn::Set(df, s.px0), v_qx0 = hn::Set(df, s.qx0), v_qy = hn::Set(df, qy_row);
+        const VF v_fpw = hn::Set(df, fpw), v_fph = hn::Set(df, fph);
+        const VF v_tol = hn::Set(df, s.tolerance), v_id_tol = hn::Set(df, s.id_tolerance);
+        const VI v_pw1 = hn::Set(di, pw - 1), v_ph1 = hn::Set(di, ph - 1), one = hn::Set(di, 1);
+        const VI izero = hn::Zero(di);
+        const VI depth_stride_v = hn::Set(di, int32_t(prev_depth_stride));
+        const VI id_stride_v = hn::Set(di, int32_t(prev_id_stride));
+        const auto* prev_id_i = reinterpret_cast<const int32_t*>(prev_id);
+        // floor() by truncation and correction, as the scalar code.
+        auto floor_split = [&](VF v, VI& i, VF& f) {
+            i = hn::ConvertTo(di, v);
+            i = i - hn::IfThenElseZero(hn::RebindMask(di, v < hn::ConvertTo(df, i)), one);
+            f = v - hn::ConvertTo(df, i);
         };
-        auto max0 = [&](__m128i a) { return _mm_andnot_si128(_mm_cmpgt_epi32(izero, a), a); };
-        auto floor_split = [](__m128 v, __m128i& i, __m128& f) {
-            i = _mm_cvttps_epi32(v);
-            i = _mm_add_epi32(i, _mm_castps_si128(_mm_cmplt_ps(v, _mm_cvtepi32_ps(i))));
-            f = _mm_sub_ps(v, _mm_cvtepi32_ps(i));
-        };
-        __m128i v_x = _mm_setr_epi32(0, 1, 2, 3);
-        for (; x + 4 <= width; x += 4, v_x = _mm_add_epi32(v_x, _mm_set1_epi32(4))) {
-            const __m128 xf = _mm_cvtepi32_ps(v_x);
-            const __m128 z = _mm_loadu_ps(zr + x);
-            const __m128 m01 = _mm_loadu_ps(&mr[x].x), m23 = _mm_loadu_ps(&mr[x + 2].x);
-            const __m128 mx = _mm_shuffle_ps(m01, m23, _MM_SHUFFLE(2, 0, 2, 0));
-            const __m128 my = _mm_shuffle_ps(m01, m23, _MM_SHUFFLE(3, 1, 3, 1));
-            const __m128 w = _mm_add_ps(_mm_mul_ps(v_wz, z), v_w1);
-            const __m128 lin = _mm_add_ps(_mm_mul_ps(v_kx, _mm_add_ps(xf, v_px0)), v_row);
-            const __m128 z_expected =
-                _mm_add_ps(_mm_mul_ps(w, lin), _mm_add_ps(_mm_mul_ps(v_kz, z), v_k1));
-            const __m128 qx = _mm_add_ps(_mm_add_ps(xf, v_qx0), mx), qy = _mm_add_ps(v_qy, my);
-            const __m128 motion_ok = _mm_and_ps(_mm_cmpeq_ps(_mm_sub_ps(mx, mx), zero),
-                                                _mm_cmpeq_ps(_mm_sub_ps(my, my), zero));
-            const __m128 surface =
-                _mm_and_ps(_mm_and_ps(_mm_cmpeq_ps(_mm_sub_ps(z, z), zero),
-                                      _mm_cmpeq_ps(_mm_sub_ps(z_expected, z_expected), zero)),
-                           _mm_cmpgt_ps(z_expected, zero));
-            const __m128 background = _mm_and_ps(_mm_cmpeq_ps(z, inf), v_background);
-            const __m128 inside =
-                _mm_and_ps(_mm_and_ps(_mm_cmpge_ps(qx, zero), _mm_cmpge_ps(qy, zero)),
-                           _mm_and_ps(_mm_cmple_ps(qx, v_fpw), _mm_cmple_ps(qy, v_fph)));
-            const __m128 go =
-                _mm_and_ps(_mm_and_ps(motion_ok, inside), _mm_or_ps(surface, background));
-            if (_mm_movemask_ps(go) != 0xF) {
-                for (int i = 0; i < 4; ++i) record(x + i, classify(x + i), hrow);
+        alignas(64) int32_t X0[HWY_MAX_BYTES / 4], X1[HWY_MAX_BYTES / 4];
+        alignas(64) int32_t Y0[HWY_MAX_BYTES / 4], Y1[HWY_MAX_BYTES / 4];
+        alignas(64) float FX[HWY_MAX_BYTES / 4], FY[HWY_MAX_BYTES / 4];
+        alignas(64) int32_t DEPTH_OK[HWY_MAX_BYTES / 4], IDS_OK[HWY_MAX_BYTES / 4];
+        for (; x + lanes <= width; x += lanes) {
+            const VF xf = hn::ConvertTo(df, hn::Iota(di, x));
+            const VF z = hn::LoadU(df, zr + x);
+            VF mx, my;
+            hn::LoadInterleaved2(df, &mr[x].x, mx, my);
+            const VF w = v_wz * z + v_w1;
+            const VF lin = v_kx * (xf + v_px0) + v_row;
+            const VF z_expected = w * lin + (v_kz * z + v_k1);
+            const VF qx = (xf + v_qx0) + mx, qy = v_qy + my;
+            const auto motion_ok = hn::And((mx - mx) == zero, (my - my) == zero);
+            const auto surface = hn::And(hn::And((z - z) == zero, (z_expected - z_expected) == zero),
+                                         z_expected > zero);
+            const auto background = background_hits ? (z == inf) : hn::FirstN(df, 0);
+            const auto inside = hn::And(hn::And(qx >= zero, qy >= zero),
+                                        hn::And(qx <= v_fpw, qy <= v_fph));
+            const auto go = hn::And(hn::And(motion_ok, inside), hn::Or(surface, background));
+            if (!hn::AllTrue(df, go)) {
+                for (int i = 0; i < lanes; ++i) record(x + i, classify(x + i), hrow);
                 continue;
             }
-            __m128i ix, iy;
-            __m128 fx, fy;
-            floor_split(_mm_sub_ps(qx, v_half), ix, fx);
-            floor_split(_mm_sub_ps(qy, v_half), iy, fy);
-            const __m128i x0 = min_i(max0(ix), v_pw1), y0 = min_i(max0(iy), v_ph1);
-            const __m128i fx0 = _mm_castps_si128(_mm_cmpeq_ps(fx, zero));
-            const __m128i fy0 = _mm_castps_si128(_mm_cmpeq_ps(fy, zero));
-            const __m128i x1 =
-                _mm_or_si128(_mm_and_si128(fx0, x0),
-                             _mm_andnot_si128(fx0, min_i(_mm_add_epi32(ix, v_one), v_pw1)));
-            const __m128i y1 =
-                _mm_or_si128(_mm_and_si128(fy0, y0),
-                             _mm_andnot_si128(fy0, min_i(_mm_add_epi32(iy, v_one), v_ph1)));
-            alignas(16) int32_t X0[4], X1[4], Y0[4], Y1[4];
-            _mm_store_si128(reinterpret_cast<__m128i*>(X0), x0);
-            _mm_store_si128(reinterpret_cast<__m128i*>(X1), x1);
-            _mm_store_si128(reinterpret_cast<__m128i*>(Y0), y0);
-            _mm_store_si128(reinterpret_cast<__m128i*>(Y1), y1);
-            // Taps straight into registers (an array store + vector load would stall forwarding).
-            const float* d0[4] = {
-                prev_depth + Y0[0] * prev_depth_stride, prev_depth + Y0[1] * prev_depth_stride,
-                prev_depth + Y0[2] * prev_depth_stride, prev_depth + Y0[3] * prev_depth_stride};
-            const float* d1[4] = {
-                prev_depth + Y1[0] * prev_depth_stride, prev_depth + Y1[1] * prev_depth_stride,
-                prev_depth + Y1[2] * prev_depth_stride, prev_depth + Y1[3] * prev_depth_stride};
-            const __m128 a = _mm_setr_ps(d0[0][X0[0]], d0[1][X0[1]], d0[2][X0[2]], d0[3][X0[3]]);
-            const __m128 b = _mm_setr_ps(d0[0][X1[0]], d0[1][X1[1]], d0[2][X1[2]], d0[3][X1[3]]);
-            const __m128 c = _mm_setr_ps(d1[0][X0[0]], d1[1][X0[1]], d1[2][X0[2]], d1[3][X0[3]]);
-            const __m128 d = _mm_setr_ps(d1[0][X1[0]], d1[1][X1[1]], d1[2][X1[2]], d1[3][X1[3]]);
-            int id_bits = 0xF;
+            VI ix, iy;
+            VF fx, fy;
+            floor_split(qx - half, ix, fx);
+            floor_split(qy - half, iy, fy);
+            const VI x0 = hn::Min(hn::Max(ix, izero), v_pw1), y0 = hn::Min(hn::Max(iy, izero), v_ph1);
+            const VI x1 = hn::IfThenElse(hn::RebindMask(di, fx == zero), x0, hn::Min(ix + one, v_pw1));
+            const VI y1 = hn::IfThenElse(hn::RebindMask(di, fy == zero), y0, hn::Min(iy + one, v_ph1));
+            const VI r0 = y0 * depth_stride_v, r1 = y1 * depth_stride_v;
+            const VF a = hn::GatherIndex(df, prev_depth, r0 + x0);
+            const VF b = hn::GatherIndex(df, prev_depth, r0 + x1);
+            const VF c = hn::GatherIndex(df, prev_depth, r1 + x0);
+            const VF d = hn::GatherIndex(df, prev_depth, r1 + x1);
+            auto ids_agree = hn::FirstN(df, size_t(lanes));
             if (use_ids) {
-                id_bits = 0;
-                for (int i = 0; i < 4; ++i) {
-                    const uint32_t* i0 = prev_id + Y0[i] * prev_id_stride;
-                    const uint32_t* i1 = prev_id + Y1[i] * prev_id_stride;
-                    const uint32_t me = ir[x + i];
-                    id_bits |= int(((i0[X0[i]] ^ me) | (i0[X1[i]] ^ me) | (i1[X0[i]] ^ me) |
-                                    (i1[X1[i]] ^ me)) == 0)
-                               << i;
-                }
+                const VI me = hn::LoadU(di, reinterpret_cast<const int32_t*>(ir) + x);
+                const VI i0 = y0 * id_stride_v, i1 = y1 * id_stride_v;
+                const auto same = hn::And(
+                    hn::And(hn::GatherIndex(di, prev_id_i, i0 + x0) == me,
+                            hn::GatherIndex(di, prev_id_i, i0 + x1) == me),
+                    hn::And(hn::GatherIndex(di, prev_id_i, i1 + x0) == me,
+                            hn::GatherIndex(di, prev_id_i, i1 + x1) == me));
+                ids_agree = hn::RebindMask(df, same);
             }
-            const __m128 ids_agree =
-                _mm_load_ps(reinterpret_cast<const float*>(kLaneMasks[id_bits]));
-            const __m128 taps_finite = _mm_cmpeq_ps(
-                _mm_add_ps(
-                    _mm_add_ps(_mm_add_ps(_mm_sub_ps(a, a), _mm_sub_ps(b, b)), _mm_sub_ps(c, c)),
-                    _mm_sub_ps(d, d)),
-                zero);
-            const __m128 top = _mm_add_ps(a, _mm_mul_ps(_mm_sub_ps(b, a), fx));
-            const __m128 bottom = _mm_add_ps(c, _mm_mul_ps(_mm_sub_ps(d, c), fx));
-            const __m128 z_previous = _mm_add_ps(top, _mm_mul_ps(_mm_sub_ps(bottom, top), fy));
-            const __m128 relaxed = use_ids ? ids_agree : zero;
-            const __m128 tolerance =
-                _mm_or_ps(_mm_and_ps(relaxed, v_id_tol), _mm_andnot_ps(relaxed, v_tol));
-            const __m128 close = _mm_cmple_ps(_mm_and_ps(_mm_sub_ps(z_expected, z_previous), v_abs),
-                                              _mm_mul_ps(tolerance, z_expected));
-            const __m128 all_background =
-                _mm_and_ps(_mm_and_ps(_mm_cmpeq_ps(a, inf), _mm_cmpeq_ps(b, inf)),
-                           _mm_and_ps(_mm_cmpeq_ps(c, inf), _mm_cmpeq_ps(d, inf)));
-            const __m128 depth_ok =
-                _mm_or_ps(_mm_and_ps(background, all_background),
-                          _mm_andnot_ps(background, _mm_and_ps(taps_finite, close)));
-            const int depth_bits = _mm_movemask_ps(depth_ok);
-            alignas(16) float FX[4], FY[4];
-            _mm_store_ps(FX, fx);
-            _mm_store_ps(FY, fy);
-            int hit_bits = depth_bits & id_bits;
-            for (int i = 0; i < 4; ++i) {
-                if (!(hit_bits >> i & 1)) {
-                    ++counts[depth_bits >> i & 1 ? OtherId : Occluded];
-                    continue;
+            const auto taps_finite = (((a - a) + (b - b)) + (c - c)) + (d - d) == zero;
+            const VF top = a + (b - a) * fx, bottom = c + (d - c) * fx;
+            const VF z_previous = top + (bottom - top) * fy;
+            const VF tolerance = use_ids ? hn::IfThenElse(ids_agree, v_id_tol, v_tol) : v_tol;
+            const auto close = hn::Abs(z_expected - z_previous) <= tolerance * z_expected;
+            const auto all_background =
+                hn::And(hn::And(a == inf, b == inf), hn::And(c == inf, d == inf));
+            const auto depth_ok = hn::Or(hn::And(background, all_background),
+                                         hn::AndNot(background, hn::And(taps_finite, close)));
+            hn::Store(x0, di, X0), hn::Store(x1, di, X1), hn::Store(y0, di, Y0), hn::Store(y1, di, Y1);
+            hn::Store(fx, df, FX), hn::Store(fy, df, FY);
+            hn::Store(hn::VecFromMask(di, hn::RebindMask(di, depth_ok)), di, DEPTH_OK);
+            hn::Store(hn::VecFromMask(di, hn::RebindMask(di, ids_agree)), di, IDS_OK);
+            for (int i = 0; i < lanes; ++i) {
+                Outcome o = Hit;
+                if (!DEPTH_OK[i]) {
+                    o = Occluded;
+                } else if (!IDS_OK[i]) {
+                    o = OtherId;
+                } else {
+                    const float* p0 = in + Y0[i] * in_stride;
+                    const float* p1 = in + Y1[i] * in_stride;
+                    const std::ptrdiff_t c0 = std::ptrdiff_t(X0[i]) * n, c1 = std::ptrdiff_t(X1[i]) * n;
+                    if (!fetch<C>(p0 + c0, p0 + c1, p1 + c0, p1 + c1, n, FX[i], FY[i],
+                                  orow + std::ptrdiff_t(x + i) * n))
+                        o = Invalid;
                 }
-                const float* r0 = in + Y0[i] * in_stride;
-                const float* r1 = in + Y1[i] * in_stride;
-                const std::ptrdiff_t c0 = std::ptrdiff_t(X0[i]) * n, c1 = std::ptrdiff_t(X1[i]) * n;
-                if (!fetch<C>(r0 + c0, r0 + c1, r1 + c0, r1 + c1, n, FX[i], FY[i],
-                              orow + std::ptrdiff_t(x + i) * n)) {
-                    hit_bits &= ~(1 << i);
-                    ++counts[Invalid];
-                }
+                record(x + i, o, hrow);
             }
-            hits += (hit_bits & 1) + (hit_bits >> 1 & 1) + (hit_bits >> 2 & 1) + (hit_bits >> 3);
-            if (hrow) std::memcpy(hrow + x, kLaneBytes[hit_bits], 4);
         }
 #endif
         for (; x < width; ++x) record(x, classify(x), hrow);
@@ -427,7 +399,24 @@ void reproject_rows(const Kernel& kernel, int y_begin, int y_end, int step, std:
     counts[Hit] += hits;
 }
 
-}  // namespace
+
+void ReprojectRows(const Kernel& kernel, int y_begin, int y_end, int step, std::size_t* counts) {
+    switch (kernel.channels) {
+        case 1: return reproject_rows<1>(kernel, y_begin, y_end, step, counts);
+        case 2: return reproject_rows<2>(kernel, y_begin, y_end, step, counts);
+        case 3: return reproject_rows<3>(kernel, y_begin, y_end, step, counts);
+        case 4: return reproject_rows<4>(kernel, y_begin, y_end, step, counts);
+        default: return reproject_rows<0>(kernel, y_begin, y_end, step, counts);
+    }
+}
+
+}  // namespace reprise::warp::HWY_NAMESPACE
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace reprise::warp {
+
+HWY_EXPORT(ReprojectRows);
 
 ReprojectCounts reproject(const GBufferView& current, const GBufferView& previous,
                           ConstPayload previous_payload, Payload out, ImageView<uint8_t> hit,
@@ -455,10 +444,6 @@ ReprojectCounts reproject(const GBufferView& current, const GBufferView& previou
                    out.stride,
                    hit.empty() ? nullptr : hit.data,
                    hit.stride};
-    using Rows = void (*)(const Kernel&, int, int, int, std::size_t*);
-    constexpr Rows kRows[5] = {reproject_rows<0>, reproject_rows<1>, reproject_rows<2>,
-                               reproject_rows<3>, reproject_rows<4>};
-    const Rows rows = kRows[k.channels <= 4 ? k.channels : 0];
     std::atomic<std::size_t> total[OutcomeCount] = {};
     const int step = std::max(1, options.step);
     const int height = current.depth.height, sampled_rows = (height + step - 1) / step;
@@ -467,7 +452,7 @@ ReprojectCounts reproject(const GBufferView& current, const GBufferView& previou
         0, sampled_rows,
         [&](int r0, int r1) {
             std::size_t n[OutcomeCount] = {};
-            rows(k, r0 * step, std::min(r1 * step, height), step, n);
+            HWY_DYNAMIC_DISPATCH(ReprojectRows)(k, r0 * step, std::min(r1 * step, height), step, n);
             for (int i = 0; i < OutcomeCount; ++i)
                 total[i].fetch_add(n[i], std::memory_order_relaxed);
         },
@@ -551,3 +536,4 @@ ReprojectCounts reproject_reference(const GBufferView& current, const GBufferVie
 }
 
 }  // namespace reprise::warp
+#endif  // HWY_ONCE

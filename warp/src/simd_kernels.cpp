@@ -1,0 +1,279 @@
+// The SIMD versions of kernels.hpp, compiled once per Highway target and chosen at run time.
+// Each spells out its scalar reference's operations in the same order (no FMA: this file is
+// compiled with -ffp-contract=off), so it gives the same bits; the last width % lanes pixels of a
+// row go through the reference itself.
+#include <cmath>
+#include <limits>
+
+#include "kernels.hpp"
+#include "reprise/warp/fill.hpp"
+
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "simd_kernels.cpp"
+#include <hwy/foreach_target.h>  // IWYU pragma: keep
+#include <hwy/highway.h>
+
+HWY_BEFORE_NAMESPACE();
+namespace reprise::warp::HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+std::size_t BlendRowSimd(const BlendRow& r) {
+    const hn::ScalableTag<float> df;
+    const hn::RebindToSigned<decltype(df)> di;
+    const hn::Rebind<uint8_t, decltype(df)> du8;
+    using VF = hn::Vec<decltype(df)>;
+    const int n = int(hn::Lanes(df));
+    const VF one_minus_s = hn::Set(df, 1.0f - r.s), s = hn::Set(df, r.s);
+    const VF scale = hn::Set(df, r.motion_scale), tolerance = hn::Set(df, 0.02f);
+    const VF inf = hn::Set(df, std::numeric_limits<float>::infinity());
+    const auto zero_i = hn::Zero(di), one_i = hn::Set(di, 1);
+    std::size_t holes = 0;
+    int x = 0;
+    for (; x + n <= r.width; x += n) {
+        const auto ca = hn::RebindMask(df, hn::PromoteTo(di, hn::LoadU(du8, r.covered_a + x)) != zero_i);
+        const auto cb = hn::RebindMask(df, hn::PromoteTo(di, hn::LoadU(du8, r.covered_b + x)) != zero_i);
+        const auto covered = hn::Or(ca, cb);
+        hn::StoreU(hn::DemoteTo(du8, hn::IfThenElseZero(hn::RebindMask(di, covered), one_i)), du8,
+                   r.valid + x);
+        holes += std::size_t(n) - hn::CountTrue(df, covered);
+
+        const VF za = hn::LoadU(df, r.depth_a + x), zb = hn::LoadU(df, r.depth + x);
+        const auto both = hn::And(ca, cb);
+        const VF nearer = hn::IfThenElse(zb < za, zb, za);  // std::min(za, zb), signed zeros too
+        const auto same = hn::And(both, hn::Abs(za - zb) <= tolerance * nearer);
+        const auto background = hn::And(both, hn::And(hn::Abs(za) == inf, hn::Abs(zb) == inf));
+        const auto blend = hn::Or(same, background);
+        const auto take_a = hn::AndNot(blend, hn::And(ca, hn::Or(hn::Not(cb), hn::Not(zb < za))));
+
+        float* color = &r.color[x].x;
+        const float* color_a = &r.color_a[x].x;
+        VF ar, ag, ab, aa, br, bg, bb, ba;
+        hn::LoadInterleaved4(df, color_a, ar, ag, ab, aa);
+        hn::LoadInterleaved4(df, color, br, bg, bb, ba);
+        auto merge = [&](VF a, VF b) {
+            return hn::IfThenElse(blend, one_minus_s * a + s * b, hn::IfThenElse(take_a, a, b));
+        };
+        hn::StoreInterleaved4(merge(ar, br), merge(ag, bg), merge(ab, bb), merge(aa, ba), df, color);
+        const VF depth = hn::IfThenElse(same, nearer, hn::IfThenElse(background, inf,
+                                                                     hn::IfThenElse(take_a, za, zb)));
+        hn::StoreU(depth, df, r.depth + x);
+
+        VF max, may, mbx, mby;
+        hn::LoadInterleaved2(df, &r.motion_a[x].x, max, may);
+        hn::LoadInterleaved2(df, &r.motion[x].x, mbx, mby);
+        hn::StoreInterleaved2(hn::IfThenElse(take_a, max, mbx) * scale,
+                              hn::IfThenElse(take_a, may, mby) * scale, df, &r.motion[x].x);
+    }
+    if (x < r.width) {
+        BlendRow tail = r;
+        tail.covered_a += x, tail.covered_b += x, tail.depth_a += x, tail.color_a += x;
+        tail.motion_a += x, tail.depth += x, tail.color += x, tail.motion += x, tail.valid += x;
+        tail.width = r.width - x;
+        holes += blend_row_reference(tail);
+    }
+    return holes;
+}
+
+std::size_t StaticLayerRowSimd(const StaticLayerTest& t, int y, int width, const float* depth,
+                               const glm::vec2* motion, float* depth_out, glm::vec2* motion_out) {
+    const hn::ScalableTag<float> df;
+    using VF = hn::Vec<decltype(df)>;
+    const int n = int(hn::Lanes(df));
+    const glm::mat4& P = t.projection;
+    const glm::mat4& A = t.to_previous;
+    const glm::mat4& B = t.to_future;
+    auto splat = [&](float v) { return hn::Set(df, v); };
+    const VF half = splat(0.5f), one = splat(1.0f), two = splat(2.0f), zero = hn::Zero(df);
+    const VF inf = splat(std::numeric_limits<float>::infinity());
+    const VF nan = splat(std::numeric_limits<float>::quiet_NaN());
+    const VF fw = splat(t.width), fh = splat(t.height), tolerance2 = splat(t.tolerance2);
+    const VF background_zv = splat(t.background_zv), background_w = splat(t.background_w);
+    const float py_scalar = float(y) + 0.5f;
+    const VF py = splat(py_scalar), ny = splat(1.0f - 2.0f * py_scalar / t.height);
+    const VF lanes = hn::Iota(df, 0.0f);
+    // Row r of M times (vx, vy, zv, w), summed as transform_row does.
+    auto row = [&](const glm::mat4& M, int r, VF vx, VF vy, VF zv, VF w) {
+        return (splat(M[0][r]) * vx + splat(M[1][r]) * vy) + (splat(M[2][r]) * zv + splat(M[3][r]) * w);
+    };
+    std::size_t dynamic = 0;
+    int x = 0;
+    for (; x + n <= width; x += n) {
+        const VF z = hn::LoadU(df, depth + x);
+        VF mx, my;
+        hn::LoadInterleaved2(df, &motion[x].x, mx, my);
+        const VF px = (splat(float(x)) + lanes) + half;
+        const VF nx = two * px / fw - one;
+        const auto background = z == inf;
+        const VF zv = hn::IfThenElse(background, background_zv, hn::Neg(z));
+        const VF w = hn::IfThenElse(background, background_w, one);
+        const VF wc = splat(P[2][3]) * zv + splat(P[3][3]) * w;
+        const VF vx = (nx * wc - splat(P[2][0]) * zv - splat(P[3][0]) * w) / splat(P[0][0]);
+        const VF vy = (ny * wc - splat(P[2][1]) * zv - splat(P[3][1]) * w) / splat(P[1][1]);
+        const VF aw = row(A, 3, vx, vy, zv, w), bw = row(B, 3, vx, vy, zv, w);
+        const VF bx = (row(A, 0, vx, vy, zv, w) / aw * half + half) * fw;
+        const VF by = (half - half * row(A, 1, vx, vy, zv, w) / aw) * fh;
+        const VF lx = (row(B, 0, vx, vy, zv, w) / bw * half + half) * fw;
+        const VF ly = (half - half * row(B, 1, vx, vy, zv, w) / bw) * fh;
+        const VF ex = bx - px - mx, ey = by - py - my;
+        const auto still = hn::And(
+            hn::And(hn::And(z == z, (mx - mx) == zero), hn::And((my - my) == zero, aw > zero)),
+            hn::And(bw > zero, ex * ex + ey * ey <= tolerance2));
+        hn::StoreU(hn::IfThenElse(still, z, nan), df, depth_out + x);
+        hn::StoreInterleaved2(hn::IfThenElse(still, lx - px, nan), hn::IfThenElse(still, ly - py, nan),
+                              df, &motion_out[x].x);
+        dynamic += std::size_t(n) - hn::CountTrue(df, still);
+    }
+    if (x < width)
+        dynamic += static_layer_row_reference(t, y, x, width, depth, motion, depth_out, motion_out);
+    return dynamic;
+}
+
+
+PullCounts PullRowSimd(const PullRow& r) {
+    const int coarse = (r.fine_width + 1) / 2;
+#if HWY_TARGET == HWY_SCALAR
+    return pull_row_reference(r, 0, coarse);
+#else
+    if (r.rows != 2) return pull_row_reference(r, 0, coarse);
+    const hn::ScalableTag<float> df;
+    const hn::RebindToUnsigned<decltype(df)> du32;
+    const hn::Rebind<uint16_t, decltype(df)> du16;
+    const hn::Rebind<uint8_t, decltype(df)> du8;
+    using VF = hn::Vec<decltype(df)>;
+    const int n = int(hn::Lanes(df));
+    const VF zero = hn::Zero(df), one = hn::Set(df, 1.0f), four = hn::Set(df, 4.0f);
+    const VF inf = hn::Set(df, std::numeric_limits<float>::infinity());
+    const VF ratio = hn::Set(df, kBackgroundDepthRatio);
+    const auto low_byte = hn::Set(du32, 0x00FFu), high_byte = hn::Set(du32, 0xFF00u);
+    const auto zero_u = hn::Zero(du32);
+    // Both children of each pair valid (a pair of bytes read as one 16-bit lane).
+    auto pair_valid = [&](const uint8_t* m) {
+        const auto v = hn::PromoteTo(du32, hn::LoadU(du16, reinterpret_cast<const uint16_t*>(m)));
+        return hn::RebindMask(df, hn::And((v & low_byte) != zero_u, (v & high_byte) != zero_u));
+    };
+    auto sane = [&](VF d) {  // sane_depth: NaN -> +inf, below 0 -> 0
+        return hn::IfThenElse(d != d, inf, hn::IfThenElse(d < zero, zero, d));
+    };
+    auto larger = [](VF a, VF b) { return hn::IfThenElse(a < b, b, a); };  // std::max(a, b)
+    PullCounts counts;
+    const int pairs = r.fine_width / 2;
+    int i = 0;
+    for (; i + n <= pairs; i += n) {
+        const int x0 = 2 * i;
+        VF sum[3];
+        {
+            VF c0[4], c1[4], c2[4], c3[4];  // row 0 pixels x0.., x0 + n..; row 1 the same
+            hn::LoadInterleaved4(df, &r.row0[x0].x, c0[0], c0[1], c0[2], c0[3]);
+            hn::LoadInterleaved4(df, &r.row0[x0 + n].x, c1[0], c1[1], c1[2], c1[3]);
+            hn::LoadInterleaved4(df, &r.row1[x0].x, c2[0], c2[1], c2[2], c2[3]);
+            hn::LoadInterleaved4(df, &r.row1[x0 + n].x, c3[0], c3[1], c3[2], c3[3]);
+            for (int c = 0; c < 3; ++c)  // (((0 + a) + b) + e) + g, children in raster order
+                sum[c] = zero + hn::ConcatEven(df, c1[c], c0[c]) + hn::ConcatOdd(df, c1[c], c0[c]) +
+                         hn::ConcatEven(df, c3[c], c2[c]) + hn::ConcatOdd(df, c3[c], c2[c]);
+        }
+        auto fast = hn::And(hn::And(pair_valid(r.valid0 + x0), pair_valid(r.valid1 + x0)),
+                            hn::And(hn::And((sum[0] - sum[0]) == zero, (sum[1] - sum[1]) == zero),
+                                    (sum[2] - sum[2]) == zero));
+        VF dmax = zero;
+        if (r.depth0) {
+            VF a, b, e, g;
+            hn::LoadInterleaved2(df, r.depth0 + x0, a, b);
+            hn::LoadInterleaved2(df, r.depth1 + x0, e, g);
+            a = sane(a), b = sane(b), e = sane(e), g = sane(g);
+            dmax = larger(larger(a, b), larger(e, g));
+            fast = hn::And(fast, hn::And(hn::And(a * ratio >= dmax, b * ratio >= dmax),
+                                         hn::And(e * ratio >= dmax, g * ratio >= dmax)));
+        }
+        if (!hn::AllTrue(df, fast)) {  // a hole or a depth edge among them: the general code
+            const PullCounts c = pull_row_reference(r, i, i + n);
+            counts.holes += c.holes, counts.empty += c.empty;
+            continue;
+        }
+        if (r.depth0) hn::StoreU(dmax, df, r.out_depth + i);
+        hn::StoreInterleaved4(sum[0] / four, sum[1] / four, sum[2] / four, one, df, &r.out[i].x);
+        hn::StoreU(hn::Zero(du8), du8, r.hole_bits + i);
+    }
+    const PullCounts tail = pull_row_reference(r, i, coarse);
+    counts.holes += tail.holes, counts.empty += tail.empty;
+    return counts;
+#endif
+}
+
+std::size_t PullLevelRowSimd(const PullLevelRow& r) {
+    const int coarse = (r.fine_width + 1) / 2;
+#if HWY_TARGET == HWY_SCALAR
+    return pull_level_row_reference(r, 0, coarse);
+#else
+    if (r.rows != 2) return pull_level_row_reference(r, 0, coarse);
+    const hn::ScalableTag<float> df;
+    using VF = hn::Vec<decltype(df)>;
+    const int n = int(hn::Lanes(df));
+    const VF zero = hn::Zero(df), one = hn::Set(df, 1.0f), four = hn::Set(df, 4.0f);
+    const VF ratio = hn::Set(df, kBackgroundDepthRatio);
+    auto larger = [](VF a, VF b) { return hn::IfThenElse(a < b, b, a); };  // std::max(a, b)
+    std::size_t empty = 0;
+    const int pairs = r.fine_width / 2;
+    int i = 0;
+    for (; i + n <= pairs; i += n) {
+        const int x0 = 2 * i;
+        VF c0[4], c1[4], c2[4], c3[4];
+        hn::LoadInterleaved4(df, &r.row0[x0].x, c0[0], c0[1], c0[2], c0[3]);
+        hn::LoadInterleaved4(df, &r.row0[x0 + n].x, c1[0], c1[1], c1[2], c1[3]);
+        hn::LoadInterleaved4(df, &r.row1[x0].x, c2[0], c2[1], c2[2], c2[3]);
+        hn::LoadInterleaved4(df, &r.row1[x0 + n].x, c3[0], c3[1], c3[2], c3[3]);
+        VF even[4][2], odd[4][2];  // [channel][row]: children (0,0) (0,1) in even, (1,0) (1,1) in odd
+        VF sum[3];
+        for (int c = 0; c < 4; ++c) {
+            even[c][0] = hn::ConcatEven(df, c1[c], c0[c]), odd[c][0] = hn::ConcatOdd(df, c1[c], c0[c]);
+            even[c][1] = hn::ConcatEven(df, c3[c], c2[c]), odd[c][1] = hn::ConcatOdd(df, c3[c], c2[c]);
+            if (c < 3) sum[c] = zero + even[c][0] + odd[c][0] + even[c][1] + odd[c][1];
+        }
+        auto fast = hn::And(hn::And(even[3][0] == one, odd[3][0] == one),
+                            hn::And(even[3][1] == one, odd[3][1] == one));
+        VF dmax = zero;
+        if (r.depth0) {
+            VF a, b, e, g;
+            hn::LoadInterleaved2(df, r.depth0 + x0, a, b);
+            hn::LoadInterleaved2(df, r.depth1 + x0, e, g);
+            dmax = larger(larger(a, b), larger(e, g));
+            fast = hn::And(fast, hn::And(hn::And(a * ratio >= dmax, b * ratio >= dmax),
+                                         hn::And(e * ratio >= dmax, g * ratio >= dmax)));
+        }
+        if (!hn::AllTrue(df, fast)) {
+            empty += pull_level_row_reference(r, i, i + n);
+            continue;
+        }
+        if (r.depth0) hn::StoreU(dmax, df, r.out_depth + i);
+        hn::StoreInterleaved4(sum[0] / four, sum[1] / four, sum[2] / four, one, df, &r.out[i].x);
+    }
+    return empty + pull_level_row_reference(r, i, coarse);
+#endif
+}
+
+}  // namespace reprise::warp::HWY_NAMESPACE
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace reprise::warp {
+
+HWY_EXPORT(BlendRowSimd);
+HWY_EXPORT(StaticLayerRowSimd);
+HWY_EXPORT(PullRowSimd);
+HWY_EXPORT(PullLevelRowSimd);
+
+std::size_t pull_level_row(const PullLevelRow& row) {
+    return HWY_DYNAMIC_DISPATCH(PullLevelRowSimd)(row);
+}
+
+PullCounts pull_row(const PullRow& row) { return HWY_DYNAMIC_DISPATCH(PullRowSimd)(row); }
+
+std::size_t blend_row(const BlendRow& row) { return HWY_DYNAMIC_DISPATCH(BlendRowSimd)(row); }
+
+std::size_t static_layer_row(const StaticLayerTest& test, int y, int width, const float* depth,
+                             const glm::vec2* motion, float* depth_out, glm::vec2* motion_out) {
+    return HWY_DYNAMIC_DISPATCH(StaticLayerRowSimd)(test, y, width, depth, motion, depth_out,
+                                                    motion_out);
+}
+
+}  // namespace reprise::warp
+#endif
