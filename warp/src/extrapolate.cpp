@@ -127,6 +127,33 @@ void extrapolate_along_motion(const GBufferView& f, float s, float motion_scale,
 
 }  // namespace
 
+std::size_t static_layer(const GBufferView& f, const glm::mat4& to_view,
+                         const glm::mat4& to_projection, float tolerance,
+                         ImageView<float> depth_out, ImageView<glm::vec2> motion_out) {
+    const int w = f.width(), h = f.height();
+    // Where each pixel's surface was under the previous camera (camera-only motion) and where it
+    // is under the target one, both from the same view-space point.
+    const StaticReprojection to_previous = camera_only_motion(f.camera, w, h);
+    const StaticReprojection to_target(f.camera, to_view, to_projection, w, h);
+    const bool axis_aligned = to_previous.unprojector().axis_aligned();
+    const StaticLayerTest axis_aligned_test(to_previous, to_target, w, h, tolerance);
+    const float tolerance2 = tolerance * tolerance;
+    std::atomic<std::size_t> dynamic{0};
+    parallel_for(0, h, [&](int y0, int y1) {
+        std::size_t local = 0;
+        for (int y = y0; y < y1; ++y) {
+            if (axis_aligned)
+                local += static_layer_row(axis_aligned_test, y, w, f.depth.row(y), f.motion.row(y),
+                                          depth_out.row(y), motion_out.row(y));
+            else
+                local += classify_row(f, y, to_previous, to_target, tolerance2, depth_out.row(y),
+                                      motion_out.row(y));
+        }
+        dynamic += local;
+    });
+    return dynamic.load();
+}
+
 void extrapolate_frame(const GBufferView& f, float s, float motion_scale, const FrucOptions& options,
                        FrucScratch& scratch, Frame& out, FrucCounters& counters) {
     const int w = f.width(), h = f.height();
@@ -141,34 +168,15 @@ void extrapolate_frame(const GBufferView& f, float s, float motion_scale, const 
     previous.projection = c.prev_projection;
     previous.time = c.time - 1.0;
     const Camera future = camera_between(previous, c, 1.0f + s);
-    // Where each pixel's surface was under the previous camera (camera-only motion) and where it
-    // will be under the future one, both from the same view-space point.
-    const StaticReprojection to_previous = camera_only_motion(c, w, h);
-    const StaticReprojection to_future(c, future.view, future.projection, w, h);
-    const Unprojector& unproject = to_previous.unprojector();
-
     // Static layer: pixels whose motion the camera alone explains, moved to the future camera;
     // the others are left out (depth and motion NaN).
     scratch.layer_depth.resize(w, h);
     scratch.layer_motion.resize(w, h);
     const ImageView<float> layer_depth = scratch.layer_depth.view();
     const ImageView<glm::vec2> layer_motion = scratch.layer_motion.view();
-    std::atomic<std::size_t> dynamic{0};
-    const float tolerance2 = options.static_tolerance * options.static_tolerance;
-    const StaticLayerTest axis_aligned_test(to_previous, to_future, w, h,
-                                            options.static_tolerance);
-    parallel_for(0, h, [&](int y0, int y1) {
-        std::size_t local = 0;
-        for (int y = y0; y < y1; ++y) {
-            if (unproject.axis_aligned())
-                local += static_layer_row(axis_aligned_test, y, w, f.depth.row(y), f.motion.row(y),
-                                          layer_depth.row(y), layer_motion.row(y));
-            else
-                local += classify_row(f, y, to_previous, to_future, tolerance2, layer_depth.row(y),
-                                      layer_motion.row(y));
-        }
-        dynamic += local;
-    });
+    const std::size_t moving_pixels =
+        static_layer(f, future.view, future.projection, options.static_tolerance, layer_depth,
+                     layer_motion);
     const GBufferView layer{.color = f.color,
                             .depth = scratch.layer_depth.view(),
                             .motion = scratch.layer_motion.view(),
@@ -186,7 +194,6 @@ void extrapolate_frame(const GBufferView& f, float s, float motion_scale, const 
     // The static layer carried its displacement to the future; backward motion per period is
     // that displacement reversed and divided by s (0 where nothing landed).
     const float to_backward = -motion_scale / s;
-    const std::size_t moving_pixels = dynamic.load();
     parallel_for(0, h, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y) {
             glm::vec2* m = out.motion.data() + std::size_t(y) * w;

@@ -56,18 +56,26 @@ void interpolate_frame(const GBufferView& a, const GBufferView& b, float s, bool
 void extrapolate_frame(const GBufferView& f, float s, float motion_scale, const FrucOptions& options,
                        FrucScratch& scratch, Frame& out, FrucCounters& counters);
 
+// The static-layer test of f against its own previous camera: static pixels (the camera alone
+// explains their motion within `tolerance` px) keep their depth in depth_out and get their
+// displacement to the camera (to_view, to_projection) in motion_out; the others NaN in both.
+// Returns the number of others.
+std::size_t static_layer(const GBufferView& f, const glm::mat4& to_view,
+                         const glm::mat4& to_projection, float tolerance,
+                         ImageView<float> depth_out, ImageView<glm::vec2> motion_out);
+
 // The motion m for which p + factor * m is where pixel p of `f` is seen by camera `to`: exact
 // for what f's camera explains (static pixels, from depth and both cameras); elsewhere the
 // `inverted` motion where it is finite (may be empty), else f's own. Returns the moving pixels.
 std::size_t motion_toward(const GBufferView& f, const Camera& to, float factor,
                           ImageView<const glm::vec2> inverted, float tolerance,
-                          ImageView<glm::vec2> out);
+                          Image<float>& static_depth, ImageView<glm::vec2> out);
 
 // The later frame's moving pixels splatted to where they were in the earlier frame, carrying
 // their backward motion (nearest wins; NaN where none lands): the earlier frame's true forward
 // motion is its negation.
-void invert_motion(const GBufferView& b, float tolerance, Image<glm::vec2>& inverted,
-                   Image<float>& depth);
+void invert_motion(const GBufferView& b, float tolerance, Image<float>& static_depth,
+                   Image<glm::vec2>& inverted, Image<float>& depth);
 
 // True when every motion vector is exactly zero (and finite).
 bool motion_is_zero(const GBufferView& f);

@@ -140,13 +140,15 @@ void interpolate_frame(const GBufferView& a, const GBufferView& b, float s, bool
         !a.depth.empty() && !b.depth.empty()) {
         const Camera at = camera_between(a.camera, b.camera, s);
         scratch.true_b.resize(w, h);
-        motion_toward(b, at, 1.0f - s, {}, options.static_tolerance, scratch.true_b.view());
+        motion_toward(b, at, 1.0f - s, {}, options.static_tolerance, scratch.layer_depth,
+                      scratch.true_b.view());
         from_b.motion = scratch.true_b.view();
         if (use_a) {
-            invert_motion(b, options.static_tolerance, scratch.inverted, scratch.inverted_depth);
+            invert_motion(b, options.static_tolerance, scratch.layer_depth, scratch.inverted,
+                          scratch.inverted_depth);
             scratch.true_a.resize(w, h);
             motion_toward(a, at, -s, std::as_const(scratch.inverted).view(),
-                          options.static_tolerance, scratch.true_a.view());
+                          options.static_tolerance, scratch.layer_depth, scratch.true_a.view());
             from_a.motion = scratch.true_a.view();
         }
     }
