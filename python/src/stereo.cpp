@@ -111,7 +111,8 @@ void bind_stereo(py::module_& m) {
                 rendered.camera, make_rig(ipd, convergence, rig), make_anchor(rendered_eye));
             const Camera& target = rendered_eye == "left" ? eyes.right : eyes.left;
             Synthesizer s;
-            return s.synthesize(rendered, target, warp, fill, history)[0];
+            const py::tuple made = s.synthesize(rendered, target, warp, fill, history);
+            return py::object(made[0]);
         },
         py::arg("rendered"), py::arg("ipd") = 0.064f, py::arg("convergence") = 10.0f,
         py::arg("rig") = "parallel", py::arg("rendered_eye") = "left", py::arg("warp") = "grid",
