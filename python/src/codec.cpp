@@ -32,13 +32,20 @@ codec::EncoderOptions encoder_options(int qp, int bitrate_kbps, double fps, int 
                             .depth_error = depth_error,
                             .skip_threshold = skip_threshold,
                             .detect_cuts = detect_cuts};
-    if (chroma == "420") o.chroma = codec::Chroma::C420;
-    else if (chroma == "444") o.chroma = codec::Chroma::C444;
-    else value_error("chroma must be '420' or '444'");
-    if (depth == "lossless") o.depth = codec::DepthMode::Lossless;
-    else if (depth == "bounded") o.depth = codec::DepthMode::Bounded;
-    else if (depth == "none") o.depth = codec::DepthMode::None;
-    else value_error("depth must be 'lossless', 'bounded' or 'none'");
+    if (chroma == "420")
+        o.chroma = codec::Chroma::C420;
+    else if (chroma == "444")
+        o.chroma = codec::Chroma::C444;
+    else
+        value_error("chroma must be '420' or '444'");
+    if (depth == "lossless")
+        o.depth = codec::DepthMode::Lossless;
+    else if (depth == "bounded")
+        o.depth = codec::DepthMode::Bounded;
+    else if (depth == "none")
+        o.depth = codec::DepthMode::None;
+    else
+        value_error("depth must be 'lossless', 'bounded' or 'none'");
     return o;
 }
 
@@ -158,8 +165,8 @@ void bind_codec(py::module_& m) {
             if (frames.empty()) value_error("encode_stream: no frames");
             for (const Frame* f : frames)
                 if (!f) type_error("encode_stream: None in the frame list");
-            auto encoder = options_init(qp, bitrate_kbps, fps, keyint, chroma, depth,
-                                        depth_error, skip_threshold, detect_cuts);
+            auto encoder = options_init(qp, bitrate_kbps, fps, keyint, chroma, depth, depth_error,
+                                        skip_threshold, detect_cuts);
             std::vector<uint8_t> file;
             const double stream_fps = frames[0]->fps > 0.0 ? frames[0]->fps : fps;
             check(codec::write_stream_header(file, frames[0]->width(), frames[0]->height(),
@@ -170,10 +177,10 @@ void bind_codec(py::module_& m) {
             }
             return py::bytes(reinterpret_cast<const char*>(file.data()), file.size());
         },
-        py::arg("frames"), py::arg("qp") = 28, py::arg("bitrate_kbps") = 0,
-        py::arg("fps") = 30.0, py::arg("keyint") = 0, py::arg("chroma") = "420",
-        py::arg("depth") = "lossless", py::arg("depth_error") = 1e-4f,
-        py::arg("skip_threshold") = 2, py::arg("detect_cuts") = true,
+        py::arg("frames"), py::arg("qp") = 28, py::arg("bitrate_kbps") = 0, py::arg("fps") = 30.0,
+        py::arg("keyint") = 0, py::arg("chroma") = "420", py::arg("depth") = "lossless",
+        py::arg("depth_error") = 1e-4f, py::arg("skip_threshold") = 2,
+        py::arg("detect_cuts") = true,
         "A whole .rps stream (file header + packets) of the frames.");
     m.def(
         "decode_stream",

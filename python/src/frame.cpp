@@ -30,8 +30,8 @@ const char* rule(Values values) {
 // `height` < 0: the array sets the size. `alt_components`: another accepted last axis
 // (RGB for RGBA colour: alpha 1).
 template <class T>
-void assign_image(Image<T>& image, const py::handle& value, const char* what, int height,
-                  int width, Values values, int alt_components = 0) {
+void assign_image(Image<T>& image, const py::handle& value, const char* what, int height, int width,
+                  Values values, int alt_components = 0) {
     using L = PixelLayout<T>;
     using S = typename L::Scalar;
     const py::array raw = py::module_::import("numpy").attr("asarray")(value);
@@ -42,8 +42,8 @@ void assign_image(Image<T>& image, const py::handle& value, const char* what, in
                    (integral ? "an integer" : "a floating-point") + " array, got dtype " +
                    py::str(raw.dtype()).cast<std::string>());
     const int ndim = L::components > 1 ? 3 : 2;
-    std::string shape_text = "(height, width" +
-                             (L::components > 1 ? ", " + std::to_string(L::components) : "") + ")";
+    std::string shape_text =
+        "(height, width" + (L::components > 1 ? ", " + std::to_string(L::components) : "") + ")";
     if (raw.ndim() != ndim)
         value_error(std::string(what) + ": expected shape " + shape_text + ", got " +
                     std::to_string(raw.ndim()) + " dimensions");
@@ -122,8 +122,7 @@ template <class T>
 void channel(py::class_<Frame>& c, const char* name, Image<T> Frame::*member, Values values,
              const char* doc, int alt_components = 0) {
     c.def_property(
-        name,
-        [member](py::object self) { return image_array(self.cast<Frame&>().*member, self); },
+        name, [member](py::object self) { return image_array(self.cast<Frame&>().*member, self); },
         [member, name, values, alt_components](Frame& f, const py::object& value) {
             if (value.is_none()) {
                 if (!(f.*member).empty())
@@ -133,10 +132,11 @@ void channel(py::class_<Frame>& c, const char* name, Image<T> Frame::*member, Va
                 return;
             }
             constexpr bool is_color = std::is_same_v<T, glm::vec4>;
-            if (f.color.empty() && !is_color) value_error(std::string(name) + ": set the colour first");
+            if (f.color.empty() && !is_color)
+                value_error(std::string(name) + ": set the colour first");
             const bool sized = !is_color || !f.color.empty();
-            assign_image(f.*member, value, name, sized ? f.height() : -1,
-                         sized ? f.width() : -1, values, alt_components);
+            assign_image(f.*member, value, name, sized ? f.height() : -1, sized ? f.width() : -1,
+                         values, alt_components);
         },
         doc);
 }
@@ -214,7 +214,9 @@ void bind_frame(py::module_& m) {
         .def_readwrite("far", &Camera::far)
         .def_property(
             "jitter", [](const Camera& c) { return std::make_pair(c.jitter.x, c.jitter.y); },
-            [](Camera& c, std::pair<float, float> j) { c.jitter = {j.first, j.second}; })
+            [](Camera& c, std::pair<float, float> j) {
+                c.jitter = {j.first, j.second};
+            })
         .def_readwrite("time", &Camera::time)
         .def("__repr__", [](const Camera& c) {
             return "<reprise.Camera near=" + std::to_string(c.near) +
@@ -227,9 +229,9 @@ void bind_frame(py::module_& m) {
                             "uint32, camera and fps. Reading a channel gives a numpy view of the "
                             "frame's own buffer (no copy); assigning copies into it.");
     frame
-        .def(py::init([](const py::object& color, const py::object& depth,
-                         const py::object& motion, const py::object& normal,
-                         const py::object& id, const py::object& camera, double fps) {
+        .def(py::init([](const py::object& color, const py::object& depth, const py::object& motion,
+                         const py::object& normal, const py::object& id, const py::object& camera,
+                         double fps) {
                  Frame f;
                  assign_image(f.color, color, "color", -1, -1, Values::Finite, 3);
                  set_channels(f, depth, motion, normal, id);
@@ -245,9 +247,11 @@ void bind_frame(py::module_& m) {
         .def_property_readonly("height", &Frame::height)
         .def_property(
             "camera", [](Frame& f) -> Camera& { return f.camera; },
-            [](Frame& f, const Camera& c) { f.camera = c; }, py::return_value_policy::reference_internal)
+            [](Frame& f, const Camera& c) { f.camera = c; },
+            py::return_value_policy::reference_internal)
         .def_readwrite("fps", &Frame::fps)
-        .def("copy", [](const Frame& f) { return Frame(f); }, "A deep copy.")
+        .def(
+            "copy", [](const Frame& f) { return Frame(f); }, "A deep copy.")
         .def("__repr__", [](const Frame& f) {
             std::string channels = "color";
             if (!f.depth.empty()) channels += ",depth";

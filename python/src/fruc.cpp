@@ -10,17 +10,28 @@ namespace {
 warp::FrucOptions fruc_options(const std::string& mode, const std::string& warp_method,
                                const std::string& fill) {
     warp::FrucOptions o;
-    if (mode == "interpolate") o.mode = warp::FrucMode::Interpolate;
-    else if (mode == "extrapolate") o.mode = warp::FrucMode::Extrapolate;
-    else value_error("mode must be 'interpolate' or 'extrapolate', got '" + mode + "'");
-    if (warp_method == "grid") o.warp = warp::WarpMethod::Grid;
-    else if (warp_method == "reverse") o.warp = warp::WarpMethod::Reverse;
-    else if (warp_method == "splat") o.warp = warp::WarpMethod::Splat;
-    else value_error("warp must be 'grid', 'reverse' or 'splat', got '" + warp_method + "'");
-    if (fill == "pullpush") o.fill = warp::FillMethod::PullPush;
-    else if (fill == "andreev") o.fill = warp::FillMethod::Andreev;
-    else if (fill == "none") o.fill = warp::FillMethod::None;
-    else value_error("fill must be 'pullpush', 'andreev' or 'none', got '" + fill + "'");
+    if (mode == "interpolate")
+        o.mode = warp::FrucMode::Interpolate;
+    else if (mode == "extrapolate")
+        o.mode = warp::FrucMode::Extrapolate;
+    else
+        value_error("mode must be 'interpolate' or 'extrapolate', got '" + mode + "'");
+    if (warp_method == "grid")
+        o.warp = warp::WarpMethod::Grid;
+    else if (warp_method == "reverse")
+        o.warp = warp::WarpMethod::Reverse;
+    else if (warp_method == "splat")
+        o.warp = warp::WarpMethod::Splat;
+    else
+        value_error("warp must be 'grid', 'reverse' or 'splat', got '" + warp_method + "'");
+    if (fill == "pullpush")
+        o.fill = warp::FillMethod::PullPush;
+    else if (fill == "andreev")
+        o.fill = warp::FillMethod::Andreev;
+    else if (fill == "none")
+        o.fill = warp::FillMethod::None;
+    else
+        value_error("fill must be 'pullpush', 'andreev' or 'none', got '" + fill + "'");
     return o;
 }
 

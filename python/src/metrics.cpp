@@ -44,8 +44,7 @@ struct Inputs {
         const char kind = raw.dtype().kind();
         if (kind != 'b' && kind != 'u' && kind != 'i')
             type_error("mask: expected a bool or integer array");
-        if (raw.ndim() != 2 || raw.shape(0) != reference.height ||
-            raw.shape(1) != reference.width)
+        if (raw.ndim() != 2 || raw.shape(0) != reference.height || raw.shape(1) != reference.width)
             value_error("mask: expected shape (height, width) of the images");
         if (kind == 'b' || raw.dtype().itemsize() == 1)
             mask_storage = py::array_t<uint8_t, py::array::c_style | py::array::forcecast>::ensure(
@@ -109,11 +108,11 @@ void bind_metrics(py::module_& m) {
             },
             py::arg("reference"), py::arg("test"), py::arg("mask") = py::none(), doc);
     };
-    one("psnr",
-        [](auto r, auto t, auto k) { return psnr(r, t, k); },
+    one(
+        "psnr", [](auto r, auto t, auto k) { return psnr(r, t, k); },
         "PSNR in dB over RGB of two display images (H, W, 3); +inf when identical.");
-    one("ssim",
-        [](auto r, auto t, auto k) { return ssim(r, t, k); },
+    one(
+        "ssim", [](auto r, auto t, auto k) { return ssim(r, t, k); },
         "Mean SSIM over RGB of two display images (H, W, 3).");
     m.def(
         "flip",
@@ -125,8 +124,8 @@ void bind_metrics(py::module_& m) {
             py::array_t<float> map;
             ImageView<float> map_view;
             if (error_map) {
-                map = py::array_t<float>({py::ssize_t(in.reference.height),
-                                          py::ssize_t(in.reference.width)});
+                map = py::array_t<float>(
+                    {py::ssize_t(in.reference.height), py::ssize_t(in.reference.width)});
                 map_view = {map.mutable_data(), in.reference.width, in.reference.height,
                             in.reference.width};
             }

@@ -15,8 +15,8 @@ struct PyScene {
         Status status;
         {
             py::gil_scoped_release release;
-            status = server::load_scene(name, scene, path,
-                                        {.allow_outside_paths = allow_outside_paths});
+            status =
+                server::load_scene(name, scene, path, {.allow_outside_paths = allow_outside_paths});
         }
         check(status);
         if (!camera.empty()) set_camera(camera);
@@ -34,9 +34,12 @@ struct PyScene {
 server::RenderSettings settings(int width, int height, const std::string& shading) {
     check(check_image_size(width, height, "render size"));
     server::RenderSettings s{.width = width, .height = height};
-    if (shading == "lit") s.shading = server::Shading::Lit;
-    else if (shading == "unlit") s.shading = server::Shading::Unlit;
-    else value_error("shading must be 'lit' or 'unlit', got '" + shading + "'");
+    if (shading == "lit")
+        s.shading = server::Shading::Lit;
+    else if (shading == "unlit")
+        s.shading = server::Shading::Unlit;
+    else
+        value_error("shading must be 'lit' or 'unlit', got '" + shading + "'");
     return s;
 }
 
@@ -66,8 +69,8 @@ struct PyRenderer {
     }
     // The scene at `time` seen by `camera`; motion towards `prev_time` with the camera's
     // previous view and projection.
-    Frame render_camera(const PyScene& s, const Camera& camera, int width, int height,
-                        double time, double prev_time, const std::string& shading) {
+    Frame render_camera(const PyScene& s, const Camera& camera, int width, int height, double time,
+                        double prev_time, const std::string& shading) {
         server::Instant now{.time = time,
                             .view = camera.view,
                             .projection = camera.projection,
@@ -111,15 +114,14 @@ void bind_render(py::module_& m) {
     py::class_<PyRenderer>(m, "Renderer",
                            "Headless OpenGL ES renderer (a GPU's EGL device, or Mesa llvmpipe).")
         .def(py::init<>())
-        .def_property_readonly("device",
-                               [](const PyRenderer& r) { return r.renderer->device(); })
+        .def_property_readonly("device", [](const PyRenderer& r) { return r.renderer->device(); })
         .def("render", &PyRenderer::render, py::arg("scene"), py::arg("frame") = 0,
              py::arg("fps") = 30.0, py::arg("width") = 640, py::arg("height") = 360,
              py::arg("shading") = "lit",
              "Frame `frame` of the scene's camera path at `fps` (time = frame / fps).")
-        .def("render_sequence", &PyRenderer::render_sequence, py::arg("scene"),
-             py::arg("frames"), py::arg("start") = 0, py::arg("fps") = 30.0,
-             py::arg("width") = 640, py::arg("height") = 360, py::arg("shading") = "lit")
+        .def("render_sequence", &PyRenderer::render_sequence, py::arg("scene"), py::arg("frames"),
+             py::arg("start") = 0, py::arg("fps") = 30.0, py::arg("width") = 640,
+             py::arg("height") = 360, py::arg("shading") = "lit")
         .def("render_camera", &PyRenderer::render_camera, py::arg("scene"), py::arg("camera"),
              py::arg("width") = 640, py::arg("height") = 360, py::arg("time") = 0.0,
              py::arg("prev_time") = 0.0, py::arg("shading") = "lit",

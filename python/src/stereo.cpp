@@ -12,9 +12,12 @@ stereo::StereoRig make_rig(float ipd, float convergence, const std::string& rig)
     if (!std::isfinite(ipd) || !(convergence > 0.0f) || !std::isfinite(convergence))
         value_error("ipd must be finite and convergence > 0");
     stereo::StereoRig r{.ipd = ipd, .convergence = convergence};
-    if (rig == "parallel") r.rig = stereo::Rig::Parallel;
-    else if (rig == "offaxis") r.rig = stereo::Rig::OffAxis;
-    else value_error("rig must be 'parallel' or 'offaxis', got '" + rig + "'");
+    if (rig == "parallel")
+        r.rig = stereo::Rig::Parallel;
+    else if (rig == "offaxis")
+        r.rig = stereo::Rig::OffAxis;
+    else
+        value_error("rig must be 'parallel' or 'offaxis', got '" + rig + "'");
     return r;
 }
 
@@ -27,13 +30,20 @@ stereo::Anchor make_anchor(const std::string& anchor) {
 
 stereo::StereoOptions make_options(const std::string& warp_method, const std::string& fill) {
     stereo::StereoOptions o;
-    if (warp_method == "grid") o.warp = stereo::StereoWarp::Grid;
-    else if (warp_method == "splat") o.warp = stereo::StereoWarp::Splat;
-    else value_error("warp must be 'grid' or 'splat', got '" + warp_method + "'");
-    if (fill == "pullpush") o.fill = stereo::StereoFill::PullPush;
-    else if (fill == "andreev") o.fill = stereo::StereoFill::Andreev;
-    else if (fill == "none") o.fill = stereo::StereoFill::None;
-    else value_error("fill must be 'pullpush', 'andreev' or 'none', got '" + fill + "'");
+    if (warp_method == "grid")
+        o.warp = stereo::StereoWarp::Grid;
+    else if (warp_method == "splat")
+        o.warp = stereo::StereoWarp::Splat;
+    else
+        value_error("warp must be 'grid' or 'splat', got '" + warp_method + "'");
+    if (fill == "pullpush")
+        o.fill = stereo::StereoFill::PullPush;
+    else if (fill == "andreev")
+        o.fill = stereo::StereoFill::Andreev;
+    else if (fill == "none")
+        o.fill = stereo::StereoFill::None;
+    else
+        value_error("fill must be 'pullpush', 'andreev' or 'none', got '" + fill + "'");
     return o;
 }
 
@@ -95,8 +105,7 @@ void bind_stereo(py::module_& m) {
                             "frames of one size.")
         .def(py::init<>())
         .def("synthesize", &Synthesizer::synthesize, py::arg("rendered"), py::arg("target"),
-             py::arg("warp") = "grid", py::arg("fill") = "pullpush",
-             py::arg("history") = nullptr,
+             py::arg("warp") = "grid", py::arg("fill") = "pullpush", py::arg("history") = nullptr,
              "(frame, stats): the view of camera `target` from `rendered` (colour, depth, "
              "camera); `history` (e.g. the previous frame's other eye) fills holes first.");
 
