@@ -517,6 +517,52 @@ TEST_F(ExrTest, BlenderWithoutOptionalPassesAndWithAView) {
     EXPECT_TRUE(f.motion.empty());
 }
 
+TEST_F(ExrTest, BlenderLayoutWritesBlenderNamesAndReadsBack) {
+    Frame written = full_frame(9, 7, 4);
+    // Values the layout converts: finite depth and motion, ids a float holds exactly.
+    for (std::size_t i = 0; i < written.color.pixel_count(); ++i) {
+        written.depth.data()[i] = i % 7 == 0 ? std::numeric_limits<float>::infinity() : 0.5f + i;
+        written.motion.data()[i] = {0.25f * float(i), -1.5f + float(i % 3)};
+        written.id.data()[i] = uint32_t(i % 11);
+    }
+    ASSERT_TRUE(write_frame(path("b.exr"), written, {.layout = ExrLayout::Blender}).ok());
+    FrameHeader header;
+    ASSERT_TRUE(read_frame_header(path("b.exr"), header).ok());
+    EXPECT_TRUE(header.blender);
+    const std::vector<std::string> expected = {
+        "ViewLayer.Combined.R", "ViewLayer.Combined.A", "ViewLayer.Depth.Z", "ViewLayer.Vector.X",
+        "ViewLayer.Vector.W",   "ViewLayer.Normal.Z",   "ViewLayer.IndexOB.X"};
+    for (const std::string& name : expected)
+        EXPECT_NE(std::find(header.channels.begin(), header.channels.end(), name),
+                  header.channels.end())
+            << name;
+    for (const char* name : {"R", "Z", "motion.x", "N.X", "id"})
+        EXPECT_EQ(std::find(header.channels.begin(), header.channels.end(), name),
+                  header.channels.end())
+            << name;
+
+    // Blender's conventions in the file: background depth 1e10, vector +y up.
+    auto in = OIIO::ImageInput::open(path("b.exr"));
+    ASSERT_TRUE(in);
+    const OIIO::ImageSpec& spec = in->spec();
+    std::vector<float> pixels(std::size_t(spec.width) * spec.height * spec.nchannels);
+    ASSERT_TRUE(in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeFloat, pixels.data()));
+    const int z = spec.channelindex("ViewLayer.Depth.Z"), vy = spec.channelindex("ViewLayer.Vector.Y");
+    EXPECT_EQ(pixels[z], 1e10f);
+    EXPECT_EQ(pixels[spec.nchannels + vy], -written.motion.data()[1].y);
+
+    Frame read;
+    const Status s = read_frame(path("b.exr"), read);
+    ASSERT_TRUE(s.ok()) << s.message();
+    EXPECT_TRUE(same_bits(read.color, written.color));
+    EXPECT_TRUE(same_bits(read.depth, written.depth));
+    EXPECT_TRUE(same_bits(read.motion, written.motion));
+    EXPECT_TRUE(same_bits(read.normal, written.normal));
+    EXPECT_TRUE(same_bits(read.id, written.id));
+    EXPECT_TRUE(same_bits(read.camera.view, written.camera.view));
+    EXPECT_EQ(read.fps, written.fps);
+}
+
 TEST_F(ExrTest, SequenceIsSortedWithFps) {
     Frame f = full_frame(4, 3, 13);
     f.fps = 24.0;

@@ -18,6 +18,7 @@ struct FrucJob {
     std::string in, out;
     int factor = 2;
     std::string mode = "interpolate", warp = "grid", fill = "pullpush";
+    std::string layout = "reprise";
 };
 
 Status run_fruc(const FrucJob& job) {
@@ -25,6 +26,11 @@ Status run_fruc(const FrucJob& job) {
     if (job.out.empty()) return Status::error("--out DIR is required");
     warp::FrucOptions options;
     REPRISE_TRY(parse_fruc_options(job.mode, job.warp, job.fill, options));
+    WriteOptions write;
+    if (job.layout == "blender")
+        write.layout = ExrLayout::Blender;
+    else if (job.layout != "reprise")
+        return Status::error("--layout must be reprise or blender, not '" + job.layout + "'");
     Sequence sequence;
     REPRISE_TRY(open_sequence(job.in, sequence));
     std::error_code ec;
@@ -56,7 +62,7 @@ Status run_fruc(const FrucJob& job) {
         auto start = std::chrono::steady_clock::now();
         REPRISE_TRY(converter.send(in));
         busy_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-        while (converter.receive(out)) REPRISE_TRY(write_frame(frame_path(job.out, written++), out));
+        while (converter.receive(out)) REPRISE_TRY(write_frame(frame_path(job.out, written++), out, write));
         std::fprintf(stderr, "\r[fruc] %zu/%zu input frames, %d written", i + 1, n, written);
     }
     const warp::FrucCounters& c = converter.counters();
@@ -86,6 +92,9 @@ int command_fruc(int argc, char** argv) {
     args.option("--warp", &job.warp, "reverse | splat | grid (default grid)");
     args.option("--fill", &job.fill, "pullpush | andreev | none (default pullpush)");
     args.option("--out", &job.out, "output folder");
+    args.option("--layout", &job.layout,
+                "EXR channel names: reprise | blender (ViewLayer.Combined.R..., opens in "
+                "Blender)");
     Status parsed = args.parse(argc, argv);
     if (!parsed.ok() || args.help_requested()) return report(args, parsed, {});
     if (job.in.empty()) return report(args, Status::error("fruc: --in DIR is required"), {});

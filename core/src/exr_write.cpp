@@ -21,19 +21,91 @@ namespace fs = std::filesystem;
 
 static_assert(sizeof(glm::vec4) == 16 && sizeof(glm::vec3) == 12 && sizeof(glm::vec2) == 8);
 
+// How a value is changed on its way into the file (Blender's conventions).
+enum class Convert {
+    None,
+    Negate,           // Blender's vector pass has +y up
+    InfToBackground,  // Cycles marks background depth with 1e10
+    UintToFloat,      // Blender's IndexOB pass is float
+};
+
 // One file channel: a 4-byte component of one of the Frame's buffers.
 struct Source {
     const char* name;
     OIIO::TypeDesc type;
     const unsigned char* first;  // the component in pixel 0
     std::size_t stride;          // bytes from one pixel to the next
+    Convert convert = Convert::None;
 };
 
 template <class T>
-Source source(const char* name, const Image<T>& image, int component) {
-    const bool is_uint = std::is_same_v<T, uint32_t>;
+Source source(const char* name, const Image<T>& image, int component,
+              Convert convert = Convert::None) {
+    const bool is_uint = std::is_same_v<T, uint32_t> && convert != Convert::UintToFloat;
     return {name, is_uint ? OIIO::TypeUInt : OIIO::TypeFloat,
-            reinterpret_cast<const unsigned char*>(image.data()) + 4 * component, sizeof(T)};
+            reinterpret_cast<const unsigned char*>(image.data()) + 4 * component, sizeof(T),
+            convert};
+}
+
+void copy_value(const unsigned char* from, unsigned char* to, Convert convert) {
+    if (convert == Convert::None) {
+        std::memcpy(to, from, 4);
+        return;
+    }
+    float v;
+    if (convert == Convert::UintToFloat) {
+        uint32_t u;
+        std::memcpy(&u, from, 4);
+        v = float(u);
+    } else {
+        std::memcpy(&v, from, 4);
+        if (convert == Convert::Negate) v = -v;
+        if (convert == Convert::InfToBackground && v >= 1e10f) v = 1e10f;
+    }
+    std::memcpy(to, &v, 4);
+}
+
+std::vector<Source> reprise_sources(const Frame& frame) {
+    std::vector<Source> sources = {source("R", frame.color, 0), source("G", frame.color, 1),
+                                   source("B", frame.color, 2), source("A", frame.color, 3)};
+    if (!frame.depth.empty()) sources.push_back(source("Z", frame.depth, 0));
+    if (!frame.motion.empty()) {
+        sources.push_back(source("motion.x", frame.motion, 0));
+        sources.push_back(source("motion.y", frame.motion, 1));
+    }
+    if (!frame.normal.empty()) {
+        sources.push_back(source("N.X", frame.normal, 0));
+        sources.push_back(source("N.Y", frame.normal, 1));
+        sources.push_back(source("N.Z", frame.normal, 2));
+    }
+    if (!frame.id.empty()) sources.push_back(source("id", frame.id, 0));
+    return sources;
+}
+
+// Blender's Vector pass holds (previous - current) in X,Y and (current - next) in Z,W; a frame
+// knows only the first, so Z,W repeat it (constant velocity).
+std::vector<Source> blender_sources(const Frame& frame) {
+    std::vector<Source> sources = {
+        source("ViewLayer.Combined.R", frame.color, 0),
+        source("ViewLayer.Combined.G", frame.color, 1),
+        source("ViewLayer.Combined.B", frame.color, 2),
+        source("ViewLayer.Combined.A", frame.color, 3)};
+    if (!frame.depth.empty())
+        sources.push_back(source("ViewLayer.Depth.Z", frame.depth, 0, Convert::InfToBackground));
+    if (!frame.motion.empty()) {
+        sources.push_back(source("ViewLayer.Vector.X", frame.motion, 0));
+        sources.push_back(source("ViewLayer.Vector.Y", frame.motion, 1, Convert::Negate));
+        sources.push_back(source("ViewLayer.Vector.Z", frame.motion, 0));
+        sources.push_back(source("ViewLayer.Vector.W", frame.motion, 1, Convert::Negate));
+    }
+    if (!frame.normal.empty()) {
+        sources.push_back(source("ViewLayer.Normal.X", frame.normal, 0));
+        sources.push_back(source("ViewLayer.Normal.Y", frame.normal, 1));
+        sources.push_back(source("ViewLayer.Normal.Z", frame.normal, 2));
+    }
+    if (!frame.id.empty())
+        sources.push_back(source("ViewLayer.IndexOB.X", frame.id, 0, Convert::UintToFloat));
+    return sources;
 }
 
 // glm stores a column-vector matrix column by column; Imath's M44f is the row-vector transpose
@@ -68,7 +140,7 @@ glm::mat4 exr_world_to_ndc(const glm::mat4& projection, const glm::mat4& view) {
     return clip_to_ndc * projection * view;
 }
 
-Status write_frame(const std::string& path, const Frame& frame) {
+Status write_frame(const std::string& path, const Frame& frame, const WriteOptions& options) {
     const int width = frame.width();
     const int height = frame.height();
     if (frame.color.empty()) return Status::error(path + ": cannot write a frame without colour");
@@ -84,19 +156,8 @@ Status write_frame(const std::string& path, const Frame& frame) {
     REPRISE_TRY(same_size(frame.normal, "normal"));
     REPRISE_TRY(same_size(frame.id, "id"));
 
-    std::vector<Source> sources = {source("R", frame.color, 0), source("G", frame.color, 1),
-                                   source("B", frame.color, 2), source("A", frame.color, 3)};
-    if (!frame.depth.empty()) sources.push_back(source("Z", frame.depth, 0));
-    if (!frame.motion.empty()) {
-        sources.push_back(source("motion.x", frame.motion, 0));
-        sources.push_back(source("motion.y", frame.motion, 1));
-    }
-    if (!frame.normal.empty()) {
-        sources.push_back(source("N.X", frame.normal, 0));
-        sources.push_back(source("N.Y", frame.normal, 1));
-        sources.push_back(source("N.Z", frame.normal, 2));
-    }
-    if (!frame.id.empty()) sources.push_back(source("id", frame.id, 0));
+    const bool blender = options.layout == ExrLayout::Blender;
+    const std::vector<Source> sources = blender ? blender_sources(frame) : reprise_sources(frame);
 
     OIIO::ImageSpec spec(width, height, int(sources.size()), OIIO::TypeFloat);
     spec.channelnames.clear();
@@ -106,6 +167,7 @@ Status write_frame(const std::string& path, const Frame& frame) {
     }
     spec.alpha_channel = 3;
     spec.z_channel = frame.depth.empty() ? -1 : 4;
+    if (blender) spec.attribute("BlenderMultiChannel", "Blender V2.55.1 and newer");
     spec.attribute("compression", "zip");
 
     const Camera& camera = frame.camera;
@@ -145,7 +207,7 @@ Status write_frame(const std::string& path, const Frame& frame) {
             const unsigned char* from = s.first + first * s.stride;
             unsigned char* to = strip.data() + 4 * c;
             for (std::size_t i = 0; i < count; ++i)
-                std::memcpy(to + i * pixel_bytes, from + i * s.stride, 4);
+                copy_value(from + i * s.stride, to + i * pixel_bytes, s.convert);
         }
         if (!out->write_scanlines(y0, y1, 0, OIIO::TypeUnknown, strip.data()))
             return fail(out->geterror());

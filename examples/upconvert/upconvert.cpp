@@ -16,8 +16,8 @@ reprise::Status upconvert(const std::string& in_dir, const std::string& out_dir,
     std::filesystem::create_directories(out_dir, error);
     if (error) return reprise::Status::error(out_dir + ": " + error.message());
 
-    reprise::warp::FrameRateConverter converter(
-        2, {.mode = reprise::warp::FrucMode::Interpolate, .fill = reprise::warp::FillMethod::PullPush});
+    reprise::warp::FrameRateConverter converter(2, {.mode = reprise::warp::FrucMode::Interpolate,
+                                                    .fill = reprise::warp::FillMethod::PullPush});
     reprise::Frame in, out;
     for (const std::string& file : sequence.files) {
         REPRISE_TRY(reprise::read_frame(file, in));

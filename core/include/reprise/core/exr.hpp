@@ -7,10 +7,23 @@
 
 namespace reprise {
 
-// Writes R,G,B,A,Z,motion.x,motion.y,N.X,N.Y,N.Z,id (absent buffers are left out) and the camera:
-// worldToCamera, worldToNDC and the reprise:* attributes of docs/exr_format.md. Writes a
-// temporary file beside `path` and renames it, so a failed write never leaves a broken frame.
-Status write_frame(const std::string& path, const Frame& frame);
+enum class ExrLayout {
+    Reprise,  // R,G,B,A,Z,motion.x,motion.y,N.X,N.Y,N.Z,id
+    // Blender's multilayer render names, which Blender (and Nuke, oiiotool) open as layers:
+    // ViewLayer.Combined.R/G/B/A, ViewLayer.Depth.Z (background 1e10), ViewLayer.Vector.X/Y/Z/W
+    // (+y up; Z,W = X,Y), ViewLayer.Normal.X/Y/Z, ViewLayer.IndexOB.X (float).
+    Blender,
+};
+
+struct WriteOptions {
+    ExrLayout layout = ExrLayout::Reprise;
+};
+
+// Writes the frame's buffers (absent buffers are left out) with the channel names of
+// `options.layout`, and the camera: worldToCamera, worldToNDC and the reprise:* attributes of
+// docs/exr_format.md. Writes a temporary file beside `path` and renames it, so a failed write
+// never leaves a broken frame. read_frame reads both layouts back to the same Frame.
+Status write_frame(const std::string& path, const Frame& frame, const WriteOptions& options = {});
 
 // Reads a reprise frame or a Blender multilayer EXR render (Combined, Depth, Vector, Normal,
 // IndexOB passes, converted to reprise's conventions). Every buffer is checked: a missing colour,

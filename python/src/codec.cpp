@@ -1,0 +1,208 @@
+// The scene-aware codec: frames to packets (bytes) and back.
+#include <pybind11/stl.h>
+
+#include <span>
+
+#include "common.hpp"
+#include "reprise/codec/codec.hpp"
+
+namespace reprise::python {
+namespace {
+
+// A bytes-like object's bytes, in place.
+std::span<const uint8_t> byte_span(const py::buffer& data, py::buffer_info& info) {
+    info = data.request();
+    if (info.ndim != 1 || info.itemsize != 1 || (info.ndim == 1 && info.strides[0] != 1))
+        type_error("expected a contiguous bytes-like object");
+    return {static_cast<const uint8_t*>(info.ptr), std::size_t(info.size)};
+}
+
+codec::EncoderOptions encoder_options(int qp, int bitrate_kbps, double fps, int keyint,
+                                      const std::string& chroma, const std::string& depth,
+                                      float depth_error, int skip_threshold, bool detect_cuts) {
+    if (qp < 0 || qp > 51) value_error("qp must be in 0..51");
+    if (bitrate_kbps < 0) value_error("bitrate_kbps must be >= 0");
+    if (!(fps > 0.0 && fps <= 10000.0)) value_error("fps must be in (0, 10000]");
+    if (keyint < 0) value_error("keyint must be >= 0");
+    if (skip_threshold < 0 || skip_threshold > 255) value_error("skip_threshold must be in 0..255");
+    codec::EncoderOptions o{.qp = qp,
+                            .bitrate_kbps = bitrate_kbps,
+                            .fps = fps,
+                            .keyint = keyint,
+                            .depth_error = depth_error,
+                            .skip_threshold = skip_threshold,
+                            .detect_cuts = detect_cuts};
+    if (chroma == "420")
+        o.chroma = codec::Chroma::C420;
+    else if (chroma == "444")
+        o.chroma = codec::Chroma::C444;
+    else
+        value_error("chroma must be '420' or '444'");
+    if (depth == "lossless")
+        o.depth = codec::DepthMode::Lossless;
+    else if (depth == "bounded")
+        o.depth = codec::DepthMode::Bounded;
+    else if (depth == "none")
+        o.depth = codec::DepthMode::None;
+    else
+        value_error("depth must be 'lossless', 'bounded' or 'none'");
+    return o;
+}
+
+py::dict stats_dict(const codec::StreamStats& s) {
+    py::dict d;
+    d["frames"] = s.frames;
+    d["key_frames"] = s.key_frames;
+    d["older_reference"] = s.older_reference;
+    d["header_bits"] = s.header_bits;
+    d["camera_bits"] = s.camera_bits;
+    d["depth_bits"] = s.depth_bits;
+    d["motion_bits"] = s.motion_bits;
+    d["color_bits"] = s.color_bits;
+    d["total_bits"] = s.total_bits();
+    d["blocks"] = s.blocks;
+    d["blocks_skipped"] = s.blocks_skipped;
+    d["intra_blocks"] = s.intra_blocks;
+    return d;
+}
+
+struct PyEncoder {
+    explicit PyEncoder(const codec::EncoderOptions& options) : encoder(options) {}
+
+    py::bytes encode(const Frame& frame) {
+        Status status;
+        codec::Packet packet;
+        {
+            py::gil_scoped_release release;
+            status = encoder.send_frame(frame);
+            if (status.ok() && encoder.receive_packet(packet) != codec::Result::Ok)
+                status = Status::error("encoder: no packet for the frame");
+        }
+        check(status);
+        return py::bytes(reinterpret_cast<const char*>(packet.data.data()), packet.data.size());
+    }
+    codec::Encoder encoder;
+};
+
+struct PyDecoder {
+    explicit PyDecoder(int64_t max_pixels) : decoder({.max_pixels = max_pixels}) {}
+
+    std::optional<Frame> decode(const py::buffer& packet) {
+        py::buffer_info info;
+        const std::span<const uint8_t> bytes = byte_span(packet, info);
+        Status status;
+        Frame frame;
+        bool made = false;
+        {
+            py::gil_scoped_release release;
+            status = decoder.send_packet(bytes);
+            if (status.ok()) made = decoder.receive_frame(frame) == codec::Result::Ok;
+        }
+        check(status);
+        if (!made) return std::nullopt;
+        return frame;
+    }
+    codec::Decoder decoder;
+};
+
+}  // namespace
+
+void bind_codec(py::module_& m) {
+    auto options_init = [](int qp, int bitrate_kbps, double fps, int keyint,
+                           const std::string& chroma, const std::string& depth, float depth_error,
+                           int skip_threshold, bool detect_cuts) {
+        return std::make_unique<PyEncoder>(encoder_options(qp, bitrate_kbps, fps, keyint, chroma,
+                                                           depth, depth_error, skip_threshold,
+                                                           detect_cuts));
+    };
+    py::class_<PyEncoder>(m, "Encoder",
+                          "Scene-aware predictive encoder: one packet (bytes) per frame "
+                          "(docs/bitstream.md).")
+        .def(py::init(options_init), py::arg("qp") = 28, py::arg("bitrate_kbps") = 0,
+             py::arg("fps") = 30.0, py::arg("keyint") = 0, py::arg("chroma") = "420",
+             py::arg("depth") = "lossless", py::arg("depth_error") = 1e-4f,
+             py::arg("skip_threshold") = 2, py::arg("detect_cuts") = true)
+        .def("encode", &PyEncoder::encode, py::arg("frame"), "The packet of the next frame.")
+        .def("request_key_frame", [](PyEncoder& e) { e.encoder.request_key_frame(); })
+        .def_property_readonly(
+            "reconstruction", [](const PyEncoder& e) { return e.encoder.reconstruction(); },
+            "What the decoder holds after the last packet (a copy).")
+        .def_property_readonly("stats",
+                               [](const PyEncoder& e) { return stats_dict(e.encoder.stats()); })
+        .def_property_readonly("last_qp", [](const PyEncoder& e) { return e.encoder.last_qp(); });
+
+    py::class_<PyDecoder>(m, "Decoder",
+                          "Decodes packets; a bad packet raises reprise.Error and the decoder "
+                          "stays usable.")
+        .def(py::init<int64_t>(), py::arg("max_pixels") = int64_t(8192) * 4320)
+        .def("decode", &PyDecoder::decode, py::arg("packet"),
+             "The frame of one packet (bytes-like), or None when it needs more.")
+        .def_property_readonly("stats",
+                               [](const PyDecoder& d) { return stats_dict(d.decoder.stats()); });
+
+    m.def(
+        "inspect_packet",
+        [](const py::buffer& packet) {
+            py::buffer_info info;
+            const std::span<const uint8_t> bytes = byte_span(packet, info);
+            codec::Packet p;
+            int64_t timestamp_us = 0;
+            check(codec::inspect_packet(bytes, p, timestamp_us));
+            py::dict d;
+            d["frame"] = p.frame;
+            d["reference"] = p.reference;
+            d["key"] = p.type == codec::PacketType::Key;
+            d["timestamp_us"] = timestamp_us;
+            return d;
+        },
+        py::arg("packet"), "Header of one packet (length, version and CRC checked).");
+
+    m.def(
+        "encode_stream",
+        [options_init](const std::vector<const Frame*>& frames, int qp, int bitrate_kbps,
+                       double fps, int keyint, const std::string& chroma, const std::string& depth,
+                       float depth_error, int skip_threshold, bool detect_cuts) {
+            if (frames.empty()) value_error("encode_stream: no frames");
+            for (const Frame* f : frames)
+                if (!f) type_error("encode_stream: None in the frame list");
+            auto encoder = options_init(qp, bitrate_kbps, fps, keyint, chroma, depth, depth_error,
+                                        skip_threshold, detect_cuts);
+            std::vector<uint8_t> file;
+            const double stream_fps = frames[0]->fps > 0.0 ? frames[0]->fps : fps;
+            check(codec::write_stream_header(file, frames[0]->width(), frames[0]->height(),
+                                             stream_fps));
+            for (const Frame* f : frames) {
+                const std::string packet = encoder->encode(*f);
+                file.insert(file.end(), packet.begin(), packet.end());
+            }
+            return py::bytes(reinterpret_cast<const char*>(file.data()), file.size());
+        },
+        py::arg("frames"), py::arg("qp") = 28, py::arg("bitrate_kbps") = 0, py::arg("fps") = 30.0,
+        py::arg("keyint") = 0, py::arg("chroma") = "420", py::arg("depth") = "lossless",
+        py::arg("depth_error") = 1e-4f, py::arg("skip_threshold") = 2,
+        py::arg("detect_cuts") = true,
+        "A whole .rps stream (file header + packets) of the frames.");
+    m.def(
+        "decode_stream",
+        [](const py::buffer& data) {
+            py::buffer_info info;
+            const std::span<const uint8_t> bytes = byte_span(data, info);
+            codec::StreamInfo stream;
+            std::vector<std::span<const uint8_t>> packets;
+            check(codec::split_stream(bytes, stream, packets));
+            codec::Decoder decoder;
+            std::vector<Frame> frames;
+            for (const auto& packet : packets) {
+                check(decoder.send_packet(packet));
+                Frame f;
+                while (decoder.receive_frame(f) == codec::Result::Ok) {
+                    if (f.fps <= 0.0) f.fps = stream.fps;
+                    frames.push_back(std::move(f));
+                }
+            }
+            return frames;
+        },
+        py::arg("data"), "The frames of a whole .rps stream (bytes-like).");
+}
+
+}  // namespace reprise::python

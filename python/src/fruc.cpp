@@ -1,0 +1,107 @@
+// FrameRateConverter: frames in, K times as many out.
+#include <pybind11/stl.h>
+
+#include "common.hpp"
+#include "reprise/warp/fruc.hpp"
+
+namespace reprise::python {
+namespace {
+
+warp::FrucOptions fruc_options(const std::string& mode, const std::string& warp_method,
+                               const std::string& fill) {
+    warp::FrucOptions o;
+    if (mode == "interpolate")
+        o.mode = warp::FrucMode::Interpolate;
+    else if (mode == "extrapolate")
+        o.mode = warp::FrucMode::Extrapolate;
+    else
+        value_error("mode must be 'interpolate' or 'extrapolate', got '" + mode + "'");
+    if (warp_method == "grid")
+        o.warp = warp::WarpMethod::Grid;
+    else if (warp_method == "reverse")
+        o.warp = warp::WarpMethod::Reverse;
+    else if (warp_method == "splat")
+        o.warp = warp::WarpMethod::Splat;
+    else
+        value_error("warp must be 'grid', 'reverse' or 'splat', got '" + warp_method + "'");
+    if (fill == "pullpush")
+        o.fill = warp::FillMethod::PullPush;
+    else if (fill == "andreev")
+        o.fill = warp::FillMethod::Andreev;
+    else if (fill == "none")
+        o.fill = warp::FillMethod::None;
+    else
+        value_error("fill must be 'pullpush', 'andreev' or 'none', got '" + fill + "'");
+    return o;
+}
+
+struct Converter {
+    Converter(int factor, const std::string& mode, const std::string& warp_method,
+              const std::string& fill)
+        : converter(checked(factor), fruc_options(mode, warp_method, fill)) {}
+
+    static int checked(int factor) {
+        if (factor < 1 || factor > 16) value_error("factor must be in 1..16");
+        return factor;
+    }
+
+    void send(const Frame& frame) {
+        Status status;
+        {
+            py::gil_scoped_release release;
+            status = converter.send(frame);
+        }
+        check(status);
+    }
+    std::optional<Frame> receive() {
+        Frame out;
+        if (!converter.receive(out)) return std::nullopt;
+        return out;
+    }
+    std::vector<Frame> convert(const std::vector<const Frame*>& frames) {
+        std::vector<Frame> out;
+        for (const Frame* f : frames) {
+            if (!f) type_error("convert: None in the frame list");
+            send(*f);
+            while (auto made = receive()) out.push_back(std::move(*made));
+        }
+        return out;
+    }
+    py::dict counters() const {
+        const warp::FrucCounters& c = converter.counters();
+        py::dict d;
+        d["inputs"] = c.inputs;
+        d["outputs"] = c.outputs;
+        d["copied_still"] = c.copied_still;
+        d["fills"] = c.fills;
+        d["fills_skipped"] = c.fills_skipped;
+        d["hole_pixels"] = c.hole_pixels;
+        d["dynamic_layers"] = c.dynamic_layers;
+        d["dynamic_skipped"] = c.dynamic_skipped;
+        d["cuts"] = c.cuts;
+        d["grid_cells"] = c.grid_cells;
+        return d;
+    }
+
+    warp::FrameRateConverter converter;
+};
+
+}  // namespace
+
+void bind_fruc(py::module_& m) {
+    py::class_<Converter>(m, "FrameRateConverter",
+                          "Frame-rate upconversion, K output frames per input frame. "
+                          "interpolate: after each frame (but the first), the K-1 frames "
+                          "between it and its predecessor, then the frame itself; extrapolate: "
+                          "the frame, then K-1 frames beyond it.")
+        .def(py::init<int, const std::string&, const std::string&, const std::string&>(),
+             py::arg("factor") = 2, py::arg("mode") = "interpolate", py::arg("warp") = "grid",
+             py::arg("fill") = "pullpush")
+        .def("send", &Converter::send, py::arg("frame"), "Feeds the next rendered frame.")
+        .def("receive", &Converter::receive, "The next output frame, or None.")
+        .def("convert", &Converter::convert, py::arg("frames"),
+             "Sends each frame and returns every output frame made.")
+        .def_property_readonly("counters", &Converter::counters);
+}
+
+}  // namespace reprise::python

@@ -1,0 +1,132 @@
+// The second eye from one rendered eye.
+#include <pybind11/stl.h>
+
+#include "common.hpp"
+#include "reprise/stereo/rig.hpp"
+#include "reprise/stereo/synthesize.hpp"
+
+namespace reprise::python {
+namespace {
+
+stereo::StereoRig make_rig(float ipd, float convergence, const std::string& rig) {
+    if (!std::isfinite(ipd) || !(convergence > 0.0f) || !std::isfinite(convergence))
+        value_error("ipd must be finite and convergence > 0");
+    stereo::StereoRig r{.ipd = ipd, .convergence = convergence};
+    if (rig == "parallel")
+        r.rig = stereo::Rig::Parallel;
+    else if (rig == "offaxis")
+        r.rig = stereo::Rig::OffAxis;
+    else
+        value_error("rig must be 'parallel' or 'offaxis', got '" + rig + "'");
+    return r;
+}
+
+stereo::Anchor make_anchor(const std::string& anchor) {
+    if (anchor == "centre" || anchor == "center") return stereo::Anchor::Centre;
+    if (anchor == "left") return stereo::Anchor::Left;
+    if (anchor == "right") return stereo::Anchor::Right;
+    value_error("anchor must be 'centre', 'left' or 'right', got '" + anchor + "'");
+}
+
+stereo::StereoOptions make_options(const std::string& warp_method, const std::string& fill) {
+    stereo::StereoOptions o;
+    if (warp_method == "grid")
+        o.warp = stereo::StereoWarp::Grid;
+    else if (warp_method == "splat")
+        o.warp = stereo::StereoWarp::Splat;
+    else
+        value_error("warp must be 'grid' or 'splat', got '" + warp_method + "'");
+    if (fill == "pullpush")
+        o.fill = stereo::StereoFill::PullPush;
+    else if (fill == "andreev")
+        o.fill = stereo::StereoFill::Andreev;
+    else if (fill == "none")
+        o.fill = stereo::StereoFill::None;
+    else
+        value_error("fill must be 'pullpush', 'andreev' or 'none', got '" + fill + "'");
+    return o;
+}
+
+// The synthesizer asserts colour and depth of one size; from Python that is a ValueError.
+void require_colour_and_depth(const Frame& f, const char* what) {
+    if (f.color.empty() || f.depth.empty())
+        value_error(std::string(what) + ": needs colour and depth");
+    if (f.depth.width() != f.width() || f.depth.height() != f.height())
+        value_error(std::string(what) + ": depth size differs from colour");
+}
+
+py::dict stats_dict(const stereo::StereoStats& s) {
+    py::dict d;
+    d["covered"] = s.covered;
+    d["holes"] = s.holes;
+    d["from_history"] = s.from_history;
+    d["filled"] = s.filled;
+    d["unfilled"] = s.unfilled;
+    d["cells"] = s.cells;
+    return d;
+}
+
+struct Synthesizer {
+    py::tuple synthesize(const Frame& rendered, const Camera& target, const std::string& warp,
+                         const std::string& fill, const Frame* history) {
+        require_colour_and_depth(rendered, "rendered");
+        if (history) require_colour_and_depth(*history, "history");
+        const stereo::StereoOptions options = make_options(warp, fill);
+        Frame out;
+        out.fps = rendered.fps;
+        stereo::StereoStats stats;
+        {
+            py::gil_scoped_release release;
+            stats = synthesizer.synthesize(rendered, target, out, options, history);
+        }
+        return py::make_tuple(std::move(out), stats_dict(stats));
+    }
+    stereo::StereoSynthesizer synthesizer;
+};
+
+}  // namespace
+
+void bind_stereo(py::module_& m) {
+    m.def(
+        "eye_cameras",
+        [](const Camera& camera, float ipd, float convergence, const std::string& rig,
+           const std::string& anchor) {
+            const stereo::EyeCameras eyes =
+                stereo::eye_cameras(camera, make_rig(ipd, convergence, rig), make_anchor(anchor));
+            return py::make_tuple(eyes.left, eyes.right);
+        },
+        py::arg("camera"), py::arg("ipd") = 0.064f, py::arg("convergence") = 10.0f,
+        py::arg("rig") = "parallel", py::arg("anchor") = "centre",
+        "(left, right) cameras of a stereo rig around `camera` (anchor 'centre'), or with "
+        "`camera` as the left/right eye.");
+
+    py::class_<Synthesizer>(m, "StereoSynthesizer",
+                            "Makes another view from a rendered one; keeps its scratch between "
+                            "frames of one size.")
+        .def(py::init<>())
+        .def("synthesize", &Synthesizer::synthesize, py::arg("rendered"), py::arg("target"),
+             py::arg("warp") = "grid", py::arg("fill") = "pullpush", py::arg("history") = nullptr,
+             "(frame, stats): the view of camera `target` from `rendered` (colour, depth, "
+             "camera); `history` (e.g. the previous frame's other eye) fills holes first.");
+
+    m.def(
+        "synthesize_eye",
+        [](const Frame& rendered, float ipd, float convergence, const std::string& rig,
+           const std::string& rendered_eye, const std::string& warp, const std::string& fill,
+           const Frame* history) {
+            if (rendered_eye != "left" && rendered_eye != "right")
+                value_error("rendered_eye must be 'left' or 'right'");
+            const stereo::EyeCameras eyes = stereo::eye_cameras(
+                rendered.camera, make_rig(ipd, convergence, rig), make_anchor(rendered_eye));
+            const Camera& target = rendered_eye == "left" ? eyes.right : eyes.left;
+            Synthesizer s;
+            const py::tuple made = s.synthesize(rendered, target, warp, fill, history);
+            return py::object(made[0]);
+        },
+        py::arg("rendered"), py::arg("ipd") = 0.064f, py::arg("convergence") = 10.0f,
+        py::arg("rig") = "parallel", py::arg("rendered_eye") = "left", py::arg("warp") = "grid",
+        py::arg("fill") = "pullpush", py::arg("history") = nullptr,
+        "The other eye of a rendered eye (its camera is that eye's).");
+}
+
+}  // namespace reprise::python

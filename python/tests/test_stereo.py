@@ -1,0 +1,34 @@
+"""The second eye from one rendered eye, against the rendered second eye."""
+import numpy as np
+import pytest
+
+import reprise
+from conftest import SIZE, psnr
+
+
+def test_synthesized_eye_is_close_to_the_rendered_one(renderer, pan_60):
+    left = pan_60[2]
+    left_camera, right_camera = reprise.eye_cameras(left.camera, ipd=0.2, anchor="left")
+    assert np.array_equal(left_camera.view, left.camera.view)
+    assert right_camera.view[0, 3] != left_camera.view[0, 3]
+    scene = reprise.Scene("pan")
+    truth = renderer.render_camera(scene, right_camera, time=left.camera.time,
+                                   prev_time=left.camera.time - 1 / 60, **SIZE)
+    made, stats = reprise.StereoSynthesizer().synthesize(left, right_camera)
+    assert stats["covered"] > 0.9 * left.width * left.height
+    same = reprise.synthesize_eye(left, ipd=0.2, rendered_eye="left")
+    assert np.array_equal(same.color, made.color)
+    print(f"synthesized right eye {psnr(truth, made):.2f} dB, left eye as is "
+          f"{psnr(truth, left):.2f} dB")
+    assert psnr(truth, made) > psnr(truth, left) + 3.0
+    assert psnr(truth, made) > 28.0
+
+
+def test_bad_stereo_input_raises(pan_60):
+    no_depth = reprise.Frame(np.zeros((4, 4, 4)))
+    with pytest.raises(ValueError, match="depth"):
+        reprise.synthesize_eye(no_depth)
+    with pytest.raises(ValueError, match="rig"):
+        reprise.synthesize_eye(pan_60[0], rig="crossed")
+    with pytest.raises(ValueError, match="history"):
+        reprise.StereoSynthesizer().synthesize(pan_60[0], pan_60[0].camera, history=no_depth)
