@@ -63,7 +63,9 @@ void main() {
     vec3 n = dot(v_normal, v_normal) > 0.0 ? normalize(gl_FrontFacing ? v_normal : -v_normal)
                                            : vec3(0.0, 0.0, 1.0);
     vec4 base = u_base_color;
-    if (u_textured) base *= texture(u_texture, v_uv, u_lod_bias);
+    // llvmpipe takes another filtering path for an explicit bias, even 0: full-resolution renders
+    // keep the plain lookup.
+    if (u_textured) base *= u_lod_bias != 0.0 ? texture(u_texture, v_uv, u_lod_bias) : texture(u_texture, v_uv);
     vec3 color = base.rgb;
     if (u_lit) {
         vec3 l = -normalize(u_light_direction);
