@@ -65,8 +65,10 @@ TEST_P(FrucMethods, InterpolationBeatsFrameRepetition) {
     const std::vector<Frame> input = render("pan", 30.0, 0, 4);
     const std::vector<Frame> truth = render("pan", 60.0, 0, 7);
     FrucOptions options{.mode = FrucMode::Interpolate, .warp = GetParam().warp, .fill = GetParam().fill};
-    std::vector<Frame> out = convert(input, 2, options);
+    FrucCounters counters;
+    std::vector<Frame> out = convert(input, 2, options, &counters);
     ASSERT_EQ(out.size(), 7u);
+    EXPECT_EQ(counters.linear_motion, 3u) << "a straight pan of still objects needs no true motion";
     for (int i = 1; i < 7; i += 2) {
         double ours = psnr_of(truth[i], out[i]), repeat = psnr_of(truth[i], input[i / 2]);
         std::printf("[fruc] %s frame %d: %.2f dB (repeating the previous frame: %.2f dB)\n",
@@ -181,9 +183,11 @@ TEST(FrucTrueMotion, CurvedMotionIsFollowedBetterThanLinearMotion) {
         double psnr[2];
         for (bool exact : {false, true}) {
             const FrucOptions options{.mode = FrucMode::Interpolate, .true_motion = exact};
-            const std::vector<Frame> out = convert(input, 2, options);
+            FrucCounters counters;
+            const std::vector<Frame> out = convert(input, 2, options, &counters);
             ASSERT_EQ(out.size(), 3u);
             psnr[exact] = psnr_of(truth, out[1]);
+            EXPECT_EQ(counters.true_motion, exact ? 1u : 0u) << "an orbit is not linear";
         }
         std::printf("[fruc] %s, orbit at 2 rad/s, 10 -> 20 Hz: true motion %.2f dB, linear %.2f dB\n",
                     scene_name, psnr[1], psnr[0]);

@@ -71,10 +71,12 @@ Status run_fruc(const FrucJob& job) {
                 job.factor, job.warp.c_str(), job.fill.c_str(), c.inputs, written, job.out.c_str());
     std::printf("  made %zu frames, %.2f ms each (without file I/O)\n", c.outputs,
                 c.outputs ? busy_ms / double(c.outputs) : 0.0);
-    std::printf("  skipped: %zu still frames copied, %zu fills (no holes), %zu dynamic layers (nothing moving)\n",
-                c.copied_still, c.fills_skipped, c.dynamic_skipped);
-    std::printf("  done: %zu fills (%zu hole pixels), %zu dynamic layers, %zu grid cells, %zu cuts\n",
-                c.fills, c.hole_pixels, c.dynamic_layers, c.grid_cells, c.cuts);
+    std::printf("  skipped: %zu still frames copied, %zu fills (no holes), %zu dynamic layers (nothing moving), "
+                "%zu true-motion passes (linear motion)\n",
+                c.copied_still, c.fills_skipped, c.dynamic_skipped, c.linear_motion);
+    std::printf("  done: %zu fills (%zu hole pixels), %zu dynamic layers, %zu grid cells, %zu cuts, "
+                "%zu true-motion frames\n",
+                c.fills, c.hole_pixels, c.dynamic_layers, c.grid_cells, c.cuts, c.true_motion);
     return {};
 }
 

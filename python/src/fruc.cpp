@@ -80,6 +80,8 @@ struct Converter {
         d["dynamic_skipped"] = c.dynamic_skipped;
         d["cuts"] = c.cuts;
         d["grid_cells"] = c.grid_cells;
+        d["true_motion"] = c.true_motion;
+        d["linear_motion"] = c.linear_motion;
         return d;
     }
 

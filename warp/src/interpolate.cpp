@@ -136,9 +136,14 @@ void interpolate_frame(const GBufferView& a, const GBufferView& b, float s, bool
     const WarpTarget into_out{out.color.view(), out.depth.view(), out.motion.view(),
                               scratch.side_b.covered.view()};
     GBufferView from_a = a, from_b = b;
-    if (options.true_motion && has_projection(a.camera) && has_projection(b.camera) &&
-        !a.depth.empty() && !b.depth.empty()) {
-        const Camera at = camera_between(a.camera, b.camera, s);
+    const bool cameras = options.true_motion && has_projection(a.camera) &&
+                         has_projection(b.camera) && !a.depth.empty() && !b.depth.empty();
+    const Camera at = cameras ? camera_between(a.camera, b.camera, s) : Camera{};
+    const bool linear = cameras && motion_is_linear(b, at, 1.0f - s, options.static_tolerance) &&
+                        (!use_a || motion_is_linear(a, at, -s, options.static_tolerance));
+    counters.linear_motion += linear;
+    if (cameras && !linear) {
+        ++counters.true_motion;
         scratch.true_b.resize(w, h);
         motion_toward(b, at, 1.0f - s, {}, options.static_tolerance, scratch.layer_depth,
                       scratch.true_b.view());

@@ -4,6 +4,7 @@
 #include <limits>
 
 #include "fruc_stages.hpp"
+#include "reprise/core/camera_math.hpp"
 #include "reprise/core/parallel.hpp"
 
 namespace reprise::warp {
@@ -13,6 +14,30 @@ namespace {
 bool finite(glm::vec2 m) { return std::isfinite(m.x) && std::isfinite(m.y); }
 
 }  // namespace
+
+bool motion_is_linear(const GBufferView& f, const Camera& to, float factor, float tolerance) {
+    constexpr int kStep = 8;            // every 8th pixel of every 8th row
+    constexpr float kDeviation = 0.02f;  // px between the true and the linear landing
+    const int w = f.width(), h = f.height();
+    const StaticReprojection to_previous = camera_only_motion(f.camera, w, h);
+    const StaticReprojection to_instant(f.camera, to.view, to.projection, w, h);
+    const Unprojector& unproject = to_previous.unprojector();
+    for (int y = kStep / 2; y < h; y += kStep)
+        for (int x = kStep / 2; x < w; x += kStep) {
+            const glm::vec2 p(float(x) + 0.5f, float(y) + 0.5f), m = f.motion(x, y);
+            const float z = f.depth(x, y);
+            if (std::isnan(z)) continue;
+            const glm::vec4 point = unproject.point(p.x, p.y, z);
+            glm::vec2 before, landed;
+            if (!finite(m) || !to_previous.land(point, before) || !to_instant.land(point, landed))
+                return false;
+            const glm::vec2 unexplained = before - p - m, off_line = landed - (p + factor * m);
+            if (glm::dot(unexplained, unexplained) > tolerance * tolerance ||
+                glm::dot(off_line, off_line) > kDeviation * kDeviation)
+                return false;
+        }
+    return true;
+}
 
 std::size_t motion_toward(const GBufferView& f, const Camera& to, float factor,
                           ImageView<const glm::vec2> inverted, float tolerance,

@@ -52,6 +52,8 @@ struct FrucCounters {
     std::size_t dynamic_skipped = 0;  // no dynamic pixels: no dynamic layer
     std::size_t cuts = 0;             // shot changes detected
     std::size_t grid_cells = 0;       // adaptive-grid cells drawn
+    std::size_t true_motion = 0;      // in-between frames whose sides followed the true motion
+    std::size_t linear_motion = 0;    // ... that did not need it: a sparse survey found it linear
 };
 
 // The camera between or beyond two instants: view matrices blended as rigid motions (rotation
