@@ -97,18 +97,25 @@ std::size_t classify_row_axis_aligned(const GBufferView& f, int y,
 
 void extrapolate_frame(const GBufferView& f, float s, float motion_scale, const FrucOptions& options,
                        FrucScratch& scratch, Frame& out, FrucCounters& counters) {
-    const int w = f.width(), h = f.height();
-    const float nan = std::numeric_limits<float>::quiet_NaN();
     const Camera& c = f.camera;
     Camera previous = c;
     previous.view = c.prev_view;
     previous.projection = c.prev_projection;
     previous.time = c.time - 1.0;
     const Camera future = camera_between(previous, c, 1.0f + s);
+    extrapolate_to_camera(f, future.view, future.projection, s, motion_scale, options, scratch, out, counters);
+}
+
+void extrapolate_to_camera(const GBufferView& f, const glm::mat4& future_view, const glm::mat4& future_projection,
+                           float s, float motion_scale, const FrucOptions& options, FrucScratch& scratch,
+                           Frame& out, FrucCounters& counters) {
+    const int w = f.width(), h = f.height();
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    const Camera& c = f.camera;
     // Where each pixel's surface was under the previous camera (camera-only motion) and where it
     // will be under the future one, both from the same view-space point.
     const StaticReprojection to_previous = camera_only_motion(c, w, h);
-    const StaticReprojection to_future(c, future.view, future.projection, w, h);
+    const StaticReprojection to_future(c, future_view, future_projection, w, h);
     const Unprojector& unproject = to_previous.unprojector();
 
     // Static layer: pixels whose motion the camera alone explains, moved to the future camera;
@@ -147,7 +154,8 @@ void extrapolate_frame(const GBufferView& f, float s, float motion_scale, const 
 
     // The static layer carried its displacement to the future; backward motion per period is
     // that displacement reversed and divided by s (0 where nothing landed).
-    const float to_backward = -motion_scale / s;
+    // s = 0 (the frame's own instant, another camera): no time passed, no motion to report.
+    const float to_backward = s > 1e-6f ? -motion_scale / s : 0.0f;
     const std::size_t moving_pixels = dynamic.load();
     parallel_for(0, h, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y) {

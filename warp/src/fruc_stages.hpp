@@ -53,6 +53,12 @@ void interpolate_frame(const GBufferView& a, const GBufferView& b, float s, bool
 void extrapolate_frame(const GBufferView& f, float s, float motion_scale, const FrucOptions& options,
                        FrucScratch& scratch, Frame& out, FrucCounters& counters);
 
+// The same towards an explicit camera (view, projection): the static layer lands where that
+// camera sees it, moving objects go s periods along their motion (constant screen velocity).
+void extrapolate_to_camera(const GBufferView& f, const glm::mat4& future_view, const glm::mat4& future_projection,
+                           float s, float motion_scale, const FrucOptions& options, FrucScratch& scratch,
+                           Frame& out, FrucCounters& counters);
+
 // True when every motion vector is exactly zero (and finite).
 bool motion_is_zero(const GBufferView& f);
 
