@@ -79,6 +79,8 @@ public:
     SecureChannel() = default;
     SecureChannel(uint64_t connection, const Key& send_key, const Key& receive_key);
     ~SecureChannel();
+    SecureChannel(const SecureChannel&) = default;
+    SecureChannel& operator=(const SecureChannel&) = default;
 
     // Seals `plaintext` (<= kMaxPlaintext) into `datagram` (resized; <= 1200 bytes).
     void seal(std::span<const uint8_t> plaintext, std::vector<uint8_t>& datagram);
@@ -88,6 +90,7 @@ public:
 
     uint64_t connection() const { return connection_; }
     uint64_t sent() const { return next_send_ - 1; }
+    uint64_t newest_received() const { return window_.newest(); }
 
 private:
     uint64_t connection_ = 0;
