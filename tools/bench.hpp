@@ -31,6 +31,9 @@ struct BenchOptions {
     std::string speed_size = "1920x1080";   // the speed ratios' size
     std::string speed_scene = "pan";
     int speed_frames = 10;                  // 0 = no speed run
+    // bench stream
+    double stream_duration = 4.0;           // seconds per condition
+    double display_rate = 120.0;
 };
 
 // A scene, its camera path and a renderer: what every benchmark that renders starts from.
@@ -58,5 +61,10 @@ Status bench_stereo(const BenchOptions& options);
 // 1080p; issue 8's targets as met / not met: OUT/codec.csv, bd_rate.csv, depth.csv, speed.csv,
 // index.html.
 Status bench_codec(const BenchOptions& options);
+// The remote-rendering loop on loopback under injected faults (loss, burst, jitter, delay, a
+// bandwidth cap): latency, bitrate, displayed-frame error and freezes of reprise's extrapolating
+// client beside frame repetition and an x264 video-only model: OUT/stream.csv,
+// stream_summary.csv, index.html.
+Status bench_stream(const BenchOptions& options);
 
 }  // namespace reprise::cli

@@ -129,8 +129,8 @@ int command_bench(int argc, char** argv) {
               "error against run time\nfor every setting beside ffmpeg minterpolate and OpenCV DIS flow "
               "(CSV + HTML report in --out).\nstereo: the synthesized second eye against the rendered one, naive DIBR peers and the "
               "renderer's\nsecond-eye time (CSV + HTML report in --out). paths: whole made frames at display "
-              "rate against cv::remap.\ncodec: reprise's codec beside x264, x265 and SVT-AV1\n(bits, PSNR/SSIM/FLIP, ms, BD-rates, depth coders, 1080p speed; CSV + HTML report in --out).");
-    args.positional("WHAT", &job.what, "render | exr | reproject | grid | fill | paths | fruc | stereo | codec");
+              "rate against cv::remap.\ncodec: reprise's codec beside x264, x265 and SVT-AV1\n(bits, PSNR/SSIM/FLIP, ms, BD-rates, depth coders, 1080p speed; CSV + HTML report in --out).\nstream: the remote-rendering loop under injected faults (latency, bitrate, displayed error; --quick: 3 conditions).");
+    args.positional("WHAT", &job.what, "render | exr | reproject | grid | fill | paths | fruc | stereo | codec | stream");
     args.option("--scene", &job.scene, "scene to render (default pan)");
     args.option("--frames", &job.frames, "frames per size (default 10); fruc: input frames (default 20); stereo: frames per scene (at most 5)");
     args.option("--sizes", &job.sizes, "comma-separated WxH list (default 640x360,1920x1080)");
@@ -147,12 +147,15 @@ int command_bench(int argc, char** argv) {
     args.option("--speed-size", &job.speed_size, "codec: size of the speed run (default 1920x1080)");
     args.option("--speed-scene", &job.speed_scene, "codec: scene of the speed run (default pan)");
     args.option("--speed-frames", &job.speed_frames, "codec: frames of the speed run (default 10, 0 = none)");
+    args.option("--duration", &job.stream_duration, "stream: seconds per condition (default 4)");
+    args.option("--display-rate", &job.display_rate, "stream: display frames per second (default 120)");
     args.flag("--exr", &job.exr, "fruc: also write the rendered input and truth as EXR under OUT/SCENE/");
     Status parsed = args.parse(argc, argv);
     if (!parsed.ok() || args.help_requested()) return report(args, parsed, {});
     if (job.what == "fruc" && !args.given("--frames")) job.frames = 20;  // reaches the cut at 0.5 s
     if (job.what == "codec" && !args.given("--frames")) job.frames = 30;
     if (job.what == "codec" && !args.given("--size")) job.size = "1280x720";
+    if (job.what == "stream" && !args.given("--size")) job.size = "256x144";
     Status result;
     if (job.frames < 1 || job.frames > 100000) result = Status::error("bench: --frames must be in 1..100000");
     else if (job.what == "render") result = bench_render(job);
@@ -164,8 +167,9 @@ int command_bench(int argc, char** argv) {
     else if (job.what == "fruc") result = bench_fruc(job);
     else if (job.what == "stereo") result = bench_stereo(job);
     else if (job.what == "codec") result = bench_codec(job);
+    else if (job.what == "stream") result = bench_stream(job);
     else result = Status::error("bench: unknown benchmark '" + job.what +
-                                "' (render, exr, reproject, grid, fill, paths, fruc, stereo, codec)");
+                                "' (render, exr, reproject, grid, fill, paths, fruc, stereo, codec, stream)");
     return report(args, parsed, result);
 }
 
