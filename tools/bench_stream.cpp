@@ -150,6 +150,8 @@ struct StreamBench {
         REPRISE_TRY(served);
         const server::StreamServerStats sst = srv->stats();
         const client::StreamClientStats cst = client->stats();
+        std::fprintf(stderr, "[bench stream] %s: server sent %zu frames, skipped %zu; client decoded %zu, %zu decode errors, %zu key requests\n",
+                     c.name.c_str(), sst.frames_sent, sst.frames_skipped, cst.frames_decoded, cst.decode_errors, cst.key_frame_requests);
         if (ticks.empty()) return Status::error("bench stream: " + c.name + ": nothing was displayed");
         const double seconds = duration;
 

@@ -26,7 +26,8 @@ struct StreamServerOptions {
     net::StreamMode mode = net::StreamMode::Full;
     int max_sessions = 4;
     bool loopback_only = false;    // refuse a non-loopback listen address (tests)
-    codec::EncoderOptions encoder{.qp = 28};
+    // Depth within 0.1 % (relative) is plenty for reprojection and costs a fifth of lossless.
+    codec::EncoderOptions encoder{.qp = 28, .depth = codec::DepthMode::Bounded, .depth_error = 1e-3f};
     // Bitrate adaptation: > 0 starts rate control there and moves it within [min, max] by the
     // client's loss reports; 0 keeps constant quality (encoder.qp).
     int bitrate_kbps = 0, min_bitrate_kbps = 100, max_bitrate_kbps = 50000;
