@@ -3,7 +3,8 @@
 // to its newest pose. Per condition: motion-to-photon latency, bitrate, PSNR/SSIM/FLIP of what
 // was displayed against the scene rendered at the displayed poses and instants, longest freeze.
 // Peers from the same run: frame repetition (the newest decoded frame shown as it is) and the
-// video-only model (x264 zerolatency of the same full-resolution frames, newest decoded shown).
+// video-only model (x264 zerolatency of the same full-resolution frames at crf 23 and 15, newest
+// decoded shown).
 #include <algorithm>
 #include <atomic>
 #include <cmath>
@@ -157,8 +158,8 @@ struct StreamBench {
 
         MethodSummary ours{c.name, "reprise", sst.bytes_sent * 8.0 / seconds / 1000.0};
         MethodSummary repeat{c.name, "repetition", ours.kbps};
-        MethodSummary video{c.name, "x264-video-only"};
-        for (MethodSummary* m : {&ours, &repeat, &video}) {
+        MethodSummary video{c.name, "x264-crf23"}, video_fine{c.name, "x264-crf15"};
+        for (MethodSummary* m : {&ours, &repeat, &video, &video_fine}) {
             m->frames_lost = cst.frames_lost;
             m->fec_recovered = cst.fec_recovered;
             m->decoded = cst.frames_decoded;
@@ -181,8 +182,8 @@ struct StreamBench {
             }
         }
         longest = std::max(longest, ticks.back().t - freeze_start);
-        for (MethodSummary* m : {&ours, &repeat, &video}) m->longest_freeze_ms = longest * 1000.0;
-        video.latency_ms = repeat.latency_ms;
+        for (MethodSummary* m : {&ours, &repeat, &video, &video_fine}) m->longest_freeze_ms = longest * 1000.0;
+        video.latency_ms = video_fine.latency_ms = repeat.latency_ms;
 
         // The video-only peer: the same source frames (rendered at their poses) through x264.
         std::vector<double> source_times;
@@ -197,12 +198,18 @@ struct StreamBench {
             sources.emplace_back(width, height);
             visualize_color(truth.color.view(), sources.back().view());
         }
-        std::vector<PeerFrame> x264;
+        // Two rate points: x264's usual crf 23 and a finer one near reprise's bitrate.
+        std::vector<PeerFrame> x264, x264_fine;
         REPRISE_TRY(encode_decode_peer(sources, {.kind = PeerKind::X264, .preset = "veryfast", .crf = 23}, fps, x264));
-        std::size_t x264_bytes = 0;
-        for (const PeerFrame& p : x264) x264_bytes += p.bytes;
+        REPRISE_TRY(encode_decode_peer(sources, {.kind = PeerKind::X264, .preset = "veryfast", .crf = 15}, fps, x264_fine));
         // The peer sends one frame per server period while the stream runs.
-        video.kbps = x264.empty() ? 0.0 : x264_bytes * 8.0 / (double(x264.size()) / fps) / 1000.0;
+        auto kbps = [&](const std::vector<PeerFrame>& frames) {
+            std::size_t bytes = 0;
+            for (const PeerFrame& p : frames) bytes += p.bytes;
+            return frames.empty() ? 0.0 : bytes * 8.0 / (double(frames.size()) / fps) / 1000.0;
+        };
+        video.kbps = kbps(x264);
+        video_fine.kbps = kbps(x264_fine);
 
         Image<glm::vec3> reference, shown;
         Image<Rgb8> truth_rgb(width, height);
@@ -214,9 +221,10 @@ struct StreamBench {
             from_rgb8(truth_rgb.view(), reference);
             const std::size_t si = std::lower_bound(source_times.begin(), source_times.end(), k.source_time) -
                                    source_times.begin();
-            const Image<Rgb8>* candidates[3] = {&k.ours, &k.repeated, si < x264.size() ? &x264[si].decoded : nullptr};
-            MethodSummary* methods[3] = {&ours, &repeat, &video};
-            for (int m = 0; m < 3; ++m) {
+            const Image<Rgb8>* candidates[4] = {&k.ours, &k.repeated, si < x264.size() ? &x264[si].decoded : nullptr,
+                                                si < x264_fine.size() ? &x264_fine[si].decoded : nullptr};
+            MethodSummary* methods[4] = {&ours, &repeat, &video, &video_fine};
+            for (int m = 0; m < 4; ++m) {
                 if (!candidates[m]) continue;
                 from_rgb8(candidates[m]->view(), shown);
                 const ImageError e = image_error(reference.view(), shown.view());
@@ -228,7 +236,7 @@ struct StreamBench {
             }
             ++index;
         }
-        for (MethodSummary* m : {&ours, &repeat, &video}) {
+        for (MethodSummary* m : {&ours, &repeat, &video, &video_fine}) {
             const ImageError e = mean_error(m->errors);
             std::printf("%-16s %-16s %9.0f %7.2f %7.4f %8.2f %8.2f %8.2f %9.0f %6zu %6zu\n", c.name.c_str(),
                         m->method.c_str(), m->kbps, e.psnr, e.flip, mean_of(m->latency_ms),
@@ -281,8 +289,8 @@ Status bench_stream(const BenchOptions& options) {
             strf("%g", b.display_rate) + " Hz, " + strf("%g", b.duration) +
             " s per condition on loopback with the in-process fault injector on both directions.",
         "reprise: every display frame extrapolated from the newest decoded frame to the newest pose. repetition: "
-        "the newest decoded frame shown as it is (same stream). x264-video-only: the same source frames through "
-        "x264 veryfast zerolatency crf 23, shown when our stream had them (same arrival times and losses; x264's "
+        "the newest decoded frame shown as it is (same stream). x264-crf23 / x264-crf15 (the video-only model): the same source frames through "
+        "x264 veryfast zerolatency at crf 23 and 15, shown when our stream had them (same arrival times and losses; x264's "
         "error propagation after a loss is not modelled, which favours it).",
         "Latency: pose sampled -> displayed, for reprise the pose each display frame was warped to, for the peers "
         "the pose of the frame the first time it is shown. Truth: the scene rendered at each displayed pose and "
