@@ -53,6 +53,7 @@ struct Session {
     int64_t newest_sent = -1, newest_acked = -1;
     uint32_t report_received = 0, report_missing = 0;
     int bitrate_kbps = 0;
+    int64_t min_rtt_us = 0;
     bool ended = false;
 
     Session(net::Endpoint p, uint64_t connection, const net::SessionKeys& keys, const codec::EncoderOptions& eo)
@@ -312,11 +313,16 @@ struct StreamServer::State {
         s.report_missing = m.missing;
         if (received + missing == 0) return;
         const double loss = double(missing) / double(received + missing);
+        if (m.rtt_us > 0) s.min_rtt_us = s.min_rtt_us > 0 ? std::min<int64_t>(s.min_rtt_us, m.rtt_us) : m.rtt_us;
         if (s.bitrate_kbps > 0) {
+            // Loss-based as in WebRTC's GCC (above 10 % back off, below 2 % probe upwards, hold
+            // between), plus a delay signal: a round trip grown 50 % over its minimum (queues
+            // building up) backs off too.
             double next = s.bitrate_kbps;
-            if (loss > 0.10) next *= 0.7;
-            else if (loss > 0.02) next *= 0.9;
-            else next *= 1.05;
+            const bool queueing = s.min_rtt_us > 0 && m.rtt_us > s.min_rtt_us * 3 / 2 + 5000;
+            if (loss > 0.10) next *= 1.0 - 0.5 * loss;
+            else if (queueing) next *= 0.9;
+            else if (loss < 0.02) next *= 1.05;
             s.bitrate_kbps = std::clamp(int(next), options.min_bitrate_kbps, options.max_bitrate_kbps);
             s.encoder.set_bitrate(s.bitrate_kbps);
         }

@@ -22,7 +22,7 @@ struct StreamClientOptions {
     bool extrapolate = true;          // false: show the newest decoded frame (frame repetition)
     bool inject_faults = false;       // put the in-process fault injector on both directions
     net::FaultOptions uplink, downlink;
-    double reconnect_after_s = 1.0;   // silence from the server that ends the connection
+    double reconnect_after_s = 2.0;   // silence from the server that ends the connection
     int max_auth_failures = 3;        // key confirmations failed in a row before giving up
 };
 
