@@ -66,5 +66,10 @@ Status bench_codec(const BenchOptions& options);
 // client beside frame repetition and an x264 video-only model: OUT/stream.csv,
 // stream_summary.csv, index.html.
 Status bench_stream(const BenchOptions& options);
+// Spatio-temporal upsampling (Herzog 2010) of low-resolution jittered colour against the full
+// render, beside cv::resize, a jitter-aware warpAffine and joint bilateral upsampling, per scene
+// and factor (--factor 2|4, default both); ms per 1080p frame against cv::remap:
+// OUT/upsample.csv, OUT/speed.csv, OUT/index.html, OUT/SCENE_1ofF.png.
+Status bench_upsample(const BenchOptions& options);
 
 }  // namespace reprise::cli

@@ -129,24 +129,24 @@ int command_bench(int argc, char** argv) {
               "error against run time\nfor every setting beside ffmpeg minterpolate and OpenCV DIS flow "
               "(CSV + HTML report in --out).\nstereo: the synthesized second eye against the rendered one, naive DIBR peers and the "
               "renderer's\nsecond-eye time (CSV + HTML report in --out). paths: whole made frames at display "
-              "rate against cv::remap.\ncodec: reprise's codec beside x264, x265 and SVT-AV1\n(bits, PSNR/SSIM/FLIP, ms, BD-rates, depth coders, 1080p speed; CSV + HTML report in --out).\nstream: the remote-rendering loop under injected faults (latency, bitrate, displayed error; --quick: 3 conditions).");
-    args.positional("WHAT", &job.what, "render | exr | reproject | grid | fill | paths | fruc | stereo | codec | stream");
+              "rate against cv::remap.\ncodec: reprise's codec beside x264, x265 and SVT-AV1\n(bits, PSNR/SSIM/FLIP, ms, BD-rates, depth coders, 1080p speed; CSV + HTML report in --out).\nupsample: Herzog spatio-temporal upsampling of 1/2 or 1/4 of the pixels against the full render,\nbeside cv::resize, warpAffine and joint bilateral peers; ms per 1080p frame against cv::remap (CSV + HTML).\nstream: the remote-rendering loop under injected faults (latency, bitrate, displayed error; --quick: 3 conditions).");
+    args.positional("WHAT", &job.what, "render | exr | reproject | grid | fill | paths | fruc | stereo | codec | upsample | stream");
     args.option("--scene", &job.scene, "scene to render (default pan)");
-    args.option("--frames", &job.frames, "frames per size (default 10); fruc: input frames (default 20); stereo: frames per scene (at most 5)");
+    args.option("--frames", &job.frames, "frames per size (default 10); fruc: input frames (default 20); stereo: frames per scene (at most 5); upsample: frames per scene (default 12)");
     args.option("--sizes", &job.sizes, "comma-separated WxH list (default 640x360,1920x1080)");
     args.option("--dir", &job.dir, "exr: folder for the files (default: the temp folder)");
-    args.option("--out", &job.out, "fruc, stereo, codec: report folder (default out/bench-WHAT)");
-    args.option("--scenes", &job.scenes, "fruc, stereo, codec: comma-separated scenes (default: every built-in scene)");
-    args.option("--factor", &job.factor, "fruc: K, output frames per input frame (default 2)");
-    args.option("--size", &job.size, "fruc, stereo: WxH (default 640x360); codec: default 1280x720");
+    args.option("--out", &job.out, "fruc, stereo, codec, upsample: report folder (default out/bench-WHAT)");
+    args.option("--scenes", &job.scenes, "fruc, stereo, codec, upsample: comma-separated scenes (default: every built-in scene)");
+    args.option("--factor", &job.factor, "fruc: K, output frames per input frame (default 2); upsample: 2 or 4 pixels per sample (default both)");
+    args.option("--size", &job.size, "fruc, stereo, upsample: WxH (default 640x360); codec: default 1280x720");
     args.flag("--quick", &job.quick, "fruc: a few settings only (grid+pullpush, reverse+pullpush, splat+none, ...)");
-    args.option("--repeat", &job.repeat, "fruc, stereo: timed runs, each frame's fastest counts (default 3)");
+    args.option("--repeat", &job.repeat, "fruc, stereo, upsample: timed runs, each frame's fastest counts (default 3)");
     args.option("--in", &job.in, "codec: also a sequence folder (EXR frames, up to --frames)");
     args.option("--threads", &job.threads, "codec: threads per codec (default 2)");
     args.option("--qps", &job.qps, "codec: reprise's qp rate points (default 22,28,34,40)");
     args.option("--speed-size", &job.speed_size, "codec: size of the speed run (default 1920x1080)");
     args.option("--speed-scene", &job.speed_scene, "codec: scene of the speed run (default pan)");
-    args.option("--speed-frames", &job.speed_frames, "codec: frames of the speed run (default 10, 0 = none)");
+    args.option("--speed-frames", &job.speed_frames, "codec, upsample: frames of the speed run (default 10; upsample 6; 0 = none)");
     args.option("--duration", &job.stream_duration, "stream: seconds per condition (default 4)");
     args.option("--display-rate", &job.display_rate, "stream: display frames per second (default 120)");
     args.flag("--exr", &job.exr, "fruc: also write the rendered input and truth as EXR under OUT/SCENE/");
@@ -156,6 +156,9 @@ int command_bench(int argc, char** argv) {
     if (job.what == "codec" && !args.given("--frames")) job.frames = 30;
     if (job.what == "codec" && !args.given("--size")) job.size = "1280x720";
     if (job.what == "stream" && !args.given("--size")) job.size = "256x144";
+    if (job.what == "upsample" && !args.given("--frames")) job.frames = 12;
+    if (job.what == "upsample" && !args.given("--factor")) job.factor = 0;  // both 4 and 2
+    if (job.what == "upsample" && !args.given("--speed-frames")) job.speed_frames = 6;
     Status result;
     if (job.frames < 1 || job.frames > 100000) result = Status::error("bench: --frames must be in 1..100000");
     else if (job.what == "render") result = bench_render(job);
@@ -168,8 +171,9 @@ int command_bench(int argc, char** argv) {
     else if (job.what == "stereo") result = bench_stereo(job);
     else if (job.what == "codec") result = bench_codec(job);
     else if (job.what == "stream") result = bench_stream(job);
+    else if (job.what == "upsample") result = bench_upsample(job);
     else result = Status::error("bench: unknown benchmark '" + job.what +
-                                "' (render, exr, reproject, grid, fill, paths, fruc, stereo, codec, stream)");
+                                "' (render, exr, reproject, grid, fill, paths, fruc, stereo, codec, upsample, stream)");
     return report(args, parsed, result);
 }
 

@@ -26,6 +26,7 @@ struct RenderJob {
     bool allow_outside_paths = false;
     double stereo = 0.0;       // IPD; > 0 renders both eyes into OUT/left and OUT/right
     double convergence = 0.0;  // > 0: off-axis rig converging there
+    int lowres = 0;            // 2 or 4: also colour at 1/lowres of the pixels, jittered, in OUT/lowres
 };
 
 Status run_render(const RenderJob& job) {
@@ -41,6 +42,10 @@ Status run_render(const RenderJob& job) {
     if (!(job.convergence >= 0.0 && job.convergence <= 1e30))
         return Status::error("--convergence must not be negative");
     const bool stereo = job.stereo > 0.0;
+    if (job.lowres != 0 && job.lowres != 2 && job.lowres != 4)
+        return Status::error("--lowres " + std::to_string(job.lowres) + " must be 2 or 4");
+    if (job.lowres != 0 && stereo) return Status::error("--lowres and --stereo do not combine");
+    const std::string lowres_dir = job.out + "/lowres";
     const stereo::StereoRig rig{
         .ipd = float(job.stereo),
         .convergence = float(job.convergence),
@@ -56,7 +61,7 @@ Status run_render(const RenderJob& job) {
         REPRISE_TRY(server::parse_camera_spec(job.camera, scene, fallback, path));
     }
     std::error_code ec;
-    for (const std::string& dir : {left_dir, stereo ? right_dir : left_dir}) {
+    for (const std::string& dir : {left_dir, stereo ? right_dir : left_dir, job.lowres ? lowres_dir : left_dir}) {
         std::filesystem::create_directories(dir, ec);
         if (ec) return Status::error(dir + ": cannot create the folder: " + ec.message());
     }
@@ -69,10 +74,21 @@ Status run_render(const RenderJob& job) {
         .width = width,
         .height = height,
         .shading = job.unlit ? server::Shading::Unlit : server::Shading::Lit};
-    Frame frame;
+    Frame frame, low;
     auto begin = std::chrono::steady_clock::now();
     for (int i = 0; i < job.frames; ++i) {
-        if (!stereo) {
+        if (job.lowres) {
+            glm::vec2 jitter(0.0f);
+            REPRISE_TRY(renderer->render_frame_lowres(scene, path, job.start + i, job.fps, settings,
+                                                      job.lowres, frame, low.color, jitter));
+            REPRISE_TRY(write_frame(frame_path(job.out, i), frame));
+            // Colour only; its camera is the full frame's with the jitter in its own pixels.
+            low.camera = frame.camera;
+            low.camera.jitter = jitter * glm::vec2(float(low.color.width()) / float(width),
+                                                   float(low.color.height()) / float(height));
+            low.fps = job.fps;
+            REPRISE_TRY(write_frame(frame_path(lowres_dir, i), low));
+        } else if (!stereo) {
             REPRISE_TRY(renderer->render_frame(scene, path, job.start + i, job.fps, settings, frame));
             REPRISE_TRY(write_frame(frame_path(job.out, i), frame));
         } else {
@@ -128,6 +144,10 @@ int command_render(int argc, char** argv) {
     args.option("--stereo", &job.stereo,
                 "IPD: render both eyes (the camera is the rig's centre) into OUT/left and OUT/right");
     args.option("--convergence", &job.convergence, "with --stereo: off-axis rig converging at this distance");
+    args.option("--lowres", &job.lowres,
+                "2|4: also colour at 1/2 (W/2 x H) or 1/4 (W/2 x H/2) of the pixels with a per-frame "
+                "sub-pixel jitter, in OUT/lowres (colour only; reprise:jitter in its own pixels); "
+                "OUT keeps the full-resolution G-buffer (reprise upsample)");
     args.option("--out", &job.out, "output folder (required)");
     Status parsed = args.parse(argc, argv);
     if (!parsed.ok() || args.help_requested()) return report(args, parsed, {});

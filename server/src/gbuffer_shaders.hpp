@@ -45,6 +45,7 @@ uniform float u_specular;
 uniform float u_shininess;
 uniform float u_id;
 uniform sampler2D u_texture;
+uniform float u_lod_bias;
 in vec4 v_clip;
 in vec4 v_previous_clip;
 in vec3 v_world;
@@ -62,7 +63,7 @@ void main() {
     vec3 n = dot(v_normal, v_normal) > 0.0 ? normalize(gl_FrontFacing ? v_normal : -v_normal)
                                            : vec3(0.0, 0.0, 1.0);
     vec4 base = u_base_color;
-    if (u_textured) base *= texture(u_texture, v_uv);
+    if (u_textured) base *= texture(u_texture, v_uv, u_lod_bias);
     vec3 color = base.rgb;
     if (u_lit) {
         vec3 l = -normalize(u_light_direction);

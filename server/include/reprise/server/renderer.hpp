@@ -1,6 +1,7 @@
 #pragma once
 // The headless G-buffer renderer: colour, linear depth, exact backward motion, world normals and
 // object ids of a Scene, through OpenGL ES 3 on EGL.
+#include <cstdint>
 #include <memory>
 #include <string>
 
@@ -19,6 +20,7 @@ struct RenderSettings {
     int width = 640;
     int height = 360;
     Shading shading = Shading::Lit;
+    float texture_lod_bias = 0.0f;  // added to the texture level of detail (negative: sharper)
 };
 
 // The camera and the animation timeline at one instant.
@@ -30,6 +32,16 @@ struct Instant {
     float near = 0.1f;
     float far = 1000.0f;
 };
+
+// Low-resolution jittered colour (Pajak et al. 2011, Herzog et al. 2010): `factor` 2 renders ½ of
+// the pixels (ceil(W/2) x H), 4 renders ¼ (ceil(W/2) x ceil(H/2)), 1 all of them. The low image
+// covers the same frustum; its jitter (in full-resolution pixels) cycles through the centres of
+// the full pixels under one low pixel: 2x1 as (-0.5, 0), (+0.5, 0); 2x2 as (-0.5, -0.5),
+// (+0.5, +0.5), (+0.5, -0.5), (-0.5, +0.5), so every full pixel is sampled once per cycle.
+// (Sizes that do not divide give proportionally placed samples instead of exact centres.)
+bool lowres_factor_valid(int factor);
+glm::ivec2 lowres_size(int width, int height, int factor);
+glm::vec2 lowres_jitter(int width, int height, int factor, int64_t index);
 
 Instant instant_on_path(const CameraPath& path, const Scene& scene, double time, int width,
                         int height);
@@ -48,6 +60,20 @@ public:
     // previous instant is one frame period earlier, so frame 0 has motion too.
     Status render_frame(const Scene& scene, const CameraPath& path, int index, double fps,
                         const RenderSettings& settings, Frame& frame);
+
+    // Frame `index` as render_frame() at full resolution, unjittered, plus its colour at 1/factor of
+    // the pixels with lowres_jitter(index) into `low_color` (texture level of detail biased
+    // towards the full resolution's, so low samples about equal full-resolution ones). `jitter`
+    // receives the jitter used, in full-resolution pixels.
+    Status render_frame_lowres(const Scene& scene, const CameraPath& path, int index, double fps,
+                               const RenderSettings& settings, int factor, Frame& frame,
+                               Image<glm::vec4>& low_color, glm::vec2& jitter);
+    // The same from explicit instants (a streaming session's poses): `current` and `previous`
+    // without jitter, their projections made for the full size; `jitter_index` picks
+    // lowres_jitter's phase (a frame counter).
+    Status render_lowres(const Scene& scene, const Instant& current, const Instant& previous,
+                         const RenderSettings& settings, int factor, int64_t jitter_index,
+                         Frame& frame, Image<glm::vec4>& low_color, glm::vec2& jitter);
 
     const std::string& device() const;
 
