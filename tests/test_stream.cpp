@@ -159,6 +159,22 @@ TEST(Stream, EndToEndDisplayedFramesMatchTheTruth) {
     EXPECT_NE(metrics.find("reprise_sessions 1"), std::string::npos) << metrics;
 }
 
+TEST(Stream, LowResolutionColourIsUpsampledToTheTruth) {
+    server::StreamServerOptions so = server_options();
+    so.mode = net::StreamMode::LowRes;
+    so.lowres_factor = 4;
+    RunningServer srv(so);
+    auto c = make_client(srv.at());
+    const Session s = run(*c, 60);
+    const double p = mean_psnr(s.kept);
+    std::printf("[stream] lowres 1/4: %zu shown, %zu decoded, PSNR %.2f dB\n", s.shown, c->stats().frames_decoded, p);
+    ASSERT_NE(c->stream_info(), nullptr);
+    EXPECT_EQ(c->stream_info()->mode, net::StreamMode::LowRes);
+    EXPECT_GE(c->stats().frames_decoded, 60u);
+    EXPECT_EQ(c->stats().decode_errors, 0u);
+    EXPECT_GE(p, 26.0);
+}
+
 TEST(Stream, FivePercentLossAndReorderingKeepTheStreamGoing) {
     server::StreamServerOptions so = server_options();
     RunningServer srv(so);

@@ -24,7 +24,7 @@ extern "C" void on_signal(int) { g_stop.store(true); }
 struct ServeJob {
     std::string scene = "pan", listen = "127.0.0.1:7000", pin, size = "640x360", mode = "full";
     double fps = 30.0, duration = 0.0;
-    int max_sessions = 4, qp = 28, bitrate = 0, fec_group = 8, metrics_port = -1;
+    int max_sessions = 4, qp = 28, bitrate = 0, fec_group = 8, metrics_port = -1, lowres = 4;
 };
 
 Status run_serve(const ServeJob& job) {
@@ -38,6 +38,8 @@ Status run_serve(const ServeJob& job) {
     if (job.mode == "full") o.mode = net::StreamMode::Full;
     else if (job.mode == "lowres") o.mode = net::StreamMode::LowRes;
     else return Status::error("--mode must be full or lowres");
+    if (job.lowres != 2 && job.lowres != 4) return Status::error("--lowres must be 2 or 4");
+    o.lowres_factor = job.lowres;
     o.max_sessions = job.max_sessions;
     if (job.qp < 0 || job.qp > 51) return Status::error("--qp must be 0..51");
     o.encoder.qp = job.qp;
@@ -192,6 +194,7 @@ int command_serve(int argc, char** argv) {
     args.option("--fps", &job.fps, "server frame rate (default 30)");
     args.option("--size", &job.size, "WxH (default 640x360)");
     args.option("--mode", &job.mode, "full (default) or lowres");
+    args.option("--lowres", &job.lowres, "lowres mode: 2 or 4 pixels per colour sample (default 4)");
     args.option("--max-sessions", &job.max_sessions, "sessions at once (default 4)");
     args.option("--qp", &job.qp, "quantiser when no --bitrate (default 28)");
     args.option("--bitrate", &job.bitrate, "start bitrate in kbps, adapted to loss (default 0: constant quality)");

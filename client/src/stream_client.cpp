@@ -7,6 +7,7 @@
 #include "reprise/net/fragment.hpp"
 #include "reprise/net/secure.hpp"
 #include "reprise/warp/extrapolate.hpp"
+#include "reprise/warp/upsample.hpp"
 
 namespace reprise::client {
 
@@ -35,6 +36,10 @@ struct StreamClient::State {
     bool have_info = false;
     std::unique_ptr<net::Reassembler> reassembler;
     std::unique_ptr<codec::Decoder> decoder;
+    std::unique_ptr<codec::Decoder> colour_decoder;  // lowres: the low-resolution colour stream
+    Frame low_decoded;
+    Image<glm::vec4> upsampled;
+    warp::SpatioTemporalUpsampler upsampler;
     int64_t newest_completed = -1;
     int consecutive_decode_errors = 0;
     uint64_t received_sealed = 0;
@@ -69,6 +74,8 @@ struct StreamClient::State {
     void reset_stream() {
         reassembler = std::make_unique<net::Reassembler>();
         decoder = std::make_unique<codec::Decoder>();
+        colour_decoder = std::make_unique<codec::Decoder>();
+        upsampler.reset();
         newest_completed = -1;
         consecutive_decode_errors = 0;
         received_sealed = 0;
@@ -109,14 +116,32 @@ struct StreamClient::State {
             abandoned.push_back(uint32_t(f));
         if (!abandoned.empty()) report_lost(abandoned, now);
         newest_completed = packet.frame;
-        if (!decoder->send_packet(packet.data).ok()) {
+        const bool lowres = have_info && info.mode == net::StreamMode::LowRes;
+        std::span<const uint8_t> geometry = packet.data, colour;
+        bool ok = !lowres || split_bundle(packet.data, geometry, colour);
+        ok = ok && decoder->send_packet(geometry).ok() && decoder->receive_frame(scratch_decoded) == codec::Result::Ok;
+        if (ok && lowres)
+            ok = colour_decoder->send_packet(colour).ok() &&
+                 colour_decoder->receive_frame(low_decoded) == codec::Result::Ok;
+        if (!ok) {
             ++stats.decode_errors;
             abandoned.assign(1, packet.frame);
             report_lost(abandoned, now);
             if (++consecutive_decode_errors >= 2) request_key(now);
             return;
         }
-        if (decoder->receive_frame(scratch_decoded) != codec::Result::Ok) return;
+        if (lowres) {
+            // Herzog 2010: the low-resolution colour to full resolution, guided by the decoded
+            // full-resolution depth and motion; the jitter comes with the colour stream's camera.
+            const int w = scratch_decoded.width(), h = scratch_decoded.height();
+            const glm::vec2 footprint(float(w) / float(low_decoded.width()), float(h) / float(low_decoded.height()));
+            const GBufferView guides{.depth = scratch_decoded.depth.view(),
+                                     .motion = scratch_decoded.motion.view(),
+                                     .camera = scratch_decoded.camera};
+            upsampled.resize(w, h);
+            upsampler.upsample(low_decoded.color.view(), low_decoded.camera.jitter * footprint, guides, upsampled.view());
+            std::swap(upsampled, scratch_decoded.color);
+        }
         consecutive_decode_errors = 0;
         std::swap(decoded, scratch_decoded);
         have_decoded = true;
@@ -126,6 +151,16 @@ struct StreamClient::State {
         message.resize(net::kMaxPlaintext);
         message.resize(net::encode(net::AckMessage{.frame = packet.frame}, message));
         send_sealed(message, now);
+    }
+
+    // lowres bundle: u8 version 1, u32 n, n bytes geometry packet, u32 m, m bytes colour packet.
+    static bool split_bundle(std::span<const uint8_t> bundle, std::span<const uint8_t>& geometry,
+                             std::span<const uint8_t>& colour) {
+        net::Reader r(bundle);
+        if (r.u8() != 1) return false;
+        geometry = r.bytes(r.u32());
+        colour = r.bytes(r.u32());
+        return r.ok() && r.remaining() == 0 && !geometry.empty() && !colour.empty();
     }
 
     void on_datagram(std::span<const uint8_t> d, int64_t now) {

@@ -46,8 +46,12 @@ struct Session {
     bool rendered_before = false;
     Instant previous;
     codec::Encoder encoder;
-    Frame frame;
-    codec::Packet packet;
+    codec::Encoder colour_encoder;  // lowres: the low-resolution colour stream
+    Frame frame, low;
+    Image<glm::vec4> low_color;
+    codec::Packet packet, colour_packet;
+    std::vector<uint8_t> bundle;
+    int64_t frames_rendered = 0;
     std::deque<std::vector<uint8_t>> queue;  // sealed datagrams waiting for the socket
     std::size_t queue_bytes = 0;
     int64_t newest_sent = -1, newest_acked = -1;
@@ -57,7 +61,7 @@ struct Session {
     bool ended = false;
 
     Session(net::Endpoint p, uint64_t connection, const net::SessionKeys& keys, const codec::EncoderOptions& eo)
-        : peer(p), channel(connection, keys.server_to_client, keys.client_to_server), encoder(eo) {}
+        : peer(p), channel(connection, keys.server_to_client, keys.client_to_server), encoder(eo), colour_encoder(eo) {}
 };
 
 }  // namespace
@@ -268,6 +272,7 @@ struct StreamServer::State {
             parsed = net::parse(plaintext, m).ok() && int64_t(m.frame) <= s->newest_sent;
             if (parsed) {
                 s->encoder.acknowledge(m.frame);
+                s->colour_encoder.acknowledge(m.frame);
                 s->newest_acked = std::max<int64_t>(s->newest_acked, m.frame);
                 s->last_progress_us = now;
                 count(&StreamServerStats::acks);
@@ -279,7 +284,10 @@ struct StreamServer::State {
             parsed = net::parse(plaintext, m).ok();
             if (parsed) {
                 for (int i = 0; i < m.count; ++i)
-                    if (int64_t(m.frames[i]) <= s->newest_sent) s->encoder.report_loss(m.frames[i]);
+                    if (int64_t(m.frames[i]) <= s->newest_sent) {
+                        s->encoder.report_loss(m.frames[i]);
+                        s->colour_encoder.report_loss(m.frames[i]);
+                    }
                 s->last_progress_us = now;
                 count(&StreamServerStats::loss_reports);
             }
@@ -289,6 +297,7 @@ struct StreamServer::State {
             parsed = plaintext.size() == 1;
             if (parsed) {
                 s->encoder.request_key_frame();
+                s->colour_encoder.request_key_frame();
                 s->last_progress_us = now;
                 count(&StreamServerStats::key_frame_requests);
             }
@@ -324,7 +333,13 @@ struct StreamServer::State {
             else if (queueing) next *= 0.9;
             else if (loss < 0.02) next *= 1.05;
             s.bitrate_kbps = std::clamp(int(next), options.min_bitrate_kbps, options.max_bitrate_kbps);
-            s.encoder.set_bitrate(s.bitrate_kbps);
+            if (options.mode == net::StreamMode::LowRes) {
+                // Geometry (depth + motion) and colour share the target by their usual weights.
+                s.encoder.set_bitrate(std::max(1, s.bitrate_kbps * 2 / 3));
+                s.colour_encoder.set_bitrate(std::max(1, s.bitrate_kbps / 3));
+            } else {
+                s.encoder.set_bitrate(s.bitrate_kbps);
+            }
         }
         std::lock_guard lock(stats_mutex);
         stats.loss = loss;
@@ -347,24 +362,47 @@ struct StreamServer::State {
         previous.time = current.time - 1.0 / options.fps;
         if (s.rendered_before) previous.view = s.previous.view;
         auto t0 = std::chrono::steady_clock::now();
-        REPRISE_TRY(renderer->render(s.scene, current, previous, {.width = w, .height = h}, s.frame));
+        const bool lowres = options.mode == net::StreamMode::LowRes;
+        glm::vec2 jitter(0.0f);
+        if (lowres)
+            REPRISE_TRY(renderer->render_lowres(s.scene, current, previous, {.width = w, .height = h},
+                                                options.lowres_factor, s.frames_rendered, s.frame, s.low_color, jitter));
+        else
+            REPRISE_TRY(renderer->render(s.scene, current, previous, {.width = w, .height = h}, s.frame));
+        ++s.frames_rendered;
         s.frame.fps = options.fps;
         const double render_ms = ms_since(t0);
         s.previous = current;
         s.rendered_before = true;
         t0 = std::chrono::steady_clock::now();
+        if (lowres) {
+            make_colour_frame(s, jitter);
+            // The geometry stream carries no colour: a constant that every prediction matches.
+            std::fill(s.frame.color.data(), s.frame.color.data() + s.frame.color.pixel_count(), glm::vec4(0.0f));
+        }
         REPRISE_TRY(s.encoder.send_frame(s.frame));
         if (s.encoder.receive_packet(s.packet) != codec::Result::Ok) return Status::error("encoder gave no packet");
+        std::span<const uint8_t> payload = s.packet.data;
+        if (lowres) {
+            REPRISE_TRY(s.colour_encoder.send_frame(s.low));
+            if (s.colour_encoder.receive_packet(s.colour_packet) != codec::Result::Ok)
+                return Status::error("colour encoder gave no packet");
+            REPRISE_ASSERT(s.colour_packet.frame == s.packet.frame);
+            bundle_packets(s.packet.data, s.colour_packet.data, s.bundle);
+            payload = s.bundle;
+        }
         const double encode_ms = ms_since(t0);
-        if (s.packet.data.size() > net::kMaxPacketBytes) {
+        if (payload.size() > net::kMaxPacketBytes) {
             s.encoder.report_loss(s.packet.frame);
+            s.colour_encoder.report_loss(s.packet.frame);
             count(&StreamServerStats::frames_skipped);
             return {};
         }
-        const std::size_t n = net::fragment_packet(s.packet.data, s.packet.frame, s.pose.client_time_us, options.fec, messages);
-        const std::size_t sealed_bytes = n * (net::kSealedHeaderSize + net::kAeadTagSize) + s.packet.data.size() * 2;
+        const std::size_t n = net::fragment_packet(payload, s.packet.frame, s.pose.client_time_us, options.fec, messages);
+        const std::size_t sealed_bytes = n * (net::kSealedHeaderSize + net::kAeadTagSize) + payload.size() * 2;
         if (s.queue_bytes + std::min(sealed_bytes, options.send_queue_bytes / 2) > options.send_queue_bytes) {
             s.encoder.report_loss(s.packet.frame);
+            s.colour_encoder.report_loss(s.packet.frame);
             count(&StreamServerStats::frames_skipped);
             return {};
         }
@@ -379,6 +417,41 @@ struct StreamServer::State {
         }
         flush(s);
         return {};
+    }
+
+    // The low-resolution colour as a frame of its own: depth and motion taken from the full
+    // G-buffer at each low pixel's sample position (motion in low pixels), the camera's jitter
+    // in low pixels, so the colour stream predicts by reprojection like any other.
+    void make_colour_frame(Session& s, glm::vec2 jitter) {
+        const int lw = s.low_color.width(), lh = s.low_color.height();
+        const int w = s.frame.width(), h = s.frame.height();
+        const glm::vec2 footprint(float(w) / float(lw), float(h) / float(lh));
+        s.low.color.resize(lw, lh);
+        s.low.depth.resize(lw, lh);
+        s.low.motion.resize(lw, lh);
+        std::copy(s.low_color.data(), s.low_color.data() + s.low_color.pixel_count(), s.low.color.data());
+        for (int v = 0; v < lh; ++v)
+            for (int u = 0; u < lw; ++u) {
+                const int x = std::clamp(int(std::floor((u + 0.5f) * footprint.x + jitter.x)), 0, w - 1);
+                const int y = std::clamp(int(std::floor((v + 0.5f) * footprint.y + jitter.y)), 0, h - 1);
+                s.low.depth(u, v) = s.frame.depth(x, y);
+                s.low.motion(u, v) = s.frame.motion(x, y) / footprint;
+            }
+        s.low.camera = s.frame.camera;
+        s.low.camera.jitter = jitter / footprint;
+        s.low.fps = s.frame.fps;
+    }
+
+    // lowres: both codec packets of one frame in one unit (docs/protocol.md, "Low-resolution mode").
+    static void bundle_packets(std::span<const uint8_t> geometry, std::span<const uint8_t> colour,
+                               std::vector<uint8_t>& out) {
+        out.resize(1 + 4 + geometry.size() + 4 + colour.size());
+        net::Writer w(out);
+        w.u8(1);
+        w.u32(uint32_t(geometry.size()));
+        w.bytes(geometry);
+        w.u32(uint32_t(colour.size()));
+        w.bytes(colour);
     }
 
     std::string metrics_text() const {
@@ -430,8 +503,10 @@ Status StreamServer::create(const StreamServerOptions& options, std::unique_ptr<
     if (options.width < 16 || options.height < 16 || options.width > 8192 || options.height > 8192)
         return Status::error("--size: each side 16..8192");
     if (options.max_sessions < 1 || options.max_sessions > 64) return Status::error("--max-sessions must be 1..64");
-    if (options.mode == net::StreamMode::LowRes)
-        return Status::error("--mode lowres: low-resolution jittered colour is not available in this build");
+    if (options.mode == net::StreamMode::LowRes && !lowres_factor_valid(options.lowres_factor))
+        return Status::error("--lowres must be 2 or 4");
+    if (options.mode == net::StreamMode::LowRes && options.lowres_factor == 1)
+        return Status::error("--lowres must be 2 or 4");
     std::unique_ptr<StreamServer> s(new StreamServer());
     s->state_ = std::make_unique<State>(options);
     REPRISE_TRY(s->state_->socket.bind(options.listen));

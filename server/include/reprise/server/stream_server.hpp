@@ -23,7 +23,10 @@ struct StreamServerOptions {
     std::string secret;            // PIN or token, 1..255 bytes
     double fps = 30.0;
     int width = 640, height = 360;
+    // LowRes (Pajak et al. 2011): colour rendered at 1/lowres_factor of the pixels with a per-frame
+    // jitter, depth and motion at full resolution; two codec streams per frame (docs/protocol.md).
     net::StreamMode mode = net::StreamMode::Full;
+    int lowres_factor = 4;  // 2 or 4
     int max_sessions = 4;
     bool loopback_only = false;    // refuse a non-loopback listen address (tests)
     // Depth within 0.1 % (relative) is plenty for reprojection and costs a fifth of lossless.
