@@ -99,7 +99,8 @@ struct StreamBench {
     CsvFile csv;
     std::vector<MethodSummary> summaries;
 
-    Status run_condition(const Condition& c) {
+    // lowres: reprise's lowres mode only (the peers come from the full-mode run).
+    Status run_condition(const Condition& c, bool lowres) {
         server::StreamServerOptions so{.scene = options.scene,
                                        .listen = {0x7f000001u, 0},
                                        .secret = "bench",
@@ -107,6 +108,10 @@ struct StreamBench {
                                        .width = width,
                                        .height = height,
                                        .loopback_only = true};
+        if (lowres) {
+            so.mode = net::StreamMode::LowRes;
+            so.lowres_factor = 4;
+        }
         std::unique_ptr<server::StreamServer> srv;
         REPRISE_TRY(server::StreamServer::create(so, srv));
         std::atomic<bool> stop{false};
@@ -156,7 +161,7 @@ struct StreamBench {
         if (ticks.empty()) return Status::error("bench stream: " + c.name + ": nothing was displayed");
         const double seconds = duration;
 
-        MethodSummary ours{c.name, "reprise", sst.bytes_sent * 8.0 / seconds / 1000.0};
+        MethodSummary ours{c.name, lowres ? "reprise-lowres4" : "reprise", sst.bytes_sent * 8.0 / seconds / 1000.0};
         MethodSummary repeat{c.name, "repetition", ours.kbps};
         MethodSummary video{c.name, "x264-crf23"}, video_fine{c.name, "x264-crf15"};
         for (MethodSummary* m : {&ours, &repeat, &video, &video_fine}) {
@@ -186,6 +191,7 @@ struct StreamBench {
         video.latency_ms = video_fine.latency_ms = repeat.latency_ms;
 
         // The video-only peer: the same source frames (rendered at their poses) through x264.
+        const int method_count = lowres ? 1 : 4;
         std::vector<double> source_times;
         for (const Tick& k : ticks)
             if (source_times.empty() || source_times.back() != k.source_time) source_times.push_back(k.source_time);
@@ -193,15 +199,17 @@ struct StreamBench {
         source_times.erase(std::unique(source_times.begin(), source_times.end()), source_times.end());
         Frame truth;
         std::vector<Image<Rgb8>> sources;
-        for (double t : source_times) {
+        for (double t : lowres ? std::vector<double>{} : source_times) {
             REPRISE_TRY(render_at(t, server::camera_view(scene.path, scene.scene, t), truth));
             sources.emplace_back(width, height);
             visualize_color(truth.color.view(), sources.back().view());
         }
         // Two rate points: x264's usual crf 23 and a finer one near reprise's bitrate.
         std::vector<PeerFrame> x264, x264_fine;
-        REPRISE_TRY(encode_decode_peer(sources, {.kind = PeerKind::X264, .preset = "veryfast", .crf = 23}, fps, x264));
-        REPRISE_TRY(encode_decode_peer(sources, {.kind = PeerKind::X264, .preset = "veryfast", .crf = 15}, fps, x264_fine));
+        if (!lowres) {
+            REPRISE_TRY(encode_decode_peer(sources, {.kind = PeerKind::X264, .preset = "veryfast", .crf = 23}, fps, x264));
+            REPRISE_TRY(encode_decode_peer(sources, {.kind = PeerKind::X264, .preset = "veryfast", .crf = 15}, fps, x264_fine));
+        }
         // The peer sends one frame per server period while the stream runs.
         auto kbps = [&](const std::vector<PeerFrame>& frames) {
             std::size_t bytes = 0;
@@ -224,7 +232,7 @@ struct StreamBench {
             const Image<Rgb8>* candidates[4] = {&k.ours, &k.repeated, si < x264.size() ? &x264[si].decoded : nullptr,
                                                 si < x264_fine.size() ? &x264_fine[si].decoded : nullptr};
             MethodSummary* methods[4] = {&ours, &repeat, &video, &video_fine};
-            for (int m = 0; m < 4; ++m) {
+            for (int m = 0; m < method_count; ++m) {
                 if (!candidates[m]) continue;
                 from_rgb8(candidates[m]->view(), shown);
                 const ImageError e = image_error(reference.view(), shown.view());
@@ -237,6 +245,7 @@ struct StreamBench {
             ++index;
         }
         for (MethodSummary* m : {&ours, &repeat, &video, &video_fine}) {
+            if (lowres && m != &ours) continue;
             const ImageError e = mean_error(m->errors);
             std::printf("%-16s %-16s %9.0f %7.2f %7.4f %8.2f %8.2f %8.2f %9.0f %6zu %6zu\n", c.name.c_str(),
                         m->method.c_str(), m->kbps, e.psnr, e.flip, mean_of(m->latency_ms),
@@ -276,7 +285,10 @@ Status bench_stream(const BenchOptions& options) {
                 b.scene.renderer->device().c_str());
     std::printf("%-16s %-16s %9s %7s %7s %8s %8s %8s %9s %6s %6s\n", "condition", "method", "kbps", "PSNR", "FLIP",
                 "lat.mean", "lat.p95", "lat.max", "freeze.ms", "lost", "fec");
-    for (const Condition& c : conditions(options.quick)) REPRISE_TRY(b.run_condition(c));
+    for (const Condition& c : conditions(options.quick)) {
+        REPRISE_TRY(b.run_condition(c, false));
+        REPRISE_TRY(b.run_condition(c, true));
+    }
 
     CsvFile summary;
     REPRISE_TRY(summary.open(out + "/stream_summary.csv",
@@ -288,7 +300,9 @@ Status bench_stream(const BenchOptions& options) {
         "Scene " + options.scene + " at " + options.size + ", server " + strf("%g", b.fps) + " Hz, display " +
             strf("%g", b.display_rate) + " Hz, " + strf("%g", b.duration) +
             " s per condition on loopback with the in-process fault injector on both directions.",
-        "reprise: every display frame extrapolated from the newest decoded frame to the newest pose. repetition: "
+        "reprise: every display frame extrapolated from the newest decoded frame to the newest pose; "
+        "reprise-lowres4: the same with colour sent at 1/4 of the pixels (jittered) and upsampled (Herzog 2010) "
+        "before extrapolation (its own session). repetition: "
         "the newest decoded frame shown as it is (same stream). x264-crf23 / x264-crf15 (the video-only model): the same source frames through "
         "x264 veryfast zerolatency at crf 23 and 15, shown when our stream had them (same arrival times and losses; x264's "
         "error propagation after a loss is not modelled, which favours it).",
