@@ -13,6 +13,7 @@
 #include "reprise/core/exr.hpp"
 #include "reprise/server/builtin_scenes.hpp"
 #include "reprise/server/stream_server.hpp"
+#include "stream_window.hpp"
 
 namespace reprise::cli {
 
@@ -78,7 +79,7 @@ Status run_serve(const ServeJob& job) {
 struct ConnectJob {
     std::string server, pin, scene, camera, out, poses;
     double display_rate = 120.0, duration = 10.0;
-    bool no_extrapolate = false;
+    bool no_extrapolate = false, window = false, interactive = false;
     double loss = 0.0, delay = 0.0, jitter = 0.0;
 };
 
@@ -134,7 +135,19 @@ Status run_connect(const ConnectJob& job) {
             REPRISE_TRY(server::parse_camera_spec(job.camera, scene, fallback, path));
         }
     }
+    std::unique_ptr<StreamWindow> window;
+    if (job.window || job.interactive) {
+        const glm::mat4 start = poses.empty() ? server::camera_view(path, scene, 0.0) : poses.front().second;
+        REPRISE_TRY(StreamWindow::open(job.interactive, start, window));
+    }
+    double last_t = 0.0;
+    bool window_open = true;
     client::PoseFunction pose = [&](double t) {
+        if (window) {
+            window_open = window->pump(t - last_t) && window_open;
+            last_t = t;
+            if (job.interactive) return window->view();
+        }
         if (poses.empty()) return server::camera_view(path, scene, t);
         auto it = std::upper_bound(poses.begin(), poses.end(), t,
                                    [](double v, const std::pair<double, glm::mat4>& p) { return v < p.first; });
@@ -168,8 +181,9 @@ Status run_connect(const ConnectJob& job) {
             log << index << ',' << info.scene_time << ',' << info.pose_us << ',' << displayed_us << ',' << latency << ','
                 << info.source_scene_time << ',' << (displayed_us - info.source_pose_us) / 1000.0 << '\n';
         }
+        if (window) window->show(f);
         ++index;
-        return write_status.ok() && !g_stop.load();
+        return write_status.ok() && !g_stop.load() && window_open;
     }));
     REPRISE_TRY(write_status);
     const client::StreamClientStats& st = c->stats();
@@ -214,6 +228,8 @@ int command_connect(int argc, char** argv) {
     args.option("--poses", &job.poses, "pose file: lines 't m00 .. m33' (view matrix column by column)");
     args.option("--out", &job.out, "write displayed frames as EXR (camera = pose, time = display time) + display.csv");
     args.option("--duration", &job.duration, "seconds (default 10)");
+    args.flag("--window", &job.window, "show the displayed frames in an SDL2 window (Esc closes)");
+    args.flag("--interactive", &job.interactive, "window with a free camera: WASD, Q/E, arrows, mouse drag");
     args.flag("--no-extrapolate", &job.no_extrapolate, "show the newest decoded frame as it is");
     args.option("--loss", &job.loss, "fault injector: random loss each way (0..1)");
     args.option("--delay", &job.delay, "fault injector: round-trip delay in ms");
