@@ -41,6 +41,7 @@ struct StreamClient::State {
     Frame decoded, scratch_decoded, displayed;
     bool have_decoded = false;
     int64_t decoded_pose_us = 0;
+    uint32_t decoded_frame = 0;
     warp::PoseExtrapolator extrapolator;
     uint32_t pose_sequence = 0;
     StreamClientStats stats;
@@ -121,6 +122,7 @@ struct StreamClient::State {
         std::swap(decoded, scratch_decoded);
         have_decoded = true;
         decoded_pose_us = packet.pose_time_us;
+        decoded_frame = packet.frame;
         ++stats.frames_decoded;
         stats.last_rtt_us = now - packet.pose_time_us;
         message.resize(net::kMaxPlaintext);
@@ -296,7 +298,7 @@ const Frame* StreamClient::display(const glm::mat4& view, double scene_time, int
     info.pose_us = pose_us;
     info.source_pose_us = s.decoded_pose_us;
     info.source_scene_time = f.camera.time;
-    info.source_frame = uint32_t(s.stats.frames_decoded);
+    info.source_frame = s.decoded_frame;
     info.extrapolated = s.options.extrapolate;
     if (!s.options.extrapolate) return &f;
     const double fps = s.have_info ? s.info.fps : (f.fps > 0 ? f.fps : 30.0);

@@ -43,7 +43,7 @@ struct DisplayInfo {
     int64_t pose_us = 0;           // when the displayed pose was sampled
     int64_t source_pose_us = 0;    // when the pose of the decoded frame was sampled
     double source_scene_time = 0.0;
-    uint32_t source_frame = 0;
+    uint32_t source_frame = 0;     // codec frame number of the decoded frame
     bool extrapolated = false;
 };
 
