@@ -114,6 +114,8 @@ Status run_connect(const ConnectJob& job) {
     REPRISE_TRY(net::parse_endpoint(job.server, o.server));
     if (job.pin.empty()) return Status::error("--pin is required");
     o.secret = job.pin;
+    if (!job.scene.empty() && !net::valid_scene_name(job.scene))
+        return Status::error("--scene '" + job.scene + "': a name from the server's catalogue (1..32 of [a-z0-9_-]), never a path");
     o.scene = job.scene;
     o.extrapolate = !job.no_extrapolate;
     if (job.loss > 0 || job.delay > 0 || job.jitter > 0) {
