@@ -34,6 +34,7 @@ struct BenchOptions {
     // bench stream
     double stream_duration = 4.0;           // seconds per condition
     double display_rate = 120.0;
+    std::string conditions;                 // comma-separated condition names; empty = all (or --quick)
 };
 
 // A scene, its camera path and a renderer: what every benchmark that renders starts from.

@@ -285,7 +285,17 @@ Status bench_stream(const BenchOptions& options) {
                 b.scene.renderer->device().c_str());
     std::printf("%-16s %-16s %9s %7s %7s %8s %8s %8s %9s %6s %6s\n", "condition", "method", "kbps", "PSNR", "FLIP",
                 "lat.mean", "lat.p95", "lat.max", "freeze.ms", "lost", "fec");
-    for (const Condition& c : conditions(options.quick)) {
+    std::vector<Condition> chosen = conditions(options.quick && options.conditions.empty());
+    if (!options.conditions.empty()) {
+        std::vector<Condition> named;
+        for (const std::string& name : split_list(options.conditions)) {
+            auto it = std::find_if(chosen.begin(), chosen.end(), [&](const Condition& c) { return c.name == name; });
+            if (it == chosen.end()) return Status::error("--conditions: unknown condition '" + name + "'");
+            named.push_back(*it);
+        }
+        chosen = named;
+    }
+    for (const Condition& c : chosen) {
         REPRISE_TRY(b.run_condition(c, false));
         REPRISE_TRY(b.run_condition(c, true));
     }

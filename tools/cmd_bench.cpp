@@ -149,6 +149,7 @@ int command_bench(int argc, char** argv) {
     args.option("--speed-frames", &job.speed_frames, "codec, upsample: frames of the speed run (default 10; upsample 6; 0 = none)");
     args.option("--duration", &job.stream_duration, "stream: seconds per condition (default 4)");
     args.option("--display-rate", &job.display_rate, "stream: display frames per second (default 120)");
+    args.option("--conditions", &job.conditions, "stream: comma-separated conditions (clean, loss1%, loss5%, burst, jitter20ms, rtt50ms, rtt100ms, rtt100ms+loss1%, cap1500kbps)");
     args.flag("--exr", &job.exr, "fruc: also write the rendered input and truth as EXR under OUT/SCENE/");
     Status parsed = args.parse(argc, argv);
     if (!parsed.ok() || args.help_requested()) return report(args, parsed, {});
