@@ -31,6 +31,10 @@ struct BenchOptions {
     std::string speed_size = "1920x1080";   // the speed ratios' size
     std::string speed_scene = "pan";
     int speed_frames = 10;                  // 0 = no speed run
+    // bench stream
+    double stream_duration = 4.0;           // seconds per condition
+    double display_rate = 120.0;
+    std::string conditions;                 // comma-separated condition names; empty = all (or --quick)
 };
 
 // A scene, its camera path and a renderer: what every benchmark that renders starts from.
@@ -67,6 +71,11 @@ Status bench_codec(const BenchOptions& options);
 // shading every frame: OUT/reuse.csv, OUT/reuse_summary.csv, OUT/index.html.
 Status bench_reuse(const BenchOptions& options);
 
+// The remote-rendering loop on loopback under injected faults (loss, burst, jitter, delay, a
+// bandwidth cap): latency, bitrate, displayed-frame error and freezes of reprise's extrapolating
+// client beside frame repetition and an x264 video-only model: OUT/stream.csv,
+// stream_summary.csv, index.html.
+Status bench_stream(const BenchOptions& options);
 // Spatio-temporal upsampling (Herzog 2010) of low-resolution jittered colour against the full
 // render, beside cv::resize, a jitter-aware warpAffine and joint bilateral upsampling, per scene
 // and factor (--factor 2|4, default both); ms per 1080p frame against cv::remap:

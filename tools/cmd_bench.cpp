@@ -129,8 +129,8 @@ int command_bench(int argc, char** argv) {
               "error against run time\nfor every setting beside ffmpeg minterpolate and OpenCV DIS flow "
               "(CSV + HTML report in --out).\nstereo: the synthesized second eye against the rendered one, naive DIBR peers and the "
               "renderer's\nsecond-eye time (CSV + HTML report in --out). paths: whole made frames at display "
-              "rate against cv::remap.\nkernels: each SIMD kernel at every level the CPU runs against its scalar reference and cv::remap (CSV in --out).\nreuse: shading reuse in the heavy renderer against full shading in the same run (speed-up, hit rate,\npixels shaded, error; CSV + HTML report in --out).\ncodec: reprise's codec beside x264, x265 and SVT-AV1\n(bits, PSNR/SSIM/FLIP, ms, BD-rates, depth coders, 1080p speed; CSV + HTML report in --out).\nupsample: Herzog spatio-temporal upsampling of 1/2 or 1/4 of the pixels against the full render,\nbeside cv::resize, warpAffine and joint bilateral peers; ms per 1080p frame against cv::remap (CSV + HTML).");
-    args.positional("WHAT", &job.what, "render | exr | reproject | grid | fill | paths | kernels | fruc | stereo | codec | reuse | upsample");
+              "rate against cv::remap.\nkernels: each SIMD kernel at every level the CPU runs against its scalar reference and cv::remap (CSV in --out).\nreuse: shading reuse in the heavy renderer against full shading in the same run (speed-up, hit rate,\npixels shaded, error; CSV + HTML report in --out).\ncodec: reprise's codec beside x264, x265 and SVT-AV1\n(bits, PSNR/SSIM/FLIP, ms, BD-rates, depth coders, 1080p speed; CSV + HTML report in --out).\nupsample: Herzog spatio-temporal upsampling of 1/2 or 1/4 of the pixels against the full render,\nbeside cv::resize, warpAffine and joint bilateral peers; ms per 1080p frame against cv::remap (CSV + HTML).\nstream: the remote-rendering loop under injected faults (latency, bitrate, displayed error; --quick: 3 conditions).");
+    args.positional("WHAT", &job.what, "render | exr | reproject | grid | fill | paths | kernels | fruc | stereo | codec | reuse | upsample | stream");
     args.option("--scene", &job.scene, "scene to render (default pan)");
     args.option("--frames", &job.frames, "frames per size (default 10); fruc: input frames (default 20); stereo: frames per scene (at most 5); upsample: frames per scene (default 12)");
     args.option("--sizes", &job.sizes, "comma-separated WxH list (default 640x360,1920x1080)");
@@ -147,6 +147,9 @@ int command_bench(int argc, char** argv) {
     args.option("--speed-size", &job.speed_size, "codec: size of the speed run (default 1920x1080)");
     args.option("--speed-scene", &job.speed_scene, "codec: scene of the speed run (default pan)");
     args.option("--speed-frames", &job.speed_frames, "codec, upsample: frames of the speed run (default 10; upsample 6; 0 = none)");
+    args.option("--duration", &job.stream_duration, "stream: seconds per condition (default 4)");
+    args.option("--display-rate", &job.display_rate, "stream: display frames per second (default 120)");
+    args.option("--conditions", &job.conditions, "stream: comma-separated conditions (clean, loss1%, loss5%, burst, jitter20ms, rtt50ms, rtt100ms, rtt100ms+loss1%, cap1500kbps)");
     args.flag("--exr", &job.exr, "fruc: also write the rendered input and truth as EXR under OUT/SCENE/");
     Status parsed = args.parse(argc, argv);
     if (!parsed.ok() || args.help_requested()) return report(args, parsed, {});
@@ -155,6 +158,7 @@ int command_bench(int argc, char** argv) {
     if (job.what == "codec" && !args.given("--size")) job.size = "1280x720";
     if (job.what == "reuse" && !args.given("--frames")) job.frames = 24;
     if (job.what == "reuse" && !args.given("--size")) job.size = "256x144";
+    if (job.what == "stream" && !args.given("--size")) job.size = "256x144";
     if (job.what == "upsample" && !args.given("--frames")) job.frames = 12;
     if (job.what == "upsample" && !args.given("--factor")) job.factor = 0;  // both 4 and 2
     if (job.what == "upsample" && !args.given("--speed-frames")) job.speed_frames = 6;
@@ -172,8 +176,9 @@ int command_bench(int argc, char** argv) {
     else if (job.what == "codec") result = bench_codec(job);
     else if (job.what == "reuse") result = bench_reuse(job);
     else if (job.what == "upsample") result = bench_upsample(job);
+    else if (job.what == "stream") result = bench_stream(job);
     else result = Status::error("bench: unknown benchmark '" + job.what +
-                                "' (render, exr, reproject, grid, fill, paths, kernels, fruc, stereo, codec, reuse, upsample)");
+                                "' (render, exr, reproject, grid, fill, paths, kernels, fruc, stereo, codec, reuse, upsample, stream)");
     return report(args, parsed, result);
 }
 

@@ -17,6 +17,8 @@ int command_fruc(int argc, char** argv);
 int command_stereo(int argc, char** argv);
 int command_encode(int argc, char** argv);
 int command_decode(int argc, char** argv);
+int command_serve(int argc, char** argv);
+int command_connect(int argc, char** argv);
 int command_upsample(int argc, char** argv);
 
 // `reprise info FILE.rps`: the stream's size, packets and bit rate.

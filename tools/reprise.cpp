@@ -22,6 +22,8 @@ constexpr Command kCommands[] = {
     {"stereo", reprise::cli::command_stereo, "the other eye of a sequence by depth warping (OUT/left, OUT/right)"},
     {"encode", reprise::cli::command_encode, "encode a sequence with the scene-aware codec (.rps)"},
     {"decode", reprise::cli::command_decode, "decode an .rps stream into an EXR sequence"},
+    {"serve", reprise::cli::command_serve, "stream a scene to clients (render from their poses, encode, send)"},
+    {"connect", reprise::cli::command_connect, "connect to a server, display its stream extrapolated to the display rate"},
     {"upsample", reprise::cli::command_upsample, "low-resolution jittered colour to full resolution (Herzog 2010)"},
     {"bench", reprise::cli::command_bench, "benchmarks (render, exr, reproject, grid, fill, fruc)"},
 };

@@ -109,6 +109,8 @@ Encoder::Encoder(const EncoderOptions& options) : state_(std::make_unique<State>
     state_->qp_state = state_->qp;
 }
 Encoder::~Encoder() = default;
+void Encoder::set_bitrate(int kbps) { state_->options.bitrate_kbps = std::max(0, kbps); }
+int Encoder::bitrate() const { return state_->options.bitrate_kbps; }
 Encoder::Encoder(Encoder&&) noexcept = default;
 Encoder& Encoder::operator=(Encoder&&) noexcept = default;
 

@@ -156,18 +156,27 @@ std::size_t static_layer(const GBufferView& f, const glm::mat4& to_view,
 
 void extrapolate_frame(const GBufferView& f, float s, float motion_scale, const FrucOptions& options,
                        FrucScratch& scratch, Frame& out, FrucCounters& counters) {
-    const int w = f.width(), h = f.height();
     if (!has_projection(f.camera)) {
         extrapolate_along_motion(f, s, motion_scale, options, scratch, out, counters);
         return;
     }
-    const float nan = std::numeric_limits<float>::quiet_NaN();
     const Camera& c = f.camera;
     Camera previous = c;
     previous.view = c.prev_view;
     previous.projection = c.prev_projection;
     previous.time = c.time - 1.0;
     const Camera future = camera_between(previous, c, 1.0f + s);
+    extrapolate_to_camera(f, future.view, future.projection, s, motion_scale, options, scratch, out,
+                          counters);
+}
+
+void extrapolate_to_camera(const GBufferView& f, const glm::mat4& future_view,
+                           const glm::mat4& future_projection, float s, float motion_scale,
+                           const FrucOptions& options, FrucScratch& scratch, Frame& out,
+                           FrucCounters& counters) {
+    const int w = f.width(), h = f.height();
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    const Camera& c = f.camera;
     // Static layer: pixels whose motion the camera alone explains, moved to the future camera;
     // the others are left out (depth and motion NaN).
     scratch.layer_depth.resize(w, h);
@@ -175,7 +184,7 @@ void extrapolate_frame(const GBufferView& f, float s, float motion_scale, const 
     const ImageView<float> layer_depth = scratch.layer_depth.view();
     const ImageView<glm::vec2> layer_motion = scratch.layer_motion.view();
     const std::size_t moving_pixels =
-        static_layer(f, future.view, future.projection, options.static_tolerance, layer_depth,
+        static_layer(f, future_view, future_projection, options.static_tolerance, layer_depth,
                      layer_motion);
     const GBufferView layer{.color = f.color,
                             .depth = scratch.layer_depth.view(),
@@ -193,7 +202,8 @@ void extrapolate_frame(const GBufferView& f, float s, float motion_scale, const 
 
     // The static layer carried its displacement to the future; backward motion per period is
     // that displacement reversed and divided by s (0 where nothing landed).
-    const float to_backward = -motion_scale / s;
+    // s = 0 (the frame's own instant, another camera): no time passed, no motion to report.
+    const float to_backward = s > 1e-6f ? -motion_scale / s : 0.0f;
     parallel_for(0, h, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y) {
             glm::vec2* m = out.motion.data() + std::size_t(y) * w;

@@ -82,6 +82,12 @@ std::size_t motion_toward(const GBufferView& f, const Camera& to, float factor,
 void invert_motion(const GBufferView& b, float tolerance, Image<float>& static_depth,
                    Image<glm::vec2>& inverted, Image<float>& depth);
 
+// The same towards an explicit camera (view, projection): the static layer lands where that
+// camera sees it, moving objects go s periods along their motion (constant screen velocity).
+void extrapolate_to_camera(const GBufferView& f, const glm::mat4& future_view, const glm::mat4& future_projection,
+                           float s, float motion_scale, const FrucOptions& options, FrucScratch& scratch,
+                           Frame& out, FrucCounters& counters);
+
 // True when every motion vector is exactly zero (and finite).
 bool motion_is_zero(const GBufferView& f);
 

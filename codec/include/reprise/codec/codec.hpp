@@ -79,6 +79,10 @@ public:
     void acknowledge(uint32_t frame);
     void report_loss(uint32_t frame);
     void request_key_frame();
+    // Changes the rate-control target from the next frame on (0 = constant quality at qp); no
+    // key frame is forced.
+    void set_bitrate(int kbps);
+    int bitrate() const;
 
     // What the decoder holds after the last packet: colour in linear light, decoded depth and
     // motion, camera (bit-identical to the decoder's output).

@@ -1,0 +1,102 @@
+#pragma once
+// Authentication and encryption (libsodium). The handshake is CPace on ristretto255: both sides
+// derive the group generator from the PIN (or token) and the client's nonce, exchange ephemeral
+// Diffie-Hellman shares on it and confirm the resulting keys both ways. The PIN never travels;
+// a passive observer learns nothing to test PIN guesses against, and an active attacker tests
+// exactly one guess per handshake (which the server rate limits). Then every datagram is
+// ChaCha20-Poly1305 (IETF) with a 64-bit sequence number as nonce and a replay window.
+// Threat model: docs/protocol.md.
+#include <array>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "reprise/core/status.hpp"
+#include "reprise/net/wire.hpp"
+
+namespace reprise::net {
+
+using Key = std::array<uint8_t, 32>;
+
+constexpr std::size_t kClientHelloSize = 128;  // padded: the reply is never larger than the request
+constexpr std::size_t kServerHelloSize = kHeaderSize + 32 + 32 + 32;  // 108
+constexpr std::size_t kClientFinishSize = kHeaderSize + 32;           // 44
+
+// libsodium must be initialised once before any of this; safe to call many times.
+[[nodiscard]] Status init_crypto();
+uint64_t random_u64();
+
+struct SessionKeys {
+    Key client_to_server{};
+    Key server_to_client{};
+};
+
+// Client side of the handshake.
+class ClientHandshake {
+public:
+    // Builds the ClientHello (kClientHelloSize bytes) for a new random connection id.
+    void start(const std::string& secret, std::vector<uint8_t>& hello);
+    // Checks the ServerHello's key confirmation; on success writes the ClientFinish and the keys.
+    [[nodiscard]] Status finish(std::span<const uint8_t> server_hello, std::vector<uint8_t>& client_finish,
+                                SessionKeys& keys);
+    uint64_t connection() const { return connection_; }
+    ~ClientHandshake();
+
+private:
+    uint64_t connection_ = 0;
+    std::array<uint8_t, 32> nonce_{}, share_{}, scalar_{}, generator_{};
+};
+
+// Server side: answers one ClientHello; what it must remember until the ClientFinish arrives.
+struct PendingHandshake {
+    uint64_t connection = 0;
+    Key client_confirm{};  // the tag the client must send
+    SessionKeys keys;
+};
+[[nodiscard]] Status answer_client_hello(const std::string& secret, std::span<const uint8_t> client_hello,
+                                         std::vector<uint8_t>& server_hello, PendingHandshake& pending);
+// True when `client_finish` carries the expected confirmation (constant-time compare).
+[[nodiscard]] Status check_client_finish(const PendingHandshake& pending,
+                                         std::span<const uint8_t> client_finish);
+
+// Sliding window over the newest 256 sequence numbers.
+class ReplayWindow {
+public:
+    bool seen_or_too_old(uint64_t seq) const;
+    void mark(uint64_t seq);
+    uint64_t newest() const { return newest_; }
+
+private:
+    static constexpr uint64_t kSize = 256;
+    uint64_t newest_ = 0;  // 0: nothing yet (sequence numbers start at 1)
+    std::array<uint64_t, kSize / 64> bits_{};
+};
+
+// One direction pair of an authenticated session.
+class SecureChannel {
+public:
+    SecureChannel() = default;
+    SecureChannel(uint64_t connection, const Key& send_key, const Key& receive_key);
+    ~SecureChannel();
+    SecureChannel(const SecureChannel&) = default;
+    SecureChannel& operator=(const SecureChannel&) = default;
+
+    // Seals `plaintext` (<= kMaxPlaintext) into `datagram` (resized; <= 1200 bytes).
+    void seal(std::span<const uint8_t> plaintext, std::vector<uint8_t>& datagram);
+    // Opens a sealed datagram: header, connection, replay window, then AEAD; only then is the
+    // sequence number marked seen. `plaintext` is resized to what it holds.
+    [[nodiscard]] Status open(std::span<const uint8_t> datagram, std::vector<uint8_t>& plaintext);
+
+    uint64_t connection() const { return connection_; }
+    uint64_t sent() const { return next_send_ - 1; }
+    uint64_t newest_received() const { return window_.newest(); }
+
+private:
+    uint64_t connection_ = 0;
+    Key send_key_{}, receive_key_{};
+    uint64_t next_send_ = 1;
+    ReplayWindow window_;
+};
+
+}  // namespace reprise::net

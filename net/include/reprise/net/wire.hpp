@@ -1,0 +1,169 @@
+#pragma once
+// What travels on the wire: datagram header, the messages inside sealed datagrams, and the
+// little-endian reader/writer that checks every length. Every field: docs/protocol.md.
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <cstring>
+#include <span>
+#include <string>
+
+#include <glm/mat4x4.hpp>
+
+#include "reprise/core/status.hpp"
+
+namespace reprise::net {
+
+constexpr uint8_t kMagic0 = 'R', kMagic1 = 'P';
+constexpr uint8_t kProtocolVersion = 1;
+constexpr std::size_t kMaxDatagram = 1200;
+constexpr std::size_t kHeaderSize = 12;           // magic, version, type, connection id
+constexpr std::size_t kSealedHeaderSize = 20;     // + u64 sequence number
+constexpr std::size_t kAeadTagSize = 16;
+constexpr std::size_t kMaxPlaintext = kMaxDatagram - kSealedHeaderSize - kAeadTagSize;  // 1164
+constexpr std::size_t kMaxSceneName = 32;
+
+enum class DatagramType : uint8_t { ClientHello = 1, ServerHello = 2, ClientFinish = 3, Sealed = 4 };
+
+struct DatagramHeader {
+    DatagramType type = DatagramType::Sealed;
+    uint64_t connection = 0;
+};
+
+// Messages inside a sealed datagram: one per datagram, the first plaintext byte is the type.
+enum class MessageType : uint8_t {
+    Start = 1,            // client -> server: scene name from the catalogue
+    StreamInfo = 2,       // server -> client: size, rate, mode, scene (also a keep-alive)
+    Pose = 3,             // client -> server
+    Ack = 4,              // client -> server: frame decoded
+    LossReport = 5,       // client -> server: frames that will never be decoded
+    KeyFrameRequest = 6,  // client -> server
+    ReceiverReport = 7,   // client -> server: media datagrams received / missing, cumulative
+    Fragment = 8,         // server -> client: a piece (or FEC parity) of one codec packet
+    Bye = 9,              // either side: the session ends
+    Error = 10,           // server -> client: why a Start was refused (text)
+};
+
+enum class StreamMode : uint8_t { Full = 0, LowRes = 1 };
+
+struct StartMessage {
+    std::string scene;  // [a-z0-9_-], 1..32 characters; empty: the server's default
+};
+struct StreamInfoMessage {
+    uint16_t width = 0, height = 0;
+    float fps = 0.0f;
+    StreamMode mode = StreamMode::Full;
+    std::string scene;
+};
+struct PoseMessage {
+    uint32_t sequence = 0;
+    int64_t client_time_us = 0;  // the client's clock when the pose was sampled
+    double scene_time = 0.0;     // seconds on the scene's animation timeline
+    glm::mat4 view{1.0f};        // world -> camera
+};
+struct AckMessage {
+    uint32_t frame = 0;
+};
+constexpr std::size_t kMaxLossReport = 32;
+struct LossReportMessage {
+    uint8_t count = 0;
+    std::array<uint32_t, kMaxLossReport> frames{};
+};
+struct ReceiverReportMessage {
+    uint32_t received = 0;  // media datagrams received since the session started
+    uint32_t missing = 0;   // media datagrams never received (after reordering settled)
+    uint32_t rtt_us = 0;    // newest measured pose round trip (pose sampled -> frame decoded)
+};
+enum class FragmentKind : uint8_t { Data = 0, Parity = 1 };
+constexpr std::size_t kFragmentHeaderSize = 1 + 4 + 4 + 2 + 2 + 2 + 1 + 1 + 8;  // 25
+constexpr std::size_t kMaxFragmentPayload = kMaxPlaintext - kFragmentHeaderSize;  // 1141
+struct FragmentMessage {
+    uint32_t frame = 0;         // codec frame number
+    uint32_t total_size = 0;    // bytes of the whole codec packet
+    uint16_t index = 0;         // data: fragment index; parity: group index
+    uint16_t data_count = 0;    // data fragments of the packet
+    uint16_t fragment_size = 0; // payload bytes of every data fragment but the last, and of parity
+    uint8_t group_size = 0;     // data fragments per parity group (0: no parity)
+    FragmentKind kind = FragmentKind::Data;
+    int64_t pose_time_us = 0;   // echo of the pose this frame was rendered from
+    std::span<const uint8_t> payload;
+};
+
+// Little-endian writer into a fixed buffer; overflow is a contract violation of the caller.
+class Writer {
+public:
+    explicit Writer(std::span<uint8_t> out) : out_(out) {}
+    void u8(uint8_t v) { put(&v, 1); }
+    void u16(uint16_t v) { uint8_t b[2] = {uint8_t(v), uint8_t(v >> 8)}; put(b, 2); }
+    void u32(uint32_t v) {
+        uint8_t b[4];
+        for (int i = 0; i < 4; ++i) b[i] = uint8_t(v >> (8 * i));
+        put(b, 4);
+    }
+    void u64(uint64_t v) {
+        uint8_t b[8];
+        for (int i = 0; i < 8; ++i) b[i] = uint8_t(v >> (8 * i));
+        put(b, 8);
+    }
+    void f32(float v) { uint32_t u; std::memcpy(&u, &v, 4); u32(u); }
+    void f64(double v) { uint64_t u; std::memcpy(&u, &v, 8); u64(u); }
+    void bytes(std::span<const uint8_t> b) { put(b.data(), b.size()); }
+    std::size_t size() const { return pos_; }
+    uint8_t* end() { return out_.data() + pos_; }
+
+private:
+    void put(const void* p, std::size_t n);
+    std::span<uint8_t> out_;
+    std::size_t pos_ = 0;
+};
+
+// Little-endian reader: each read checks what remains and remembers the first failure.
+class Reader {
+public:
+    explicit Reader(std::span<const uint8_t> in) : in_(in) {}
+    uint8_t u8();
+    uint16_t u16();
+    uint32_t u32();
+    uint64_t u64();
+    float f32();
+    double f64();
+    std::span<const uint8_t> bytes(std::size_t n);
+    std::size_t remaining() const { return failed_ ? 0 : in_.size() - pos_; }
+    bool ok() const { return !failed_; }
+
+private:
+    bool take(std::size_t n);
+    std::span<const uint8_t> in_;
+    std::size_t pos_ = 0;
+    bool failed_ = false;
+};
+
+void write_header(Writer& w, const DatagramHeader& header);
+[[nodiscard]] Status parse_header(std::span<const uint8_t> datagram, DatagramHeader& header);
+
+// Scene names: 1..32 of [a-z0-9_-] (never a path).
+bool valid_scene_name(const std::string& name);
+
+// Each encoder writes one message (type byte first) and returns its size (<= kMaxPlaintext).
+std::size_t encode(const StartMessage& m, std::span<uint8_t> out);
+std::size_t encode(const StreamInfoMessage& m, std::span<uint8_t> out);
+std::size_t encode(const PoseMessage& m, std::span<uint8_t> out);
+std::size_t encode(const AckMessage& m, std::span<uint8_t> out);
+std::size_t encode(const LossReportMessage& m, std::span<uint8_t> out);
+std::size_t encode(const ReceiverReportMessage& m, std::span<uint8_t> out);
+std::size_t encode(const FragmentMessage& m, std::span<uint8_t> out);
+std::size_t encode_empty(MessageType type, std::span<uint8_t> out);  // KeyFrameRequest, Bye
+std::size_t encode_error(const std::string& text, std::span<uint8_t> out);
+
+// Parsers take the whole plaintext (type byte included) and check every field.
+[[nodiscard]] Status message_type(std::span<const uint8_t> plaintext, MessageType& type);
+[[nodiscard]] Status parse(std::span<const uint8_t> plaintext, StartMessage& m);
+[[nodiscard]] Status parse(std::span<const uint8_t> plaintext, StreamInfoMessage& m);
+[[nodiscard]] Status parse(std::span<const uint8_t> plaintext, PoseMessage& m);
+[[nodiscard]] Status parse(std::span<const uint8_t> plaintext, AckMessage& m);
+[[nodiscard]] Status parse(std::span<const uint8_t> plaintext, LossReportMessage& m);
+[[nodiscard]] Status parse(std::span<const uint8_t> plaintext, ReceiverReportMessage& m);
+[[nodiscard]] Status parse(std::span<const uint8_t> plaintext, FragmentMessage& m);
+[[nodiscard]] Status parse_error(std::span<const uint8_t> plaintext, std::string& text);
+
+}  // namespace reprise::net

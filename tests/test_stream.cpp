@@ -1,0 +1,406 @@
+// The remote-rendering loop end to end on loopback: server thread, client, truth rendered from
+// the poses the client displayed. Bounded: small frames, a few seconds per test.
+#include <gtest/gtest.h>
+
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <cmath>
+#include <thread>
+
+#include "reprise/client/stream_client.hpp"
+#include "reprise/core/metrics.hpp"
+#include "reprise/net/secure.hpp"
+#include "reprise/server/builtin_scenes.hpp"
+#include "reprise/server/renderer.hpp"
+#include "reprise/server/stream_server.hpp"
+
+using namespace reprise;
+
+namespace {
+
+constexpr int kWidth = 160, kHeight = 90;
+
+struct RunningServer {
+    std::unique_ptr<server::StreamServer> server;
+    std::atomic<bool> stop{false};
+    std::thread thread;
+    Status result;
+
+    explicit RunningServer(server::StreamServerOptions o) {
+        o.loopback_only = true;
+        Status s = server::StreamServer::create(o, server);
+        EXPECT_TRUE(s.ok()) << s.message();
+        if (server) thread = std::thread([this] { result = server->run(stop); });
+    }
+    ~RunningServer() {
+        stop = true;
+        if (thread.joinable()) thread.join();
+        EXPECT_TRUE(result.ok()) << result.message();
+    }
+    net::Endpoint at() const { return server->local(); }
+};
+
+server::StreamServerOptions server_options(uint16_t port = 0) {
+    return {.scene = "pan",
+            .listen = {0x7f000001u, port},
+            .secret = "2468",
+            .fps = 30.0,
+            .width = kWidth,
+            .height = kHeight,
+            .session_timeout_s = 2.0};
+}
+
+struct Shown {
+    double t;
+    glm::mat4 view;
+    Image<glm::vec4> color;
+};
+
+struct Session {
+    std::vector<Shown> kept;  // every `keep_every`-th displayed frame
+    std::size_t shown = 0;
+    double max_latency_ms = 0.0;
+};
+
+// Runs a client until it decoded `frames` frames (at most `max_seconds`, so a slow machine only
+// takes longer); keeps every keep_every-th displayed frame after `warmup` s.
+Session run(client::StreamClient& c, std::size_t frames, double max_seconds = 30.0, int keep_every = 6,
+            double warmup = 0.5) {
+    server::Scene scene;
+    server::CameraPath path;
+    EXPECT_TRUE(server::load_scene("pan", scene, path).ok());
+    Session s;
+    Status st = client::run_client(c, max_seconds, 60.0, [&](double t) { return server::camera_view(path, scene, t); },
+                                   [&](const Frame& f, const client::DisplayInfo& info, int64_t displayed_us) {
+        s.max_latency_ms = std::max(s.max_latency_ms, (displayed_us - info.pose_us) / 1000.0);
+        if (info.scene_time >= warmup && s.shown++ % keep_every == 0) {
+            Shown k{info.scene_time, f.camera.view, {}};
+            k.color = f.color;
+            s.kept.push_back(std::move(k));
+        }
+        return c.stats().frames_decoded < frames;
+    });
+    EXPECT_TRUE(st.ok()) << st.message();
+    return s;
+}
+
+// Mean PSNR of the kept frames against the scene rendered at their poses and times.
+double mean_psnr(const std::vector<Shown>& kept) {
+    std::unique_ptr<server::Renderer> r;
+    EXPECT_TRUE(server::Renderer::create(r).ok());
+    server::Scene scene;
+    server::CameraPath path;
+    EXPECT_TRUE(server::load_scene("pan", scene, path).ok());
+    Frame truth;
+    Image<glm::vec3> a(kWidth, kHeight), b(kWidth, kHeight);
+    double sum = 0.0;
+    for (const Shown& k : kept) {
+        server::Instant now = server::instant_on_path(path, scene, k.t, kWidth, kHeight);
+        now.view = k.view;
+        server::Instant before = now;
+        before.time -= 1.0 / 30.0;
+        EXPECT_TRUE(r->render(scene, now, before, {.width = kWidth, .height = kHeight}, truth).ok());
+        to_display(truth.color.view(), a.view());
+        to_display(k.color.view(), b.view());
+        sum += std::min(60.0, psnr(a.view(), b.view()));
+    }
+    return kept.empty() ? 0.0 : sum / double(kept.size());
+}
+
+std::unique_ptr<client::StreamClient> make_client(const net::Endpoint& at, client::StreamClientOptions o = {}) {
+    o.server = at;
+    if (o.secret.empty()) o.secret = "2468";
+    std::unique_ptr<client::StreamClient> c;
+    Status s = client::StreamClient::create(o, c);
+    EXPECT_TRUE(s.ok()) << s.message();
+    return c;
+}
+
+// The whole HTTP answer of the metrics endpoint (plain POSIX sockets, 127.0.0.1 only).
+std::string fetch_metrics(int port) {
+    const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    a.sin_port = htons(uint16_t(port));
+    a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+    std::string text;
+    if (::connect(fd, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0) {
+        const char request[] = "GET /metrics HTTP/1.0\r\n\r\n";
+        (void)!::write(fd, request, sizeof request - 1);
+        char buf[4096];
+        for (ssize_t n; (n = ::read(fd, buf, sizeof buf)) > 0;) text.append(buf, std::size_t(n));
+    }
+    ::close(fd);
+    return text;
+}
+
+}  // namespace
+
+TEST(Stream, EndToEndDisplayedFramesMatchTheTruth) {
+    server::StreamServerOptions so = server_options();
+    so.metrics_port = 0;
+    RunningServer srv(so);
+    auto c = make_client(srv.at());
+    const Session s = run(*c, 60);
+    const double p = mean_psnr(s.kept);
+    std::printf("[stream] clean: %zu shown, %zu decoded, PSNR %.2f dB\n", s.shown, c->stats().frames_decoded, p);
+    EXPECT_GE(c->stats().frames_decoded, 60u);
+    EXPECT_GE(c->stats().connects, 1u);
+    EXPECT_EQ(c->stats().frames_lost, 0u);
+    EXPECT_GE(s.kept.size(), 10u);
+    EXPECT_GE(p, 28.0);
+    const std::string metrics = fetch_metrics(srv.server->metrics_port());
+    EXPECT_NE(metrics.find("200 OK"), std::string::npos) << metrics;
+    EXPECT_NE(metrics.find("# TYPE reprise_frames_sent_total counter"), std::string::npos) << metrics;
+    EXPECT_NE(metrics.find("reprise_sessions 1"), std::string::npos) << metrics;
+}
+
+TEST(Stream, LowResolutionColourIsUpsampledToTheTruth) {
+    server::StreamServerOptions so = server_options();
+    so.mode = net::StreamMode::LowRes;
+    so.lowres_factor = 4;
+    RunningServer srv(so);
+    auto c = make_client(srv.at());
+    const Session s = run(*c, 60);
+    const double p = mean_psnr(s.kept);
+    std::printf("[stream] lowres 1/4: %zu shown, %zu decoded, PSNR %.2f dB\n", s.shown, c->stats().frames_decoded, p);
+    ASSERT_NE(c->stream_info(), nullptr);
+    EXPECT_EQ(c->stream_info()->mode, net::StreamMode::LowRes);
+    EXPECT_GE(c->stats().frames_decoded, 60u);
+    EXPECT_EQ(c->stats().decode_errors, 0u);
+    EXPECT_GE(p, 26.0);
+}
+
+TEST(Stream, FivePercentLossAndReorderingKeepTheStreamGoing) {
+    server::StreamServerOptions so = server_options();
+    RunningServer srv(so);
+    client::StreamClientOptions o;
+    o.inject_faults = true;
+    o.downlink = {.loss = 0.05, .delay_ms = 10, .jitter_ms = 4, .reorder = 0.1, .seed = 11};
+    o.uplink = {.loss = 0.05, .delay_ms = 10, .jitter_ms = 4, .reorder = 0.1, .seed = 12};
+    auto c = make_client(srv.at(), o);
+    const Session s = run(*c, 60);
+    const double p = mean_psnr(s.kept);
+    const auto& st = c->stats();
+    std::printf("[stream] 5%% loss: %zu shown, %zu decoded, %zu lost, %zu FEC-recovered, PSNR %.2f dB\n", s.shown,
+                st.frames_decoded, st.frames_lost, st.fec_recovered, p);
+    EXPECT_GE(st.frames_decoded, 60u);
+    EXPECT_GT(st.fec_recovered, 0u);
+    EXPECT_GE(p, 24.0);
+}
+
+TEST(Stream, HeavyLossLowersTheBitrateTarget) {
+    server::StreamServerOptions so = server_options();
+    so.bitrate_kbps = 2000;
+    RunningServer srv(so);
+    client::StreamClientOptions o;
+    o.inject_faults = true;
+    o.downlink = {.loss = 0.3, .seed = 21};
+    auto c = make_client(srv.at(), o);
+    server::Scene scene;
+    server::CameraPath path;
+    ASSERT_TRUE(server::load_scene("pan", scene, path).ok());
+    // Until the target fell (at most 20 s: a slow machine only takes longer).
+    ASSERT_TRUE(client::run_client(*c, 20.0, 60.0, [&](double t) { return server::camera_view(path, scene, t); },
+                                   [&](const Frame&, const client::DisplayInfo&, int64_t) {
+                                       return srv.server->stats().bitrate_kbps >= 1000 ||
+                                              srv.server->stats().bitrate_kbps == 0;
+                                   }).ok());
+    const auto st = srv.server->stats();
+    EXPECT_GT(st.loss, 0.1);
+    EXPECT_LT(st.bitrate_kbps, 1000) << "30 % loss for up to 20 s";
+}
+
+namespace {
+
+// A hand-driven peer for attacks: raw datagrams, optionally its own authenticated session.
+struct RawPeer {
+    net::UdpSocket socket;
+    net::Endpoint server;
+    net::SecureChannel channel;
+    std::vector<uint8_t> datagram;
+
+    explicit RawPeer(net::Endpoint s) : server(s) { EXPECT_TRUE(socket.bind({0x7f000001u, 0}).ok()); }
+
+    bool receive_within(int64_t us, std::vector<uint8_t>& out) {
+        const int64_t end = net::now_us() + us;
+        net::Endpoint from;
+        while (net::now_us() < end) {
+            if (socket.receive(out, from, net::kMaxDatagram)) return true;
+            socket.wait_readable(10000);
+        }
+        return false;
+    }
+
+    bool handshake(const std::string& secret, std::vector<uint8_t>* finish_out = nullptr) {
+        net::ClientHandshake h;
+        std::vector<uint8_t> hello, finish;
+        h.start(secret, hello);
+        socket.send_to(hello, server);
+        if (!receive_within(2'000'000, datagram)) return false;
+        net::SessionKeys keys;
+        if (!h.finish(datagram, finish, keys).ok()) return false;
+        socket.send_to(finish, server);
+        if (finish_out) *finish_out = finish;
+        channel = net::SecureChannel(h.connection(), keys.client_to_server, keys.server_to_client);
+        return true;
+    }
+
+    template <class M>
+    std::vector<uint8_t> seal(const M& m) {
+        std::vector<uint8_t> plain(net::kMaxPlaintext), sealed;
+        plain.resize(net::encode(m, plain));
+        channel.seal(plain, sealed);
+        return sealed;
+    }
+};
+
+// Calls step() until done() or max_seconds passed; returns done().
+template <class Done, class Step>
+bool eventually(Done done, Step step, double max_seconds = 20.0) {
+    const int64_t end = net::now_us() + int64_t(max_seconds * 1e6);
+    while (!done() && net::now_us() < end) step();
+    return done();
+}
+
+void poll_for(client::StreamClient& c, double seconds) {
+    const int64_t end = net::now_us() + int64_t(seconds * 1e6);
+    while (net::now_us() < end) {
+        c.wait(2000);
+        ASSERT_TRUE(c.poll(net::now_us()).ok());
+    }
+}
+
+}  // namespace
+
+TEST(Stream, BadDatagramsAreDroppedWhileAnotherClientIsServed) {
+    RunningServer srv(server_options());
+    auto c = make_client(srv.at());
+    server::Scene scene;
+    server::CameraPath path;
+    ASSERT_TRUE(server::load_scene("pan", scene, path).ok());
+    // The good client streams on in the background of the attack (poses from its own thread).
+    std::atomic<bool> done{false};
+    std::size_t decoded_before_attack = 0;
+    std::thread good([&] {
+        const int64_t start = net::now_us();
+        while (!done) {
+            const double t = (net::now_us() - start) * 1e-6;
+            c->wait(5000);
+            EXPECT_TRUE(c->poll(net::now_us()).ok());
+            c->send_pose(server::camera_view(path, scene, t), t, net::now_us());
+        }
+    });
+    eventually([&] { return c->stats().frames_decoded >= 10; },
+               [] { std::this_thread::sleep_for(std::chrono::milliseconds(10)); });
+    decoded_before_attack = c->stats().frames_decoded;
+    const auto before = srv.server->stats();
+
+    RawPeer attacker(srv.at());
+    std::vector<uint8_t> garbage(300);
+    for (std::size_t i = 0; i < garbage.size(); ++i) garbage[i] = uint8_t(i * 7);
+    attacker.socket.send_to(garbage, srv.at());                                    // garbage
+    std::vector<uint8_t> oversized(1400, 0);
+    oversized[0] = 'R', oversized[1] = 'P', oversized[2] = 1, oversized[3] = 4;
+    attacker.socket.send_to(oversized, srv.at());                                  // oversized
+    std::vector<uint8_t> truncated = {'R', 'P', 1, 1, 0, 0};
+    attacker.socket.send_to(truncated, srv.at());                                  // truncated
+    // Wrong PIN: the server answers the hello, the attacker cannot confirm; a forged finish fails.
+    EXPECT_FALSE(attacker.handshake("1111"));
+    // A sealed datagram for no session, and one from a real session replayed.
+    RawPeer honest(srv.at());
+    ASSERT_TRUE(honest.handshake("2468"));
+    const auto start_message = honest.seal(net::StartMessage{});
+    honest.socket.send_to(start_message, srv.at());
+    honest.socket.send_to(start_message, srv.at());                                // replayed
+    std::vector<uint8_t> tampered = start_message;
+    tampered.back() ^= 1;
+    honest.socket.send_to(tampered, srv.at());                                     // tampered
+    eventually([&] { return c->stats().frames_decoded > decoded_before_attack + 10; },
+               [] { std::this_thread::sleep_for(std::chrono::milliseconds(10)); });
+    done = true;
+    good.join();
+    const auto after = srv.server->stats();
+    EXPECT_GE(after.dropped_datagrams - before.dropped_datagrams, 5u);
+    EXPECT_EQ(after.handshakes_ok - before.handshakes_ok, 1u);  // the honest raw peer only
+    EXPECT_GT(c->stats().frames_decoded, decoded_before_attack + 10) << "the good client kept being served";
+}
+
+TEST(Stream, ClientReconnectsAfterServerRestartAndServerServesANewClient) {
+    auto first = std::make_unique<RunningServer>(server_options());
+    const net::Endpoint at = first->at();
+    client::StreamClientOptions o;
+    o.reconnect_after_s = 0.4;
+    auto c = make_client(at, o);
+    server::Scene scene;
+    server::CameraPath path;
+    ASSERT_TRUE(server::load_scene("pan", scene, path).ok());
+    auto pump = [&] {
+        c->wait(5000);
+        ASSERT_TRUE(c->poll(net::now_us()).ok());
+        c->send_pose(server::camera_view(path, scene, 0.0), 0.0, net::now_us());
+    };
+    EXPECT_TRUE(eventually([&] { return c->stats().frames_decoded > 5; }, pump));
+    const std::size_t connects = c->stats().connects;
+    const std::size_t decoded = c->stats().frames_decoded;
+    first.reset();  // the server goes away (its clients get a Bye)
+    RunningServer second(server_options(at.port));
+    EXPECT_TRUE(eventually([&] { return c->stats().frames_decoded > decoded + 5; }, pump));
+    EXPECT_GT(c->stats().connects, connects);
+    // A client that leaves and a new one that comes.
+    c.reset();
+    auto d = make_client(at);
+    EXPECT_TRUE(eventually([&] { return d->stats().frames_decoded > 5; }, [&] {
+        d->wait(5000);
+        ASSERT_TRUE(d->poll(net::now_us()).ok());
+        d->send_pose(server::camera_view(path, scene, 0.0), 0.0, net::now_us());
+    }));
+}
+
+TEST(Stream, WrongPinAndUnknownSceneAreRefusedAtTheClient) {
+    RunningServer srv(server_options());
+    auto wrong = make_client(srv.at(), {.secret = "0000", .max_auth_failures = 1});
+    Status s;
+    const int64_t end = net::now_us() + 3'000'000;
+    while (s.ok() && net::now_us() < end) {
+        wrong->wait(5000);
+        s = wrong->poll(net::now_us());
+    }
+    EXPECT_FALSE(s.ok());
+    EXPECT_NE(s.message().find("wrong PIN"), std::string::npos) << s.message();
+
+    auto unknown = make_client(srv.at(), {.secret = "2468", .scene = "nosuchscene"});
+    s = {};
+    const int64_t end2 = net::now_us() + 3'000'000;
+    while (s.ok() && net::now_us() < end2) {
+        unknown->wait(5000);
+        s = unknown->poll(net::now_us());
+    }
+    EXPECT_FALSE(s.ok());
+    EXPECT_NE(s.message().find("catalogue"), std::string::npos) << s.message();
+}
+
+TEST(Stream, AClientThatStopsReadingKeepsServerMemoryBounded) {
+    server::StreamServerOptions o = server_options();
+    o.max_in_flight_frames = 4;
+    o.send_queue_bytes = 256 * 1024;
+    RunningServer srv(o);
+    RawPeer silent(srv.at());
+    ASSERT_TRUE(silent.handshake("2468"));
+    silent.socket.send_to(silent.seal(net::StartMessage{}), srv.at());
+    silent.socket.send_to(silent.seal(net::PoseMessage{.sequence = 1}), srv.at());
+    // It never reads and never acknowledges; a normal client streams beside it.
+    auto c = make_client(srv.at());
+    poll_for(*c, 0.2);
+    EXPECT_TRUE(eventually([&] { return srv.server->stats().frames_skipped > 5; },
+                           [] { std::this_thread::sleep_for(std::chrono::milliseconds(10)); }));
+    EXPECT_LE(srv.server->stats().max_queue_bytes, o.send_queue_bytes);
+    // Both sessions end by the (2 s) timeout: nothing is held for them any more.
+    EXPECT_TRUE(eventually([&] { return srv.server->stats().sessions == 0; },
+                           [] { std::this_thread::sleep_for(std::chrono::milliseconds(10)); }));
+    EXPECT_LE(srv.server->stats().max_queue_bytes, o.send_queue_bytes);
+}

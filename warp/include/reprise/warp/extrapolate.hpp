@@ -1,0 +1,29 @@
+#pragma once
+// Extrapolation of one frame to any camera (latency hiding, as ASW and Outatime): the static
+// scene is reprojected with depth to the new camera, moving objects are carried `periods` frame
+// periods further along their motion, holes are filled.
+#include <memory>
+
+#include "reprise/warp/fruc.hpp"
+
+namespace reprise::warp {
+
+class PoseExtrapolator {
+public:
+    explicit PoseExtrapolator(const FrucOptions& options = {.mode = FrucMode::Extrapolate});
+    ~PoseExtrapolator();
+    PoseExtrapolator(PoseExtrapolator&&) noexcept;
+    PoseExtrapolator& operator=(PoseExtrapolator&&) noexcept;
+
+    // `out` gets colour, depth and motion of `frame` as seen by (view, projection) `periods`
+    // frame periods after it (periods >= 0; its motion is per period). Scratch is sized once.
+    void extrapolate(const GBufferView& frame, const glm::mat4& view, const glm::mat4& projection,
+                     float periods, Frame& out);
+    const FrucCounters& counters() const;
+
+private:
+    struct State;
+    std::unique_ptr<State> state_;
+};
+
+}  // namespace reprise::warp

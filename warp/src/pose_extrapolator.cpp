@@ -1,0 +1,37 @@
+#include "fruc_stages.hpp"
+#include "reprise/warp/extrapolate.hpp"
+
+namespace reprise::warp {
+
+struct PoseExtrapolator::State {
+    FrucOptions options;
+    FrucScratch scratch;
+    FrucCounters counters;
+};
+
+PoseExtrapolator::PoseExtrapolator(const FrucOptions& options) : state_(std::make_unique<State>()) {
+    state_->options = options;
+    state_->options.mode = FrucMode::Extrapolate;
+}
+PoseExtrapolator::~PoseExtrapolator() = default;
+PoseExtrapolator::PoseExtrapolator(PoseExtrapolator&&) noexcept = default;
+PoseExtrapolator& PoseExtrapolator::operator=(PoseExtrapolator&&) noexcept = default;
+
+void PoseExtrapolator::extrapolate(const GBufferView& frame, const glm::mat4& view, const glm::mat4& projection,
+                                   float periods, Frame& out) {
+    REPRISE_ASSERT(periods >= 0.0f);
+    State& s = *state_;
+    ++s.counters.inputs;
+    ++s.counters.outputs;
+    extrapolate_to_camera(frame, view, projection, periods, 1.0f, s.options, s.scratch, out, s.counters);
+    out.camera = frame.camera;
+    out.camera.prev_view = frame.camera.view;
+    out.camera.prev_projection = frame.camera.projection;
+    out.camera.view = view;
+    out.camera.projection = projection;
+    out.camera.jitter = glm::vec2(0.0f);
+}
+
+const FrucCounters& PoseExtrapolator::counters() const { return state_->counters; }
+
+}  // namespace reprise::warp
