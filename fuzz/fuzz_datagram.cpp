@@ -45,7 +45,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
     (void)parse_header(input, header);
     std::vector<uint8_t> reply;
     PendingHandshake pending;
-    if (answer_client_hello("1234", input, reply, pending).ok()) (void)check_client_finish(pending, input);
+    if (answer_client_hello("1234", input, reply, pending).ok())
+        (void)check_client_finish(pending, input);
     ClientHandshake client;
     std::vector<uint8_t> hello, finish;
     client.start("1234", hello);
