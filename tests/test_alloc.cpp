@@ -39,8 +39,9 @@ void* allocate(std::size_t size, std::size_t alignment = 0) {
         trace();
     }
     if (size == 0) size = 1;
-    void* p = alignment ? std::aligned_alloc(alignment, (size + alignment - 1) / alignment * alignment)
-                        : std::malloc(size);
+    void* p = alignment
+                  ? std::aligned_alloc(alignment, (size + alignment - 1) / alignment * alignment)
+                  : std::malloc(size);
     if (!p) throw std::bad_alloc();
     return p;
 }
@@ -60,7 +61,9 @@ long allocations_during(F&& body) {
 void* operator new(std::size_t size) { return allocate(size); }
 void* operator new[](std::size_t size) { return allocate(size); }
 void* operator new(std::size_t size, std::align_val_t a) { return allocate(size, std::size_t(a)); }
-void* operator new[](std::size_t size, std::align_val_t a) { return allocate(size, std::size_t(a)); }
+void* operator new[](std::size_t size, std::align_val_t a) {
+    return allocate(size, std::size_t(a));
+}
 void* operator new(std::size_t size, const std::nothrow_t&) noexcept {
     try {
         return allocate(size);
@@ -98,7 +101,8 @@ Camera camera_at(int frame) {
     Camera c;
     c.projection = glm::ortho(-kW / 2.0f, kW / 2.0f, -kH / 2.0f, kH / 2.0f, 0.1f, 100.0f);
     c.view = glm::translate(glm::mat4(1.0f), glm::vec3(-float(kStep * frame), 0.0f, 0.0f));
-    c.prev_view = glm::translate(glm::mat4(1.0f), glm::vec3(-float(kStep * (frame - 1)), 0.0f, 0.0f));
+    c.prev_view =
+        glm::translate(glm::mat4(1.0f), glm::vec3(-float(kStep * (frame - 1)), 0.0f, 0.0f));
     c.prev_projection = c.projection;
     c.time = frame / 30.0;
     return c;
@@ -149,9 +153,7 @@ void run_converter(warp::FrucMode mode) {
 TEST(Allocations, CounterSeesAnAllocation) {
     // The counter itself works: a vector growing in the counted region is seen.
     std::vector<int>* v = nullptr;
-    const long counted = allocations_during([&] {
-        v = new std::vector<int>(100);
-    });
+    const long counted = allocations_during([&] { v = new std::vector<int>(100); });
     delete v;
     EXPECT_GE(counted, 2);
 }
@@ -200,7 +202,8 @@ TEST(Allocations, UpsamplingSteadyStateAllocatesNothing) {
     upsampler.upsample(low.view(), {-0.5f, -0.5f}, frames[0], out.view(), &stats);
     const long counted = allocations_during([&] {
         for (int i = 1; i < 4; ++i)
-            upsampler.upsample(low.view(), {0.5f * (i & 1) - 0.25f, 0.25f}, frames[std::size_t(i)], out.view(), &stats);
+            upsampler.upsample(low.view(), {0.5f * (i & 1) - 0.25f, 0.25f}, frames[std::size_t(i)],
+                               out.view(), &stats);
     });
     EXPECT_GT(stats.history_used, 0);
     EXPECT_EQ(counted, 0) << "allocations in 3 steady-state upsampled frames";

@@ -16,11 +16,13 @@ namespace {
 constexpr int kW = 320, kH = 200;
 
 // Pixel positions and depths spread over the image and the depth range.
-void round_trip(const glm::mat4& projection, bool expect_axis_aligned, float depth_lo, float depth_hi) {
+void round_trip(const glm::mat4& projection, bool expect_axis_aligned, float depth_lo,
+                float depth_hi) {
     const Unprojector unproject(projection, kW, kH);
     EXPECT_EQ(unproject.axis_aligned(), expect_axis_aligned);
     std::mt19937 rng(7);
-    std::uniform_real_distribution<float> ux(0.0f, float(kW)), uy(0.0f, float(kH)), ud(depth_lo, depth_hi);
+    std::uniform_real_distribution<float> ux(0.0f, float(kW)), uy(0.0f, float(kH)),
+        ud(depth_lo, depth_hi);
     for (int i = 0; i < 500; ++i) {
         const float px = ux(rng), py = uy(rng), depth = ud(rng);
         const glm::vec4 point = unproject.point(px, py, depth);
@@ -36,7 +38,8 @@ void round_trip(const glm::mat4& projection, bool expect_axis_aligned, float dep
 
 TEST(CameraMath, UnprojectionRoundTripsForEveryProjection) {
     round_trip(glm::perspective(1.0f, float(kW) / kH, 0.1f, 100.0f), true, 0.2f, 90.0f);
-    round_trip(glm::frustum(-0.03f, 0.05f, -0.02f, 0.04f, 0.1f, 100.0f), true, 0.2f, 90.0f);  // off-centre
+    round_trip(glm::frustum(-0.03f, 0.05f, -0.02f, 0.04f, 0.1f, 100.0f), true, 0.2f,
+               90.0f);  // off-centre
     round_trip(glm::ortho(-4.0f, 4.0f, -3.0f, 3.0f, 0.1f, 50.0f), true, 0.2f, 45.0f);
     glm::mat4 skewed = glm::perspective(1.0f, float(kW) / kH, 0.1f, 100.0f);
     skewed[1][0] = 0.3f;  // x depends on y: the 2x2 solve

@@ -21,8 +21,10 @@ fs::path scratch(const std::string& name) {
     return fresh_directory(fs::temp_directory_path() / ("reprise-cli-" + name));
 }
 
-void expect_clean_failure(const Outcome& r, const std::string& must_mention, const std::string& what) {
-    EXPECT_TRUE(r.status == 1 || r.status == 2) << what << ": status " << r.status << "\n" << r.output;
+void expect_clean_failure(const Outcome& r, const std::string& must_mention,
+                          const std::string& what) {
+    EXPECT_TRUE(r.status == 1 || r.status == 2) << what << ": status " << r.status << "\n"
+                                                << r.output;
     EXPECT_NE(r.output.find(must_mention), std::string::npos) << what << ":\n" << r.output;
     EXPECT_EQ(r.output.find("Sanitizer"), std::string::npos) << what << ":\n" << r.output;
 }
@@ -35,27 +37,39 @@ TEST(CliBadInput, ArgumentsGetOneMessageAndStatusTwo) {
     expect_clean_failure(run("frobnicate"), "unknown command", "unknown command");
     expect_clean_failure(run("render --nope 3"), "--nope", "unknown option");
     expect_clean_failure(run("render --frames"), "--frames", "missing value");
-    expect_clean_failure(run("render --frames ten --out " + out.string()), "--frames", "bad integer");
+    expect_clean_failure(run("render --frames ten --out " + out.string()), "--frames",
+                         "bad integer");
     expect_clean_failure(run("render --fps nan --out " + out.string()), "--fps", "NaN rate");
     expect_clean_failure(run("render --fps -30 --out " + out.string()), "--fps", "negative rate");
     expect_clean_failure(run("render --frames 0 --out " + out.string()), "--frames", "zero frames");
     expect_clean_failure(run("render --size 0x0 --out " + out.string()), "0x0", "empty size");
-    expect_clean_failure(run("render --size 20000x10 --out " + out.string()), "20000x10", "huge size");
+    expect_clean_failure(run("render --size 20000x10 --out " + out.string()), "20000x10",
+                         "huge size");
     expect_clean_failure(run("render --size wide --out " + out.string()), "wide", "not a size");
-    expect_clean_failure(run("render --scene nowhere --out " + out.string()), "nowhere", "bad scene");
-    expect_clean_failure(run("render --camera spiral --out " + out.string()), "spiral", "bad camera");
-    expect_clean_failure(run("render --camera orbit:speed=x --out " + out.string()), "'x'", "bad param");
+    expect_clean_failure(run("render --scene nowhere --out " + out.string()), "nowhere",
+                         "bad scene");
+    expect_clean_failure(run("render --camera spiral --out " + out.string()), "spiral",
+                         "bad camera");
+    expect_clean_failure(run("render --camera orbit:speed=x --out " + out.string()), "'x'",
+                         "bad param");
     expect_clean_failure(run("render"), "--out", "no output");
-    expect_clean_failure(run("render --reuse always --scene courtyard --out " + out.string()), "always", "bad reuse");
-    expect_clean_failure(run("render --reuse cache --scene pan --out " + out.string()), "heavy", "reuse needs heavy");
-    expect_clean_failure(run("render --shading glossy --out " + out.string()), "glossy", "bad shading");
-    expect_clean_failure(run("render --scene courtyard --reuse cache --refresh tiles:4 --out " + out.string()),
-                         "tiles:4", "bad refresh kind");
-    expect_clean_failure(run("render --scene courtyard --reuse cache --refresh tiled:0 --out " + out.string()),
-                         "tiled:0", "bad refresh period");
-    expect_clean_failure(run("render --scene courtyard --reuse adaptive --threshold nan --out " + out.string()),
-                         "--threshold", "NaN threshold");
-    expect_clean_failure(run("render --scene courtyard --pcf 99 --out " + out.string()), "--pcf", "huge PCF");
+    expect_clean_failure(run("render --reuse always --scene courtyard --out " + out.string()),
+                         "always", "bad reuse");
+    expect_clean_failure(run("render --reuse cache --scene pan --out " + out.string()), "heavy",
+                         "reuse needs heavy");
+    expect_clean_failure(run("render --shading glossy --out " + out.string()), "glossy",
+                         "bad shading");
+    expect_clean_failure(
+        run("render --scene courtyard --reuse cache --refresh tiles:4 --out " + out.string()),
+        "tiles:4", "bad refresh kind");
+    expect_clean_failure(
+        run("render --scene courtyard --reuse cache --refresh tiled:0 --out " + out.string()),
+        "tiled:0", "bad refresh period");
+    expect_clean_failure(
+        run("render --scene courtyard --reuse adaptive --threshold nan --out " + out.string()),
+        "--threshold", "NaN threshold");
+    expect_clean_failure(run("render --scene courtyard --pcf 99 --out " + out.string()), "--pcf",
+                         "huge PCF");
     EXPECT_EQ(run("render --help").status, 0);
     EXPECT_EQ(run("--help").status, 0);
 }
@@ -78,9 +92,9 @@ TEST(CliBadInput, BrokenFramesGetOneMessageAndStatusOne) {
     fs::copy_file(good, dir / "cut.exr");
     fs::resize_file(dir / "cut.exr", size / 2);
     expect_clean_failure(run("info " + (dir / "cut.exr").string()), "cut.exr", "truncated frame");
-    expect_clean_failure(run("metrics --ref " + (dir / "ok").string() + " --test " +
-                             (dir / "cut.exr").string()),
-                         "cut.exr", "metrics on a truncated frame");
+    expect_clean_failure(
+        run("metrics --ref " + (dir / "ok").string() + " --test " + (dir / "cut.exr").string()),
+        "cut.exr", "metrics on a truncated frame");
 }
 
 // Every glTF file of the assimp test models either renders or fails with one message naming it.
@@ -92,8 +106,8 @@ TEST(CliBadInput, EveryAssimpGltfModelRendersOrFailsCleanly) {
     for (const auto& entry : fs::recursive_directory_iterator(models)) {
         std::string ext = entry.path().extension().string();
         if (ext != ".gltf" && ext != ".glb") continue;
-        Outcome r = run("render --scene '" + entry.path().string() + "' --frames 2 --size 96x64 --out " +
-                    out.string());
+        Outcome r = run("render --scene '" + entry.path().string() +
+                        "' --frames 2 --size 96x64 --out " + out.string());
         if (r.status == 0) {
             ++rendered;
             EXPECT_TRUE(fs::exists(out / "frame_00001.exr")) << entry.path();

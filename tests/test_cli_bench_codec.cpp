@@ -3,8 +3,8 @@
 #include <gtest/gtest.h>
 
 #include <bit>
-#include <cstdio>
 #include <cmath>
+#include <cstdio>
 #include <random>
 
 #include "bd_rate.hpp"
@@ -68,7 +68,8 @@ std::vector<float> test_depth(int w, int h) {
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
             float z = 2.0f + 0.01f * x + 0.003f * y * y / h;  // a smooth surface
-            if ((x - w / 2) * (x - w / 2) + (y - h / 3) * (y - h / 3) < w * h / 40) z = 1.25f + 0.001f * x;
+            if ((x - w / 2) * (x - w / 2) + (y - h / 3) * (y - h / 3) < w * h / 40)
+                z = 1.25f + 0.001f * x;
             if (y < h / 5) z = INFINITY;  // sky
             depth[std::size_t(y) * w + x] = z;
         }
@@ -180,7 +181,8 @@ double psnr_of(const Image<Rgb8>& a, const Image<Rgb8>& b) {
 }
 
 void expect_round_trip(const PeerConfig& config, int w, int h, double min_psnr) {
-    if (!peer_available(config.kind)) GTEST_SKIP() << peer_name(config.kind) << " not in libavcodec";
+    if (!peer_available(config.kind))
+        GTEST_SKIP() << peer_name(config.kind) << " not in libavcodec";
     const auto frames = moving_square(w, h, 3);
     std::vector<PeerFrame> out;
     const Status status = encode_decode_peer(frames, config, 30.0, out);
@@ -248,7 +250,7 @@ TEST(CliBenchCodec, TinySceneWritesRowsForEveryPeer) {
         for (std::string cell; std::getline(stream, cell, ',');) cells.push_back(cell);
         ASSERT_EQ(cells.size(), 10u) << line;
         ++rows[cells[1]];
-        EXPECT_GT(std::stod(cells[4]), 0.0) << line;  // bits
+        EXPECT_GT(std::stod(cells[4]), 0.0) << line;   // bits
         EXPECT_GT(std::stod(cells[5]), 20.0) << line;  // PSNR: figures seen 27..45 dB
     }
     for (PeerKind kind : {PeerKind::X264, PeerKind::X265, PeerKind::SvtAv1}) {

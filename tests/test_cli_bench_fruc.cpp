@@ -29,7 +29,7 @@ std::vector<std::string> fields(const std::string& line) {
 }
 
 class CliBenchFruc : public testing::Test {
-  protected:
+protected:
     static void SetUpTestSuite() {
         // One folder per process: ctest may run the cases of this suite side by side.
         dir_ = fs::temp_directory_path() / ("reprise-cli-bench-fruc-" + std::to_string(getpid()));

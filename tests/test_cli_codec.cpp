@@ -24,21 +24,28 @@ std::string bytes_of(const fs::path& path) {
 }  // namespace
 
 TEST(CliCodec, EncodeDecodeInfoAndThreadCountIndependence) {
-    const fs::path dir = test::fresh_directory(fs::temp_directory_path() / ("reprise_cli_codec_" + std::to_string(::getpid())));
+    const fs::path dir = test::fresh_directory(fs::temp_directory_path() /
+                                               ("reprise_cli_codec_" + std::to_string(::getpid())));
     const std::string frames = (dir / "frames").string();
-    ASSERT_EQ(test::run_command(cli::command_render, {"--scene", "crossing", "--frames", "4", "--size", "160x96", "--out", frames}), 0);
+    ASSERT_EQ(test::run_command(cli::command_render, {"--scene", "crossing", "--frames", "4",
+                                                      "--size", "160x96", "--out", frames}),
+              0);
     const std::string one = (dir / "one.rps").string(), two = (dir / "two.rps").string();
-    const test::Outcome a = test::run_reprise("encode --in " + frames + " --out " + one + " --qp 24", 120);
+    const test::Outcome a =
+        test::run_reprise("encode --in " + frames + " --out " + one + " --qp 24", 120);
     ASSERT_EQ(a.status, 0) << a.output;
     EXPECT_NE(a.output.find("colour"), std::string::npos) << a.output;
     EXPECT_NE(a.output.find("skipped"), std::string::npos) << a.output;
     // The same stream with one worker thread and with four.
-    const test::Outcome b = test::run_reprise("encode --in " + frames + " --out " + two + " --qp 24", 120);
+    const test::Outcome b =
+        test::run_reprise("encode --in " + frames + " --out " + two + " --qp 24", 120);
     ASSERT_EQ(b.status, 0);
     ASSERT_EQ(::setenv("REPRISE_THREADS", "1", 1), 0);
-    const test::Outcome c = test::run_reprise("encode --in " + frames + " --out " + (dir / "t1.rps").string() + " --qp 24", 120);
+    const test::Outcome c = test::run_reprise(
+        "encode --in " + frames + " --out " + (dir / "t1.rps").string() + " --qp 24", 120);
     ASSERT_EQ(::setenv("REPRISE_THREADS", "4", 1), 0);
-    const test::Outcome d = test::run_reprise("encode --in " + frames + " --out " + (dir / "t4.rps").string() + " --qp 24", 120);
+    const test::Outcome d = test::run_reprise(
+        "encode --in " + frames + " --out " + (dir / "t4.rps").string() + " --qp 24", 120);
     ::unsetenv("REPRISE_THREADS");
     ASSERT_EQ(c.status, 0);
     ASSERT_EQ(d.status, 0);
@@ -68,19 +75,26 @@ TEST(CliCodec, EncodeDecodeInfoAndThreadCountIndependence) {
     damaged[damaged.size() - 5] ^= 0x40;
     const fs::path bad = dir / "bad.rps";
     std::ofstream(bad, std::ios::binary) << damaged;
-    const test::Outcome f = test::run_reprise("decode " + bad.string() + " --out " + (dir / "bad").string(), 60);
+    const test::Outcome f =
+        test::run_reprise("decode " + bad.string() + " --out " + (dir / "bad").string(), 60);
     EXPECT_EQ(f.status, 1) << f.output;
     EXPECT_NE(f.output.find("packet 3"), std::string::npos) << f.output;
     EXPECT_NE(f.output.find("CRC"), std::string::npos) << f.output;
     EXPECT_TRUE(fs::exists(frame_path((dir / "bad").string(), 2)));
     // Truncated, not a stream, bad arguments.
     std::ofstream(dir / "short.rps", std::ios::binary) << stream.substr(0, stream.size() / 2);
-    const test::Outcome g = test::run_reprise("decode " + (dir / "short.rps").string() + " --out " + (dir / "s").string(), 60);
+    const test::Outcome g = test::run_reprise(
+        "decode " + (dir / "short.rps").string() + " --out " + (dir / "s").string(), 60);
     EXPECT_EQ(g.status, 1) << g.output;
     EXPECT_NE(g.output.find("runs past the end"), std::string::npos) << g.output;
-    const test::Outcome h = test::run_reprise("info " + frame_path(frames, 0).substr(0, 0) + (dir / "frames" / "x.rps").string(), 60);
+    const test::Outcome h = test::run_reprise(
+        "info " + frame_path(frames, 0).substr(0, 0) + (dir / "frames" / "x.rps").string(), 60);
     EXPECT_EQ(h.status, 1) << h.output;
-    EXPECT_EQ(test::run_reprise("encode --in " + frames + " --out " + one + " --qp 60", 60).status, 2);
-    EXPECT_EQ(test::run_reprise("encode --in " + frames + " --out " + one + " --depth bounded:7", 60).status, 2);
+    EXPECT_EQ(test::run_reprise("encode --in " + frames + " --out " + one + " --qp 60", 60).status,
+              2);
+    EXPECT_EQ(
+        test::run_reprise("encode --in " + frames + " --out " + one + " --depth bounded:7", 60)
+            .status,
+        2);
     fs::remove_all(dir);
 }

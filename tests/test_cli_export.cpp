@@ -25,7 +25,7 @@ using test::run_command;
 using test::run_output;
 
 class CliExport : public testing::Test {
-  protected:
+protected:
     void SetUp() override {
         root_ = fresh_directory(fs::temp_directory_path() /
                                 ("reprise_test_cli_export_" + std::to_string(::getpid()) + "_" +

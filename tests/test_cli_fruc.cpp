@@ -14,15 +14,17 @@ using namespace reprise;
 namespace fs = std::filesystem;
 
 TEST(CliFruc, ColourOnlyInputIsInterpolatedWithOpticalFlow) {
-    const fs::path dir = fs::temp_directory_path() / ("reprise_cli_fruc_" + std::to_string(::getpid()));
+    const fs::path dir =
+        fs::temp_directory_path() / ("reprise_cli_fruc_" + std::to_string(::getpid()));
     fs::remove_all(dir);
     const std::string rendered = (dir / "rendered").string(), truth = (dir / "truth").string();
     const std::string bare = (dir / "bare").string(), made = (dir / "made").string();
-    ASSERT_EQ(test::run_command(cli::command_render, {"--scene", "pan", "--frames", "3", "--fps", "30",
-                                                      "--size", "192x108", "--out", rendered}),
-              0);
-    ASSERT_EQ(test::run_command(cli::command_render, {"--scene", "pan", "--frames", "5", "--fps", "60",
-                                                      "--size", "192x108", "--out", truth}),
+    ASSERT_EQ(
+        test::run_command(cli::command_render, {"--scene", "pan", "--frames", "3", "--fps", "30",
+                                                "--size", "192x108", "--out", rendered}),
+        0);
+    ASSERT_EQ(test::run_command(cli::command_render, {"--scene", "pan", "--frames", "5", "--fps",
+                                                      "60", "--size", "192x108", "--out", truth}),
               0);
     fs::create_directories(bare);
     std::vector<Frame> input(3);
@@ -33,7 +35,8 @@ TEST(CliFruc, ColourOnlyInputIsInterpolatedWithOpticalFlow) {
         colour_only.fps = input[i].fps;
         ASSERT_TRUE(write_frame(frame_path(bare, i), colour_only).ok());
     }
-    const test::Outcome r = test::run_reprise("fruc --in " + bare + " --factor 2 --out " + made, 120);
+    const test::Outcome r =
+        test::run_reprise("fruc --in " + bare + " --factor 2 --out " + made, 120);
     ASSERT_EQ(r.status, 0) << r.output;
     EXPECT_NE(r.output.find("no motion channels"), std::string::npos) << r.output;
     EXPECT_NE(r.output.find("optical flow"), std::string::npos) << r.output;
@@ -44,7 +47,8 @@ TEST(CliFruc, ColourOnlyInputIsInterpolatedWithOpticalFlow) {
         ASSERT_TRUE(read_frame(frame_path(truth, k), expected).ok());
         const double psnr = test::display_psnr(expected.color, ours.color);
         const double repeat = test::display_psnr(expected.color, input[k / 2].color);
-        std::printf("[fruc] colour only, frame %d: %.2f dB (repeating: %.2f dB)\n", k, psnr, repeat);
+        std::printf("[fruc] colour only, frame %d: %.2f dB (repeating: %.2f dB)\n", k, psnr,
+                    repeat);
         // Measured: 37.14 / 34.82 and 37.81 / 33.82 dB.
         EXPECT_GT(psnr, 36.5) << k;
         EXPECT_GT(psnr, repeat + 1.5) << k;

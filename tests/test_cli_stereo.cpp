@@ -31,11 +31,12 @@ double psnr_of(const std::string& a_file, const std::string& b_file) {
 }  // namespace
 
 TEST(CliStereo, RenderBothEyesSynthesizeAndExport) {
-    const fs::path dir = fs::temp_directory_path() / ("reprise_cli_stereo_" + std::to_string(::getpid()));
+    const fs::path dir =
+        fs::temp_directory_path() / ("reprise_cli_stereo_" + std::to_string(::getpid()));
     fs::remove_all(dir);
     const std::string truth = (dir / "truth").string(), made = (dir / "made").string();
-    ASSERT_EQ(run_command(cli::command_render, {"--scene", "pan", "--frames", "2", "--size", "160x90",
-                                                "--stereo", "0.1", "--out", truth}),
+    ASSERT_EQ(run_command(cli::command_render, {"--scene", "pan", "--frames", "2", "--size",
+                                                "160x90", "--stereo", "0.1", "--out", truth}),
               0);
     ASSERT_TRUE(fs::exists(frame_path(truth + "/left", 1)));
     ASSERT_TRUE(fs::exists(frame_path(truth + "/right", 1)));
@@ -61,25 +62,29 @@ TEST(CliStereo, RenderBothEyesSynthesizeAndExport) {
 }
 
 TEST(CliStereo, BadArgumentsExitWithTwo) {
-    EXPECT_EQ(run_command(cli::command_stereo, {"--in", "x", "--out", "y", "--rig", "diagonal"}), 2);
-    EXPECT_EQ(run_command(cli::command_stereo, {"--in", "x", "--out", "y", "--convergence", "-1"}), 2);
+    EXPECT_EQ(run_command(cli::command_stereo, {"--in", "x", "--out", "y", "--rig", "diagonal"}),
+              2);
+    EXPECT_EQ(run_command(cli::command_stereo, {"--in", "x", "--out", "y", "--convergence", "-1"}),
+              2);
     EXPECT_EQ(run_command(cli::command_stereo, {"--in", "x", "--out", "y", "--ipd", "abc"}), 2);
     EXPECT_EQ(run_command(cli::command_stereo, {"--out", "y"}), 2);
     EXPECT_EQ(run_command(cli::command_export, {"x", "--stereo", "3d", "--png", "a.png"}), 2);
     // A folder that holds no sequence is bad data: exit 1.
-    EXPECT_EQ(run_command(cli::command_stereo, {"--in", "/nonexistent_reprise", "--out",
-                                                (fs::temp_directory_path() / "reprise_stereo_none").string()}),
+    EXPECT_EQ(run_command(cli::command_stereo,
+                          {"--in", "/nonexistent_reprise", "--out",
+                           (fs::temp_directory_path() / "reprise_stereo_none").string()}),
               1);
 }
 
 // Blender renders carry no camera: without the focal length the eye would be wrong, so stereo
 // refuses until --fov gives it, and then matches the run that had the camera.
 TEST(CliStereo, InputWithoutACameraNeedsTheFieldOfView) {
-    const fs::path dir = fs::temp_directory_path() / ("reprise_cli_stereo_fov_" + std::to_string(::getpid()));
+    const fs::path dir =
+        fs::temp_directory_path() / ("reprise_cli_stereo_fov_" + std::to_string(::getpid()));
     fs::remove_all(dir);
     const std::string truth = (dir / "truth").string(), bare = (dir / "bare").string();
-    ASSERT_EQ(run_command(cli::command_render, {"--scene", "pan", "--frames", "1", "--size", "160x90",
-                                                "--stereo", "0.1", "--out", truth}),
+    ASSERT_EQ(run_command(cli::command_render, {"--scene", "pan", "--frames", "1", "--size",
+                                                "160x90", "--stereo", "0.1", "--out", truth}),
               0);
     Frame frame;
     ASSERT_TRUE(read_frame(frame_path(truth + "/left", 0), frame).ok());
@@ -87,15 +92,19 @@ TEST(CliStereo, InputWithoutACameraNeedsTheFieldOfView) {
     frame.camera = Camera{};
     fs::create_directories(bare);
     ASSERT_TRUE(write_frame(frame_path(bare, 0), frame).ok());
-    const test::Outcome refused =
-        test::run_reprise("stereo --in " + bare + " --ipd 0.1 --out " + (dir / "none").string(), 60);
+    const test::Outcome refused = test::run_reprise(
+        "stereo --in " + bare + " --ipd 0.1 --out " + (dir / "none").string(), 60);
     EXPECT_EQ(refused.status, 1) << refused.output;
     EXPECT_NE(refused.output.find("has no camera"), std::string::npos) << refused.output;
     EXPECT_NE(refused.output.find("--fov"), std::string::npos) << refused.output;
     EXPECT_FALSE(fs::exists(frame_path((dir / "none/right").string(), 0)));
     const std::string with_camera = (dir / "camera").string(), with_fov = (dir / "fov").string();
-    ASSERT_EQ(run_command(cli::command_stereo, {"--in", truth + "/left", "--ipd", "0.1", "--out", with_camera}), 0);
-    ASSERT_EQ(run_command(cli::command_stereo, {"--in", bare, "--ipd", "0.1", "--fov", std::to_string(fov_degrees), "--out", with_fov}), 0);
+    ASSERT_EQ(run_command(cli::command_stereo,
+                          {"--in", truth + "/left", "--ipd", "0.1", "--out", with_camera}),
+              0);
+    ASSERT_EQ(run_command(cli::command_stereo, {"--in", bare, "--ipd", "0.1", "--fov",
+                                                std::to_string(fov_degrees), "--out", with_fov}),
+              0);
     const std::string right = frame_path(truth + "/right", 0);
     const double camera_psnr = psnr_of(right, frame_path(with_camera + "/right", 0));
     const double fov_psnr = psnr_of(right, frame_path(with_fov + "/right", 0));

@@ -14,15 +14,18 @@ using reprise::test::Outcome;
 using reprise::test::run_reprise;
 
 TEST(CliStream, ServeAndConnectWriteDisplayedFrames) {
-    const fs::path out = reprise::test::fresh_directory(fs::temp_directory_path() / "reprise-cli-stream");
+    const fs::path out =
+        reprise::test::fresh_directory(fs::temp_directory_path() / "reprise-cli-stream");
     const std::string port = std::to_string(20000 + getpid() % 20000);
     Outcome served;
     std::thread server([&] {
-        served = run_reprise("serve --listen 127.0.0.1:" + port + " --pin 7788 --size 96x64 --duration 7", 60);
+        served = run_reprise(
+            "serve --listen 127.0.0.1:" + port + " --pin 7788 --size 96x64 --duration 7", 60);
     });
-    const Outcome connected = run_reprise("connect 127.0.0.1:" + port +
-                                              " --pin 7788 --display-rate 30 --duration 3 --out " + out.string(),
-                                          60);
+    const Outcome connected =
+        run_reprise("connect 127.0.0.1:" + port +
+                        " --pin 7788 --display-rate 30 --duration 3 --out " + out.string(),
+                    60);
     server.join();
     EXPECT_EQ(connected.status, 0) << connected.output;
     EXPECT_EQ(served.status, 0) << served.output;
@@ -42,7 +45,8 @@ TEST(CliStream, BadArgumentsAreRefused) {
     expect_refused("serve --pin 1 --mode sideways", "--mode");
     expect_refused("serve --pin 1 --lowres 3 --mode lowres", "--lowres");
     expect_refused("serve --pin 1 --listen nowhere", "HOST:PORT");
-    expect_refused("connect 127.0.0.1:9 --pin 1 --scene ../../etc/passwd --duration 1", "never a path");
+    expect_refused("connect 127.0.0.1:9 --pin 1 --scene ../../etc/passwd --duration 1",
+                   "never a path");
     expect_refused("connect 127.0.0.1 --pin 1", "HOST:PORT");
     expect_refused("connect 127.0.0.1:9", "--pin");
 }

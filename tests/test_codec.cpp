@@ -33,7 +33,8 @@ std::vector<Frame> render(const std::string& scene_name, int frames, int w, int 
     EXPECT_TRUE(s.ok()) << s.message();
     std::vector<Frame> out(frames);
     for (int i = 0; i < frames; ++i) {
-        s = test::shared_renderer().render_frame(scene, path, first + i, 30.0, {.width = w, .height = h}, out[i]);
+        s = test::shared_renderer().render_frame(scene, path, first + i, 30.0,
+                                                 {.width = w, .height = h}, out[i]);
         EXPECT_TRUE(s.ok()) << s.message();
     }
     return out;
@@ -109,7 +110,10 @@ TEST(CodecPieces, RangeCoderRoundTripsBitsAndIntegers) {
     for (int& b : bits) b = (rng() % 10) < 2;
     for (std::size_t i = 0; i < values.size(); ++i) {
         const int kind = int(rng() % 4);
-        values[i] = kind == 0 ? 0 : kind == 1 ? int64_t(rng() % 7) - 3 : kind == 2 ? int64_t(int32_t(rng())) : -int64_t(0xFFFFFFFFll);
+        values[i] = kind == 0   ? 0
+                    : kind == 1 ? int64_t(rng() % 7) - 3
+                    : kind == 2 ? int64_t(int32_t(rng()))
+                                : -int64_t(0xFFFFFFFFll);
     }
     std::vector<uint8_t> bytes;
     {
@@ -195,7 +199,8 @@ TEST(Codec, RenderedSceneDecodesBitIdenticalWithLosslessDepth) {
             }
     }
     EXPECT_EQ(coded.packets[0].type, PacketType::Key);
-    for (std::size_t i = 1; i < coded.packets.size(); ++i) EXPECT_EQ(coded.packets[i].type, PacketType::Inter);
+    for (std::size_t i = 1; i < coded.packets.size(); ++i)
+        EXPECT_EQ(coded.packets[i].type, PacketType::Inter);
 }
 
 // 4:2:0 halves chroma resolution: on a 160x96 render the cap is 32.5 dB even at qp 0 (43 dB at
@@ -237,10 +242,12 @@ TEST(Codec, StillSceneCostsAtMost64BytesPerFrame) {
         frames[i].camera.prev_view = frames[i].camera.view;
         frames[i].camera.prev_projection = frames[i].camera.projection;
         frames[i].camera.time = double(i) / 30.0;
-        std::fill(frames[i].motion.data(), frames[i].motion.data() + frames[i].motion.pixel_count(), glm::vec2(0.0f));
+        std::fill(frames[i].motion.data(), frames[i].motion.data() + frames[i].motion.pixel_count(),
+                  glm::vec2(0.0f));
     }
     const Coded coded = encode_all(frames, {});
-    for (std::size_t i = 1; i < frames.size(); ++i) EXPECT_LE(coded.packets[i].data.size(), 64u) << "frame " << i;
+    for (std::size_t i = 1; i < frames.size(); ++i)
+        EXPECT_LE(coded.packets[i].data.size(), 64u) << "frame " << i;
     const auto decoded = decode_all(coded.packets);
     ASSERT_EQ(decoded.size(), frames.size());
     EXPECT_TRUE(same_bits(decoded.back().color, decoded[0].color));
@@ -377,7 +384,8 @@ TEST(Codec, BadPacketsGiveAStatusAndTheDecoderResumes) {
     for (int trial = 0; trial < 300; ++trial) {
         auto damaged = coded.packets[1 + trial % 3].data;
         const int flips = 1 + int(rng() % 8);
-        for (int f = 0; f < flips; ++f) damaged[32 + rng() % (damaged.size() - 32)] ^= uint8_t(1 + rng() % 255);
+        for (int f = 0; f < flips; ++f)
+            damaged[32 + rng() % (damaged.size() - 32)] ^= uint8_t(1 + rng() % 255);
         if (trial % 5 == 0) damaged.resize(32 + rng() % (damaged.size() - 32));
         uint32_t length = uint32_t(damaged.size() - 32);
         std::memcpy(damaged.data() + 24, &length, 4);
@@ -428,7 +436,8 @@ TEST(Codec, ExtremeInputs) {
         ASSERT_EQ(decoded.size(), frames.size()) << w << "x" << h;
         for (std::size_t i = 0; i < frames.size(); ++i) {
             EXPECT_TRUE(same_frame(decoded[i], coded.reconstructions[i]));
-            EXPECT_TRUE(same_bits(decoded[i].depth, frames[i].depth)) << "lossless keeps NaN and -3";
+            EXPECT_TRUE(same_bits(decoded[i].depth, frames[i].depth))
+                << "lossless keeps NaN and -3";
             for (std::size_t p = 0; p < decoded[i].color.pixel_count(); ++p)
                 ASSERT_TRUE(std::isfinite(decoded[i].color.data()[p].r));
         }
@@ -439,7 +448,8 @@ TEST(Codec, EightKFrame) {
     const int w = 8192, h = 4320;
     Frame f = test::constant_frame(w, h, 5.0f, {0.0f, 0.0f});
     for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) f.color(x, y) = {float(x % 256) / 255.0f, float(y % 256) / 255.0f, 0.5f, 1.0f};
+        for (int x = 0; x < w; ++x)
+            f.color(x, y) = {float(x % 256) / 255.0f, float(y % 256) / 255.0f, 0.5f, 1.0f};
     f.camera = camera_at(w, h);
     Encoder encoder(EncoderOptions{});
     Decoder decoder;
@@ -447,7 +457,8 @@ TEST(Codec, EightKFrame) {
     auto corner = [](const Image<glm::vec4>& image) {
         Image<glm::vec4> c(256, 256);
         for (int y = 0; y < 256; ++y)
-            for (int x = 0; x < 256; ++x) c(x, y) = image(image.width() - 256 + x, image.height() - 256 + y);
+            for (int x = 0; x < 256; ++x)
+                c(x, y) = image(image.width() - 256 + x, image.height() - 256 + y);
         return c;
     };
     for (int i = 0; i < 2; ++i) {
@@ -479,7 +490,8 @@ TEST(Codec, TenThousandFramesWithoutDrift) {
         for (int y = 0; y < h; ++y)
             for (int x = 0; x < w; ++x) {
                 const float u = float(x) + 0.37f * float(i);
-                f.color(x, y) = {0.5f + 0.4f * std::sin(u * 0.3f), 0.5f + 0.4f * std::cos(float(y) * 0.5f), 0.3f, 1.0f};
+                f.color(x, y) = {0.5f + 0.4f * std::sin(u * 0.3f),
+                                 0.5f + 0.4f * std::cos(float(y) * 0.5f), 0.3f, 1.0f};
             }
         f.camera = camera_at(w, h);
         f.camera.time = i / 30.0;
@@ -506,7 +518,8 @@ TEST(Codec, TenThousandFramesWithoutDrift) {
 TEST(Codec, BitrateTargetWithBoundedFrameSizes) {
     const auto frames = render("crossing", 24, 192, 108);  // bounded depth is part of the budget
     for (int kbps : {150, 600}) {
-        Encoder encoder({.bitrate_kbps = kbps, .fps = 30.0, .depth = DepthMode::Bounded, .depth_error = 1e-2f});
+        Encoder encoder(
+            {.bitrate_kbps = kbps, .fps = 30.0, .depth = DepthMode::Bounded, .depth_error = 1e-2f});
         std::size_t total = 0;
         const double budget = kbps * 1000.0 / 30.0;
         for (std::size_t i = 0; i < frames.size(); ++i) {
@@ -517,7 +530,8 @@ TEST(Codec, BitrateTargetWithBoundedFrameSizes) {
             ASSERT_EQ(encoder.receive_packet(p), Result::Ok);
             const double bits = 8.0 * double(p.data.size());
             total += p.data.size();
-            EXPECT_LE(bits, (p.type == PacketType::Key ? 6.0 : 3.0) * budget) << kbps << " frame " << i;
+            EXPECT_LE(bits, (p.type == PacketType::Key ? 6.0 : 3.0) * budget)
+                << kbps << " frame " << i;
         }
         const double mean_kbps = 8.0 * double(total) / double(frames.size()) * 30.0 / 1000.0;
         EXPECT_GT(mean_kbps, 0.5 * kbps) << kbps;

@@ -22,7 +22,7 @@ using namespace reprise;
 namespace {
 
 class ExrTest : public ::testing::Test {
-  protected:
+protected:
     void SetUp() override {
         const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
         dir_ = test::fresh_directory(
@@ -347,15 +347,18 @@ TEST_F(ExrTest, HeadersAskingForHugeAllocationsAreRefused) {
     const std::string multipart("\x76\x2f\x31\x01\x02\x10\0\0", 8);
     const std::string end(1, '\0');
     const std::vector<std::pair<std::string, std::string>> files = {
-        {"huge.exr", magic + data_window(4, 4) + attribute("Software", "string", 1828716733) + "oiio"},
+        {"huge.exr",
+         magic + data_window(4, 4) + attribute("Software", "string", 1828716733) + "oiio"},
         {"negative.exr", magic + attribute("owner", "string", -5) + "x"},
         {"parts.exr", multipart + data_window(4, 4) + end + data_window(4, 4) +
                           attribute("name", "string", 1 << 30) + "b"},
         {"no-window.exr", magic + attribute("capDate", "string", 1) + "x" + end + "pixels"},
-        {"no-window-part.exr", multipart + data_window(4, 4) + end + attribute("name", "string", 1) +
-                                   "b" + end + end},
+        {"no-window-part.exr",
+         multipart + data_window(4, 4) + end + attribute("name", "string", 1) + "b" + end + end},
         {"wide.exr", magic + data_window(1 << 30, 6) + end + "pixels"},
-        {"long-type.exr", magic + data_window(4, 4) + attribute("Software", "string" + std::string(40, 'x'), 4) + "oiio" + end},
+        {"long-type.exr", magic + data_window(4, 4) +
+                              attribute("Software", "string" + std::string(40, 'x'), 4) + "oiio" +
+                              end},
         {"inverted.exr", magic + data_window(-3, 6) + end + "pixels"},
         {"tiles.exr", magic + data_window(4, 4) + attribute("tiles", "tiledesc", 9) +
                           std::string("\0\x20\0\0\0\x20\0\0\0", 9) + end + "pixels"},
@@ -530,7 +533,7 @@ TEST_F(ExrTest, BlenderLayoutWritesBlenderNamesAndReadsBack) {
     ASSERT_TRUE(read_frame_header(path("b.exr"), header).ok());
     EXPECT_TRUE(header.blender);
     const std::vector<std::string> expected = {
-        "ViewLayer.Combined.R", "ViewLayer.Combined.A", "ViewLayer.Depth.Z", "ViewLayer.Vector.X",
+        "ViewLayer.Combined.R", "ViewLayer.Combined.A", "ViewLayer.Depth.Z",  "ViewLayer.Vector.X",
         "ViewLayer.Vector.W",   "ViewLayer.Normal.Z",   "ViewLayer.IndexOB.X"};
     for (const std::string& name : expected)
         EXPECT_NE(std::find(header.channels.begin(), header.channels.end(), name),
@@ -547,7 +550,8 @@ TEST_F(ExrTest, BlenderLayoutWritesBlenderNamesAndReadsBack) {
     const OIIO::ImageSpec& spec = in->spec();
     std::vector<float> pixels(std::size_t(spec.width) * spec.height * spec.nchannels);
     ASSERT_TRUE(in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeFloat, pixels.data()));
-    const int z = spec.channelindex("ViewLayer.Depth.Z"), vy = spec.channelindex("ViewLayer.Vector.Y");
+    const int z = spec.channelindex("ViewLayer.Depth.Z"),
+              vy = spec.channelindex("ViewLayer.Vector.Y");
     EXPECT_EQ(pixels[z], 1e10f);
     EXPECT_EQ(pixels[spec.nchannels + vy], -written.motion.data()[1].y);
 

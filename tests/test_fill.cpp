@@ -93,8 +93,8 @@ void expect_fast_matches_reference(int w, int h, double hole_fraction, bool with
     PullPush pp;
     const FillStats a = pp.fill(fast.view(), mask.view(), depth.view());
     const FillStats b = pp.fill_reference(reference.view(), mask.view(), depth.view());
-    SCOPED_TRACE(::testing::Message() << w << "x" << h << " holes " << hole_fraction
-                                      << (with_depth ? " depth" : ""));
+    SCOPED_TRACE(::testing::Message()
+                 << w << "x" << h << " holes " << hole_fraction << (with_depth ? " depth" : ""));
     EXPECT_EQ(a.holes, b.holes);
     EXPECT_EQ(a.unfilled, b.unfilled);
     EXPECT_EQ(a.levels, b.levels);
@@ -365,8 +365,10 @@ FillStats naive_andreev(Image<vec4>& color, const Image<uint8_t>& mask, const Im
                     // Opposite sides: the nearer one loses when they differ by more than the ratio.
                     for (int d : {0, 2}) {
                         if (!use[d] || !use[d + 1]) continue;
-                        if (dk[d] * kBackgroundDepthRatio < dk[d + 1]) use[d] = false;
-                        else if (dk[d + 1] * kBackgroundDepthRatio < dk[d]) use[d + 1] = false;
+                        if (dk[d] * kBackgroundDepthRatio < dk[d + 1])
+                            use[d] = false;
+                        else if (dk[d + 1] * kBackgroundDepthRatio < dk[d])
+                            use[d + 1] = false;
                     }
                     for (int d = 0; d < 4; ++d)
                         if (use[d]) dmax = std::max(dmax, dk[d]);
@@ -452,9 +454,9 @@ TEST(Andreev, MatchesBruteForceAndOnlyWritesHoles) {
                     const FillStats a =
                         inpaint.fill(fast.view(), mask.view(), depth.view(), passes);
                     const FillStats b = naive_andreev(naive, mask, depth, passes);
-                    SCOPED_TRACE(::testing::Message() << w << "x" << h << " holes " << fraction
-                                                      << (with_depth ? " depth" : "") << " passes "
-                                                      << passes);
+                    SCOPED_TRACE(::testing::Message()
+                                 << w << "x" << h << " holes " << fraction
+                                 << (with_depth ? " depth" : "") << " passes " << passes);
                     EXPECT_EQ(a.holes, b.holes);
                     EXPECT_EQ(a.unfilled, b.unfilled);
                     EXPECT_EQ(a.levels, b.levels);

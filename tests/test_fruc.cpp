@@ -28,7 +28,10 @@ std::vector<Frame> render(const std::string& scene_name, double fps, int first, 
     EXPECT_TRUE(server::load_scene(scene_name, scene, path).ok());
     std::vector<Frame> frames(count);
     for (int i = 0; i < count; ++i)
-        EXPECT_TRUE(shared_renderer().render_frame(scene, path, first + i, fps, {.width = w, .height = h}, frames[i]).ok());
+        EXPECT_TRUE(
+            shared_renderer()
+                .render_frame(scene, path, first + i, fps, {.width = w, .height = h}, frames[i])
+                .ok());
     return frames;
 }
 
@@ -64,7 +67,8 @@ class FrucMethods : public ::testing::TestWithParam<Setting> {};
 TEST_P(FrucMethods, InterpolationBeatsFrameRepetition) {
     const std::vector<Frame> input = render("pan", 30.0, 0, 4);
     const std::vector<Frame> truth = render("pan", 60.0, 0, 7);
-    FrucOptions options{.mode = FrucMode::Interpolate, .warp = GetParam().warp, .fill = GetParam().fill};
+    FrucOptions options{
+        .mode = FrucMode::Interpolate, .warp = GetParam().warp, .fill = GetParam().fill};
     FrucCounters counters;
     std::vector<Frame> out = convert(input, 2, options, &counters);
     ASSERT_EQ(out.size(), 7u);
@@ -82,21 +86,24 @@ TEST_P(FrucMethods, InterpolationBeatsFrameRepetition) {
 TEST_P(FrucMethods, ExtrapolationBeatsFrameRepetition) {
     const std::vector<Frame> input = render("crossing", 30.0, 10, 2);
     const std::vector<Frame> truth = render("crossing", 60.0, 20, 4);
-    FrucOptions options{.mode = FrucMode::Extrapolate, .warp = GetParam().warp, .fill = GetParam().fill};
+    FrucOptions options{
+        .mode = FrucMode::Extrapolate, .warp = GetParam().warp, .fill = GetParam().fill};
     FrucCounters counters;
     std::vector<Frame> out = convert(input, 2, options, &counters);
     ASSERT_EQ(out.size(), 4u);
     double ours = psnr_of(truth[3], out[3]), repeat = psnr_of(truth[3], input[1]);
-    std::printf("[fruc] extrapolate %s: %.2f dB (repeating: %.2f dB)\n", GetParam().name, ours, repeat);
+    std::printf("[fruc] extrapolate %s: %.2f dB (repeating: %.2f dB)\n", GetParam().name, ours,
+                repeat);
     EXPECT_GT(ours, repeat + 3.0) << GetParam().name;
     EXPECT_GT(counters.dynamic_layers, 0u) << "crossing has moving objects";
 }
 
-INSTANTIATE_TEST_SUITE_P(AllWarps, FrucMethods,
-                         ::testing::Values(Setting{WarpMethod::Grid, FillMethod::PullPush, "grid_pullpush"},
-                                           Setting{WarpMethod::Splat, FillMethod::PullPush, "splat_pullpush"},
-                                           Setting{WarpMethod::Reverse, FillMethod::Andreev, "reverse_andreev"}),
-                         [](const auto& setting) { return std::string(setting.param.name); });
+INSTANTIATE_TEST_SUITE_P(
+    AllWarps, FrucMethods,
+    ::testing::Values(Setting{WarpMethod::Grid, FillMethod::PullPush, "grid_pullpush"},
+                      Setting{WarpMethod::Splat, FillMethod::PullPush, "splat_pullpush"},
+                      Setting{WarpMethod::Reverse, FillMethod::Andreev, "reverse_andreev"}),
+    [](const auto& setting) { return std::string(setting.param.name); });
 
 TEST(Fruc, StillFramesAreCopiedNotWarped) {
     std::vector<Frame> input = render("pan", 30.0, 0, 3, 64, 36);
@@ -144,7 +151,8 @@ TEST(Fruc, CameraCutResetsHistoryWithoutGhosts) {
 }
 
 TEST(Fruc, BadValuesNeverSpreadAndTinyImagesWork) {
-    const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+    const float nan = std::numeric_limits<float>::quiet_NaN(),
+                inf = std::numeric_limits<float>::infinity();
     for (auto [w, h] : {std::pair{1, 1}, std::pair{7, 3}, std::pair{64, 36}}) {
         std::vector<Frame> input = render("crossing", 30.0, 5, 3, w, h);
         input[1].motion(0, 0) = glm::vec2(nan, 1e30f);
@@ -175,7 +183,9 @@ TEST(FrucTrueMotion, CurvedMotionIsFollowedBetterThanLinearMotion) {
         ASSERT_TRUE(server::parse_camera_spec("orbit:speed=2", scene, path, path).ok());
         auto frame_at = [&](int index, double fps) {
             Frame f;
-            EXPECT_TRUE(shared_renderer().render_frame(scene, path, index, fps, {.width = 320, .height = 180}, f).ok());
+            EXPECT_TRUE(shared_renderer()
+                            .render_frame(scene, path, index, fps, {.width = 320, .height = 180}, f)
+                            .ok());
             return f;
         };
         const std::vector<Frame> input = {frame_at(2, 10.0), frame_at(3, 10.0)};
@@ -189,8 +199,9 @@ TEST(FrucTrueMotion, CurvedMotionIsFollowedBetterThanLinearMotion) {
             psnr[exact] = psnr_of(truth, out[1]);
             EXPECT_EQ(counters.true_motion, exact ? 1u : 0u) << "an orbit is not linear";
         }
-        std::printf("[fruc] %s, orbit at 2 rad/s, 10 -> 20 Hz: true motion %.2f dB, linear %.2f dB\n",
-                    scene_name, psnr[1], psnr[0]);
+        std::printf(
+            "[fruc] %s, orbit at 2 rad/s, 10 -> 20 Hz: true motion %.2f dB, linear %.2f dB\n",
+            scene_name, psnr[1], psnr[0]);
         const bool pan = std::string(scene_name) == "pan";  // measured 27.49 / 25.27, 22.39 / 21.04
         EXPECT_GT(psnr[1], pan ? 27.0 : 22.0) << scene_name;
         EXPECT_GT(psnr[1], psnr[0] + (pan ? 1.5 : 1.0)) << scene_name;
@@ -206,7 +217,8 @@ TEST(FrucWithoutCameras, ExtrapolationFollowsTheMotionAlone) {
         std::vector<Frame> bare = input;
         for (Frame& f : bare) f.camera = Camera{};
         const FrucOptions options{.mode = FrucMode::Extrapolate};
-        const std::vector<Frame> with = convert(input, 4, options), without = convert(bare, 4, options);
+        const std::vector<Frame> with = convert(input, 4, options),
+                                 without = convert(bare, 4, options);
         ASSERT_EQ(with.size(), 8u);
         ASSERT_EQ(without.size(), 8u);
         double sum_with = 0, sum_without = 0, sum_repeat = 0;
@@ -215,8 +227,10 @@ TEST(FrucWithoutCameras, ExtrapolationFollowsTheMotionAlone) {
             sum_without += psnr_of(truth[k], without[4 + k]);
             sum_repeat += psnr_of(truth[k], input[1]);
         }
-        std::printf("[fruc] %s x4 extrapolated: %.2f dB without cameras, %.2f dB with, %.2f dB "
-                    "repeating\n", scene, sum_without / 3, sum_with / 3, sum_repeat / 3);
+        std::printf(
+            "[fruc] %s x4 extrapolated: %.2f dB without cameras, %.2f dB with, %.2f dB "
+            "repeating\n",
+            scene, sum_without / 3, sum_with / 3, sum_repeat / 3);
         // Measured: pan 39.11 / 39.11 / 32.79 (moving camera), crossing 42.40 / 37.11 / 33.42
         // (still camera, moving objects).
         EXPECT_GT(sum_without, sum_with - 3.0) << scene;

@@ -508,7 +508,7 @@ std::vector<uint8_t> make_glb(const json& doc, const std::vector<uint8_t>& bin) 
 }
 
 class GltfSynthetic : public ::testing::Test {
-  protected:
+protected:
     void SetUp() override {
         const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
         dir_ = fs::path(::testing::TempDir()) /
@@ -992,10 +992,9 @@ TEST_F(GltfSynthetic, BrokenImagesAreRejected) {
         "lacks");
 }
 
-
 // External files: only inside the glTF file's folder tree (canonical paths), unless allowed.
 class GltfPaths : public GltfSynthetic {
-  protected:
+protected:
     // dir_/scene/tri.gltf whose buffer is `uri`, and the buffer's bytes at `buffer_at`.
     fs::path write_external(const std::string& uri, const fs::path& buffer_at) const {
         fs::create_directories(dir_ / "scene");
@@ -1023,17 +1022,20 @@ class GltfPaths : public GltfSynthetic {
 // which read beyond the allocation (heap-buffer-overflow under ASan).
 TEST_F(GltfSynthetic, ImageBufferViewPastItsBufferIsRefused) {
     json doc = triangle_document();
-    doc["bufferViews"].push_back(json::parse(R"({"buffer": 0, "byteOffset": 200, "byteLength": 4000})"));
+    doc["bufferViews"].push_back(
+        json::parse(R"({"buffer": 0, "byteOffset": 200, "byteLength": 4000})"));
     doc["images"] = json::parse(R"([{"bufferView": 8, "mimeType": "image/png"}])");
     const Status status = load(write("view.glb", make_glb(doc, triangle_buffer())));
     ASSERT_FALSE(status.ok());
     EXPECT_NE(status.message().find("view.glb: "), std::string::npos) << status.message();
-    EXPECT_NE(status.message().find("bufferView runs past the end of its buffer"), std::string::npos)
+    EXPECT_NE(status.message().find("bufferView runs past the end of its buffer"),
+              std::string::npos)
         << status.message();
 }
 
 TEST_F(GltfPaths, BuffersInsideTheFolderTreeLoad) {
-    for (const std::string uri : {"tri.bin", "sub/tri.bin", "sub/../sub/tri.bin", "./sub/tri.bin"}) {
+    for (const std::string uri :
+         {"tri.bin", "sub/tri.bin", "sub/../sub/tri.bin", "./sub/tri.bin"}) {
         const fs::path gltf = write_external(uri, dir_ / "scene" / uri);
         const Status status = load(gltf);
         ASSERT_TRUE(status.ok()) << uri << ": " << status.message();
@@ -1093,7 +1095,8 @@ TEST_F(GltfPaths, ImagesOutsideTheTreeAreRefused) {
     json doc = triangle_document();
     doc["images"] = json::parse(R"([{"uri": "../outside.png"}])");
     doc["textures"] = json::parse(R"([{"source": 0}])");
-    doc["materials"] = json::parse(R"([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}])");
+    doc["materials"] =
+        json::parse(R"([{"pbrMetallicRoughness": {"baseColorTexture": {"index": 0}}}])");
     doc["meshes"][0]["primitives"][0]["material"] = 0;
     doc["meshes"][0]["primitives"][0]["attributes"]["TEXCOORD_0"] = 6;
     const fs::path gltf = write_gltf("scene/tri.gltf", doc, triangle_buffer());

@@ -11,7 +11,7 @@
 namespace reprise::warp {
 namespace {
 
-const std::vector<std::pair<int, int>> kSizes = {{1, 1}, {1, 7}, {3, 2}, {7, 5}, {17, 3},
+const std::vector<std::pair<int, int>> kSizes = {{1, 1},  {1, 7},  {3, 2},    {7, 5},  {17, 3},
                                                  {33, 4}, {67, 9}, {130, 33}, {257, 6}};
 
 struct RestoreTarget {

@@ -10,9 +10,7 @@ using namespace reprise;
 
 namespace {
 
-Image<glm::vec3> flat(int w, int h, float v) {
-    return Image<glm::vec3>(w, h, glm::vec3(v));
-}
+Image<glm::vec3> flat(int w, int h, float v) { return Image<glm::vec3>(w, h, glm::vec3(v)); }
 
 // A smooth, textured display image in [0.2, 0.8].
 Image<glm::vec3> pattern(int w, int h) {

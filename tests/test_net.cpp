@@ -79,7 +79,8 @@ TEST(NetHandshake, MalformedHellosAreRefused) {
     std::vector<uint8_t> truncated(hello.begin(), hello.end() - 1);
     EXPECT_FALSE(answer_client_hello("1234", truncated, reply, pending).ok());
     std::vector<uint8_t> bad_point = hello;
-    for (int i = 0; i < 32; ++i) bad_point[kHeaderSize + 32 + i] = 0xff;  // not a canonical encoding
+    for (int i = 0; i < 32; ++i)
+        bad_point[kHeaderSize + 32 + i] = 0xff;  // not a canonical encoding
     EXPECT_FALSE(answer_client_hello("1234", bad_point, reply, pending).ok());
     std::vector<uint8_t> identity = hello;
     std::fill(identity.begin() + kHeaderSize + 32, identity.begin() + kHeaderSize + 64, 0);
@@ -106,7 +107,8 @@ TEST(NetChannel, SealOpenRejectsReplayTamperAndOtherKeys) {
     tampered = datagram;
     tampered[13] ^= 1;  // the sequence number is authenticated too
     EXPECT_FALSE(server.open(tampered, plain).ok());
-    EXPECT_TRUE(server.open(datagram, plain).ok()) << "a rejected forgery must not burn the sequence number";
+    EXPECT_TRUE(server.open(datagram, plain).ok())
+        << "a rejected forgery must not burn the sequence number";
     // The server's own direction does not open as the client's.
     server.seal(message, datagram);
     EXPECT_FALSE(server.open(datagram, plain).ok());
@@ -121,7 +123,7 @@ TEST(NetChannel, ReplayWindowAcceptsReorderingRejectsDuplicatesAndOld) {
         w.mark(s);
         EXPECT_TRUE(w.seen_or_too_old(s)) << s;
     }
-    EXPECT_TRUE(w.seen_or_too_old(44));   // 256 or more behind the newest
+    EXPECT_TRUE(w.seen_or_too_old(44));  // 256 or more behind the newest
     EXPECT_FALSE(w.seen_or_too_old(299));
     EXPECT_FALSE(w.seen_or_too_old(100));
 }
@@ -180,7 +182,8 @@ TEST(NetFragment, EveryPacketSizeReassemblesAndOneLossPerGroupIsRecovered) {
         std::vector<uint8_t> packet(size);
         for (auto& b : packet) b = uint8_t(rng());
         std::vector<std::vector<uint8_t>> messages;
-        const std::size_t n = fragment_packet(packet, 9, 1234, {.group = 4, .fragment_payload = 1100}, messages);
+        const std::size_t n =
+            fragment_packet(packet, 9, 1234, {.group = 4, .fragment_payload = 1100}, messages);
         const std::size_t data = (size + 1099) / 1100;
         ASSERT_EQ(n, data + (data + 3) / 4);
         for (std::size_t i = 0; i < n; ++i) ASSERT_LE(messages[i].size(), kMaxPlaintext);
@@ -202,7 +205,8 @@ TEST(NetFragment, EveryPacketSizeReassemblesAndOneLossPerGroupIsRecovered) {
             ASSERT_TRUE(done) << size << " mode " << drop_mode;
             EXPECT_EQ(out.frame, 9u);
             EXPECT_EQ(out.pose_time_us, 1234);
-            EXPECT_TRUE(std::equal(out.data.begin(), out.data.end(), packet.begin(), packet.end())) << size;
+            EXPECT_TRUE(std::equal(out.data.begin(), out.data.end(), packet.begin(), packet.end()))
+                << size;
         }
     }
 }
@@ -232,7 +236,12 @@ TEST(NetFragment, ReassemblerMemoryStaysBoundedAndOldFramesAreGivenUp) {
 TEST(NetFragment, InconsistentFragmentsAreRefused) {
     std::vector<uint8_t> buf(kMaxPlaintext);
     std::vector<uint8_t> payload(100, 1);
-    FragmentMessage m{.frame = 1, .total_size = 100, .index = 0, .data_count = 2, .fragment_size = 100, .payload = payload};
+    FragmentMessage m{.frame = 1,
+                      .total_size = 100,
+                      .index = 0,
+                      .data_count = 2,
+                      .fragment_size = 100,
+                      .payload = payload};
     buf.resize(encode(m, buf));
     FragmentMessage back;
     EXPECT_FALSE(parse(buf, back).ok());  // two fragments of 100 cannot make 100 bytes
@@ -240,7 +249,8 @@ TEST(NetFragment, InconsistentFragmentsAreRefused) {
 
 TEST(NetFaults, SameSeedSameOutcomeAndLossRateNearTheSetting) {
     auto run = [](uint64_t seed, std::vector<int>& order, FaultStats& stats) {
-        FaultInjector f({.loss = 0.05, .burst_start = 0.01, .jitter_ms = 10, .reorder = 0.1, .seed = seed});
+        FaultInjector f(
+            {.loss = 0.05, .burst_start = 0.01, .jitter_ms = 10, .reorder = 0.1, .seed = seed});
         std::vector<uint8_t> d(4), out;
         int64_t now = 0;
         for (int i = 0; i < 20000; ++i) {
@@ -249,7 +259,8 @@ TEST(NetFaults, SameSeedSameOutcomeAndLossRateNearTheSetting) {
             now += 1000;
             while (f.deliver(now, out)) order.push_back(out[0] | out[1] << 8 | out[2] << 16);
         }
-        while (f.deliver(now + 1'000'000, out)) order.push_back(out[0] | out[1] << 8 | out[2] << 16);
+        while (f.deliver(now + 1'000'000, out))
+            order.push_back(out[0] | out[1] << 8 | out[2] << 16);
         stats = f.stats();
     };
     std::vector<int> a, b, c;
@@ -280,13 +291,14 @@ TEST(NetFaults, BandwidthCapSerialisesAndDropsBeyondTheQueue) {
 }
 
 TEST(NetRateLimit, HandshakesPerSourceAndGloballyAreBounded) {
-    HandshakeRateLimiter r({.per_second = 10, .burst = 10, .per_source_per_second = 1, .per_source_burst = 3});
+    HandshakeRateLimiter r(
+        {.per_second = 10, .burst = 10, .per_source_per_second = 1, .per_source_burst = 3});
     int allowed = 0;
     for (int i = 0; i < 100; ++i) allowed += r.allow(0x7f000001u, 0);
     EXPECT_EQ(allowed, 3);
     int others = 0;
     for (uint32_t a = 0; a < 100; ++a) others += r.allow(0x7f000100u + a, 0);
-    EXPECT_EQ(others, 7);  // the global bucket held 10
+    EXPECT_EQ(others, 7);                          // the global bucket held 10
     EXPECT_TRUE(r.allow(0x7f000001u, 2'000'000));  // refilled
     r.penalise(0x7f000002u, 2'000'000);
     EXPECT_FALSE(r.allow(0x7f000002u, 2'000'000));

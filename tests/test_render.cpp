@@ -76,7 +76,9 @@ TEST(Render, StaticCameraAndSceneGiveExactlyZeroMotion) {
     scene.animations.clear();
     path.motion = CameraMotion::Static;
     Frame frame;
-    ASSERT_TRUE(shared_renderer().render_frame(scene, path, 3, 30.0, {.width = 160, .height = 90}, frame).ok());
+    ASSERT_TRUE(shared_renderer()
+                    .render_frame(scene, path, 3, 30.0, {.width = 160, .height = 90}, frame)
+                    .ok());
     int geometry = 0;
     for (int y = 0; y < 90; ++y)
         for (int x = 0; x < 160; ++x) {
@@ -101,7 +103,8 @@ TEST(Render, SidewaysTranslationMovesContentExactlyKPixelsPerFrame) {
     double focal = (h / 2.0) / std::tan(path.model.yfov / 2.0);  // pixels per unit at depth 1
     path.speed = float(k * distance / focal * fps);
     Frame frame;
-    ASSERT_TRUE(shared_renderer().render_frame(scene, path, 7, fps, {.width = w, .height = h}, frame).ok());
+    ASSERT_TRUE(
+        shared_renderer().render_frame(scene, path, 7, fps, {.width = w, .height = h}, frame).ok());
     double worst = 0.0;
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
@@ -119,7 +122,8 @@ TEST(Render, JitterShiftsSamplesButNotMotion) {
     Instant now = instant_on_path(path, scene, 0.0, 64, 64), before = now;
     now.jitter = {0.25f, -0.5f};
     Frame frame;
-    ASSERT_TRUE(shared_renderer().render(scene, now, before, {.width = 64, .height = 64}, frame).ok());
+    ASSERT_TRUE(
+        shared_renderer().render(scene, now, before, {.width = 64, .height = 64}, frame).ok());
     EXPECT_EQ(frame.camera.jitter, now.jitter);
     for (int y = 0; y < 64; ++y)
         for (int x = 0; x < 64; ++x) ASSERT_EQ(frame.motion(x, y), glm::vec2(0.0f));
@@ -136,7 +140,8 @@ TEST(Render, BackgroundMotionFollowsCameraRotation) {
     const float angle = 0.01f;
     before.view = glm::rotate(glm::mat4(1.0f), angle, glm::vec3(0, 1, 0));
     Frame frame;
-    ASSERT_TRUE(shared_renderer().render(scene, now, before, {.width = w, .height = h}, frame).ok());
+    ASSERT_TRUE(
+        shared_renderer().render(scene, now, before, {.width = w, .height = h}, frame).ok());
     double focal = (h / 2.0) / std::tan(lens.yfov / 2.0);
     // Rotating the view by +angle about y turns the camera left: content was further right.
     glm::vec2 m = frame.motion(w / 2, h / 2);
@@ -166,23 +171,37 @@ TEST(Render, SkinnedAndMorphedMotionMatchesFiniteDifferences) {
     scene.nodes.push_back(tip);
     scene.nodes[1].children = {2};
     scene.roots = {0, 1};
-    scene.skins.push_back({.joints = {1, 2}, .inverse_bind = {glm::mat4(1.0f),
-                           glm::translate(glm::mat4(1.0f), glm::vec3(-1, 0, 0))}});
+    scene.skins.push_back(
+        {.joints = {1, 2},
+         .inverse_bind = {glm::mat4(1.0f), glm::translate(glm::mat4(1.0f), glm::vec3(-1, 0, 0))}});
     Animation a;
-    a.channels.push_back({.node = 2, .path = AnimatedPath::Rotation, .times = {0, 0.4f},
-                          .values = {0, 0, 0, 1, 0, 0.38268343f, 0, 0.92387953f}, .components = 4});
-    a.channels.push_back({.node = 0, .path = AnimatedPath::Weights, .times = {0, 0.4f},
-                          .values = {0, 1}, .components = 1});
-    a.channels.push_back({.node = 1, .path = AnimatedPath::Translation, .times = {0, 0.4f},
-                          .values = {0, 0, 0, 0.3f, 0.2f, 0}, .components = 3});
+    a.channels.push_back({.node = 2,
+                          .path = AnimatedPath::Rotation,
+                          .times = {0, 0.4f},
+                          .values = {0, 0, 0, 1, 0, 0.38268343f, 0, 0.92387953f},
+                          .components = 4});
+    a.channels.push_back({.node = 0,
+                          .path = AnimatedPath::Weights,
+                          .times = {0, 0.4f},
+                          .values = {0, 1},
+                          .components = 1});
+    a.channels.push_back({.node = 1,
+                          .path = AnimatedPath::Translation,
+                          .times = {0, 0.4f},
+                          .values = {0, 0, 0, 0.3f, 0.2f, 0},
+                          .components = 3});
     scene.animations.push_back(a);
-    CameraPath path{.motion = CameraMotion::Static, .target = {0, 0, 0}, .eye = {0.3f, 0.4f, 3.5f},
+    CameraPath path{.motion = CameraMotion::Static,
+                    .target = {0, 0, 0},
+                    .eye = {0.3f, 0.4f, 3.5f},
                     .model = {.yfov = glm::radians(50.0f), .znear = 0.1f, .zfar = 20.0f}};
     const int w = 320, h = 240;
     const double fps = 30.0;
     const int index = 20;
     Frame frame;
-    ASSERT_TRUE(shared_renderer().render_frame(scene, path, index, fps, {.width = w, .height = h}, frame).ok());
+    ASSERT_TRUE(shared_renderer()
+                    .render_frame(scene, path, index, fps, {.width = w, .height = h}, frame)
+                    .ok());
 
     Pose now, before;
     evaluate_pose(scene, index / fps, now);
@@ -207,7 +226,8 @@ TEST(Render, SkinnedAndMorphedMotionMatchesFiniteDifferences) {
         if (!inside) continue;
         float fx = at.x - 0.5f - x0, fy = at.y - 0.5f - y0;
         auto m = [&](int i, int j) { return frame.motion(x0 + i, y0 + j); };
-        glm::vec2 got = (m(0, 0) * (1 - fx) + m(1, 0) * fx) * (1 - fy) + (m(0, 1) * (1 - fx) + m(1, 1) * fx) * fy;
+        glm::vec2 got = (m(0, 0) * (1 - fx) + m(1, 0) * fx) * (1 - fy) +
+                        (m(0, 1) * (1 - fx) + m(1, 1) * fx) * fy;
         worst = std::max(worst, double(glm::length(got - expected)));
         ++checked;
     }
@@ -232,8 +252,10 @@ TEST_P(BuiltinMotion, WarpingThePreviousFrameReproducesTheCurrentOne) {
     const RenderSettings settings{.width = w, .height = h, .shading = Shading::Unlit};
     for (int index : {6, 24}) {
         Frame previous, current;
-        ASSERT_TRUE(shared_renderer().render_frame(scene, path, index - 1, 30.0, settings, previous).ok());
-        ASSERT_TRUE(shared_renderer().render_frame(scene, path, index, 30.0, settings, current).ok());
+        ASSERT_TRUE(
+            shared_renderer().render_frame(scene, path, index - 1, 30.0, settings, previous).ok());
+        ASSERT_TRUE(
+            shared_renderer().render_frame(scene, path, index, 30.0, settings, current).ok());
         Image<glm::vec4> warped(w, h), reference(w, h);
         Image<uint8_t> mask(w, h, 0);
         int valid = 0;
@@ -259,7 +281,8 @@ TEST_P(BuiltinMotion, WarpingThePreviousFrameReproducesTheCurrentOne) {
                 for (int j = 0; j < 2; ++j)
                     for (int i = 0; i < 2; ++i) {
                         same &= previous.id(x0 + i, y0 + j) == id;
-                        same &= std::abs(previous.depth(x0 + i, y0 + j) - expected) < 0.01f * expected;
+                        same &=
+                            std::abs(previous.depth(x0 + i, y0 + j) - expected) < 0.01f * expected;
                     }
                 if (!same) continue;
                 warped(x, y) = bilinear(previous.color, q);
@@ -272,8 +295,8 @@ TEST_P(BuiltinMotion, WarpingThePreviousFrameReproducesTheCurrentOne) {
         double db = psnr(a.view(), b.view(), mask.view());
         EXPECT_GT(valid, w * h / 4) << GetParam() << " frame " << index;
         EXPECT_GE(db, 40.0) << GetParam() << " frame " << index << " over " << valid << " pixels";
-        std::printf("[motion] %-9s frame %2d: %.2f dB over %.0f%% of pixels\n", GetParam(), index, db,
-                    100.0 * valid / (w * h));
+        std::printf("[motion] %-9s frame %2d: %.2f dB over %.0f%% of pixels\n", GetParam(), index,
+                    db, 100.0 * valid / (w * h));
     }
 }
 
@@ -285,7 +308,8 @@ INSTANTIATE_TEST_SUITE_P(AllScenes, BuiltinMotion,
 struct ModelCase {
     const char* path;
     bool animated;
-    bool varied = true;  // false: a single flat-lit colour is right (simple_skin bends in its plane)
+    bool varied =
+        true;  // false: a single flat-lit colour is right (simple_skin bends in its plane)
 };
 
 class GltfModels : public ::testing::TestWithParam<ModelCase> {};
@@ -299,7 +323,9 @@ TEST_P(GltfModels, RenderWithCoverageAndMotion) {
     path.motion = path.motion == CameraMotion::Gltf ? path.motion : CameraMotion::Static;
     const int w = 160, h = 120;
     Frame frame;
-    ASSERT_TRUE(shared_renderer().render_frame(scene, path, 10, 30.0, {.width = w, .height = h}, frame).ok());
+    ASSERT_TRUE(shared_renderer()
+                    .render_frame(scene, path, 10, 30.0, {.width = w, .height = h}, frame)
+                    .ok());
     int covered = 0, moving = 0;
     float lo = 1e9f, hi = -1e9f;
     for (int y = 0; y < h; ++y)
@@ -325,7 +351,8 @@ TEST_P(GltfModels, RenderWithCoverageAndMotion) {
 INSTANTIATE_TEST_SUITE_P(
     AssimpTestModels, GltfModels,
     ::testing::Values(ModelCase{"2CylinderEngine-glTF-Binary/2CylinderEngine.glb", false},
-                      ModelCase{"glTF-Sample-Models/AnimatedMorphCube-glTF/AnimatedMorphCube.gltf", true},
+                      ModelCase{"glTF-Sample-Models/AnimatedMorphCube-glTF/AnimatedMorphCube.gltf",
+                                true},
                       ModelCase{"simple_skin/simple_skin.gltf", true, false},
                       ModelCase{"BoxTextured-glTF/BoxTextured.gltf", false},
                       ModelCase{"ClearCoat-glTF/ClearCoatTest.gltf", false}),

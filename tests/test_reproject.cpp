@@ -52,9 +52,7 @@ Buffer random_payload(int w, int h, int c, uint32_t seed) {
 
 using Size = std::pair<int, int>;
 
-std::size_t total(const ReprojectCounts& c) {
-    return c.hits + c.misses();
-}
+std::size_t total(const ReprojectCounts& c) { return c.hits + c.misses(); }
 
 // ---------------------------------------------------------------------------------------------
 // Analytic cases
@@ -380,13 +378,14 @@ TEST(Reproject, StepLooksUpOnlyTheSampledPixelsAndAgreesWithTheFullRun) {
         Image<uint8_t> hit_full(w, h, 9), hit_sampled(w, h, 9), hit_ref(w, h, 9);
         reproject(k.cur, k.prev, k.payload.cview(), full.view(), hit_full.view());
         ReprojectOptions options{.step = step};
-        const ReprojectCounts counts =
-            reproject(k.cur, k.prev, k.payload.cview(), sampled.view(), hit_sampled.view(), options);
-        const ReprojectCounts ref = reproject_reference(k.cur, k.prev, k.payload.cview(),
-                                                        sampled_ref.view(), hit_ref.view(), options);
+        const ReprojectCounts counts = reproject(k.cur, k.prev, k.payload.cview(), sampled.view(),
+                                                 hit_sampled.view(), options);
+        const ReprojectCounts ref = reproject_reference(
+            k.cur, k.prev, k.payload.cview(), sampled_ref.view(), hit_ref.view(), options);
         EXPECT_EQ(counts, ref);
         EXPECT_TRUE(hit_sampled == hit_ref);
-        EXPECT_EQ(0, std::memcmp(sampled.v.data(), sampled_ref.v.data(), sampled.v.size() * sizeof(float)));
+        EXPECT_EQ(0, std::memcmp(sampled.v.data(), sampled_ref.v.data(),
+                                 sampled.v.size() * sizeof(float)));
         std::size_t looked = 0, hits = 0;
         for (int y = 0; y < h; ++y)
             for (int x = 0; x < w; ++x) {

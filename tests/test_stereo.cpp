@@ -29,7 +29,8 @@ using test::shared_renderer;
 
 Camera camera_at(int w, int h) {
     Camera c;
-    c.view = glm::lookAt(glm::vec3(0.3f, 1.0f, 5.0f), glm::vec3(0.3f, 1.0f, 0.0f), glm::vec3(0, 1, 0));
+    c.view =
+        glm::lookAt(glm::vec3(0.3f, 1.0f, 5.0f), glm::vec3(0.3f, 1.0f, 0.0f), glm::vec3(0, 1, 0));
     c.prev_view = c.view;
     c.projection = glm::perspective(0.8f, float(w) / float(h), 0.1f, 100.0f);
     c.prev_projection = c.projection;
@@ -52,7 +53,8 @@ float focal_px(const Camera& c, int w) { return c.projection[0][0] * 0.5f * floa
 bool all_finite(const Image<glm::vec4>& image) {
     for (std::size_t i = 0; i < image.pixel_count(); ++i) {
         const glm::vec4& c = image.data()[i];
-        if (!std::isfinite(c.x) || !std::isfinite(c.y) || !std::isfinite(c.z) || !std::isfinite(c.w))
+        if (!std::isfinite(c.x) || !std::isfinite(c.y) || !std::isfinite(c.z) ||
+            !std::isfinite(c.w))
             return false;
     }
     return true;
@@ -110,9 +112,11 @@ TEST(StereoSynthesis, IpdZeroIsABitExactCopy) {
     Frame f = plane(w, h, 3.0f, camera_at(w, h));
     std::mt19937 rng(7);
     std::uniform_real_distribution<float> u(0.5f, 50.0f);
-    for (std::size_t i = 0; i < f.depth.pixel_count(); ++i) f.depth.data()[i] = i % 7 ? u(rng) : kInf;
+    for (std::size_t i = 0; i < f.depth.pixel_count(); ++i)
+        f.depth.data()[i] = i % 7 ? u(rng) : kInf;
     for (Rig r : {Rig::Parallel, Rig::OffAxis}) {
-        const EyeCameras eyes = eye_cameras(f.camera, {.ipd = 0.0f, .convergence = 4.0f, .rig = r}, Anchor::Left);
+        const EyeCameras eyes =
+            eye_cameras(f.camera, {.ipd = 0.0f, .convergence = 4.0f, .rig = r}, Anchor::Left);
         Frame out;
         StereoStats stats = synthesize_eye(f, eyes.right, {}, out);
         EXPECT_EQ(out.color, f.color);
@@ -164,7 +168,8 @@ TEST(StereoSynthesis, OffAxisConvergencePlaneHasZeroDisparityAndParallaxFlipsSig
         Frame left = plane(w, h, z, eyes.left);
         stereo_displacement(left, eyes.right, d.view(), td.view());
         const float expected = -disparity_px(rig, c.projection, w, z);  // x_right - x_left
-        for (std::size_t i = 0; i < d.pixel_count(); ++i) ASSERT_NEAR(d.data()[i].x, expected, 2e-3f) << z;
+        for (std::size_t i = 0; i < d.pixel_count(); ++i)
+            ASSERT_NEAR(d.data()[i].x, expected, 2e-3f) << z;
         if (z == 5.0f) {
             EXPECT_NEAR(d(10, 10).x, 0.0f, 2e-3f);
         } else if (z < 5.0f) {
@@ -203,12 +208,14 @@ TEST(StereoSynthesis, NonFiniteDepthAndColourNeverSpread) {
     std::mt19937 rng(3);
     for (std::size_t i = 0; i < left.depth.pixel_count(); ++i)
         if (rng() % 5 == 0) left.depth.data()[i] = bad[rng() % 7];
-    for (int i = 0; i < 20; ++i) left.color.data()[rng() % left.color.pixel_count()] = glm::vec4(nan);
+    for (int i = 0; i < 20; ++i)
+        left.color.data()[rng() % left.color.pixel_count()] = glm::vec4(nan);
     const EyeCameras eyes = eye_cameras(c, {.ipd = 0.3f}, Anchor::Left);
     for (StereoWarp method : {StereoWarp::Grid, StereoWarp::Splat})
         for (StereoFill fill : {StereoFill::PullPush, StereoFill::Andreev, StereoFill::None}) {
             Frame right;
-            StereoStats stats = synthesize_eye(left, eyes.right, {.warp = method, .fill = fill}, right);
+            StereoStats stats =
+                synthesize_eye(left, eyes.right, {.warp = method, .fill = fill}, right);
             EXPECT_TRUE(all_finite(right.color)) << int(method) << " " << int(fill);
             EXPECT_EQ(stats.covered + stats.holes, std::size_t(w) * h);
         }
@@ -250,11 +257,13 @@ TEST(StereoRendered, SynthesizedRightEyeIsCloseToTheRenderedOne) {
         EyePair pair = render_eyes("pan", 0.5, 1.0 / 30.0, rig);
         for (StereoWarp method : {StereoWarp::Grid, StereoWarp::Splat}) {
             Frame right;
-            StereoStats stats = synthesize_eye(pair.left, pair.cameras.right, {.warp = method}, right);
+            StereoStats stats =
+                synthesize_eye(pair.left, pair.cameras.right, {.warp = method}, right);
             const double ours = display_psnr(pair.right.color, right.color);
             const double copy = display_psnr(pair.right.color, pair.left.color);
-            std::printf("[stereo] pan ipd %.3f %s: %.2f dB (copying the left eye: %.2f dB), %zu holes\n",
-                        ipd, method == StereoWarp::Grid ? "grid" : "splat", ours, copy, stats.holes);
+            std::printf(
+                "[stereo] pan ipd %.3f %s: %.2f dB (copying the left eye: %.2f dB), %zu holes\n",
+                ipd, method == StereoWarp::Grid ? "grid" : "splat", ours, copy, stats.holes);
             if (method == StereoWarp::Grid) {
                 EXPECT_GT(ours, 30.0);
                 EXPECT_GT(ours, copy + 6.0);
@@ -270,7 +279,8 @@ TEST(StereoTemporal, StillCameraAndSceneReproduceTheRenderedEyeExactly) {
     EyePair pair = render_eyes("pan", 0.5, 0.0, rig);  // previous instant = current: still
     Frame right;
     StereoSynthesizer synthesizer;
-    StereoStats stats = synthesizer.synthesize(pair.left, pair.cameras.right, right, {}, &pair.right);
+    StereoStats stats =
+        synthesizer.synthesize(pair.left, pair.cameras.right, right, {}, &pair.right);
     EXPECT_EQ(right.color, pair.right.color);
     EXPECT_EQ(stats.from_history, right.color.pixel_count());
 }
@@ -283,11 +293,12 @@ TEST(StereoTemporal, PreviousOtherEyeFillsDisocclusions) {
     StereoSynthesizer synthesizer;
     Frame plain, temporal;
     synthesizer.synthesize(now.left, now.cameras.right, plain);
-    StereoStats stats = synthesizer.synthesize(now.left, now.cameras.right, temporal, {}, &before.right);
+    StereoStats stats =
+        synthesizer.synthesize(now.left, now.cameras.right, temporal, {}, &before.right);
     const double a = display_psnr(now.right.color, plain.color),
                  b = display_psnr(now.right.color, temporal.color);
-    std::printf("[stereo] temporal: %.2f dB (without: %.2f dB), %zu of %zu holes from history\n", b, a,
-                stats.from_history, stats.holes);
+    std::printf("[stereo] temporal: %.2f dB (without: %.2f dB), %zu of %zu holes from history\n", b,
+                a, stats.from_history, stats.holes);
     EXPECT_GT(stats.from_history, 0u);
     EXPECT_GT(b, a - 0.5);
 }
@@ -312,5 +323,6 @@ TEST(StereoCompose, LayoutsPlaceTheEyesAndAnaglyphUsesDubois) {
     // Grey in both eyes: the rows of the two matrices sum to about 1 in R, G and B.
     Image<glm::vec4> grey(4, 2, {0.5f, 0.5f, 0.5f, 1.0f});
     compose(grey.view(), grey.view(), Layout::Anaglyph, out);
-    for (int k = 0; k < 3; ++k) EXPECT_NEAR(out(0, 0)[k], std::lround(linear_to_srgb(0.5f) * 255.0f), 6);
+    for (int k = 0; k < 3; ++k)
+        EXPECT_NEAR(out(0, 0)[k], std::lround(linear_to_srgb(0.5f) * 255.0f), 6);
 }

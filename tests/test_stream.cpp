@@ -68,22 +68,23 @@ struct Session {
 
 // Runs a client until it decoded `frames` frames (at most `max_seconds`, so a slow machine only
 // takes longer); keeps every keep_every-th displayed frame after `warmup` s.
-Session run(client::StreamClient& c, std::size_t frames, double max_seconds = 30.0, int keep_every = 6,
-            double warmup = 0.5) {
+Session run(client::StreamClient& c, std::size_t frames, double max_seconds = 30.0,
+            int keep_every = 6, double warmup = 0.5) {
     server::Scene scene;
     server::CameraPath path;
     EXPECT_TRUE(server::load_scene("pan", scene, path).ok());
     Session s;
-    Status st = client::run_client(c, max_seconds, 60.0, [&](double t) { return server::camera_view(path, scene, t); },
-                                   [&](const Frame& f, const client::DisplayInfo& info, int64_t displayed_us) {
-        s.max_latency_ms = std::max(s.max_latency_ms, (displayed_us - info.pose_us) / 1000.0);
-        if (info.scene_time >= warmup && s.shown++ % keep_every == 0) {
-            Shown k{info.scene_time, f.camera.view, {}};
-            k.color = f.color;
-            s.kept.push_back(std::move(k));
-        }
-        return c.stats().frames_decoded < frames;
-    });
+    Status st = client::run_client(
+        c, max_seconds, 60.0, [&](double t) { return server::camera_view(path, scene, t); },
+        [&](const Frame& f, const client::DisplayInfo& info, int64_t displayed_us) {
+            s.max_latency_ms = std::max(s.max_latency_ms, (displayed_us - info.pose_us) / 1000.0);
+            if (info.scene_time >= warmup && s.shown++ % keep_every == 0) {
+                Shown k{info.scene_time, f.camera.view, {}};
+                k.color = f.color;
+                s.kept.push_back(std::move(k));
+            }
+            return c.stats().frames_decoded < frames;
+        });
     EXPECT_TRUE(st.ok()) << st.message();
     return s;
 }
@@ -103,7 +104,8 @@ double mean_psnr(const std::vector<Shown>& kept) {
         now.view = k.view;
         server::Instant before = now;
         before.time -= 1.0 / 30.0;
-        EXPECT_TRUE(r->render(scene, now, before, {.width = kWidth, .height = kHeight}, truth).ok());
+        EXPECT_TRUE(
+            r->render(scene, now, before, {.width = kWidth, .height = kHeight}, truth).ok());
         to_display(truth.color.view(), a.view());
         to_display(k.color.view(), b.view());
         sum += std::min(60.0, psnr(a.view(), b.view()));
@@ -111,7 +113,8 @@ double mean_psnr(const std::vector<Shown>& kept) {
     return kept.empty() ? 0.0 : sum / double(kept.size());
 }
 
-std::unique_ptr<client::StreamClient> make_client(const net::Endpoint& at, client::StreamClientOptions o = {}) {
+std::unique_ptr<client::StreamClient> make_client(const net::Endpoint& at,
+                                                  client::StreamClientOptions o = {}) {
     o.server = at;
     if (o.secret.empty()) o.secret = "2468";
     std::unique_ptr<client::StreamClient> c;
@@ -147,7 +150,8 @@ TEST(Stream, EndToEndDisplayedFramesMatchTheTruth) {
     auto c = make_client(srv.at());
     const Session s = run(*c, 60);
     const double p = mean_psnr(s.kept);
-    std::printf("[stream] clean: %zu shown, %zu decoded, PSNR %.2f dB\n", s.shown, c->stats().frames_decoded, p);
+    std::printf("[stream] clean: %zu shown, %zu decoded, PSNR %.2f dB\n", s.shown,
+                c->stats().frames_decoded, p);
     EXPECT_GE(c->stats().frames_decoded, 60u);
     EXPECT_GE(c->stats().connects, 1u);
     EXPECT_EQ(c->stats().frames_lost, 0u);
@@ -155,7 +159,8 @@ TEST(Stream, EndToEndDisplayedFramesMatchTheTruth) {
     EXPECT_GE(p, 28.0);
     const std::string metrics = fetch_metrics(srv.server->metrics_port());
     EXPECT_NE(metrics.find("200 OK"), std::string::npos) << metrics;
-    EXPECT_NE(metrics.find("# TYPE reprise_frames_sent_total counter"), std::string::npos) << metrics;
+    EXPECT_NE(metrics.find("# TYPE reprise_frames_sent_total counter"), std::string::npos)
+        << metrics;
     EXPECT_NE(metrics.find("reprise_sessions 1"), std::string::npos) << metrics;
 }
 
@@ -167,7 +172,8 @@ TEST(Stream, LowResolutionColourIsUpsampledToTheTruth) {
     auto c = make_client(srv.at());
     const Session s = run(*c, 60);
     const double p = mean_psnr(s.kept);
-    std::printf("[stream] lowres 1/4: %zu shown, %zu decoded, PSNR %.2f dB\n", s.shown, c->stats().frames_decoded, p);
+    std::printf("[stream] lowres 1/4: %zu shown, %zu decoded, PSNR %.2f dB\n", s.shown,
+                c->stats().frames_decoded, p);
     ASSERT_NE(c->stream_info(), nullptr);
     EXPECT_EQ(c->stream_info()->mode, net::StreamMode::LowRes);
     EXPECT_GE(c->stats().frames_decoded, 60u);
@@ -186,8 +192,9 @@ TEST(Stream, FivePercentLossAndReorderingKeepTheStreamGoing) {
     const Session s = run(*c, 60);
     const double p = mean_psnr(s.kept);
     const auto& st = c->stats();
-    std::printf("[stream] 5%% loss: %zu shown, %zu decoded, %zu lost, %zu FEC-recovered, PSNR %.2f dB\n", s.shown,
-                st.frames_decoded, st.frames_lost, st.fec_recovered, p);
+    std::printf(
+        "[stream] 5%% loss: %zu shown, %zu decoded, %zu lost, %zu FEC-recovered, PSNR %.2f dB\n",
+        s.shown, st.frames_decoded, st.frames_lost, st.fec_recovered, p);
     EXPECT_GE(st.frames_decoded, 60u);
     EXPECT_GT(st.fec_recovered, 0u);
     EXPECT_GE(p, 24.0);
@@ -205,11 +212,13 @@ TEST(Stream, HeavyLossLowersTheBitrateTarget) {
     server::CameraPath path;
     ASSERT_TRUE(server::load_scene("pan", scene, path).ok());
     // Until the target fell (at most 20 s: a slow machine only takes longer).
-    ASSERT_TRUE(client::run_client(*c, 20.0, 60.0, [&](double t) { return server::camera_view(path, scene, t); },
-                                   [&](const Frame&, const client::DisplayInfo&, int64_t) {
-                                       return srv.server->stats().bitrate_kbps >= 1000 ||
-                                              srv.server->stats().bitrate_kbps == 0;
-                                   }).ok());
+    ASSERT_TRUE(client::run_client(
+                    *c, 20.0, 60.0, [&](double t) { return server::camera_view(path, scene, t); },
+                    [&](const Frame&, const client::DisplayInfo&, int64_t) {
+                        return srv.server->stats().bitrate_kbps >= 1000 ||
+                               srv.server->stats().bitrate_kbps == 0;
+                    })
+                    .ok());
     const auto st = srv.server->stats();
     EXPECT_GT(st.loss, 0.1);
     EXPECT_LT(st.bitrate_kbps, 1000) << "30 % loss for up to 20 s";
@@ -224,7 +233,9 @@ struct RawPeer {
     net::SecureChannel channel;
     std::vector<uint8_t> datagram;
 
-    explicit RawPeer(net::Endpoint s) : server(s) { EXPECT_TRUE(socket.bind({0x7f000001u, 0}).ok()); }
+    explicit RawPeer(net::Endpoint s) : server(s) {
+        EXPECT_TRUE(socket.bind({0x7f000001u, 0}).ok());
+    }
 
     bool receive_within(int64_t us, std::vector<uint8_t>& out) {
         const int64_t end = net::now_us() + us;
@@ -303,12 +314,12 @@ TEST(Stream, BadDatagramsAreDroppedWhileAnotherClientIsServed) {
     RawPeer attacker(srv.at());
     std::vector<uint8_t> garbage(300);
     for (std::size_t i = 0; i < garbage.size(); ++i) garbage[i] = uint8_t(i * 7);
-    attacker.socket.send_to(garbage, srv.at());                                    // garbage
+    attacker.socket.send_to(garbage, srv.at());  // garbage
     std::vector<uint8_t> oversized(1400, 0);
     oversized[0] = 'R', oversized[1] = 'P', oversized[2] = 1, oversized[3] = 4;
-    attacker.socket.send_to(oversized, srv.at());                                  // oversized
+    attacker.socket.send_to(oversized, srv.at());  // oversized
     std::vector<uint8_t> truncated = {'R', 'P', 1, 1, 0, 0};
-    attacker.socket.send_to(truncated, srv.at());                                  // truncated
+    attacker.socket.send_to(truncated, srv.at());  // truncated
     // Wrong PIN: the server answers the hello, the attacker cannot confirm; a forged finish fails.
     EXPECT_FALSE(attacker.handshake("1111"));
     // A sealed datagram for no session, and one from a real session replayed.
@@ -316,10 +327,10 @@ TEST(Stream, BadDatagramsAreDroppedWhileAnotherClientIsServed) {
     ASSERT_TRUE(honest.handshake("2468"));
     const auto start_message = honest.seal(net::StartMessage{});
     honest.socket.send_to(start_message, srv.at());
-    honest.socket.send_to(start_message, srv.at());                                // replayed
+    honest.socket.send_to(start_message, srv.at());  // replayed
     std::vector<uint8_t> tampered = start_message;
     tampered.back() ^= 1;
-    honest.socket.send_to(tampered, srv.at());                                     // tampered
+    honest.socket.send_to(tampered, srv.at());  // tampered
     eventually([&] { return c->stats().frames_decoded > decoded_before_attack + 10; },
                [] { std::this_thread::sleep_for(std::chrono::milliseconds(10)); });
     done = true;
@@ -327,7 +338,8 @@ TEST(Stream, BadDatagramsAreDroppedWhileAnotherClientIsServed) {
     const auto after = srv.server->stats();
     EXPECT_GE(after.dropped_datagrams - before.dropped_datagrams, 5u);
     EXPECT_EQ(after.handshakes_ok - before.handshakes_ok, 1u);  // the honest raw peer only
-    EXPECT_GT(c->stats().frames_decoded, decoded_before_attack + 10) << "the good client kept being served";
+    EXPECT_GT(c->stats().frames_decoded, decoded_before_attack + 10)
+        << "the good client kept being served";
 }
 
 TEST(Stream, ClientReconnectsAfterServerRestartAndServerServesANewClient) {
@@ -354,11 +366,13 @@ TEST(Stream, ClientReconnectsAfterServerRestartAndServerServesANewClient) {
     // A client that leaves and a new one that comes.
     c.reset();
     auto d = make_client(at);
-    EXPECT_TRUE(eventually([&] { return d->stats().frames_decoded > 5; }, [&] {
-        d->wait(5000);
-        ASSERT_TRUE(d->poll(net::now_us()).ok());
-        d->send_pose(server::camera_view(path, scene, 0.0), 0.0, net::now_us());
-    }));
+    EXPECT_TRUE(eventually([&] { return d->stats().frames_decoded > 5; },
+                           [&] {
+                               d->wait(5000);
+                               ASSERT_TRUE(d->poll(net::now_us()).ok());
+                               d->send_pose(server::camera_view(path, scene, 0.0), 0.0,
+                                            net::now_us());
+                           }));
 }
 
 TEST(Stream, WrongPinAndUnknownSceneAreRefusedAtTheClient) {

@@ -186,9 +186,7 @@ TwoFrames two_frames(int w, int h, glm::vec4 a, glm::vec4 b) {
     return t;
 }
 
-bool inside(int x, int y) {
-    return x >= 8 && x < 16 && y >= 4 && y < 12;
-}
+bool inside(int x, int y) { return x >= 8 && x < 16 && y >= 4 && y < 12; }
 
 TEST(Upsample, NewIdOrDisocclusionTakesNoHistory) {
     const int w = 32, h = 16;

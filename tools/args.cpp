@@ -112,8 +112,10 @@ std::string Args::usage() const {
     if (!positionals_.empty() || !options_.empty()) text += "\n";
     auto line = [&](const Spec& s, const char* meta) {
         std::string left = "  " + s.name + meta;
-        if (left.size() < 26) left.resize(26, ' ');
-        else left += "  ";
+        if (left.size() < 26)
+            left.resize(26, ' ');
+        else
+            left += "  ";
         text += left + s.help + "\n";
     };
     for (const Spec& s : positionals_) line(s, "");

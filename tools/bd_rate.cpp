@@ -16,11 +16,10 @@ std::vector<RatePoint> clean(std::vector<RatePoint> curve) {
     std::sort(curve.begin(), curve.end(), [](const RatePoint& a, const RatePoint& b) {
         return a.quality != b.quality ? a.quality < b.quality : a.rate < b.rate;
     });
-    curve.erase(std::unique(curve.begin(), curve.end(),
-                            [](const RatePoint& a, const RatePoint& b) {
-                                return a.quality == b.quality;
-                            }),
-                curve.end());
+    curve.erase(
+        std::unique(curve.begin(), curve.end(),
+                    [](const RatePoint& a, const RatePoint& b) { return a.quality == b.quality; }),
+        curve.end());
     return curve;
 }
 
@@ -45,8 +44,10 @@ std::vector<double> slopes(const std::vector<double>& x, const std::vector<doubl
     }
     auto end_slope = [](double h0, double h1, double d0, double d1) {
         double s = ((2.0 * h0 + h1) * d0 - h0 * d1) / (h0 + h1);
-        if (sign(s) != sign(d0)) s = 0.0;
-        else if (sign(d0) != sign(d1) && std::abs(s) > std::abs(3.0 * d0)) s = 3.0 * d0;
+        if (sign(s) != sign(d0))
+            s = 0.0;
+        else if (sign(d0) != sign(d1) && std::abs(s) > std::abs(3.0 * d0))
+            s = 3.0 * d0;
         return s;
     };
     d[0] = end_slope(h[0], h[1], delta[0], delta[1]);

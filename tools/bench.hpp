@@ -13,28 +13,28 @@ namespace reprise::cli {
 
 struct BenchOptions {
     std::string scene = "pan";
-    int frames = 10;                        // repetitions / frames per measurement
+    int frames = 10;  // repetitions / frames per measurement
     std::string sizes = "640x360,1920x1080";
-    std::string dir;                        // where files go (default: the temp folder)
-    std::string out;                        // report folder (bench fruc)
+    std::string dir;  // where files go (default: the temp folder)
+    std::string out;  // report folder (bench fruc)
     // bench fruc
-    std::string scenes;                     // comma-separated; empty = every built-in scene
-    int factor = 2;                         // K
+    std::string scenes;  // comma-separated; empty = every built-in scene
+    int factor = 2;      // K
     std::string size = "640x360";
-    bool quick = false;                     // a few settings only
-    bool exr = false;                       // also write the rendered input and truth as EXR
-    int repeat = 3;                         // timed runs; each frame's fastest counts
+    bool quick = false;  // a few settings only
+    bool exr = false;    // also write the rendered input and truth as EXR
+    int repeat = 3;      // timed runs; each frame's fastest counts
     // bench codec
-    std::string in;                         // a sequence folder, besides the scenes
-    int threads = 2;                        // per codec
-    std::string qps = "22,28,34,40";        // reprise's rate points
-    std::string speed_size = "1920x1080";   // the speed ratios' size
+    std::string in;                        // a sequence folder, besides the scenes
+    int threads = 2;                       // per codec
+    std::string qps = "22,28,34,40";       // reprise's rate points
+    std::string speed_size = "1920x1080";  // the speed ratios' size
     std::string speed_scene = "pan";
-    int speed_frames = 10;                  // 0 = no speed run
+    int speed_frames = 10;  // 0 = no speed run
     // bench stream
-    double stream_duration = 4.0;           // seconds per condition
+    double stream_duration = 4.0;  // seconds per condition
     double display_rate = 120.0;
-    std::string conditions;                 // comma-separated condition names; empty = all (or --quick)
+    std::string conditions;  // comma-separated condition names; empty = all (or --quick)
 };
 
 // A scene, its camera path and a renderer: what every benchmark that renders starts from.

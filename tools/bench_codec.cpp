@@ -22,9 +22,9 @@
 #include "bd_rate.hpp"
 #include "bench.hpp"
 #include "bench_report.hpp"
-#include "reprise/codec/codec.hpp"
 #include "codec_peers.hpp"
 #include "depth_peers.hpp"
+#include "reprise/codec/codec.hpp"
 #include "reprise/core/exr.hpp"
 #include "reprise/core/metrics.hpp"
 #include "reprise/core/parallel.hpp"
@@ -73,9 +73,9 @@ struct Sequence {
     std::string name, note;
     bool builtin = false;
     double fps = 30.0;
-    std::vector<Frame> frames;               // the G-buffers (colour, depth, motion, camera)
-    std::vector<Image<Rgb8>> shown;          // 8-bit display values: what every codec gets
-    std::vector<Image<glm::vec3>> truth;     // display values of the original colour
+    std::vector<Frame> frames;            // the G-buffers (colour, depth, motion, camera)
+    std::vector<Image<Rgb8>> shown;       // 8-bit display values: what every codec gets
+    std::vector<Image<glm::vec3>> truth;  // display values of the original colour
 };
 
 struct DepthResult {
@@ -101,8 +101,8 @@ void add_frame(Sequence& seq, Frame&& frame) {
     seq.frames.push_back(std::move(frame));
 }
 
-Status render_sequence(server::Renderer& renderer, const std::string& scene_name, int frames,
-                       int w, int h, Sequence& seq) {
+Status render_sequence(server::Renderer& renderer, const std::string& scene_name, int frames, int w,
+                       int h, Sequence& seq) {
     server::Scene scene;
     server::CameraPath path;
     REPRISE_TRY(server::load_scene(scene_name, scene, path));
@@ -112,7 +112,8 @@ Status render_sequence(server::Renderer& renderer, const std::string& scene_name
         if (info.name == scene_name) seq.note = info.stresses, seq.builtin = true;
     for (int i = 0; i < frames; ++i) {
         Frame frame;
-        REPRISE_TRY(renderer.render_frame(scene, path, i, seq.fps, {.width = w, .height = h}, frame));
+        REPRISE_TRY(
+            renderer.render_frame(scene, path, i, seq.fps, {.width = w, .height = h}, frame));
         add_frame(seq, std::move(frame));
         std::fprintf(stderr, "\r[codec] %s: rendering %d/%d   ", seq.name.c_str(), i + 1, frames);
     }
@@ -131,7 +132,8 @@ Status read_sequence(const std::string& dir, int frames, Sequence& seq) {
     for (int i = 0; i < n; ++i) {
         Frame frame;
         REPRISE_TRY(read_frame(files.files[i], frame));
-        if (i > 0 && (frame.width() != seq.frames[0].width() || frame.height() != seq.frames[0].height()))
+        if (i > 0 &&
+            (frame.width() != seq.frames[0].width() || frame.height() != seq.frames[0].height()))
             return Status::error(files.files[i] + ": size differs from the first frame");
         add_frame(seq, std::move(frame));
         std::fprintf(stderr, "\r[codec] %s: reading %d/%d   ", seq.name.c_str(), i + 1, n);
@@ -141,7 +143,8 @@ Status read_sequence(const std::string& dir, int frames, Sequence& seq) {
     return {};
 }
 
-ImageError score(const Image<glm::vec3>& truth, const Image<Rgb8>& decoded, Image<glm::vec3>& scratch) {
+ImageError score(const Image<glm::vec3>& truth, const Image<Rgb8>& decoded,
+                 Image<glm::vec3>& scratch) {
     from_rgb8(decoded.view(), scratch);
     return image_error(truth.view(), scratch.view());
 }
@@ -178,10 +181,11 @@ Status run_ours(const Sequence& seq, int qp, bool bounded_depth, RunResult& tota
     const char* name = bounded_depth ? kOursBounded : kOurs;
     total = {name, setting, name, {}};
     color = {kOursColor, setting, kOursColor, {}};
-    codec::Encoder encoder({.qp = qp,
-                            .fps = seq.fps,
-                            .depth = bounded_depth ? codec::DepthMode::Bounded : codec::DepthMode::Lossless,
-                            .depth_error = 1e-3f});
+    codec::Encoder encoder(
+        {.qp = qp,
+         .fps = seq.fps,
+         .depth = bounded_depth ? codec::DepthMode::Bounded : codec::DepthMode::Lossless,
+         .depth_error = 1e-3f});
     codec::Decoder decoder;
     codec::Packet packet;
     Frame decoded;
@@ -199,8 +203,10 @@ Status run_ours(const Sequence& seq, int qp, bool bounded_depth, RunResult& tota
         const double decode_ms = ms_since(start);
         const codec::StreamStats& stats = encoder.last_frame_stats();
         if (8 * packet.data.size() < stats.total_bits() && i == 0)
-            std::fprintf(stderr, "[codec] note: reprise's stream stats count %zu bits, its packet "
-                         "has %zu\n", stats.total_bits(), 8 * packet.data.size());
+            std::fprintf(stderr,
+                         "[codec] note: reprise's stream stats count %zu bits, its packet "
+                         "has %zu\n",
+                         stats.total_bits(), 8 * packet.data.size());
         display.resize(decoded.width(), decoded.height());
         to_display(decoded.color.view(), display.view());
         Sample s{int(i), 8.0 * double(packet.data.size()),
@@ -230,7 +236,8 @@ void run_depth_peers(const Sequence& seq, std::vector<DepthResult>& results) {
         REPRISE_ASSERT(ok.ok());
         for (DepthResult* r : {&rvl, &rvl16}) {
             const RvlOptions options{.mode = r == &rvl ? RvlMode::FloatBits : RvlMode::Inverse16,
-                                     .near = frame.camera.near, .far = frame.camera.far};
+                                     .near = frame.camera.near,
+                                     .far = frame.camera.far};
             start = BenchClock::now();
             rvl_encode(depth, options, bytes);
             r->encode_ms.push_back(ms_since(start));
@@ -267,15 +274,16 @@ std::vector<RatePoint> rd_curve(const std::vector<RunResult>& runs, const std::s
     std::vector<RatePoint> points;
     for (const RunResult& r : runs)
         if (r.group == group)
-            points.push_back({r.mean(&Sample::bits),
-                              flip ? -r.mean_error(&ImageError::flip) : r.mean_error(&ImageError::psnr)});
+            points.push_back({r.mean(&Sample::bits), flip ? -r.mean_error(&ImageError::flip)
+                                                          : r.mean_error(&ImageError::psnr)});
     return points;
 }
 
 std::vector<std::string> groups_of(const std::vector<RunResult>& runs) {
     std::vector<std::string> groups;
     for (const RunResult& r : runs)
-        if (std::find(groups.begin(), groups.end(), r.group) == groups.end()) groups.push_back(r.group);
+        if (std::find(groups.begin(), groups.end(), r.group) == groups.end())
+            groups.push_back(r.group);
     return groups;
 }
 
@@ -288,9 +296,7 @@ struct BdRow {
 
 std::string pct(double v) { return std::isnan(v) ? std::string("n/a") : strf("%+.1f%%", v); }
 
-std::string verdict(bool known, bool met) {
-    return !known ? "n/a" : met ? "met" : "NOT met";
-}
+std::string verdict(bool known, bool met) { return !known ? "n/a" : met ? "met" : "NOT met"; }
 
 struct SpeedResult {
     bool measured = false;
@@ -301,24 +307,27 @@ struct SpeedResult {
     double x264_ultrafast_encode = NAN;
 };
 
-Status measure_speed(server::Renderer& renderer, const BenchOptions& job, int threads,
-                     int mid_qp, SpeedResult& speed) {
+Status measure_speed(server::Renderer& renderer, const BenchOptions& job, int threads, int mid_qp,
+                     SpeedResult& speed) {
     REPRISE_TRY(parse_size(job.speed_size, speed.w, speed.h));
     Sequence seq;
-    REPRISE_TRY(render_sequence(renderer, job.speed_scene, job.speed_frames, speed.w, speed.h, seq));
+    REPRISE_TRY(
+        render_sequence(renderer, job.speed_scene, job.speed_frames, speed.w, speed.h, seq));
     seq.name = "speed-" + seq.name;
     speed.frames = int(seq.frames.size());
     RunResult run;
     std::fprintf(stderr, "[codec] speed: x264 veryfast at %dx%d\n", speed.w, speed.h);
     double convert_ms[2] = {NAN, NAN};
-    REPRISE_TRY(run_peer(seq, {.kind = PeerKind::X264, .preset = "veryfast", .crf = 26, .threads = threads},
-                         run, convert_ms));
+    REPRISE_TRY(
+        run_peer(seq, {.kind = PeerKind::X264, .preset = "veryfast", .crf = 26, .threads = threads},
+                 run, convert_ms));
     speed.rgb_to_yuv = convert_ms[0];
     speed.yuv_to_rgb = convert_ms[1];
     speed.x264_veryfast_encode = run.mean(&Sample::encode_ms);
     speed.x264_veryfast_decode = run.mean(&Sample::decode_ms);
     std::fprintf(stderr, "[codec] speed: x264 ultrafast\n");
-    REPRISE_TRY(run_peer(seq, {.kind = PeerKind::X264, .preset = "ultrafast", .crf = 26, .threads = threads}, run));
+    REPRISE_TRY(run_peer(
+        seq, {.kind = PeerKind::X264, .preset = "ultrafast", .crf = 26, .threads = threads}, run));
     speed.x264_ultrafast_encode = run.mean(&Sample::encode_ms);
     std::fprintf(stderr, "[codec] speed: reprise qp %d\n", mid_qp);
     RunResult color;
@@ -353,17 +362,22 @@ Status bench_codec(const BenchOptions& job) {
 
     std::vector<PeerConfig> peers;
     for (const PeerConfig& c : standard_peer_configs(job.threads)) {
-        if (peer_available(c.kind)) peers.push_back(c);
+        if (peer_available(c.kind))
+            peers.push_back(c);
         else if (peers.empty() || peers.back().kind != c.kind)
-            std::printf("note: libavcodec lacks %s; that peer is skipped\n", peer_name(c.kind).c_str());
+            std::printf("note: libavcodec lacks %s; that peer is skipped\n",
+                        peer_name(c.kind).c_str());
     }
 
     CsvFile csv, bd_csv, depth_csv, speed_csv;
     REPRISE_TRY(csv.open(out_dir + "/codec.csv",
                          "scene,codec,setting,frame,bits,psnr,ssim,flip,encode_ms,decode_ms"));
-    REPRISE_TRY(bd_csv.open(out_dir + "/bd_rate.csv", "scene,anchor,metric,reprise_bits,bd_rate_percent"));
-    REPRISE_TRY(depth_csv.open(out_dir + "/depth.csv", "scene,coder,frame,bytes,encode_ms,decode_ms"));
-    REPRISE_TRY(speed_csv.open(out_dir + "/speed.csv", "size,frames,codec,setting,encode_ms,decode_ms"));
+    REPRISE_TRY(
+        bd_csv.open(out_dir + "/bd_rate.csv", "scene,anchor,metric,reprise_bits,bd_rate_percent"));
+    REPRISE_TRY(
+        depth_csv.open(out_dir + "/depth.csv", "scene,coder,frame,bytes,encode_ms,decode_ms"));
+    REPRISE_TRY(
+        speed_csv.open(out_dir + "/speed.csv", "size,frames,codec,setting,encode_ms,decode_ms"));
 
     std::unique_ptr<server::Renderer> renderer;
     REPRISE_TRY(server::Renderer::create(renderer));
@@ -399,16 +413,21 @@ Status bench_codec(const BenchOptions& job) {
     if (!job.in.empty()) inputs.push_back("in:" + job.in);
     for (const std::string& input : inputs) {
         Sequence seq;
-        if (input.rfind("in:", 0) == 0) REPRISE_TRY(read_sequence(input.substr(3), job.frames, seq));
-        else REPRISE_TRY(render_sequence(*renderer, input, job.frames, w, h, seq));
+        if (input.rfind("in:", 0) == 0)
+            REPRISE_TRY(read_sequence(input.substr(3), job.frames, seq));
+        else
+            REPRISE_TRY(render_sequence(*renderer, input, job.frames, w, h, seq));
         const int sw = seq.frames[0].width(), sh = seq.frames[0].height();
 
         std::vector<RunResult> runs;
         std::vector<double> our_depth_bits;
         for (int qp : qps) {
             RunResult total, color;
-            REPRISE_TRY(run_ours(seq, qp, false, total, color, our_depth_bits.empty() ? &our_depth_bits : nullptr));
-            std::fprintf(stderr, "[codec] %s: reprise qp %2d: %9.0f bits/frame (colour %9.0f) %6.2f dB %8.2f ms enc %8.2f ms dec\n",
+            REPRISE_TRY(run_ours(seq, qp, false, total, color,
+                                 our_depth_bits.empty() ? &our_depth_bits : nullptr));
+            std::fprintf(stderr,
+                         "[codec] %s: reprise qp %2d: %9.0f bits/frame (colour %9.0f) %6.2f dB "
+                         "%8.2f ms enc %8.2f ms dec\n",
                          seq.name.c_str(), qp, total.mean(&Sample::bits), color.mean(&Sample::bits),
                          total.mean_error(&ImageError::psnr), total.mean(&Sample::encode_ms),
                          total.mean(&Sample::decode_ms));
@@ -421,18 +440,20 @@ Status bench_codec(const BenchOptions& job) {
         for (const PeerConfig& config : peers) {
             RunResult run;
             REPRISE_TRY(run_peer(seq, config, run));
-            std::fprintf(stderr, "[codec] %s: %-8s %-18s %9.0f bits/frame %6.2f dB %8.2f ms enc %8.2f ms dec\n",
-                         seq.name.c_str(), run.codec.c_str(), run.setting.c_str(),
-                         run.mean(&Sample::bits), run.mean_error(&ImageError::psnr),
-                         run.mean(&Sample::encode_ms), run.mean(&Sample::decode_ms));
+            std::fprintf(
+                stderr,
+                "[codec] %s: %-8s %-18s %9.0f bits/frame %6.2f dB %8.2f ms enc %8.2f ms dec\n",
+                seq.name.c_str(), run.codec.c_str(), run.setting.c_str(), run.mean(&Sample::bits),
+                run.mean_error(&ImageError::psnr), run.mean(&Sample::encode_ms),
+                run.mean(&Sample::decode_ms));
             runs.push_back(std::move(run));
         }
         for (const RunResult& r : runs)
             for (const Sample& s : r.samples)
-                csv.row({seq.name, r.codec, r.setting, std::to_string(s.frame), strf("%.0f", s.bits),
-                         strf("%.4f", s.error.psnr), strf("%.6f", s.error.ssim),
-                         strf("%.6f", s.error.flip), strf("%.4f", s.encode_ms),
-                         strf("%.4f", s.decode_ms)});
+                csv.row({seq.name, r.codec, r.setting, std::to_string(s.frame),
+                         strf("%.0f", s.bits), strf("%.4f", s.error.psnr),
+                         strf("%.6f", s.error.ssim), strf("%.6f", s.error.flip),
+                         strf("%.4f", s.encode_ms), strf("%.4f", s.decode_ms)});
         csv.flush();
 
         // Depth coders.
@@ -468,12 +489,15 @@ Status bench_codec(const BenchOptions& job) {
             row.psnr_total = bd_rate(rd_curve(runs, g, false), rd_curve(runs, kOurs, false));
             row.flip_color = bd_rate(rd_curve(runs, g, true), rd_curve(runs, kOursColor, true));
             row.flip_total = bd_rate(rd_curve(runs, g, true), rd_curve(runs, kOurs, true));
-            row.psnr_bounded = bd_rate(rd_curve(runs, g, false), rd_curve(runs, kOursBounded, false));
+            row.psnr_bounded =
+                bd_rate(rd_curve(runs, g, false), rd_curve(runs, kOursBounded, false));
             row.flip_bounded = bd_rate(rd_curve(runs, g, true), rd_curve(runs, kOursBounded, true));
-            for (auto [metric, bits, v] :
-                 {std::tuple{"psnr", "color", row.psnr_color}, {"psnr", "total", row.psnr_total},
-                  {"flip", "color", row.flip_color}, {"flip", "total", row.flip_total},
-                  {"psnr", "total-depth1e-3", row.psnr_bounded}, {"flip", "total-depth1e-3", row.flip_bounded}})
+            for (auto [metric, bits, v] : {std::tuple{"psnr", "color", row.psnr_color},
+                                           {"psnr", "total", row.psnr_total},
+                                           {"flip", "color", row.flip_color},
+                                           {"flip", "total", row.flip_total},
+                                           {"psnr", "total-depth1e-3", row.psnr_bounded},
+                                           {"flip", "total-depth1e-3", row.flip_bounded}})
                 bd_csv.row({seq.name, g, metric, bits, strf("%.3f", v)});
             bd_rows.push_back(row);
         }
@@ -502,21 +526,22 @@ Status bench_codec(const BenchOptions& job) {
                               r.mean_error(&ImageError::ssim), r.mean_error(&ImageError::flip),
                               r.mean(&Sample::encode_ms), r.mean(&Sample::decode_ms));
                 if (r.codec != kOursColor)
-                    section.points.push_back({r.codec == kOurs ? std::string(kOurs) : r.group,
-                                              r.setting, r.mean_error(&ImageError::psnr),
-                                              r.mean_error(&ImageError::ssim),
-                                              r.mean_error(&ImageError::flip), r.mean(&Sample::encode_ms)});
+                    section.points.push_back(
+                        {r.codec == kOurs ? std::string(kOurs) : r.group, r.setting,
+                         r.mean_error(&ImageError::psnr), r.mean_error(&ImageError::ssim),
+                         r.mean_error(&ImageError::flip), r.mean(&Sample::encode_ms)});
             }
             psnr_series.push_back(std::move(ps));
             flip_series.push_back(std::move(fs_));
             if (g != kOursColor) bars.push_back({g, {enc / n, dec / n}});
         }
-        section.html = "<p>PSNR against bits per frame</p>\n" +
-                       line_plot_svg(psnr_series, {"bits per frame", "PSNR, dB (higher is better)"}) +
-                       "<p>FLIP against bits per frame</p>\n" +
-                       line_plot_svg(flip_series, {"bits per frame", "LDR-FLIP (lower is better)"}) +
-                       "<p>Time per frame, mean over the rate points</p>\n" +
-                       bar_chart_svg(bars, {"encode", "decode"}, "ms per frame");
+        section.html =
+            "<p>PSNR against bits per frame</p>\n" +
+            line_plot_svg(psnr_series, {"bits per frame", "PSNR, dB (higher is better)"}) +
+            "<p>FLIP against bits per frame</p>\n" +
+            line_plot_svg(flip_series, {"bits per frame", "LDR-FLIP (lower is better)"}) +
+            "<p>Time per frame, mean over the rate points</p>\n" +
+            bar_chart_svg(bars, {"encode", "decode"}, "ms per frame");
         section.time_label = "encode ms per frame (log scale)";
         report.sections.push_back(std::move(section));
         std::printf("%s\n", table.c_str());
@@ -526,15 +551,17 @@ Status bench_codec(const BenchOptions& job) {
     // BD-rate table, with the mean over the built-in scenes.
     std::string bd_text;
     {
-        bd_text = strf("BD-rate of reprise against each peer (negative = reprise needs fewer bits "
-                       "for the same quality; total: all bits with lossless depth, and with depth within 1e-3)\n"
-                       "%-10s %-20s %12s %12s %12s %12s %14s %14s\n",
-                       "scene", "anchor", "PSNR colour", "PSNR total", "FLIP colour", "FLIP total",
-                       "PSNR tot 1e-3", "FLIP tot 1e-3");
+        bd_text = strf(
+            "BD-rate of reprise against each peer (negative = reprise needs fewer bits "
+            "for the same quality; total: all bits with lossless depth, and with depth within "
+            "1e-3)\n"
+            "%-10s %-20s %12s %12s %12s %12s %14s %14s\n",
+            "scene", "anchor", "PSNR colour", "PSNR total", "FLIP colour", "FLIP total",
+            "PSNR tot 1e-3", "FLIP tot 1e-3");
         std::map<std::string, std::vector<const BdRow*>> by_peer;
         for (const BdRow& r : bd_rows) {
-            bd_text += strf("%-10s %-20s %12s %12s %12s %12s %14s %14s\n", r.scene.c_str(), r.peer.c_str(),
-                            pct(r.psnr_color).c_str(), pct(r.psnr_total).c_str(),
+            bd_text += strf("%-10s %-20s %12s %12s %12s %12s %14s %14s\n", r.scene.c_str(),
+                            r.peer.c_str(), pct(r.psnr_color).c_str(), pct(r.psnr_total).c_str(),
                             pct(r.flip_color).c_str(), pct(r.flip_total).c_str(),
                             pct(r.psnr_bounded).c_str(), pct(r.flip_bounded).c_str());
             if (r.builtin) by_peer[r.peer].push_back(&r);
@@ -543,36 +570,39 @@ Status bench_codec(const BenchOptions& job) {
             double sums[6] = {0, 0, 0, 0, 0, 0};
             int counts[6] = {0, 0, 0, 0, 0, 0};
             for (const BdRow* r : rows) {
-                const double v[6] = {r->psnr_color, r->psnr_total, r->flip_color, r->flip_total,
-                                     r->psnr_bounded, r->flip_bounded};
+                const double v[6] = {r->psnr_color, r->psnr_total,   r->flip_color,
+                                     r->flip_total, r->psnr_bounded, r->flip_bounded};
                 for (int k = 0; k < 6; ++k)
                     if (!std::isnan(v[k])) sums[k] += v[k], ++counts[k];
             }
             double m[6];
             for (int k = 0; k < 6; ++k) m[k] = counts[k] ? sums[k] / counts[k] : NAN;
             bd_text += strf("%-10s %-20s %12s %12s %12s %12s %14s %14s\n", "mean", peer.c_str(),
-                            pct(m[0]).c_str(), pct(m[1]).c_str(), pct(m[2]).c_str(), pct(m[3]).c_str(),
-                            pct(m[4]).c_str(), pct(m[5]).c_str());
-            for (auto [metric, bits, v] : {std::tuple{"psnr", "color", m[0]}, {"psnr", "total", m[1]},
-                                           {"flip", "color", m[2]}, {"flip", "total", m[3]},
-                                           {"psnr", "total-depth1e-3", m[4]}, {"flip", "total-depth1e-3", m[5]}})
+                            pct(m[0]).c_str(), pct(m[1]).c_str(), pct(m[2]).c_str(),
+                            pct(m[3]).c_str(), pct(m[4]).c_str(), pct(m[5]).c_str());
+            for (auto [metric, bits, v] : {std::tuple{"psnr", "color", m[0]},
+                                           {"psnr", "total", m[1]},
+                                           {"flip", "color", m[2]},
+                                           {"flip", "total", m[3]},
+                                           {"psnr", "total-depth1e-3", m[4]},
+                                           {"flip", "total-depth1e-3", m[5]}})
                 bd_csv.row({"mean-builtin", peer, metric, bits, strf("%.3f", v)});
         }
     }
 
     // Depth table.
-    std::string depth_text = strf("depth, bytes over all frames (raw float = 4 bytes/pixel)\n"
-                                  "%-10s %12s %12s %12s %12s %14s %12s\n", "scene", "raw",
-                                  "zstd -3", "rvl float", "rvl 16 lossy", "reprise lossl.",
-                                  "zstd/reprise");
+    std::string depth_text = strf(
+        "depth, bytes over all frames (raw float = 4 bytes/pixel)\n"
+        "%-10s %12s %12s %12s %12s %14s %12s\n",
+        "scene", "raw", "zstd -3", "rvl float", "rvl 16 lossy", "reprise lossl.", "zstd/reprise");
     double depth_ratio_sum = 0.0;
     int depth_ratio_n = 0;
     for (const DepthSummary& d : depth_rows) {
         const double ratio = d.zstd / d.ours;
-        depth_text += strf("%-10s %12.0f %12.0f %12.0f %12.0f %14s %12s\n", d.scene.c_str(), d.raw,
-                           d.zstd, d.rvl, d.rvl16,
-                           std::isnan(d.ours) ? "n/a" : strf("%.0f", d.ours).c_str(),
-                           std::isnan(ratio) ? "n/a" : strf("%.2fx", ratio).c_str());
+        depth_text +=
+            strf("%-10s %12.0f %12.0f %12.0f %12.0f %14s %12s\n", d.scene.c_str(), d.raw, d.zstd,
+                 d.rvl, d.rvl16, std::isnan(d.ours) ? "n/a" : strf("%.0f", d.ours).c_str(),
+                 std::isnan(ratio) ? "n/a" : strf("%.2fx", ratio).c_str());
         if (!std::isnan(ratio)) depth_ratio_sum += ratio, ++depth_ratio_n;
     }
 
@@ -605,8 +635,7 @@ Status bench_codec(const BenchOptions& job) {
             "  reprise decode speed / its encode speed = %.2fx (>= 2 wanted)\n",
             qps[qps.size() / 2], speed.ours_encode, speed.ours_decode,
             speed.x264_veryfast_encode / speed.ours_encode,
-            speed.x264_ultrafast_encode / speed.ours_encode,
-            speed.ours_encode / speed.ours_decode);
+            speed.x264_ultrafast_encode / speed.ours_encode, speed.ours_encode / speed.ours_decode);
     }
 
     // Targets of issue 8 §7.
@@ -615,7 +644,8 @@ Status bench_codec(const BenchOptions& job) {
         double sum = 0.0;
         int n = 0;
         for (const BdRow& r : bd_rows)
-            if (r.builtin && r.peer == "x264 veryfast" && !std::isnan(r.psnr_color)) sum += r.psnr_color, ++n;
+            if (r.builtin && r.peer == "x264 veryfast" && !std::isnan(r.psnr_color))
+                sum += r.psnr_color, ++n;
         if (n) bd_vf = sum / n;
     }
     const double enc_ratio = speed.x264_veryfast_encode / speed.ours_encode;
@@ -623,17 +653,21 @@ Status bench_codec(const BenchOptions& job) {
     const double depth_ratio = depth_ratio_n ? depth_ratio_sum / depth_ratio_n : NAN;
     const bool full_hd = speed.w == 1920 && speed.h == 1080;
     std::string targets = "targets (issue 8 §7)\n";
-    targets += strf("  colour BD-rate (PSNR) vs x264 veryfast, mean over built-in scenes: %s (<= %.0f%%): %s\n",
-                    pct(bd_vf).c_str(), kColorBdTarget,
-                    verdict(!std::isnan(bd_vf), bd_vf <= kColorBdTarget).c_str());
-    targets += strf("  encode at least as fast as x264 veryfast at 1920x1080, %d threads: %.2fx: %s%s\n",
-                    job.threads, enc_ratio, verdict(!std::isnan(enc_ratio), enc_ratio >= 1.0).c_str(),
-                    full_hd || !speed.measured ? "" : strf(" (measured at %dx%d)", speed.w, speed.h).c_str());
-    targets += strf("  decode >= %.0fx our encode speed: %.2fx: %s\n", kDecodeOverEncodeTarget,
-                    dec_ratio, verdict(!std::isnan(dec_ratio), dec_ratio >= kDecodeOverEncodeTarget).c_str());
-    targets += strf("  lossless depth >= %.0fx smaller than zstd -3 (mean ratio over sequences): %.2fx: %s\n",
-                    kDepthRatioTarget, depth_ratio,
-                    verdict(!std::isnan(depth_ratio), depth_ratio >= kDepthRatioTarget).c_str());
+    targets += strf(
+        "  colour BD-rate (PSNR) vs x264 veryfast, mean over built-in scenes: %s (<= %.0f%%): %s\n",
+        pct(bd_vf).c_str(), kColorBdTarget,
+        verdict(!std::isnan(bd_vf), bd_vf <= kColorBdTarget).c_str());
+    targets += strf(
+        "  encode at least as fast as x264 veryfast at 1920x1080, %d threads: %.2fx: %s%s\n",
+        job.threads, enc_ratio, verdict(!std::isnan(enc_ratio), enc_ratio >= 1.0).c_str(),
+        full_hd || !speed.measured ? "" : strf(" (measured at %dx%d)", speed.w, speed.h).c_str());
+    targets +=
+        strf("  decode >= %.0fx our encode speed: %.2fx: %s\n", kDecodeOverEncodeTarget, dec_ratio,
+             verdict(!std::isnan(dec_ratio), dec_ratio >= kDecodeOverEncodeTarget).c_str());
+    targets += strf(
+        "  lossless depth >= %.0fx smaller than zstd -3 (mean ratio over sequences): %.2fx: %s\n",
+        kDepthRatioTarget, depth_ratio,
+        verdict(!std::isnan(depth_ratio), depth_ratio >= kDepthRatioTarget).c_str());
 
     const std::string text = bd_text + (bd_text.empty() ? "" : "\n") + depth_text + "\n" +
                              speed_text + (speed_text.empty() ? "" : "\n") + targets;

@@ -101,8 +101,8 @@ Status bench_fill(const BenchOptions& options) {
 
         for (int f = -1; f < options.frames; ++f) {  // frame -1: untimed warm-up of frame 0
             const int index = std::max(f, 0);
-            REPRISE_TRY(renderer->render_frame(scene, path, index, 30.0, {.width = w, .height = h},
-                                               frame));
+            REPRISE_TRY(
+                renderer->render_frame(scene, path, index, 30.0, {.width = w, .height = h}, frame));
             const Image<uint8_t> kind =
                 make_holes(frame.depth, unsigned(index), std::max(2, w / 240));
             std::size_t holes = 0;
@@ -140,13 +140,11 @@ Status bench_fill(const BenchOptions& options) {
                 score(m);
             };
             run(methods[0], [&] { (void)pull_push.fill(work.view(), valid.view()); });
-            run(methods[1], [&] {
-                (void)pull_push.fill(work.view(), valid.view(), frame.depth.view());
-            });
+            run(methods[1],
+                [&] { (void)pull_push.fill(work.view(), valid.view(), frame.depth.view()); });
             run(methods[2], [&] { (void)andreev.fill(work.view(), valid.view()); });
-            run(methods[3], [&] {
-                (void)andreev.fill(work.view(), valid.view(), frame.depth.view());
-            });
+            run(methods[3],
+                [&] { (void)andreev.fill(work.view(), valid.view(), frame.depth.view()); });
             const auto t = BenchClock::now();
             cv::inpaint(bgr, cv_mask, cv_out, 3.0, cv::INPAINT_TELEA);
             const double telea_ms = ms_since(t);
@@ -168,8 +166,10 @@ Status bench_fill(const BenchOptions& options) {
             const Method& m = methods[i];
             char ratio[32];
             const double r = m.ms / telea;
-            if (r < 1.0) std::snprintf(ratio, sizeof ratio, "%.3f (1/%.0f)", r, 1.0 / r);
-            else std::snprintf(ratio, sizeof ratio, "%.2f", r);
+            if (r < 1.0)
+                std::snprintf(ratio, sizeof ratio, "%.3f (1/%.0f)", r, 1.0 / r);
+            else
+                std::snprintf(ratio, sizeof ratio, "%.2f", r);
             std::printf("%-11s %6.2f  %-22s %9.2f %15s %8.2f %8.2f %8.2f\n",
                         i == 0 ? size.c_str() : "", 100 * hole_fraction / options.frames, m.name,
                         m.ms / options.frames, i + 1 < methods.size() ? ratio : "-",

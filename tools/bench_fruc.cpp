@@ -13,9 +13,9 @@
 
 #include "args.hpp"
 #include "bench.hpp"
+#include "bench_report.hpp"
 #include "fruc_options.hpp"
 #include "peers.hpp"
-#include "bench_report.hpp"
 #include "reprise/core/exr.hpp"
 #include "reprise/core/metrics.hpp"
 #include "reprise/core/parallel.hpp"
@@ -358,15 +358,16 @@ std::string summary_table(const std::vector<SceneSummary>& rows) {
                                        : "no: margin under 3 dB and slower";
             if (!(has_ffmpeg && has_dis)) verdict += " (one peer only)";
         }
-        std::snprintf(line, sizeof line,
-                      "%-24s %-18s %7s %8s | %-17s %7s %8s | %7s %8s | %7s %8s | %7s %8s | %7s  %s\n",
-                      r.scene.c_str(), r.interpolation.setting.c_str(),
-                      value(r.interpolation, false).c_str(), value(r.interpolation, true).c_str(),
-                      r.extrapolation.setting.c_str(), value(r.extrapolation, false).c_str(),
-                      value(r.extrapolation, true).c_str(), value(r.ffmpeg, false).c_str(),
-                      value(r.ffmpeg, true).c_str(), value(r.dis, false).c_str(),
-                      value(r.dis, true).c_str(), value(r.vectors, false).c_str(),
-                      value(r.vectors, true).c_str(), margin.c_str(), verdict.c_str());
+        std::snprintf(
+            line, sizeof line,
+            "%-24s %-18s %7s %8s | %-17s %7s %8s | %7s %8s | %7s %8s | %7s %8s | %7s  %s\n",
+            r.scene.c_str(), r.interpolation.setting.c_str(), value(r.interpolation, false).c_str(),
+            value(r.interpolation, true).c_str(), r.extrapolation.setting.c_str(),
+            value(r.extrapolation, false).c_str(), value(r.extrapolation, true).c_str(),
+            value(r.ffmpeg, false).c_str(), value(r.ffmpeg, true).c_str(),
+            value(r.dis, false).c_str(), value(r.dis, true).c_str(),
+            value(r.vectors, false).c_str(), value(r.vectors, true).c_str(), margin.c_str(),
+            verdict.c_str());
         text += line;
     }
     return text;
@@ -478,7 +479,8 @@ Status bench_fruc(const BenchOptions& job) {
         for (const server::SceneInfo& info : server::builtin_scenes())
             if (scene_name == info.name) section.note = info.stresses;
         if (is_held_out(scene_name))
-            section.note = "held out: a glTF sample model no default was tuned on (" + scene_name + ")";
+            section.note =
+                "held out: a glTF sample model no default was tuned on (" + scene_name + ")";
         for (const Run& run : runs) {
             for (const Score& s : run.scores)
                 csv.error_row(scene.name, run.method, run.setting, s.frame, s.error, s.ms);

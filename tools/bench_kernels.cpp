@@ -31,9 +31,13 @@ Timing time_remap(int w, int h, int runs) {
         }
     Timing timing;
     for (int i = 0; i < runs + 1; ++i) {
-        auto remap = [&] { cv::remap(src, dst, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT); };
-        if (i == 0) remap();  // warm-up
-        else time_once(timing, remap);
+        auto remap = [&] {
+            cv::remap(src, dst, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT);
+        };
+        if (i == 0)
+            remap();  // warm-up
+        else
+            time_once(timing, remap);
     }
     return timing;
 }
@@ -58,20 +62,22 @@ Status bench_kernels_size(int w, int h, int runs, CsvFile& csv) {
         k->generate(w, h, warp::KernelInputs::Random, 7);
         // The peer in between each kernel's runs: the machine's load moves during a run.
         const Timing remap = time_remap(w, h, runs);
-        const Timing reference =
-            time_kernel(runs, [&] { k->reset_reference(); }, [&] { k->run_reference(); });
+        const Timing reference = time_kernel(
+            runs, [&] { k->reset_reference(); }, [&] { k->run_reference(); });
         auto line = [&](const char* level, const Timing& t, const char* agrees) {
             std::printf("%-26s %-9s %9.3f %9.3f %9.2fx %9.2fx  %s\n", entry.name, level, t.best(),
                         t.median(), reference.best() / t.best(), t.best() / remap.best(), agrees);
-            csv.row({entry.name, level, std::to_string(w), std::to_string(h), strf("%.4f", t.best()),
-                     strf("%.4f", t.median()), strf("%.4f", reference.best() / t.best()),
+            csv.row({entry.name, level, std::to_string(w), std::to_string(h),
+                     strf("%.4f", t.best()), strf("%.4f", t.median()),
+                     strf("%.4f", reference.best() / t.best()),
                      strf("%.4f", t.best() / remap.best()), strf("%.4f", remap.best()), agrees,
                      entry.promise});
         };
         line("reference", reference, "-");
         for (const simd::Target& target : targets) {
             simd::force_target(target.bits);
-            const Timing t = time_kernel(runs, [&] { k->reset(); }, [&] { k->run(); });
+            const Timing t = time_kernel(
+                runs, [&] { k->reset(); }, [&] { k->run(); });
             const std::string difference = k->compare();
             simd::force_target(0);
             if (!difference.empty())
@@ -80,7 +86,8 @@ Status bench_kernels_size(int w, int h, int runs, CsvFile& csv) {
             line(entry.dispatched ? target.name : "built-in", t, difference.empty() ? "yes" : "NO");
             if (!entry.dispatched) break;  // its vector path was chosen when it was compiled
         }
-        std::printf("%-26s %-9s %9.3f %9.3f\n", "cv::remap (peer)", "", remap.best(), remap.median());
+        std::printf("%-26s %-9s %9.3f %9.3f\n", "cv::remap (peer)", "", remap.best(),
+                    remap.median());
     }
     return status;
 }
@@ -98,8 +105,10 @@ Status bench_kernels(const BenchOptions& options) {
                          "kernel,target,width,height,best_ms,median_ms,speedup_vs_reference,"
                          "best_vs_remap,remap_best_ms,agrees,promise"));
     std::printf(
-        "warp kernels at every SIMD level this CPU runs (Highway runtime dispatch) against their scalar\n"
-        "reference and cv::remap (INTER_LINEAR, CV_32FC4, float maps) of an image of the same size;\n"
+        "warp kernels at every SIMD level this CPU runs (Highway runtime dispatch) against their "
+        "scalar\n"
+        "reference and cv::remap (INTER_LINEAR, CV_32FC4, float maps) of an image of the same "
+        "size;\n"
         "%d threads (reprise) / %d (OpenCV), best and median of %d runs, ms; random inputs.\n"
         "x ref = reference best / best; x remap = best / remap best; the reverse reprojection's\n"
         "reference is single-threaded (the others run on the same threads as their kernels).\n",

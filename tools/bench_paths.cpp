@@ -51,17 +51,20 @@ Status bench_paths_size(const BenchScene& bench, int w, int h, int timed) {
     std::vector<Frame> frames(std::size_t(timed + 2));
     for (int i = 0; i < timed + 2; ++i) {
         REPRISE_TRY(bench.renderer->render_frame(bench.scene, bench.path, 10 + i, 30.0,
-                                                 {.width = w, .height = h}, frames[std::size_t(i)]));
+                                                 {.width = w, .height = h},
+                                                 frames[std::size_t(i)]));
         std::fprintf(stderr, "\r[bench] rendering %d/%d", i + 1, timed + 2);
     }
     std::fprintf(stderr, "\r%40s\r", "");
 
     using warp::FrucMode, warp::WarpMethod, warp::FillMethod;
     Converter converters[] = {
-        {"interpolate grid+pullpush", {2, {.mode = FrucMode::Interpolate, .warp = WarpMethod::Grid}}},
+        {"interpolate grid+pullpush",
+         {2, {.mode = FrucMode::Interpolate, .warp = WarpMethod::Grid}}},
         {"interpolate reverse+pullpush",
          {2, {.mode = FrucMode::Interpolate, .warp = WarpMethod::Reverse}}},
-        {"extrapolate grid+pullpush", {2, {.mode = FrucMode::Extrapolate, .warp = WarpMethod::Grid}}},
+        {"extrapolate grid+pullpush",
+         {2, {.mode = FrucMode::Extrapolate, .warp = WarpMethod::Grid}}},
     };
     stereo::StereoSynthesizer synthesizer;
     Frame eye;
@@ -80,14 +83,18 @@ Status bench_paths_size(const BenchScene& bench, int w, int h, int timed) {
                 while (c.converter.receive(c.out)) {
                 }
             };
-            if (timing) time_into(c.times, run);
-            else run();
+            if (timing)
+                time_into(c.times, run);
+            else
+                run();
             REPRISE_TRY(sent);
         }
         const stereo::EyeCameras eyes = stereo::eye_cameras(f.camera, {}, stereo::Anchor::Left);
         auto synthesize = [&] { synthesizer.synthesize(f, eyes.right, eye); };
-        if (timing) time_into(stereo_times, synthesize);
-        else synthesize();
+        if (timing)
+            time_into(stereo_times, synthesize);
+        else
+            synthesize();
         // The peer: cv::remap of this frame's colour along its motion (bilinear, float maps).
         for (int y = 0; y < h; ++y)
             for (int x = 0; x < w; ++x) {
@@ -97,9 +104,13 @@ Status bench_paths_size(const BenchScene& bench, int w, int h, int timed) {
                 map_y.at<float>(y, x) = ok ? float(y) + 0.5f * m.y : -1e6f;
             }
         const cv::Mat src(h, w, CV_32FC4, const_cast<glm::vec4*>(f.color.data()));
-        auto remap = [&] { cv::remap(src, dst, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT); };
-        if (timing) time_into(remap_times, remap);
-        else remap();
+        auto remap = [&] {
+            cv::remap(src, dst, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT);
+        };
+        if (timing)
+            time_into(remap_times, remap);
+        else
+            remap();
         std::fprintf(stderr, "\r[bench] %dx%d %d/%d", w, h, i + 1, timed + 2);
     }
     std::fprintf(stderr, "\r%40s\r", "");

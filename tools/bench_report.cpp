@@ -12,9 +12,7 @@ double ms_since(BenchClock::time_point start) {
     return std::chrono::duration<double, std::milli>(BenchClock::now() - start).count();
 }
 
-double Timing::best() const {
-    return ms.empty() ? NAN : *std::min_element(ms.begin(), ms.end());
-}
+double Timing::best() const { return ms.empty() ? NAN : *std::min_element(ms.begin(), ms.end()); }
 
 double Timing::median() const {
     if (ms.empty()) return NAN;
@@ -116,8 +114,8 @@ Status write_worst_window_sheet(const std::string& path, std::vector<Image<Rgb8>
     std::vector<Tile> tiles;
     for (std::size_t i = 0; i < images.size(); ++i) tiles.push_back({images[i].view(), labels[i]});
     Image<Rgb8> sheet = contact_sheet(
-        tiles, {.columns = int(columns),
-                .tile_width = std::min(std::max(2 * cw, 320), max_tile_width)});
+        tiles,
+        {.columns = int(columns), .tile_width = std::min(std::max(2 * cw, 320), max_tile_width)});
     return write_png(path, sheet.view());
 }
 

@@ -69,7 +69,7 @@ Status write_worst_window_sheet(const std::string& path, std::vector<Image<Rgb8>
 
 // A CSV file written row by row; closed by the destructor.
 class CsvFile {
-  public:
+public:
     CsvFile() = default;
     ~CsvFile();
     CsvFile(const CsvFile&) = delete;
@@ -88,7 +88,7 @@ class CsvFile {
     FILE* file() { return file_; }
     const std::string& path() const { return path_; }
 
-  private:
+private:
     FILE* file_ = nullptr;
     std::string path_;
 };

@@ -21,7 +21,6 @@ namespace reprise::cli {
 
 namespace {
 
-
 Status bench_size(server::Renderer& renderer, const server::Scene& scene,
                   const server::CameraPath& path, int w, int h, int repetitions) {
     Frame prev, cur;

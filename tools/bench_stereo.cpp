@@ -33,14 +33,14 @@ namespace {
 namespace fs = std::filesystem;
 
 // Issue 4's targets.
-constexpr double kPairRatioTarget = 0.6;   // (one render + synthesis) / (two renders)
+constexpr double kPairRatioTarget = 0.6;    // (one render + synthesis) / (two renders)
 constexpr double kSynthesisTargetMs = 8.0;  // at 1920x1080
 
 const char* const kOurs = "ours";
-const char* const kSplatPeer = "dibr-splat";   // forward splat, footprint 1, no fill
-const char* const kRemapPeer = "cv-remap";     // backward remap by the left eye's disparity
+const char* const kSplatPeer = "dibr-splat";  // forward splat, footprint 1, no fill
+const char* const kRemapPeer = "cv-remap";    // backward remap by the left eye's disparity
 const char* const kCopyPeer = "copy-left-eye";
-const char* const kRender = "render";          // the renderer's second eye (the truth)
+const char* const kRender = "render";  // the renderer's second eye (the truth)
 
 // Naive backward DIBR peer: right(x) = left(x + d(x)), d from the left eye's own depth at x.
 void remap_by_disparity(const Frame& left, const stereo::StereoRig& rig, Image<glm::vec4>& out) {
@@ -49,7 +49,8 @@ void remap_by_disparity(const Frame& left, const stereo::StereoRig& rig, Image<g
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
             const float z = left.depth(x, y);
-            const float d = z > 0.0f ? stereo::disparity_px(rig, left.camera.projection, w, z) : 0.0f;
+            const float d =
+                z > 0.0f ? stereo::disparity_px(rig, left.camera.projection, w, z) : 0.0f;
             map_x.at<float>(y, x) = float(x) + (std::isfinite(d) ? d : 0.0f);
             map_y.at<float>(y, x) = float(y);
         }
@@ -115,8 +116,8 @@ Status worst_picture(const Run& ours, const Run& truth, const Run* peer, const s
 
 struct SceneSummary {
     std::string scene;
-    ReportPoint best, best_dis;       // our best setting (by PSNR on all pixels)
-    ReportPoint fastest, fastest_dis;  // our fastest setting (mean ms)
+    ReportPoint best, best_dis;                   // our best setting (by PSNR on all pixels)
+    ReportPoint fastest, fastest_dis;             // our fastest setting (mean ms)
     double splat = NAN, remap = NAN, copy = NAN;  // peers' PSNR, all pixels
     double render_left_ms = NAN, render_right_ms = NAN;
     double disoccluded_fraction = NAN;
@@ -137,15 +138,18 @@ std::string summary_table(const std::vector<SceneSummary>& rows, bool full_hd) {
             const ReportPoint& p = fastest ? r.fastest : r.best;
             const ReportPoint& d = fastest ? r.fastest_dis : r.best_dis;
             const double ratio = r.ratio(p);
-            std::string verdict = std::string("ratio ") + (ratio <= kPairRatioTarget ? "met" : "NOT met");
-            verdict += full_hd ? std::string(", ms ") + (p.ms <= kSynthesisTargetMs ? "met" : "NOT met")
-                               : std::string(", ms n/a (not 1920x1080)");
+            std::string verdict =
+                std::string("ratio ") + (ratio <= kPairRatioTarget ? "met" : "NOT met");
+            verdict += full_hd
+                           ? std::string(", ms ") + (p.ms <= kSynthesisTargetMs ? "met" : "NOT met")
+                           : std::string(", ms n/a (not 1920x1080)");
             const std::string label = (fastest ? "  fastest: " : "") + p.setting;
-            std::snprintf(line, sizeof line,
-                          "%-9s %-22s %7.2f %7.2f %8.2f | %7.2f %7.2f %7.2f | %9.2f %6.2f %6.3f %s\n",
-                          fastest ? "" : r.scene.c_str(), label.c_str(), p.psnr, d.psnr, p.ms,
-                          r.splat, r.remap, r.copy, r.render_right_ms,
-                          100.0 * r.disoccluded_fraction, ratio, verdict.c_str());
+            std::snprintf(
+                line, sizeof line,
+                "%-9s %-22s %7.2f %7.2f %8.2f | %7.2f %7.2f %7.2f | %9.2f %6.2f %6.3f %s\n",
+                fastest ? "" : r.scene.c_str(), label.c_str(), p.psnr, d.psnr, p.ms, r.splat,
+                r.remap, r.copy, r.render_right_ms, 100.0 * r.disoccluded_fraction, ratio,
+                verdict.c_str());
             out += line;
         }
     return out;
@@ -190,7 +194,8 @@ Status bench_stereo(const BenchOptions& options) {
         for (auto [fill_name, fill] : {std::pair{"none", stereo::StereoFill::None},
                                        std::pair{"pullpush", stereo::StereoFill::PullPush},
                                        std::pair{"andreev", stereo::StereoFill::Andreev}})
-            settings.push_back({std::string(warp_name) + "+" + fill_name, {.warp = warp, .fill = fill}});
+            settings.push_back(
+                {std::string(warp_name) + "+" + fill_name, {.warp = warp, .fill = fill}});
     settings.push_back({"grid+pullpush+history", {}, true});
 
     Report report;
@@ -198,7 +203,8 @@ Status bench_stereo(const BenchOptions& options) {
     char text[2048];
     std::snprintf(
         text, sizeof text,
-        "The right eye synthesized from the rendered left eye (parallel rig, ipd %.3f) compared with "
+        "The right eye synthesized from the rendered left eye (parallel rig, ipd %.3f) compared "
+        "with "
         "the right eye rendered, %dx%d, %d frames per scene from t = 10/30 s, renderer %s. Display "
         "values: PSNR, SSIM, LDR-FLIP. Each scene has two plots: all pixels, and only the "
         "disoccluded pixels (those no left-eye pixel lands on under a nearest-pixel splat).",
@@ -206,7 +212,8 @@ Status bench_stereo(const BenchOptions& options) {
     report.paragraphs.push_back(text);
     std::snprintf(
         text, sizeof text,
-        "ms = wall-clock milliseconds per synthesized eye on this machine (%d threads), the fastest "
+        "ms = wall-clock milliseconds per synthesized eye on this machine (%d threads), the "
+        "fastest "
         "of %d runs. ours: StereoSynthesizer::synthesize() from the left eye's colour + depth in "
         "memory, per warp (adaptive grid, splat) and fill (none, pull-push, Andreev); "
         "+history also warps the previous frame's rendered right eye (as when the rendered eye "
@@ -242,9 +249,11 @@ Status bench_stereo(const BenchOptions& options) {
         double render_left = 0.0, render_right = 0.0, dis_fraction = 0.0;
 
         // Renders one eye of the centre camera at time t; the fastest of `times` runs.
-        auto render_eye = [&](double t, stereo::Eye e, int times, Frame& out, double& ms) -> Status {
+        auto render_eye = [&](double t, stereo::Eye e, int times, Frame& out,
+                              double& ms) -> Status {
             const server::Instant now = server::instant_on_path(path, scene, t, w, h);
-            const server::Instant before = server::instant_on_path(path, scene, t - 1.0 / fps, w, h);
+            const server::Instant before =
+                server::instant_on_path(path, scene, t - 1.0 / fps, w, h);
             Camera centre;
             centre.view = now.view;
             centre.projection = now.projection;
@@ -274,7 +283,8 @@ Status bench_stereo(const BenchOptions& options) {
             double left_ms = 0.0, right_ms = 0.0, unused = 0.0;
             failure = render_eye(t, stereo::Eye::Left, repeat, left, left_ms);
             if (failure.ok()) failure = render_eye(t, stereo::Eye::Right, repeat, right, right_ms);
-            if (failure.ok()) failure = render_eye(t - 1.0 / fps, stereo::Eye::Right, 1, history, unused);
+            if (failure.ok())
+                failure = render_eye(t - 1.0 / fps, stereo::Eye::Right, 1, history, unused);
             if (!failure.ok()) break;
             render_left += left_ms / frames, render_right += right_ms / frames;
             const Camera& target = right.camera;
@@ -340,7 +350,8 @@ Status bench_stereo(const BenchOptions& options) {
             }
             record(runs[render_i], right.color, right_ms);
             std::printf("[stereo] %s frame %d: render L %.1f ms, R %.1f ms, %.2f%% disoccluded\n",
-                        name.c_str(), i, left_ms, right_ms, 100.0 * double(dis) / disoccluded.pixel_count());
+                        name.c_str(), i, left_ms, right_ms,
+                        100.0 * double(dis) / disoccluded.pixel_count());
             std::fflush(stdout);
         }
         if (!failure.ok()) break;
@@ -366,7 +377,8 @@ Status bench_stereo(const BenchOptions& options) {
         for (const Run& run : runs) {
             if (run.ours() && (!best || run.mean().psnr > best->mean().psnr)) best = &run;
             if (run.ours() && (!fastest || run.mean_ms() < fastest->mean_ms())) fastest = &run;
-            if (!run.ours() && run.method != kRender && (!peer || run.mean().psnr > peer->mean().psnr))
+            if (!run.ours() && run.method != kRender &&
+                (!peer || run.mean().psnr > peer->mean().psnr))
                 peer = &run;
             if (run.method == kSplatPeer) row.splat = run.mean().psnr;
             if (run.method == kRemapPeer) row.remap = run.mean().psnr;
@@ -382,18 +394,21 @@ Status bench_stereo(const BenchOptions& options) {
         row.render_right_ms = render_right;
         row.disoccluded_fraction = dis_fraction;
         summaries.push_back(row);
-        std::snprintf(text, sizeof text,
-                      " Mean disoccluded fraction %.2f%%; renderer: left eye %.2f ms, right eye %.2f ms; "
-                      "pair ratio (render + ours %s) / (two renders) = %.3f.",
-                      100.0 * dis_fraction, render_left, render_right, best->setting.c_str(), row.ratio(row.best));
+        std::snprintf(
+            text, sizeof text,
+            " Mean disoccluded fraction %.2f%%; renderer: left eye %.2f ms, right eye %.2f ms; "
+            "pair ratio (render + ours %s) / (two renders) = %.3f.",
+            100.0 * dis_fraction, render_left, render_right, best->setting.c_str(),
+            row.ratio(row.best));
         all.note += text;
         const std::string picture = name + "/worst_frame.png";
         failure = worst_picture(*best, runs[render_i], peer, out_dir + "/" + picture);
         if (!failure.ok()) break;
-        all.images.push_back({picture, "The lowest-PSNR frame of our best setting (" + best->setting +
-                                           ") beside the rendered right eye and the best peer (" +
-                                           (peer ? peer->method : std::string("-")) +
-                                           "); below, the window where ours differs most, enlarged."});
+        all.images.push_back(
+            {picture, "The lowest-PSNR frame of our best setting (" + best->setting +
+                          ") beside the rendered right eye and the best peer (" +
+                          (peer ? peer->method : std::string("-")) +
+                          "); below, the window where ours differs most, enlarged."});
         report.sections.push_back(std::move(all));
         report.sections.push_back(std::move(dis_section));
     }
@@ -404,7 +419,8 @@ Status bench_stereo(const BenchOptions& options) {
                   "stereo, %dx%d, %d frames per scene, ipd %.3f, fastest of %d runs, %d threads; "
                   "PSNR dB (psnr_d: disoccluded pixels only); ms per synthesized eye; splat/remap/"
                   "copyL: peers' PSNR; render_ms: the renderer's right eye; dis%%: disoccluded "
-                  "pixels; ratio = (render L + ours) / (render L + render R); per scene our best setting by PSNR, "
+                  "pixels; ratio = (render L + ours) / (render L + render R); per scene our best "
+                  "setting by PSNR, "
                   "then our fastest\n",
                   w, h, frames, rig.ipd, repeat, thread_count());
     report.preformatted = std::string(text) + table;

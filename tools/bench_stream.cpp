@@ -86,7 +86,8 @@ ImageError mean_error(const std::vector<ImageError>& e) {
         m.ssim += x.ssim;
         m.flip += x.flip;
     }
-    if (!e.empty()) m.psnr /= double(e.size()), m.ssim /= double(e.size()), m.flip /= double(e.size());
+    if (!e.empty())
+        m.psnr /= double(e.size()), m.ssim /= double(e.size()), m.flip /= double(e.size());
     return m;
 }
 
@@ -129,39 +130,46 @@ struct StreamBench {
         ticks.reserve(std::size_t(duration * display_rate) + 8);
         Image<Rgb8> rgb(width, height);
         if (s.ok())
-            s = client::run_client(*client, duration, display_rate,
-                                   [&](double t) { return server::camera_view(scene.path, scene.scene, t); },
-                                   [&](const Frame& f, const client::DisplayInfo& info, int64_t displayed_us) {
-                Tick k;
-                k.t = info.scene_time;
-                k.view = f.camera.view;
-                k.pose_us = info.pose_us;
-                k.displayed_us = displayed_us;
-                k.source_pose_us = info.source_pose_us;
-                k.source_time = info.source_scene_time;
-                k.decoded = client->stats().frames_decoded;
-                k.evaluated = ticks.size() % eval_every == 0 && f.width() == width && f.height() == height;
-                if (k.evaluated) {
-                    k.ours = Image<Rgb8>(width, height);
-                    visualize_color(f.color.view(), k.ours.view());
-                    k.repeated = Image<Rgb8>(width, height);
-                    visualize_color(client->newest_decoded()->color.view(), k.repeated.view());
-                }
-                ticks.push_back(std::move(k));
-                return true;
-            });
+            s = client::run_client(
+                *client, duration, display_rate,
+                [&](double t) { return server::camera_view(scene.path, scene.scene, t); },
+                [&](const Frame& f, const client::DisplayInfo& info, int64_t displayed_us) {
+                    Tick k;
+                    k.t = info.scene_time;
+                    k.view = f.camera.view;
+                    k.pose_us = info.pose_us;
+                    k.displayed_us = displayed_us;
+                    k.source_pose_us = info.source_pose_us;
+                    k.source_time = info.source_scene_time;
+                    k.decoded = client->stats().frames_decoded;
+                    k.evaluated = ticks.size() % eval_every == 0 && f.width() == width &&
+                                  f.height() == height;
+                    if (k.evaluated) {
+                        k.ours = Image<Rgb8>(width, height);
+                        visualize_color(f.color.view(), k.ours.view());
+                        k.repeated = Image<Rgb8>(width, height);
+                        visualize_color(client->newest_decoded()->color.view(), k.repeated.view());
+                    }
+                    ticks.push_back(std::move(k));
+                    return true;
+                });
         stop = true;
         thread.join();
         REPRISE_TRY(s);
         REPRISE_TRY(served);
         const server::StreamServerStats sst = srv->stats();
         const client::StreamClientStats cst = client->stats();
-        std::fprintf(stderr, "[bench stream] %s: server sent %zu frames, skipped %zu; client decoded %zu, %zu decode errors, %zu key requests\n",
-                     c.name.c_str(), sst.frames_sent, sst.frames_skipped, cst.frames_decoded, cst.decode_errors, cst.key_frame_requests);
-        if (ticks.empty()) return Status::error("bench stream: " + c.name + ": nothing was displayed");
+        std::fprintf(stderr,
+                     "[bench stream] %s: server sent %zu frames, skipped %zu; client decoded %zu, "
+                     "%zu decode errors, %zu key requests\n",
+                     c.name.c_str(), sst.frames_sent, sst.frames_skipped, cst.frames_decoded,
+                     cst.decode_errors, cst.key_frame_requests);
+        if (ticks.empty())
+            return Status::error("bench stream: " + c.name + ": nothing was displayed");
         const double seconds = duration;
 
-        MethodSummary ours{c.name, lowres ? "reprise-lowres4" : "reprise", sst.bytes_sent * 8.0 / seconds / 1000.0};
+        MethodSummary ours{c.name, lowres ? "reprise-lowres4" : "reprise",
+                           sst.bytes_sent * 8.0 / seconds / 1000.0};
         MethodSummary repeat{c.name, "repetition", ours.kbps};
         MethodSummary video{c.name, "x264-crf23"}, video_fine{c.name, "x264-crf15"};
         for (MethodSummary* m : {&ours, &repeat, &video, &video_fine}) {
@@ -187,16 +195,19 @@ struct StreamBench {
             }
         }
         longest = std::max(longest, ticks.back().t - freeze_start);
-        for (MethodSummary* m : {&ours, &repeat, &video, &video_fine}) m->longest_freeze_ms = longest * 1000.0;
+        for (MethodSummary* m : {&ours, &repeat, &video, &video_fine})
+            m->longest_freeze_ms = longest * 1000.0;
         video.latency_ms = video_fine.latency_ms = repeat.latency_ms;
 
         // The video-only peer: the same source frames (rendered at their poses) through x264.
         const int method_count = lowres ? 1 : 4;
         std::vector<double> source_times;
         for (const Tick& k : ticks)
-            if (source_times.empty() || source_times.back() != k.source_time) source_times.push_back(k.source_time);
+            if (source_times.empty() || source_times.back() != k.source_time)
+                source_times.push_back(k.source_time);
         std::sort(source_times.begin(), source_times.end());
-        source_times.erase(std::unique(source_times.begin(), source_times.end()), source_times.end());
+        source_times.erase(std::unique(source_times.begin(), source_times.end()),
+                           source_times.end());
         Frame truth;
         std::vector<Image<Rgb8>> sources;
         for (double t : lowres ? std::vector<double>{} : source_times) {
@@ -207,8 +218,11 @@ struct StreamBench {
         // Two rate points: x264's usual crf 23 and a finer one near reprise's bitrate.
         std::vector<PeerFrame> x264, x264_fine;
         if (!lowres) {
-            REPRISE_TRY(encode_decode_peer(sources, {.kind = PeerKind::X264, .preset = "veryfast", .crf = 23}, fps, x264));
-            REPRISE_TRY(encode_decode_peer(sources, {.kind = PeerKind::X264, .preset = "veryfast", .crf = 15}, fps, x264_fine));
+            REPRISE_TRY(encode_decode_peer(
+                sources, {.kind = PeerKind::X264, .preset = "veryfast", .crf = 23}, fps, x264));
+            REPRISE_TRY(encode_decode_peer(
+                sources, {.kind = PeerKind::X264, .preset = "veryfast", .crf = 15}, fps,
+                x264_fine));
         }
         // The peer sends one frame per server period while the stream runs.
         auto kbps = [&](const std::vector<PeerFrame>& frames) {
@@ -227,18 +241,20 @@ struct StreamBench {
             REPRISE_TRY(render_at(k.t, k.view, truth));
             visualize_color(truth.color.view(), truth_rgb.view());
             from_rgb8(truth_rgb.view(), reference);
-            const std::size_t si = std::lower_bound(source_times.begin(), source_times.end(), k.source_time) -
-                                   source_times.begin();
-            const Image<Rgb8>* candidates[4] = {&k.ours, &k.repeated, si < x264.size() ? &x264[si].decoded : nullptr,
-                                                si < x264_fine.size() ? &x264_fine[si].decoded : nullptr};
+            const std::size_t si =
+                std::lower_bound(source_times.begin(), source_times.end(), k.source_time) -
+                source_times.begin();
+            const Image<Rgb8>* candidates[4] = {
+                &k.ours, &k.repeated, si < x264.size() ? &x264[si].decoded : nullptr,
+                si < x264_fine.size() ? &x264_fine[si].decoded : nullptr};
             MethodSummary* methods[4] = {&ours, &repeat, &video, &video_fine};
             for (int m = 0; m < method_count; ++m) {
                 if (!candidates[m]) continue;
                 from_rgb8(candidates[m]->view(), shown);
                 const ImageError e = image_error(reference.view(), shown.view());
                 methods[m]->errors.push_back(e);
-                csv.row({c.name, methods[m]->method, std::to_string(index), strf("%.4f", e.psnr), strf("%.6f", e.ssim),
-                         strf("%.6f", e.flip),
+                csv.row({c.name, methods[m]->method, std::to_string(index), strf("%.4f", e.psnr),
+                         strf("%.6f", e.ssim), strf("%.6f", e.flip),
                          strf("%.3f", m == 0 ? (k.displayed_us - k.pose_us) / 1000.0
                                              : (k.displayed_us - k.source_pose_us) / 1000.0)});
             }
@@ -247,10 +263,11 @@ struct StreamBench {
         for (MethodSummary* m : {&ours, &repeat, &video, &video_fine}) {
             if (lowres && m != &ours) continue;
             const ImageError e = mean_error(m->errors);
-            std::printf("%-16s %-16s %9.0f %7.2f %7.4f %8.2f %8.2f %8.2f %9.0f %6zu %6zu\n", c.name.c_str(),
-                        m->method.c_str(), m->kbps, e.psnr, e.flip, mean_of(m->latency_ms),
-                        percentile(m->latency_ms, 0.95), percentile(m->latency_ms, 1.0), m->longest_freeze_ms,
-                        m->frames_lost, m->fec_recovered);
+            std::printf("%-16s %-16s %9.0f %7.2f %7.4f %8.2f %8.2f %8.2f %9.0f %6zu %6zu\n",
+                        c.name.c_str(), m->method.c_str(), m->kbps, e.psnr, e.flip,
+                        mean_of(m->latency_ms), percentile(m->latency_ms, 0.95),
+                        percentile(m->latency_ms, 1.0), m->longest_freeze_ms, m->frames_lost,
+                        m->fec_recovered);
             std::fflush(stdout);
             summaries.push_back(*m);
         }
@@ -262,7 +279,8 @@ struct StreamBench {
         now.view = view;
         server::Instant before = now;
         before.time -= 1.0 / fps;
-        return scene.renderer->render(scene.scene, now, before, {.width = width, .height = height}, out);
+        return scene.renderer->render(scene.scene, now, before, {.width = width, .height = height},
+                                      out);
     }
 };
 
@@ -273,24 +291,29 @@ Status bench_stream(const BenchOptions& options) {
     REPRISE_TRY(parse_size(options.size, b.width, b.height));
     b.duration = options.stream_duration;
     b.display_rate = options.display_rate;
-    if (!(b.duration > 0.5 && b.duration <= 600)) return Status::error("--duration must be in (0.5, 600]");
+    if (!(b.duration > 0.5 && b.duration <= 600))
+        return Status::error("--duration must be in (0.5, 600]");
     const std::string out = options.out.empty() ? "out/bench-stream" : options.out;
     std::error_code ec;
     std::filesystem::create_directories(out, ec);
     if (ec) return Status::error(out + ": cannot create the folder: " + ec.message());
     REPRISE_TRY(open_bench_scene(options.scene, b.scene));
-    REPRISE_TRY(b.csv.open(out + "/stream.csv", "condition,method,frame,psnr,ssim,flip,latency_ms"));
-    std::printf("[bench stream] %s %dx%d, server %g Hz, display %g Hz, %g s per condition, renderer %s\n",
-                options.scene.c_str(), b.width, b.height, b.fps, b.display_rate, b.duration,
-                b.scene.renderer->device().c_str());
-    std::printf("%-16s %-16s %9s %7s %7s %8s %8s %8s %9s %6s %6s\n", "condition", "method", "kbps", "PSNR", "FLIP",
-                "lat.mean", "lat.p95", "lat.max", "freeze.ms", "lost", "fec");
+    REPRISE_TRY(
+        b.csv.open(out + "/stream.csv", "condition,method,frame,psnr,ssim,flip,latency_ms"));
+    std::printf(
+        "[bench stream] %s %dx%d, server %g Hz, display %g Hz, %g s per condition, renderer %s\n",
+        options.scene.c_str(), b.width, b.height, b.fps, b.display_rate, b.duration,
+        b.scene.renderer->device().c_str());
+    std::printf("%-16s %-16s %9s %7s %7s %8s %8s %8s %9s %6s %6s\n", "condition", "method", "kbps",
+                "PSNR", "FLIP", "lat.mean", "lat.p95", "lat.max", "freeze.ms", "lost", "fec");
     std::vector<Condition> chosen = conditions(options.quick && options.conditions.empty());
     if (!options.conditions.empty()) {
         std::vector<Condition> named;
         for (const std::string& name : split_list(options.conditions)) {
-            auto it = std::find_if(chosen.begin(), chosen.end(), [&](const Condition& c) { return c.name == name; });
-            if (it == chosen.end()) return Status::error("--conditions: unknown condition '" + name + "'");
+            auto it = std::find_if(chosen.begin(), chosen.end(),
+                                   [&](const Condition& c) { return c.name == name; });
+            if (it == chosen.end())
+                return Status::error("--conditions: unknown condition '" + name + "'");
             named.push_back(*it);
         }
         chosen = named;
@@ -301,54 +324,65 @@ Status bench_stream(const BenchOptions& options) {
     }
 
     CsvFile summary;
-    REPRISE_TRY(summary.open(out + "/stream_summary.csv",
-                             "condition,method,kbps,psnr,ssim,flip,latency_mean_ms,latency_p95_ms,latency_max_ms,"
-                             "longest_freeze_ms,frames_decoded,frames_lost,fec_recovered"));
+    REPRISE_TRY(summary.open(
+        out + "/stream_summary.csv",
+        "condition,method,kbps,psnr,ssim,flip,latency_mean_ms,latency_p95_ms,latency_max_ms,"
+        "longest_freeze_ms,frames_decoded,frames_lost,fec_recovered"));
     Report report;
     report.title = "reprise bench stream";
     report.paragraphs = {
-        "Scene " + options.scene + " at " + options.size + ", server " + strf("%g", b.fps) + " Hz, display " +
-            strf("%g", b.display_rate) + " Hz, " + strf("%g", b.duration) +
+        "Scene " + options.scene + " at " + options.size + ", server " + strf("%g", b.fps) +
+            " Hz, display " + strf("%g", b.display_rate) + " Hz, " + strf("%g", b.duration) +
             " s per condition on loopback with the in-process fault injector on both directions.",
-        "reprise: every display frame extrapolated from the newest decoded frame to the newest pose; "
-        "reprise-lowres4: the same with colour sent at 1/4 of the pixels (jittered) and upsampled (Herzog 2010) "
+        "reprise: every display frame extrapolated from the newest decoded frame to the newest "
+        "pose; "
+        "reprise-lowres4: the same with colour sent at 1/4 of the pixels (jittered) and upsampled "
+        "(Herzog 2010) "
         "before extrapolation (its own session). repetition: "
-        "the newest decoded frame shown as it is (same stream). x264-crf23 / x264-crf15 (the video-only model): the same source frames through "
-        "x264 veryfast zerolatency at crf 23 and 15, shown when our stream had them (same arrival times and losses; x264's "
+        "the newest decoded frame shown as it is (same stream). x264-crf23 / x264-crf15 (the "
+        "video-only model): the same source frames through "
+        "x264 veryfast zerolatency at crf 23 and 15, shown when our stream had them (same arrival "
+        "times and losses; x264's "
         "error propagation after a loss is not modelled, which favours it).",
-        "Latency: pose sampled -> displayed, for reprise the pose each display frame was warped to, for the peers "
-        "the pose of the frame the first time it is shown. Truth: the scene rendered at each displayed pose and "
+        "Latency: pose sampled -> displayed, for reprise the pose each display frame was warped "
+        "to, for the peers "
+        "the pose of the frame the first time it is shown. Truth: the scene rendered at each "
+        "displayed pose and "
         "instant."};
-    std::string table = strf("%-16s %-16s %9s %7s %7s %8s %8s %9s\n", "condition", "method", "kbps", "PSNR", "FLIP",
-                             "lat.mean", "lat.p95", "freeze.ms");
+    std::string table = strf("%-16s %-16s %9s %7s %7s %8s %8s %9s\n", "condition", "method", "kbps",
+                             "PSNR", "FLIP", "lat.mean", "lat.p95", "freeze.ms");
     std::map<std::string, PlotSeries> by_method;
     std::vector<BarRow> latency_rows;
     for (const MethodSummary& m : b.summaries) {
         const ImageError e = mean_error(m.errors);
-        summary.row({m.condition, m.method, strf("%.1f", m.kbps), strf("%.4f", e.psnr), strf("%.6f", e.ssim),
-                     strf("%.6f", e.flip), strf("%.3f", mean_of(m.latency_ms)),
-                     strf("%.3f", percentile(m.latency_ms, 0.95)), strf("%.3f", percentile(m.latency_ms, 1.0)),
-                     strf("%.1f", m.longest_freeze_ms), std::to_string(m.decoded), std::to_string(m.frames_lost),
+        summary.row({m.condition, m.method, strf("%.1f", m.kbps), strf("%.4f", e.psnr),
+                     strf("%.6f", e.ssim), strf("%.6f", e.flip),
+                     strf("%.3f", mean_of(m.latency_ms)),
+                     strf("%.3f", percentile(m.latency_ms, 0.95)),
+                     strf("%.3f", percentile(m.latency_ms, 1.0)), strf("%.1f", m.longest_freeze_ms),
+                     std::to_string(m.decoded), std::to_string(m.frames_lost),
                      std::to_string(m.fec_recovered)});
-        table += strf("%-16s %-16s %9.0f %7.2f %7.4f %8.2f %8.2f %9.0f\n", m.condition.c_str(), m.method.c_str(),
-                      m.kbps, e.psnr, e.flip, mean_of(m.latency_ms), percentile(m.latency_ms, 0.95),
-                      m.longest_freeze_ms);
+        table += strf("%-16s %-16s %9.0f %7.2f %7.4f %8.2f %8.2f %9.0f\n", m.condition.c_str(),
+                      m.method.c_str(), m.kbps, e.psnr, e.flip, mean_of(m.latency_ms),
+                      percentile(m.latency_ms, 0.95), m.longest_freeze_ms);
         PlotSeries& s = by_method[m.method];
         s.name = m.method;
         s.x.push_back(m.kbps);
         s.y.push_back(e.psnr);
-        latency_rows.push_back({m.condition + " " + m.method, {mean_of(m.latency_ms), percentile(m.latency_ms, 0.95)}});
+        latency_rows.push_back({m.condition + " " + m.method,
+                                {mean_of(m.latency_ms), percentile(m.latency_ms, 0.95)}});
     }
     report.preformatted = table;
     std::vector<PlotSeries> series;
     for (auto& [name, s] : by_method) series.push_back(s);
-    report.sections.push_back({.title = "Displayed-frame error against bitrate (one point per condition)",
-                               .html = line_plot_svg(series, {.x_label = "kbps (log scale)", .y_label = "PSNR dB"})});
+    report.sections.push_back(
+        {.title = "Displayed-frame error against bitrate (one point per condition)",
+         .html = line_plot_svg(series, {.x_label = "kbps (log scale)", .y_label = "PSNR dB"})});
     report.sections.push_back({.title = "Motion-to-photon latency",
                                .html = bar_chart_svg(latency_rows, {"mean", "p95"}, "ms")});
     REPRISE_TRY(write_html_report(out + "/index.html", report));
-    std::printf("[bench stream] %s/stream.csv, %s/stream_summary.csv, %s/index.html\n", out.c_str(), out.c_str(),
-                out.c_str());
+    std::printf("[bench stream] %s/stream.csv, %s/stream_summary.csv, %s/index.html\n", out.c_str(),
+                out.c_str(), out.c_str());
     return {};
 }
 

@@ -2,8 +2,8 @@
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
-#include <functional>
 #include <fstream>
+#include <functional>
 #include <vector>
 
 #include "args.hpp"
@@ -70,8 +70,9 @@ Status bench_exr(const BenchJob& job) {
     BenchScene bench;
     REPRISE_TRY(open_bench_scene(job.scene, bench));
     auto& [scene, path, renderer] = bench;
-    std::string dir = job.dir.empty() ? (std::filesystem::temp_directory_path() / "reprise-bench-exr").string()
-                                      : job.dir;
+    std::string dir = job.dir.empty()
+                          ? (std::filesystem::temp_directory_path() / "reprise-bench-exr").string()
+                          : job.dir;
     std::error_code ec;
     std::filesystem::create_directories(dir, ec);
     if (ec) return Status::error(dir + ": " + ec.message());
@@ -95,7 +96,8 @@ Status bench_exr(const BenchJob& job) {
             REPRISE_TRY(read_frame(file, back));
             read_s += seconds_since(t);
             t = Clock::now();
-            std::ofstream(raw_path, std::ios::binary).write(raw.data(), std::streamsize(raw.size()));
+            std::ofstream(raw_path, std::ios::binary)
+                .write(raw.data(), std::streamsize(raw.size()));
             raw_write_s += seconds_since(t);
             t = Clock::now();
             std::ifstream(raw_path, std::ios::binary).read(raw.data(), std::streamsize(raw.size()));
@@ -105,9 +107,9 @@ Status bench_exr(const BenchJob& job) {
         std::fprintf(stderr, "\r%40s\r", "");
         double file_mb = double(std::filesystem::file_size(frame_path(dir, 0))) / 1e6;
         std::printf("%-11s %9.1f %9.1f %9.1f %9.1f %10.1fx %10.1fx\n",
-                    (std::to_string(w) + "x" + std::to_string(h)).c_str(), 1e3 * write_s / job.frames,
-                    1e3 * read_s / job.frames, bytes / 1e6, file_mb, write_s / raw_write_s,
-                    read_s / raw_read_s);
+                    (std::to_string(w) + "x" + std::to_string(h)).c_str(),
+                    1e3 * write_s / job.frames, 1e3 * read_s / job.frames, bytes / 1e6, file_mb,
+                    write_s / raw_write_s, read_s / raw_read_s);
         for (int i = 0; i < job.frames; ++i) std::filesystem::remove(frame_path(dir, i), ec);
         std::filesystem::remove(raw_path, ec);
         return Status{};
@@ -123,34 +125,65 @@ Status open_bench_scene(const std::string& name, BenchScene& bench) {
 
 int command_bench(int argc, char** argv) {
     BenchJob job;
-    Args args("bench",
-              "Benchmarks. render: renderer frames per second; exr: frame write/read time against "
-              "raw file I/O\nof the same bytes, measured in the same run. fruc: frame-rate upconversion "
-              "error against run time\nfor every setting beside ffmpeg minterpolate and OpenCV DIS flow "
-              "(CSV + HTML report in --out).\nstereo: the synthesized second eye against the rendered one, naive DIBR peers and the "
-              "renderer's\nsecond-eye time (CSV + HTML report in --out). paths: whole made frames at display "
-              "rate against cv::remap.\nkernels: each SIMD kernel at every level the CPU runs against its scalar reference and cv::remap (CSV in --out).\nreuse: shading reuse in the heavy renderer against full shading in the same run (speed-up, hit rate,\npixels shaded, error; CSV + HTML report in --out).\ncodec: reprise's codec beside x264, x265 and SVT-AV1\n(bits, PSNR/SSIM/FLIP, ms, BD-rates, depth coders, 1080p speed; CSV + HTML report in --out).\nupsample: Herzog spatio-temporal upsampling of 1/2 or 1/4 of the pixels against the full render,\nbeside cv::resize, warpAffine and joint bilateral peers; ms per 1080p frame against cv::remap (CSV + HTML).\nstream: the remote-rendering loop under injected faults (latency, bitrate, displayed error; --quick: 3 conditions).");
-    args.positional("WHAT", &job.what, "render | exr | reproject | grid | fill | paths | kernels | fruc | stereo | codec | reuse | upsample | stream");
+    Args args(
+        "bench",
+        "Benchmarks. render: renderer frames per second; exr: frame write/read time against "
+        "raw file I/O\nof the same bytes, measured in the same run. fruc: frame-rate upconversion "
+        "error against run time\nfor every setting beside ffmpeg minterpolate and OpenCV DIS flow "
+        "(CSV + HTML report in --out).\nstereo: the synthesized second eye against the rendered "
+        "one, naive DIBR peers and the "
+        "renderer's\nsecond-eye time (CSV + HTML report in --out). paths: whole made frames at "
+        "display "
+        "rate against cv::remap.\nkernels: each SIMD kernel at every level the CPU runs against "
+        "its scalar reference and cv::remap (CSV in --out).\nreuse: shading reuse in the heavy "
+        "renderer against full shading in the same run (speed-up, hit rate,\npixels shaded, error; "
+        "CSV + HTML report in --out).\ncodec: reprise's codec beside x264, x265 and "
+        "SVT-AV1\n(bits, PSNR/SSIM/FLIP, ms, BD-rates, depth coders, 1080p speed; CSV + HTML "
+        "report in --out).\nupsample: Herzog spatio-temporal upsampling of 1/2 or 1/4 of the "
+        "pixels against the full render,\nbeside cv::resize, warpAffine and joint bilateral peers; "
+        "ms per 1080p frame against cv::remap (CSV + HTML).\nstream: the remote-rendering loop "
+        "under injected faults (latency, bitrate, displayed error; --quick: 3 conditions).");
+    args.positional("WHAT", &job.what,
+                    "render | exr | reproject | grid | fill | paths | kernels | fruc | stereo | "
+                    "codec | reuse | upsample | stream");
     args.option("--scene", &job.scene, "scene to render (default pan)");
-    args.option("--frames", &job.frames, "frames per size (default 10); fruc: input frames (default 20); stereo: frames per scene (at most 5); upsample: frames per scene (default 12)");
+    args.option("--frames", &job.frames,
+                "frames per size (default 10); fruc: input frames (default 20); stereo: frames per "
+                "scene (at most 5); upsample: frames per scene (default 12)");
     args.option("--sizes", &job.sizes, "comma-separated WxH list (default 640x360,1920x1080)");
     args.option("--dir", &job.dir, "exr: folder for the files (default: the temp folder)");
-    args.option("--out", &job.out, "fruc, stereo, codec, kernels, reuse, upsample: report folder (default out/bench-WHAT)");
-    args.option("--scenes", &job.scenes, "fruc, stereo, codec, reuse, upsample: comma-separated scenes or glTF files (default: every built-in scene; fruc adds the held-out glTF models, also named by held-out)");
-    args.option("--factor", &job.factor, "fruc: K, output frames per input frame (default 2); upsample: 2 or 4 pixels per sample (default both)");
-    args.option("--size", &job.size, "fruc, stereo, upsample: WxH (default 640x360); codec: default 1280x720");
-    args.flag("--quick", &job.quick, "fruc: a few settings only (grid+pullpush, reverse+pullpush, splat+none, ...)");
-    args.option("--repeat", &job.repeat, "fruc, stereo, upsample: timed runs, each frame's fastest counts (default 3)");
+    args.option(
+        "--out", &job.out,
+        "fruc, stereo, codec, kernels, reuse, upsample: report folder (default out/bench-WHAT)");
+    args.option(
+        "--scenes", &job.scenes,
+        "fruc, stereo, codec, reuse, upsample: comma-separated scenes or glTF files (default: "
+        "every built-in scene; fruc adds the held-out glTF models, also named by held-out)");
+    args.option("--factor", &job.factor,
+                "fruc: K, output frames per input frame (default 2); upsample: 2 or 4 pixels per "
+                "sample (default both)");
+    args.option("--size", &job.size,
+                "fruc, stereo, upsample: WxH (default 640x360); codec: default 1280x720");
+    args.flag("--quick", &job.quick,
+              "fruc: a few settings only (grid+pullpush, reverse+pullpush, splat+none, ...)");
+    args.option("--repeat", &job.repeat,
+                "fruc, stereo, upsample: timed runs, each frame's fastest counts (default 3)");
     args.option("--in", &job.in, "codec: also a sequence folder (EXR frames, up to --frames)");
     args.option("--threads", &job.threads, "codec: threads per codec (default 2)");
     args.option("--qps", &job.qps, "codec: reprise's qp rate points (default 22,28,34,40)");
-    args.option("--speed-size", &job.speed_size, "codec: size of the speed run (default 1920x1080)");
+    args.option("--speed-size", &job.speed_size,
+                "codec: size of the speed run (default 1920x1080)");
     args.option("--speed-scene", &job.speed_scene, "codec: scene of the speed run (default pan)");
-    args.option("--speed-frames", &job.speed_frames, "codec, upsample: frames of the speed run (default 10; upsample 6; 0 = none)");
+    args.option("--speed-frames", &job.speed_frames,
+                "codec, upsample: frames of the speed run (default 10; upsample 6; 0 = none)");
     args.option("--duration", &job.stream_duration, "stream: seconds per condition (default 4)");
-    args.option("--display-rate", &job.display_rate, "stream: display frames per second (default 120)");
-    args.option("--conditions", &job.conditions, "stream: comma-separated conditions (clean, loss1%, loss5%, burst, jitter20ms, rtt50ms, rtt100ms, rtt100ms+loss1%, cap1500kbps)");
-    args.flag("--exr", &job.exr, "fruc: also write the rendered input and truth as EXR under OUT/SCENE/");
+    args.option("--display-rate", &job.display_rate,
+                "stream: display frames per second (default 120)");
+    args.option("--conditions", &job.conditions,
+                "stream: comma-separated conditions (clean, loss1%, loss5%, burst, jitter20ms, "
+                "rtt50ms, rtt100ms, rtt100ms+loss1%, cap1500kbps)");
+    args.flag("--exr", &job.exr,
+              "fruc: also write the rendered input and truth as EXR under OUT/SCENE/");
     Status parsed = args.parse(argc, argv);
     if (!parsed.ok() || args.help_requested()) return report(args, parsed, {});
     if (job.what == "fruc" && !args.given("--frames")) job.frames = 20;  // reaches the cut at 0.5 s
@@ -163,22 +196,38 @@ int command_bench(int argc, char** argv) {
     if (job.what == "upsample" && !args.given("--factor")) job.factor = 0;  // both 4 and 2
     if (job.what == "upsample" && !args.given("--speed-frames")) job.speed_frames = 6;
     Status result;
-    if (job.frames < 1 || job.frames > 100000) result = Status::error("bench: --frames must be in 1..100000");
-    else if (job.what == "render") result = bench_render(job);
-    else if (job.what == "exr") result = bench_exr(job);
-    else if (job.what == "reproject") result = bench_reproject(job);
-    else if (job.what == "grid") result = bench_grid(job);
-    else if (job.what == "fill") result = bench_fill(job);
-    else if (job.what == "paths") result = bench_paths(job);
-    else if (job.what == "kernels") result = bench_kernels(job);
-    else if (job.what == "fruc") result = bench_fruc(job);
-    else if (job.what == "stereo") result = bench_stereo(job);
-    else if (job.what == "codec") result = bench_codec(job);
-    else if (job.what == "reuse") result = bench_reuse(job);
-    else if (job.what == "upsample") result = bench_upsample(job);
-    else if (job.what == "stream") result = bench_stream(job);
-    else result = Status::error("bench: unknown benchmark '" + job.what +
-                                "' (render, exr, reproject, grid, fill, paths, kernels, fruc, stereo, codec, reuse, upsample, stream)");
+    if (job.frames < 1 || job.frames > 100000)
+        result = Status::error("bench: --frames must be in 1..100000");
+    else if (job.what == "render")
+        result = bench_render(job);
+    else if (job.what == "exr")
+        result = bench_exr(job);
+    else if (job.what == "reproject")
+        result = bench_reproject(job);
+    else if (job.what == "grid")
+        result = bench_grid(job);
+    else if (job.what == "fill")
+        result = bench_fill(job);
+    else if (job.what == "paths")
+        result = bench_paths(job);
+    else if (job.what == "kernels")
+        result = bench_kernels(job);
+    else if (job.what == "fruc")
+        result = bench_fruc(job);
+    else if (job.what == "stereo")
+        result = bench_stereo(job);
+    else if (job.what == "codec")
+        result = bench_codec(job);
+    else if (job.what == "reuse")
+        result = bench_reuse(job);
+    else if (job.what == "upsample")
+        result = bench_upsample(job);
+    else if (job.what == "stream")
+        result = bench_stream(job);
+    else
+        result = Status::error("bench: unknown benchmark '" + job.what +
+                               "' (render, exr, reproject, grid, fill, paths, kernels, fruc, "
+                               "stereo, codec, reuse, upsample, stream)");
     return report(args, parsed, result);
 }
 

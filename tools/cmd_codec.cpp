@@ -57,10 +57,12 @@ Status parse_depth_mode(const std::string& text, codec::EncoderOptions& o) {
             char* end = nullptr;
             o.depth_error = std::strtof(text.c_str() + 8, &end);
             if (*end || !(o.depth_error >= 1e-7f && o.depth_error <= 0.1f))
-                return Status::error("encode: --depth " + text + ": the bound must be a number in 1e-7..0.1");
+                return Status::error("encode: --depth " + text +
+                                     ": the bound must be a number in 1e-7..0.1");
         }
     } else {
-        return Status::error("encode: --depth " + text + ": expected lossless, bounded[:E] or none");
+        return Status::error("encode: --depth " + text +
+                             ": expected lossless, bounded[:E] or none");
     }
     return {};
 }
@@ -68,8 +70,9 @@ Status parse_depth_mode(const std::string& text, codec::EncoderOptions& o) {
 void print_stats(const codec::StreamStats& s, double fps) {
     const double n = double(std::max<std::size_t>(1, s.frames));
     auto line = [&](const char* what, std::size_t bits) {
-        std::printf("  %-7s %12.1f kbit %10.0f bits/frame %9.1f kbit/s %6.1f %%\n", what, bits / 1e3, bits / n,
-                    bits / n * fps / 1e3, 100.0 * double(bits) / double(std::max<std::size_t>(1, s.total_bits())));
+        std::printf("  %-7s %12.1f kbit %10.0f bits/frame %9.1f kbit/s %6.1f %%\n", what,
+                    bits / 1e3, bits / n, bits / n * fps / 1e3,
+                    100.0 * double(bits) / double(std::max<std::size_t>(1, s.total_bits())));
     };
     line("header", s.header_bits);
     line("camera", s.camera_bits);
@@ -77,12 +80,16 @@ void print_stats(const codec::StreamStats& s, double fps) {
     line("motion", s.motion_bits);
     line("colour", s.color_bits);
     line("total", s.total_bits());
-    std::printf("  left out: %zu of %zu colour blocks skipped (%.1f %%), %zu depth blocks predicted exactly, "
-                "motion residual on %zu pixels\n",
-                s.blocks_skipped, s.blocks, 100.0 * double(s.blocks_skipped) / double(std::max<std::size_t>(1, s.blocks)),
-                s.depth_zero_blocks, s.motion_residual_pixels);
-    std::printf("  %zu frames: %zu key, %zu predicted from an older reference, %zu intra macroblocks\n", s.frames,
-                s.key_frames, s.older_reference, s.intra_blocks);
+    std::printf(
+        "  left out: %zu of %zu colour blocks skipped (%.1f %%), %zu depth blocks predicted "
+        "exactly, "
+        "motion residual on %zu pixels\n",
+        s.blocks_skipped, s.blocks,
+        100.0 * double(s.blocks_skipped) / double(std::max<std::size_t>(1, s.blocks)),
+        s.depth_zero_blocks, s.motion_residual_pixels);
+    std::printf(
+        "  %zu frames: %zu key, %zu predicted from an older reference, %zu intra macroblocks\n",
+        s.frames, s.key_frames, s.older_reference, s.intra_blocks);
 }
 
 struct EncodeJob {
@@ -106,9 +113,12 @@ Status encoder_options(const EncodeJob& job, codec::EncoderOptions& o) {
     o.bitrate_kbps = job.bitrate;
     o.keyint = job.keyint;
     o.skip_threshold = job.skip;
-    if (job.chroma == "420") o.chroma = codec::Chroma::C420;
-    else if (job.chroma == "444") o.chroma = codec::Chroma::C444;
-    else return Status::error("encode: --chroma " + job.chroma + ": expected 420 or 444");
+    if (job.chroma == "420")
+        o.chroma = codec::Chroma::C420;
+    else if (job.chroma == "444")
+        o.chroma = codec::Chroma::C444;
+    else
+        return Status::error("encode: --chroma " + job.chroma + ": expected 420 or 444");
     return parse_depth_mode(job.depth, o);
 }
 
@@ -124,7 +134,8 @@ Status run_encode(const EncodeJob& job, const codec::EncoderOptions& o) {
     for (std::size_t i = 0; i < n; ++i) {
         REPRISE_TRY(read_frame(sequence.files[i], frame));
         if (frame.fps <= 0) frame.fps = fps;
-        if (i == 0) REPRISE_TRY(codec::write_stream_header(file, frame.width(), frame.height(), fps));
+        if (i == 0)
+            REPRISE_TRY(codec::write_stream_header(file, frame.width(), frame.height(), fps));
         const auto start = Clock::now();
         const Status sent = encoder.send_frame(frame);
         busy_ms += ms_since(start);
@@ -136,8 +147,11 @@ Status run_encode(const EncodeJob& job, const codec::EncoderOptions& o) {
     }
     std::fprintf(stderr, "\n");
     REPRISE_TRY(write_file(job.out, file));
-    std::printf("encoded %zu frames (%dx%d at %.3g fps) into %s: %zu bytes, %.2f ms per frame (without file I/O)\n", n,
-                frame.width(), frame.height(), fps, job.out.c_str(), file.size(), busy_ms / double(std::max<std::size_t>(1, n)));
+    std::printf(
+        "encoded %zu frames (%dx%d at %.3g fps) into %s: %zu bytes, %.2f ms per frame (without "
+        "file I/O)\n",
+        n, frame.width(), frame.height(), fps, job.out.c_str(), file.size(),
+        busy_ms / double(std::max<std::size_t>(1, n)));
     print_stats(encoder.stats(), fps);
     return {};
 }
@@ -165,16 +179,21 @@ Status run_decode(const std::string& in, const std::string& out) {
         if (!s.ok()) {
             ++failed;
             std::fprintf(stderr, "\n%s: packet %zu: %s\n", in.c_str(), i, s.message().c_str());
-            if (first_error.empty()) first_error = in + ": packet " + std::to_string(i) + ": " + s.message();
+            if (first_error.empty())
+                first_error = in + ": packet " + std::to_string(i) + ": " + s.message();
         }
-        while (decoder.receive_frame(frame) == codec::Result::Ok) REPRISE_TRY(write_frame(frame_path(out, written++), frame));
-        std::fprintf(stderr, "\r[decode] %zu/%zu packets, %d frames written", i + 1, packets.size(), written);
+        while (decoder.receive_frame(frame) == codec::Result::Ok)
+            REPRISE_TRY(write_frame(frame_path(out, written++), frame));
+        std::fprintf(stderr, "\r[decode] %zu/%zu packets, %d frames written", i + 1, packets.size(),
+                     written);
     }
     std::fprintf(stderr, "\n");
-    std::printf("decoded %d frames of %zu packets into %s, %.2f ms per frame (without file I/O)\n", written,
-                packets.size(), out.c_str(), busy_ms / double(std::max(1, written)));
+    std::printf("decoded %d frames of %zu packets into %s, %.2f ms per frame (without file I/O)\n",
+                written, packets.size(), out.c_str(), busy_ms / double(std::max(1, written)));
     print_stats(decoder.stats(), info.fps > 0 ? info.fps : 30.0);
-    if (failed) return Status::error(std::to_string(failed) + " packets could not be decoded; first: " + first_error);
+    if (failed)
+        return Status::error(std::to_string(failed) +
+                             " packets could not be decoded; first: " + first_error);
     return {};
 }
 
@@ -187,8 +206,8 @@ Status describe_stream(const std::string& path) {
     std::vector<std::span<const uint8_t>> packets;
     const Status split = codec::split_stream(bytes, info, packets);
     if (!split.ok()) return Status::error(path + ": " + split.message());
-    std::printf("%s: reprise stream, %dx%d, %.3g fps, %zu packets, %zu bytes\n", path.c_str(), info.width, info.height,
-                info.fps, packets.size(), bytes.size());
+    std::printf("%s: reprise stream, %dx%d, %.3g fps, %zu packets, %zu bytes\n", path.c_str(),
+                info.width, info.height, info.fps, packets.size(), bytes.size());
     std::size_t keys = 0, older = 0, key_bytes = 0, inter_bytes = 0, bad = 0, largest = 0;
     for (std::size_t i = 0; i < packets.size(); ++i) {
         codec::Packet p;
@@ -205,29 +224,39 @@ Status describe_stream(const std::string& path) {
         (key ? key_bytes : inter_bytes) += packets[i].size();
         largest = std::max(largest, packets[i].size());
     }
-    std::printf("  key frames: %zu (%zu bytes), inter frames: %zu (%zu bytes), %zu from an older reference\n", keys,
-                key_bytes, packets.size() - keys - bad, inter_bytes, older);
+    std::printf(
+        "  key frames: %zu (%zu bytes), inter frames: %zu (%zu bytes), %zu from an older "
+        "reference\n",
+        keys, key_bytes, packets.size() - keys - bad, inter_bytes, older);
     const double fps = info.fps > 0 ? info.fps : 30.0;
-    std::printf("  mean %.1f kbit/s, largest packet %zu bytes\n",
-                packets.empty() ? 0.0 : 8.0 * double(bytes.size()) / double(packets.size()) * fps / 1e3, largest);
+    std::printf(
+        "  mean %.1f kbit/s, largest packet %zu bytes\n",
+        packets.empty() ? 0.0 : 8.0 * double(bytes.size()) / double(packets.size()) * fps / 1e3,
+        largest);
     if (bad) return Status::error(path + ": " + std::to_string(bad) + " packets are damaged");
     return {};
 }
 
 int command_encode(int argc, char** argv) {
     EncodeJob job;
-    Args args("encode",
-              "Encodes an EXR sequence with reprise's scene-aware codec: each frame predicted by reprojecting\n"
-              "the previous decoded frame with the rendered depth and motion; prints bits per stream.");
+    Args args(
+        "encode",
+        "Encodes an EXR sequence with reprise's scene-aware codec: each frame predicted by "
+        "reprojecting\n"
+        "the previous decoded frame with the rendered depth and motion; prints bits per stream.");
     args.option("--in", &job.in, "input sequence (folder of EXR frames)");
     args.option("--out", &job.out, "output stream (.rps)");
     args.option("--qp", &job.qp, "quantiser 0 (finest) .. 51 (default 28), constant quality");
     args.option("--quality", &job.quality, "0..100 (100 best), instead of --qp");
-    args.option("--bitrate", &job.bitrate, "target kbit/s with bounded frame sizes (default: constant quality)");
-    args.option("--keyint", &job.keyint, "a key frame at least every N frames (default 0: cuts and requests only)");
+    args.option("--bitrate", &job.bitrate,
+                "target kbit/s with bounded frame sizes (default: constant quality)");
+    args.option("--keyint", &job.keyint,
+                "a key frame at least every N frames (default 0: cuts and requests only)");
     args.option("--chroma", &job.chroma, "420 | 444 (default 420)");
-    args.option("--depth", &job.depth, "lossless | bounded[:E] (relative error E, default 1e-4) | none");
-    args.option("--skip", &job.skip, "blocks within this many 8-bit levels of their prediction are skipped (default 2)");
+    args.option("--depth", &job.depth,
+                "lossless | bounded[:E] (relative error E, default 1e-4) | none");
+    args.option("--skip", &job.skip,
+                "blocks within this many 8-bit levels of their prediction are skipped (default 2)");
     const Status parsed = args.parse(argc, argv);
     if (!parsed.ok() || args.help_requested()) return report(args, parsed, {});
     codec::EncoderOptions options;
@@ -238,7 +267,9 @@ int command_encode(int argc, char** argv) {
 
 int command_decode(int argc, char** argv) {
     std::string in, out;
-    Args args("decode", "Decodes a reprise stream (.rps) into an EXR sequence (colour, depth, motion, camera).");
+    Args args(
+        "decode",
+        "Decodes a reprise stream (.rps) into an EXR sequence (colour, depth, motion, camera).");
     args.positional("FILE", &in, "the .rps stream");
     args.option("--out", &out, "output folder");
     const Status parsed = args.parse(argc, argv);

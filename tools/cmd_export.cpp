@@ -102,12 +102,10 @@ Status display(const Frame& f, const std::string& file, Channel c, const Ranges&
     return {};
 }
 
-std::string stem(const std::string& file) {
-    return fs::path(file).stem().string();
-}
+std::string stem(const std::string& file) { return fs::path(file).stem().string(); }
 
 class Progress {
-  public:
+public:
     Progress(const char* what, std::size_t total)
         : what_(what), total_(total), tty_(::isatty(::fileno(stderr))) {}
     void step(std::size_t done) const {
@@ -118,7 +116,7 @@ class Progress {
         std::fprintf(stderr, "[%s] %zu frames -> %s\n", what_, total_, result.c_str());
     }
 
-  private:
+private:
     const char* what_;
     std::size_t total_;
     bool tty_;
@@ -261,10 +259,12 @@ Status export_stereo(const Options& o, stereo::Layout layout) {
             return Status::error(right.files[i] + ": size differs from " + left.files[i]);
         stereo::compose(l.color.view(), r.color.view(), layout, picture);
         if (!o.mp4.empty()) {
-            if (i == 0) REPRISE_TRY(writer.open(o.mp4, picture.width(), picture.height(), {.fps = fps}));
+            if (i == 0)
+                REPRISE_TRY(writer.open(o.mp4, picture.width(), picture.height(), {.fps = fps}));
             REPRISE_TRY(writer.write(picture.view()));
         } else if (folder) {
-            REPRISE_TRY(write_png((fs::path(o.png) / (stem(left.files[i]) + ".png")).string(), picture.view()));
+            REPRISE_TRY(write_png((fs::path(o.png) / (stem(left.files[i]) + ".png")).string(),
+                                  picture.view()));
         } else {
             REPRISE_TRY(write_png(o.png, picture.view()));
         }
@@ -277,7 +277,7 @@ Status export_stereo(const Options& o, stereo::Layout layout) {
 
 Status run(const Options& o, Channel channel) {
     if (!o.stereo.empty())
-        return export_stereo(o, o.stereo == "sbs" ? stereo::Layout::SideBySide
+        return export_stereo(o, o.stereo == "sbs"  ? stereo::Layout::SideBySide
                                 : o.stereo == "tb" ? stereo::Layout::TopBottom
                                                    : stereo::Layout::Anaglyph);
     Sequence seq;
@@ -319,8 +319,10 @@ int command_export(int argc, char** argv) {
                                    "' is not color, depth, motion, normal or id");
         else if (args.given("--fps") && !(o.fps > 0.0 && o.fps <= 1000.0))
             parsed = Status::error("export: --fps must be in (0, 1000]");
-        else if (!o.stereo.empty() && o.stereo != "sbs" && o.stereo != "tb" && o.stereo != "anaglyph")
-            parsed = Status::error("export: --stereo: '" + o.stereo + "' is not sbs, tb or anaglyph");
+        else if (!o.stereo.empty() && o.stereo != "sbs" && o.stereo != "tb" &&
+                 o.stereo != "anaglyph")
+            parsed =
+                Status::error("export: --stereo: '" + o.stereo + "' is not sbs, tb or anaglyph");
         else if (o.motion_max < 0.0)
             parsed = Status::error("export: --motion-max must not be negative");
         else

@@ -5,10 +5,10 @@
 
 #include "args.hpp"
 #include "commands.hpp"
-#include "reprise/core/exr.hpp"
-#include "reprise/warp/fruc.hpp"
 #include "flow_motion.hpp"
 #include "fruc_options.hpp"
+#include "reprise/core/exr.hpp"
+#include "reprise/warp/fruc.hpp"
 
 namespace reprise::cli {
 
@@ -50,19 +50,25 @@ Status run_fruc(const FrucJob& job) {
         if (i == 0 && (in.motion.empty() || in.depth.empty())) {
             // Said once, before any work: what the input lacks and what stands in for it.
             if (in.motion.empty())
-                std::fprintf(stderr, "[fruc] %s: no motion channels (motion.x, motion.y): motion is "
+                std::fprintf(stderr,
+                             "[fruc] %s: no motion channels (motion.x, motion.y): motion is "
                              "estimated by optical flow (OpenCV DIS) between consecutive frames\n",
                              sequence.files[i].c_str());
             if (in.depth.empty())
-                std::fprintf(stderr, "[fruc] %s: no depth channel (Z): every pixel is given one "
-                             "depth, so nothing occludes anything\n", sequence.files[i].c_str());
+                std::fprintf(stderr,
+                             "[fruc] %s: no depth channel (Z): every pixel is given one "
+                             "depth, so nothing occludes anything\n",
+                             sequence.files[i].c_str());
             estimating = true;
         }
         if (estimating) flow.complete(in);
         auto start = std::chrono::steady_clock::now();
         REPRISE_TRY(converter.send(in));
-        busy_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-        while (converter.receive(out)) REPRISE_TRY(write_frame(frame_path(job.out, written++), out, write));
+        busy_ms +=
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+                .count();
+        while (converter.receive(out))
+            REPRISE_TRY(write_frame(frame_path(job.out, written++), out, write));
         std::fprintf(stderr, "\r[fruc] %zu/%zu input frames, %d written", i + 1, n, written);
     }
     const warp::FrucCounters& c = converter.counters();
@@ -71,12 +77,15 @@ Status run_fruc(const FrucJob& job) {
                 job.factor, job.warp.c_str(), job.fill.c_str(), c.inputs, written, job.out.c_str());
     std::printf("  made %zu frames, %.2f ms each (without file I/O)\n", c.outputs,
                 c.outputs ? busy_ms / double(c.outputs) : 0.0);
-    std::printf("  skipped: %zu still frames copied, %zu fills (no holes), %zu dynamic layers (nothing moving), "
-                "%zu true-motion passes (linear motion)\n",
-                c.copied_still, c.fills_skipped, c.dynamic_skipped, c.linear_motion);
-    std::printf("  done: %zu fills (%zu hole pixels), %zu dynamic layers, %zu grid cells, %zu cuts, "
-                "%zu true-motion frames\n",
-                c.fills, c.hole_pixels, c.dynamic_layers, c.grid_cells, c.cuts, c.true_motion);
+    std::printf(
+        "  skipped: %zu still frames copied, %zu fills (no holes), %zu dynamic layers (nothing "
+        "moving), "
+        "%zu true-motion passes (linear motion)\n",
+        c.copied_still, c.fills_skipped, c.dynamic_skipped, c.linear_motion);
+    std::printf(
+        "  done: %zu fills (%zu hole pixels), %zu dynamic layers, %zu grid cells, %zu cuts, "
+        "%zu true-motion frames\n",
+        c.fills, c.hole_pixels, c.dynamic_layers, c.grid_cells, c.cuts, c.true_motion);
     return {};
 }
 

@@ -25,7 +25,6 @@ struct Options {
     double ppd = 67.0;
 };
 
-
 // One PNG for every frame, or a folder with one PNG per frame.
 Status list_masks(const std::string& path, std::size_t frames, std::vector<std::string>& masks) {
     std::error_code ec;

@@ -35,7 +35,7 @@ struct RenderJob {
     bool allow_outside_paths = false;
     double stereo = 0.0;       // IPD; > 0 renders both eyes into OUT/left and OUT/right
     double convergence = 0.0;  // > 0: off-axis rig converging there
-    int lowres = 0;            // 2 or 4: also colour at 1/lowres of the pixels, jittered, in OUT/lowres
+    int lowres = 0;  // 2 or 4: also colour at 1/lowres of the pixels, jittered, in OUT/lowres
 };
 
 struct ReuseTotals : server::ReuseStats {
@@ -45,20 +45,31 @@ struct ReuseTotals : server::ReuseStats {
     }
 };
 
-Status parse_shading(const RenderJob& job, const server::Scene& scene, server::RenderSettings& settings) {
-    const std::string shading =
-        !job.shading.empty() ? job.shading : job.unlit ? "unlit" : scene.heavy_shading ? "heavy" : "lit";
-    if (shading == "lit") settings.shading = server::Shading::Lit;
-    else if (shading == "unlit") settings.shading = server::Shading::Unlit;
-    else if (shading == "heavy") settings.shading = server::Shading::Heavy;
-    else return Status::error("--shading '" + shading + "' must be lit, unlit or heavy");
+Status parse_shading(const RenderJob& job, const server::Scene& scene,
+                     server::RenderSettings& settings) {
+    const std::string shading = !job.shading.empty()  ? job.shading
+                                : job.unlit           ? "unlit"
+                                : scene.heavy_shading ? "heavy"
+                                                      : "lit";
+    if (shading == "lit")
+        settings.shading = server::Shading::Lit;
+    else if (shading == "unlit")
+        settings.shading = server::Shading::Unlit;
+    else if (shading == "heavy")
+        settings.shading = server::Shading::Heavy;
+    else
+        return Status::error("--shading '" + shading + "' must be lit, unlit or heavy");
     if (job.unlit && settings.shading != server::Shading::Unlit)
         return Status::error("--unlit contradicts --shading " + shading);
     server::ReuseSettings& reuse = settings.reuse;
-    if (job.reuse == "off") reuse.mode = server::Reuse::Off;
-    else if (job.reuse == "cache") reuse.mode = server::Reuse::Cache;
-    else if (job.reuse == "adaptive") reuse.mode = server::Reuse::Adaptive, reuse.period = 16;
-    else return Status::error("--reuse '" + job.reuse + "' must be off, cache or adaptive");
+    if (job.reuse == "off")
+        reuse.mode = server::Reuse::Off;
+    else if (job.reuse == "cache")
+        reuse.mode = server::Reuse::Cache;
+    else if (job.reuse == "adaptive")
+        reuse.mode = server::Reuse::Adaptive, reuse.period = 16;
+    else
+        return Status::error("--reuse '" + job.reuse + "' must be off, cache or adaptive");
     if (reuse.mode != server::Reuse::Off && settings.shading != server::Shading::Heavy)
         return Status::error("--reuse " + job.reuse + " needs --shading heavy");
     if (!job.refresh.empty()) REPRISE_TRY(server::parse_refresh(job.refresh, reuse));
@@ -84,10 +95,10 @@ Status run_render(const RenderJob& job) {
     if (job.frames < 1 || job.frames > 1000000)
         return Status::error("--frames " + std::to_string(job.frames) + " must be in 1..1000000");
     if (job.start < 0) return Status::error("--start must not be negative");
-    if (!(job.fps > 0 && job.fps <= 10000))
-        return Status::error("--fps must be in (0, 10000]");
+    if (!(job.fps > 0 && job.fps <= 10000)) return Status::error("--fps must be in (0, 10000]");
     if (job.out.empty()) return Status::error("--out DIR is required");
-    if (!(job.stereo >= 0.0 && job.stereo <= 1e6)) return Status::error("--stereo IPD must be in [0, 1e6]");
+    if (!(job.stereo >= 0.0 && job.stereo <= 1e6))
+        return Status::error("--stereo IPD must be in [0, 1e6]");
     if (!(job.convergence >= 0.0 && job.convergence <= 1e30))
         return Status::error("--convergence must not be negative");
     const bool stereo = job.stereo > 0.0;
@@ -99,12 +110,13 @@ Status run_render(const RenderJob& job) {
         .ipd = float(job.stereo),
         .convergence = float(job.convergence),
         .rig = job.convergence > 0.0 ? stereo::Rig::OffAxis : stereo::Rig::Parallel};
-    const std::string left_dir = stereo ? job.out + "/left" : job.out, right_dir = job.out + "/right";
+    const std::string left_dir = stereo ? job.out + "/left" : job.out,
+                      right_dir = job.out + "/right";
 
     server::Scene scene;
     server::CameraPath path;
     REPRISE_TRY(server::load_scene(job.scene, scene, path,
-                                    {.allow_outside_paths = job.allow_outside_paths}));
+                                   {.allow_outside_paths = job.allow_outside_paths}));
     if (!job.camera.empty()) {
         server::CameraPath fallback = path;
         REPRISE_TRY(server::parse_camera_spec(job.camera, scene, fallback, path));
@@ -112,19 +124,21 @@ Status run_render(const RenderJob& job) {
     server::RenderSettings settings{.width = width, .height = height};
     REPRISE_TRY(parse_shading(job, scene, settings));
     if (settings.reuse.mode != server::Reuse::Off && job.lowres)
-        return Status::error("--reuse and --lowres do not combine (the low-resolution pass would drop the cache)");
+        return Status::error(
+            "--reuse and --lowres do not combine (the low-resolution pass would drop the cache)");
     if (settings.reuse.mode != server::Reuse::Off && stereo)
         return Status::error("--reuse works on one eye only (no --stereo)");
     std::error_code ec;
-    for (const std::string& dir : {left_dir, stereo ? right_dir : left_dir, job.lowres ? lowres_dir : left_dir}) {
+    for (const std::string& dir :
+         {left_dir, stereo ? right_dir : left_dir, job.lowres ? lowres_dir : left_dir}) {
         std::filesystem::create_directories(dir, ec);
         if (ec) return Status::error(dir + ": cannot create the folder: " + ec.message());
     }
 
     std::unique_ptr<server::Renderer> renderer;
     REPRISE_TRY(server::Renderer::create(renderer));
-    std::fprintf(stderr, "[render] %s, %dx%d, %d frames at %g Hz on %s\n", job.scene.c_str(),
-                 width, height, job.frames, job.fps, renderer->device().c_str());
+    std::fprintf(stderr, "[render] %s, %dx%d, %d frames at %g Hz on %s\n", job.scene.c_str(), width,
+                 height, job.frames, job.fps, renderer->device().c_str());
     ReuseTotals totals;
     Frame frame, low;
     auto begin = std::chrono::steady_clock::now();
@@ -141,9 +155,11 @@ Status run_render(const RenderJob& job) {
             low.fps = job.fps;
             REPRISE_TRY(write_frame(frame_path(lowres_dir, i), low));
         } else if (!stereo) {
-            REPRISE_TRY(renderer->render_frame(scene, path, job.start + i, job.fps, settings, frame));
+            REPRISE_TRY(
+                renderer->render_frame(scene, path, job.start + i, job.fps, settings, frame));
             // Frame 0 has no cache and pays llvmpipe's shader compilation: left out.
-            if (settings.shading == server::Shading::Heavy && i > 0) totals.add(renderer->reuse_stats());
+            if (settings.shading == server::Shading::Heavy && i > 0)
+                totals.add(renderer->reuse_stats());
             REPRISE_TRY(write_frame(frame_path(job.out, i), frame));
         } else {
             // The path's camera is the rig's centre; each eye renders with its own view.
@@ -165,7 +181,8 @@ Status run_render(const RenderJob& job) {
                 b.projection = eyes[e].prev_projection;
                 REPRISE_TRY(renderer->render(scene, a, b, settings, frame));
                 frame.fps = job.fps;
-                REPRISE_TRY(write_frame(frame_path(e == stereo::Eye::Left ? left_dir : right_dir, i), frame));
+                REPRISE_TRY(write_frame(
+                    frame_path(e == stereo::Eye::Left ? left_dir : right_dir, i), frame));
             }
         }
         std::fprintf(stderr, "\r[render] %d/%d", i + 1, job.frames);
@@ -176,10 +193,12 @@ Status run_render(const RenderJob& job) {
                  job.frames / seconds, job.out.c_str());
     const double frames = std::max(job.frames - 1, 1);
     if (settings.shading == server::Shading::Heavy)
-        std::printf("reuse %s: hit rate %.1f %%, pixels shaded %.1f %% (%.0f per frame), shading pass "
-                    "%.1f ms/frame (CPU %.1f ms), frames 1..\n",
-                    job.reuse.c_str(), 100.0 * totals.hit_rate(), 100.0 * totals.shaded_fraction(),
-                    double(totals.shaded) / frames, totals.shading_ms / frames, totals.shading_cpu_ms / frames);
+        std::printf(
+            "reuse %s: hit rate %.1f %%, pixels shaded %.1f %% (%.0f per frame), shading pass "
+            "%.1f ms/frame (CPU %.1f ms), frames 1..\n",
+            job.reuse.c_str(), 100.0 * totals.hit_rate(), 100.0 * totals.shaded_fraction(),
+            double(totals.shaded) / frames, totals.shading_ms / frames,
+            totals.shading_cpu_ms / frames);
     return {};
 }
 
@@ -190,7 +209,8 @@ int command_render(int argc, char** argv) {
     Args args("render",
               "Renders a built-in scene or a glTF file to an EXR sequence: colour, depth, backward "
               "motion,\nnormals and object ids, frame i at time (start + i) / fps.");
-    args.option("--scene", &job.scene, "built-in scene name (reprise scenes) or FILE.gltf/.glb; default pan");
+    args.option("--scene", &job.scene,
+                "built-in scene name (reprise scenes) or FILE.gltf/.glb; default pan");
     args.option("--frames", &job.frames, "number of frames (default 30)");
     args.option("--start", &job.start, "index of the first frame on the timeline (default 0)");
     args.option("--fps", &job.fps, "frame rate (default 30)");
@@ -204,25 +224,32 @@ int command_render(int argc, char** argv) {
     args.option("--reuse", &job.reuse,
                 "off|cache|adaptive: heavy shading reuses its expensive term through a "
                 "reprojection cache (default off)");
-    args.option("--refresh", &job.refresh,
-                "KIND:N with --reuse: tiled|random|blocks|interleaved, each pixel reshaded at "
-                "least every N frames (default blocks:4; adaptive: N caps the deadline, default 16)");
-    args.option("--octaves", &job.octaves, "heavy: noise octaves per layer, three layers (default 8)");
+    args.option(
+        "--refresh", &job.refresh,
+        "KIND:N with --reuse: tiled|random|blocks|interleaved, each pixel reshaded at "
+        "least every N frames (default blocks:4; adaptive: N caps the deadline, default 16)");
+    args.option("--octaves", &job.octaves,
+                "heavy: noise octaves per layer, three layers (default 8)");
     args.option("--pcf", &job.pcf_radius, "heavy: PCF radius r, (2r+1)^2 shadow taps (default 5)");
-    args.option("--threshold", &job.threshold, "adaptive: allowed change per channel in 1/255 (default 8)");
+    args.option("--threshold", &job.threshold,
+                "adaptive: allowed change per channel in 1/255 (default 8)");
     args.option("--depth-epsilon", &job.depth_epsilon,
                 "cache hit test: depth tolerance in 24-bit Z-buffer steps (default 1024)");
     args.option("--smoothing", &job.smoothing,
                 "amortized shadow supersampling alpha on cache hits (0 = off, default)");
-    args.flag("--allow-outside-paths", &job.allow_outside_paths,
-              "let a glTF file read buffers and images outside its own folder (trusted files only)");
-    args.option("--stereo", &job.stereo,
-                "IPD: render both eyes (the camera is the rig's centre) into OUT/left and OUT/right");
-    args.option("--convergence", &job.convergence, "with --stereo: off-axis rig converging at this distance");
-    args.option("--lowres", &job.lowres,
-                "2|4: also colour at 1/2 (W/2 x H) or 1/4 (W/2 x H/2) of the pixels with a per-frame "
-                "sub-pixel jitter, in OUT/lowres (colour only; reprise:jitter in its own pixels); "
-                "OUT keeps the full-resolution G-buffer (reprise upsample)");
+    args.flag(
+        "--allow-outside-paths", &job.allow_outside_paths,
+        "let a glTF file read buffers and images outside its own folder (trusted files only)");
+    args.option(
+        "--stereo", &job.stereo,
+        "IPD: render both eyes (the camera is the rig's centre) into OUT/left and OUT/right");
+    args.option("--convergence", &job.convergence,
+                "with --stereo: off-axis rig converging at this distance");
+    args.option(
+        "--lowres", &job.lowres,
+        "2|4: also colour at 1/2 (W/2 x H) or 1/4 (W/2 x H/2) of the pixels with a per-frame "
+        "sub-pixel jitter, in OUT/lowres (colour only; reprise:jitter in its own pixels); "
+        "OUT keeps the full-resolution G-buffer (reprise upsample)");
     args.option("--out", &job.out, "output folder (required)");
     Status parsed = args.parse(argc, argv);
     if (!parsed.ok() || args.help_requested()) return report(args, parsed, {});

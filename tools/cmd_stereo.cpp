@@ -50,7 +50,8 @@ Status check(const StereoJob& j, stereo::StereoRig& rig, stereo::StereoOptions& 
     return {};
 }
 
-Status run_stereo(const StereoJob& job, const stereo::StereoRig& rig, const stereo::StereoOptions& options) {
+Status run_stereo(const StereoJob& job, const stereo::StereoRig& rig,
+                  const stereo::StereoOptions& options) {
     Sequence seq;
     REPRISE_TRY(open_sequence(job.in, seq));
     const bool given_left = job.eye == "left";
@@ -74,8 +75,9 @@ Status run_stereo(const StereoJob& job, const stereo::StereoRig& rig, const ster
         // Disparity needs the focal length: from the file's camera, else from --fov.
         if (!has_projection(frame.camera)) {
             if (job.fov == 0.0)
-                return Status::error(file + ": has no camera (Blender renders carry none); give "
-                                            "--fov DEG, the camera's vertical field of view");
+                return Status::error(file +
+                                     ": has no camera (Blender renders carry none); give "
+                                     "--fov DEG, the camera's vertical field of view");
             frame.camera.projection = glm::perspective(float(glm::radians(job.fov)),
                                                        float(frame.width()) / float(frame.height()),
                                                        frame.camera.near, frame.camera.far);
@@ -89,7 +91,8 @@ Status run_stereo(const StereoJob& job, const stereo::StereoRig& rig, const ster
         stereo::StereoStats stats = synthesizer.synthesize(
             frame, target, made, options, job.temporal && have_previous ? &previous : nullptr);
         made.fps = frame.fps;
-        ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - begin).count();
+        ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - begin)
+                  .count();
         holes += stats.holes;
         from_history += stats.from_history;
         REPRISE_TRY(write_frame(frame_path(rendered_dir, int(i)), frame));
@@ -99,8 +102,9 @@ Status run_stereo(const StereoJob& job, const stereo::StereoRig& rig, const ster
             have_previous = true;
         }
     }
-    std::fprintf(stderr, "[stereo] %zu frames, %.2f ms per eye, %zu holes, %zu pixels from history -> %s\n",
-                 seq.files.size(), ms / double(seq.files.size()), holes, from_history, job.out.c_str());
+    std::fprintf(
+        stderr, "[stereo] %zu frames, %.2f ms per eye, %zu holes, %zu pixels from history -> %s\n",
+        seq.files.size(), ms / double(seq.files.size()), holes, from_history, job.out.c_str());
     return {};
 }
 
@@ -116,8 +120,10 @@ int command_stereo(int argc, char** argv) {
     args.option("--in", &job.in, "input sequence folder (required)");
     args.option("--out", &job.out, "output folder (required)");
     args.option("--ipd", &job.ipd, "eye separation in scene units (default 0.064)");
-    args.option("--convergence", &job.convergence, "zero-disparity distance, offaxis rig (default 10)");
-    args.option("--fov", &job.fov, "vertical field of view in degrees, for inputs without a camera");
+    args.option("--convergence", &job.convergence,
+                "zero-disparity distance, offaxis rig (default 10)");
+    args.option("--fov", &job.fov,
+                "vertical field of view in degrees, for inputs without a camera");
     args.option("--rig", &job.rig, "parallel|offaxis (default parallel)");
     args.option("--eye", &job.eye, "which eye the input is: left|right (default left)");
     args.option("--warp", &job.warp, "grid|splat (default grid)");

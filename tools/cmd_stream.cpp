@@ -36,17 +36,22 @@ Status run_serve(const ServeJob& job) {
     if (job.pin.empty()) return Status::error("--pin is required");
     REPRISE_TRY(parse_size(job.size, o.width, o.height));
     o.fps = job.fps;
-    if (job.mode == "full") o.mode = net::StreamMode::Full;
-    else if (job.mode == "lowres") o.mode = net::StreamMode::LowRes;
-    else return Status::error("--mode must be full or lowres");
+    if (job.mode == "full")
+        o.mode = net::StreamMode::Full;
+    else if (job.mode == "lowres")
+        o.mode = net::StreamMode::LowRes;
+    else
+        return Status::error("--mode must be full or lowres");
     if (job.lowres != 2 && job.lowres != 4) return Status::error("--lowres must be 2 or 4");
     o.lowres_factor = job.lowres;
     o.max_sessions = job.max_sessions;
     if (job.qp < 0 || job.qp > 51) return Status::error("--qp must be 0..51");
     o.encoder.qp = job.qp;
-    if (job.bitrate < 0 || job.bitrate > 1000000) return Status::error("--bitrate must be 0..1000000 kbps");
+    if (job.bitrate < 0 || job.bitrate > 1000000)
+        return Status::error("--bitrate must be 0..1000000 kbps");
     o.bitrate_kbps = job.bitrate;
-    if (job.fec_group < 0 || job.fec_group > 255) return Status::error("--fec-group must be 0..255");
+    if (job.fec_group < 0 || job.fec_group > 255)
+        return Status::error("--fec-group must be 0..255");
     o.fec.group = job.fec_group;
     o.metrics_port = job.metrics_port;
     // The served scene must load before anyone connects.
@@ -55,9 +60,11 @@ Status run_serve(const ServeJob& job) {
     REPRISE_TRY(server::load_scene(job.scene, scene, path));
     std::unique_ptr<server::StreamServer> srv;
     REPRISE_TRY(server::StreamServer::create(o, srv));
-    std::fprintf(stderr, "[serve] %s on %s, %dx%d at %g Hz, %s mode%s\n", job.scene.c_str(), srv->local().text().c_str(),
-                 o.width, o.height, o.fps, job.mode.c_str(),
-                 o.metrics_port >= 0 ? (", metrics on 127.0.0.1:" + std::to_string(srv->metrics_port())).c_str() : "");
+    std::fprintf(stderr, "[serve] %s on %s, %dx%d at %g Hz, %s mode%s\n", job.scene.c_str(),
+                 srv->local().text().c_str(), o.width, o.height, o.fps, job.mode.c_str(),
+                 o.metrics_port >= 0
+                     ? (", metrics on 127.0.0.1:" + std::to_string(srv->metrics_port())).c_str()
+                     : "");
     std::signal(SIGINT, on_signal);
     std::signal(SIGTERM, on_signal);
     std::thread timer;
@@ -73,8 +80,11 @@ Status run_serve(const ServeJob& job) {
     g_stop.store(true);
     if (timer.joinable()) timer.join();
     const server::StreamServerStats st = srv->stats();
-    std::fprintf(stderr, "[serve] %zu sessions, %zu frames sent, %zu skipped, %.1f MB, %zu datagrams dropped\n",
-                 st.sessions_total, st.frames_sent, st.frames_skipped, st.bytes_sent / 1e6, st.dropped_datagrams);
+    std::fprintf(
+        stderr,
+        "[serve] %zu sessions, %zu frames sent, %zu skipped, %.1f MB, %zu datagrams dropped\n",
+        st.sessions_total, st.frames_sent, st.frames_skipped, st.bytes_sent / 1e6,
+        st.dropped_datagrams);
     return s;
 }
 
@@ -101,7 +111,8 @@ Status read_poses(const std::string& file, std::vector<std::pair<double, glm::ma
         fields >> t;
         for (int c = 0; c < 4; ++c)
             for (int r = 0; r < 4; ++r) fields >> m[c][r];
-        if (!fields || !std::isfinite(t)) return Status::error(file + ":" + std::to_string(number) + ": expected 17 numbers");
+        if (!fields || !std::isfinite(t))
+            return Status::error(file + ":" + std::to_string(number) + ": expected 17 numbers");
         if (!poses.empty() && t < poses.back().first)
             return Status::error(file + ":" + std::to_string(number) + ": times must not decrease");
         if (poses.size() >= 1000000) return Status::error(file + ": more than 10^6 poses");
@@ -117,14 +128,17 @@ Status run_connect(const ConnectJob& job) {
     if (job.pin.empty()) return Status::error("--pin is required");
     o.secret = job.pin;
     if (!job.scene.empty() && !net::valid_scene_name(job.scene))
-        return Status::error("--scene '" + job.scene + "': a name from the server's catalogue (1..32 of [a-z0-9_-]), never a path");
+        return Status::error(
+            "--scene '" + job.scene +
+            "': a name from the server's catalogue (1..32 of [a-z0-9_-]), never a path");
     o.scene = job.scene;
     o.extrapolate = !job.no_extrapolate;
     if (job.loss > 0 || job.delay > 0 || job.jitter > 0) {
         if (!(job.loss >= 0 && job.loss <= 1)) return Status::error("--loss must be in [0, 1]");
         o.inject_faults = true;
         o.downlink = {.loss = job.loss, .delay_ms = job.delay / 2, .jitter_ms = job.jitter};
-        o.uplink = {.loss = job.loss, .delay_ms = job.delay / 2, .jitter_ms = job.jitter, .seed = 2};
+        o.uplink = {
+            .loss = job.loss, .delay_ms = job.delay / 2, .jitter_ms = job.jitter, .seed = 2};
     }
     // The camera: a path of a built-in scene (the client's catalogue name) or a pose file.
     std::vector<std::pair<double, glm::mat4>> poses;
@@ -141,7 +155,8 @@ Status run_connect(const ConnectJob& job) {
     }
     std::unique_ptr<StreamWindow> window;
     if (job.window || job.interactive) {
-        const glm::mat4 start = poses.empty() ? server::camera_view(path, scene, 0.0) : poses.front().second;
+        const glm::mat4 start =
+            poses.empty() ? server::camera_view(path, scene, 0.0) : poses.front().second;
         REPRISE_TRY(StreamWindow::open(job.interactive, start, window));
     }
     double last_t = 0.0;
@@ -153,8 +168,9 @@ Status run_connect(const ConnectJob& job) {
             if (job.interactive) return window->view();
         }
         if (poses.empty()) return server::camera_view(path, scene, t);
-        auto it = std::upper_bound(poses.begin(), poses.end(), t,
-                                   [](double v, const std::pair<double, glm::mat4>& p) { return v < p.first; });
+        auto it = std::upper_bound(
+            poses.begin(), poses.end(), t,
+            [](double v, const std::pair<double, glm::mat4>& p) { return v < p.first; });
         return it == poses.begin() ? poses.front().second : std::prev(it)->second;
     };
     if (!job.out.empty()) {
@@ -167,34 +183,39 @@ Status run_connect(const ConnectJob& job) {
     std::ofstream log;
     if (!job.out.empty()) {
         log.open(job.out + "/display.csv");
-        log << "index,scene_time,pose_us,displayed_us,latency_ms,source_scene_time,source_latency_ms\n";
+        log << "index,scene_time,pose_us,displayed_us,latency_ms,source_scene_time,source_latency_"
+               "ms\n";
     }
     int index = 0;
     double latency_sum = 0.0;
     Status write_status;
     Frame out;
-    REPRISE_TRY(client::run_client(*c, job.duration, job.display_rate, pose,
-                                   [&](const Frame& f, const client::DisplayInfo& info, int64_t displayed_us) {
-        const double latency = (displayed_us - info.pose_us) / 1000.0;
-        latency_sum += latency;
-        if (!job.out.empty()) {
-            out = f;
-            out.camera.time = info.scene_time;
-            out.fps = job.display_rate;
-            write_status = write_frame(frame_path(job.out, index), out);
-            log << index << ',' << info.scene_time << ',' << info.pose_us << ',' << displayed_us << ',' << latency << ','
-                << info.source_scene_time << ',' << (displayed_us - info.source_pose_us) / 1000.0 << '\n';
-        }
-        if (window) window->show(f);
-        ++index;
-        return write_status.ok() && !g_stop.load() && window_open;
-    }));
+    REPRISE_TRY(client::run_client(
+        *c, job.duration, job.display_rate, pose,
+        [&](const Frame& f, const client::DisplayInfo& info, int64_t displayed_us) {
+            const double latency = (displayed_us - info.pose_us) / 1000.0;
+            latency_sum += latency;
+            if (!job.out.empty()) {
+                out = f;
+                out.camera.time = info.scene_time;
+                out.fps = job.display_rate;
+                write_status = write_frame(frame_path(job.out, index), out);
+                log << index << ',' << info.scene_time << ',' << info.pose_us << ',' << displayed_us
+                    << ',' << latency << ',' << info.source_scene_time << ','
+                    << (displayed_us - info.source_pose_us) / 1000.0 << '\n';
+            }
+            if (window) window->show(f);
+            ++index;
+            return write_status.ok() && !g_stop.load() && window_open;
+        }));
     REPRISE_TRY(write_status);
     const client::StreamClientStats& st = c->stats();
-    std::fprintf(stderr, "[connect] %d frames displayed, %zu decoded, %zu lost, %zu recovered by FEC, %zu connects, "
-                 "mean motion-to-photon %.2f ms, last round trip %.1f ms\n",
-                 index, st.frames_decoded, st.frames_lost, st.fec_recovered, st.connects,
-                 index ? latency_sum / index : 0.0, st.last_rtt_us / 1000.0);
+    std::fprintf(
+        stderr,
+        "[connect] %d frames displayed, %zu decoded, %zu lost, %zu recovered by FEC, %zu connects, "
+        "mean motion-to-photon %.2f ms, last round trip %.1f ms\n",
+        index, st.frames_decoded, st.frames_lost, st.fec_recovered, st.connects,
+        index ? latency_sum / index : 0.0, st.last_rtt_us / 1000.0);
     if (index == 0) return Status::error("no frame was decoded from " + job.server);
     return {};
 }
@@ -203,20 +224,27 @@ Status run_connect(const ConnectJob& job) {
 
 int command_serve(int argc, char** argv) {
     ServeJob job;
-    Args args("serve", "Serves a scene to streaming clients: renders from each client's pose, encodes, sends.");
-    args.option("--scene", &job.scene, "built-in scene or glTF file served by default (default pan)");
+    Args args(
+        "serve",
+        "Serves a scene to streaming clients: renders from each client's pose, encodes, sends.");
+    args.option("--scene", &job.scene,
+                "built-in scene or glTF file served by default (default pan)");
     args.option("--listen", &job.listen, "UDP address A.B.C.D:PORT (default 127.0.0.1:7000)");
     args.option("--pin", &job.pin, "PIN or token clients must know (required; never sent)");
     args.option("--fps", &job.fps, "server frame rate (default 30)");
     args.option("--size", &job.size, "WxH (default 640x360)");
     args.option("--mode", &job.mode, "full (default) or lowres");
-    args.option("--lowres", &job.lowres, "lowres mode: 2 or 4 pixels per colour sample (default 4)");
+    args.option("--lowres", &job.lowres,
+                "lowres mode: 2 or 4 pixels per colour sample (default 4)");
     args.option("--max-sessions", &job.max_sessions, "sessions at once (default 4)");
     args.option("--qp", &job.qp, "quantiser when no --bitrate (default 28)");
-    args.option("--bitrate", &job.bitrate, "start bitrate in kbps, adapted to loss (default 0: constant quality)");
-    args.option("--fec-group", &job.fec_group, "data fragments per parity fragment, 0 = no FEC (default 8)");
+    args.option("--bitrate", &job.bitrate,
+                "start bitrate in kbps, adapted to loss (default 0: constant quality)");
+    args.option("--fec-group", &job.fec_group,
+                "data fragments per parity fragment, 0 = no FEC (default 8)");
     args.option("--metrics-port", &job.metrics_port, "Prometheus text metrics on 127.0.0.1:PORT");
-    args.option("--duration", &job.duration, "stop after this many seconds (default: until SIGINT)");
+    args.option("--duration", &job.duration,
+                "stop after this many seconds (default: until SIGINT)");
     Status parsed = args.parse(argc, argv);
     if (!parsed.ok() || args.help_requested()) return report(args, parsed, {});
     return report(args, parsed, run_serve(job));
@@ -224,17 +252,23 @@ int command_serve(int argc, char** argv) {
 
 int command_connect(int argc, char** argv) {
     ConnectJob job;
-    Args args("connect", "Connects to `reprise serve`, shows the stream at the display rate, extrapolated to the newest pose.");
+    Args args("connect",
+              "Connects to `reprise serve`, shows the stream at the display rate, extrapolated to "
+              "the newest pose.");
     args.positional("HOST:PORT", &job.server, "server address");
     args.option("--pin", &job.pin, "the server's PIN or token (required)");
     args.option("--scene", &job.scene, "scene from the server's catalogue (default: the server's)");
     args.option("--display-rate", &job.display_rate, "display frames per second (default 120)");
-    args.option("--camera", &job.camera, "camera path spec of the scene (see reprise render --help)");
-    args.option("--poses", &job.poses, "pose file: lines 't m00 .. m33' (view matrix column by column)");
-    args.option("--out", &job.out, "write displayed frames as EXR (camera = pose, time = display time) + display.csv");
+    args.option("--camera", &job.camera,
+                "camera path spec of the scene (see reprise render --help)");
+    args.option("--poses", &job.poses,
+                "pose file: lines 't m00 .. m33' (view matrix column by column)");
+    args.option("--out", &job.out,
+                "write displayed frames as EXR (camera = pose, time = display time) + display.csv");
     args.option("--duration", &job.duration, "seconds (default 10)");
     args.flag("--window", &job.window, "show the displayed frames in an SDL2 window (Esc closes)");
-    args.flag("--interactive", &job.interactive, "window with a free camera: WASD, Q/E, arrows, mouse drag");
+    args.flag("--interactive", &job.interactive,
+              "window with a free camera: WASD, Q/E, arrows, mouse drag");
     args.flag("--no-extrapolate", &job.no_extrapolate, "show the newest decoded frame as it is");
     args.option("--loss", &job.loss, "fault injector: random loss each way (0..1)");
     args.option("--delay", &job.delay, "fault injector: round-trip delay in ms");

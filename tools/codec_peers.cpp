@@ -20,18 +20,24 @@ namespace {
 
 const char* encoder_name(PeerKind kind) {
     switch (kind) {
-        case PeerKind::X264: return "libx264";
-        case PeerKind::X265: return "libx265";
-        case PeerKind::SvtAv1: return "libsvtav1";
+        case PeerKind::X264:
+            return "libx264";
+        case PeerKind::X265:
+            return "libx265";
+        case PeerKind::SvtAv1:
+            return "libsvtav1";
     }
     return "";
 }
 
 const char* decoder_name(PeerKind kind) {
     switch (kind) {
-        case PeerKind::X264: return "h264";
-        case PeerKind::X265: return "hevc";
-        case PeerKind::SvtAv1: return "libdav1d";
+        case PeerKind::X264:
+            return "h264";
+        case PeerKind::X265:
+            return "hevc";
+        case PeerKind::SvtAv1:
+            return "libdav1d";
     }
     return "";
 }
@@ -68,7 +74,8 @@ int padded_side(PeerKind kind, int side) {
 Status open_encoder(const PeerConfig& config, int w, int h, double fps, CodecContext& out) {
     const std::string who = peer_name(config.kind) + ": ";
     const AVCodec* codec = avcodec_find_encoder_by_name(encoder_name(config.kind));
-    if (!codec) return Status::error(who + "libavcodec has no encoder " + encoder_name(config.kind));
+    if (!codec)
+        return Status::error(who + "libavcodec has no encoder " + encoder_name(config.kind));
     AVCodecContext* c = out.context = avcodec_alloc_context3(codec);
     if (!c) return Status::error(who + "avcodec_alloc_context3 failed");
     const int rate = std::max(1, int(std::lround(fps)));
@@ -108,7 +115,8 @@ Status open_encoder(const PeerConfig& config, int w, int h, double fps, CodecCon
 Status open_decoder(const PeerConfig& config, CodecContext& out) {
     const std::string who = peer_name(config.kind) + ": ";
     const AVCodec* codec = avcodec_find_decoder_by_name(decoder_name(config.kind));
-    if (!codec) return Status::error(who + "libavcodec has no decoder " + decoder_name(config.kind));
+    if (!codec)
+        return Status::error(who + "libavcodec has no decoder " + decoder_name(config.kind));
     AVCodecContext* c = out.context = avcodec_alloc_context3(codec);
     if (!c) return Status::error(who + "avcodec_alloc_context3 failed");
     c->thread_count = config.threads;
@@ -146,9 +154,12 @@ void pad(const Image<Rgb8>& frame, RgbBuffer& padded) {
 
 std::string peer_name(PeerKind kind) {
     switch (kind) {
-        case PeerKind::X264: return "x264";
-        case PeerKind::X265: return "x265";
-        case PeerKind::SvtAv1: return "svt-av1";
+        case PeerKind::X264:
+            return "x264";
+        case PeerKind::X265:
+            return "x265";
+        case PeerKind::SvtAv1:
+            return "svt-av1";
     }
     return "?";
 }
@@ -167,12 +178,14 @@ std::vector<PeerConfig> standard_peer_configs(int threads) {
     std::vector<PeerConfig> configs;
     for (const char* preset : {"ultrafast", "veryfast", "medium"})
         for (int crf : {20, 26, 32, 38})
-            configs.push_back({.kind = PeerKind::X264, .preset = preset, .crf = crf, .threads = threads});
+            configs.push_back(
+                {.kind = PeerKind::X264, .preset = preset, .crf = crf, .threads = threads});
     for (int crf : {20, 26, 32, 38})
         configs.push_back(
             {.kind = PeerKind::X265, .preset = "ultrafast", .crf = crf, .threads = threads});
     for (int crf : {28, 38, 48, 58})
-        configs.push_back({.kind = PeerKind::SvtAv1, .preset = "10", .crf = crf, .threads = threads});
+        configs.push_back(
+            {.kind = PeerKind::SvtAv1, .preset = "10", .crf = crf, .threads = threads});
     return configs;
 }
 
@@ -186,8 +199,7 @@ Status encode_decode_peer(const std::vector<Image<Rgb8>>& frames, const PeerConf
         return Status::error(who + "frame size " + std::to_string(w) + "x" + std::to_string(h) +
                              " outside 2x2..8192x8192");
     for (const Image<Rgb8>& f : frames)
-        if (f.width() != w || f.height() != h)
-            return Status::error(who + "frames differ in size");
+        if (f.width() != w || f.height() != h) return Status::error(who + "frames differ in size");
     if (config.threads < 1 || config.threads > 64)
         return Status::error(who + "threads must be in 1..64");
     if (config.kind == PeerKind::SvtAv1 && !std::getenv("SVT_LOG"))
@@ -200,8 +212,7 @@ Status encode_decode_peer(const std::vector<Image<Rgb8>>& frames, const PeerConf
     REPRISE_TRY(open_decoder(config, decoder));
     FrameOwner yuv, decoded;
     PacketOwner packet;
-    if (!yuv.frame || !decoded.frame || !packet.packet)
-        return Status::error(who + "out of memory");
+    if (!yuv.frame || !decoded.frame || !packet.packet) return Status::error(who + "out of memory");
     yuv.frame->format = AV_PIX_FMT_YUV420P;
     yuv.frame->width = pw;
     yuv.frame->height = ph;
@@ -280,9 +291,9 @@ Status encode_decode_peer(const std::vector<Image<Rgb8>>& frames, const PeerConf
             AVFrame* f = decoded.frame;
             if (f->width != pw || f->height != ph)
                 return Status::error(who + "decoded frame has another size");
-            to_rgb.context = sws_getCachedContext(to_rgb.context, pw, ph, AVPixelFormat(f->format),
-                                                  pw, ph, AV_PIX_FMT_RGB24, SWS_BICUBIC, nullptr,
-                                                  nullptr, nullptr);
+            to_rgb.context =
+                sws_getCachedContext(to_rgb.context, pw, ph, AVPixelFormat(f->format), pw, ph,
+                                     AV_PIX_FMT_RGB24, SWS_BICUBIC, nullptr, nullptr, nullptr);
             if (!to_rgb.context) return Status::error(who + "sws_getContext (YUV -> RGB) failed");
             uint8_t* dst[1] = {shown.row(0)};
             const int dst_stride[1] = {shown.stride};

@@ -29,11 +29,11 @@ std::string peer_setting(const PeerConfig& config);
 bool peer_available(PeerKind kind);
 
 struct PeerFrame {
-    std::size_t bytes = 0;    // the frame's packet
-    double encode_ms = 0.0;   // RGB -> YUV conversion, send_frame and receive_packet
-    double decode_ms = 0.0;   // send_packet, receive_frame and YUV -> RGB conversion
+    std::size_t bytes = 0;   // the frame's packet
+    double encode_ms = 0.0;  // RGB -> YUV conversion, send_frame and receive_packet
+    double decode_ms = 0.0;  // send_packet, receive_frame and YUV -> RGB conversion
     double encode_convert_ms = 0.0, decode_convert_ms = 0.0;  // the conversions alone
-    Image<Rgb8> decoded;      // same size as the input
+    Image<Rgb8> decoded;                                      // same size as the input
 };
 
 // Encodes `frames` (all the same size, at least 2x2) as one low-delay stream (tune

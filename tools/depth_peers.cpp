@@ -28,7 +28,7 @@ float from_code(uint32_t code, const RvlOptions& o) {
 }
 
 class NibbleWriter {
-  public:
+public:
     explicit NibbleWriter(std::vector<uint8_t>& out) : out_(out) {}
     void value(uint32_t v) {
         do {
@@ -42,7 +42,7 @@ class NibbleWriter {
         if (half_) out_.push_back(pending_);
     }
 
-  private:
+private:
     void put(uint32_t nibble) {
         if (!half_) {
             pending_ = uint8_t(nibble);
@@ -57,7 +57,7 @@ class NibbleWriter {
 };
 
 class NibbleReader {
-  public:
+public:
     explicit NibbleReader(std::span<const uint8_t> in) : in_(in) {}
     bool value(uint32_t& v) {
         v = 0;
@@ -74,7 +74,7 @@ class NibbleReader {
     // Whole bytes used (a last half byte is padding).
     std::size_t bytes_used() const { return (at_ + 1) / 2; }
 
-  private:
+private:
     std::span<const uint8_t> in_;
     std::size_t at_ = 0;  // in nibbles
 };
@@ -98,7 +98,8 @@ void zstd_compress_depth(std::span<const float> depth, int level, std::vector<ui
 Status zstd_decompress_depth(std::span<const uint8_t> in, std::size_t count,
                              std::vector<float>& out) {
     out.resize(count);
-    const std::size_t size = ZSTD_decompress(out.data(), count * sizeof(float), in.data(), in.size());
+    const std::size_t size =
+        ZSTD_decompress(out.data(), count * sizeof(float), in.data(), in.size());
     if (ZSTD_isError(size))
         return Status::error(std::string("zstd depth: ") + ZSTD_getErrorName(size));
     if (size != count * sizeof(float))
@@ -107,7 +108,8 @@ Status zstd_decompress_depth(std::span<const uint8_t> in, std::size_t count,
     return {};
 }
 
-void rvl_encode(std::span<const float> depth, const RvlOptions& options, std::vector<uint8_t>& out) {
+void rvl_encode(std::span<const float> depth, const RvlOptions& options,
+                std::vector<uint8_t>& out) {
     out.clear();
     NibbleWriter writer(out);
     uint32_t previous = 0;

@@ -5,11 +5,11 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/video/tracking.hpp>
 
-
 namespace reprise::cli {
 
 struct FlowMotion::State {
-    cv::Ptr<cv::DISOpticalFlow> flow = cv::DISOpticalFlow::create(cv::DISOpticalFlow::PRESET_MEDIUM);
+    cv::Ptr<cv::DISOpticalFlow> flow =
+        cv::DISOpticalFlow::create(cv::DISOpticalFlow::PRESET_MEDIUM);
     cv::Mat grey, previous_grey, backward;
 };
 
@@ -26,7 +26,8 @@ void FlowMotion::complete(Frame& frame) {
         for (int x = 0; x < w; ++x) {
             const glm::vec4 c = frame.color(x, y);
             const float luma = 0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b;
-            const float display = linear_to_srgb(std::isfinite(luma) ? std::clamp(luma, 0.0f, 1.0f) : 0.0f);
+            const float display =
+                linear_to_srgb(std::isfinite(luma) ? std::clamp(luma, 0.0f, 1.0f) : 0.0f);
             st.grey.at<uint8_t>(y, x) = uint8_t(display * 255.0f + 0.5f);
         }
     if (frame.motion.empty()) {

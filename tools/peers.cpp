@@ -155,7 +155,8 @@ void RenderedVectorsInterpolator::interpolate(const Frame& a, const Frame& b, fl
             for (int x = 0; x < w; ++x) {
                 const float z = f.depth(x, y);
                 const glm::vec2 to = glm::vec2(x + 0.5f, y + 0.5f) + factors[k] * f.motion(x, y);
-                if (!(z == z) || !(to.x >= 0.0f && to.y >= 0.0f && to.x < float(w) && to.y < float(h)))
+                if (!(z == z) ||
+                    !(to.x >= 0.0f && to.y >= 0.0f && to.x < float(w) && to.y < float(h)))
                     continue;
                 const int tx = int(to.x), ty = int(to.y);
                 if (!covered_[k](tx, ty) || z < depth_[k](tx, ty)) {
@@ -180,7 +181,8 @@ void RenderedVectorsInterpolator::interpolate(const Frame& a, const Frame& b, fl
                 c = in_a ? color_[0](x, y) : color_[1](x, y);
             }
             holes_(x, y) = !(in_a || in_b);
-            display(x, y) = glm::vec3(linear_to_srgb(c.r), linear_to_srgb(c.g), linear_to_srgb(c.b));
+            display(x, y) =
+                glm::vec3(linear_to_srgb(c.r), linear_to_srgb(c.g), linear_to_srgb(c.b));
         }
     inpaint_telea(display.view(), holes_.view());
 }

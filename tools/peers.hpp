@@ -24,14 +24,14 @@ Status ffmpeg_minterpolate(const std::vector<Image<Rgb8>>& input, int factor,
 // OpenCV's dense inverse search flow (preset MEDIUM) on grey levels, both ways between two
 // frames; an in-between frame warps both backwards along the scaled flow and blends them.
 class DisInterpolator {
-  public:
+public:
     DisInterpolator();
     ~DisInterpolator();
     void set_pair(ImageView<const Rgb8> a, ImageView<const Rgb8> b);
     // The frame at fraction s in (0, 1) from a to b, same size as the pair.
     void interpolate(float s, ImageView<Rgb8> out);
 
-  private:
+private:
     struct State;
     std::unique_ptr<State> state_;
 };
@@ -45,10 +45,10 @@ void inpaint_telea(ImageView<glm::vec3> display, ImageView<const uint8_t> holes)
 // winning, the two blended where they land within 2 % in depth, holes by Telea inpainting;
 // display values out.
 class RenderedVectorsInterpolator {
-  public:
+public:
     void interpolate(const Frame& a, const Frame& b, float s, Image<glm::vec3>& display);
 
-  private:
+private:
     Image<glm::vec3> color_[2];
     Image<float> depth_[2];
     Image<uint8_t> covered_[2], holes_;

@@ -141,8 +141,8 @@ std::string error_time_svg(const std::vector<ReportPoint>& points, const std::st
                "\" text-anchor=\"end\">" + format("%g", db) + "</text>\n";
     }
     svg += "<text x=\"" + format("%.1f", left + plot_w / 2) + "\" y=\"" +
-           format("%.1f", top + plot_h + 32) +
-           "\" text-anchor=\"middle\">" + escape(time_label) + "</text>\n";
+           format("%.1f", top + plot_h + 32) + "\" text-anchor=\"middle\">" + escape(time_label) +
+           "</text>\n";
     svg += "<text transform=\"translate(16 " + format("%.1f", top + plot_h / 2) +
            ") rotate(-90)\" text-anchor=\"middle\">PSNR, dB (higher is better)</text>\n";
 
@@ -258,10 +258,11 @@ std::string line_plot_svg(const std::vector<PlotSeries>& series, const PlotAxes&
     auto px = [&](double x) { return left + (xv(x) - x_lo) / (x_hi - x_lo) * plot_w; };
     auto py = [&](double y) { return top + (y_hi - y) / (y_hi - y_lo) * plot_h; };
     std::string svg = "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"" + format("%.0f", width) +
-                      "\" height=\"" + format("%.0f", height) + "\" font-family=\"sans-serif\" "
-                      "font-size=\"11\">\n<rect x=\"" + format("%.1f", left) + "\" y=\"" +
-                      format("%.1f", top) + "\" width=\"" + format("%.1f", plot_w) +
-                      "\" height=\"" + format("%.1f", plot_h) +
+                      "\" height=\"" + format("%.0f", height) +
+                      "\" font-family=\"sans-serif\" "
+                      "font-size=\"11\">\n<rect x=\"" +
+                      format("%.1f", left) + "\" y=\"" + format("%.1f", top) + "\" width=\"" +
+                      format("%.1f", plot_w) + "\" height=\"" + format("%.1f", plot_h) +
                       "\" fill=\"#fafafa\" stroke=\"#888\"/>\n";
     auto vline = [&](double x, const char* color) {
         svg += "<line x1=\"" + format("%.1f", x) + "\" y1=\"" + format("%.1f", top) + "\" x2=\"" +
@@ -295,8 +296,8 @@ std::string line_plot_svg(const std::vector<PlotSeries>& series, const PlotAxes&
                "</text>\n";
     }
     svg += "<text x=\"" + format("%.1f", left + plot_w / 2) + "\" y=\"" +
-           format("%.1f", top + plot_h + 30) + "\" text-anchor=\"middle\">" +
-           escape(axes.x_label) + (axes.log_x ? " (log scale)" : "") + "</text>\n";
+           format("%.1f", top + plot_h + 30) + "\" text-anchor=\"middle\">" + escape(axes.x_label) +
+           (axes.log_x ? " (log scale)" : "") + "</text>\n";
     svg += "<text transform=\"translate(16 " + format("%.1f", top + plot_h / 2) +
            ") rotate(-90)\" text-anchor=\"middle\">" + escape(axes.y_label) + "</text>\n";
     for (std::size_t k = 0; k < series.size(); ++k) {
@@ -313,21 +314,22 @@ std::string line_plot_svg(const std::vector<PlotSeries>& series, const PlotAxes&
                     format("%.4g", s.x[i]) + ", " + format("%.4g", s.y[i]) + "</title></circle>";
         }
         svg += "<path d=\"" + path + "\" fill=\"none\" stroke=\"" + color +
-               "\" stroke-width=\"1.5\"" + (s.dashed ? " stroke-dasharray=\"5 3\"" : "") +
-               "/>" + dots + "\n";
+               "\" stroke-width=\"1.5\"" + (s.dashed ? " stroke-dasharray=\"5 3\"" : "") + "/>" +
+               dots + "\n";
         const double lx = left + double(k % 4) * (plot_w / 4);
         const double ly = top + plot_h + 48 + 16 * double(k / 4);
-        svg += "<path d=\"M" + format("%.1f", lx) + " " + format("%.1f", ly - 4) + " h18\" stroke=\"" +
-               color + "\" stroke-width=\"2\"" + (s.dashed ? " stroke-dasharray=\"5 3\"" : "") +
-               "/><text x=\"" + format("%.1f", lx + 22) + "\" y=\"" + format("%.1f", ly) + "\">" +
-               escape(s.name) + "</text>\n";
+        svg += "<path d=\"M" + format("%.1f", lx) + " " + format("%.1f", ly - 4) +
+               " h18\" stroke=\"" + color + "\" stroke-width=\"2\"" +
+               (s.dashed ? " stroke-dasharray=\"5 3\"" : "") + "/><text x=\"" +
+               format("%.1f", lx + 22) + "\" y=\"" + format("%.1f", ly) + "\">" + escape(s.name) +
+               "</text>\n";
     }
     svg += "</svg>\n";
     return svg;
 }
 
-std::string bar_chart_svg(const std::vector<BarRow>& rows, const std::vector<std::string>& value_names,
-                          const std::string& unit) {
+std::string bar_chart_svg(const std::vector<BarRow>& rows,
+                          const std::vector<std::string>& value_names, const std::string& unit) {
     const std::size_t bars = std::max<std::size_t>(1, value_names.size());
     const double label_w = 230, width = 760, bar_h = 11, row_h = bar_h * double(bars) + 8;
     const double top = 24, plot_w = width - label_w - 90;
@@ -387,9 +389,10 @@ Status write_html_report(const std::string& path, const Report& report) {
         html += section.html;
         if (!section.points.empty()) html += error_time_svg(section.points, section.time_label);
         std::vector<std::size_t> front = pareto_front(section.points);
-        if (!section.points.empty()) html +=
-            "<table><tr><th>method</th><th>setting</th><th>PSNR dB</th><th>SSIM</th>"
-            "<th>FLIP</th><th>ms</th><th>Pareto</th></tr>\n";
+        if (!section.points.empty())
+            html +=
+                "<table><tr><th>method</th><th>setting</th><th>PSNR dB</th><th>SSIM</th>"
+                "<th>FLIP</th><th>ms</th><th>Pareto</th></tr>\n";
         for (std::size_t i = 0; i < section.points.size(); ++i) {
             const ReportPoint& p = section.points[i];
             const bool on_front = std::find(front.begin(), front.end(), i) != front.end();

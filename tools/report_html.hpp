@@ -64,8 +64,8 @@ struct BarRow {
     std::string label;
     std::vector<double> values;
 };
-std::string bar_chart_svg(const std::vector<BarRow>& rows, const std::vector<std::string>& value_names,
-                          const std::string& unit);
+std::string bar_chart_svg(const std::vector<BarRow>& rows,
+                          const std::vector<std::string>& value_names, const std::string& unit);
 
 Status write_html_report(const std::string& path, const Report& report);
 

@@ -36,12 +36,14 @@ struct StreamWindow::State {
 StreamWindow::StreamWindow() : state_(std::make_unique<State>()) {}
 StreamWindow::~StreamWindow() = default;
 
-Status StreamWindow::open(bool interactive, const glm::mat4& start_view, std::unique_ptr<StreamWindow>& window) {
-    if (SDL_InitSubSystem(SDL_INIT_VIDEO) != 0) return Status::error(std::string("SDL2: ") + SDL_GetError());
+Status StreamWindow::open(bool interactive, const glm::mat4& start_view,
+                          std::unique_ptr<StreamWindow>& window) {
+    if (SDL_InitSubSystem(SDL_INIT_VIDEO) != 0)
+        return Status::error(std::string("SDL2: ") + SDL_GetError());
     std::unique_ptr<StreamWindow> w(new StreamWindow());
     State& s = *w->state_;
-    s.window = SDL_CreateWindow("reprise connect", SDL_WINDOWPOS_UNDEFINED, SDL_WINDOWPOS_UNDEFINED, 960, 540,
-                                SDL_WINDOW_RESIZABLE);
+    s.window = SDL_CreateWindow("reprise connect", SDL_WINDOWPOS_UNDEFINED, SDL_WINDOWPOS_UNDEFINED,
+                                960, 540, SDL_WINDOW_RESIZABLE);
     if (!s.window) return Status::error(std::string("SDL2 window: ") + SDL_GetError());
     s.renderer = SDL_CreateRenderer(s.window, -1, 0);
     if (!s.renderer) return Status::error(std::string("SDL2 renderer: ") + SDL_GetError());
@@ -92,13 +94,15 @@ void StreamWindow::show(const Frame& frame) {
     const int w = frame.width(), h = frame.height();
     if (!s.texture || s.tw != w || s.th != h) {
         if (s.texture) SDL_DestroyTexture(s.texture);
-        s.texture = SDL_CreateTexture(s.renderer, SDL_PIXELFORMAT_RGB24, SDL_TEXTUREACCESS_STREAMING, w, h);
+        s.texture =
+            SDL_CreateTexture(s.renderer, SDL_PIXELFORMAT_RGB24, SDL_TEXTUREACCESS_STREAMING, w, h);
         s.tw = w, s.th = h;
         s.pixels = Image<Rgb8>(w, h);
     }
     if (!s.texture) return;
     visualize_color(frame.color.view(), s.pixels.view());
-    SDL_UpdateTexture(s.texture, nullptr, s.pixels.data(), int(s.pixels.view().stride * sizeof(Rgb8)));
+    SDL_UpdateTexture(s.texture, nullptr, s.pixels.data(),
+                      int(s.pixels.view().stride * sizeof(Rgb8)));
     SDL_RenderClear(s.renderer);
     SDL_RenderCopy(s.renderer, s.texture, nullptr, nullptr);
     SDL_RenderPresent(s.renderer);

@@ -11,7 +11,8 @@ namespace reprise::cli {
 class StreamWindow {
 public:
     // Fails (a Status, no crash) where SDL2 finds no display.
-    static Status open(bool interactive, const glm::mat4& start_view, std::unique_ptr<StreamWindow>& window);
+    static Status open(bool interactive, const glm::mat4& start_view,
+                       std::unique_ptr<StreamWindow>& window);
     ~StreamWindow();
 
     // Handles pending events and moves the camera by `dt` seconds; false once the window closed.

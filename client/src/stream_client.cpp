@@ -56,8 +56,10 @@ struct StreamClient::State {
     State(const StreamClientOptions& o) : options(o), uplink(o.uplink), downlink(o.downlink) {}
 
     void transmit(std::span<const uint8_t> d, int64_t now) {
-        if (options.inject_faults) uplink.submit(d, now);
-        else socket.send_to(d, options.server);
+        if (options.inject_faults)
+            uplink.submit(d, now);
+        else
+            socket.send_to(d, options.server);
     }
 
     void send_sealed(std::span<const uint8_t> plain, int64_t now) {
@@ -113,14 +115,16 @@ struct StreamClient::State {
     void on_packet(const net::Reassembled& packet, int64_t now) {
         // Frames between the previous completed one and this one will never come.
         abandoned.clear();
-        for (int64_t f = newest_completed + 1; f < int64_t(packet.frame) && abandoned.size() < 64; ++f)
+        for (int64_t f = newest_completed + 1; f < int64_t(packet.frame) && abandoned.size() < 64;
+             ++f)
             abandoned.push_back(uint32_t(f));
         if (!abandoned.empty()) report_lost(abandoned, now);
         newest_completed = packet.frame;
         const bool lowres = have_info && info.mode == net::StreamMode::LowRes;
         std::span<const uint8_t> geometry = packet.data, colour;
         bool ok = !lowres || split_bundle(packet.data, geometry, colour);
-        ok = ok && decoder->send_packet(geometry).ok() && decoder->receive_frame(scratch_decoded) == codec::Result::Ok;
+        ok = ok && decoder->send_packet(geometry).ok() &&
+             decoder->receive_frame(scratch_decoded) == codec::Result::Ok;
         if (ok && lowres)
             ok = colour_decoder->send_packet(colour).ok() &&
                  colour_decoder->receive_frame(low_decoded) == codec::Result::Ok;
@@ -135,12 +139,14 @@ struct StreamClient::State {
             // Herzog 2010: the low-resolution colour to full resolution, guided by the decoded
             // full-resolution depth and motion; the jitter comes with the colour stream's camera.
             const int w = scratch_decoded.width(), h = scratch_decoded.height();
-            const glm::vec2 footprint(float(w) / float(low_decoded.width()), float(h) / float(low_decoded.height()));
+            const glm::vec2 footprint(float(w) / float(low_decoded.width()),
+                                      float(h) / float(low_decoded.height()));
             const GBufferView guides{.depth = scratch_decoded.depth.view(),
                                      .motion = scratch_decoded.motion.view(),
                                      .camera = scratch_decoded.camera};
             upsampled.resize(w, h);
-            upsampler.upsample(low_decoded.color.view(), low_decoded.camera.jitter * footprint, guides, upsampled.view());
+            upsampler.upsample(low_decoded.color.view(), low_decoded.camera.jitter * footprint,
+                               guides, upsampled.view());
             std::swap(upsampled, scratch_decoded.color);
         }
         consecutive_decode_errors = 0;
@@ -182,7 +188,8 @@ struct StreamClient::State {
                 ++stats.datagrams_dropped;
                 return;
             }
-            channel = net::SecureChannel(handshake.connection(), keys.client_to_server, keys.server_to_client);
+            channel = net::SecureChannel(handshake.connection(), keys.client_to_server,
+                                         keys.server_to_client);
             phase = Phase::Finished;
             phase_started_us = last_sent_hello_us = now;
             stats.auth_failures = 0;
@@ -191,7 +198,8 @@ struct StreamClient::State {
             send_start(now);
             return;
         }
-        if (h.type != net::DatagramType::Sealed || phase < Phase::Finished || !channel.open(d, plaintext).ok()) {
+        if (h.type != net::DatagramType::Sealed || phase < Phase::Finished ||
+            !channel.open(d, plaintext).ok()) {
             ++stats.datagrams_dropped;
             return;
         }
@@ -202,44 +210,48 @@ struct StreamClient::State {
         net::MessageType type;
         if (!net::message_type(plaintext, type).ok()) return;
         switch (type) {
-        case net::MessageType::StreamInfo: {
-            net::StreamInfoMessage m;
-            if (!net::parse(plaintext, m).ok()) return;
-            info = m;
-            have_info = true;
-            if (phase == Phase::Finished) {
-                phase = Phase::Streaming;
-                ++stats.connects;
+            case net::MessageType::StreamInfo: {
+                net::StreamInfoMessage m;
+                if (!net::parse(plaintext, m).ok()) return;
+                info = m;
+                have_info = true;
+                if (phase == Phase::Finished) {
+                    phase = Phase::Streaming;
+                    ++stats.connects;
+                }
+                break;
             }
-            break;
-        }
-        case net::MessageType::Fragment: {
-            net::FragmentMessage m;
-            if (!net::parse(plaintext, m).ok()) return;
-            net::Reassembled packet;
-            abandoned.clear();
-            const bool done = reassembler->add(m, packet, abandoned);
-            if (!abandoned.empty()) report_lost(abandoned, now);
-            if (done) on_packet(packet, now);
-            stats.fec_recovered = reassembler->stats().recovered;
-            break;
-        }
-        case net::MessageType::Error: {
-            std::string text;
-            if (net::parse_error(plaintext, text).ok()) stats.refused = text;
-            phase = Phase::Idle;
-            break;
-        }
-        case net::MessageType::Bye: phase = Phase::Idle; break;
-        default: break;
+            case net::MessageType::Fragment: {
+                net::FragmentMessage m;
+                if (!net::parse(plaintext, m).ok()) return;
+                net::Reassembled packet;
+                abandoned.clear();
+                const bool done = reassembler->add(m, packet, abandoned);
+                if (!abandoned.empty()) report_lost(abandoned, now);
+                if (done) on_packet(packet, now);
+                stats.fec_recovered = reassembler->stats().recovered;
+                break;
+            }
+            case net::MessageType::Error: {
+                std::string text;
+                if (net::parse_error(plaintext, text).ok()) stats.refused = text;
+                phase = Phase::Idle;
+                break;
+            }
+            case net::MessageType::Bye:
+                phase = Phase::Idle;
+                break;
+            default:
+                break;
         }
     }
 
     void send_report(int64_t now) {
         const uint64_t newest = channel.newest_received();
-        net::ReceiverReportMessage m{.received = uint32_t(received_sealed),
-                                     .missing = uint32_t(newest > received_sealed ? newest - received_sealed : 0),
-                                     .rtt_us = uint32_t(std::clamp<int64_t>(stats.last_rtt_us, 0, 1'000'000'000))};
+        net::ReceiverReportMessage m{
+            .received = uint32_t(received_sealed),
+            .missing = uint32_t(newest > received_sealed ? newest - received_sealed : 0),
+            .rtt_us = uint32_t(std::clamp<int64_t>(stats.last_rtt_us, 0, 1'000'000'000))};
         message.resize(net::kMaxPlaintext);
         message.resize(net::encode(m, message));
         send_sealed(message, now);
@@ -250,9 +262,11 @@ struct StreamClient::State {
 StreamClient::StreamClient() = default;
 StreamClient::~StreamClient() = default;
 
-Status StreamClient::create(const StreamClientOptions& options, std::unique_ptr<StreamClient>& client) {
+Status StreamClient::create(const StreamClientOptions& options,
+                            std::unique_ptr<StreamClient>& client) {
     REPRISE_TRY(net::init_crypto());
-    if (options.secret.empty() || options.secret.size() > 255) return Status::error("--pin: 1..255 characters");
+    if (options.secret.empty() || options.secret.size() > 255)
+        return Status::error("--pin: 1..255 characters");
     if (!options.scene.empty() && !net::valid_scene_name(options.scene))
         return Status::error("--scene: a catalogue name (1..32 of [a-z0-9_-]), never a path");
     if (options.server.port == 0) return Status::error("server address: port 0");
@@ -266,42 +280,51 @@ Status StreamClient::create(const StreamClientOptions& options, std::unique_ptr<
 Status StreamClient::poll(int64_t now) {
     State& s = *state_;
     if (s.stats.auth_failures >= std::size_t(s.options.max_auth_failures))
-        return Status::error("the server rejected the key confirmation " + std::to_string(s.stats.auth_failures) +
-                             " times (wrong PIN?)");
-    if (!s.stats.refused.empty()) return Status::error("the server refused the session: " + s.stats.refused);
+        return Status::error("the server rejected the key confirmation " +
+                             std::to_string(s.stats.auth_failures) + " times (wrong PIN?)");
+    if (!s.stats.refused.empty())
+        return Status::error("the server refused the session: " + s.stats.refused);
     // Uplink faults: datagrams leave when the simulated link delivers them.
     if (s.options.inject_faults)
         while (s.uplink.deliver(now, s.datagram)) s.socket.send_to(s.datagram, s.options.server);
     net::Endpoint from;
     for (int i = 0; i < 4096 && s.socket.receive(s.datagram, from, net::kMaxDatagram); ++i) {
         if (!(from == s.options.server)) continue;
-        if (s.options.inject_faults) s.downlink.submit(s.datagram, now);
-        else s.on_datagram(s.datagram, now);
+        if (s.options.inject_faults)
+            s.downlink.submit(s.datagram, now);
+        else
+            s.on_datagram(s.datagram, now);
     }
     if (s.options.inject_faults)
         while (s.downlink.deliver(now, s.datagram)) s.on_datagram(s.datagram, now);
 
     switch (s.phase) {
-    case Phase::Idle: s.start_handshake(now); break;
-    case Phase::HelloSent:
-        if (now - s.phase_started_us > kHandshakeGiveUpUs) s.start_handshake(now);
-        else if (now - s.last_sent_hello_us > kHelloRetryUs) {
-            s.last_sent_hello_us = now;
-            s.transmit(s.hello, now);
-        }
-        break;
-    case Phase::Finished:
-        if (now - s.phase_started_us > kHandshakeGiveUpUs) s.start_handshake(now);
-        else if (now - s.last_sent_hello_us > kHelloRetryUs) {
-            s.last_sent_hello_us = now;
-            s.transmit(s.finish_datagram, now);
-            s.send_start(now);
-        }
-        break;
-    case Phase::Streaming:
-        if (now - s.last_heard_us > int64_t(s.options.reconnect_after_s * 1e6)) s.start_handshake(now);
-        else if (now - s.last_report_us > kReportIntervalUs) s.send_report(now);
-        break;
+        case Phase::Idle:
+            s.start_handshake(now);
+            break;
+        case Phase::HelloSent:
+            if (now - s.phase_started_us > kHandshakeGiveUpUs)
+                s.start_handshake(now);
+            else if (now - s.last_sent_hello_us > kHelloRetryUs) {
+                s.last_sent_hello_us = now;
+                s.transmit(s.hello, now);
+            }
+            break;
+        case Phase::Finished:
+            if (now - s.phase_started_us > kHandshakeGiveUpUs)
+                s.start_handshake(now);
+            else if (now - s.last_sent_hello_us > kHelloRetryUs) {
+                s.last_sent_hello_us = now;
+                s.transmit(s.finish_datagram, now);
+                s.send_start(now);
+            }
+            break;
+        case Phase::Streaming:
+            if (now - s.last_heard_us > int64_t(s.options.reconnect_after_s * 1e6))
+                s.start_handshake(now);
+            else if (now - s.last_report_us > kReportIntervalUs)
+                s.send_report(now);
+            break;
     }
     return {};
 }
@@ -309,8 +332,10 @@ Status StreamClient::poll(int64_t now) {
 void StreamClient::wait(int64_t timeout_us) {
     State& s = *state_;
     if (s.options.inject_faults) {
-        const int64_t due = std::min(s.uplink.next_due(net::now_us()) < 0 ? timeout_us : s.uplink.next_due(net::now_us()),
-                                     s.downlink.next_due(net::now_us()) < 0 ? timeout_us : s.downlink.next_due(net::now_us()));
+        const int64_t due = std::min(
+            s.uplink.next_due(net::now_us()) < 0 ? timeout_us : s.uplink.next_due(net::now_us()),
+            s.downlink.next_due(net::now_us()) < 0 ? timeout_us
+                                                   : s.downlink.next_due(net::now_us()));
         timeout_us = std::min(timeout_us, due);
     }
     if (timeout_us > 0) s.socket.wait_readable(timeout_us);
@@ -319,13 +344,17 @@ void StreamClient::wait(int64_t timeout_us) {
 void StreamClient::send_pose(const glm::mat4& view, double scene_time, int64_t now_us) {
     State& s = *state_;
     if (s.phase != Phase::Streaming) return;
-    net::PoseMessage m{.sequence = ++s.pose_sequence, .client_time_us = now_us, .scene_time = scene_time, .view = view};
+    net::PoseMessage m{.sequence = ++s.pose_sequence,
+                       .client_time_us = now_us,
+                       .scene_time = scene_time,
+                       .view = view};
     s.message.resize(net::kMaxPlaintext);
     s.message.resize(net::encode(m, s.message));
     s.send_sealed(s.message, now_us);
 }
 
-const Frame* StreamClient::display(const glm::mat4& view, double scene_time, int64_t pose_us, DisplayInfo& info) {
+const Frame* StreamClient::display(const glm::mat4& view, double scene_time, int64_t pose_us,
+                                   DisplayInfo& info) {
     State& s = *state_;
     if (!s.have_decoded) return nullptr;
     const Frame& f = s.decoded;
@@ -345,14 +374,20 @@ const Frame* StreamClient::display(const glm::mat4& view, double scene_time, int
 }
 
 bool StreamClient::connected() const { return state_->phase == Phase::Streaming; }
-const net::StreamInfoMessage* StreamClient::stream_info() const { return state_->have_info ? &state_->info : nullptr; }
+const net::StreamInfoMessage* StreamClient::stream_info() const {
+    return state_->have_info ? &state_->info : nullptr;
+}
 const StreamClientStats& StreamClient::stats() const { return state_->stats; }
-const Frame* StreamClient::newest_decoded() const { return state_->have_decoded ? &state_->decoded : nullptr; }
+const Frame* StreamClient::newest_decoded() const {
+    return state_->have_decoded ? &state_->decoded : nullptr;
+}
 
-Status run_client(StreamClient& client, double duration_s, double display_rate, const PoseFunction& pose,
-                  const ShowFunction& show) {
-    if (!(display_rate > 0 && display_rate <= 1000)) return Status::error("--display-rate must be in (0, 1000]");
-    if (!(duration_s > 0 && duration_s <= 1e6)) return Status::error("--duration must be in (0, 1e6]");
+Status run_client(StreamClient& client, double duration_s, double display_rate,
+                  const PoseFunction& pose, const ShowFunction& show) {
+    if (!(display_rate > 0 && display_rate <= 1000))
+        return Status::error("--display-rate must be in (0, 1000]");
+    if (!(duration_s > 0 && duration_s <= 1e6))
+        return Status::error("--duration must be in (0, 1e6]");
     const int64_t start = net::now_us();
     const int64_t period = int64_t(1e6 / display_rate);
     int64_t tick = 0;

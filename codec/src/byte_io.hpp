@@ -15,10 +15,21 @@ public:
     void u16(uint16_t v) { put(v, 2); }
     void u32(uint32_t v) { put(v, 4); }
     void u64(uint64_t v) { put(v, 8); }
-    void f32(float v) { uint32_t u; std::memcpy(&u, &v, 4); u32(u); }
-    void f64(double v) { uint64_t u; std::memcpy(&u, &v, 8); u64(u); }
+    void f32(float v) {
+        uint32_t u;
+        std::memcpy(&u, &v, 4);
+        u32(u);
+    }
+    void f64(double v) {
+        uint64_t u;
+        std::memcpy(&u, &v, 8);
+        u64(u);
+    }
     void varint(uint64_t v) {
-        while (v >= 0x80) { out_.push_back(uint8_t(v | 0x80)); v >>= 7; }
+        while (v >= 0x80) {
+            out_.push_back(uint8_t(v | 0x80));
+            v >>= 7;
+        }
         out_.push_back(uint8_t(v));
     }
     void bytes(std::span<const uint8_t> b) { out_.insert(out_.end(), b.begin(), b.end()); }
@@ -39,8 +50,18 @@ public:
     uint16_t u16() { return uint16_t(get(2)); }
     uint32_t u32() { return uint32_t(get(4)); }
     uint64_t u64() { return get(8); }
-    float f32() { uint32_t u = u32(); float v; std::memcpy(&v, &u, 4); return v; }
-    double f64() { uint64_t u = u64(); double v; std::memcpy(&v, &u, 8); return v; }
+    float f32() {
+        uint32_t u = u32();
+        float v;
+        std::memcpy(&v, &u, 4);
+        return v;
+    }
+    double f64() {
+        uint64_t u = u64();
+        double v;
+        std::memcpy(&v, &u, 8);
+        return v;
+    }
     uint64_t varint() {
         uint64_t v = 0;
         for (int shift = 0; shift < 64; shift += 7) {
@@ -53,7 +74,10 @@ public:
     }
     // The next n bytes (empty and failed when fewer remain).
     std::span<const uint8_t> bytes(uint64_t n) {
-        if (!ok_ || n > remaining()) { fail("needs " + std::to_string(n) + " bytes"); return {}; }
+        if (!ok_ || n > remaining()) {
+            fail("needs " + std::to_string(n) + " bytes");
+            return {};
+        }
         auto s = in_.subspan(pos_, std::size_t(n));
         pos_ += std::size_t(n);
         return s;
@@ -70,8 +94,8 @@ public:
 private:
     uint64_t get(int n) {
         if (!ok_ || remaining() < std::size_t(n)) {
-            fail("truncated (needs " + std::to_string(n) + " bytes, " + std::to_string(remaining()) +
-                 " left)");
+            fail("truncated (needs " + std::to_string(n) + " bytes, " +
+                 std::to_string(remaining()) + " left)");
             return 0;
         }
         uint64_t v = 0;

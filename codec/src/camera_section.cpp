@@ -84,7 +84,9 @@ Status decode_camera(std::span<const uint8_t> in, const Picture* ref, Camera& c,
     time = r.f64();
     c.time = time;
     if (!r.ok()) return Status::error(r.error());
-    if (r.remaining()) return Status::error("camera section: " + std::to_string(r.remaining()) + " bytes left over");
+    if (r.remaining())
+        return Status::error("camera section: " + std::to_string(r.remaining()) +
+                             " bytes left over");
     return {};
 }
 

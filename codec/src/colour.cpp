@@ -78,8 +78,10 @@ void planes_from_linear(ImageView<const glm::vec4> color, const SequenceParams& 
                 const int y = std::min(h - 1, 2 * r + i);
                 const glm::vec4* src = color.row(y);
                 int16_t* py = out.p[0].data() + std::size_t(y) * pw;
-                int16_t* pco = sub ? co_rows.data() + std::size_t(i) * w : out.p[1].data() + std::size_t(y) * cpw;
-                int16_t* pcg = sub ? cg_rows.data() + std::size_t(i) * w : out.p[2].data() + std::size_t(y) * cpw;
+                int16_t* pco = sub ? co_rows.data() + std::size_t(i) * w
+                                   : out.p[1].data() + std::size_t(y) * cpw;
+                int16_t* pcg = sub ? cg_rows.data() + std::size_t(i) * w
+                                   : out.p[2].data() + std::size_t(y) * cpw;
                 for (int x = 0; x < w; ++x) {
                     const int R = encode(src[x].r), G = encode(src[x].g), B = encode(src[x].b);
                     const int co = R - B;
@@ -96,8 +98,10 @@ void planes_from_linear(ImageView<const glm::vec4> color, const SequenceParams& 
             int16_t* pcg = out.p[2].data() + std::size_t(r) * cpw;
             for (int cx = 0; cx < cw; ++cx) {
                 const int x0 = 2 * cx, x1 = std::min(w - 1, 2 * cx + 1);
-                pco[cx] = int16_t((co_rows[x0] + co_rows[x1] + co_rows[w + x0] + co_rows[w + x1] + 2) >> 2);
-                pcg[cx] = int16_t((cg_rows[x0] + cg_rows[x1] + cg_rows[w + x0] + cg_rows[w + x1] + 2) >> 2);
+                pco[cx] = int16_t(
+                    (co_rows[x0] + co_rows[x1] + co_rows[w + x0] + co_rows[w + x1] + 2) >> 2);
+                pcg[cx] = int16_t(
+                    (cg_rows[x0] + cg_rows[x1] + cg_rows[w + x0] + cg_rows[w + x1] + 2) >> 2);
             }
         }
     });
@@ -108,13 +112,14 @@ void planes_from_linear(ImageView<const glm::vec4> color, const SequenceParams& 
         for (int y = 0; y < rh; ++y)
             for (int x = rw; x < p.width(); ++x) p(x, y) = p(rw - 1, y);
         for (int y = rh; y < p.height(); ++y)
-            std::copy(p.data() + std::size_t(rh - 1) * p.width(), p.data() + std::size_t(rh) * p.width(),
+            std::copy(p.data() + std::size_t(rh - 1) * p.width(),
+                      p.data() + std::size_t(rh) * p.width(),
                       p.data() + std::size_t(y) * p.width());
     }
 }
 
-void linear_from_planes(const Planes& planes, const SequenceParams& sp, ImageView<const float> depth,
-                        Image<glm::vec4>& out) {
+void linear_from_planes(const Planes& planes, const SequenceParams& sp,
+                        ImageView<const float> depth, Image<glm::vec4>& out) {
     const int w = sp.width, h = sp.height, cw = sp.chroma_width(), ch = sp.chroma_height();
     ensure_size(out, w, h);
     const auto& lut = srgb_to_linear_table();
@@ -133,9 +138,11 @@ void linear_from_planes(const Planes& planes, const SequenceParams& sp, ImageVie
                     int cx, nx;
                     chroma_taps(x, cw, cx, nx);
                     co = (9 * co_plane(cx, cy) + 3 * co_plane(nx, cy) + 3 * co_plane(cx, ny) +
-                          co_plane(nx, ny) + 8) >> 4;
+                          co_plane(nx, ny) + 8) >>
+                         4;
                     cg = (9 * cg_plane(cx, cy) + 3 * cg_plane(nx, cy) + 3 * cg_plane(cx, ny) +
-                          cg_plane(nx, ny) + 8) >> 4;
+                          cg_plane(nx, ny) + 8) >>
+                         4;
                 } else {
                     co = co_plane(x, y);
                     cg = cg_plane(x, y);

@@ -44,7 +44,8 @@ Geometry geometry(const SequenceParams& sp) {
 
 // Intra prediction of the 8x8 block at (bx, by) of plane `rec` from its decoded top row (when
 // by > top, the slice's first row in this plane) and left column.
-void intra_predict(const Image<int16_t>& rec, int bx, int by, int top, int mode, int neutral, Block& pred) {
+void intra_predict(const Image<int16_t>& rec, int bx, int by, int top, int mode, int neutral,
+                   Block& pred) {
     const bool has_top = by > top, has_left = bx > 0;
     int t[8], l[8];
     int sum = 0, count = 0;
@@ -71,9 +72,12 @@ void intra_predict(const Image<int16_t>& rec, int bx, int by, int top, int mode,
     for (int y = 0; y < 8; ++y)
         for (int x = 0; x < 8; ++x) {
             int v = dc;
-            if (mode == 1) v = t[x];
-            else if (mode == 2) v = l[y];
-            else if (mode == 3) v = (t[x] + l[y] + 1) >> 1;
+            if (mode == 1)
+                v = t[x];
+            else if (mode == 2)
+                v = l[y];
+            else if (mode == 3)
+                v = (t[x] + l[y] + 1) >> 1;
             pred[y * 8 + x] = v;
         }
 }
@@ -112,7 +116,8 @@ bool decode_levels(RangeDecoder& rc, Models& m, int type, Block& levels) {
         uint32_t a = 1;
         if (rc.bit(m.greater1[type][i == 0 ? 0 : i < 6 ? 1 : 2])) {
             uint32_t rest = 0;
-            if (!decode_uint(rc, m.remaining[type], rest) || rest > uint32_t(kMaxLevel)) return false;
+            if (!decode_uint(rc, m.remaining[type], rest) || rest > uint32_t(kMaxLevel))
+                return false;
             a = rest + 2;
         }
         levels[kZigzag[i]] = rc.bypass() ? -int32_t(a) : int32_t(a);
@@ -120,7 +125,8 @@ bool decode_levels(RangeDecoder& rc, Models& m, int type, Block& levels) {
     return true;
 }
 
-void store(Image<int16_t>& p, int bx, int by, const Block& pred, const Block* residual, int lo, int hi) {
+void store(Image<int16_t>& p, int bx, int by, const Block& pred, const Block* residual, int lo,
+           int hi) {
     for (int y = 0; y < 8; ++y)
         for (int x = 0; x < 8; ++x) {
             const int v = pred[y * 8 + x] + (residual ? (*residual)[y * 8 + x] : 0);
@@ -172,8 +178,8 @@ int sad(const Block& a, const Block& b) {
 
 // The decoded block: prediction plus the dequantised, inverse-transformed levels (none: the
 // prediction alone, which counts as skipped for inter blocks).
-void reconstruct(SliceJob& j, int k, int bx, int by, const Block& pred, const Block* levels, bool intra,
-                 int32_t scale, int lo) {
+void reconstruct(SliceJob& j, int k, int bx, int by, const Block& pred, const Block* levels,
+                 bool intra, int32_t scale, int lo) {
     if (!levels) {
         store(j.out->p[k], bx, by, pred, nullptr, lo, 255);
         j.skipped += !intra;
@@ -224,7 +230,8 @@ bool code_slice(SliceJob& j, Coder& rc) {
                         load(j.predicted->p[k], bx, by, pred);
                         inter_sad += sad(src, pred);
                         samples += 64;
-                        for (int i = 0; i < 64 && all_within; ++i) all_within = std::abs(src[i] - pred[i]) <= limit;
+                        for (int i = 0; i < 64 && all_within; ++i)
+                            all_within = std::abs(src[i] - pred[i]) <= limit;
                     });
                     skip = all_within;
                     if (!skip && inter_sad > 2 * samples) {
@@ -234,7 +241,8 @@ bool code_slice(SliceJob& j, Coder& rc) {
                             load(j.source->p[k], bx, by, src);
                             int best = 1 << 30;
                             for (int mode = 0; mode < kModes; ++mode) {
-                                intra_predict(j.source->p[k], bx, by, j.mb_y0 * 8 * n, mode, k ? 0 : 128, pred2);
+                                intra_predict(j.source->p[k], bx, by, j.mb_y0 * 8 * n, mode,
+                                              k ? 0 : 128, pred2);
                                 best = std::min(best, sad(src, pred2));
                             }
                             intra_sad += best;
@@ -276,7 +284,8 @@ bool code_slice(SliceJob& j, Coder& rc) {
                         if (intra) {
                             int best = 1 << 30;
                             for (int candidate = 0; candidate < kModes; ++candidate) {
-                                intra_predict(j.out->p[k], bx, by, top, candidate, k ? 0 : 128, pred2);
+                                intra_predict(j.out->p[k], bx, by, top, candidate, k ? 0 : 128,
+                                              pred2);
                                 const int s = sad(src, pred2);
                                 if (s < best) {
                                     best = s;
@@ -292,7 +301,8 @@ bool code_slice(SliceJob& j, Coder& rc) {
                         bool coded = true;
                         if (!intra) {
                             bool within = true;
-                            for (int i = 0; i < 64 && within; ++i) within = std::abs(src[i] - pred[i]) <= limit;
+                            for (int i = 0; i < 64 && within; ++i)
+                                within = std::abs(src[i] - pred[i]) <= limit;
                             coded = !within;
                         }
                         int nonzero = 0;
@@ -308,7 +318,8 @@ bool code_slice(SliceJob& j, Coder& rc) {
                         rc.bit(m.cbf[type], nonzero > 0);
                         j.mark(k, bx, by, intra || nonzero);
                         if (nonzero) code_levels(rc, m, type, levels);
-                        reconstruct(j, k, bx, by, pred, nonzero ? &levels : nullptr, intra, scale, lo);
+                        reconstruct(j, k, bx, by, pred, nonzero ? &levels : nullptr, intra, scale,
+                                    lo);
                     } else {
                         if (intra) {
                             mode = rc.bit(m.mode[k > 0][0]) << 1;
@@ -332,12 +343,12 @@ bool code_slice(SliceJob& j, Coder& rc) {
     return true;
 }
 
-std::vector<SliceJob> slice_jobs(const Geometry& g, const Planes* source, const Planes* predicted, Planes& out,
-                                 int qp, int skip_threshold, Workspace& work) {
+std::vector<SliceJob> slice_jobs(const Geometry& g, const Planes* source, const Planes* predicted,
+                                 Planes& out, int qp, int skip_threshold, Workspace& work) {
     std::vector<SliceJob> jobs;
     for (int s = 0; s < g.sp->slices; ++s)
-        jobs.push_back({&g, source, predicted, &out, qp, skip_threshold, g.sp->slice_begin(s), g.sp->slice_begin(s + 1),
-                        work.coded_blocks});
+        jobs.push_back({&g, source, predicted, &out, qp, skip_threshold, g.sp->slice_begin(s),
+                        g.sp->slice_begin(s + 1), work.coded_blocks});
     return jobs;
 }
 
@@ -350,9 +361,9 @@ void prepare(const SequenceParams& sp, Planes& out, Workspace& work) {
 
 }  // namespace
 
-ColorEncodeResult encode_color(const FrameContext& fc, const Planes& source, ImageView<const glm::vec2> motion,
-                               int qp, int skip_threshold, Planes& out, std::vector<uint8_t>& bytes,
-                               StreamStats& stats) {
+ColorEncodeResult encode_color(const FrameContext& fc, const Planes& source,
+                               ImageView<const glm::vec2> motion, int qp, int skip_threshold,
+                               Planes& out, std::vector<uint8_t>& bytes, StreamStats& stats) {
     const SequenceParams& sp = *fc.sp;
     prepare(sp, out, *fc.work);
     Planes& predicted = fc.work->predicted;
@@ -361,7 +372,8 @@ ColorEncodeResult encode_color(const FrameContext& fc, const Planes& source, Ima
     ByteWriter w(bytes);
     w.u8(uint8_t(qp));
     const Geometry g = geometry(sp);
-    std::vector<SliceJob> jobs = slice_jobs(g, &source, fc.key ? nullptr : &predicted, out, qp, skip_threshold, *fc.work);
+    std::vector<SliceJob> jobs =
+        slice_jobs(g, &source, fc.key ? nullptr : &predicted, out, qp, skip_threshold, *fc.work);
     std::vector<uint8_t>& body = fc.work->section;
     body.clear();
     encode_slices(sp.slices, fc.work->slice_bytes, body, [&](int s, std::vector<uint8_t>& b) {
@@ -390,8 +402,8 @@ ColorEncodeResult encode_color(const FrameContext& fc, const Planes& source, Ima
     return result;
 }
 
-Status decode_color(const FrameContext& fc, ImageView<const glm::vec2> motion, std::span<const uint8_t> in,
-                    Planes& out, StreamStats& stats) {
+Status decode_color(const FrameContext& fc, ImageView<const glm::vec2> motion,
+                    std::span<const uint8_t> in, Planes& out, StreamStats& stats) {
     const SequenceParams& sp = *fc.sp;
     prepare(sp, out, *fc.work);
     ByteReader r(in, "colour section");
@@ -399,25 +411,32 @@ Status decode_color(const FrameContext& fc, ImageView<const glm::vec2> motion, s
     const uint8_t flags = r.u8();
     if (!r.ok()) return Status::error(r.error());
     if (qp > 51) return Status::error("colour section: qp " + std::to_string(qp) + " is above 51");
-    if (flags & ~kAllSkipped) return Status::error("colour section: unknown flags " + std::to_string(flags));
-    if ((flags & kAllSkipped) && fc.key) return Status::error("colour section: a key frame cannot skip its blocks");
+    if (flags & ~kAllSkipped)
+        return Status::error("colour section: unknown flags " + std::to_string(flags));
+    if ((flags & kAllSkipped) && fc.key)
+        return Status::error("colour section: a key frame cannot skip its blocks");
     Planes& predicted = fc.work->predicted;
     if (!fc.key) predict_planes(fc.reference->planes, sp, motion, predicted);
-    const std::size_t blocks = std::size_t(sp.mb_cols()) * sp.mb_rows() * (4 + 2 * (sp.chroma == Chroma::C420 ? 1 : 4));
+    const std::size_t blocks =
+        std::size_t(sp.mb_cols()) * sp.mb_rows() * (4 + 2 * (sp.chroma == Chroma::C420 ? 1 : 4));
     if (flags & kAllSkipped) {
         if (r.remaining()) return Status::error("colour section: bytes after an all-skipped flag");
-        for (int k = 0; k < 3; ++k) std::copy(predicted.p[k].data(), predicted.p[k].data() + predicted.p[k].pixel_count(), out.p[k].data());
+        for (int k = 0; k < 3; ++k)
+            std::copy(predicted.p[k].data(), predicted.p[k].data() + predicted.p[k].pixel_count(),
+                      out.p[k].data());
         stats.blocks += blocks;
         stats.blocks_skipped += blocks;
     } else {
         std::vector<std::span<const uint8_t>> slices;
         if (!read_slices(r, sp.slices, slices)) return Status::error(r.error());
         const Geometry g = geometry(sp);
-        std::vector<SliceJob> jobs = slice_jobs(g, nullptr, fc.key ? nullptr : &predicted, out, qp, 0, *fc.work);
-        REPRISE_TRY(decode_slices(slices, "colour section", [&](int s, std::span<const uint8_t> bytes) {
-            RangeDecoder rc(bytes);
-            return code_slice<false>(jobs[s], rc);
-        }));
+        std::vector<SliceJob> jobs =
+            slice_jobs(g, nullptr, fc.key ? nullptr : &predicted, out, qp, 0, *fc.work);
+        REPRISE_TRY(
+            decode_slices(slices, "colour section", [&](int s, std::span<const uint8_t> bytes) {
+                RangeDecoder rc(bytes);
+                return code_slice<false>(jobs[s], rc);
+            }));
         for (const SliceJob& j : jobs) {
             stats.blocks += j.blocks;
             stats.blocks_skipped += j.skipped;

@@ -27,8 +27,10 @@ Thresholds thresholds(int qp, bool chroma) {
     return t;
 }
 
-inline void filter(int16_t& p1, int16_t& p0, int16_t& q0, int16_t& q1, const Thresholds& t, int lo) {
-    if (std::abs(p0 - q0) >= t.alpha || std::abs(p1 - p0) >= t.beta || std::abs(q1 - q0) >= t.beta) return;
+inline void filter(int16_t& p1, int16_t& p0, int16_t& q0, int16_t& q1, const Thresholds& t,
+                   int lo) {
+    if (std::abs(p0 - q0) >= t.alpha || std::abs(p1 - p0) >= t.beta || std::abs(q1 - q0) >= t.beta)
+        return;
     const int d = std::clamp((4 * (q0 - p0) + (p1 - q1) + 4) >> 3, -t.tc, t.tc);
     p0 = int16_t(std::clamp(p0 + d, lo, 255));
     q0 = int16_t(std::clamp(q0 - d, lo, 255));
@@ -51,22 +53,26 @@ void deblock(Planes& planes, const std::vector<uint8_t> (&coded)[3], int qp) {
                 int16_t* row = p.data() + std::size_t(y) * w;
                 const uint8_t* cr = c + std::size_t(y / 8) * bw;
                 for (int b = 1; b < bw; ++b)
-                    if (cr[b - 1] | cr[b]) filter(row[8 * b - 2], row[8 * b - 1], row[8 * b], row[8 * b + 1], t, lo);
+                    if (cr[b - 1] | cr[b])
+                        filter(row[8 * b - 2], row[8 * b - 1], row[8 * b], row[8 * b + 1], t, lo);
             }
         });
         // Horizontal edges, one block row boundary per task.
-        parallel_for(1, h / 8, [&](int e0, int e1) {
-            for (int e = e0; e < e1; ++e) {
-                int16_t* r0 = p.data() + std::size_t(8 * e - 2) * w;
-                int16_t* r1 = r0 + w;
-                int16_t* r2 = r1 + w;
-                int16_t* r3 = r2 + w;
-                const uint8_t* above = c + std::size_t(e - 1) * bw;
-                const uint8_t* below = above + bw;
-                for (int x = 0; x < w; ++x)
-                    if (above[x / 8] | below[x / 8]) filter(r0[x], r1[x], r2[x], r3[x], t, lo);
-            }
-        }, 1);
+        parallel_for(
+            1, h / 8,
+            [&](int e0, int e1) {
+                for (int e = e0; e < e1; ++e) {
+                    int16_t* r0 = p.data() + std::size_t(8 * e - 2) * w;
+                    int16_t* r1 = r0 + w;
+                    int16_t* r2 = r1 + w;
+                    int16_t* r3 = r2 + w;
+                    const uint8_t* above = c + std::size_t(e - 1) * bw;
+                    const uint8_t* below = above + bw;
+                    for (int x = 0; x < w; ++x)
+                        if (above[x / 8] | below[x / 8]) filter(r0[x], r1[x], r2[x], r3[x], t, lo);
+                }
+            },
+            1);
     }
 }
 

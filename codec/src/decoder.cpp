@@ -12,7 +12,6 @@ namespace {
 
 constexpr std::size_t kMaxQueuedFrames = 16;
 
-
 }  // namespace
 
 struct Decoder::State {
@@ -31,7 +30,9 @@ struct Decoder::State {
     int slot_of(uint32_t frame) const { return held_slot(refs, frame); }
 };
 
-Decoder::Decoder(const DecoderOptions& options) : state_(std::make_unique<State>()) { state_->options = options; }
+Decoder::Decoder(const DecoderOptions& options) : state_(std::make_unique<State>()) {
+    state_->options = options;
+}
 Decoder::~Decoder() = default;
 Decoder::Decoder(Decoder&&) noexcept = default;
 Decoder& Decoder::operator=(Decoder&&) noexcept = default;
@@ -43,30 +44,38 @@ Status Decoder::send_packet(std::span<const uint8_t> packet) {
     REPRISE_TRY(parse_packet(packet, h, payload));
     const std::string where = "frame " + std::to_string(h.frame);
     if (s.queue.size() >= kMaxQueuedFrames)
-        return Status::error(where + ": " + std::to_string(s.queue.size()) + " decoded frames not taken by receive_frame");
+        return Status::error(where + ": " + std::to_string(s.queue.size()) +
+                             " decoded frames not taken by receive_frame");
     const bool key = h.type == PacketType::Key;
     if (!key && s.have_newest && h.frame <= s.newest)
-        return Status::error(where + ": not newer than frame " + std::to_string(s.newest) + " (duplicate or late)");
+        return Status::error(where + ": not newer than frame " + std::to_string(s.newest) +
+                             " (duplicate or late)");
     ByteReader r(payload, where);
     SequenceParams sp = s.sp;
     if (key) {
         REPRISE_TRY(read_params(r, sp));
         if (int64_t(sp.width) * sp.height > s.options.max_pixels)
-            return Status::error(where + ": " + std::to_string(sp.width) + "x" + std::to_string(sp.height) +
-                                 " is more than this decoder's limit of " + std::to_string(s.options.max_pixels) + " pixels");
+            return Status::error(where + ": " + std::to_string(sp.width) + "x" +
+                                 std::to_string(sp.height) +
+                                 " is more than this decoder's limit of " +
+                                 std::to_string(s.options.max_pixels) + " pixels");
     } else if (!s.started) {
         return Status::error(where + ": inter frame before any key frame");
     }
     const Picture* ref = nullptr;
     if (!key) {
         const int slot = s.slot_of(h.reference);
-        if (slot < 0) return Status::error(where + ": reference frame " + std::to_string(h.reference) + " is not held");
+        if (slot < 0)
+            return Status::error(where + ": reference frame " + std::to_string(h.reference) +
+                                 " is not held");
         ref = &s.refs[slot];
     }
     std::span<const uint8_t> sections[4];
     for (auto& section : sections) section = r.bytes(r.varint());
     if (!r.ok()) return Status::error(r.error());
-    if (r.remaining()) return Status::error(where + ": " + std::to_string(r.remaining()) + " bytes after the last section");
+    if (r.remaining())
+        return Status::error(where + ": " + std::to_string(r.remaining()) +
+                             " bytes after the last section");
 
     FrameContext fc{&sp, ref, key, &s.work};
     Picture& pic = s.scratch;
@@ -83,7 +92,8 @@ Status Decoder::send_packet(std::span<const uint8_t> packet) {
     fs.camera_bits += 8 * sections[0].size();
     fs.frames = 1;
     fs.key_frames = key;
-    fs.header_bits = 8 * packet.size() - (fs.camera_bits + fs.depth_bits + fs.motion_bits + fs.color_bits);
+    fs.header_bits =
+        8 * packet.size() - (fs.camera_bits + fs.depth_bits + fs.motion_bits + fs.color_bits);
 
     // Commit: the picture takes the oldest (or a free) slot; a key frame drops the rest.
     pic.camera = camera;

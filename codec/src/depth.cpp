@@ -49,10 +49,14 @@ struct Mapping {
         if (k > (1 << 30) || k < -(1 << 30)) return std::numeric_limits<float>::quiet_NaN();
         return float(exact_exp2(double(k) * step));
     }
-    uint32_t empty() const { return lossless ? code(std::numeric_limits<float>::infinity()) : kInfCode; }
+    uint32_t empty() const {
+        return lossless ? code(std::numeric_limits<float>::infinity()) : kInfCode;
+    }
 };
 
-Mapping mapping_of(const SequenceParams& sp) { return {sp.depth == DepthMode::Lossless, sp.depth_step()}; }
+Mapping mapping_of(const SequenceParams& sp) {
+    return {sp.depth == DepthMode::Lossless, sp.depth_step()};
+}
 
 inline uint32_t median_edge(int64_t a, int64_t b, int64_t c) {
     if (c >= std::max(a, b)) return uint32_t(std::min(a, b));
@@ -76,7 +80,7 @@ struct Models {
 struct SliceJob {
     const Mapping* map;
     int width, y0, y1;
-    ImageView<uint32_t> codes;          // decoder fills, encoder has them
+    ImageView<uint32_t> codes;           // decoder fills, encoder has them
     ImageView<const uint32_t> temporal;  // kNoPrediction where nothing landed; empty on key frames
     ImageView<uint32_t> residuals;
     std::size_t zero_blocks = 0;
@@ -90,16 +94,21 @@ inline uint32_t inverse_depth_median(const Mapping& map, uint32_t ca, uint32_t c
         return median_edge(ca, cb, cc);
     const float ia = 1.0f / a, ib = 1.0f / b, ic = 1.0f / c;
     float p;
-    if (ic >= std::max(ia, ib)) p = std::min(ia, ib);
-    else if (ic <= std::min(ia, ib)) p = std::max(ia, ib);
-    else p = ia + ib - ic;
+    if (ic >= std::max(ia, ib))
+        p = std::min(ia, ib);
+    else if (ic <= std::min(ia, ib))
+        p = std::max(ia, ib);
+    else
+        p = ia + ib - ic;
     return map.code(1.0f / p);
 }
 
 inline uint32_t spatial(const SliceJob& j, int x, int y) {
     const bool left = x > 0, top = y > j.y0;
     if (left && top) {
-        if (j.map->lossless) return inverse_depth_median(*j.map, j.codes(x - 1, y), j.codes(x, y - 1), j.codes(x - 1, y - 1));
+        if (j.map->lossless)
+            return inverse_depth_median(*j.map, j.codes(x - 1, y), j.codes(x, y - 1),
+                                        j.codes(x - 1, y - 1));
         return median_edge(j.codes(x - 1, y), j.codes(x, y - 1), j.codes(x - 1, y - 1));
     }
     if (left) return j.codes(x - 1, y);
@@ -121,8 +130,8 @@ inline int residual_context(const SliceJob& j, int x, int y) {
 
 // Cost estimate of coding a block with one predictor. The encoder knows every code up front
 // (coding is lossless), so spatial predictions are made once into `spatial_codes`.
-uint64_t block_cost(const SliceJob& j, ImageView<const uint32_t> spatial_codes, int bx, int by, int bw, int bh,
-                    bool temporal) {
+uint64_t block_cost(const SliceJob& j, ImageView<const uint32_t> spatial_codes, int bx, int by,
+                    int bw, int bh, bool temporal) {
     uint64_t cost = 0;
     for (int y = by; y < by + bh; ++y)
         for (int x = bx; x < bx + bw; ++x) {
@@ -172,7 +181,8 @@ void encode_slice(SliceJob& j, std::vector<uint8_t>& bytes) {
                 const uint32_t r = j.codes(x, y) - p;
                 j.residuals(x, y) = r;
                 if (block_zero[b]) continue;
-                encode_int(rc, m.residual[block_temporal[b]][residual_context(j, x, y)], int64_t(int32_t(r)));
+                encode_int(rc, m.residual[block_temporal[b]][residual_context(j, x, y)],
+                           int64_t(int32_t(r)));
             }
     }
     rc.finish();
@@ -209,7 +219,8 @@ bool decode_slice(SliceJob& j, std::span<const uint8_t> bytes) {
 }
 
 // Codes of the reference depth seen from `camera`; empty on key frames or without reference depth.
-void temporal_codes(const FrameContext& fc, const Camera& camera, const Mapping& map, Image<uint32_t>& out) {
+void temporal_codes(const FrameContext& fc, const Camera& camera, const Mapping& map,
+                    Image<uint32_t>& out) {
     if (fc.key || !fc.reference || fc.reference->depth.empty()) {
         out.clear();
         return;
@@ -228,8 +239,9 @@ void temporal_codes(const FrameContext& fc, const Camera& camera, const Mapping&
     });
 }
 
-std::vector<SliceJob> slice_jobs(const SequenceParams& sp, const Mapping& map, Image<uint32_t>& codes,
-                                 const Image<uint32_t>& temporal, Image<uint32_t>& residuals) {
+std::vector<SliceJob> slice_jobs(const SequenceParams& sp, const Mapping& map,
+                                 Image<uint32_t>& codes, const Image<uint32_t>& temporal,
+                                 Image<uint32_t>& residuals) {
     std::vector<SliceJob> jobs;
     for (int s = 0; s < sp.slices; ++s) {
         const int y0 = std::min(sp.height, sp.slice_begin(s) * kMb);
@@ -261,10 +273,12 @@ void depth_from_codes(const Mapping& map, const Image<uint32_t>& codes, Image<fl
 
 // Codes are log2(z) / step rounded: the decoded z is within 2^(step / 2) - 1 of the truth; a
 // little margin keeps float rounding of the result inside the bound.
-double SequenceParams::depth_step() const { return 2.0 * exact_log2(1.0 + 0.999 * double(depth_error)); }
+double SequenceParams::depth_step() const {
+    return 2.0 * exact_log2(1.0 + 0.999 * double(depth_error));
+}
 
-void encode_depth(const FrameContext& fc, const Camera& camera, ImageView<const float> source, Image<float>& out,
-                  std::vector<uint8_t>& bytes, StreamStats& stats) {
+void encode_depth(const FrameContext& fc, const Camera& camera, ImageView<const float> source,
+                  Image<float>& out, std::vector<uint8_t>& bytes, StreamStats& stats) {
     const SequenceParams& sp = *fc.sp;
     if (sp.depth == DepthMode::None) {
         out.clear();
@@ -279,7 +293,8 @@ void encode_depth(const FrameContext& fc, const Camera& camera, ImageView<const 
     ensure_size(residuals, w, h);
     parallel_for(0, h, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y)
-            for (int x = 0; x < w; ++x) codes(x, y) = map.code(source.empty() ? INFINITY : source(x, y));
+            for (int x = 0; x < w; ++x)
+                codes(x, y) = map.code(source.empty() ? INFINITY : source(x, y));
     });
     temporal_codes(fc, camera, map, temporal);
     const std::size_t start = bytes.size();
@@ -289,18 +304,20 @@ void encode_depth(const FrameContext& fc, const Camera& camera, ImageView<const 
     ByteWriter wr(bytes);
     wr.u8(all_predicted ? kAllPredicted : 0);
     if (all_predicted) {
-        stats.depth_zero_blocks += std::size_t((w + kBlock - 1) / kBlock) * ((h + kBlock - 1) / kBlock);
+        stats.depth_zero_blocks +=
+            std::size_t((w + kBlock - 1) / kBlock) * ((h + kBlock - 1) / kBlock);
     } else {
         std::vector<SliceJob> jobs = slice_jobs(sp, map, codes, temporal, residuals);
-        encode_slices(sp.slices, fc.work->slice_bytes, bytes, [&](int s, std::vector<uint8_t>& b) { encode_slice(jobs[s], b); });
+        encode_slices(sp.slices, fc.work->slice_bytes, bytes,
+                      [&](int s, std::vector<uint8_t>& b) { encode_slice(jobs[s], b); });
         for (const SliceJob& j : jobs) stats.depth_zero_blocks += j.zero_blocks;
     }
     stats.depth_bits += 8 * (bytes.size() - start);
     depth_from_codes(map, codes, out);
 }
 
-Status decode_depth(const FrameContext& fc, const Camera& camera, std::span<const uint8_t> in, Image<float>& out,
-                    StreamStats& stats) {
+Status decode_depth(const FrameContext& fc, const Camera& camera, std::span<const uint8_t> in,
+                    Image<float>& out, StreamStats& stats) {
     const SequenceParams& sp = *fc.sp;
     if (sp.depth == DepthMode::None) {
         if (!in.empty()) return Status::error("depth section: present in a stream without depth");
@@ -318,21 +335,25 @@ Status decode_depth(const FrameContext& fc, const Camera& camera, std::span<cons
     ByteReader r(in, "depth section");
     const uint8_t flags = r.u8();
     if (!r.ok()) return Status::error(r.error());
-    if (flags & ~kAllPredicted) return Status::error("depth section: unknown flags " + std::to_string(flags));
+    if (flags & ~kAllPredicted)
+        return Status::error("depth section: unknown flags " + std::to_string(flags));
     if (flags & kAllPredicted) {
-        if (temporal.empty()) return Status::error("depth section: predicted from a reference on a key frame");
+        if (temporal.empty())
+            return Status::error("depth section: predicted from a reference on a key frame");
         if (r.remaining()) return Status::error("depth section: bytes after an all-predicted flag");
         for (std::size_t i = 0; i < codes.pixel_count(); ++i) {
             const uint32_t t = temporal.data()[i];
             codes.data()[i] = t == kNoPrediction ? map.empty() : t;
         }
-        stats.depth_zero_blocks += std::size_t((w + kBlock - 1) / kBlock) * ((h + kBlock - 1) / kBlock);
+        stats.depth_zero_blocks +=
+            std::size_t((w + kBlock - 1) / kBlock) * ((h + kBlock - 1) / kBlock);
     } else {
         std::vector<std::span<const uint8_t>> slices;
         if (!read_slices(r, sp.slices, slices)) return Status::error(r.error());
         std::vector<SliceJob> jobs = slice_jobs(sp, map, codes, temporal, residuals);
-        REPRISE_TRY(decode_slices(slices, "depth section",
-                                  [&](int s, std::span<const uint8_t> bytes) { return decode_slice(jobs[s], bytes); }));
+        REPRISE_TRY(decode_slices(
+            slices, "depth section",
+            [&](int s, std::span<const uint8_t> bytes) { return decode_slice(jobs[s], bytes); }));
         for (const SliceJob& j : jobs) stats.depth_zero_blocks += j.zero_blocks;
     }
     stats.depth_bits += 8 * in.size();

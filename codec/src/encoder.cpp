@@ -66,8 +66,8 @@ struct Encoder::State {
         return best;
     }
 
-    Status encode(const Frame& frame, int ref_slot, int qp_now, Picture& pic, std::vector<uint8_t>& payload,
-                  StreamStats& fs, ColorEncodeResult& colour) {
+    Status encode(const Frame& frame, int ref_slot, int qp_now, Picture& pic,
+                  std::vector<uint8_t>& payload, StreamStats& fs, ColorEncodeResult& colour) {
         const bool key = ref_slot < 0;
         const Picture* ref = key ? nullptr : &refs[ref_slot];
         FrameContext fc{&sp, ref, key, &work};
@@ -84,13 +84,15 @@ struct Encoder::State {
         append_section(payload, section);
 
         section.clear();
-        encode_motion(fc, frame.camera, pic.depth.view(), frame.motion.view(), pic.motion, section, fs);
+        encode_motion(fc, frame.camera, pic.depth.view(), frame.motion.view(), pic.motion, section,
+                      fs);
         append_section(payload, section);
 
         const ImageView<const glm::vec2> motion =
             motion_to_reference(sp, frame.camera, pic.depth, pic.motion, ref, next_frame, work);
         section.clear();
-        colour = encode_color(fc, source_planes, motion, qp_now, options.skip_threshold, pic.planes, section, fs);
+        colour = encode_color(fc, source_planes, motion, qp_now, options.skip_threshold, pic.planes,
+                              section, fs);
         append_section(payload, section);
         // The packet header, key frame parameters and section lengths.
         fs.header_bits = 8 * (kPacketHeaderSize + payload.size()) -
@@ -119,12 +121,16 @@ Status Encoder::send_frame(const Frame& frame) {
     const int w = frame.color.width(), h = frame.color.height();
     REPRISE_TRY(check_image_size(w, h, "encoder input frame " + std::to_string(s.next_frame)));
     if (!frame.depth.empty() && (frame.depth.width() != w || frame.depth.height() != h))
-        return Status::error("encoder input frame " + std::to_string(s.next_frame) + ": depth size differs from colour");
+        return Status::error("encoder input frame " + std::to_string(s.next_frame) +
+                             ": depth size differs from colour");
     if (!frame.motion.empty() && (frame.motion.width() != w || frame.motion.height() != h))
-        return Status::error("encoder input frame " + std::to_string(s.next_frame) + ": motion size differs from colour");
+        return Status::error("encoder input frame " + std::to_string(s.next_frame) +
+                             ": motion size differs from colour");
     if (s.queue.size() >= kMaxQueuedPackets)
-        return Status::error("encoder: " + std::to_string(s.queue.size()) + " packets not taken by receive_packet");
-    if (s.options.depth == DepthMode::Bounded && !(s.options.depth_error >= 1e-7f && s.options.depth_error <= 0.1f))
+        return Status::error("encoder: " + std::to_string(s.queue.size()) +
+                             " packets not taken by receive_packet");
+    if (s.options.depth == DepthMode::Bounded &&
+        !(s.options.depth_error >= 1e-7f && s.options.depth_error <= 0.1f))
         return Status::error("encoder: depth error bound must lie in 1e-7..0.1");
 
     SequenceParams sp;
@@ -141,7 +147,8 @@ Status Encoder::send_frame(const Frame& frame) {
     planes_from_linear(frame.color.view(), sp, s.source_planes);
     int ref = s.choose_reference();
     // Rate control: bounded frame sizes, re-encoding with a coarser quantiser when one is too big.
-    const double target_bits = s.options.bitrate_kbps > 0 ? s.options.bitrate_kbps * 1000.0 / std::max(1.0, sp.fps) : 0.0;
+    const double target_bits =
+        s.options.bitrate_kbps > 0 ? s.options.bitrate_kbps * 1000.0 / std::max(1.0, sp.fps) : 0.0;
     int qp = s.qp;
     Picture& pic = s.scratch;
     std::vector<uint8_t> payload;
@@ -151,7 +158,8 @@ Status Encoder::send_frame(const Frame& frame) {
         ColorEncodeResult colour;
         const int qp_now = std::clamp(ref < 0 ? qp - 3 : qp, 0, 51);
         REPRISE_TRY(s.encode(frame, ref, qp_now, pic, payload, fs, colour));
-        if (ref >= 0 && s.options.detect_cuts && colour.intra_macroblocks * 10 > colour.macroblocks * 6) {
+        if (ref >= 0 && s.options.detect_cuts &&
+            colour.intra_macroblocks * 10 > colour.macroblocks * 6) {
             ref = -1;  // a cut: most of the frame is new
             --attempt;
             continue;
@@ -166,13 +174,15 @@ Status Encoder::send_frame(const Frame& frame) {
     }
     if (target_bits > 0) {
         const double bits = 8.0 * (payload.size() + kPacketHeaderSize);
-        s.qp_state = std::clamp(s.qp_state + 0.5 * 6.0 * std::log2(std::max(bits, 1.0) / target_bits), 4.0, 51.0);
+        s.qp_state = std::clamp(
+            s.qp_state + 0.5 * 6.0 * std::log2(std::max(bits, 1.0) / target_bits), 4.0, 51.0);
         s.qp = int(std::lround(s.qp_state));
     }
 
     const bool key = ref < 0;
     PacketHeader header{key ? PacketType::Key : PacketType::Inter, s.next_frame,
-                        key ? s.next_frame : s.refs[ref].frame, int64_t(std::llround(frame.camera.time * 1e6))};
+                        key ? s.next_frame : s.refs[ref].frame,
+                        int64_t(std::llround(frame.camera.time * 1e6))};
     Packet packet;
     write_packet(header, payload, packet.data);
     packet.frame = header.frame;
@@ -229,7 +239,8 @@ void Encoder::report_loss(uint32_t frame) {
             if (!s.refs[i].held) continue;
             if (s.refs[i].frame == frame) s.tainted[i] = true;
             const int r = s.slot_of(s.reference_of[i]);
-            if (s.reference_of[i] != s.refs[i].frame && (s.reference_of[i] == frame || (r >= 0 && s.tainted[r])))
+            if (s.reference_of[i] != s.refs[i].frame &&
+                (s.reference_of[i] == frame || (r >= 0 && s.tainted[r])))
                 s.tainted[i] = true;
         }
 }

@@ -37,14 +37,15 @@ struct Unprojector {
         if (background) z = far_plane;
         const float zv = -z;
         const float wc = p[2][3] * zv + p[3][3];
-        out = {(x_ndc * wc - p[2][0] * zv - p[3][0]) / p[0][0], (y_ndc * wc - p[2][1] * zv - p[3][1]) / p[1][1],
-               zv, 1.0f};
+        out = {(x_ndc * wc - p[2][0] * zv - p[3][0]) / p[0][0],
+               (y_ndc * wc - p[2][1] * zv - p[3][1]) / p[1][1], zv, 1.0f};
         return true;
     }
 };
 
 Unprojector unprojector(const Camera& c, int w, int h) {
-    return {c.projection, c.projection[2][3] != 0.0f, std::isfinite(c.far) ? c.far : 1e6f, float(w), float(h)};
+    return {c.projection, c.projection[2][3] != 0.0f, std::isfinite(c.far) ? c.far : 1e6f, float(w),
+            float(h)};
 }
 
 glm::mat4 between(const glm::mat4& from_view, const glm::mat4& to_view) {
@@ -62,7 +63,8 @@ void camera_motion(const Camera& from, ImageView<const float> depth, const glm::
         return;
     }
     const Unprojector un = unprojector(from, w, h);
-    const glm::mat4 to_clip = glm::mat4(glm::dmat4(to_projection) * glm::dmat4(between(from.view, to_view)));
+    const glm::mat4 to_clip =
+        glm::mat4(glm::dmat4(to_projection) * glm::dmat4(between(from.view, to_view)));
     // Under perspective a finite depth's point is a + z b with a and b affine along a row, so its
     // clip position is c0 + z c1 with c0 = A0 + x A1 and c1 = B0 + x B1 (per row, in double).
     const glm::dmat4 p(from.projection), m(to_clip);
@@ -72,12 +74,16 @@ void camera_motion(const Camera& from, ImageView<const float> depth, const glm::
             glm::vec2* out_row = out.row(y);
             const double y_ndc = 1.0 - 2.0 * (double(y) + 0.5) / double(h);
             // a = ((x_ndc p33 - p30) / p00, (y_ndc p33 - p31) / p11, 0, 1)
-            // b = ((p20 - x_ndc p23) / p00, (p21 - y_ndc p23) / p11, -1, 0), x_ndc = 2 (x + 0.5) / w - 1
-            const double ay = (y_ndc * p[3][3] - p[3][1]) / p[1][1], by = (p[2][1] - y_ndc * p[2][3]) / p[1][1];
+            // b = ((p20 - x_ndc p23) / p00, (p21 - y_ndc p23) / p11, -1, 0), x_ndc = 2 (x + 0.5) /
+            // w - 1
+            const double ay = (y_ndc * p[3][3] - p[3][1]) / p[1][1],
+                         by = (p[2][1] - y_ndc * p[2][3]) / p[1][1];
             const double sx = 2.0 / double(w), x0 = sx * 0.5 - 1.0;  // x_ndc = x0 + sx x
-            const glm::dvec4 a_at0 = m * glm::dvec4((x0 * p[3][3] - p[3][0]) / p[0][0], ay, 0.0, 1.0);
+            const glm::dvec4 a_at0 =
+                m * glm::dvec4((x0 * p[3][3] - p[3][0]) / p[0][0], ay, 0.0, 1.0);
             const glm::dvec4 a_step = m * glm::dvec4(sx * p[3][3] / p[0][0], 0.0, 0.0, 0.0);
-            const glm::dvec4 b_at0 = m * glm::dvec4((p[2][0] - x0 * p[2][3]) / p[0][0], by, -1.0, 0.0);
+            const glm::dvec4 b_at0 =
+                m * glm::dvec4((p[2][0] - x0 * p[2][3]) / p[0][0], by, -1.0, 0.0);
             const glm::dvec4 b_step = m * glm::dvec4(-sx * p[2][3] / p[0][0], 0.0, 0.0, 0.0);
             const glm::vec4 A0(a_at0), A1(a_step), B0(b_at0), B1(b_step);
             const float cy = float(y) + 0.5f;
@@ -107,7 +113,8 @@ void camera_motion(const Camera& from, ImageView<const float> depth, const glm::
     });
 }
 
-void reproject_depth(const Camera& from, ImageView<const float> depth, const Camera& to, ImageView<float> out) {
+void reproject_depth(const Camera& from, ImageView<const float> depth, const Camera& to,
+                     ImageView<float> out) {
     const int w = depth.width, h = depth.height;
     REPRISE_ASSERT(out.width == w && out.height == h);
     if (from.view == to.view && from.projection == to.projection) {
@@ -160,14 +167,18 @@ constexpr auto kExp2Series = exp2_series();
 }  // namespace
 
 ImageView<const glm::vec2> motion_to_reference(const SequenceParams& sp, const Camera& camera,
-                                               const Image<float>& depth, const Image<glm::vec2>& motion,
-                                               const Picture* reference, uint32_t frame, Workspace& work) {
+                                               const Image<float>& depth,
+                                               const Image<glm::vec2>& motion,
+                                               const Picture* reference, uint32_t frame,
+                                               Workspace& work) {
     if (!reference || reference->frame + 1 == frame) return motion.view();
     ensure_size(work.to_reference, sp.width, sp.height);
     if (depth.empty())
-        std::fill(work.to_reference.data(), work.to_reference.data() + work.to_reference.pixel_count(), glm::vec2(0.0f));
+        std::fill(work.to_reference.data(),
+                  work.to_reference.data() + work.to_reference.pixel_count(), glm::vec2(0.0f));
     else
-        camera_motion(camera, depth.view(), reference->camera.view, reference->camera.projection, work.to_reference.view());
+        camera_motion(camera, depth.view(), reference->camera.view, reference->camera.projection,
+                      work.to_reference.view());
     return work.to_reference.view();
 }
 

@@ -66,8 +66,10 @@ struct PacketHeader {
     uint32_t frame = 0, reference = 0;
     int64_t timestamp_us = 0;
 };
-void write_packet(const PacketHeader& header, std::span<const uint8_t> payload, std::vector<uint8_t>& out);
-Status parse_packet(std::span<const uint8_t> packet, PacketHeader& header, std::span<const uint8_t>& payload);
+void write_packet(const PacketHeader& header, std::span<const uint8_t> payload,
+                  std::vector<uint8_t>& out);
+Status parse_packet(std::span<const uint8_t> packet, PacketHeader& header,
+                    std::span<const uint8_t>& payload);
 void write_params(const SequenceParams& sp, std::vector<uint8_t>& out);
 class ByteReader;
 Status read_params(ByteReader& r, SequenceParams& sp);
@@ -86,8 +88,8 @@ int held_slot(const Picture (&refs)[kReferences], uint32_t frame);
 // Linear colour -> 8-bit sRGB -> YCoCg-R, chroma averaged 2x2 for 4:2:0.
 void planes_from_linear(ImageView<const glm::vec4> color, const SequenceParams& sp, Planes& out);
 // YCoCg-R planes -> linear RGB (A = alpha_one ? 1 : coverage from depth).
-void linear_from_planes(const Planes& planes, const SequenceParams& sp, ImageView<const float> depth,
-                        Image<glm::vec4>& out);
+void linear_from_planes(const Planes& planes, const SequenceParams& sp,
+                        ImageView<const float> depth, Image<glm::vec4>& out);
 
 // --- geometry.cpp
 // Backward motion that the cameras alone explain: pixel p of a frame seen by `from` with depth z
@@ -102,8 +104,10 @@ void reproject_depth(const Camera& from, ImageView<const float> depth, const Cam
 // What drives colour prediction: the decoded motion when the reference is the previous frame,
 // else the camera motion from this frame to the reference's camera (0 without depth).
 ImageView<const glm::vec2> motion_to_reference(const SequenceParams& sp, const Camera& camera,
-                                               const Image<float>& depth, const Image<glm::vec2>& motion,
-                                               const Picture* reference, uint32_t frame, Workspace& work);
+                                               const Image<float>& depth,
+                                               const Image<glm::vec2>& motion,
+                                               const Picture* reference, uint32_t frame,
+                                               Workspace& work);
 // Deterministic log2 / exp2 (IEEE double arithmetic only, no libm).
 double exact_log2(double x);
 double exact_exp2(double x);
@@ -142,8 +146,10 @@ struct FrameContext {
     Workspace* work = nullptr;
 };
 
-void encode_camera(const Camera& camera, double time, const Picture* reference, std::vector<uint8_t>& out);
-Status decode_camera(std::span<const uint8_t> in, const Picture* reference, Camera& camera, double& time);
+void encode_camera(const Camera& camera, double time, const Picture* reference,
+                   std::vector<uint8_t>& out);
+Status decode_camera(std::span<const uint8_t> in, const Picture* reference, Camera& camera,
+                     double& time);
 
 // Depth: `source` is the input depth (any floats), reconstruction goes to `out`.
 void encode_depth(const FrameContext& fc, const Camera& camera, ImageView<const float> source,
@@ -162,17 +168,17 @@ Status decode_motion(const FrameContext& fc, const Camera& camera, ImageView<con
 struct ColorEncodeResult {
     std::size_t intra_macroblocks = 0, macroblocks = 0;
 };
-ColorEncodeResult encode_color(const FrameContext& fc, const Planes& source, ImageView<const glm::vec2> motion,
-                               int qp, int skip_threshold, Planes& out, std::vector<uint8_t>& bytes,
-                               StreamStats& stats);
-Status decode_color(const FrameContext& fc, ImageView<const glm::vec2> motion, std::span<const uint8_t> in,
-                    Planes& out, StreamStats& stats);
+ColorEncodeResult encode_color(const FrameContext& fc, const Planes& source,
+                               ImageView<const glm::vec2> motion, int qp, int skip_threshold,
+                               Planes& out, std::vector<uint8_t>& bytes, StreamStats& stats);
+Status decode_color(const FrameContext& fc, ImageView<const glm::vec2> motion,
+                    std::span<const uint8_t> in, Planes& out, StreamStats& stats);
 
 // --- deblock.cpp: in-loop filter of the 8x8 edges next to coded blocks.
 void deblock(Planes& planes, const std::vector<uint8_t> (&coded)[3], int qp);
 
 // Inter prediction of all three planes from the reference by `motion` (Catmull-Rom, integer).
-void predict_planes(const Planes& reference, const SequenceParams& sp, ImageView<const glm::vec2> motion,
-                    Planes& out);
+void predict_planes(const Planes& reference, const SequenceParams& sp,
+                    ImageView<const glm::vec2> motion, Planes& out);
 
 }  // namespace reprise::codec

@@ -56,7 +56,7 @@ struct Models {
 struct SliceJob {
     int width, y0, y1;
     ImageView<const glm::vec2> base;
-    const Residual* targets;            // encoder only: the residual of every pixel
+    const Residual* targets;  // encoder only: the residual of every pixel
     ImageView<glm::vec2> out;
     Residual* residuals;  // per pixel of the frame, for contexts and prediction
     std::size_t pixels = 0;
@@ -120,12 +120,14 @@ bool code_slice(SliceJob& j, Coder& rc) {
                         r.invalid = rc.bit(m.invalid);
                         if (!r.invalid) {
                             int64_t vx = 0, vy = 0;
-                            if (!decode_int(rc, m.component[0], vx) || !decode_int(rc, m.component[1], vy))
+                            if (!decode_int(rc, m.component[0], vx) ||
+                                !decode_int(rc, m.component[1], vy))
                                 return false;
                             const Residual p = neighbour_prediction(j, x, y);
                             vx += p.x;
                             vy += p.y;
-                            if (std::abs(vx) > kMaxResidual || std::abs(vy) > kMaxResidual) return false;
+                            if (std::abs(vx) > kMaxResidual || std::abs(vy) > kMaxResidual)
+                                return false;
                             r.x = int32_t(vx);
                             r.y = int32_t(vy);
                         }
@@ -143,7 +145,8 @@ bool code_slice(SliceJob& j, Coder& rc) {
 }
 
 // Motion the cameras explain (to the previous frame as this frame's camera records it).
-void base_motion(const Camera& camera, ImageView<const float> depth, int w, int h, Image<glm::vec2>& base) {
+void base_motion(const Camera& camera, ImageView<const float> depth, int w, int h,
+                 Image<glm::vec2>& base) {
     ensure_size(base, w, h);
     if (depth.empty()) {
         std::fill(base.data(), base.data() + base.pixel_count(), glm::vec2(0.0f));
@@ -152,8 +155,9 @@ void base_motion(const Camera& camera, ImageView<const float> depth, int w, int 
     camera_motion(camera, depth, camera.prev_view, camera.prev_projection, base.view());
 }
 
-std::vector<SliceJob> slice_jobs(const SequenceParams& sp, const Image<glm::vec2>& base, const Residual* targets,
-                                 Image<glm::vec2>& out, std::vector<Residual>& residuals) {
+std::vector<SliceJob> slice_jobs(const SequenceParams& sp, const Image<glm::vec2>& base,
+                                 const Residual* targets, Image<glm::vec2>& out,
+                                 std::vector<Residual>& residuals) {
     std::vector<SliceJob> jobs;
     for (int s = 0; s < sp.slices; ++s) {
         const int y0 = std::min(sp.height, sp.slice_begin(s) * kMb);
@@ -166,8 +170,8 @@ std::vector<SliceJob> slice_jobs(const SequenceParams& sp, const Image<glm::vec2
 }  // namespace
 
 void encode_motion(const FrameContext& fc, const Camera& camera, ImageView<const float> depth,
-                   ImageView<const glm::vec2> source, Image<glm::vec2>& out, std::vector<uint8_t>& bytes,
-                   StreamStats& stats) {
+                   ImageView<const glm::vec2> source, Image<glm::vec2>& out,
+                   std::vector<uint8_t>& bytes, StreamStats& stats) {
     const SequenceParams& sp = *fc.sp;
     const int w = sp.width, h = sp.height;
     Image<glm::vec2>& base = fc.work->base_motion;
@@ -215,7 +219,8 @@ Status decode_motion(const FrameContext& fc, const Camera& camera, ImageView<con
     ByteReader r(in, "motion section");
     const uint8_t flags = r.u8();
     if (!r.ok()) return Status::error(r.error());
-    if (flags & ~kNoResidual) return Status::error("motion section: unknown flags " + std::to_string(flags));
+    if (flags & ~kNoResidual)
+        return Status::error("motion section: unknown flags " + std::to_string(flags));
     if (flags & kNoResidual) {
         if (r.remaining()) return Status::error("motion section: bytes after a no-residual flag");
         std::copy(base.data(), base.data() + base.pixel_count(), out.data());
@@ -225,10 +230,11 @@ Status decode_motion(const FrameContext& fc, const Camera& camera, ImageView<con
         std::vector<Residual>& residuals = fc.work->motion_residuals;
         residuals.resize(std::size_t(w) * h);
         std::vector<SliceJob> jobs = slice_jobs(sp, base, nullptr, out, residuals);
-        REPRISE_TRY(decode_slices(slices, "motion section", [&](int s, std::span<const uint8_t> bytes) {
-            RangeDecoder rc(bytes);
-            return code_slice<false>(jobs[s], rc);
-        }));
+        REPRISE_TRY(
+            decode_slices(slices, "motion section", [&](int s, std::span<const uint8_t> bytes) {
+                RangeDecoder rc(bytes);
+                return code_slice<false>(jobs[s], rc);
+            }));
         for (const SliceJob& j : jobs) stats.motion_residual_pixels += j.pixels;
     }
     stats.motion_bits += 8 * in.size();

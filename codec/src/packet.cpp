@@ -12,7 +12,8 @@ int default_slices(int height) {
     return std::clamp((mb_rows + 7) / 8, 1, kMaxSlices);
 }
 
-void write_packet(const PacketHeader& h, std::span<const uint8_t> payload, std::vector<uint8_t>& out) {
+void write_packet(const PacketHeader& h, std::span<const uint8_t> payload,
+                  std::vector<uint8_t>& out) {
     out.clear();
     ByteWriter w(out);
     w.u32(kPacketMagic);
@@ -31,7 +32,8 @@ void write_packet(const PacketHeader& h, std::span<const uint8_t> payload, std::
     out.insert(out.begin() + 28, tail.begin(), tail.end());
 }
 
-Status parse_packet(std::span<const uint8_t> packet, PacketHeader& h, std::span<const uint8_t>& payload) {
+Status parse_packet(std::span<const uint8_t> packet, PacketHeader& h,
+                    std::span<const uint8_t>& payload) {
     ByteReader r(packet, "packet header");
     const uint32_t magic = r.u32();
     const uint8_t version = r.u8();
@@ -43,19 +45,27 @@ Status parse_packet(std::span<const uint8_t> packet, PacketHeader& h, std::span<
     const uint32_t length = r.u32();
     const uint32_t crc = r.u32();
     if (!r.ok()) return Status::error(r.error());
-    if (magic != kPacketMagic) return Status::error("packet header: bad magic (not a reprise packet)");
-    if (version != kVersion) return Status::error("packet header: version " + std::to_string(version) + " (this decoder reads 1)");
-    if (type > uint8_t(PacketType::Inter)) return Status::error("packet header: unknown type " + std::to_string(type));
+    if (magic != kPacketMagic)
+        return Status::error("packet header: bad magic (not a reprise packet)");
+    if (version != kVersion)
+        return Status::error("packet header: version " + std::to_string(version) +
+                             " (this decoder reads 1)");
+    if (type > uint8_t(PacketType::Inter))
+        return Status::error("packet header: unknown type " + std::to_string(type));
     if (flags) return Status::error("packet header: reserved flags set");
-    if (length > kMaxPayload) return Status::error("packet header: payload length " + std::to_string(length) + " above the maximum");
+    if (length > kMaxPayload)
+        return Status::error("packet header: payload length " + std::to_string(length) +
+                             " above the maximum");
     if (length != r.remaining())
         return Status::error("packet header: payload length " + std::to_string(length) + " but " +
                              std::to_string(r.remaining()) + " bytes follow");
     const uint32_t expected = crc32c(packet.subspan(28 + 4), crc32c(packet.first(28), 0));
-    if (crc != expected) return Status::error("packet " + std::to_string(h.frame) + ": CRC mismatch");
+    if (crc != expected)
+        return Status::error("packet " + std::to_string(h.frame) + ": CRC mismatch");
     h.type = PacketType(type);
     if (h.type == PacketType::Key && h.reference != h.frame)
-        return Status::error("packet header: key frame " + std::to_string(h.frame) + " names a reference");
+        return Status::error("packet header: key frame " + std::to_string(h.frame) +
+                             " names a reference");
     payload = r.bytes(length);
     return {};
 }
@@ -92,8 +102,11 @@ Status read_params(ByteReader& r, SequenceParams& sp) {
     sp.fps = r.f64();
     if (!r.ok()) return Status::error(r.error());
     REPRISE_TRY(check_image_size(sp.width, sp.height, "key frame parameters"));
-    if (chroma > uint8_t(Chroma::C444)) return Status::error("key frame parameters: unknown chroma format " + std::to_string(chroma));
-    if (depth > uint8_t(DepthMode::None)) return Status::error("key frame parameters: unknown depth mode " + std::to_string(depth));
+    if (chroma > uint8_t(Chroma::C444))
+        return Status::error("key frame parameters: unknown chroma format " +
+                             std::to_string(chroma));
+    if (depth > uint8_t(DepthMode::None))
+        return Status::error("key frame parameters: unknown depth mode " + std::to_string(depth));
     sp.chroma = Chroma(chroma);
     sp.depth = DepthMode(depth);
     if (sp.depth == DepthMode::Bounded && !(sp.depth_error >= 1e-7f && sp.depth_error <= 0.1f))
@@ -101,7 +114,8 @@ Status read_params(ByteReader& r, SequenceParams& sp) {
     if (sp.slices < 1 || sp.slices > std::min(kMaxSlices, sp.mb_rows()))
         return Status::error("key frame parameters: " + std::to_string(sp.slices) + " slices for " +
                              std::to_string(sp.mb_rows()) + " macroblock rows");
-    if (!(sp.fps >= 0.0 && sp.fps <= 1000.0)) return Status::error("key frame parameters: frame rate outside 0..1000");
+    if (!(sp.fps >= 0.0 && sp.fps <= 1000.0))
+        return Status::error("key frame parameters: frame rate outside 0..1000");
     return {};
 }
 
@@ -118,7 +132,8 @@ Status write_stream_header(std::vector<uint8_t>& out, int width, int height, dou
     return {};
 }
 
-Status split_stream(std::span<const uint8_t> file, StreamInfo& info, std::vector<std::span<const uint8_t>>& packets) {
+Status split_stream(std::span<const uint8_t> file, StreamInfo& info,
+                    std::vector<std::span<const uint8_t>>& packets) {
     ByteReader r(file, "stream");
     const uint32_t magic = r.u32();
     const uint8_t version = r.u8();
@@ -129,7 +144,9 @@ Status split_stream(std::span<const uint8_t> file, StreamInfo& info, std::vector
     info.fps = r.f64();
     if (!r.ok()) return Status::error(r.error());
     if (magic != kFileMagic) return Status::error("stream: not a reprise stream (bad magic)");
-    if (version != kVersion) return Status::error("stream: version " + std::to_string(version) + " (this reader reads 1)");
+    if (version != kVersion)
+        return Status::error("stream: version " + std::to_string(version) +
+                             " (this reader reads 1)");
     REPRISE_TRY(check_image_size(info.width, info.height, "stream header"));
     packets.clear();
     while (r.remaining()) {
@@ -139,7 +156,8 @@ Status split_stream(std::span<const uint8_t> file, StreamInfo& info, std::vector
         ByteReader peek(file.subspan(at + 24, 4), "stream");
         const uint32_t length = peek.u32();
         if (length > kMaxPayload || length > r.remaining() - kPacketHeaderSize)
-            return Status::error("stream: packet at byte " + std::to_string(at) + " runs past the end of the file");
+            return Status::error("stream: packet at byte " + std::to_string(at) +
+                                 " runs past the end of the file");
         packets.push_back(r.bytes(kPacketHeaderSize + length));
     }
     return {};

@@ -20,8 +20,8 @@ const std::array<std::array<int32_t, 4>, kPhases>& weights() {
         std::array<std::array<int32_t, 4>, kPhases> t{};
         for (int p = 0; p < kPhases; ++p) {
             const double f = double(p) / kPhases, f2 = f * f, f3 = f2 * f;
-            const double w[4] = {0.5 * (-f3 + 2 * f2 - f), 0.5 * (3 * f3 - 5 * f2 + 2), 0.5 * (-3 * f3 + 4 * f2 + f),
-                                 0.5 * (f3 - f2)};
+            const double w[4] = {0.5 * (-f3 + 2 * f2 - f), 0.5 * (3 * f3 - 5 * f2 + 2),
+                                 0.5 * (-3 * f3 + 4 * f2 + f), 0.5 * (f3 - f2)};
             int sum = 0, largest = 0;
             for (int i = 0; i < 4; ++i) {
                 t[p][i] = int32_t(std::lround(w[i] * 128.0));
@@ -48,7 +48,8 @@ inline int sample(const Image<int16_t>& ref, int32_t qx, int32_t qy, int lo, int
     const auto& wx = weights()[qx & 63];
     const auto& wy = weights()[qy & 63];
     const int w = ref.width(), h = ref.height();
-    if ((qx & 63) == 0 && (qy & 63) == 0) return ref(std::clamp(ix, 0, w - 1), std::clamp(iy, 0, h - 1));
+    if ((qx & 63) == 0 && (qy & 63) == 0)
+        return ref(std::clamp(ix, 0, w - 1), std::clamp(iy, 0, h - 1));
     int32_t sum = 0;
     if (ix >= 1 && iy >= 1 && ix + 2 < w && iy + 2 < h) {  // the whole 4x4 window inside
         const int16_t* row = ref.data() + std::size_t(iy - 1) * w + (ix - 1);
@@ -71,10 +72,13 @@ inline glm::vec2 usable(glm::vec2 m) {
 
 }  // namespace
 
-void predict_planes(const Planes& ref, const SequenceParams& sp, ImageView<const glm::vec2> motion, Planes& out) {
+void predict_planes(const Planes& ref, const SequenceParams& sp, ImageView<const glm::vec2> motion,
+                    Planes& out) {
     const int w = sp.width, h = sp.height;
     for (int k = 0; k < 3; ++k) ensure_size(out.p[k], sp.plane_width(k), sp.plane_height(k));
-    auto motion_at = [&](int x, int y) { return usable(motion(std::min(x, w - 1), std::min(y, h - 1))); };
+    auto motion_at = [&](int x, int y) {
+        return usable(motion(std::min(x, w - 1), std::min(y, h - 1)));
+    };
     for (int k = 0; k < 3; ++k) {
         const int s = sp.shift(k), pw = sp.plane_width(k), ph = sp.plane_height(k);
         const int lo = k ? -255 : 0, hi = 255;
@@ -86,8 +90,9 @@ void predict_planes(const Planes& ref, const SequenceParams& sp, ImageView<const
                     if (s == 0) {
                         m = motion_at(x, y);
                     } else {  // mean of the 2x2 luma motions, in chroma pixels
-                        m = (motion_at(2 * x, 2 * y) + motion_at(2 * x + 1, 2 * y) + motion_at(2 * x, 2 * y + 1) +
-                             motion_at(2 * x + 1, 2 * y + 1)) * 0.125f;
+                        m = (motion_at(2 * x, 2 * y) + motion_at(2 * x + 1, 2 * y) +
+                             motion_at(2 * x, 2 * y + 1) + motion_at(2 * x + 1, 2 * y + 1)) *
+                            0.125f;
                     }
                     dst[x] = int16_t(sample(ref.p[k], fixed_position(float(x) + 0.5f, m.x, pw),
                                             fixed_position(float(y) + 0.5f, m.y, ph), lo, hi));

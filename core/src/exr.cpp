@@ -45,7 +45,6 @@ bool natural_less(const std::string& a, const std::string& b) {
     return a < b;  // equal up to leading zeros: keep a total order
 }
 
-
 Status open_sequence(const std::string& path, Sequence& sequence) {
     sequence = Sequence{};
     std::error_code ec;

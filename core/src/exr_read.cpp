@@ -116,7 +116,8 @@ Status check_exr_header(const std::string& path) {
         if (name == "dataWindow" && type == "box2i" && size == 16) {
             int32_t box[4];
             file.read(reinterpret_cast<char*>(box), 16);
-            const int64_t width = int64_t(box[2]) - box[0] + 1, height = int64_t(box[3]) - box[1] + 1;
+            const int64_t width = int64_t(box[2]) - box[0] + 1,
+                          height = int64_t(box[3]) - box[1] + 1;
             if (width < 1 || height < 1 || width > kMaxImageSide || height > kMaxImageSide)
                 return fail("dataWindow " + std::to_string(width) + "x" + std::to_string(height) +
                             " is outside 1.." + std::to_string(kMaxImageSide));

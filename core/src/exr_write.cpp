@@ -85,11 +85,10 @@ std::vector<Source> reprise_sources(const Frame& frame) {
 // Blender's Vector pass holds (previous - current) in X,Y and (current - next) in Z,W; a frame
 // knows only the first, so Z,W repeat it (constant velocity).
 std::vector<Source> blender_sources(const Frame& frame) {
-    std::vector<Source> sources = {
-        source("ViewLayer.Combined.R", frame.color, 0),
-        source("ViewLayer.Combined.G", frame.color, 1),
-        source("ViewLayer.Combined.B", frame.color, 2),
-        source("ViewLayer.Combined.A", frame.color, 3)};
+    std::vector<Source> sources = {source("ViewLayer.Combined.R", frame.color, 0),
+                                   source("ViewLayer.Combined.G", frame.color, 1),
+                                   source("ViewLayer.Combined.B", frame.color, 2),
+                                   source("ViewLayer.Combined.A", frame.color, 3)};
     if (!frame.depth.empty())
         sources.push_back(source("ViewLayer.Depth.Z", frame.depth, 0, Convert::InfToBackground));
     if (!frame.motion.empty()) {

@@ -1,8 +1,8 @@
 #include "reprise/core/parallel.hpp"
 
 #include <algorithm>
-#include <cstdint>
 #include <condition_variable>
+#include <cstdint>
 #include <cstdlib>
 #include <mutex>
 #include <thread>
@@ -111,14 +111,17 @@ void parallel_for_ref(int begin, int end, RangeBody body, int grain) {
         RangeBody body;
     };
     const Split split{begin, n, std::min(n / std::max(grain, 1), threads * 4), body};
-    pool().run(split.chunks, [](const void* context, int c) {
-        const Split& s = *static_cast<const Split*>(context);
-        inside_parallel = true;
-        const int a = s.begin + int(std::int64_t(s.n) * c / s.chunks);
-        const int b = s.begin + int(std::int64_t(s.n) * (c + 1) / s.chunks);
-        s.body(a, b);
-        inside_parallel = false;
-    }, &split);
+    pool().run(
+        split.chunks,
+        [](const void* context, int c) {
+            const Split& s = *static_cast<const Split*>(context);
+            inside_parallel = true;
+            const int a = s.begin + int(std::int64_t(s.n) * c / s.chunks);
+            const int b = s.begin + int(std::int64_t(s.n) * (c + 1) / s.chunks);
+            s.body(a, b);
+            inside_parallel = false;
+        },
+        &split);
 }
 
 }  // namespace reprise

@@ -29,9 +29,7 @@ void check_same_size(ImageView<In> in, ImageView<Rgb8> out) {
     REPRISE_ASSERT(in.width == out.width && in.height == out.height);
 }
 
-bool valid_depth(float d) {
-    return std::isfinite(d) && d > 0.0f;
-}
+bool valid_depth(float d) { return std::isfinite(d) && d > 0.0f; }
 
 }  // namespace
 

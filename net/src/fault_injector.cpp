@@ -5,10 +5,13 @@
 namespace reprise::net {
 
 namespace {
-bool later(const auto& a, const auto& b) { return a.due_us != b.due_us ? a.due_us > b.due_us : a.order > b.order; }
+bool later(const auto& a, const auto& b) {
+    return a.due_us != b.due_us ? a.due_us > b.due_us : a.order > b.order;
+}
 }  // namespace
 
-FaultInjector::FaultInjector(const FaultOptions& options) : options_(options), state_(options.seed) {}
+FaultInjector::FaultInjector(const FaultOptions& options)
+    : options_(options), state_(options.seed) {}
 
 double FaultInjector::uniform() {
     uint64_t z = (state_ += 0x9e3779b97f4a7c15ull);
@@ -21,7 +24,8 @@ double FaultInjector::uniform() {
 void FaultInjector::submit(std::span<const uint8_t> datagram, int64_t now_us) {
     ++stats_.submitted;
     // Every random draw happens for every datagram, so one option never shifts another's sequence.
-    const double u_loss = uniform(), u_burst = uniform(), u_jitter = uniform(), u_reorder = uniform();
+    const double u_loss = uniform(), u_burst = uniform(), u_jitter = uniform(),
+                 u_reorder = uniform();
     if (bad_) {
         if (u_burst < options_.burst_end) bad_ = false;
     } else if (u_burst < options_.burst_start) {
@@ -60,12 +64,14 @@ void FaultInjector::submit(std::span<const uint8_t> datagram, int64_t now_us) {
     }
     f.data.assign(datagram.begin(), datagram.end());
     flight_.push_back(std::move(f));
-    std::push_heap(flight_.begin(), flight_.end(), [](const InFlight& a, const InFlight& b) { return later(a, b); });
+    std::push_heap(flight_.begin(), flight_.end(),
+                   [](const InFlight& a, const InFlight& b) { return later(a, b); });
 }
 
 bool FaultInjector::deliver(int64_t now_us, std::vector<uint8_t>& datagram) {
     if (flight_.empty() || flight_.front().due_us > now_us) return false;
-    std::pop_heap(flight_.begin(), flight_.end(), [](const InFlight& a, const InFlight& b) { return later(a, b); });
+    std::pop_heap(flight_.begin(), flight_.end(),
+                  [](const InFlight& a, const InFlight& b) { return later(a, b); });
     std::swap(datagram, flight_.back().data);
     spare_.push_back(std::move(flight_.back().data));
     flight_.pop_back();

@@ -5,9 +5,11 @@
 namespace reprise::net {
 
 std::size_t fragment_packet(std::span<const uint8_t> packet, uint32_t frame, int64_t pose_time_us,
-                            const FecOptions& options, std::vector<std::vector<uint8_t>>& messages) {
+                            const FecOptions& options,
+                            std::vector<std::vector<uint8_t>>& messages) {
     REPRISE_ASSERT(!packet.empty() && packet.size() <= kMaxPacketBytes);
-    const std::size_t size = std::clamp<std::size_t>(options.fragment_payload, 16, kMaxFragmentPayload);
+    const std::size_t size =
+        std::clamp<std::size_t>(options.fragment_payload, 16, kMaxFragmentPayload);
     const std::size_t count = (packet.size() + size - 1) / size;
     REPRISE_ASSERT(count <= kMaxFragments);
     const int group = std::clamp(options.group, 0, 255);
@@ -54,7 +56,8 @@ Reassembler::Reassembler(const ReassemblerOptions& options) : options_(options) 
 
 std::size_t Reassembler::bytes_held() const {
     std::size_t n = 0;
-    for (const Slot& s : slots_) n += s.data.capacity() + s.parity.capacity() + s.have.capacity() + s.have_parity.capacity();
+    for (const Slot& s : slots_)
+        n += s.data.capacity() + s.parity.capacity() + s.have.capacity() + s.have_parity.capacity();
     return n;
 }
 
@@ -72,7 +75,8 @@ bool Reassembler::try_complete(Slot& s) {
         const std::size_t groups = (s.count + s.group - 1) / s.group;
         for (std::size_t g = 0; g < groups; ++g) {
             if (!s.have_parity[g]) continue;
-            const std::size_t begin = g * s.group, end = std::min<std::size_t>(s.count, begin + s.group);
+            const std::size_t begin = g * s.group,
+                              end = std::min<std::size_t>(s.count, begin + s.group);
             std::size_t missing = 0, which = 0;
             for (std::size_t i = begin; i < end; ++i)
                 if (!s.have[i]) ++missing, which = i;
@@ -92,7 +96,8 @@ bool Reassembler::try_complete(Slot& s) {
     return s.received == s.count;
 }
 
-bool Reassembler::add(const FragmentMessage& f, Reassembled& out, std::vector<uint32_t>& abandoned) {
+bool Reassembler::add(const FragmentMessage& f, Reassembled& out,
+                      std::vector<uint32_t>& abandoned) {
     ++stats_.fragments;
     if (int64_t(f.frame) <= newest_done_ || f.total_size > options_.max_packet_bytes) {
         ++stats_.stale;
@@ -101,8 +106,8 @@ bool Reassembler::add(const FragmentMessage& f, Reassembled& out, std::vector<ui
     Slot* slot = nullptr;
     for (Slot& s : slots_)
         if (s.used && s.frame == f.frame) slot = &s;
-    if (slot && (slot->total != f.total_size || slot->count != f.data_count || slot->group != f.group_size ||
-                 slot->payload != f.fragment_size)) {
+    if (slot && (slot->total != f.total_size || slot->count != f.data_count ||
+                 slot->group != f.group_size || slot->payload != f.fragment_size)) {
         ++stats_.inconsistent;
         return false;
     }
@@ -141,7 +146,8 @@ bool Reassembler::add(const FragmentMessage& f, Reassembled& out, std::vector<ui
             ++stats_.duplicates;
             return false;
         }
-        std::copy(f.payload.begin(), f.payload.end(), s.data.begin() + std::size_t(f.index) * s.payload);
+        std::copy(f.payload.begin(), f.payload.end(),
+                  s.data.begin() + std::size_t(f.index) * s.payload);
         s.have[f.index] = 1;
         ++s.received;
     } else {
@@ -149,7 +155,8 @@ bool Reassembler::add(const FragmentMessage& f, Reassembled& out, std::vector<ui
             ++stats_.duplicates;
             return false;
         }
-        std::copy(f.payload.begin(), f.payload.end(), s.parity.begin() + std::size_t(f.index) * s.payload);
+        std::copy(f.payload.begin(), f.payload.end(),
+                  s.parity.begin() + std::size_t(f.index) * s.payload);
         s.have_parity[f.index] = 1;
     }
     if (!try_complete(s)) return false;

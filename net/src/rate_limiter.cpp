@@ -11,7 +11,8 @@ HandshakeRateLimiter::HandshakeRateLimiter(const RateLimitOptions& options) : op
 }
 
 void HandshakeRateLimiter::refill(Bucket& b, double rate, double burst, int64_t now_us) {
-    if (b.updated_us >= 0 && now_us > b.updated_us) b.tokens = std::min(burst, b.tokens + rate * (now_us - b.updated_us) * 1e-6);
+    if (b.updated_us >= 0 && now_us > b.updated_us)
+        b.tokens = std::min(burst, b.tokens + rate * (now_us - b.updated_us) * 1e-6);
     b.updated_us = now_us;
 }
 
@@ -22,8 +23,9 @@ HandshakeRateLimiter::Bucket& HandshakeRateLimiter::source(uint32_t address, int
         sources_.push_back({address, options_.per_source_burst, now_us});
         return sources_.back();
     }
-    Bucket& oldest = *std::min_element(sources_.begin(), sources_.end(),
-                                       [](const Bucket& a, const Bucket& b) { return a.updated_us < b.updated_us; });
+    Bucket& oldest = *std::min_element(
+        sources_.begin(), sources_.end(),
+        [](const Bucket& a, const Bucket& b) { return a.updated_us < b.updated_us; });
     oldest = {address, options_.per_source_burst, now_us};
     return oldest;
 }

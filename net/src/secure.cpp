@@ -7,12 +7,18 @@ namespace reprise::net {
 namespace {
 
 constexpr char kKdfContext[crypto_kdf_CONTEXTBYTES + 1] = "reprise1";
-enum Subkey : uint64_t { ClientToServer = 1, ServerToClient = 2, ServerConfirm = 3, ClientConfirm = 4 };
+enum Subkey : uint64_t {
+    ClientToServer = 1,
+    ServerToClient = 2,
+    ServerConfirm = 3,
+    ClientConfirm = 4
+};
 
 // CPace generator: a ristretto255 point from the secret, the client's nonce and the connection.
-Status generator(const std::string& secret, std::span<const uint8_t, 32> client_nonce, uint64_t connection,
-                 std::array<uint8_t, 32>& g) {
-    if (secret.empty() || secret.size() > 255) return Status::error("handshake: secret must be 1..255 bytes");
+Status generator(const std::string& secret, std::span<const uint8_t, 32> client_nonce,
+                 uint64_t connection, std::array<uint8_t, 32>& g) {
+    if (secret.empty() || secret.size() > 255)
+        return Status::error("handshake: secret must be 1..255 bytes");
     uint8_t hash[crypto_core_ristretto255_HASHBYTES];
     crypto_generichash_state st;
     crypto_generichash_init(&st, nullptr, 0, sizeof hash);
@@ -37,8 +43,9 @@ struct Derived {
 };
 
 // Keys and both confirmation tags from the shared point and the whole transcript.
-void derive(const uint8_t shared[32], uint64_t connection, const uint8_t* client_nonce, const uint8_t* server_nonce,
-            const uint8_t* client_share, const uint8_t* server_share, Derived& d) {
+void derive(const uint8_t shared[32], uint64_t connection, const uint8_t* client_nonce,
+            const uint8_t* server_nonce, const uint8_t* client_share, const uint8_t* server_share,
+            Derived& d) {
     uint8_t master[32];
     crypto_generichash_state st;
     crypto_generichash_init(&st, shared, 32, sizeof master);
@@ -53,8 +60,10 @@ void derive(const uint8_t shared[32], uint64_t connection, const uint8_t* client
     crypto_generichash_update(&st, server_share, 32);
     crypto_generichash_final(&st, master, sizeof master);
     Key confirm_s, confirm_c;
-    crypto_kdf_derive_from_key(d.keys.client_to_server.data(), 32, ClientToServer, kKdfContext, master);
-    crypto_kdf_derive_from_key(d.keys.server_to_client.data(), 32, ServerToClient, kKdfContext, master);
+    crypto_kdf_derive_from_key(d.keys.client_to_server.data(), 32, ClientToServer, kKdfContext,
+                               master);
+    crypto_kdf_derive_from_key(d.keys.server_to_client.data(), 32, ServerToClient, kKdfContext,
+                               master);
     crypto_kdf_derive_from_key(confirm_s.data(), 32, ServerConfirm, kKdfContext, master);
     crypto_kdf_derive_from_key(confirm_c.data(), 32, ClientConfirm, kKdfContext, master);
     auto tag = [&](const Key& key, const char* who, Key& out) {
@@ -101,8 +110,8 @@ void ClientHandshake::start(const std::string& secret, std::vector<uint8_t>& hel
     w.bytes(share_);
 }
 
-Status ClientHandshake::finish(std::span<const uint8_t> server_hello, std::vector<uint8_t>& client_finish,
-                               SessionKeys& keys) {
+Status ClientHandshake::finish(std::span<const uint8_t> server_hello,
+                               std::vector<uint8_t>& client_finish, SessionKeys& keys) {
     DatagramHeader h;
     REPRISE_TRY(parse_header(server_hello, h));
     if (h.type != DatagramType::ServerHello || server_hello.size() != kServerHelloSize)
@@ -114,7 +123,8 @@ Status ClientHandshake::finish(std::span<const uint8_t> server_hello, std::vecto
     if (crypto_scalarmult_ristretto255(shared, scalar_.data(), server_share.data()) != 0)
         return Status::error("server hello: invalid share");
     Derived d;
-    derive(shared, connection_, nonce_.data(), server_nonce.data(), share_.data(), server_share.data(), d);
+    derive(shared, connection_, nonce_.data(), server_nonce.data(), share_.data(),
+           server_share.data(), d);
     sodium_memzero(shared, sizeof shared);
     if (sodium_memcmp(d.server_tag.data(), tag.data(), 32) != 0)
         return Status::error("server hello: key confirmation failed (wrong PIN?)");
@@ -142,12 +152,14 @@ Status answer_client_hello(const std::string& secret, std::span<const uint8_t> c
         crypto_core_ristretto255_scalar_random(scalar.data());
     } while (crypto_scalarmult_ristretto255(share.data(), scalar.data(), g.data()) != 0);
     uint8_t shared[32];
-    const bool bad = crypto_scalarmult_ristretto255(shared, scalar.data(), client_share.data()) != 0;
+    const bool bad =
+        crypto_scalarmult_ristretto255(shared, scalar.data(), client_share.data()) != 0;
     sodium_memzero(scalar.data(), 32);
     if (bad) return Status::error("client hello: share gives the identity");
     randombytes_buf(server_nonce.data(), 32);
     Derived d;
-    derive(shared, h.connection, nonce.data(), server_nonce.data(), client_share.data(), share.data(), d);
+    derive(shared, h.connection, nonce.data(), server_nonce.data(), client_share.data(),
+           share.data(), d);
     sodium_memzero(shared, sizeof shared);
     server_hello.assign(kServerHelloSize, 0);
     Writer w(server_hello);
@@ -161,12 +173,14 @@ Status answer_client_hello(const std::string& secret, std::span<const uint8_t> c
     return {};
 }
 
-Status check_client_finish(const PendingHandshake& pending, std::span<const uint8_t> client_finish) {
+Status check_client_finish(const PendingHandshake& pending,
+                           std::span<const uint8_t> client_finish) {
     DatagramHeader h;
     REPRISE_TRY(parse_header(client_finish, h));
     if (h.type != DatagramType::ClientFinish || client_finish.size() != kClientFinishSize)
         return Status::error("client finish: wrong type or size");
-    if (h.connection != pending.connection) return Status::error("client finish: another connection");
+    if (h.connection != pending.connection)
+        return Status::error("client finish: another connection");
     if (sodium_memcmp(client_finish.data() + kHeaderSize, pending.client_confirm.data(), 32) != 0)
         return Status::error("client finish: key confirmation failed (wrong PIN?)");
     return {};
@@ -186,7 +200,8 @@ void ReplayWindow::mark(uint64_t seq) {
         if (advance >= kSize) {
             bits_.fill(0);
         } else {
-            for (uint64_t s = newest_ + 1; s <= seq; ++s) bits_[(s % kSize) / 64] &= ~(uint64_t(1) << (s % 64));
+            for (uint64_t s = newest_ + 1; s <= seq; ++s)
+                bits_[(s % kSize) / 64] &= ~(uint64_t(1) << (s % 64));
         }
         newest_ = seq;
     }
@@ -218,9 +233,9 @@ void SecureChannel::seal(std::span<const uint8_t> plaintext, std::vector<uint8_t
     uint8_t nonce[12];
     nonce_of(seq, nonce);
     unsigned long long written = 0;
-    crypto_aead_chacha20poly1305_ietf_encrypt(datagram.data() + kSealedHeaderSize, &written, plaintext.data(),
-                                              plaintext.size(), datagram.data(), kSealedHeaderSize, nullptr, nonce,
-                                              send_key_.data());
+    crypto_aead_chacha20poly1305_ietf_encrypt(datagram.data() + kSealedHeaderSize, &written,
+                                              plaintext.data(), plaintext.size(), datagram.data(),
+                                              kSealedHeaderSize, nullptr, nonce, send_key_.data());
     REPRISE_ASSERT(written == plaintext.size() + kAeadTagSize);
 }
 
@@ -238,10 +253,10 @@ Status SecureChannel::open(std::span<const uint8_t> datagram, std::vector<uint8_
     nonce_of(seq, nonce);
     plaintext.resize(datagram.size() - kSealedHeaderSize - kAeadTagSize);
     unsigned long long length = 0;
-    if (crypto_aead_chacha20poly1305_ietf_decrypt(plaintext.data(), &length, nullptr,
-                                                  datagram.data() + kSealedHeaderSize,
-                                                  datagram.size() - kSealedHeaderSize, datagram.data(),
-                                                  kSealedHeaderSize, nonce, receive_key_.data()) != 0) {
+    if (crypto_aead_chacha20poly1305_ietf_decrypt(
+            plaintext.data(), &length, nullptr, datagram.data() + kSealedHeaderSize,
+            datagram.size() - kSealedHeaderSize, datagram.data(), kSealedHeaderSize, nonce,
+            receive_key_.data()) != 0) {
         plaintext.clear();
         return Status::error("sealed datagram: authentication failed");
     }

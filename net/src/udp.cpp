@@ -2,8 +2,8 @@
 
 #include <poll.h>
 
-#include <asio/ip/udp.hpp>
 #include <asio/io_context.hpp>
+#include <asio/ip/udp.hpp>
 #include <charconv>
 #include <chrono>
 
@@ -11,17 +11,20 @@ namespace reprise::net {
 
 std::string Endpoint::text() const {
     return std::to_string(address >> 24) + "." + std::to_string((address >> 16) & 255) + "." +
-           std::to_string((address >> 8) & 255) + "." + std::to_string(address & 255) + ":" + std::to_string(port);
+           std::to_string((address >> 8) & 255) + "." + std::to_string(address & 255) + ":" +
+           std::to_string(port);
 }
 
 Status parse_endpoint(const std::string& text, Endpoint& endpoint) {
     const auto colon = text.rfind(':');
-    if (colon == std::string::npos) return Status::error("address '" + text + "': expected HOST:PORT");
+    if (colon == std::string::npos)
+        return Status::error("address '" + text + "': expected HOST:PORT");
     std::string host = text.substr(0, colon), port = text.substr(colon + 1);
     if (host == "localhost") host = "127.0.0.1";
     asio::error_code ec;
     const asio::ip::address_v4 a = asio::ip::make_address_v4(host, ec);
-    if (ec) return Status::error("address '" + text + "': host must be an IPv4 address or localhost");
+    if (ec)
+        return Status::error("address '" + text + "': host must be an IPv4 address or localhost");
     unsigned value = 0;
     auto [end, err] = std::from_chars(port.data(), port.data() + port.size(), value);
     if (port.empty() || err != std::errc() || end != port.data() + port.size() || value > 65535)
@@ -37,7 +40,9 @@ struct UdpSocket::Impl {
 };
 
 namespace {
-asio::ip::udp::endpoint to_asio(const Endpoint& e) { return {asio::ip::address_v4(e.address), e.port}; }
+asio::ip::udp::endpoint to_asio(const Endpoint& e) {
+    return {asio::ip::address_v4(e.address), e.port};
+}
 }  // namespace
 
 UdpSocket::UdpSocket() : impl_(std::make_unique<Impl>()) {}
@@ -82,7 +87,8 @@ bool UdpSocket::receive(std::vector<uint8_t>& datagram, Endpoint& from, std::siz
     asio::ip::udp::endpoint sender;
     asio::error_code ec;
     for (;;) {
-        const std::size_t n = impl_->socket.receive_from(asio::buffer(datagram.data(), datagram.size()), sender, 0, ec);
+        const std::size_t n = impl_->socket.receive_from(
+            asio::buffer(datagram.data(), datagram.size()), sender, 0, ec);
         if (ec == asio::error::connection_refused) continue;  // ICMP from an earlier send
         if (ec) return false;
         datagram.resize(n);
@@ -100,7 +106,8 @@ bool UdpSocket::wait_readable(int64_t timeout_us) {
 }
 
 int64_t now_us() {
-    return std::chrono::duration_cast<std::chrono::microseconds>(std::chrono::steady_clock::now().time_since_epoch())
+    return std::chrono::duration_cast<std::chrono::microseconds>(
+               std::chrono::steady_clock::now().time_since_epoch())
         .count();
 }
 

@@ -70,15 +70,18 @@ void write_header(Writer& w, const DatagramHeader& header) {
 
 Status parse_header(std::span<const uint8_t> datagram, DatagramHeader& header) {
     if (datagram.size() > kMaxDatagram)
-        return Status::error("datagram: " + std::to_string(datagram.size()) + " bytes, more than 1200");
+        return Status::error("datagram: " + std::to_string(datagram.size()) +
+                             " bytes, more than 1200");
     Reader r(datagram);
     const uint8_t m0 = r.u8(), m1 = r.u8(), version = r.u8(), type = r.u8();
     header.connection = r.u64();
     if (!r.ok()) return Status::error("datagram: shorter than its 12-byte header");
     if (m0 != kMagic0 || m1 != kMagic1) return Status::error("datagram: bad magic");
     if (version != kProtocolVersion)
-        return Status::error("datagram: protocol version " + std::to_string(version) + ", expected 1");
-    if (type < 1 || type > 4) return Status::error("datagram: unknown type " + std::to_string(type));
+        return Status::error("datagram: protocol version " + std::to_string(version) +
+                             ", expected 1");
+    if (type < 1 || type > 4)
+        return Status::error("datagram: unknown type " + std::to_string(type));
     header.type = DatagramType(type);
     return {};
 }
@@ -86,7 +89,8 @@ Status parse_header(std::span<const uint8_t> datagram, DatagramHeader& header) {
 bool valid_scene_name(const std::string& name) {
     if (name.empty() || name.size() > kMaxSceneName) return false;
     for (char c : name)
-        if (!((c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' || c == '-')) return false;
+        if (!((c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_' || c == '-'))
+            return false;
     return true;
 }
 
@@ -223,7 +227,8 @@ Status parse(std::span<const uint8_t> plaintext, StreamInfoMessage& m) {
     REPRISE_TRY(finish(r, "stream info"));
     if (m.width < 1 || m.height < 1 || m.width > 8192 || m.height > 8192)
         return Status::error("stream info: size outside 1..8192");
-    if (!(m.fps > 0.0f && m.fps <= 1000.0f)) return Status::error("stream info: fps outside (0, 1000]");
+    if (!(m.fps > 0.0f && m.fps <= 1000.0f))
+        return Status::error("stream info: fps outside (0, 1000]");
     if (mode > 1) return Status::error("stream info: unknown mode " + std::to_string(mode));
     m.mode = StreamMode(mode);
     return {};
@@ -255,7 +260,8 @@ Status parse(std::span<const uint8_t> plaintext, LossReportMessage& m) {
     Reader r(plaintext);
     REPRISE_TRY(expect(r, MessageType::LossReport, "loss report"));
     m.count = r.u8();
-    if (m.count < 1 || m.count > kMaxLossReport) return Status::error("loss report: count outside 1..32");
+    if (m.count < 1 || m.count > kMaxLossReport)
+        return Status::error("loss report: count outside 1..32");
     for (int i = 0; i < m.count; ++i) m.frames[i] = r.u32();
     return finish(r, "loss report");
 }
@@ -293,7 +299,8 @@ Status parse(std::span<const uint8_t> plaintext, FragmentMessage& m) {
     const bool last = m.kind == FragmentKind::Data && m.index + 1u == m.data_count;
     const std::size_t expected =
         last ? m.total_size - std::size_t(m.data_count - 1) * m.fragment_size : m.fragment_size;
-    if (m.payload.size() != expected) return Status::error("fragment: payload size disagrees with the header");
+    if (m.payload.size() != expected)
+        return Status::error("fragment: payload size disagrees with the header");
     if (m.kind == FragmentKind::Data && m.index >= m.data_count)
         return Status::error("fragment: index " + std::to_string(m.index) + " beyond count " +
                              std::to_string(m.data_count));

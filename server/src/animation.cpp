@@ -70,8 +70,8 @@ void sample(const AnimationChannel& c, float t, float* out) {
             float h00 = 2 * s3 - 3 * s2 + 1, h10 = s3 - 2 * s2 + s;
             float h01 = -2 * s3 + 3 * s2, h11 = s3 - s2;
             for (int i = 0; i < n; ++i)
-                out[i] = h00 * a[i] + h10 * dt * out_tangent[i] + h01 * b[i] +
-                         h11 * dt * in_tangent[i];
+                out[i] =
+                    h00 * a[i] + h10 * dt * out_tangent[i] + h01 * b[i] + h11 * dt * in_tangent[i];
             return;
         }
     }
@@ -93,9 +93,12 @@ void evaluate_pose(const Scene& scene, double time, Pose& pose) {
     for (std::size_t i = 0; i < count; ++i) {
         const Node& n = scene.nodes[i];
         local[i] = {n.translation, n.rotation, n.scale};
-        if (!n.weights.empty()) pose.weights[i] = n.weights;
-        else if (n.mesh >= 0) pose.weights[i] = scene.meshes[n.mesh].weights;
-        else pose.weights[i].clear();
+        if (!n.weights.empty())
+            pose.weights[i] = n.weights;
+        else if (n.mesh >= 0)
+            pose.weights[i] = scene.meshes[n.mesh].weights;
+        else
+            pose.weights[i].clear();
     }
     double duration = animation_duration(scene);
     // Loop after the end; before the start, keys clamp (or extend, for keys at negative times).
@@ -114,8 +117,12 @@ void evaluate_pose(const Scene& scene, double time, Pose& pose) {
             Local& l = local[c.node];
             animated[c.node] = 1;
             switch (c.path) {
-                case AnimatedPath::Translation: l.translation = {out[0], out[1], out[2]}; break;
-                case AnimatedPath::Scale: l.scale = {out[0], out[1], out[2]}; break;
+                case AnimatedPath::Translation:
+                    l.translation = {out[0], out[1], out[2]};
+                    break;
+                case AnimatedPath::Scale:
+                    l.scale = {out[0], out[1], out[2]};
+                    break;
                 case AnimatedPath::Rotation:
                     l.rotation = glm::normalize(glm::quat(out[3], out[0], out[1], out[2]));
                     break;
@@ -166,7 +173,8 @@ void pose_vertices(const Scene& scene, const Pose& pose, int node, const Primiti
         float w = weights[t];
         if (w == 0.0f) continue;
         const MorphTarget& target = primitive.targets[t];
-        for (std::size_t v = 0; v < target.positions.size(); ++v) positions[v] += w * target.positions[v];
+        for (std::size_t v = 0; v < target.positions.size(); ++v)
+            positions[v] += w * target.positions[v];
         for (std::size_t v = 0; v < target.normals.size() && v < normals.size(); ++v)
             normals[v] += w * target.normals[v];
     }
@@ -185,7 +193,8 @@ void pose_vertices(const Scene& scene, const Pose& pose, int node, const Primiti
     for (std::size_t v = 0; v < count; ++v) {
         const glm::u16vec4 ji = primitive.joints[v];
         const glm::vec4 wi = primitive.weights[v];
-        glm::mat4 m = wi.x * joint[ji.x] + wi.y * joint[ji.y] + wi.z * joint[ji.z] + wi.w * joint[ji.w];
+        glm::mat4 m =
+            wi.x * joint[ji.x] + wi.y * joint[ji.y] + wi.z * joint[ji.z] + wi.w * joint[ji.w];
         positions[v] = glm::vec3(m * glm::vec4(positions[v], 1.0f));
         if (v < normals.size()) normals[v] = normal_matrix(glm::mat3(m)) * normals[v];
     }

@@ -96,7 +96,8 @@ Primitive cylinder(float radius, float height, int segments) {
         p.uv0.push_back({0.5f + 0.5f * std::cos(a), 0.5f + 0.5f * std::sin(a)});
     }
     for (int i = 0; i < segments; ++i)
-        for (uint32_t k : {top, top + 2 + uint32_t(i), top + 1 + uint32_t(i)}) p.indices.push_back(k);
+        for (uint32_t k : {top, top + 2 + uint32_t(i), top + 1 + uint32_t(i)})
+            p.indices.push_back(k);
     return p;
 }
 
@@ -106,7 +107,8 @@ Primitive sphere(float radius, int rings, int segments) {
         float phi = glm::pi<float>() * float(r) / float(rings);
         for (int s = 0; s <= segments; ++s) {
             float theta = glm::two_pi<float>() * float(s) / float(segments);
-            glm::vec3 n(std::sin(phi) * std::cos(theta), std::cos(phi), std::sin(phi) * std::sin(theta));
+            glm::vec3 n(std::sin(phi) * std::cos(theta), std::cos(phi),
+                        std::sin(phi) * std::sin(theta));
             p.positions.push_back(radius * n);
             p.normals.push_back(n);
             p.uv0.push_back({2.0f * float(s) / float(segments), float(r) / float(rings)});
@@ -169,7 +171,8 @@ Texture tiles_texture(glm::vec3 a, glm::vec3 b, uint32_t seed) {
 
 Texture noise_texture(glm::vec3 a, glm::vec3 b, uint32_t seed) {
     return make_texture([=](float u, float v) {
-        float n = 0.6f * smooth_noise(8 * u, 8 * v, seed) + 0.4f * smooth_noise(24 * u, 24 * v, seed + 7);
+        float n =
+            0.6f * smooth_noise(8 * u, 8 * v, seed) + 0.4f * smooth_noise(24 * u, 24 * v, seed + 7);
         float stripes = 0.5f + 0.5f * std::sin(glm::two_pi<float>() * 6 * (u + 0.1f * n));
         return glm::mix(a, b, 0.6f * n + 0.4f * stripes);
     });
@@ -208,7 +211,8 @@ struct Builder {
     // linear keys: exact at every instant, including the instant before frame 0).
     void move(int node, glm::vec3 velocity, float seconds = 60.0f) {
         glm::vec3 a = scene.nodes[node].translation - velocity, b = a + velocity * (seconds + 1.0f);
-        channel(node, AnimatedPath::Translation, {-1.0f, seconds}, {a.x, a.y, a.z, b.x, b.y, b.z}, 3);
+        channel(node, AnimatedPath::Translation, {-1.0f, seconds}, {a.x, a.y, a.z, b.x, b.y, b.z},
+                3);
     }
     // Constant spin about an axis, keyed every quarter turn.
     void spin(int node, glm::vec3 axis, float radians_per_second, float seconds = 60.0f) {
@@ -240,7 +244,8 @@ CameraModel builtin_lens() {
 void add_boxes(Builder& b, int material, float x0, float x1, float z0, float z1, int count,
                uint32_t seed) {
     for (int i = 0; i < count; ++i) {
-        float r1 = smooth_noise(i * 1.7f + 0.3f, 0.5f, seed), r2 = smooth_noise(0.5f, i * 2.3f + 0.7f, seed);
+        float r1 = smooth_noise(i * 1.7f + 0.3f, 0.5f, seed),
+              r2 = smooth_noise(0.5f, i * 2.3f + 0.7f, seed);
         float r3 = smooth_noise(i * 3.1f + 0.1f, i * 0.9f, seed + 1);
         glm::vec3 size(0.8f + 1.6f * r1, 0.8f + 2.2f * r2, 0.8f + 1.2f * r3);
         float x = x0 + (x1 - x0) * (float(i) + 0.5f) / float(count);
@@ -253,8 +258,10 @@ void add_boxes(Builder& b, int material, float x0, float x1, float z0, float z1,
 Scene pan_scene(CameraPath& camera, float speed) {
     Builder b;
     b.scene.name = speed > 10 ? "fast" : "pan";
-    int grass = b.material({1, 1, 1}, b.texture(tiles_texture({0.55f, 0.5f, 0.4f}, {0.3f, 0.42f, 0.25f}, 3)));
-    int crate = b.material({1, 1, 1}, b.texture(noise_texture({0.6f, 0.35f, 0.2f}, {0.9f, 0.75f, 0.5f}, 5)));
+    int grass = b.material({1, 1, 1},
+                           b.texture(tiles_texture({0.55f, 0.5f, 0.4f}, {0.3f, 0.42f, 0.25f}, 3)));
+    int crate = b.material({1, 1, 1},
+                           b.texture(noise_texture({0.6f, 0.35f, 0.2f}, {0.9f, 0.75f, 0.5f}, 5)));
     float length = speed > 10 ? 400.0f : 80.0f;
     b.add("ground", ground(length, 60, 4), grass, {0.5f * length - 20, 0, 0});
     add_boxes(b, crate, -10, length - 30, -9, -3, speed > 10 ? 60 : 14, 11);
@@ -275,9 +282,11 @@ Scene pan_scene(CameraPath& camera, float speed) {
 Scene fence_scene(CameraPath& camera) {
     Builder b;
     b.scene.name = "fence";
-    int grass = b.material({1, 1, 1}, b.texture(tiles_texture({0.5f, 0.55f, 0.35f}, {0.35f, 0.45f, 0.3f}, 9)));
+    int grass = b.material({1, 1, 1},
+                           b.texture(tiles_texture({0.5f, 0.55f, 0.35f}, {0.35f, 0.45f, 0.3f}, 9)));
     int wood = b.material({0.45f, 0.3f, 0.18f});
-    int paint = b.material({1, 1, 1}, b.texture(noise_texture({0.7f, 0.2f, 0.15f}, {0.95f, 0.9f, 0.8f}, 4)));
+    int paint = b.material({1, 1, 1},
+                           b.texture(noise_texture({0.7f, 0.2f, 0.15f}, {0.95f, 0.9f, 0.8f}, 4)));
     b.add("ground", ground(60, 60, 4), grass, {0, 0, 0});
     for (int i = 0; i <= 24; ++i)
         b.add("pole" + std::to_string(i), cylinder(0.035f, 1.4f, 12), wood, {-6 + 0.5f * i, 0, 0});
@@ -295,10 +304,14 @@ Scene fence_scene(CameraPath& camera) {
 Scene crossing_scene(CameraPath& camera) {
     Builder b;
     b.scene.name = "crossing";
-    int floor = b.material({1, 1, 1}, b.texture(tiles_texture({0.6f, 0.6f, 0.55f}, {0.35f, 0.35f, 0.4f}, 2)));
-    int poster = b.material({1, 1, 1}, b.texture(noise_texture({0.15f, 0.3f, 0.6f}, {0.9f, 0.8f, 0.4f}, 8)));
-    int red = b.material({1, 1, 1}, b.texture(tiles_texture({0.8f, 0.15f, 0.1f}, {0.95f, 0.85f, 0.8f}, 6)));
-    int green = b.material({1, 1, 1}, b.texture(noise_texture({0.1f, 0.5f, 0.2f}, {0.8f, 0.9f, 0.6f}, 12)));
+    int floor = b.material({1, 1, 1},
+                           b.texture(tiles_texture({0.6f, 0.6f, 0.55f}, {0.35f, 0.35f, 0.4f}, 2)));
+    int poster =
+        b.material({1, 1, 1}, b.texture(noise_texture({0.15f, 0.3f, 0.6f}, {0.9f, 0.8f, 0.4f}, 8)));
+    int red = b.material({1, 1, 1},
+                         b.texture(tiles_texture({0.8f, 0.15f, 0.1f}, {0.95f, 0.85f, 0.8f}, 6)));
+    int green =
+        b.material({1, 1, 1}, b.texture(noise_texture({0.1f, 0.5f, 0.2f}, {0.8f, 0.9f, 0.6f}, 12)));
     b.add("floor", ground(40, 30, 3), floor, {0, 0, 0});
     b.add("wall", wall(30, 10, 3), poster, {0, 0, -6});
     int cube = b.add("cube", box({1.2f, 1.2f, 1.2f}, 0.6f), red, {-5, 0.6f, -1});
@@ -320,12 +333,14 @@ Scene specular_scene(CameraPath& camera) {
     Builder b;
     b.scene.name = "specular";
     b.scene.light.direction = {-0.6f, -0.5f, -0.6f};
-    int floor = b.material({1, 1, 1}, b.texture(tiles_texture({0.3f, 0.3f, 0.32f}, {0.5f, 0.48f, 0.45f}, 1)),
+    int floor = b.material({1, 1, 1},
+                           b.texture(tiles_texture({0.3f, 0.3f, 0.32f}, {0.5f, 0.48f, 0.45f}, 1)),
                            0.6f, 80.0f);
     int chrome = b.material({0.6f, 0.6f, 0.65f}, -1, 1.5f, 120.0f);
     int gold = b.material({0.8f, 0.55f, 0.2f}, -1, 1.2f, 60.0f);
-    int plastic = b.material({1, 1, 1}, b.texture(noise_texture({0.1f, 0.2f, 0.7f}, {0.7f, 0.8f, 0.95f}, 3)),
-                             0.9f, 200.0f);
+    int plastic =
+        b.material({1, 1, 1}, b.texture(noise_texture({0.1f, 0.2f, 0.7f}, {0.7f, 0.8f, 0.95f}, 3)),
+                   0.9f, 200.0f);
     b.add("floor", ground(40, 40, 2), floor, {0, 0, 0});
     b.add("chrome ball", sphere(1.0f, 32, 64), chrome, {-1.8f, 1.0f, 0});
     b.add("gold box", box({1.4f, 1.4f, 1.4f}), gold, {1.6f, 0.7f, -0.5f},
@@ -351,11 +366,13 @@ Scene cut_scene(CameraPath& camera) {
 
 // Eight coloured point lights on a ring `radius` around `centre`, `height` above the ground.
 void ring_of_lights(Scene& scene, glm::vec3 centre, float radius, float height, float power) {
-    const glm::vec3 tints[4] = {{1.0f, 0.75f, 0.5f}, {0.55f, 0.7f, 1.0f}, {1.0f, 0.55f, 0.7f}, {0.6f, 1.0f, 0.7f}};
+    const glm::vec3 tints[4] = {
+        {1.0f, 0.75f, 0.5f}, {0.55f, 0.7f, 1.0f}, {1.0f, 0.55f, 0.7f}, {0.6f, 1.0f, 0.7f}};
     for (int i = 0; i < 8; ++i) {
         float a = glm::two_pi<float>() * (float(i) + 0.5f) / 8.0f;
-        scene.point_lights.push_back({.position = centre + glm::vec3(radius * std::cos(a), height, radius * std::sin(a)),
-                                      .color = power * tints[i % 4]});
+        scene.point_lights.push_back(
+            {.position = centre + glm::vec3(radius * std::cos(a), height, radius * std::sin(a)),
+             .color = power * tints[i % 4]});
     }
 }
 
@@ -363,7 +380,9 @@ Scene courtyard_scene(CameraPath& camera) {
     Builder b;
     b.scene.name = "courtyard";
     b.scene.heavy_shading = true;
-    b.scene.light = {.direction = {-0.5f, -1.0f, -0.35f}, .color = {1.0f, 0.95f, 0.85f}, .ambient = {0.1f, 0.11f, 0.14f}};
+    b.scene.light = {.direction = {-0.5f, -1.0f, -0.35f},
+                     .color = {1.0f, 0.95f, 0.85f},
+                     .ambient = {0.1f, 0.11f, 0.14f}};
     int stone = b.material({0.85f, 0.82f, 0.78f}, -1, 0.2f, 24.0f);
     int brick = b.material({0.8f, 0.5f, 0.4f}, -1, 0.1f, 16.0f);
     int marble = b.material({0.9f, 0.9f, 0.95f}, -1, 0.6f, 64.0f);
@@ -371,7 +390,8 @@ Scene courtyard_scene(CameraPath& camera) {
     b.add("ground", ground(30, 24, 4), stone, {0, 0, -2});
     b.add("wall", wall(30, 8, 3), brick, {0, 0, -8});
     for (int i = 0; i < 4; ++i)
-        b.add("pillar" + std::to_string(i), cylinder(0.35f, 4.0f, 24), marble, {-4.5f + 3.0f * i, 0, -5.5f});
+        b.add("pillar" + std::to_string(i), cylinder(0.35f, 4.0f, 24), marble,
+              {-4.5f + 3.0f * i, 0, -5.5f});
     int cube = b.add("cube", box({1.2f, 1.2f, 1.2f}, 0.6f), bronze, {-4, 0.6f, -1});
     b.move(cube, {1.6f, 0, 0});
     b.spin(cube, {0, 1, 0}, 0.9f);
@@ -392,7 +412,9 @@ Scene stroll_scene(CameraPath& camera) {
     Builder b;
     b.scene.name = "stroll";
     b.scene.heavy_shading = true;
-    b.scene.light = {.direction = {-0.6f, -0.9f, -0.4f}, .color = {1.0f, 0.95f, 0.85f}, .ambient = {0.1f, 0.11f, 0.14f}};
+    b.scene.light = {.direction = {-0.6f, -0.9f, -0.4f},
+                     .color = {1.0f, 0.95f, 0.85f},
+                     .ambient = {0.1f, 0.11f, 0.14f}};
     int stone = b.material({0.8f, 0.78f, 0.72f}, -1, 0.2f, 24.0f);
     int marble = b.material({0.92f, 0.9f, 0.88f}, -1, 0.7f, 80.0f);
     int moss = b.material({0.45f, 0.6f, 0.35f}, -1, 0.05f, 8.0f);
@@ -401,7 +423,8 @@ Scene stroll_scene(CameraPath& camera) {
     for (int i = 0; i < 6; ++i) {
         float a = glm::two_pi<float>() * float(i) / 6.0f;
         glm::vec3 at(3.5f * std::cos(a), 0, 3.5f * std::sin(a));
-        b.add("column" + std::to_string(i), cylinder(0.3f, 2.5f + 0.4f * float(i % 3), 24), marble, at);
+        b.add("column" + std::to_string(i), cylinder(0.3f, 2.5f + 0.4f * float(i % 3), 24), marble,
+              at);
     }
     b.add("plinth", box({2.0f, 0.8f, 2.0f}, 1.0f), moss, {0, 0.4f, 0});
     b.add("statue", sphere(0.7f, 24, 48), bronze, {0, 1.5f, 0});
@@ -421,14 +444,22 @@ Scene stroll_scene(CameraPath& camera) {
 Status load_scene(const std::string& name_or_file, Scene& scene, CameraPath& camera,
                   const GltfOptions& gltf) {
     const std::string& n = name_or_file;
-    if (n == "pan") scene = pan_scene(camera, 1.5f);
-    else if (n == "fast") scene = pan_scene(camera, 24.0f);
-    else if (n == "fence") scene = fence_scene(camera);
-    else if (n == "crossing") scene = crossing_scene(camera);
-    else if (n == "specular") scene = specular_scene(camera);
-    else if (n == "cut") scene = cut_scene(camera);
-    else if (n == "courtyard") scene = courtyard_scene(camera);
-    else if (n == "stroll") scene = stroll_scene(camera);
+    if (n == "pan")
+        scene = pan_scene(camera, 1.5f);
+    else if (n == "fast")
+        scene = pan_scene(camera, 24.0f);
+    else if (n == "fence")
+        scene = fence_scene(camera);
+    else if (n == "crossing")
+        scene = crossing_scene(camera);
+    else if (n == "specular")
+        scene = specular_scene(camera);
+    else if (n == "cut")
+        scene = cut_scene(camera);
+    else if (n == "courtyard")
+        scene = courtyard_scene(camera);
+    else if (n == "stroll")
+        scene = stroll_scene(camera);
     else {
         auto ext = std::filesystem::path(n).extension().string();
         if (ext != ".gltf" && ext != ".glb")

@@ -156,17 +156,24 @@ Status parse_camera_spec(const std::string& spec, const Scene& scene, const Came
         if (ec != std::errc() || last != text.data() + text.size() || !std::isfinite(value))
             return bad("'" + text + "' is not a number");
         glm::vec3 offset = path.eye - path.target;
-        if (key == "speed") path.speed = value;
-        else if (key == "shake") path.shake = value;
-        else if (key == "time") path.cut_time = value;
-        else if (key == "angle") path.cut_angle = value;
-        else if (key == "height") path.eye.y = path.target.y + value;
+        if (key == "speed")
+            path.speed = value;
+        else if (key == "shake")
+            path.shake = value;
+        else if (key == "time")
+            path.cut_time = value;
+        else if (key == "angle")
+            path.cut_angle = value;
+        else if (key == "height")
+            path.eye.y = path.target.y + value;
         else if (key == "radius") {
             float r = std::hypot(offset.x, offset.z);
             if (value <= 0) return bad("radius must be positive");
             glm::vec3 flat = r > 0 ? glm::vec3(offset.x, 0, offset.z) / r : glm::vec3(0, 0, 1);
             path.eye = path.target + flat * value + glm::vec3(0, offset.y, 0);
-        } else return bad("unknown parameter '" + key + "' (speed, radius, height, shake, time, angle)");
+        } else
+            return bad("unknown parameter '" + key +
+                       "' (speed, radius, height, shake, time, angle)");
     }
     return {};
 }

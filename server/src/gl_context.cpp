@@ -22,7 +22,8 @@ bool has_extension(const char* list, const char* name) {
 
 // The first EGL device backed by real hardware (not Mesa's software device).
 EGLDisplay hardware_display() {
-    auto query_devices = reinterpret_cast<PFNEGLQUERYDEVICESEXTPROC>(eglGetProcAddress("eglQueryDevicesEXT"));
+    auto query_devices =
+        reinterpret_cast<PFNEGLQUERYDEVICESEXTPROC>(eglGetProcAddress("eglQueryDevicesEXT"));
     auto query_string = reinterpret_cast<PFNEGLQUERYDEVICESTRINGEXTPROC>(
         eglGetProcAddress("eglQueryDeviceStringEXT"));
     auto get_display = reinterpret_cast<PFNEGLGETPLATFORMDISPLAYEXTPROC>(
@@ -63,8 +64,9 @@ Status GlContext::create(std::unique_ptr<GlContext>& context) {
         return Status::error("EGL: no hardware EGL device found (REPRISE_EGL=device)");
     if (display == EGL_NO_DISPLAY) {
         if (!has_extension(client_extensions, "EGL_MESA_platform_surfaceless"))
-            return Status::error("EGL: Mesa's surfaceless platform is not available "
-                                 "(install libegl-mesa0 and libgl1-mesa-dri)");
+            return Status::error(
+                "EGL: Mesa's surfaceless platform is not available "
+                "(install libegl-mesa0 and libgl1-mesa-dri)");
         display = surfaceless_display();
     }
     EGLint major = 0, minor = 0;
@@ -73,7 +75,7 @@ Status GlContext::create(std::unique_ptr<GlContext>& context) {
                              std::to_string(eglGetError()) + ")");
     if (!eglBindAPI(EGL_OPENGL_ES_API)) return Status::error("EGL: OpenGL ES is not supported");
     const EGLint config_attributes[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_ES3_BIT, EGL_SURFACE_TYPE,
-                                       EGL_PBUFFER_BIT, EGL_NONE};
+                                        EGL_PBUFFER_BIT, EGL_NONE};
     EGLConfig config = nullptr;
     EGLint configs = 0;
     if (!eglChooseConfig(display, config_attributes, &config, 1, &configs) || configs < 1) {
@@ -101,7 +103,8 @@ Status GlContext::create(std::unique_ptr<GlContext>& context) {
     context->context_ = egl_context;
     const char* renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
     const char* version = reinterpret_cast<const char*>(glGetString(GL_VERSION));
-    context->description_ = std::string(renderer ? renderer : "?") + ", " + (version ? version : "?");
+    context->description_ =
+        std::string(renderer ? renderer : "?") + ", " + (version ? version : "?");
     const char* gl_extensions = reinterpret_cast<const char*>(glGetString(GL_EXTENSIONS));
     GLint gl_major = 0, gl_minor = 0;
     glGetIntegerv(GL_MAJOR_VERSION, &gl_major);
@@ -110,8 +113,9 @@ Status GlContext::create(std::unique_ptr<GlContext>& context) {
                          has_extension(gl_extensions, "GL_EXT_color_buffer_float");
     if (!float_targets) {
         context.reset();
-        return Status::error("OpenGL ES: float render targets (GL_EXT_color_buffer_float) are "
-                             "not supported");
+        return Status::error(
+            "OpenGL ES: float render targets (GL_EXT_color_buffer_float) are "
+            "not supported");
     }
     return {};
 }

@@ -24,7 +24,9 @@ Status MetricsEndpoint::open(int port) {
     if (!ec) impl_->acceptor.bind(at, ec);
     if (!ec) impl_->acceptor.listen(8, ec);
     if (!ec) impl_->acceptor.non_blocking(true, ec);
-    if (ec) return Status::error("metrics endpoint 127.0.0.1:" + std::to_string(port) + ": " + ec.message());
+    if (ec)
+        return Status::error("metrics endpoint 127.0.0.1:" + std::to_string(port) + ": " +
+                             ec.message());
     return {};
 }
 
@@ -48,8 +50,9 @@ void MetricsEndpoint::serve(const std::string& body) {
         s.non_blocking(true, ec);
         s.read_some(asio::buffer(request), ec);
         s.non_blocking(false, ec);
-        const std::string response = "HTTP/1.0 200 OK\r\nContent-Type: text/plain; version=0.0.4\r\nContent-Length: " +
-                                     std::to_string(body.size()) + "\r\nConnection: close\r\n\r\n" + body;
+        const std::string response =
+            "HTTP/1.0 200 OK\r\nContent-Type: text/plain; version=0.0.4\r\nContent-Length: " +
+            std::to_string(body.size()) + "\r\nConnection: close\r\n\r\n" + body;
         asio::write(s, asio::buffer(response), ec);
         s.shutdown(asio::ip::tcp::socket::shutdown_both, ec);
         s.close(ec);

@@ -63,7 +63,8 @@ Status link(const char* vertex, const char* fragment, const char* what, GLuint& 
         if (!linked) {
             char log[2048] = {};
             glGetProgramInfoLog(program, sizeof log, nullptr, log);
-            status = Status::error(std::string("OpenGL ES: the ") + what + " program does not link: " + log);
+            status = Status::error(std::string("OpenGL ES: the ") + what +
+                                   " program does not link: " + log);
         }
     }
     glDeleteShader(vs);
@@ -99,7 +100,8 @@ Status check_heavy_settings(const RenderSettings& settings) {
         return Status::error("heavy shading: PCF radius must be in 0..8");
     const ReuseSettings& r = settings.reuse;
     if (r.period < 1 || r.period > 255)
-        return Status::error("reuse: refresh period " + std::to_string(r.period) + " must be in 1..255");
+        return Status::error("reuse: refresh period " + std::to_string(r.period) +
+                             " must be in 1..255");
     if (!(r.threshold > 0.0f && r.threshold <= 1.0f))
         return Status::error("reuse: threshold must be in (0, 1]");
     if (r.filter_radius < 0 || r.filter_radius > 3)
@@ -129,10 +131,14 @@ glm::mat4 shadow_light_matrix(const Vertices& vertices, glm::vec3 direction) {
 
 const char* to_string(Refresh refresh) {
     switch (refresh) {
-    case Refresh::Tiled: return "tiled";
-    case Refresh::Random: return "random";
-    case Refresh::Blocks: return "blocks";
-    case Refresh::Interleaved: return "interleaved";
+        case Refresh::Tiled:
+            return "tiled";
+        case Refresh::Random:
+            return "random";
+        case Refresh::Blocks:
+            return "blocks";
+        case Refresh::Interleaved:
+            return "interleaved";
     }
     return "?";
 }
@@ -140,10 +146,14 @@ const char* to_string(Refresh refresh) {
 Status parse_refresh(const std::string& spec, ReuseSettings& reuse) {
     const std::size_t colon = spec.find(':');
     const std::string kind = spec.substr(0, colon);
-    if (kind == "tiled") reuse.refresh = Refresh::Tiled;
-    else if (kind == "random") reuse.refresh = Refresh::Random;
-    else if (kind == "blocks") reuse.refresh = Refresh::Blocks;
-    else if (kind == "interleaved") reuse.refresh = Refresh::Interleaved;
+    if (kind == "tiled")
+        reuse.refresh = Refresh::Tiled;
+    else if (kind == "random")
+        reuse.refresh = Refresh::Random;
+    else if (kind == "blocks")
+        reuse.refresh = Refresh::Blocks;
+    else if (kind == "interleaved")
+        reuse.refresh = Refresh::Interleaved;
     else
         return Status::error("--refresh '" + spec +
                              "': the kind must be tiled, random, blocks or interleaved");
@@ -152,15 +162,14 @@ Status parse_refresh(const std::string& spec, ReuseSettings& reuse) {
         char* end = nullptr;
         long period = std::strtol(n.c_str(), &end, 10);
         if (n.empty() || *end != '\0' || period < 1 || period > 255)
-            return Status::error("--refresh '" + spec + "': the period must be an integer in 1..255");
+            return Status::error("--refresh '" + spec +
+                                 "': the period must be an integer in 1..255");
         reuse.period = int(period);
     }
     return {};
 }
 
-namespace {
-
-}  // namespace
+namespace {}  // namespace
 
 struct Renderer::Gpu {
     std::unique_ptr<GlContext> context;
@@ -171,8 +180,8 @@ struct Renderer::Gpu {
     GLuint heavy_program[3] = {}, shadow_program = 0;
     GLuint shadow_framebuffer = 0, shadow_map = 0;
     GLuint cache_term[2] = {}, cache_meta[2] = {};
-    int cache_slot = 0;          // the slot written by the next reusing frame
-    bool cache_valid = false;    // the other slot holds the frame rendered at cache_time/view
+    int cache_slot = 0;        // the slot written by the next reusing frame
+    bool cache_valid = false;  // the other slot holds the frame rendered at cache_time/view
     double cache_time = 0.0;
     glm::mat4 cache_view{0.0f};
     const Scene* cache_scene = nullptr;
@@ -236,9 +245,11 @@ struct Renderer::Gpu {
             const std::string fragment = std::string("#version 300 es\n#define REUSE ") +
                                          (pass ? "1" : "0") + "\n#define PASS " + char('0' + pass) +
                                          "\n" + shaders::kHeavyFragment;
-            REPRISE_TRY(link(vertex.c_str(), fragment.c_str(), "heavy shading", heavy_program[pass]));
+            REPRISE_TRY(
+                link(vertex.c_str(), fragment.c_str(), "heavy shading", heavy_program[pass]));
         }
-        REPRISE_TRY(link(shaders::kShadowVertex, shaders::kShadowFragment, "shadow map", shadow_program));
+        REPRISE_TRY(
+            link(shaders::kShadowVertex, shaders::kShadowFragment, "shadow map", shadow_program));
         glGenTextures(1, &shadow_map);
         glBindTexture(GL_TEXTURE_2D, shadow_map);
         glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT32F, kShadowMapSize, kShadowMapSize, 0,
@@ -306,9 +317,12 @@ struct Renderer::Gpu {
                                    targets[i], 0);
         }
         glBindRenderbuffer(GL_RENDERBUFFER, depth_buffer);
-        glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH32F_STENCIL8, w, h);  // stencil: reuse's passes
-        glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER, depth_buffer);
-        const GLenum buffers[3] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
+        glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH32F_STENCIL8, w,
+                              h);  // stencil: reuse's passes
+        glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_STENCIL_ATTACHMENT, GL_RENDERBUFFER,
+                                  depth_buffer);
+        const GLenum buffers[3] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1,
+                                   GL_COLOR_ATTACHMENT2};
         glDrawBuffers(3, buffers);
         if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
             return Status::error("OpenGL ES: the float G-buffer is not renderable on this device");
@@ -335,7 +349,8 @@ struct Renderer::Gpu {
             glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, wrap);
             glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, wrap);
             glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
-            glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, t.nearest ? GL_NEAREST : GL_LINEAR);
+            glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER,
+                            t.nearest ? GL_NEAREST : GL_LINEAR);
             if (max_anisotropy > 1.0f)
                 glTexParameterf(GL_TEXTURE_2D, 0x84FE /* TEXTURE_MAX_ANISOTROPY_EXT */,
                                 std::min(8.0f, max_anisotropy));
@@ -363,14 +378,14 @@ struct Renderer::Gpu {
                 pose_vertices(s, pose, node, p, positions, normals);
                 pose_vertices(s, previous_pose, node, p, previous_positions, unused);
                 if (p.normals.empty()) smooth_normals(positions, p.indices, normals);
-                const std::vector<glm::vec2>& uv = p.material >= 0 &&
-                    s.materials[p.material].texcoord == 1 ? p.uv1 : p.uv0;
+                const std::vector<glm::vec2>& uv =
+                    p.material >= 0 && s.materials[p.material].texcoord == 1 ? p.uv1 : p.uv0;
                 uint32_t base = uint32_t(vertices.size());
                 for (std::size_t v = 0; v < positions.size(); ++v)
                     vertices.push_back({positions[v], previous_positions[v], normals[v],
                                         v < uv.size() ? uv[v] : glm::vec2(0.0f)});
-                draws.push_back({GLsizei(indices.size()), GLsizei(p.indices.size()), p.material, id,
-                                 mirrored});
+                draws.push_back(
+                    {GLsizei(indices.size()), GLsizei(p.indices.size()), p.material, id, mirrored});
                 for (uint32_t i : p.indices) indices.push_back(base + i);
             }
         }
@@ -389,7 +404,8 @@ void Renderer::Gpu::set_heavy_uniforms(const Scene& drawn, const Instant& curren
     const int lights = int(std::min<std::size_t>(drawn.point_lights.size(), 16));
     glm::vec3 light_positions[16], light_colors[16];
     for (int i = 0; i < lights; ++i)
-        light_positions[i] = drawn.point_lights[i].position, light_colors[i] = drawn.point_lights[i].color;
+        light_positions[i] = drawn.point_lights[i].position,
+        light_colors[i] = drawn.point_lights[i].color;
     glUniform1i(g.uniform("u_point_count"), lights);
     if (lights > 0) {
         glUniform3fv(g.uniform("u_point_position"), lights, glm::value_ptr(light_positions[0]));
@@ -404,13 +420,16 @@ void Renderer::Gpu::set_heavy_uniforms(const Scene& drawn, const Instant& curren
     for (int d = 1; d * d <= r.period; ++d)
         if (r.period % d == 0) rows = d;
     glUniform2i(g.uniform("u_tiles"), r.period / rows, rows);
-    glUniform1i(g.uniform("u_interleave_step"), std::max(1, int(std::lround(std::sqrt(double(r.period))))));
+    glUniform1i(g.uniform("u_interleave_step"),
+                std::max(1, int(std::lround(std::sqrt(double(r.period))))));
     glUniform1f(g.uniform("u_threshold"), r.threshold);
     glUniform1i(g.uniform("u_filter_radius"), r.filter_radius);
     // One step of a 24-bit Z-buffer, in the cache's depth key (heavy_shaders.hpp).
     const bool orthographic = current.projection[3][3] == 1.0f;
-    const float inverse_range = orthographic ? 1.0f
-                                             : 1.0f / current.near - (std::isfinite(current.far) ? 1.0f / current.far : 0.0f);
+    const float inverse_range =
+        orthographic
+            ? 1.0f
+            : 1.0f / current.near - (std::isfinite(current.far) ? 1.0f / current.far : 0.0f);
     glUniform1i(g.uniform("u_orthographic"), orthographic);
     glUniform1f(g.uniform("u_epsilon"), r.depth_epsilon / 16777215.0f * inverse_range);
     glUniform1f(g.uniform("u_smoothing"), r.smoothing);
@@ -451,7 +470,7 @@ void Renderer::Gpu::read_reuse(bool reusing, const Image<uint32_t>& ids) {
         const glm::vec4* row = g.readback.data() + std::size_t(h - 1 - y) * w;
         for (int x = 0; x < w; ++x) {
             const glm::vec4 meta = row[x];  // depth, id, age, gradient (< 0: shaded on a miss)
-            const uint8_t status = meta.y == 0.0f ? kReuseBackground
+            const uint8_t status = meta.y == 0.0f  ? kReuseBackground
                                    : meta.z > 0.0f ? kReuseHit
                                    : meta.w < 0.0f ? kReuseMiss
                                                    : kReuseRefresh;
@@ -478,7 +497,8 @@ glm::vec2 lowres_jitter(int width, int height, int factor, int64_t index) {
     const glm::vec2 footprint(float(width) / float(low.x), float(height) / float(low.y));
     // Offsets of the sample within its low pixel, as fractions of the footprint: 2x1 alternates
     // left/right; 2x2 visits the diagonal first so consecutive frames are far apart.
-    static constexpr glm::vec2 kCycle2x2[4] = {{0.25f, 0.25f}, {0.75f, 0.75f}, {0.75f, 0.25f}, {0.25f, 0.75f}};
+    static constexpr glm::vec2 kCycle2x2[4] = {
+        {0.25f, 0.25f}, {0.75f, 0.75f}, {0.75f, 0.25f}, {0.25f, 0.75f}};
     static constexpr glm::vec2 kCycle2x1[2] = {{0.25f, 0.5f}, {0.75f, 0.5f}};
     if (factor == 1) return glm::vec2(0.0f);
     const int64_t phase = index < 0 ? -index : index;
@@ -524,8 +544,8 @@ Status Renderer::create(std::unique_ptr<Renderer>& renderer) {
     glEnableVertexAttribArray(3);
     glVertexAttribPointer(3, 2, GL_FLOAT, GL_FALSE, stride, (void*)offsetof(Vertex, uv));
     const char* extensions = reinterpret_cast<const char*>(glGetString(GL_EXTENSIONS));
-    if (extensions && std::string(extensions).find("GL_EXT_texture_filter_anisotropic") !=
-                          std::string::npos)
+    if (extensions &&
+        std::string(extensions).find("GL_EXT_texture_filter_anisotropic") != std::string::npos)
         glGetFloatv(0x84FF /* MAX_TEXTURE_MAX_ANISOTROPY_EXT */, &g.max_anisotropy);
     renderer = std::move(r);
     return {};
@@ -542,9 +562,9 @@ Status Renderer::render(const Scene& scene, const Instant& current, const Instan
     g.gather(scene, current.time, previous.time);
 
     // Pixel p samples the unjittered image at p + jitter: shift the image by -jitter.
-    glm::mat4 shift = glm::translate(glm::mat4(1.0f),
-                                     glm::vec3(-2.0f * current.jitter.x / float(w),
-                                               2.0f * current.jitter.y / float(h), 0.0f));
+    glm::mat4 shift = glm::translate(
+        glm::mat4(1.0f),
+        glm::vec3(-2.0f * current.jitter.x / float(w), 2.0f * current.jitter.y / float(h), 0.0f));
     glm::mat4 view_projection = shift * current.projection * current.view;
     glm::mat4 previous_view_projection = previous.projection * previous.view;
     glm::vec3 eye = glm::vec3(glm::inverse(current.view)[3]);
@@ -593,8 +613,10 @@ Status Renderer::render(const Scene& scene, const Instant& current, const Instan
     glViewport(0, 0, w, h);
     const int slot = g.cache_slot;
     if (reusing) {
-        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT3, GL_TEXTURE_2D, g.cache_term[slot], 0);
-        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT4, GL_TEXTURE_2D, g.cache_meta[slot], 0);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT3, GL_TEXTURE_2D,
+                               g.cache_term[slot], 0);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT4, GL_TEXTURE_2D,
+                               g.cache_meta[slot], 0);
         const GLenum buffers[5] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2,
                                    GL_COLOR_ATTACHMENT3, GL_COLOR_ATTACHMENT4};
         glDrawBuffers(5, buffers);
@@ -602,7 +624,8 @@ Status Renderer::render(const Scene& scene, const Instant& current, const Instan
         glClearBufferfv(GL_COLOR, 3, glm::value_ptr(glm::vec4(0.0f)));
         glClearBufferfv(GL_COLOR, 4, glm::value_ptr(empty_meta));
     } else {
-        const GLenum buffers[3] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2};
+        const GLenum buffers[3] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1,
+                                   GL_COLOR_ATTACHMENT2};
         glDrawBuffers(3, buffers);
     }
     const glm::vec4 sky(scene.background, 0.0f), zero(0.0f);
@@ -621,7 +644,8 @@ Status Renderer::render(const Scene& scene, const Instant& current, const Instan
     auto use = [&](GLuint program) {
         g.active = program;
         glUseProgram(program);
-        glUniformMatrix4fv(g.uniform("u_view_projection"), 1, GL_FALSE, glm::value_ptr(view_projection));
+        glUniformMatrix4fv(g.uniform("u_view_projection"), 1, GL_FALSE,
+                           glm::value_ptr(view_projection));
         glUniformMatrix4fv(g.uniform("u_unjittered_view_projection"), 1, GL_FALSE,
                            glm::value_ptr(unjittered));
         glUniformMatrix4fv(g.uniform("u_view"), 1, GL_FALSE, glm::value_ptr(current.view));
@@ -634,7 +658,8 @@ Status Renderer::render(const Scene& scene, const Instant& current, const Instan
         glUniform3fv(g.uniform("u_ambient"), 1, glm::value_ptr(scene.light.ambient));
         glUniform1i(g.uniform("u_lit"), settings.shading == Shading::Lit);
         glUniform1i(g.uniform("u_texture"), 0);
-        glUniform1f(g.uniform("u_lod_bias"), std::isfinite(settings.texture_lod_bias) ? settings.texture_lod_bias : 0.0f);
+        glUniform1f(g.uniform("u_lod_bias"),
+                    std::isfinite(settings.texture_lod_bias) ? settings.texture_lod_bias : 0.0f);
         if (heavy) g.set_heavy_uniforms(scene, current, settings, light_matrix, cache_usable);
         glActiveTexture(GL_TEXTURE0);
     };
@@ -648,13 +673,16 @@ Status Renderer::render(const Scene& scene, const Instant& current, const Instan
             if (materials) {
                 glUniform4fv(base_color, 1, glm::value_ptr(m.base_color));
                 glUniform1i(textured, m.base_color_texture >= 0);
-                if (m.base_color_texture >= 0) glBindTexture(GL_TEXTURE_2D, g.textures[m.base_color_texture]);
+                if (m.base_color_texture >= 0)
+                    glBindTexture(GL_TEXTURE_2D, g.textures[m.base_color_texture]);
                 glUniform1f(specular, m.specular);
                 glUniform1f(shininess, m.shininess);
                 glUniform1f(id, d.id);
             }
-            if (m.double_sided) glDisable(GL_CULL_FACE);
-            else glEnable(GL_CULL_FACE);
+            if (m.double_sided)
+                glDisable(GL_CULL_FACE);
+            else
+                glEnable(GL_CULL_FACE);
             glFrontFace(d.mirrored ? GL_CW : GL_CCW);
             glDrawElements(GL_TRIANGLES, d.index_count, GL_UNSIGNED_INT,
                            (void*)(std::size_t(d.first_index) * sizeof(uint32_t)));
@@ -669,7 +697,8 @@ Status Renderer::render(const Scene& scene, const Instant& current, const Instan
         // Depth pre-pass: each pixel then runs the heavy shader once.
         g.active = g.shadow_program;
         glUseProgram(g.shadow_program);
-        glUniformMatrix4fv(g.uniform("u_light_matrix"), 1, GL_FALSE, glm::value_ptr(view_projection));
+        glUniformMatrix4fv(g.uniform("u_light_matrix"), 1, GL_FALSE,
+                           glm::value_ptr(view_projection));
         glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
         draw_all(false);
         glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
@@ -700,7 +729,8 @@ Status Renderer::render(const Scene& scene, const Instant& current, const Instan
         glDepthFunc(GL_LESS);
         glFinish();
         g.stats.shading_ms = std::chrono::duration<double, std::milli>(
-                                 std::chrono::steady_clock::now() - shading_start).count();
+                                 std::chrono::steady_clock::now() - shading_start)
+                                 .count();
         g.stats.shading_cpu_ms = process_cpu_ms() - shading_cpu_start;
     }
 
@@ -727,7 +757,8 @@ Status Renderer::render(const Scene& scene, const Instant& current, const Instan
     // both ends projected the same way (a still camera gives exactly 0).
     // Orthographic cameras see the far plane instead (w = 1: a point, not a direction).
     const double point = current.projection[3][3] == 1.0f ? 1.0 : 0.0;
-    const glm::dmat4 unproject = glm::inverse(glm::dmat4(shift * current.projection * current.view));
+    const glm::dmat4 unproject =
+        glm::inverse(glm::dmat4(shift * current.projection * current.view));
     auto to_pixels = [&](const glm::mat4& matrix, glm::dvec4 world, glm::dvec2& pixel) {
         glm::dvec4 clip = glm::dmat4(matrix) * world;
         pixel = {(clip.x / clip.w * 0.5 + 0.5) * w, (0.5 - 0.5 * clip.y / clip.w) * h};
@@ -745,11 +776,13 @@ Status Renderer::render(const Scene& scene, const Instant& current, const Instan
         frame.depth(x, y) = std::numeric_limits<float>::infinity();
         frame.id(x, y) = 0;
         glm::dvec2 ndc(2.0 * (x + 0.5) / w - 1.0, 1.0 - 2.0 * (y + 0.5) / h);
-        glm::dvec4 a = unproject * glm::dvec4(ndc, -1.0, 1.0), b = unproject * glm::dvec4(ndc, point, 1.0);
-        glm::dvec4 world = point == 1.0 ? b / b.w : glm::dvec4(glm::dvec3(b) / b.w - glm::dvec3(a) / a.w, 0.0);
+        glm::dvec4 a = unproject * glm::dvec4(ndc, -1.0, 1.0),
+                   b = unproject * glm::dvec4(ndc, point, 1.0);
+        glm::dvec4 world =
+            point == 1.0 ? b / b.w : glm::dvec4(glm::dvec3(b) / b.w - glm::dvec3(a) / a.w, 0.0);
         glm::dvec2 here, there;
-        bool visible = to_pixels(unjittered, world, here) &&
-                       to_pixels(previous_view_projection, world, there);
+        bool visible =
+            to_pixels(unjittered, world, here) && to_pixels(previous_view_projection, world, there);
         frame.motion(x, y) = visible ? glm::vec2(there - here) : glm::vec2(nan);
     });
     if (heavy) g.read_reuse(reusing, frame.id);
@@ -783,7 +816,8 @@ Status Renderer::render_frame(const Scene& scene, const CameraPath& path, int in
     const int w = settings.width, h = settings.height;
     Instant now = instant_on_path(path, scene, index / fps, w, h);
     Instant before = instant_on_path(path, scene, (index - 1) / fps, w, h);
-    now.cut = path.motion == CameraMotion::Cut && before.time < path.cut_time && now.time >= path.cut_time;
+    now.cut = path.motion == CameraMotion::Cut && before.time < path.cut_time &&
+              now.time >= path.cut_time;
     REPRISE_TRY(render(scene, now, before, settings, frame));
     frame.fps = fps;
     return {};
@@ -795,8 +829,10 @@ Status Renderer::render_frame_lowres(const Scene& scene, const CameraPath& path,
     REPRISE_ASSERT(fps > 0);
     REPRISE_TRY(check_image_size(settings.width, settings.height, "renderer"));
     const Instant now = instant_on_path(path, scene, index / fps, settings.width, settings.height);
-    const Instant before = instant_on_path(path, scene, (index - 1) / fps, settings.width, settings.height);
-    REPRISE_TRY(render_lowres(scene, now, before, settings, factor, index, frame, low_color, jitter));
+    const Instant before =
+        instant_on_path(path, scene, (index - 1) / fps, settings.width, settings.height);
+    REPRISE_TRY(
+        render_lowres(scene, now, before, settings, factor, index, frame, low_color, jitter));
     frame.fps = fps;
     return {};
 }
@@ -810,7 +846,8 @@ Status Renderer::render_lowres(const Scene& scene, const Instant& current, const
     const glm::ivec2 low = lowres_size(settings.width, settings.height, factor);
     // Relative to the unjittered full image (the full frame's own jitter, usually 0, included).
     jitter = current.jitter + lowres_jitter(settings.width, settings.height, factor, jitter_index);
-    const glm::vec2 footprint(float(settings.width) / float(low.x), float(settings.height) / float(low.y));
+    const glm::vec2 footprint(float(settings.width) / float(low.x),
+                              float(settings.height) / float(low.y));
     // The same frustum (projection of the full size) at the low size; the jitter in low pixels.
     Instant now = current;
     now.jitter = jitter / footprint;
@@ -825,7 +862,8 @@ Status Renderer::render_lowres(const Scene& scene, const Instant& current, const
     Frame& scratch = gpu_->lowres_scratch;
     REPRISE_TRY(render(scene, now, previous, low_settings, scratch));
     low_color.resize(low.x, low.y);
-    std::copy(scratch.color.data(), scratch.color.data() + scratch.color.pixel_count(), low_color.data());
+    std::copy(scratch.color.data(), scratch.color.data() + scratch.color.pixel_count(),
+              low_color.data());
     return {};
 }
 

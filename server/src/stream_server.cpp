@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <chrono>
-#include <cstdio>
 #include <cmath>
+#include <cstdio>
 #include <deque>
 #include <mutex>
 #include <sstream>
@@ -20,7 +20,8 @@ namespace {
 constexpr std::size_t kMaxPending = 32;
 constexpr int64_t kPendingLifetimeUs = 5'000'000;
 constexpr int64_t kInfoIntervalUs = 500'000;
-constexpr int64_t kProbeIntervalUs = 1'000'000;  // a stalled window still sends one frame this often
+constexpr int64_t kProbeIntervalUs =
+    1'000'000;  // a stalled window still sends one frame this often
 
 double ms_since(std::chrono::steady_clock::time_point t) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
@@ -60,8 +61,12 @@ struct Session {
     int64_t min_rtt_us = 0;
     bool ended = false;
 
-    Session(net::Endpoint p, uint64_t connection, const net::SessionKeys& keys, const codec::EncoderOptions& eo)
-        : peer(p), channel(connection, keys.server_to_client, keys.client_to_server), encoder(eo), colour_encoder(eo) {}
+    Session(net::Endpoint p, uint64_t connection, const net::SessionKeys& keys,
+            const codec::EncoderOptions& eo)
+        : peer(p),
+          channel(connection, keys.server_to_client, keys.client_to_server),
+          encoder(eo),
+          colour_encoder(eo) {}
 };
 
 }  // namespace
@@ -135,14 +140,19 @@ struct StreamServer::State {
             return;
         }
         switch (h.type) {
-        case net::DatagramType::ClientHello: return client_hello(d, h, from, now);
-        case net::DatagramType::ClientFinish: return client_finish(d, h, from, now);
-        case net::DatagramType::Sealed: return sealed_datagram(d, h, from, now);
-        default: count(&StreamServerStats::dropped_datagrams);
+            case net::DatagramType::ClientHello:
+                return client_hello(d, h, from, now);
+            case net::DatagramType::ClientFinish:
+                return client_finish(d, h, from, now);
+            case net::DatagramType::Sealed:
+                return sealed_datagram(d, h, from, now);
+            default:
+                count(&StreamServerStats::dropped_datagrams);
         }
     }
 
-    void client_hello(std::span<const uint8_t> d, const net::DatagramHeader& h, const net::Endpoint& from, int64_t now) {
+    void client_hello(std::span<const uint8_t> d, const net::DatagramHeader& h,
+                      const net::Endpoint& from, int64_t now) {
         for (Pending& p : pending)
             if (p.handshake.connection == h.connection && p.peer == from) {
                 socket.send_to(p.server_hello, from);  // a retransmitted hello gets the same answer
@@ -164,15 +174,17 @@ struct StreamServer::State {
             return;
         }
         if (pending.size() >= kMaxPending) {
-            auto oldest = std::min_element(pending.begin(), pending.end(),
-                                           [](const Pending& a, const Pending& b) { return a.created_us < b.created_us; });
+            auto oldest = std::min_element(
+                pending.begin(), pending.end(),
+                [](const Pending& a, const Pending& b) { return a.created_us < b.created_us; });
             pending.erase(oldest);
         }
         socket.send_to(p.server_hello, from);
         pending.push_back(std::move(p));
     }
 
-    void client_finish(std::span<const uint8_t> d, const net::DatagramHeader& h, const net::Endpoint& from, int64_t now) {
+    void client_finish(std::span<const uint8_t> d, const net::DatagramHeader& h,
+                       const net::Endpoint& from, int64_t now) {
         auto it = std::find_if(pending.begin(), pending.end(), [&](const Pending& p) {
             return p.handshake.connection == h.connection && p.peer == from;
         });
@@ -218,7 +230,8 @@ struct StreamServer::State {
             if (std::find(names.begin(), names.end(), name) == names.end())
                 return refuse(s, "scene '" + name + "' is not in the catalogue");
         }
-        if (Status st = load_scene(name, s.scene, s.path); !st.ok()) return refuse(s, "scene: " + st.message());
+        if (Status st = load_scene(name, s.scene, s.path); !st.ok())
+            return refuse(s, "scene: " + st.message());
         s.scene_name = m.scene.empty() ? std::string("default") : m.scene;
         s.started = true;
         send_info(s, net_now());
@@ -238,7 +251,8 @@ struct StreamServer::State {
         s.last_info_us = now;
     }
 
-    void sealed_datagram(std::span<const uint8_t> d, const net::DatagramHeader& h, const net::Endpoint& from, int64_t now) {
+    void sealed_datagram(std::span<const uint8_t> d, const net::DatagramHeader& h,
+                         const net::Endpoint& from, int64_t now) {
         Session* s = find(h.connection);
         if (!s || !(s->peer == from) || !s->channel.open(d, plaintext).ok()) {
             count(&StreamServerStats::dropped_datagrams);
@@ -252,87 +266,96 @@ struct StreamServer::State {
         }
         bool parsed = true;
         switch (type) {
-        case net::MessageType::Start: {
-            net::StartMessage m;
-            parsed = net::parse(plaintext, m).ok();
-            if (parsed) start(*s, m);
-            break;
-        }
-        case net::MessageType::Pose: {
-            net::PoseMessage m;
-            parsed = net::parse(plaintext, m).ok();
-            if (parsed && (!s->have_pose || m.sequence > s->pose.sequence)) {
-                s->pose = m;
-                s->have_pose = true;
+            case net::MessageType::Start: {
+                net::StartMessage m;
+                parsed = net::parse(plaintext, m).ok();
+                if (parsed) start(*s, m);
+                break;
             }
-            break;
-        }
-        case net::MessageType::Ack: {
-            net::AckMessage m;
-            parsed = net::parse(plaintext, m).ok() && int64_t(m.frame) <= s->newest_sent;
-            if (parsed) {
-                s->encoder.acknowledge(m.frame);
-                s->colour_encoder.acknowledge(m.frame);
-                s->newest_acked = std::max<int64_t>(s->newest_acked, m.frame);
-                s->last_progress_us = now;
-                count(&StreamServerStats::acks);
+            case net::MessageType::Pose: {
+                net::PoseMessage m;
+                parsed = net::parse(plaintext, m).ok();
+                if (parsed && (!s->have_pose || m.sequence > s->pose.sequence)) {
+                    s->pose = m;
+                    s->have_pose = true;
+                }
+                break;
             }
-            break;
-        }
-        case net::MessageType::LossReport: {
-            net::LossReportMessage m;
-            parsed = net::parse(plaintext, m).ok();
-            if (parsed) {
-                for (int i = 0; i < m.count; ++i)
-                    if (int64_t(m.frames[i]) <= s->newest_sent) {
-                        s->encoder.report_loss(m.frames[i]);
-                        s->colour_encoder.report_loss(m.frames[i]);
-                    }
-                s->last_progress_us = now;
-                count(&StreamServerStats::loss_reports);
+            case net::MessageType::Ack: {
+                net::AckMessage m;
+                parsed = net::parse(plaintext, m).ok() && int64_t(m.frame) <= s->newest_sent;
+                if (parsed) {
+                    s->encoder.acknowledge(m.frame);
+                    s->colour_encoder.acknowledge(m.frame);
+                    s->newest_acked = std::max<int64_t>(s->newest_acked, m.frame);
+                    s->last_progress_us = now;
+                    count(&StreamServerStats::acks);
+                }
+                break;
             }
-            break;
-        }
-        case net::MessageType::KeyFrameRequest:
-            parsed = plaintext.size() == 1;
-            if (parsed) {
-                s->encoder.request_key_frame();
-                s->colour_encoder.request_key_frame();
-                s->last_progress_us = now;
-                count(&StreamServerStats::key_frame_requests);
+            case net::MessageType::LossReport: {
+                net::LossReportMessage m;
+                parsed = net::parse(plaintext, m).ok();
+                if (parsed) {
+                    for (int i = 0; i < m.count; ++i)
+                        if (int64_t(m.frames[i]) <= s->newest_sent) {
+                            s->encoder.report_loss(m.frames[i]);
+                            s->colour_encoder.report_loss(m.frames[i]);
+                        }
+                    s->last_progress_us = now;
+                    count(&StreamServerStats::loss_reports);
+                }
+                break;
             }
-            break;
-        case net::MessageType::ReceiverReport: {
-            net::ReceiverReportMessage m;
-            parsed = net::parse(plaintext, m).ok();
-            if (parsed) adapt(*s, m);
-            break;
-        }
-        case net::MessageType::Bye: s->ended = true; break;
-        default: parsed = false;
+            case net::MessageType::KeyFrameRequest:
+                parsed = plaintext.size() == 1;
+                if (parsed) {
+                    s->encoder.request_key_frame();
+                    s->colour_encoder.request_key_frame();
+                    s->last_progress_us = now;
+                    count(&StreamServerStats::key_frame_requests);
+                }
+                break;
+            case net::MessageType::ReceiverReport: {
+                net::ReceiverReportMessage m;
+                parsed = net::parse(plaintext, m).ok();
+                if (parsed) adapt(*s, m);
+                break;
+            }
+            case net::MessageType::Bye:
+                s->ended = true;
+                break;
+            default:
+                parsed = false;
         }
         if (!parsed) count(&StreamServerStats::dropped_datagrams);
     }
 
     // Loss over the interval since the previous report moves the rate-control target.
     void adapt(Session& s, const net::ReceiverReportMessage& m) {
-        const uint32_t received = m.received - s.report_received, missing = m.missing - s.report_missing;
+        const uint32_t received = m.received - s.report_received,
+                       missing = m.missing - s.report_missing;
         if (m.received < s.report_received || m.missing < s.report_missing) return;  // stale report
         s.report_received = m.received;
         s.report_missing = m.missing;
         if (received + missing == 0) return;
         const double loss = double(missing) / double(received + missing);
-        if (m.rtt_us > 0) s.min_rtt_us = s.min_rtt_us > 0 ? std::min<int64_t>(s.min_rtt_us, m.rtt_us) : m.rtt_us;
+        if (m.rtt_us > 0)
+            s.min_rtt_us = s.min_rtt_us > 0 ? std::min<int64_t>(s.min_rtt_us, m.rtt_us) : m.rtt_us;
         if (s.bitrate_kbps > 0) {
             // Loss-based as in WebRTC's GCC (above 10 % back off, below 2 % probe upwards, hold
             // between), plus a delay signal: a round trip grown 50 % over its minimum (queues
             // building up) backs off too.
             double next = s.bitrate_kbps;
             const bool queueing = s.min_rtt_us > 0 && m.rtt_us > s.min_rtt_us * 3 / 2 + 5000;
-            if (loss > 0.10) next *= 1.0 - 0.5 * loss;
-            else if (queueing) next *= 0.9;
-            else if (loss < 0.02) next *= 1.05;
-            s.bitrate_kbps = std::clamp(int(next), options.min_bitrate_kbps, options.max_bitrate_kbps);
+            if (loss > 0.10)
+                next *= 1.0 - 0.5 * loss;
+            else if (queueing)
+                next *= 0.9;
+            else if (loss < 0.02)
+                next *= 1.05;
+            s.bitrate_kbps =
+                std::clamp(int(next), options.min_bitrate_kbps, options.max_bitrate_kbps);
             if (options.mode == net::StreamMode::LowRes) {
                 // Geometry (depth + motion) and colour share the target by their usual weights.
                 s.encoder.set_bitrate(std::max(1, s.bitrate_kbps * 2 / 3));
@@ -365,10 +388,12 @@ struct StreamServer::State {
         const bool lowres = options.mode == net::StreamMode::LowRes;
         glm::vec2 jitter(0.0f);
         if (lowres)
-            REPRISE_TRY(renderer->render_lowres(s.scene, current, previous, {.width = w, .height = h},
-                                                options.lowres_factor, s.frames_rendered, s.frame, s.low_color, jitter));
+            REPRISE_TRY(renderer->render_lowres(s.scene, current, previous,
+                                                {.width = w, .height = h}, options.lowres_factor,
+                                                s.frames_rendered, s.frame, s.low_color, jitter));
         else
-            REPRISE_TRY(renderer->render(s.scene, current, previous, {.width = w, .height = h}, s.frame));
+            REPRISE_TRY(
+                renderer->render(s.scene, current, previous, {.width = w, .height = h}, s.frame));
         ++s.frames_rendered;
         s.frame.fps = options.fps;
         const double render_ms = ms_since(t0);
@@ -378,10 +403,12 @@ struct StreamServer::State {
         if (lowres) {
             make_colour_frame(s, jitter);
             // The geometry stream carries no colour: a constant that every prediction matches.
-            std::fill(s.frame.color.data(), s.frame.color.data() + s.frame.color.pixel_count(), glm::vec4(0.0f));
+            std::fill(s.frame.color.data(), s.frame.color.data() + s.frame.color.pixel_count(),
+                      glm::vec4(0.0f));
         }
         REPRISE_TRY(s.encoder.send_frame(s.frame));
-        if (s.encoder.receive_packet(s.packet) != codec::Result::Ok) return Status::error("encoder gave no packet");
+        if (s.encoder.receive_packet(s.packet) != codec::Result::Ok)
+            return Status::error("encoder gave no packet");
         std::span<const uint8_t> payload = s.packet.data;
         if (lowres) {
             REPRISE_TRY(s.colour_encoder.send_frame(s.low));
@@ -398,9 +425,12 @@ struct StreamServer::State {
             count(&StreamServerStats::frames_skipped);
             return {};
         }
-        const std::size_t n = net::fragment_packet(payload, s.packet.frame, s.pose.client_time_us, options.fec, messages);
-        const std::size_t sealed_bytes = n * (net::kSealedHeaderSize + net::kAeadTagSize) + payload.size() * 2;
-        if (s.queue_bytes + std::min(sealed_bytes, options.send_queue_bytes / 2) > options.send_queue_bytes) {
+        const std::size_t n = net::fragment_packet(payload, s.packet.frame, s.pose.client_time_us,
+                                                   options.fec, messages);
+        const std::size_t sealed_bytes =
+            n * (net::kSealedHeaderSize + net::kAeadTagSize) + payload.size() * 2;
+        if (s.queue_bytes + std::min(sealed_bytes, options.send_queue_bytes / 2) >
+            options.send_queue_bytes) {
             s.encoder.report_loss(s.packet.frame);
             s.colour_encoder.report_loss(s.packet.frame);
             count(&StreamServerStats::frames_skipped);
@@ -429,11 +459,14 @@ struct StreamServer::State {
         s.low.color.resize(lw, lh);
         s.low.depth.resize(lw, lh);
         s.low.motion.resize(lw, lh);
-        std::copy(s.low_color.data(), s.low_color.data() + s.low_color.pixel_count(), s.low.color.data());
+        std::copy(s.low_color.data(), s.low_color.data() + s.low_color.pixel_count(),
+                  s.low.color.data());
         for (int v = 0; v < lh; ++v)
             for (int u = 0; u < lw; ++u) {
-                const int x = std::clamp(int(std::floor((u + 0.5f) * footprint.x + jitter.x)), 0, w - 1);
-                const int y = std::clamp(int(std::floor((v + 0.5f) * footprint.y + jitter.y)), 0, h - 1);
+                const int x =
+                    std::clamp(int(std::floor((u + 0.5f) * footprint.x + jitter.x)), 0, w - 1);
+                const int y =
+                    std::clamp(int(std::floor((v + 0.5f) * footprint.y + jitter.y)), 0, h - 1);
                 s.low.depth(u, v) = s.frame.depth(x, y);
                 s.low.motion(u, v) = s.frame.motion(x, y) / footprint;
             }
@@ -442,7 +475,8 @@ struct StreamServer::State {
         s.low.fps = s.frame.fps;
     }
 
-    // lowres: both codec packets of one frame in one unit (docs/protocol.md, "Low-resolution mode").
+    // lowres: both codec packets of one frame in one unit (docs/protocol.md, "Low-resolution
+    // mode").
     static void bundle_packets(std::span<const uint8_t> geometry, std::span<const uint8_t> colour,
                                std::vector<uint8_t>& out) {
         out.resize(1 + 4 + geometry.size() + 4 + colour.size());
@@ -462,20 +496,25 @@ struct StreamServer::State {
         }
         std::ostringstream o;
         auto metric = [&](const char* name, const char* type, const char* help, double value) {
-            o << "# HELP reprise_" << name << ' ' << help << "\n# TYPE reprise_" << name << ' ' << type << "\nreprise_"
-              << name << ' ' << value << '\n';
+            o << "# HELP reprise_" << name << ' ' << help << "\n# TYPE reprise_" << name << ' '
+              << type << "\nreprise_" << name << ' ' << value << '\n';
         };
         metric("sessions", "gauge", "Sessions connected.", double(st.sessions));
-        metric("sessions_total", "counter", "Sessions admitted since start.", double(st.sessions_total));
-        metric("handshakes_failed_total", "counter", "Key confirmations that failed.", double(st.handshakes_failed));
-        metric("handshakes_rate_limited_total", "counter", "Client hellos refused by the rate limit.",
-               double(st.handshakes_rate_limited));
-        metric("dropped_datagrams_total", "counter", "Datagrams dropped unread.", double(st.dropped_datagrams));
+        metric("sessions_total", "counter", "Sessions admitted since start.",
+               double(st.sessions_total));
+        metric("handshakes_failed_total", "counter", "Key confirmations that failed.",
+               double(st.handshakes_failed));
+        metric("handshakes_rate_limited_total", "counter",
+               "Client hellos refused by the rate limit.", double(st.handshakes_rate_limited));
+        metric("dropped_datagrams_total", "counter", "Datagrams dropped unread.",
+               double(st.dropped_datagrams));
         metric("frames_sent_total", "counter", "Frames encoded and sent.", double(st.frames_sent));
-        metric("frames_skipped_total", "counter", "Frames skipped (slow client or link).", double(st.frames_skipped));
+        metric("frames_skipped_total", "counter", "Frames skipped (slow client or link).",
+               double(st.frames_skipped));
         metric("bytes_sent_total", "counter", "UDP payload bytes sent.", double(st.bytes_sent));
         metric("fps", "gauge", "Configured server frame rate.", options.fps);
-        metric("bitrate_target_kbps", "gauge", "Rate-control target of the last adapted session.", st.bitrate_kbps);
+        metric("bitrate_target_kbps", "gauge", "Rate-control target of the last adapted session.",
+               st.bitrate_kbps);
         metric("loss_ratio", "gauge", "Media loss the newest receiver report measured.", st.loss);
         metric("encode_ms_mean", "gauge", "Mean encode time per frame.",
                st.frames_sent ? st.encode_ms_total / double(st.frames_sent) : 0.0);
@@ -494,15 +533,20 @@ std::vector<std::string> scene_catalogue() {
 StreamServer::StreamServer() = default;
 StreamServer::~StreamServer() = default;
 
-Status StreamServer::create(const StreamServerOptions& options, std::unique_ptr<StreamServer>& server) {
+Status StreamServer::create(const StreamServerOptions& options,
+                            std::unique_ptr<StreamServer>& server) {
     REPRISE_TRY(net::init_crypto());
-    if (options.secret.empty() || options.secret.size() > 255) return Status::error("--pin: 1..255 characters");
+    if (options.secret.empty() || options.secret.size() > 255)
+        return Status::error("--pin: 1..255 characters");
     if (options.loopback_only && !options.listen.loopback())
-        return Status::error("listen address " + options.listen.text() + " is not loopback (127.0.0.0/8)");
-    if (!(options.fps > 0.0 && options.fps <= 240.0)) return Status::error("--fps must be in (0, 240]");
+        return Status::error("listen address " + options.listen.text() +
+                             " is not loopback (127.0.0.0/8)");
+    if (!(options.fps > 0.0 && options.fps <= 240.0))
+        return Status::error("--fps must be in (0, 240]");
     if (options.width < 16 || options.height < 16 || options.width > 8192 || options.height > 8192)
         return Status::error("--size: each side 16..8192");
-    if (options.max_sessions < 1 || options.max_sessions > 64) return Status::error("--max-sessions must be 1..64");
+    if (options.max_sessions < 1 || options.max_sessions > 64)
+        return Status::error("--max-sessions must be 1..64");
     if (options.mode == net::StreamMode::LowRes && !lowres_factor_valid(options.lowres_factor))
         return Status::error("--lowres must be 2 or 4");
     if (options.mode == net::StreamMode::LowRes && options.lowres_factor == 1)
@@ -550,7 +594,8 @@ Status StreamServer::run(const std::atomic<bool>& stop) {
             if (s->started && now - s->last_info_us > kInfoIntervalUs) st.send_info(*s, now);
             st.flush(*s);
         }
-        std::erase_if(st.pending, [&](const Pending& p) { return now - p.created_us > kPendingLifetimeUs; });
+        std::erase_if(st.pending,
+                      [&](const Pending& p) { return now - p.created_us > kPendingLifetimeUs; });
         const int64_t timeout = int64_t(st.options.session_timeout_s * 1e6);
         std::erase_if(st.sessions, [&](const std::unique_ptr<Session>& s) {
             return s->ended || now - s->last_heard_us > timeout;
@@ -559,7 +604,8 @@ Status StreamServer::run(const std::atomic<bool>& stop) {
             std::lock_guard lock(st.stats_mutex);
             st.stats.sessions = st.sessions.size();
             st.stats.sessions_total = st.sessions_total;
-            for (auto& s : st.sessions) st.stats.max_queue_bytes = std::max(st.stats.max_queue_bytes, s->queue_bytes);
+            for (auto& s : st.sessions)
+                st.stats.max_queue_bytes = std::max(st.stats.max_queue_bytes, s->queue_bytes);
         }
         if (st.metrics.is_open()) st.metrics.serve(st.metrics_text());
     }

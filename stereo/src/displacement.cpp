@@ -12,8 +12,8 @@ namespace {
 
 // Row y for an axis-aligned projection, branch-free so that it vectorises (Unprojector::point_ndc
 // and StaticReprojection::land spelled out, same arithmetic).
-void displace_row_axis_aligned(const GBufferView& source, const StaticReprojection& to_target, int y,
-                               glm::vec2* displacement, float* target_depth) {
+void displace_row_axis_aligned(const GBufferView& source, const StaticReprojection& to_target,
+                               int y, glm::vec2* displacement, float* target_depth) {
     const Unprojector& unproject = to_target.unprojector();
     // Copies: the stores below could otherwise alias them and the loop would not vectorise.
     const glm::mat4 P = unproject.projection(), M = to_target.to_clip(), V = to_target.to_view();
@@ -64,7 +64,8 @@ void stereo_displacement(const GBufferView& source, const Camera& target,
     parallel_for(0, h, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y) {
             if (unproject.axis_aligned()) {
-                displace_row_axis_aligned(source, to_target, y, displacement.row(y), target_depth.row(y));
+                displace_row_axis_aligned(source, to_target, y, displacement.row(y),
+                                          target_depth.row(y));
                 continue;
             }
             const float* z_row = source.depth.row(y);

@@ -47,7 +47,8 @@ EyeCameras eye_cameras(const Camera& camera, const StereoRig& rig, Anchor anchor
 
 float disparity_px(const StereoRig& rig, const glm::mat4& projection, int width, float depth) {
     const float f = projection[0][0] * 0.5f * float(width);
-    const float inv_c = rig.rig == Rig::OffAxis && rig.convergence > 0.0f ? 1.0f / rig.convergence : 0.0f;
+    const float inv_c =
+        rig.rig == Rig::OffAxis && rig.convergence > 0.0f ? 1.0f / rig.convergence : 0.0f;
     return f * rig.ipd * (1.0f / depth - inv_c);
 }
 

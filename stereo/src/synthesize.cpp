@@ -31,9 +31,12 @@ float distance_between(const Camera& a, const Camera& b) {
 template <class T>
 void copy_into(Image<T>& to, ImageView<const T> from) {
     to.resize(from.width, from.height);
-    parallel_for(0, from.height, [&](int y0, int y1) {
-        for (int y = y0; y < y1; ++y) std::copy_n(from.row(y), from.width, &to(0, y));
-    }, 64);
+    parallel_for(
+        0, from.height,
+        [&](int y0, int y1) {
+            for (int y = y0; y < y1; ++y) std::copy_n(from.row(y), from.width, &to(0, y));
+        },
+        64);
 }
 
 }  // namespace
@@ -73,10 +76,10 @@ StereoStats StereoSynthesizer::synthesize(const GBufferView& rendered, const Cam
     const bool history_usable = history && history->width() == w && history->height() == h &&
                                 history->depth.width == w && history->depth.height == h;
     // The same viewpoint: nothing to warp.
-    const GBufferView* exact = same_camera(rendered.camera, target) ? &rendered
-                         : history_usable && same_camera(history->camera, target) && all_still(rendered)
-                             ? history
-                             : nullptr;
+    const GBufferView* exact =
+        same_camera(rendered.camera, target)                                            ? &rendered
+        : history_usable && same_camera(history->camera, target) && all_still(rendered) ? history
+                                                                                        : nullptr;
     if (exact) {
         copy_into(out.color, exact->color);
         copy_into(out.depth, exact->depth);
@@ -88,8 +91,9 @@ StereoStats StereoSynthesizer::synthesize(const GBufferView& rendered, const Cam
 
     out.color.resize(w, h);
     out.depth.resize(w, h);
-    stats.covered = warp_into(rendered, target, o,
-                              {out.color.view(), out.depth.view(), {}, covered_.view()}, stats.cells);
+    stats.covered =
+        warp_into(rendered, target, o, {out.color.view(), out.depth.view(), {}, covered_.view()},
+                  stats.cells);
     stats.holes = n - stats.covered;
 
     std::size_t history_holes_filled = 0;
@@ -106,7 +110,7 @@ StereoStats StereoSynthesizer::synthesize(const GBufferView& rendered, const Cam
                   {history_color_.view(), history_depth_.view(), {}, history_covered_.view()},
                   stats.cells);
         const bool closer = o.history_replaces && distance_between(history->camera, target) <
-                            distance_between(rendered.camera, target);
+                                                      distance_between(rendered.camera, target);
         const float tol = o.history_depth_tolerance;
         std::size_t taken = 0, holes_taken = 0;
         for (std::size_t i = 0; i < n; ++i) {
@@ -141,7 +145,8 @@ StereoStats StereoSynthesizer::synthesize(const GBufferView& rendered, const Cam
     parallel_for(0, h, [&](int y0, int y1) {
         for (std::size_t i = std::size_t(y0) * w; i < std::size_t(y1) * w; ++i) {
             glm::vec4& c = out.color.data()[i];
-            if (!(std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z) && std::isfinite(c.w)))
+            if (!(std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z) &&
+                  std::isfinite(c.w)))
                 c = glm::vec4(0.0f);
         }
     });

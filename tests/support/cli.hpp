@@ -22,8 +22,8 @@ struct Outcome {
 // Runs `reprise ARGUMENTS` (REPRISE_BINARY) with stderr folded into stdout, killed after
 // `timeout_seconds`.
 inline Outcome run_reprise(const std::string& arguments, int timeout_seconds) {
-    std::string command = "timeout " + std::to_string(timeout_seconds) + " " REPRISE_BINARY " " +
-                          arguments + " 2>&1";
+    std::string command =
+        "timeout " + std::to_string(timeout_seconds) + " " REPRISE_BINARY " " + arguments + " 2>&1";
     Outcome r;
     FILE* pipe = popen(command.c_str(), "r");
     if (!pipe) return r;

@@ -5,8 +5,8 @@
 
 #include <cstdint>
 
-#include "reprise/warp/splat.hpp"
 #include "frames.hpp"
+#include "reprise/warp/splat.hpp"
 
 namespace reprise::test {
 

@@ -66,7 +66,8 @@ StaticLayerTest::StaticLayerTest(const StaticReprojection& previous,
 std::size_t static_layer_row_reference(const StaticLayerTest& t, int y, int x_begin, int x_end,
                                        const float* __restrict depth,
                                        const glm::vec2* __restrict motion,
-                                       float* __restrict depth_out, glm::vec2* __restrict motion_out) {
+                                       float* __restrict depth_out,
+                                       glm::vec2* __restrict motion_out) {
     // Copies: the stores below could otherwise alias the matrices and the loop would not vectorise.
     const glm::mat4 P = t.projection, A = t.to_previous, B = t.to_future;
     const float background_zv = t.background_zv, background_w = t.background_w;
@@ -85,7 +86,9 @@ std::size_t static_layer_row_reference(const StaticLayerTest& t, int y, int x_be
         const float wc = P[2][3] * zv + P[3][3] * w;
         const float vx = (nx * wc - P[2][0] * zv - P[3][0] * w) / P[0][0];
         const float vy = (ny * wc - P[2][1] * zv - P[3][1] * w) / P[1][1];
-        auto clip = [&](const glm::mat4& M, int row) { return transform_row(M, row, vx, vy, zv, w); };
+        auto clip = [&](const glm::mat4& M, int row) {
+            return transform_row(M, row, vx, vy, zv, w);
+        };
         const float aw = clip(A, 3), bw = clip(B, 3);
         const float bx = (clip(A, 0) / aw * 0.5f + 0.5f) * fw;
         const float by = (0.5f - 0.5f * clip(A, 1) / aw) * fh;
@@ -113,7 +116,8 @@ void extrapolate_along_motion(const GBufferView& f, float s, float motion_scale,
     out.depth.resize(w, h);
     out.motion.resize(w, h);
     scratch.valid.resize(w, h);
-    const WarpTarget target{out.color.view(), out.depth.view(), out.motion.view(), scratch.valid.view()};
+    const WarpTarget target{out.color.view(), out.depth.view(), out.motion.view(),
+                            scratch.valid.view()};
     const std::size_t covered = warp_into(f, -s, options, scratch, target, counters);
     fill_holes(out.color.view(), scratch.valid.view(), out.depth.view(),
                std::size_t(w) * std::size_t(h) - covered, options, scratch, counters);
@@ -154,8 +158,9 @@ std::size_t static_layer(const GBufferView& f, const glm::mat4& to_view,
     return dynamic.load();
 }
 
-void extrapolate_frame(const GBufferView& f, float s, float motion_scale, const FrucOptions& options,
-                       FrucScratch& scratch, Frame& out, FrucCounters& counters) {
+void extrapolate_frame(const GBufferView& f, float s, float motion_scale,
+                       const FrucOptions& options, FrucScratch& scratch, Frame& out,
+                       FrucCounters& counters) {
     if (!has_projection(f.camera)) {
         extrapolate_along_motion(f, s, motion_scale, options, scratch, out, counters);
         return;
@@ -183,9 +188,8 @@ void extrapolate_to_camera(const GBufferView& f, const glm::mat4& future_view,
     scratch.layer_motion.resize(w, h);
     const ImageView<float> layer_depth = scratch.layer_depth.view();
     const ImageView<glm::vec2> layer_motion = scratch.layer_motion.view();
-    const std::size_t moving_pixels =
-        static_layer(f, future_view, future_projection, options.static_tolerance, layer_depth,
-                     layer_motion);
+    const std::size_t moving_pixels = static_layer(
+        f, future_view, future_projection, options.static_tolerance, layer_depth, layer_motion);
     const GBufferView layer{.color = f.color,
                             .depth = scratch.layer_depth.view(),
                             .motion = scratch.layer_motion.view(),
@@ -195,7 +199,8 @@ void extrapolate_to_camera(const GBufferView& f, const glm::mat4& future_view,
     out.motion.resize(w, h);
     scratch.valid.resize(w, h);
     // Drawn straight into the output: where nothing lands, colour 0, depth +inf, motion 0.
-    const WarpTarget base{out.color.view(), out.depth.view(), out.motion.view(), scratch.valid.view()};
+    const WarpTarget base{out.color.view(), out.depth.view(), out.motion.view(),
+                          scratch.valid.view()};
     const std::size_t covered = warp_into(layer, 1.0f, options, scratch, base, counters);
     fill_holes(out.color.view(), scratch.valid.view(), out.depth.view(),
                std::size_t(w) * std::size_t(h) - covered, options, scratch, counters);

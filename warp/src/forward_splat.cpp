@@ -147,9 +147,9 @@ Scatter make_scatter(const GBufferView& source, float factor, const WarpTarget& 
     REPRISE_ASSERT(options.footprint == 1 || options.footprint == 2);
     REPRISE_ASSERT(std::isfinite(factor));
     const float tol = std::clamp(options.depth_tolerance, 0.0f, 0.5f);
-    return {source.color, source.depth, source.motion, factor,
-            options.footprint,   1.0f - tol,          1.0f + tol,           target.color.width,
-            target.color.height};
+    return {source.color, source.depth,       source.motion,
+            factor,       options.footprint,  1.0f - tol,
+            1.0f + tol,   target.color.width, target.color.height};
 }
 
 struct Scratch {

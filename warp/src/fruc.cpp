@@ -72,8 +72,10 @@ private:
 
 template <class T>
 void size_like(Image<T>& image, const ImageView<const T>& like) {
-    if (like.empty()) image.clear();
-    else image.resize(like.width, like.height);
+    if (like.empty())
+        image.clear();
+    else
+        image.resize(like.width, like.height);
 }
 
 // Row bytes into one or two destinations with streaming stores where everything is 16-byte
@@ -81,7 +83,9 @@ void size_like(Image<T>& image, const ImageView<const T>& like) {
 // be fetched first.
 void stream_row(const void* from, void* to, void* to2, std::size_t bytes) {
 #if defined(__SSE2__)
-    const auto aligned = [](const void* p) { return reinterpret_cast<std::uintptr_t>(p) % 16 == 0; };
+    const auto aligned = [](const void* p) {
+        return reinterpret_cast<std::uintptr_t>(p) % 16 == 0;
+    };
     if (aligned(from) && aligned(to) && (!to2 || aligned(to2))) {
         const __m128i* s = static_cast<const __m128i*>(from);
         __m128i* d = static_cast<__m128i*>(to);
@@ -93,7 +97,8 @@ void stream_row(const void* from, void* to, void* to2, std::size_t bytes) {
             if (d2) _mm_stream_si128(d2 + i, v);
         }
         const std::size_t done = n * 16;
-        std::memcpy(static_cast<char*>(to) + done, static_cast<const char*>(from) + done, bytes - done);
+        std::memcpy(static_cast<char*>(to) + done, static_cast<const char*>(from) + done,
+                    bytes - done);
         if (to2)
             std::memcpy(static_cast<char*>(to2) + done, static_cast<const char*>(from) + done,
                         bytes - done);
@@ -119,7 +124,8 @@ void copy_rows(ImageView<const T> from, Image<T>& to, int y0, int y1, Image<T>* 
 template <class T>
 void copy_image(ImageView<const T> from, Image<T>& to) {
     size_like(to, from);
-    parallel_for(0, from.height, [&](int y0, int y1) { copy_rows(from, to, y0, y1); }, 64);
+    parallel_for(
+        0, from.height, [&](int y0, int y1) { copy_rows(from, to, y0, y1); }, 64);
 }
 
 }  // namespace
@@ -144,12 +150,14 @@ struct FrameRateConverter::State {
         if (frame.depth.empty() || frame.motion.empty() || previous.depth.empty()) return false;
         scratch.reprojected.resize(w, h);
         scratch.valid.resize(w, h);
-        ReprojectCounts counts = reproject(frame, previous, payload_of(std::as_const(previous.color).view()),
-                                           payload_of(scratch.reprojected.view()),
-                                           scratch.valid.view(),
-                                           {.depth_tolerance = 0.05f, .step = kCutStep});
-        const double pixels = double((w + kCutStep - 1) / kCutStep) * ((h + kCutStep - 1) / kCutStep);
-        const double lost = double(counts.behind + counts.occluded + counts.other_id + counts.invalid);
+        ReprojectCounts counts =
+            reproject(frame, previous, payload_of(std::as_const(previous.color).view()),
+                      payload_of(scratch.reprojected.view()), scratch.valid.view(),
+                      {.depth_tolerance = 0.05f, .step = kCutStep});
+        const double pixels =
+            double((w + kCutStep - 1) / kCutStep) * ((h + kCutStep - 1) / kCutStep);
+        const double lost =
+            double(counts.behind + counts.occluded + counts.other_id + counts.invalid);
         if (lost > options.cut_misses * pixels) return true;
         if (counts.hits == 0) return counts.offscreen > options.cut_misses * pixels;
         // Mean display-colour difference over the hits.
@@ -157,25 +165,30 @@ struct FrameRateConverter::State {
         std::atomic<std::size_t> sampled{0};
         std::atomic<long long> difference{0};  // in units of 2^-20, summed exactly in any order
         const int rows = (h + kCutStep - 1) / kCutStep;
-        parallel_for(0, rows, [&](int r0, int r1) {
-            double local = 0.0;
-            std::size_t count = 0;
-            for (int y = r0 * kCutStep; y < std::min(r1 * kCutStep, h); y += kCutStep)
-                for (int x = 0; x < w; x += kCutStep) {
-                    if (!scratch.valid(x, y)) continue;
-                    const glm::vec4 a = frame.color(x, y), b = scratch.reprojected(x, y);
-                    for (int k = 0; k < 3; ++k) local += std::abs(display(a[k]) - display(b[k]));
-                    ++count;
-                }
-            difference += std::llround(local * 1048576.0);
-            sampled += count;
-        }, 8);
+        parallel_for(
+            0, rows,
+            [&](int r0, int r1) {
+                double local = 0.0;
+                std::size_t count = 0;
+                for (int y = r0 * kCutStep; y < std::min(r1 * kCutStep, h); y += kCutStep)
+                    for (int x = 0; x < w; x += kCutStep) {
+                        if (!scratch.valid(x, y)) continue;
+                        const glm::vec4 a = frame.color(x, y), b = scratch.reprojected(x, y);
+                        for (int k = 0; k < 3; ++k)
+                            local += std::abs(display(a[k]) - display(b[k]));
+                        ++count;
+                    }
+                difference += std::llround(local * 1048576.0);
+                sampled += count;
+            },
+            8);
         if (sampled == 0) return false;
         return double(difference) / 1048576.0 / (3.0 * double(sampled)) > options.cut_color;
     }
 
     // Stamps the camera and time of a made frame (its motion is already per output period).
-    void finish(Frame& out, const Camera& a, const Camera& b, double fps, float s, float previous_s) {
+    void finish(Frame& out, const Camera& a, const Camera& b, double fps, float s,
+                float previous_s) {
         Camera before = camera_between(a, b, previous_s);
         out.camera = camera_between(a, b, s);
         out.camera.prev_view = before.view;
@@ -214,29 +227,33 @@ struct FrameRateConverter::State {
         auto rows_of = [](const auto& view, int y0, int y1) {
             return std::pair(std::min(y0, view.height), std::min(y1, view.height));
         };
-        parallel_for(0, frame.height(), [&](int y0, int y1) {
-            copy_rows(in.color, out.color, y0, y1, &previous.color);
-            auto [d0, d1] = rows_of(in.depth, y0, y1);
-            copy_rows(in.depth, out.depth, d0, d1, &previous.depth);
-            auto [m0, m1] = rows_of(in.motion, y0, y1);
-            copy_rows(in.motion, previous.motion, m0, m1);
-            for (int y = m0; y < m1; ++y) {
-                const glm::vec2* from = in.motion.row(y);
-                glm::vec2* to = &out.motion(0, y);
-                for (int x = 0; x < in.motion.width; ++x) to[x] = from[x] * scale;
-            }
-            auto [n0, n1] = rows_of(in.normal, y0, y1);
-            copy_rows(in.normal, out.normal, n0, n1);
-            auto [i0, i1] = rows_of(in.id, y0, y1);
-            copy_rows(in.id, out.id, i0, i1, &previous.id);
-        }, 32);
+        parallel_for(
+            0, frame.height(),
+            [&](int y0, int y1) {
+                copy_rows(in.color, out.color, y0, y1, &previous.color);
+                auto [d0, d1] = rows_of(in.depth, y0, y1);
+                copy_rows(in.depth, out.depth, d0, d1, &previous.depth);
+                auto [m0, m1] = rows_of(in.motion, y0, y1);
+                copy_rows(in.motion, previous.motion, m0, m1);
+                for (int y = m0; y < m1; ++y) {
+                    const glm::vec2* from = in.motion.row(y);
+                    glm::vec2* to = &out.motion(0, y);
+                    for (int x = 0; x < in.motion.width; ++x) to[x] = from[x] * scale;
+                }
+                auto [n0, n1] = rows_of(in.normal, y0, y1);
+                copy_rows(in.normal, out.normal, n0, n1);
+                auto [i0, i1] = rows_of(in.id, y0, y1);
+                copy_rows(in.id, out.id, i0, i1, &previous.id);
+            },
+            32);
         out.camera = previous.camera = frame.camera;
         out.fps = frame.fps > 0 ? frame.fps * factor : 0.0;
         previous.fps = frame.fps;
     }
 
     // Colour and depth of `frame` with zero motion.
-    void emit_copy(const GBufferView& frame, const Camera& a, const Camera& b, double fps, float s) {
+    void emit_copy(const GBufferView& frame, const Camera& a, const Camera& b, double fps,
+                   float s) {
         Frame& out = ready.push();
         copy_image(frame.color, out.color);
         copy_image(frame.depth, out.depth);
@@ -267,7 +284,9 @@ Status FrameRateConverter::send(const Frame& frame) {
     State& st = *state_;
     const int w = frame.width(), h = frame.height();
     REPRISE_TRY(check_image_size(w, h, "fruc input frame"));
-    auto sized = [&](auto& image) { return image.empty() || (image.width() == w && image.height() == h); };
+    auto sized = [&](auto& image) {
+        return image.empty() || (image.width() == w && image.height() == h);
+    };
     if (!sized(frame.depth) || !sized(frame.motion))
         return Status::error("fruc input frame: depth or motion size differs from colour");
     ++st.counters.inputs;
@@ -281,7 +300,8 @@ Status FrameRateConverter::send(const Frame& frame) {
     if (st.options.mode == FrucMode::Interpolate) {
         if (st.has_previous) {
             const Frame& a = st.previous;
-            const bool a_warpable = !a.depth.empty() && !a.motion.empty() && !st.previous_starts_shot;
+            const bool a_warpable =
+                !a.depth.empty() && !a.motion.empty() && !st.previous_starts_shot;
             const Camera a_before = State::previous_instant(a.camera, a.fps);
             for (int k = 1; k < k_max; ++k) {
                 float s = float(k) / float(k_max);
@@ -294,7 +314,8 @@ Status FrameRateConverter::send(const Frame& frame) {
                     extrapolate_frame(a, s, scale, st.options, st.scratch, out, st.counters);
                     st.finish(out, a_before, a.camera, a.fps, 1.0f + s, 1.0f + s - 1.0f / k_max);
                 } else if (!warpable || a.depth.empty() || a.motion.empty()) {
-                    st.emit_copy(s < 0.5f ? a.view() : frame.view(), a.camera, frame.camera, fps, s);
+                    st.emit_copy(s < 0.5f ? a.view() : frame.view(), a.camera, frame.camera, fps,
+                                 s);
                 } else if (motion_is_zero(frame)) {
                     ++st.counters.copied_still;
                     st.emit_copy(frame, a.camera, frame.camera, fps, s);

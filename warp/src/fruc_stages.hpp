@@ -18,10 +18,10 @@ struct WarpBuffers {
 
 // Scratch for one converter: every per-frame buffer lives here.
 struct FrucScratch {
-    WarpBuffers side_a;       // interpolation: frame a warped; extrapolation: the dynamic layer
-    WarpBuffers side_b;       // interpolation: b's coverage (b is warped into the output)
-    Image<float> layer_depth;        // extrapolation: the input's depth with some pixels left out
-    Image<glm::vec2> layer_motion;   // and the static layer's displacement
+    WarpBuffers side_a;        // interpolation: frame a warped; extrapolation: the dynamic layer
+    WarpBuffers side_b;        // interpolation: b's coverage (b is warped into the output)
+    Image<float> layer_depth;  // extrapolation: the input's depth with some pixels left out
+    Image<glm::vec2> layer_motion;    // and the static layer's displacement
     Image<glm::vec2> true_a, true_b;  // interpolation: motion that lands where the frame goes
     Image<glm::vec2> inverted;        // the later frame's moving pixels, at their earlier place
     Image<float> inverted_depth;
@@ -53,8 +53,9 @@ void interpolate_frame(const GBufferView& a, const GBufferView& b, float s, bool
 // Frame s frame periods after f (Andreev: static layer by camera-only reprojection, holes
 // filled from static neighbourhoods, dynamic objects drawn on top at extrapolated positions);
 // its backward motion per input period times motion_scale.
-void extrapolate_frame(const GBufferView& f, float s, float motion_scale, const FrucOptions& options,
-                       FrucScratch& scratch, Frame& out, FrucCounters& counters);
+void extrapolate_frame(const GBufferView& f, float s, float motion_scale,
+                       const FrucOptions& options, FrucScratch& scratch, Frame& out,
+                       FrucCounters& counters);
 
 // The static-layer test of f against its own previous camera: static pixels (the camera alone
 // explains their motion within `tolerance` px) keep their depth in depth_out and get their
@@ -84,9 +85,10 @@ void invert_motion(const GBufferView& b, float tolerance, Image<float>& static_d
 
 // The same towards an explicit camera (view, projection): the static layer lands where that
 // camera sees it, moving objects go s periods along their motion (constant screen velocity).
-void extrapolate_to_camera(const GBufferView& f, const glm::mat4& future_view, const glm::mat4& future_projection,
-                           float s, float motion_scale, const FrucOptions& options, FrucScratch& scratch,
-                           Frame& out, FrucCounters& counters);
+void extrapolate_to_camera(const GBufferView& f, const glm::mat4& future_view,
+                           const glm::mat4& future_projection, float s, float motion_scale,
+                           const FrucOptions& options, FrucScratch& scratch, Frame& out,
+                           FrucCounters& counters);
 
 // True when every motion vector is exactly zero (and finite).
 bool motion_is_zero(const GBufferView& f);

@@ -149,7 +149,7 @@ int32_t to_fixed(float v) {
 
 // Grows the cells of one row of starting cells.
 class Builder {
-  public:
+public:
     Builder(const GBufferView& source, const Params& params, bool simd, Scratch& scratch)
         : depth_(source.depth),
           motion_(source.motion),
@@ -203,7 +203,7 @@ class Builder {
         }
     }
 
-  private:
+private:
     // `failed`: the block is known not to fit.
     void subdivide(int x, int y, int s, bool failed = false) {
         if (x >= w_ || y >= h_) return;

@@ -80,9 +80,7 @@ Params make_params(const GridOptions& options, float factor);
 inline int first_centre(int64_t v) {
     return int((v - kSubpixel / 2 + kSubpixel - 1) >> kSubpixelBits);
 }
-inline int last_centre(int64_t v) {
-    return int((v - kSubpixel / 2) >> kSubpixelBits);
-}
+inline int last_centre(int64_t v) { return int((v - kSubpixel / 2) >> kSubpixelBits); }
 
 // Replaces rows[r] by the cells grown from row r of starting cells, in a fixed order, for r in
 // [begin, end). `simd` picks the vectorised smoothness test (same cells).

@@ -60,7 +60,7 @@ struct Triangle {
 };
 
 class Raster {
-  public:
+public:
     Raster(ImageView<const glm::vec4> source, const Band& band, bool simd)
         : src_(source), band_(band), motion_(!band.view.motion.empty()), simd_(simd) {}
 
@@ -69,7 +69,7 @@ class Raster {
         triangle(c.v[0], c.v[2], c.v[3], c.perspective);
     }
 
-  private:
+private:
     void triangle(const Vertex& a, const Vertex& b_in, const Vertex& c_in, bool perspective) const {
         const Vertex* b = &b_in;
         const Vertex* c = &c_in;

@@ -55,8 +55,8 @@ GridStats GridWarper::run(const GBufferView& source, float factor, const WarpTar
     // Sized here, not on first use: which worker gets work depends on scheduling, and a worker
     // that first gets some in a later frame must not allocate then.
     for (int k = 0; k < workers; ++k)
-        grid::size_scratch(st.scratch[std::size_t(k)], params, source.width(),
-                           target.color.width, kBandRows, !target.motion.empty());
+        grid::size_scratch(st.scratch[std::size_t(k)], params, source.width(), target.color.width,
+                           kBandRows, !target.motion.empty());
     if (threaded) {
         std::atomic<int> next{0};
         parallel_for(
@@ -124,8 +124,8 @@ GridStats GridWarper::warp(const GBufferView& source, float factor, const WarpTa
     return run(source, factor, target, options, true);
 }
 
-GridStats GridWarper::warp_reference(const GBufferView& source, float factor, const WarpTarget& target,
-                                     const GridOptions& options) {
+GridStats GridWarper::warp_reference(const GBufferView& source, float factor,
+                                     const WarpTarget& target, const GridOptions& options) {
     return run(source, factor, target, options, false);
 }
 

@@ -90,8 +90,10 @@ void fill_holes(ImageView<glm::vec4> color, ImageView<const uint8_t> valid,
         return;
     }
     ++counters.fills;
-    if (options.fill == FillMethod::PullPush) scratch.pull_push.fill(color, valid, depth);
-    else scratch.andreev.fill(color, valid, depth);
+    if (options.fill == FillMethod::PullPush)
+        scratch.pull_push.fill(color, valid, depth);
+    else
+        scratch.andreev.fill(color, valid, depth);
 }
 
 std::size_t blend_row_reference(const BlendRow& r) {
@@ -158,8 +160,10 @@ void interpolate_frame(const GBufferView& a, const GBufferView& b, float s, bool
         }
     }
     warp_into(from_b, 1.0f - s, options, scratch, into_out, counters);
-    if (use_a) warp_into(from_a, -s, options, scratch, wa.target(), counters);
-    else wa.covered.fill(0);
+    if (use_a)
+        warp_into(from_a, -s, options, scratch, wa.target(), counters);
+    else
+        wa.covered.fill(0);
     std::atomic<std::size_t> holes{0};
     parallel_for(0, h, [&](int y0, int y1) {
         std::size_t local_holes = 0;

@@ -31,8 +31,9 @@ float uniform(std::mt19937& rng, float a, float b) {
 
 // The worst values a float input can hold, picked at random.
 float worst_value(std::mt19937& rng) {
-    constexpr float values[] = {kNaN, kInf, -kInf, 0.0f, -0.0f, 1e30f, -1e30f, 1e-30f, -1.0f,
-                                std::numeric_limits<float>::denorm_min()};
+    constexpr float values[] = {
+        kNaN,  kInf,   -kInf,  0.0f,  -0.0f,
+        1e30f, -1e30f, 1e-30f, -1.0f, std::numeric_limits<float>::denorm_min()};
     return values[rng() % std::size(values)];
 }
 
@@ -47,8 +48,8 @@ std::string compare_bits(const char* what, const std::vector<T>& a, const std::v
             float va, vb;
             std::memcpy(&va, fa + i, 4);
             std::memcpy(&vb, fb + i, 4);
-            return std::string(what) + ": float " + std::to_string(i) + " is " + std::to_string(va) +
-                   ", reference " + std::to_string(vb);
+            return std::string(what) + ": float " + std::to_string(i) + " is " +
+                   std::to_string(va) + ", reference " + std::to_string(vb);
         }
     return {};
 }
@@ -56,9 +57,11 @@ std::string compare_bits(const char* what, const std::vector<T>& a, const std::v
 // Two cameras a little apart (a translation and a turn), perspective or orthographic.
 Camera random_camera(std::mt19937& rng, int w, int h, bool ortho, float move) {
     Camera c;
-    c.projection = ortho ? glm::ortho(-4.0f, 4.0f, -3.0f, 3.0f, 0.1f, 50.0f)
-                         : glm::perspective(uniform(rng, 0.5f, 1.5f), float(w) / float(h), 0.1f, 100.0f);
-    c.view = glm::translate(glm::mat4(1.0f), glm::vec3(uniform(rng, -1, 1), 0, uniform(rng, -1, 1)));
+    c.projection =
+        ortho ? glm::ortho(-4.0f, 4.0f, -3.0f, 3.0f, 0.1f, 50.0f)
+              : glm::perspective(uniform(rng, 0.5f, 1.5f), float(w) / float(h), 0.1f, 100.0f);
+    c.view =
+        glm::translate(glm::mat4(1.0f), glm::vec3(uniform(rng, -1, 1), 0, uniform(rng, -1, 1)));
     c.prev_view = glm::rotate(glm::translate(c.view, move * glm::vec3(0.05f, -0.02f, 0.1f)),
                               uniform(rng, -0.05f, 0.05f), glm::vec3(0, 1, 0));
     c.prev_projection = c.projection;
@@ -84,10 +87,18 @@ public:
             const float z = uniform(rng, 0.5f, 50.0f);
             depth_a_[i] = z;
             switch (rng() % 4) {  // same surface, nearer, farther, background on both
-                case 0: depth_b_[i] = z * uniform(rng, 0.97f, 1.03f); break;  // about the 2 % line
-                case 1: depth_b_[i] = z * 0.5f; break;
-                case 2: depth_b_[i] = z * 2.0f; break;
-                default: depth_a_[i] = depth_b_[i] = kInf; break;
+                case 0:
+                    depth_b_[i] = z * uniform(rng, 0.97f, 1.03f);
+                    break;  // about the 2 % line
+                case 1:
+                    depth_b_[i] = z * 0.5f;
+                    break;
+                case 2:
+                    depth_b_[i] = z * 2.0f;
+                    break;
+                default:
+                    depth_a_[i] = depth_b_[i] = kInf;
+                    break;
             }
             for (int c = 0; c < 4; ++c) {
                 color_a_[i][c] = uniform(rng, 0.0f, 4.0f);
@@ -97,10 +108,18 @@ public:
             motion_b_[i] = {uniform(rng, -20, 20), uniform(rng, -20, 20)};
             if (!worst || rng() % 3) continue;
             switch (rng() % 5) {
-                case 0: depth_a_[i] = worst_value(rng); break;
-                case 1: depth_b_[i] = worst_value(rng); break;
-                case 2: color_a_[i][int(rng() % 4)] = worst_value(rng); break;
-                case 3: motion_a_[i][int(rng() % 2)] = worst_value(rng); break;
+                case 0:
+                    depth_a_[i] = worst_value(rng);
+                    break;
+                case 1:
+                    depth_b_[i] = worst_value(rng);
+                    break;
+                case 2:
+                    color_a_[i][int(rng() % 4)] = worst_value(rng);
+                    break;
+                case 3:
+                    motion_a_[i][int(rng() % 2)] = worst_value(rng);
+                    break;
                 default:
                     depth_a_[i] = rng() % 2 ? 0.0f : -0.0f;
                     depth_b_[i] = rng() % 2 ? 0.0f : -0.0f;
@@ -181,8 +200,8 @@ public:
         // Worst case: the previous camera moved far forward, so near points are behind it.
         const Camera c = random_camera(rng, w, h, seed % 3 == 2, worst ? 60.0f : 1.0f);
         const StaticReprojection previous = camera_only_motion(c, w, h);
-        const glm::mat4 future_view =
-            glm::translate(c.view, glm::vec3(uniform(rng, -0.1f, 0.1f), 0.0f, uniform(rng, -0.1f, 0.1f)));
+        const glm::mat4 future_view = glm::translate(
+            c.view, glm::vec3(uniform(rng, -0.1f, 0.1f), 0.0f, uniform(rng, -0.1f, 0.1f)));
         const StaticReprojection future(c, future_view, c.projection, w, h);
         test_.emplace(previous, future, w, h, uniform(rng, 0.25f, 1.0f));
         const std::size_t n = std::size_t(w) * std::size_t(h);
@@ -195,14 +214,24 @@ public:
                 glm::vec2 before(0.0f);
                 const bool lands = previous.land(p.x, p.y, z, before);
                 // Most pixels static (their motion is the camera's, give or take), some moving.
-                glm::vec2 m = lands && rng() % 4 ? before - p : glm::vec2(uniform(rng, -30, 30), uniform(rng, -30, 30));
+                glm::vec2 m = lands && rng() % 4
+                                  ? before - p
+                                  : glm::vec2(uniform(rng, -30, 30), uniform(rng, -30, 30));
                 m += glm::vec2(uniform(rng, -0.3f, 0.3f), uniform(rng, -0.3f, 0.3f));
                 if (worst && rng() % 3 == 0) {
                     switch (rng() % 4) {
-                        case 0: z = worst_value(rng); break;
-                        case 1: m[int(rng() % 2)] = worst_value(rng); break;
-                        case 2: m = {1e30f, -1e30f}; break;
-                        default: z = -uniform(rng, 0.1f, 10.0f); break;  // behind this camera
+                        case 0:
+                            z = worst_value(rng);
+                            break;
+                        case 1:
+                            m[int(rng() % 2)] = worst_value(rng);
+                            break;
+                        case 2:
+                            m = {1e30f, -1e30f};
+                            break;
+                        default:
+                            z = -uniform(rng, 0.1f, 10.0f);
+                            break;  // behind this camera
                     }
                 }
                 depth_[i] = z, motion_[i] = m;
@@ -270,23 +299,29 @@ public:
             const int x = int(i % std::size_t(w)), y = int(i / std::size_t(w));
             // A few percent holes: disocclusion strips beside depth edges, and single pixels;
             // worst case: a third of the pixels, and depth edges everywhere.
-            const bool strip = worst ? (x / 3 + y / 2) % 3 == 0 : (x / 48 + y / 32) % 11 == 0 && x % 48 < 6;
+            const bool strip =
+                worst ? (x / 3 + y / 2) % 3 == 0 : (x / 48 + y / 32) % 11 == 0 && x % 48 < 6;
             valid_[i] = uint8_t(strip || rng() % 64 == 0 ? 0 : worst ? 1 + rng() % 255 : 1);
             for (int c = 0; c < 4; ++c) color_[i][c] = uniform(rng, 0.0f, 4.0f);
             const float base = ((worst ? x / 2 : x / 48) + y / 32) % 3 == 0 ? 2.0f : 20.0f;
             depth_[i] = y < h / 8 ? kInf : base * uniform(rng, 0.95f, 1.15f);
             if (!worst || rng() % 3) continue;
             switch (rng() % 3) {
-                case 0: color_[i][int(rng() % 4)] = worst_value(rng); break;
-                case 1: depth_[i] = worst_value(rng); break;
-                default: color_[i] = glm::vec4(3e38f); break;  // finite, the sum of four is not
+                case 0:
+                    color_[i][int(rng() % 4)] = worst_value(rng);
+                    break;
+                case 1:
+                    depth_[i] = worst_value(rng);
+                    break;
+                default:
+                    color_[i] = glm::vec4(3e38f);
+                    break;  // finite, the sum of four is not
             }
         }
     }
     void run_reference() override {
-        run_into(reference_, [](const PullRow& r) {
-            return pull_row_reference(r, 0, (r.fine_width + 1) / 2);
-        });
+        run_into(reference_,
+                 [](const PullRow& r) { return pull_row_reference(r, 0, (r.fine_width + 1) / 2); });
     }
     void run() override { run_into(optimized_, pull_row); }
     std::string compare() const override {
@@ -315,19 +350,21 @@ private:
             PullCounts local;
             for (int j = j0; j < j1; ++j) {
                 const int y0 = 2 * j, y1 = std::min(y0 + 1, h - 1);
-                const std::size_t o0 = std::size_t(y0) * std::size_t(w), o1 = std::size_t(y1) * std::size_t(w);
+                const std::size_t o0 = std::size_t(y0) * std::size_t(w),
+                                  o1 = std::size_t(y1) * std::size_t(w);
                 const std::size_t oc = std::size_t(j) * std::size_t(cw);
-                const PullCounts c = kernel({.row0 = color_.data() + o0,
-                                             .row1 = color_.data() + o1,
-                                             .valid0 = valid_.data() + o0,
-                                             .valid1 = valid_.data() + o1,
-                                             .depth0 = use_depth_ ? depth_.data() + o0 : nullptr,
-                                             .depth1 = use_depth_ ? depth_.data() + o1 : nullptr,
-                                             .fine_width = w,
-                                             .rows = y1 - y0 + 1,
-                                             .out = out.color.data() + oc,
-                                             .out_depth = use_depth_ ? out.depth.data() + oc : nullptr,
-                                             .hole_bits = out.bits.data() + oc});
+                const PullCounts c =
+                    kernel({.row0 = color_.data() + o0,
+                            .row1 = color_.data() + o1,
+                            .valid0 = valid_.data() + o0,
+                            .valid1 = valid_.data() + o1,
+                            .depth0 = use_depth_ ? depth_.data() + o0 : nullptr,
+                            .depth1 = use_depth_ ? depth_.data() + o1 : nullptr,
+                            .fine_width = w,
+                            .rows = y1 - y0 + 1,
+                            .out = out.color.data() + oc,
+                            .out_depth = use_depth_ ? out.depth.data() + oc : nullptr,
+                            .hole_bits = out.bits.data() + oc});
                 local.holes += c.holes, local.empty += c.empty;
             }
             holes += local.holes, empty += local.empty;
@@ -358,12 +395,15 @@ public:
         for (std::size_t i = 0; i < n; ++i) {
             const int x = int(i % std::size_t(w)), y = int(i / std::size_t(w));
             const bool partial =
-                worst ? rng() % 3 == 0 : ((x / 24 + y / 16) % 11 == 0 && x % 24 < 4) || rng() % 97 == 0;
+                worst ? rng() % 3 == 0
+                      : ((x / 24 + y / 16) % 11 == 0 && x % 24 < 4) || rng() % 97 == 0;
             const float weight = !partial ? 1.0f : rng() % 2 ? 0.0f : uniform(rng, 0.25f, 1.0f);
             for (int c = 0; c < 3; ++c) level_[i][c] = weight * uniform(rng, 0.0f, 4.0f);
             level_[i].a = weight;
             const float base = ((worst ? x / 2 : x / 24) + y / 16) % 3 == 0 ? 2.0f : 20.0f;
-            depth_[i] = y < h / 8 ? kInf : weight == 0.0f ? 0.0f : base * uniform(rng, 0.95f, 1.15f);
+            depth_[i] = y < h / 8        ? kInf
+                        : weight == 0.0f ? 0.0f
+                                         : base * uniform(rng, 0.95f, 1.15f);
             if (worst && rng() % 5 == 0) level_[i][int(rng() % 3)] = rng() % 2 ? 3e38f : -0.0f;
             if (worst && rng() % 7 == 0) level_[i].a = std::nextafter(1.0f, 0.0f);
         }
@@ -397,7 +437,8 @@ private:
             std::size_t local = 0;
             for (int j = j0; j < j1; ++j) {
                 const int y0 = 2 * j, y1 = std::min(y0 + 1, h - 1);
-                const std::size_t o0 = std::size_t(y0) * std::size_t(w), o1 = std::size_t(y1) * std::size_t(w);
+                const std::size_t o0 = std::size_t(y0) * std::size_t(w),
+                                  o1 = std::size_t(y1) * std::size_t(w);
                 const std::size_t oc = std::size_t(j) * std::size_t(cw);
                 local += kernel({.row0 = level_.data() + o0,
                                  .row1 = level_.data() + o1,
@@ -438,23 +479,36 @@ public:
         payload_.assign(w, h, glm::vec4(0.0f));
         for (int y = 0; y < h; ++y)
             for (int x = 0; x < w; ++x) {
-                const float z = 5.0f + 2.0f * std::sin(float(x) * 0.1f) * std::cos(float(y) * 0.13f);
+                const float z =
+                    5.0f + 2.0f * std::sin(float(x) * 0.1f) * std::cos(float(y) * 0.13f);
                 const bool block = (x / 7 + y / 5) % 4 == 0;
                 current_.depth(x, y) = block ? z * 0.5f : z;
                 previous_.depth(x, y) = z * uniform(rng, 0.97f, 1.03f);
                 current_.id(x, y) = block ? 2 : 1;
                 previous_.id(x, y) = (x / 6 + y / 6) % 5 == 0 ? 2 : 1;
-                current_.motion(x, y) = {1.5f * std::sin(float(y) * 0.07f) + uniform(rng, -0.5f, 0.5f),
-                                         std::cos(float(x) * 0.05f) + uniform(rng, -0.5f, 0.5f)};
+                current_.motion(x, y) = {
+                    1.5f * std::sin(float(y) * 0.07f) + uniform(rng, -0.5f, 0.5f),
+                    std::cos(float(x) * 0.05f) + uniform(rng, -0.5f, 0.5f)};
                 for (int c = 0; c < 4; ++c) payload_(x, y)[c] = uniform(rng, -4.0f, 4.0f);
                 if (!worst || rng() % 3) continue;
                 switch (rng() % 6) {
-                    case 0: current_.depth(x, y) = worst_value(rng); break;
-                    case 1: previous_.depth(x, y) = worst_value(rng); break;
-                    case 2: current_.motion(x, y)[int(rng() % 2)] = worst_value(rng); break;
-                    case 3: current_.motion(x, y) = {1e30f, -1e30f}; break;
-                    case 4: payload_(x, y)[int(rng() % 4)] = worst_value(rng); break;
-                    default: current_.depth(x, y) = kInf, previous_.depth(x, y) = kInf;
+                    case 0:
+                        current_.depth(x, y) = worst_value(rng);
+                        break;
+                    case 1:
+                        previous_.depth(x, y) = worst_value(rng);
+                        break;
+                    case 2:
+                        current_.motion(x, y)[int(rng() % 2)] = worst_value(rng);
+                        break;
+                    case 3:
+                        current_.motion(x, y) = {1e30f, -1e30f};
+                        break;
+                    case 4:
+                        payload_(x, y)[int(rng() % 4)] = worst_value(rng);
+                        break;
+                    default:
+                        current_.depth(x, y) = kInf, previous_.depth(x, y) = kInf;
                 }
             }
     }
@@ -466,8 +520,10 @@ public:
     std::string compare() const override {
         if (!(optimized_ == reference_)) return "counts differ";
         if (!(optimized_hit_ == reference_hit_)) return "hits differ";
-        std::vector<glm::vec4> a(optimized_out_.data(), optimized_out_.data() + optimized_out_.pixel_count());
-        std::vector<glm::vec4> b(reference_out_.data(), reference_out_.data() + reference_out_.pixel_count());
+        std::vector<glm::vec4> a(optimized_out_.data(),
+                                 optimized_out_.data() + optimized_out_.pixel_count());
+        std::vector<glm::vec4> b(reference_out_.data(),
+                                 reference_out_.data() + reference_out_.pixel_count());
         return compare_bits("payload", a, b);
     }
 

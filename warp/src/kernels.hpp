@@ -42,7 +42,7 @@ struct StaticLayerTest {
     glm::mat4 projection, to_previous, to_future;  // P; view -> previous clip; view -> future clip
     float background_zv, background_w;             // the view point of depth +inf
     float width, height;                           // image size in pixels
-    float tolerance2;                               // squared tolerance in pixels
+    float tolerance2;                              // squared tolerance in pixels
 
     StaticLayerTest(const StaticReprojection& previous, const StaticReprojection& future,
                     int image_width, int image_height, float tolerance);
@@ -70,7 +70,7 @@ struct PullRow {
     const float* depth0;  // null without depth
     const float* depth1;
     int fine_width;
-    int rows;  // 2, or 1 for the last row of an odd height
+    int rows;        // 2, or 1 for the last row of an odd height
     glm::vec4* out;  // (fine_width + 1) / 2 pixels
     float* out_depth;
     uint8_t* hole_bits;
@@ -92,7 +92,7 @@ struct PullLevelRow {
     const float* depth0;    // null without depth
     const float* depth1;
     int fine_width;
-    int rows;  // 2, or 1
+    int rows;        // 2, or 1
     glm::vec4* out;  // (fine_width + 1) / 2 pixels
     float* out_depth;
 };

@@ -17,13 +17,14 @@ PoseExtrapolator::~PoseExtrapolator() = default;
 PoseExtrapolator::PoseExtrapolator(PoseExtrapolator&&) noexcept = default;
 PoseExtrapolator& PoseExtrapolator::operator=(PoseExtrapolator&&) noexcept = default;
 
-void PoseExtrapolator::extrapolate(const GBufferView& frame, const glm::mat4& view, const glm::mat4& projection,
-                                   float periods, Frame& out) {
+void PoseExtrapolator::extrapolate(const GBufferView& frame, const glm::mat4& view,
+                                   const glm::mat4& projection, float periods, Frame& out) {
     REPRISE_ASSERT(periods >= 0.0f);
     State& s = *state_;
     ++s.counters.inputs;
     ++s.counters.outputs;
-    extrapolate_to_camera(frame, view, projection, periods, 1.0f, s.options, s.scratch, out, s.counters);
+    extrapolate_to_camera(frame, view, projection, periods, 1.0f, s.options, s.scratch, out,
+                          s.counters);
     out.camera = frame.camera;
     out.camera.prev_view = frame.camera.view;
     out.camera.prev_projection = frame.camera.projection;

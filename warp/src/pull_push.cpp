@@ -10,8 +10,8 @@
 #include <cmath>
 #include <cstring>
 
-#include "reprise/core/parallel.hpp"
 #include "kernels.hpp"
+#include "reprise/core/parallel.hpp"
 #include "reprise/warp/fill.hpp"
 
 namespace reprise::warp {
@@ -143,7 +143,8 @@ std::size_t pull_level_row_reference(const PullLevelRow& r, int i_begin, int i_e
                 float dmax = 0.0f;
                 bool same_layer = true;
                 if (use_depth) {
-                    const float d[4] = {r.depth0[x0], r.depth0[x0 + 1], r.depth1[x0], r.depth1[x0 + 1]};
+                    const float d[4] = {r.depth0[x0], r.depth0[x0 + 1], r.depth1[x0],
+                                        r.depth1[x0 + 1]};
                     dmax = std::max(std::max(d[0], d[1]), std::max(d[2], d[3]));
                     for (float dk : d) same_layer &= dk * kBackgroundDepthRatio >= dmax;
                 }
@@ -329,35 +330,38 @@ FillStats PullPush::fill(ImageView<glm::vec4> color, ImageView<const uint8_t> va
     std::atomic<std::size_t> holes{0}, empty{0};
     {
         Image<vec4>& c1 = color_levels_[0];
-        parallel_for(0, c1.height(), [&](int j0, int j1) {
-            std::size_t count = 0, empty_count = 0;
-            for (int j = j0; j < j1; ++j) {
-                const int y0 = 2 * j, ny = std::min(2, height - y0);
-                const vec4* row0 = color.row(y0);
-                const vec4* row1 = color.row(y0 + ny - 1);
-                const uint8_t* m0 = valid.row(y0);
-                const uint8_t* m1 = valid.row(y0 + ny - 1);
-                vec4* out = &c1(0, j);
-                uint8_t* bits = &hole_bits_(0, j);
-                float* out_d = use_depth ? &depth_levels_[0](0, j) : nullptr;
-                const PullCounts counts =
-                    pull_row({.row0 = row0,
-                              .row1 = row1,
-                              .valid0 = m0,
-                              .valid1 = m1,
-                              .depth0 = use_depth ? depth.row(y0) : nullptr,
-                              .depth1 = use_depth ? depth.row(y0 + ny - 1) : nullptr,
-                              .fine_width = width,
-                              .rows = ny,
-                              .out = out,
-                              .out_depth = out_d,
-                              .hole_bits = bits});
-                count += counts.holes;
-                empty_count += counts.empty;
-            }
-            holes += count;
-            empty += empty_count;
-        }, grain_rows(width));
+        parallel_for(
+            0, c1.height(),
+            [&](int j0, int j1) {
+                std::size_t count = 0, empty_count = 0;
+                for (int j = j0; j < j1; ++j) {
+                    const int y0 = 2 * j, ny = std::min(2, height - y0);
+                    const vec4* row0 = color.row(y0);
+                    const vec4* row1 = color.row(y0 + ny - 1);
+                    const uint8_t* m0 = valid.row(y0);
+                    const uint8_t* m1 = valid.row(y0 + ny - 1);
+                    vec4* out = &c1(0, j);
+                    uint8_t* bits = &hole_bits_(0, j);
+                    float* out_d = use_depth ? &depth_levels_[0](0, j) : nullptr;
+                    const PullCounts counts =
+                        pull_row({.row0 = row0,
+                                  .row1 = row1,
+                                  .valid0 = m0,
+                                  .valid1 = m1,
+                                  .depth0 = use_depth ? depth.row(y0) : nullptr,
+                                  .depth1 = use_depth ? depth.row(y0 + ny - 1) : nullptr,
+                                  .fine_width = width,
+                                  .rows = ny,
+                                  .out = out,
+                                  .out_depth = out_d,
+                                  .hole_bits = bits});
+                    count += counts.holes;
+                    empty_count += counts.empty;
+                }
+                holes += count;
+                empty += empty_count;
+            },
+            grain_rows(width));
     }
     stats.holes = holes.load();
     if (stats.holes == 0) return stats;
@@ -374,21 +378,24 @@ FillStats PullPush::fill(ImageView<glm::vec4> color, ImageView<const uint8_t> va
         const Image<float>* fd = depth_at(top);
         Image<vec4>& c = color_levels_[top + 1];
         Image<float>* cd = depth_at(top + 1);
-        parallel_for(0, c.height(), [&](int j0, int j1) {
-            std::size_t empty_count = 0;
-            for (int j = j0; j < j1; ++j) {
-                const int y0 = 2 * j, y1 = std::min(y0 + 1, f.height() - 1);
-                empty_count += pull_level_row({.row0 = &f(0, y0),
-                                               .row1 = &f(0, y1),
-                                               .depth0 = fd ? &(*fd)(0, y0) : nullptr,
-                                               .depth1 = fd ? &(*fd)(0, y1) : nullptr,
-                                               .fine_width = f.width(),
-                                               .rows = y1 - y0 + 1,
-                                               .out = &c(0, j),
-                                               .out_depth = cd ? &(*cd)(0, j) : nullptr});
-            }
-            empty += empty_count;
-        }, grain_rows(c.width()));
+        parallel_for(
+            0, c.height(),
+            [&](int j0, int j1) {
+                std::size_t empty_count = 0;
+                for (int j = j0; j < j1; ++j) {
+                    const int y0 = 2 * j, y1 = std::min(y0 + 1, f.height() - 1);
+                    empty_count += pull_level_row({.row0 = &f(0, y0),
+                                                   .row1 = &f(0, y1),
+                                                   .depth0 = fd ? &(*fd)(0, y0) : nullptr,
+                                                   .depth1 = fd ? &(*fd)(0, y1) : nullptr,
+                                                   .fine_width = f.width(),
+                                                   .rows = y1 - y0 + 1,
+                                                   .out = &c(0, j),
+                                                   .out_depth = cd ? &(*cd)(0, j) : nullptr});
+                }
+                empty += empty_count;
+            },
+            grain_rows(c.width()));
         ++top;
     }
     stats.levels = int(top) + 1;
@@ -400,26 +407,32 @@ FillStats PullPush::fill(ImageView<glm::vec4> color, ImageView<const uint8_t> va
     // Push back down; level 0 writes only the holes its hole bits name.
     for (std::size_t s = top; s-- > 0;) {
         Image<vec4>& f = color_levels_[s];
-        parallel_for(0, f.height(), [&](int y0, int y1) {
-            push_rows(f, depth_at(s), color_levels_[s + 1], depth_at(s + 1), y0, y1);
-        }, grain_rows(f.width()));
+        parallel_for(
+            0, f.height(),
+            [&](int y0, int y1) {
+                push_rows(f, depth_at(s), color_levels_[s + 1], depth_at(s + 1), y0, y1);
+            },
+            grain_rows(f.width()));
     }
     const Image<vec4>& c1 = color_levels_[0];
     const Image<float>* d1 = depth_at(0);
-    parallel_for(0, hole_bits_.height(), [&](int j0, int j1) {
-        for (int j = j0; j < j1; ++j) {
-            const uint8_t* bits = &hole_bits_(0, j);
-            for (int i = 0; i < hole_bits_.width(); ++i) {
-                if (!bits[i]) continue;
-                for (int b = 0; b < 4; ++b)
-                    if (bits[i] & (1u << b)) {
-                        const int x = 2 * i + (b & 1), y = 2 * j + (b >> 1);
-                        float ud;
-                        color(x, y) = vec4(upsample(c1, d1, x, y, ud), color(x, y).a);
-                    }
+    parallel_for(
+        0, hole_bits_.height(),
+        [&](int j0, int j1) {
+            for (int j = j0; j < j1; ++j) {
+                const uint8_t* bits = &hole_bits_(0, j);
+                for (int i = 0; i < hole_bits_.width(); ++i) {
+                    if (!bits[i]) continue;
+                    for (int b = 0; b < 4; ++b)
+                        if (bits[i] & (1u << b)) {
+                            const int x = 2 * i + (b & 1), y = 2 * j + (b >> 1);
+                            float ud;
+                            color(x, y) = vec4(upsample(c1, d1, x, y, ud), color(x, y).a);
+                        }
+                }
             }
-        }
-    }, grain_rows(2 * width));
+        },
+        grain_rows(2 * width));
     return stats;
 }
 

@@ -140,10 +140,7 @@ struct Kernel {
     std::ptrdiff_t hit_stride;
 };
 
-inline bool finite(float v) {
-    return v - v == 0.0f;
-}
-
+inline bool finite(float v) { return v - v == 0.0f; }
 
 // Bilinear over taps a, b (row 0) and c, d (row 1) of n channels; writes `dst` only when every
 // channel is finite.
@@ -330,11 +327,11 @@ void reproject_rows(const Kernel& kernel, int y_begin, int y_end, int step, std:
             const VF z_expected = w * lin + (v_kz * z + v_k1);
             const VF qx = (xf + v_qx0) + mx, qy = v_qy + my;
             const auto motion_ok = hn::And((mx - mx) == zero, (my - my) == zero);
-            const auto surface = hn::And(hn::And((z - z) == zero, (z_expected - z_expected) == zero),
-                                         z_expected > zero);
+            const auto surface = hn::And(
+                hn::And((z - z) == zero, (z_expected - z_expected) == zero), z_expected > zero);
             const auto background = background_hits ? (z == inf) : hn::FirstN(df, 0);
-            const auto inside = hn::And(hn::And(qx >= zero, qy >= zero),
-                                        hn::And(qx <= v_fpw, qy <= v_fph));
+            const auto inside =
+                hn::And(hn::And(qx >= zero, qy >= zero), hn::And(qx <= v_fpw, qy <= v_fph));
             const auto go = hn::And(hn::And(motion_ok, inside), hn::Or(surface, background));
             if (!hn::AllTrue(df, go)) {
                 for (int i = 0; i < lanes; ++i) record(x + i, classify(x + i), hrow);
@@ -344,9 +341,12 @@ void reproject_rows(const Kernel& kernel, int y_begin, int y_end, int step, std:
             VF fx, fy;
             floor_split(qx - half, ix, fx);
             floor_split(qy - half, iy, fy);
-            const VI x0 = hn::Min(hn::Max(ix, izero), v_pw1), y0 = hn::Min(hn::Max(iy, izero), v_ph1);
-            const VI x1 = hn::IfThenElse(hn::RebindMask(di, fx == zero), x0, hn::Min(ix + one, v_pw1));
-            const VI y1 = hn::IfThenElse(hn::RebindMask(di, fy == zero), y0, hn::Min(iy + one, v_ph1));
+            const VI x0 = hn::Min(hn::Max(ix, izero), v_pw1),
+                     y0 = hn::Min(hn::Max(iy, izero), v_ph1);
+            const VI x1 =
+                hn::IfThenElse(hn::RebindMask(di, fx == zero), x0, hn::Min(ix + one, v_pw1));
+            const VI y1 =
+                hn::IfThenElse(hn::RebindMask(di, fy == zero), y0, hn::Min(iy + one, v_ph1));
             const VI r0 = y0 * depth_stride_v, r1 = y1 * depth_stride_v;
             const VF a = hn::GatherIndex(df, prev_depth, r0 + x0);
             const VF b = hn::GatherIndex(df, prev_depth, r0 + x1);
@@ -356,11 +356,10 @@ void reproject_rows(const Kernel& kernel, int y_begin, int y_end, int step, std:
             if (use_ids) {
                 const VI me = hn::LoadU(di, reinterpret_cast<const int32_t*>(ir) + x);
                 const VI i0 = y0 * id_stride_v, i1 = y1 * id_stride_v;
-                const auto same = hn::And(
-                    hn::And(hn::GatherIndex(di, prev_id_i, i0 + x0) == me,
-                            hn::GatherIndex(di, prev_id_i, i0 + x1) == me),
-                    hn::And(hn::GatherIndex(di, prev_id_i, i1 + x0) == me,
-                            hn::GatherIndex(di, prev_id_i, i1 + x1) == me));
+                const auto same = hn::And(hn::And(hn::GatherIndex(di, prev_id_i, i0 + x0) == me,
+                                                  hn::GatherIndex(di, prev_id_i, i0 + x1) == me),
+                                          hn::And(hn::GatherIndex(di, prev_id_i, i1 + x0) == me,
+                                                  hn::GatherIndex(di, prev_id_i, i1 + x1) == me));
                 ids_agree = hn::RebindMask(df, same);
             }
             const auto taps_finite = (((a - a) + (b - b)) + (c - c)) + (d - d) == zero;
@@ -372,7 +371,8 @@ void reproject_rows(const Kernel& kernel, int y_begin, int y_end, int step, std:
                 hn::And(hn::And(a == inf, b == inf), hn::And(c == inf, d == inf));
             const auto depth_ok = hn::Or(hn::And(background, all_background),
                                          hn::AndNot(background, hn::And(taps_finite, close)));
-            hn::Store(x0, di, X0), hn::Store(x1, di, X1), hn::Store(y0, di, Y0), hn::Store(y1, di, Y1);
+            hn::Store(x0, di, X0), hn::Store(x1, di, X1), hn::Store(y0, di, Y0),
+                hn::Store(y1, di, Y1);
             hn::Store(fx, df, FX), hn::Store(fy, df, FY);
             hn::Store(hn::VecFromMask(di, hn::RebindMask(di, depth_ok)), di, DEPTH_OK);
             hn::Store(hn::VecFromMask(di, hn::RebindMask(di, ids_agree)), di, IDS_OK);
@@ -385,7 +385,8 @@ void reproject_rows(const Kernel& kernel, int y_begin, int y_end, int step, std:
                 } else {
                     const float* p0 = in + Y0[i] * in_stride;
                     const float* p1 = in + Y1[i] * in_stride;
-                    const std::ptrdiff_t c0 = std::ptrdiff_t(X0[i]) * n, c1 = std::ptrdiff_t(X1[i]) * n;
+                    const std::ptrdiff_t c0 = std::ptrdiff_t(X0[i]) * n,
+                                         c1 = std::ptrdiff_t(X1[i]) * n;
                     if (!fetch<C>(p0 + c0, p0 + c1, p1 + c0, p1 + c1, n, FX[i], FY[i],
                                   orow + std::ptrdiff_t(x + i) * n))
                         o = Invalid;
@@ -399,14 +400,18 @@ void reproject_rows(const Kernel& kernel, int y_begin, int y_end, int step, std:
     counts[Hit] += hits;
 }
 
-
 void ReprojectRows(const Kernel& kernel, int y_begin, int y_end, int step, std::size_t* counts) {
     switch (kernel.channels) {
-        case 1: return reproject_rows<1>(kernel, y_begin, y_end, step, counts);
-        case 2: return reproject_rows<2>(kernel, y_begin, y_end, step, counts);
-        case 3: return reproject_rows<3>(kernel, y_begin, y_end, step, counts);
-        case 4: return reproject_rows<4>(kernel, y_begin, y_end, step, counts);
-        default: return reproject_rows<0>(kernel, y_begin, y_end, step, counts);
+        case 1:
+            return reproject_rows<1>(kernel, y_begin, y_end, step, counts);
+        case 2:
+            return reproject_rows<2>(kernel, y_begin, y_end, step, counts);
+        case 3:
+            return reproject_rows<3>(kernel, y_begin, y_end, step, counts);
+        case 4:
+            return reproject_rows<4>(kernel, y_begin, y_end, step, counts);
+        default:
+            return reproject_rows<0>(kernel, y_begin, y_end, step, counts);
     }
 }
 

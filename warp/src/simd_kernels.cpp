@@ -30,8 +30,10 @@ std::size_t BlendRowSimd(const BlendRow& r) {
     std::size_t holes = 0;
     int x = 0;
     for (; x + n <= r.width; x += n) {
-        const auto ca = hn::RebindMask(df, hn::PromoteTo(di, hn::LoadU(du8, r.covered_a + x)) != zero_i);
-        const auto cb = hn::RebindMask(df, hn::PromoteTo(di, hn::LoadU(du8, r.covered_b + x)) != zero_i);
+        const auto ca =
+            hn::RebindMask(df, hn::PromoteTo(di, hn::LoadU(du8, r.covered_a + x)) != zero_i);
+        const auto cb =
+            hn::RebindMask(df, hn::PromoteTo(di, hn::LoadU(du8, r.covered_b + x)) != zero_i);
         const auto covered = hn::Or(ca, cb);
         hn::StoreU(hn::DemoteTo(du8, hn::IfThenElseZero(hn::RebindMask(di, covered), one_i)), du8,
                    r.valid + x);
@@ -53,9 +55,10 @@ std::size_t BlendRowSimd(const BlendRow& r) {
         auto merge = [&](VF a, VF b) {
             return hn::IfThenElse(blend, one_minus_s * a + s * b, hn::IfThenElse(take_a, a, b));
         };
-        hn::StoreInterleaved4(merge(ar, br), merge(ag, bg), merge(ab, bb), merge(aa, ba), df, color);
-        const VF depth = hn::IfThenElse(same, nearer, hn::IfThenElse(background, inf,
-                                                                     hn::IfThenElse(take_a, za, zb)));
+        hn::StoreInterleaved4(merge(ar, br), merge(ag, bg), merge(ab, bb), merge(aa, ba), df,
+                              color);
+        const VF depth = hn::IfThenElse(
+            same, nearer, hn::IfThenElse(background, inf, hn::IfThenElse(take_a, za, zb)));
         hn::StoreU(depth, df, r.depth + x);
 
         VF max, may, mbx, mby;
@@ -93,7 +96,8 @@ std::size_t StaticLayerRowSimd(const StaticLayerTest& t, int y, int width, const
     const VF lanes = hn::Iota(df, 0.0f);
     // Row r of M times (vx, vy, zv, w), summed as transform_row does.
     auto row = [&](const glm::mat4& M, int r, VF vx, VF vy, VF zv, VF w) {
-        return (splat(M[0][r]) * vx + splat(M[1][r]) * vy) + (splat(M[2][r]) * zv + splat(M[3][r]) * w);
+        return (splat(M[0][r]) * vx + splat(M[1][r]) * vy) +
+               (splat(M[2][r]) * zv + splat(M[3][r]) * w);
     };
     std::size_t dynamic = 0;
     int x = 0;
@@ -119,15 +123,14 @@ std::size_t StaticLayerRowSimd(const StaticLayerTest& t, int y, int width, const
             hn::And(hn::And(z == z, (mx - mx) == zero), hn::And((my - my) == zero, aw > zero)),
             hn::And(bw > zero, ex * ex + ey * ey <= tolerance2));
         hn::StoreU(hn::IfThenElse(still, z, nan), df, depth_out + x);
-        hn::StoreInterleaved2(hn::IfThenElse(still, lx - px, nan), hn::IfThenElse(still, ly - py, nan),
-                              df, &motion_out[x].x);
+        hn::StoreInterleaved2(hn::IfThenElse(still, lx - px, nan),
+                              hn::IfThenElse(still, ly - py, nan), df, &motion_out[x].x);
         dynamic += std::size_t(n) - hn::CountTrue(df, still);
     }
     if (x < width)
         dynamic += static_layer_row_reference(t, y, x, width, depth, motion, depth_out, motion_out);
     return dynamic;
 }
-
 
 PullCounts PullRowSimd(const PullRow& r) {
     const int coarse = (r.fine_width + 1) / 2;
@@ -221,11 +224,14 @@ std::size_t PullLevelRowSimd(const PullLevelRow& r) {
         hn::LoadInterleaved4(df, &r.row0[x0 + n].x, c1[0], c1[1], c1[2], c1[3]);
         hn::LoadInterleaved4(df, &r.row1[x0].x, c2[0], c2[1], c2[2], c2[3]);
         hn::LoadInterleaved4(df, &r.row1[x0 + n].x, c3[0], c3[1], c3[2], c3[3]);
-        VF even[4][2], odd[4][2];  // [channel][row]: children (0,0) (0,1) in even, (1,0) (1,1) in odd
+        VF even[4][2],
+            odd[4][2];  // [channel][row]: children (0,0) (0,1) in even, (1,0) (1,1) in odd
         VF sum[3];
         for (int c = 0; c < 4; ++c) {
-            even[c][0] = hn::ConcatEven(df, c1[c], c0[c]), odd[c][0] = hn::ConcatOdd(df, c1[c], c0[c]);
-            even[c][1] = hn::ConcatEven(df, c3[c], c2[c]), odd[c][1] = hn::ConcatOdd(df, c3[c], c2[c]);
+            even[c][0] = hn::ConcatEven(df, c1[c], c0[c]),
+            odd[c][0] = hn::ConcatOdd(df, c1[c], c0[c]);
+            even[c][1] = hn::ConcatEven(df, c3[c], c2[c]),
+            odd[c][1] = hn::ConcatOdd(df, c3[c], c2[c]);
             if (c < 3) sum[c] = zero + even[c][0] + odd[c][0] + even[c][1] + odd[c][1];
         }
         auto fast = hn::And(hn::And(even[3][0] == one, odd[3][0] == one),

@@ -16,7 +16,7 @@ bool finite(glm::vec2 m) { return std::isfinite(m.x) && std::isfinite(m.y); }
 }  // namespace
 
 bool motion_is_linear(const GBufferView& f, const Camera& to, float factor, float tolerance) {
-    constexpr int kStep = 8;            // every 8th pixel of every 8th row
+    constexpr int kStep = 8;             // every 8th pixel of every 8th row
     constexpr float kDeviation = 0.02f;  // px between the true and the linear landing
     const int w = f.width(), h = f.height();
     const StaticReprojection to_previous = camera_only_motion(f.camera, w, h);
@@ -54,8 +54,10 @@ std::size_t motion_toward(const GBufferView& f, const Camera& to, float factor,
             const glm::vec2* m = f.motion.row(y);
             glm::vec2* o = out.row(y);
             for (int x = 0; x < w; ++x) {
-                if (!std::isnan(z[x])) o[x] *= per_factor;
-                else o[x] = !inverted.empty() && finite(inverted(x, y)) ? inverted(x, y) : m[x];
+                if (!std::isnan(z[x]))
+                    o[x] *= per_factor;
+                else
+                    o[x] = !inverted.empty() && finite(inverted(x, y)) ? inverted(x, y) : m[x];
             }
         }
     });

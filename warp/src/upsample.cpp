@@ -20,9 +20,7 @@ bool finite3(const glm::vec4& c) {
     return std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z);
 }
 
-float luminance(const glm::vec4& c) {
-    return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z;
-}
+float luminance(const glm::vec4& c) { return 0.2126f * c.x + 0.7152f * c.y + 0.0722f * c.z; }
 
 // log2 and exp2 to about 1e-4 relative with short polynomials (powf dominated the filter).
 float fast_log2(float x) {  // x > 0, finite
@@ -51,9 +49,7 @@ float fast_exp2(float e) {  // e <= 0
     return p * scale;
 }
 
-float fast_pow(float base, float gamma) {
-    return fast_exp2(gamma * fast_log2(base));
-}
+float fast_pow(float base, float gamma) { return fast_exp2(gamma * fast_log2(base)); }
 
 // base^gamma of eq. 3 for base = max(eps, 1 - x / sigma).
 float falloff_of_base(float base, float gamma) {
@@ -229,9 +225,7 @@ struct Counters {
 
 SpatioTemporalUpsampler::SpatioTemporalUpsampler(UpsampleOptions options) : options_(options) {}
 
-void SpatioTemporalUpsampler::reset() {
-    has_history_ = false;
-}
+void SpatioTemporalUpsampler::reset() { has_history_ = false; }
 
 void SpatioTemporalUpsampler::upsample(ImageView<const glm::vec4> low_color, glm::vec2 jitter_px,
                                        const GBufferView& full, ImageView<glm::vec4> out,

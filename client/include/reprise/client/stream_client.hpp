@@ -18,32 +18,32 @@ namespace reprise::client {
 struct StreamClientOptions {
     net::Endpoint server{0x7f000001u, 0};
     std::string secret;
-    std::string scene;                // from the server's catalogue; empty: the server's default
-    bool extrapolate = true;          // false: show the newest decoded frame (frame repetition)
-    bool inject_faults = false;       // put the in-process fault injector on both directions
+    std::string scene;           // from the server's catalogue; empty: the server's default
+    bool extrapolate = true;     // false: show the newest decoded frame (frame repetition)
+    bool inject_faults = false;  // put the in-process fault injector on both directions
     net::FaultOptions uplink, downlink;
-    double reconnect_after_s = 2.0;   // silence from the server that ends the connection
-    int max_auth_failures = 3;        // key confirmations failed in a row before giving up
+    double reconnect_after_s = 2.0;  // silence from the server that ends the connection
+    int max_auth_failures = 3;       // key confirmations failed in a row before giving up
 };
 
 struct StreamClientStats {
-    std::size_t connects = 0;               // sessions established (reconnects = connects - 1)
+    std::size_t connects = 0;  // sessions established (reconnects = connects - 1)
     std::size_t auth_failures = 0;
     std::size_t frames_decoded = 0, decode_errors = 0, frames_lost = 0;
     std::size_t key_frame_requests = 0;
     std::size_t datagrams_received = 0, datagrams_dropped = 0, bytes_received = 0;
     std::size_t fec_recovered = 0;
-    int64_t last_rtt_us = 0;               // pose sampled -> frame decoded
-    std::string refused;                   // the server's reason when it refused the session
+    int64_t last_rtt_us = 0;  // pose sampled -> frame decoded
+    std::string refused;      // the server's reason when it refused the session
 };
 
 // What one display frame was made from.
 struct DisplayInfo {
-    double scene_time = 0.0;       // the displayed instant
-    int64_t pose_us = 0;           // when the displayed pose was sampled
-    int64_t source_pose_us = 0;    // when the pose of the decoded frame was sampled
+    double scene_time = 0.0;     // the displayed instant
+    int64_t pose_us = 0;         // when the displayed pose was sampled
+    int64_t source_pose_us = 0;  // when the pose of the decoded frame was sampled
     double source_scene_time = 0.0;
-    uint32_t source_frame = 0;     // codec frame number of the decoded frame
+    uint32_t source_frame = 0;  // codec frame number of the decoded frame
     bool extrapolated = false;
 };
 
@@ -61,10 +61,12 @@ public:
     void send_pose(const glm::mat4& view, double scene_time, int64_t now_us);
     // The display frame for this pose: the newest decoded frame extrapolated to it (or shown as
     // it is without extrapolation). Null before the first frame was decoded.
-    const Frame* display(const glm::mat4& view, double scene_time, int64_t pose_us, DisplayInfo& info);
+    const Frame* display(const glm::mat4& view, double scene_time, int64_t pose_us,
+                         DisplayInfo& info);
 
     bool connected() const;
-    const net::StreamInfoMessage* stream_info() const;  // null before the server described the stream
+    const net::StreamInfoMessage* stream_info()
+        const;  // null before the server described the stream
     const StreamClientStats& stats() const;
     const Frame* newest_decoded() const;
 
@@ -79,8 +81,9 @@ private:
 // scene time t (seconds since the start), sends it and shows the display frame to `show`.
 // `pose` gives the world -> camera matrix at t; `show` may return false to stop early.
 using PoseFunction = std::function<glm::mat4(double t)>;
-using ShowFunction = std::function<bool(const Frame& frame, const DisplayInfo& info, int64_t displayed_us)>;
-[[nodiscard]] Status run_client(StreamClient& client, double duration_s, double display_rate, const PoseFunction& pose,
-                                const ShowFunction& show);
+using ShowFunction =
+    std::function<bool(const Frame& frame, const DisplayInfo& info, int64_t displayed_us)>;
+[[nodiscard]] Status run_client(StreamClient& client, double duration_s, double display_rate,
+                                const PoseFunction& pose, const ShowFunction& show);
 
 }  // namespace reprise::client

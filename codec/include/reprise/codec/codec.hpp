@@ -20,10 +20,10 @@ enum class DepthMode : uint8_t {
 };
 
 struct EncoderOptions {
-    int qp = 28;               // quantiser, 0 (finest) .. 51; constant quality when bitrate_kbps = 0
-    int bitrate_kbps = 0;      // > 0: rate control to this bitrate (frames bounded in size)
-    double fps = 30.0;         // for rate control and timestamps when the frames carry none
-    int keyint = 0;            // a key frame at least every keyint frames; 0 = only on cuts/requests
+    int qp = 28;           // quantiser, 0 (finest) .. 51; constant quality when bitrate_kbps = 0
+    int bitrate_kbps = 0;  // > 0: rate control to this bitrate (frames bounded in size)
+    double fps = 30.0;     // for rate control and timestamps when the frames carry none
+    int keyint = 0;        // a key frame at least every keyint frames; 0 = only on cuts/requests
     Chroma chroma = Chroma::C420;
     DepthMode depth = DepthMode::Lossless;
     float depth_error = 1e-4f;  // relative bound for DepthMode::Bounded
@@ -31,7 +31,7 @@ struct EncoderOptions {
     // channel is skipped (Mueller et al. 2021: T = 8/255 stays under one JND). 0 = skip only
     // what quantises to nothing.
     int skip_threshold = 2;
-    bool detect_cuts = true;   // key frame when the prediction misses most pixels
+    bool detect_cuts = true;  // key frame when the prediction misses most pixels
 };
 
 enum class PacketType : uint8_t { Key = 0, Inter = 1 };
@@ -39,7 +39,7 @@ enum class PacketType : uint8_t { Key = 0, Inter = 1 };
 struct Packet {
     std::vector<uint8_t> data;  // header + payload, as sent
     uint32_t frame = 0;
-    uint32_t reference = 0;     // frame it was predicted from (== frame for key frames)
+    uint32_t reference = 0;  // frame it was predicted from (== frame for key frames)
     PacketType type = PacketType::Key;
 };
 
@@ -49,9 +49,9 @@ struct StreamStats {
     std::size_t key_frames = 0;
     std::size_t older_reference = 0;  // predicted from a frame before the previous one
     std::size_t header_bits = 0, camera_bits = 0, depth_bits = 0, motion_bits = 0, color_bits = 0;
-    std::size_t blocks = 0;           // 8x8 colour transform blocks (all planes)
-    std::size_t blocks_skipped = 0;   // coded as a flag only
-    std::size_t intra_blocks = 0;     // macroblocks predicted from the current frame
+    std::size_t blocks = 0;                  // 8x8 colour transform blocks (all planes)
+    std::size_t blocks_skipped = 0;          // coded as a flag only
+    std::size_t intra_blocks = 0;            // macroblocks predicted from the current frame
     std::size_t motion_residual_pixels = 0;  // pixels whose motion the cameras do not explain
     std::size_t depth_zero_blocks = 0;       // depth blocks predicted exactly
     std::size_t total_bits() const {
@@ -127,10 +127,12 @@ private:
 };
 
 // Checks one packet (length, version, CRC) and reads its header into `info` (data left empty).
-[[nodiscard]] Status inspect_packet(std::span<const uint8_t> packet, Packet& info, int64_t& timestamp_us);
+[[nodiscard]] Status inspect_packet(std::span<const uint8_t> packet, Packet& info,
+                                    int64_t& timestamp_us);
 
 // A .rps file: a file header followed by packets (docs/bitstream.md).
-[[nodiscard]] Status write_stream_header(std::vector<uint8_t>& out, int width, int height, double fps);
+[[nodiscard]] Status write_stream_header(std::vector<uint8_t>& out, int width, int height,
+                                         double fps);
 struct StreamInfo {
     int width = 0, height = 0;
     double fps = 0.0;

@@ -7,14 +7,14 @@ namespace reprise {
 
 // OpenGL conventions: the camera looks down -Z; clip space has w = -z_view.
 struct Camera {
-    glm::mat4 view{1.0f};             // world -> camera
-    glm::mat4 projection{1.0f};       // camera -> clip, without jitter
-    glm::mat4 prev_view{1.0f};        // the previous frame's pair
+    glm::mat4 view{1.0f};        // world -> camera
+    glm::mat4 projection{1.0f};  // camera -> clip, without jitter
+    glm::mat4 prev_view{1.0f};   // the previous frame's pair
     glm::mat4 prev_projection{1.0f};
-    float near = 0.1f;                // scene units
+    float near = 0.1f;  // scene units
     float far = 1000.0f;
-    glm::vec2 jitter{0.0f};           // sub-pixel offset of the rendered samples, pixels
-    double time = 0.0;                // seconds on the animation timeline
+    glm::vec2 jitter{0.0f};  // sub-pixel offset of the rendered samples, pixels
+    double time = 0.0;       // seconds on the animation timeline
 };
 
 // False for a default Camera (identity projection): the input carried no camera (Blender's

@@ -1,7 +1,8 @@
 #pragma once
 // The camera math every warp shares: pixel + depth -> view-space point, point -> pixel in
 // another camera, camera-only motion. Pixel positions follow docs/conventions.md (origin top-left,
-// +y down, pixel (i, j) centred at (i + 0.5, j + 0.5)); depth is linear view depth (z_view = -depth).
+// +y down, pixel (i, j) centred at (i + 0.5, j + 0.5)); depth is linear view depth (z_view =
+// -depth).
 #include <cmath>
 
 #include <glm/mat4x4.hpp>
@@ -93,8 +94,12 @@ public:
 
 private:
     // (x, y) from P00 x + P10 y = rx, P01 x + P11 y = ry.
-    float solve_x(float rx, float ry) const { return axis_aligned_ ? rx / p_[0][0] : i00_ * rx + i01_ * ry; }
-    float solve_y(float rx, float ry) const { return axis_aligned_ ? ry / p_[1][1] : i10_ * rx + i11_ * ry; }
+    float solve_x(float rx, float ry) const {
+        return axis_aligned_ ? rx / p_[0][0] : i00_ * rx + i01_ * ry;
+    }
+    float solve_y(float rx, float ry) const {
+        return axis_aligned_ ? ry / p_[1][1] : i10_ * rx + i11_ * ry;
+    }
 
     glm::mat4 p_, inverse_{1.0f};
     float width_, height_, far_ = 1e6f;

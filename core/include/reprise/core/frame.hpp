@@ -7,13 +7,13 @@
 namespace reprise {
 
 struct Frame {
-    Image<glm::vec4> color;    // linear-light RGB, A = coverage (1 geometry, 0 background)
-    Image<float> depth;        // linear view depth, scene units; background +inf
-    Image<glm::vec2> motion;   // backward motion, pixels: p + motion = p in the previous frame
-    Image<glm::vec3> normal;   // world-space unit normal (0 on background)
-    Image<uint32_t> id;        // object id, 0 = background
+    Image<glm::vec4> color;   // linear-light RGB, A = coverage (1 geometry, 0 background)
+    Image<float> depth;       // linear view depth, scene units; background +inf
+    Image<glm::vec2> motion;  // backward motion, pixels: p + motion = p in the previous frame
+    Image<glm::vec3> normal;  // world-space unit normal (0 on background)
+    Image<uint32_t> id;       // object id, 0 = background
     Camera camera;
-    double fps = 0.0;          // frame rate of the sequence this frame belongs to (0 = unknown)
+    double fps = 0.0;  // frame rate of the sequence this frame belongs to (0 = unknown)
 
     int width() const { return color.width(); }
     int height() const { return color.height(); }

@@ -10,9 +10,10 @@
 namespace reprise {
 
 struct GBufferView {
-    ImageView<const glm::vec4> color;   // linear-light RGB, A = coverage (1 geometry, 0 background)
-    ImageView<const float> depth;       // linear view depth (positive, scene units); background +inf
-    ImageView<const glm::vec2> motion;  // backward motion in pixels: p + motion = p in the previous frame
+    ImageView<const glm::vec4> color;  // linear-light RGB, A = coverage (1 geometry, 0 background)
+    ImageView<const float> depth;      // linear view depth (positive, scene units); background +inf
+    ImageView<const glm::vec2>
+        motion;  // backward motion in pixels: p + motion = p in the previous frame
     ImageView<const glm::vec3> normal;  // world-space unit normal (0 on background)
     ImageView<const uint32_t> id;       // object id, 0 = background
     Camera camera;                      // view/projection of this instant and the previous one

@@ -1,8 +1,8 @@
 #pragma once
 // Non-owning image views and owning images with a typed pixel format.
 // Rows are `stride` elements apart; pixel (x, y) has its centre at (x + 0.5, y + 0.5).
-#include <cstddef>
 #include <algorithm>
+#include <cstddef>
 #include <cstdint>
 #include <string>
 #include <string_view>
@@ -29,9 +29,7 @@ struct ImageView {
     bool empty() const { return width <= 0 || height <= 0; }
     std::size_t pixel_count() const { return std::size_t(width) * std::size_t(height); }
 
-    operator ImageView<const T>() const
-        requires(!std::is_const_v<T>)
-    {
+    operator ImageView<const T>() const requires(!std::is_const_v<T>) {
         return {data, width, height, stride};
     }
 };

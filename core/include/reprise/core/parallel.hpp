@@ -10,12 +10,10 @@ namespace reprise {
 class RangeBody {
 public:
     template <class F>
-        requires(!std::is_same_v<std::remove_cvref_t<F>, RangeBody>)
-    RangeBody(F& body)  // NOLINT: implicit on purpose
+    requires(!std::is_same_v<std::remove_cvref_t<F>, RangeBody>)
+        RangeBody(F& body)  // NOLINT: implicit on purpose
         : object_(const_cast<void*>(static_cast<const void*>(std::addressof(body)))),
-          call_([](void* object, int a, int b) {
-              (*static_cast<F*>(object))(a, b);
-          }) {}
+          call_([](void* object, int a, int b) { (*static_cast<F*>(object))(a, b); }) {}
     void operator()(int a, int b) const { call_(object_, a, b); }
 
 private:

@@ -7,8 +7,8 @@
 namespace reprise::simd {
 
 struct Target {
-    int64_t bits = 0;          // a Highway target bit (HWY_AVX2, HWY_SSE4, ...)
-    const char* name = "";     // "AVX2", "SSE4", "EMU128" (Highway's portable scalar code), ...
+    int64_t bits = 0;       // a Highway target bit (HWY_AVX2, HWY_SSE4, ...)
+    const char* name = "";  // "AVX2", "SSE4", "EMU128" (Highway's portable scalar code), ...
 };
 
 // Best first.

@@ -28,17 +28,17 @@ inline Status ok() { return {}; }
 
 }  // namespace reprise
 
-#define REPRISE_ASSERT(expr)                                                               \
-    do {                                                                                   \
-        if (!(expr)) {                                                                     \
+#define REPRISE_ASSERT(expr)                                                                  \
+    do {                                                                                      \
+        if (!(expr)) {                                                                        \
             std::fprintf(stderr, "%s:%d: assertion failed: %s\n", __FILE__, __LINE__, #expr); \
-            std::abort();                                                                  \
-        }                                                                                  \
+            std::abort();                                                                     \
+        }                                                                                     \
     } while (0)
 
 // Returns from the calling function when a Status is an error.
-#define REPRISE_TRY(expr)                       \
-    do {                                        \
-        ::reprise::Status status_ = (expr);     \
-        if (!status_.ok()) return status_;      \
+#define REPRISE_TRY(expr)                   \
+    do {                                    \
+        ::reprise::Status status_ = (expr); \
+        if (!status_.ok()) return status_;  \
     } while (0)

@@ -18,7 +18,7 @@ struct VideoOptions {
 // Push frames one at a time; close() waits for ffmpeg and reports its failure.
 // Odd sizes are padded to even (yuv420p) by repeating the last column / row.
 class VideoWriter {
-  public:
+public:
     VideoWriter() = default;
     VideoWriter(const VideoWriter&) = delete;
     VideoWriter& operator=(const VideoWriter&) = delete;
@@ -30,7 +30,7 @@ class VideoWriter {
     bool is_open() const { return pid_ > 0; }
     int frames_written() const { return frames_; }
 
-  private:
+private:
     std::string path_;
     int pid_ = -1;
     int fd_ = -1;

@@ -10,22 +10,23 @@
 namespace reprise::net {
 
 struct FaultOptions {
-    double loss = 0.0;          // independent loss probability per datagram
+    double loss = 0.0;  // independent loss probability per datagram
     // Burst loss (Gilbert-Elliott): the link turns bad with burst_start per datagram, stays bad
     // with probability 1 - burst_end, and loses every datagram while bad.
     double burst_start = 0.0;
     double burst_end = 0.25;
-    double delay_ms = 0.0;      // one-way delay
-    double jitter_ms = 0.0;     // uniform extra delay in [0, jitter_ms] (reorders)
-    double reorder = 0.0;       // probability that a datagram is held back by reorder_ms more
+    double delay_ms = 0.0;   // one-way delay
+    double jitter_ms = 0.0;  // uniform extra delay in [0, jitter_ms] (reorders)
+    double reorder = 0.0;    // probability that a datagram is held back by reorder_ms more
     double reorder_ms = 5.0;
-    double bandwidth_kbps = 0.0;  // 0 = unlimited; else serialised at this rate
+    double bandwidth_kbps = 0.0;           // 0 = unlimited; else serialised at this rate
     std::size_t queue_bytes = 256 * 1024;  // bottleneck queue; tail drop beyond it
     uint64_t seed = 1;
 };
 
 struct FaultStats {
-    std::size_t submitted = 0, delivered = 0, lost_random = 0, lost_burst = 0, lost_queue = 0, reordered = 0;
+    std::size_t submitted = 0, delivered = 0, lost_random = 0, lost_burst = 0, lost_queue = 0,
+                reordered = 0;
 };
 
 class FaultInjector {

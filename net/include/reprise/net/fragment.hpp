@@ -26,13 +26,13 @@ std::size_t fragment_packet(std::span<const uint8_t> packet, uint32_t frame, int
                             const FecOptions& options, std::vector<std::vector<uint8_t>>& messages);
 
 struct ReassemblerOptions {
-    int slots = 4;                               // packets being reassembled at once
+    int slots = 4;  // packets being reassembled at once
     std::size_t max_packet_bytes = kMaxPacketBytes;
 };
 
 struct ReassemblyStats {
     std::size_t fragments = 0;
-    std::size_t recovered = 0;     // data fragments rebuilt from parity
+    std::size_t recovered = 0;  // data fragments rebuilt from parity
     std::size_t duplicates = 0;
     std::size_t stale = 0;         // for packets already delivered or given up
     std::size_t inconsistent = 0;  // disagreeing with earlier fragments of the same frame
@@ -68,11 +68,11 @@ private:
         uint32_t total = 0;
         uint16_t count = 0;
         uint8_t group = 0;
-        std::size_t payload = 0;   // bytes per data fragment (all but the last are full)
+        std::size_t payload = 0;  // bytes per data fragment (all but the last are full)
         int64_t pose_time_us = 0;
-        std::vector<uint8_t> data;      // count * payload bytes
-        std::vector<uint8_t> parity;    // groups * payload bytes
-        std::vector<uint8_t> have;      // per data fragment
+        std::vector<uint8_t> data;    // count * payload bytes
+        std::vector<uint8_t> parity;  // groups * payload bytes
+        std::vector<uint8_t> have;    // per data fragment
         std::vector<uint8_t> have_parity;
         std::size_t received = 0;
     };

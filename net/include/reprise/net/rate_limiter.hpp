@@ -8,11 +8,11 @@
 namespace reprise::net {
 
 struct RateLimitOptions {
-    double per_second = 20.0;      // all sources together
+    double per_second = 20.0;  // all sources together
     double burst = 20.0;
     double per_source_per_second = 2.0;
     double per_source_burst = 5.0;
-    std::size_t sources = 256;     // addresses remembered
+    std::size_t sources = 256;  // addresses remembered
 };
 
 class HandshakeRateLimiter {

@@ -38,8 +38,8 @@ public:
     // Builds the ClientHello (kClientHelloSize bytes) for a new random connection id.
     void start(const std::string& secret, std::vector<uint8_t>& hello);
     // Checks the ServerHello's key confirmation; on success writes the ClientFinish and the keys.
-    [[nodiscard]] Status finish(std::span<const uint8_t> server_hello, std::vector<uint8_t>& client_finish,
-                                SessionKeys& keys);
+    [[nodiscard]] Status finish(std::span<const uint8_t> server_hello,
+                                std::vector<uint8_t>& client_finish, SessionKeys& keys);
     uint64_t connection() const { return connection_; }
     ~ClientHandshake();
 
@@ -54,8 +54,10 @@ struct PendingHandshake {
     Key client_confirm{};  // the tag the client must send
     SessionKeys keys;
 };
-[[nodiscard]] Status answer_client_hello(const std::string& secret, std::span<const uint8_t> client_hello,
-                                         std::vector<uint8_t>& server_hello, PendingHandshake& pending);
+[[nodiscard]] Status answer_client_hello(const std::string& secret,
+                                         std::span<const uint8_t> client_hello,
+                                         std::vector<uint8_t>& server_hello,
+                                         PendingHandshake& pending);
 // True when `client_finish` carries the expected confirmation (constant-time compare).
 [[nodiscard]] Status check_client_finish(const PendingHandshake& pending,
                                          std::span<const uint8_t> client_finish);

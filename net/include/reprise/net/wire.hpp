@@ -17,13 +17,18 @@ namespace reprise::net {
 constexpr uint8_t kMagic0 = 'R', kMagic1 = 'P';
 constexpr uint8_t kProtocolVersion = 1;
 constexpr std::size_t kMaxDatagram = 1200;
-constexpr std::size_t kHeaderSize = 12;           // magic, version, type, connection id
-constexpr std::size_t kSealedHeaderSize = 20;     // + u64 sequence number
+constexpr std::size_t kHeaderSize = 12;        // magic, version, type, connection id
+constexpr std::size_t kSealedHeaderSize = 20;  // + u64 sequence number
 constexpr std::size_t kAeadTagSize = 16;
 constexpr std::size_t kMaxPlaintext = kMaxDatagram - kSealedHeaderSize - kAeadTagSize;  // 1164
 constexpr std::size_t kMaxSceneName = 32;
 
-enum class DatagramType : uint8_t { ClientHello = 1, ServerHello = 2, ClientFinish = 3, Sealed = 4 };
+enum class DatagramType : uint8_t {
+    ClientHello = 1,
+    ServerHello = 2,
+    ClientFinish = 3,
+    Sealed = 4
+};
 
 struct DatagramHeader {
     DatagramType type = DatagramType::Sealed;
@@ -75,17 +80,17 @@ struct ReceiverReportMessage {
     uint32_t rtt_us = 0;    // newest measured pose round trip (pose sampled -> frame decoded)
 };
 enum class FragmentKind : uint8_t { Data = 0, Parity = 1 };
-constexpr std::size_t kFragmentHeaderSize = 1 + 4 + 4 + 2 + 2 + 2 + 1 + 1 + 8;  // 25
+constexpr std::size_t kFragmentHeaderSize = 1 + 4 + 4 + 2 + 2 + 2 + 1 + 1 + 8;    // 25
 constexpr std::size_t kMaxFragmentPayload = kMaxPlaintext - kFragmentHeaderSize;  // 1141
 struct FragmentMessage {
-    uint32_t frame = 0;         // codec frame number
-    uint32_t total_size = 0;    // bytes of the whole codec packet
-    uint16_t index = 0;         // data: fragment index; parity: group index
-    uint16_t data_count = 0;    // data fragments of the packet
-    uint16_t fragment_size = 0; // payload bytes of every data fragment but the last, and of parity
-    uint8_t group_size = 0;     // data fragments per parity group (0: no parity)
+    uint32_t frame = 0;          // codec frame number
+    uint32_t total_size = 0;     // bytes of the whole codec packet
+    uint16_t index = 0;          // data: fragment index; parity: group index
+    uint16_t data_count = 0;     // data fragments of the packet
+    uint16_t fragment_size = 0;  // payload bytes of every data fragment but the last, and of parity
+    uint8_t group_size = 0;      // data fragments per parity group (0: no parity)
     FragmentKind kind = FragmentKind::Data;
-    int64_t pose_time_us = 0;   // echo of the pose this frame was rendered from
+    int64_t pose_time_us = 0;  // echo of the pose this frame was rendered from
     std::span<const uint8_t> payload;
 };
 
@@ -94,7 +99,10 @@ class Writer {
 public:
     explicit Writer(std::span<uint8_t> out) : out_(out) {}
     void u8(uint8_t v) { put(&v, 1); }
-    void u16(uint16_t v) { uint8_t b[2] = {uint8_t(v), uint8_t(v >> 8)}; put(b, 2); }
+    void u16(uint16_t v) {
+        uint8_t b[2] = {uint8_t(v), uint8_t(v >> 8)};
+        put(b, 2);
+    }
     void u32(uint32_t v) {
         uint8_t b[4];
         for (int i = 0; i < 4; ++i) b[i] = uint8_t(v >> (8 * i));
@@ -105,8 +113,16 @@ public:
         for (int i = 0; i < 8; ++i) b[i] = uint8_t(v >> (8 * i));
         put(b, 8);
     }
-    void f32(float v) { uint32_t u; std::memcpy(&u, &v, 4); u32(u); }
-    void f64(double v) { uint64_t u; std::memcpy(&u, &v, 8); u64(u); }
+    void f32(float v) {
+        uint32_t u;
+        std::memcpy(&u, &v, 4);
+        u32(u);
+    }
+    void f64(double v) {
+        uint64_t u;
+        std::memcpy(&u, &v, 8);
+        u64(u);
+    }
     void bytes(std::span<const uint8_t> b) { put(b.data(), b.size()); }
     std::size_t size() const { return pos_; }
     uint8_t* end() { return out_.data() + pos_; }

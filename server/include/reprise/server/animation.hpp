@@ -7,8 +7,8 @@
 namespace reprise::server {
 
 struct Pose {
-    std::vector<glm::mat4> world;               // per node, local -> world
-    std::vector<std::vector<float>> weights;    // per node, morph weights of its mesh
+    std::vector<glm::mat4> world;             // per node, local -> world
+    std::vector<std::vector<float>> weights;  // per node, morph weights of its mesh
 };
 
 // Animations play together and loop over the longest one's duration.

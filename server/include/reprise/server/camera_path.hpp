@@ -11,15 +11,15 @@ enum class CameraMotion { Static, Orbit, Pan, Dolly, Shake, Cut, Gltf };
 
 struct CameraPath {
     CameraMotion motion = CameraMotion::Orbit;
-    glm::vec3 target{0.0f};         // looked-at point (orbit, shake, cut)
+    glm::vec3 target{0.0f};           // looked-at point (orbit, shake, cut)
     glm::vec3 eye{0.0f, 2.0f, 8.0f};  // start position (static, pan, dolly) and orbit radius/height
-    float speed = 0.3f;             // orbit: rad/s; pan, dolly: scene units/s
+    float speed = 0.3f;               // orbit: rad/s; pan, dolly: scene units/s
     glm::vec3 direction{1.0f, 0.0f, 0.0f};  // pan/dolly direction of travel
-    float shake = 0.01f;            // handheld: rotation amplitude, radians
-    float cut_time = 1.0f;          // cut: seconds at which the second shot starts
-    float cut_angle = 2.0f;         // cut: orbit angle of the second shot, radians
-    int gltf_node = -1;             // Gltf: the node holding the camera
-    CameraModel model;              // projection
+    float shake = 0.01f;                    // handheld: rotation amplitude, radians
+    float cut_time = 1.0f;                  // cut: seconds at which the second shot starts
+    float cut_angle = 2.0f;                 // cut: orbit angle of the second shot, radians
+    int gltf_node = -1;                     // Gltf: the node holding the camera
+    CameraModel model;                      // projection
 };
 
 // "orbit", "pan:speed=2", "dolly:speed=1.5", "shake", "cut:time=0.5", "static", "gltf[:N]",

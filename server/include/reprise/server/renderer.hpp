@@ -40,7 +40,7 @@ enum class Refresh {
 struct ReuseSettings {
     Reuse mode = Reuse::Off;
     Refresh refresh = Refresh::Blocks;
-    int period = 4;                   // every covered pixel is reshaded at least this often (1..255)
+    int period = 4;  // every covered pixel is reshaded at least this often (1..255)
     float threshold = 8.0f / 255.0f;  // Adaptive: allowed change per display channel
     int filter_radius = 1;            // Adaptive: spatial max filter of gradients, (2r+1)^2 (0..3)
     // Hit test: bilinear depth within this many steps of a 24-bit Z-buffer (Nehab's ε is one
@@ -56,18 +56,19 @@ struct RenderSettings {
     int height = 360;
     Shading shading = Shading::Lit;
     ReuseSettings reuse;
-    int heavy_octaves = 8;     // per noise layer (three layers)
-    int heavy_pcf_radius = 5;  // (2r+1)^2 shadow-map comparisons
+    int heavy_octaves = 8;          // per noise layer (three layers)
+    int heavy_pcf_radius = 5;       // (2r+1)^2 shadow-map comparisons
     float texture_lod_bias = 0.0f;  // added to the texture level of detail (negative: sharper)
 };
 
 // What reuse did in the last frame rendered with Shading::Heavy.
 struct ReuseStats {
-    int64_t covered = 0;    // pixels with geometry
-    int64_t hits = 0;       // covered pixels whose reprojection passed the depth and id test
-    int64_t reused = 0;     // hits that reused the cache (not reshaded)
-    int64_t shaded = 0;     // covered pixels that ran the expensive term
-    double shading_ms = 0;      // depth pre-pass and shading passes to glFinish (no shadow map, no read-back)
+    int64_t covered = 0;  // pixels with geometry
+    int64_t hits = 0;     // covered pixels whose reprojection passed the depth and id test
+    int64_t reused = 0;   // hits that reused the cache (not reshaded)
+    int64_t shaded = 0;   // covered pixels that ran the expensive term
+    double shading_ms =
+        0;  // depth pre-pass and shading passes to glFinish (no shadow map, no read-back)
     double shading_cpu_ms = 0;  // the same pass in CPU time of the whole process (software GL)
     double hit_rate() const { return covered ? double(hits) / double(covered) : 0.0; }
     double shaded_fraction() const { return covered ? double(shaded) / double(covered) : 0.0; }
@@ -125,8 +126,8 @@ public:
     Status render_frame(const Scene& scene, const CameraPath& path, int index, double fps,
                         const RenderSettings& settings, Frame& frame);
 
-    // Frame `index` as render_frame() at full resolution, unjittered, plus its colour at 1/factor of
-    // the pixels with lowres_jitter(index) into `low_color` (texture level of detail biased
+    // Frame `index` as render_frame() at full resolution, unjittered, plus its colour at 1/factor
+    // of the pixels with lowres_jitter(index) into `low_color` (texture level of detail biased
     // towards the full resolution's, so low samples about equal full-resolution ones). `jitter`
     // receives the jitter used, in full-resolution pixels.
     Status render_frame_lowres(const Scene& scene, const CameraPath& path, int index, double fps,

@@ -22,11 +22,11 @@ struct Texture {
 };
 
 struct Material {
-    glm::vec4 base_color{1.0f};      // linear RGBA factor
-    int base_color_texture = -1;     // index into Scene::textures
-    int texcoord = 0;                // which UV set the texture uses (0 or 1)
-    float specular = 0.25f;          // strength of the view-dependent highlight
-    float shininess = 48.0f;         // Blinn-Phong exponent
+    glm::vec4 base_color{1.0f};   // linear RGBA factor
+    int base_color_texture = -1;  // index into Scene::textures
+    int texcoord = 0;             // which UV set the texture uses (0 or 1)
+    float specular = 0.25f;       // strength of the view-dependent highlight
+    float shininess = 48.0f;      // Blinn-Phong exponent
     bool double_sided = false;
 };
 
@@ -37,13 +37,13 @@ struct MorphTarget {
 
 struct Primitive {
     std::vector<glm::vec3> positions;
-    std::vector<glm::vec3> normals;       // empty: computed flat by the renderer
-    std::vector<glm::vec2> uv0, uv1;      // empty or one per vertex
-    std::vector<glm::u16vec4> joints;     // skinning, empty or one per vertex
+    std::vector<glm::vec3> normals;    // empty: computed flat by the renderer
+    std::vector<glm::vec2> uv0, uv1;   // empty or one per vertex
+    std::vector<glm::u16vec4> joints;  // skinning, empty or one per vertex
     std::vector<glm::vec4> weights;
     std::vector<MorphTarget> targets;
-    std::vector<uint32_t> indices;        // triangle list, each < positions.size()
-    int material = -1;                    // -1: default material
+    std::vector<uint32_t> indices;  // triangle list, each < positions.size()
+    int material = -1;              // -1: default material
 };
 
 struct Mesh {
@@ -53,8 +53,8 @@ struct Mesh {
 };
 
 struct Skin {
-    std::vector<int> joints;               // node indices
-    std::vector<glm::mat4> inverse_bind;   // one per joint
+    std::vector<int> joints;              // node indices
+    std::vector<glm::mat4> inverse_bind;  // one per joint
 };
 
 struct Node {
@@ -63,13 +63,13 @@ struct Node {
     glm::vec3 translation{0.0f};
     glm::quat rotation{1.0f, 0.0f, 0.0f, 0.0f};  // w, x, y, z
     glm::vec3 scale{1.0f};
-    glm::mat4 matrix{1.0f};        // used instead of TRS when has_matrix
+    glm::mat4 matrix{1.0f};  // used instead of TRS when has_matrix
     bool has_matrix = false;
     int mesh = -1;
     int skin = -1;
     int camera = -1;
-    std::vector<float> weights;    // morph weights overriding the mesh's
-    uint32_t object_id = 0;        // written to the id buffer; 0 = the renderer numbers it
+    std::vector<float> weights;  // morph weights overriding the mesh's
+    uint32_t object_id = 0;      // written to the id buffer; 0 = the renderer numbers it
 };
 
 enum class Interpolation { Linear, Step, CubicSpline };
@@ -79,7 +79,7 @@ struct AnimationChannel {
     int node = -1;
     AnimatedPath path = AnimatedPath::Translation;
     Interpolation interpolation = Interpolation::Linear;
-    std::vector<float> times;   // strictly increasing, finite
+    std::vector<float> times;  // strictly increasing, finite
     // Keyframe values, flattened: per key `components` floats (3 T/S, 4 rotation xyzw,
     // number of morph targets for weights); CubicSpline stores in-tangent, value, out-tangent.
     std::vector<float> values;
@@ -93,11 +93,11 @@ struct Animation {
 
 struct CameraModel {
     bool perspective = true;
-    float yfov = 0.8f;          // radians, perspective
-    float aspect = 0.0f;        // 0: from the image size
+    float yfov = 0.8f;               // radians, perspective
+    float aspect = 0.0f;             // 0: from the image size
     float xmag = 1.0f, ymag = 1.0f;  // orthographic half extents
     float znear = 0.1f;
-    float zfar = 1000.0f;       // perspective may use an infinite far plane (0)
+    float zfar = 1000.0f;  // perspective may use an infinite far plane (0)
 };
 
 struct Light {
@@ -115,7 +115,7 @@ struct PointLight {
 struct Scene {
     std::string name;
     std::vector<Node> nodes;
-    std::vector<int> roots;          // nodes drawn, with their descendants
+    std::vector<int> roots;  // nodes drawn, with their descendants
     std::vector<Mesh> meshes;
     std::vector<Material> materials;
     std::vector<Texture> textures;

@@ -18,9 +18,9 @@
 namespace reprise::server {
 
 struct StreamServerOptions {
-    std::string scene = "pan";     // served when the client names none (a built-in name or a file)
+    std::string scene = "pan";  // served when the client names none (a built-in name or a file)
     net::Endpoint listen{0x7f000001u, 0};
-    std::string secret;            // PIN or token, 1..255 bytes
+    std::string secret;  // PIN or token, 1..255 bytes
     double fps = 30.0;
     int width = 640, height = 360;
     // LowRes (Pajak et al. 2011): colour rendered at 1/lowres_factor of the pixels with a per-frame
@@ -28,9 +28,10 @@ struct StreamServerOptions {
     net::StreamMode mode = net::StreamMode::Full;
     int lowres_factor = 4;  // 2 or 4
     int max_sessions = 4;
-    bool loopback_only = false;    // refuse a non-loopback listen address (tests)
+    bool loopback_only = false;  // refuse a non-loopback listen address (tests)
     // Depth within 0.1 % (relative) is plenty for reprojection and costs a fifth of lossless.
-    codec::EncoderOptions encoder{.qp = 28, .depth = codec::DepthMode::Bounded, .depth_error = 1e-3f};
+    codec::EncoderOptions encoder{
+        .qp = 28, .depth = codec::DepthMode::Bounded, .depth_error = 1e-3f};
     // Bitrate adaptation: > 0 starts rate control there and moves it within [min, max] by the
     // client's loss reports; 0 keeps constant quality (encoder.qp).
     int bitrate_kbps = 0, min_bitrate_kbps = 100, max_bitrate_kbps = 50000;
@@ -46,14 +47,14 @@ struct StreamServerStats {
     std::size_t sessions = 0;
     std::size_t sessions_total = 0;
     std::size_t handshakes_ok = 0, handshakes_failed = 0, handshakes_rate_limited = 0;
-    std::size_t dropped_datagrams = 0;   // garbage, truncated, oversized, unauthenticated, replayed
+    std::size_t dropped_datagrams = 0;  // garbage, truncated, oversized, unauthenticated, replayed
     std::size_t frames_sent = 0, frames_skipped = 0;
     std::size_t datagrams_sent = 0, bytes_sent = 0;
     std::size_t loss_reports = 0, key_frame_requests = 0, acks = 0;
-    std::size_t max_queue_bytes = 0;    // largest send queue of any session
+    std::size_t max_queue_bytes = 0;  // largest send queue of any session
     double encode_ms_total = 0.0, render_ms_total = 0.0;
-    double loss = 0.0;                  // newest reported media loss fraction (any session)
-    int bitrate_kbps = 0;               // newest target of the last session adapted
+    double loss = 0.0;     // newest reported media loss fraction (any session)
+    int bitrate_kbps = 0;  // newest target of the last session adapted
 };
 
 class StreamServer {

@@ -15,8 +15,8 @@ enum class Rig {
 };
 
 struct StereoRig {
-    float ipd = 0.064f;          // eye separation, scene units
-    float convergence = 10.0f;   // zero-disparity distance (OffAxis), scene units
+    float ipd = 0.064f;         // eye separation, scene units
+    float convergence = 10.0f;  // zero-disparity distance (OffAxis), scene units
     Rig rig = Rig::Parallel;
 };
 

@@ -40,19 +40,18 @@ struct StereoStats {
 
 // Sizes its scratch on the first frame and reuses it while the size stays the same.
 class StereoSynthesizer {
-  public:
+public:
     // Makes the view of `target` from `rendered` (colour + depth + camera) into out.color,
-    // out.depth and out.camera (out.motion, normal and id are cleared; out.fps is left as it is). Displacements are
-    // exact for static geometry: each pixel is unprojected with the rendered camera and
-    // projected with the target (background +inf by its direction). `history` (may be null),
-    // an earlier view with colour, depth and camera, e.g. the previous frame's other eye, is
+    // out.depth and out.camera (out.motion, normal and id are cleared; out.fps is left as it is).
+    // Displacements are exact for static geometry: each pixel is unprojected with the rendered
+    // camera and projected with the target (background +inf by its direction). `history` (may be
+    // null), an earlier view with colour, depth and camera, e.g. the previous frame's other eye, is
     // warped to the target the same way and fills the holes first. When the rendered frame's
     // motion is all zero (still camera and scene) and the history's camera is the target, the
     // history is already the target view and is returned as it is. Cameras without jitter;
     // projections perspective or orthographic without skew.
     StereoStats synthesize(const GBufferView& rendered, const Camera& target, Frame& out,
-                           const StereoOptions& options = {},
-                           const GBufferView* history = nullptr);
+                           const StereoOptions& options = {}, const GBufferView* history = nullptr);
     StereoStats synthesize(const GBufferView& rendered, const Camera& target, Frame& out,
                            const StereoOptions& options, const Frame* history) {
         const GBufferView h = history ? history->view() : GBufferView{};
@@ -62,7 +61,7 @@ class StereoSynthesizer {
     // 1 where the last synthesis covered the pixel from the rendered eye (size of the output).
     ImageView<const uint8_t> coverage() const { return covered_.view(); }
 
-  private:
+private:
     // Warps `source` to `target` into `into`; returns the covered pixel count (cells in `cells`).
     std::size_t warp_into(const GBufferView& source, const Camera& target, const StereoOptions& o,
                           const warp::WarpTarget& into, std::size_t& cells);

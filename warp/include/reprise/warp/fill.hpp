@@ -60,7 +60,7 @@ public:
                    ImageView<const float> depth = {}, int max_passes = 64);
 
 private:
-    Image<uint8_t> state_;     // 0 hole, 1 valid on entry, 2 filled by an earlier pass
+    Image<uint8_t> state_;       // 0 hole, 1 valid on entry, 2 filled by an earlier pass
     Image<uint16_t> up_, down_;  // holes: distance to the nearest valid pixel; valid: run length
     Image<float> filled_depth_;
 };

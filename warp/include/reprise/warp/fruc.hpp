@@ -43,10 +43,10 @@ struct FrucOptions {
 // What was done and what was left out because the frame did not need it.
 struct FrucCounters {
     std::size_t inputs = 0;
-    std::size_t outputs = 0;          // frames made (inputs passed through are not counted)
-    std::size_t copied_still = 0;     // zero motion: exact copy, nothing warped
-    std::size_t fills = 0;            // frames whose holes were filled
-    std::size_t fills_skipped = 0;    // no holes: no fill
+    std::size_t outputs = 0;        // frames made (inputs passed through are not counted)
+    std::size_t copied_still = 0;   // zero motion: exact copy, nothing warped
+    std::size_t fills = 0;          // frames whose holes were filled
+    std::size_t fills_skipped = 0;  // no holes: no fill
     std::size_t hole_pixels = 0;
     std::size_t dynamic_layers = 0;   // extrapolation: frames with moving objects drawn on top
     std::size_t dynamic_skipped = 0;  // no dynamic pixels: no dynamic layer

@@ -45,7 +45,7 @@ struct GridStats {
 // hairline cracks. Cells with a vertex further than 2^20 pixels away are dropped, and so is motion
 // of 1e30 px or more. Same pixel coordinates in source and target, whose sizes may differ.
 class GridWarper {
-  public:
+public:
     GridStats warp(const GBufferView& source, float factor, const WarpTarget& target,
                    const GridOptions& options = {});
     // The single-threaded scalar reference.
@@ -59,7 +59,7 @@ class GridWarper {
 
     struct State;  // cells and per-thread scratch (grid_internal.hpp)
 
-  private:
+private:
     GridStats run(const GBufferView& source, float factor, const WarpTarget& target,
                   const GridOptions& options, bool threaded);
     std::unique_ptr<State> state_;

@@ -24,7 +24,9 @@ struct ConstPayload {
     int height = 0;
     int channels = 0;
     std::ptrdiff_t stride = 0;
-    const float* pixel(int x, int y) const { return data + y * stride + std::ptrdiff_t(x) * channels; }
+    const float* pixel(int x, int y) const {
+        return data + y * stride + std::ptrdiff_t(x) * channels;
+    }
 };
 ConstPayload payload_of(ImageView<const glm::vec4> rgba);
 Payload payload_of(ImageView<glm::vec4> rgba);
@@ -51,11 +53,11 @@ struct ReprojectOptions {
 
 struct ReprojectCounts {
     std::size_t hits = 0;
-    std::size_t offscreen = 0;   // p + motion outside the previous image
-    std::size_t behind = 0;      // the point was behind the previous camera (w <= 0)
-    std::size_t occluded = 0;    // depth test failed
-    std::size_t other_id = 0;    // id test failed
-    std::size_t invalid = 0;     // NaN/Inf in motion, depth or the fetched payload
+    std::size_t offscreen = 0;  // p + motion outside the previous image
+    std::size_t behind = 0;     // the point was behind the previous camera (w <= 0)
+    std::size_t occluded = 0;   // depth test failed
+    std::size_t other_id = 0;   // id test failed
+    std::size_t invalid = 0;    // NaN/Inf in motion, depth or the fetched payload
     std::size_t misses() const { return offscreen + behind + occluded + other_id + invalid; }
     bool operator==(const ReprojectCounts&) const = default;
 };
@@ -69,7 +71,8 @@ struct ReprojectCounts {
 // copies exactly. A camera whose projection is neither perspective nor orthographic (last row
 // with x/y terms) or not invertible makes every non-background pixel invalid.
 ReprojectCounts reproject(const GBufferView& current, const GBufferView& previous,
-                          ConstPayload previous_payload, Payload out, ImageView<uint8_t> hit, const ReprojectOptions& options = {});
+                          ConstPayload previous_payload, Payload out, ImageView<uint8_t> hit,
+                          const ReprojectOptions& options = {});
 // The scalar single-threaded reference of the same function (tests compare the two).
 ReprojectCounts reproject_reference(const GBufferView& current, const GBufferView& previous,
                                     ConstPayload previous_payload, Payload out,

@@ -77,7 +77,8 @@ T bicubic_fetch(ImageView<const T> image, float x, float y) {
                 const float* row = &(image.row(y0 + j) + x0)->x;
                 __m128 line = _mm_setzero_ps();
                 for (int i = 0; i < 4; ++i)
-                    line = _mm_add_ps(line, _mm_mul_ps(_mm_set1_ps(wx[i]), _mm_loadu_ps(row + 4 * i)));
+                    line =
+                        _mm_add_ps(line, _mm_mul_ps(_mm_set1_ps(wx[i]), _mm_loadu_ps(row + 4 * i)));
                 acc = _mm_add_ps(acc, _mm_mul_ps(_mm_set1_ps(wy[j]), line));
             }
             _mm_storeu_ps(&sum.x, acc);

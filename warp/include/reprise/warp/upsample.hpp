@@ -74,7 +74,7 @@ struct UpsampleStats {
 };
 
 class SpatioTemporalUpsampler {
-  public:
+public:
     explicit SpatioTemporalUpsampler(UpsampleOptions options = {});
 
     // `low_color`: linear RGBA at lw x lh (see above), rendered with `jitter_px` (full-resolution
@@ -93,7 +93,7 @@ class SpatioTemporalUpsampler {
 
     const UpsampleOptions& options() const { return options_; }
 
-  private:
+private:
     UpsampleOptions options_;
     // History, double-buffered (read at p + motion while the next one is written).
     Image<glm::vec4> history_, next_history_;  // h_r rgb, a = h_w
