@@ -40,12 +40,44 @@ const char* const kHeldOut[] = {"2CylinderEngine-glTF-Binary/2CylinderEngine.glb
                                 "glTF-Sample-Models/AnimatedMorphCube-glTF/AnimatedMorphCube.gltf",
                                 "BoxTextured-glTF-Binary/BoxTextured.glb"};
 
-bool is_held_out(const std::string& scene) { return scene.rfind(kHeldOutDir, 0) == 0; }
+// Sequence folders given by --in are listed as "in:DIR".
+const char* const kSequencePrefix = "in:";
 
-// The --scenes list with `held-out` expanded; empty = every built-in scene and the held-out ones.
-std::vector<std::string> scene_list(const std::string& spec) {
+bool is_sequence(const std::string& scene) { return scene.rfind(kSequencePrefix, 0) == 0; }
+bool is_held_out(const std::string& scene) {
+    return scene.rfind(kHeldOutDir, 0) == 0 || is_sequence(scene);
+}
+
+bool holds_exr(const fs::path& dir) {
+    std::error_code ec;
+    for (const fs::directory_entry& e : fs::directory_iterator(dir, ec))
+        if (e.path().extension() == ".exr") return true;
+    return false;
+}
+bool holds_sequence(const fs::path& dir) { return holds_exr(dir / "input"); }
+
+// Each --in folder holds a sequence (input/, truth/) or folders that do.
+std::vector<std::string> sequence_list(const std::string& spec) {
+    std::vector<std::string> sequences;
+    for (const std::string& dir : split_list(spec)) {
+        std::error_code ec;
+        std::vector<std::string> inner;
+        if (!holds_sequence(dir))
+            for (const fs::directory_entry& e : fs::directory_iterator(dir, ec))
+                if (e.is_directory() && holds_sequence(e.path()))
+                    inner.push_back(e.path().string());
+        std::sort(inner.begin(), inner.end(), natural_less);
+        if (inner.empty()) inner.push_back(dir);  // read_scene names what is missing
+        for (const std::string& d : inner) sequences.push_back(kSequencePrefix + d);
+    }
+    return sequences;
+}
+
+// The --scenes list with `held-out` expanded, then the --in sequences; with neither, every
+// built-in scene and the held-out ones.
+std::vector<std::string> scene_list(const std::string& spec, const std::string& in) {
     std::vector<std::string> given = split_list(spec), scenes;
-    if (given.empty()) {
+    if (given.empty() && in.empty()) {
         for (const server::SceneInfo& s : server::builtin_scenes()) scenes.push_back(s.name);
         given = {"held-out"};
     }
@@ -58,6 +90,7 @@ std::vector<std::string> scene_list(const std::string& spec) {
             if (fs::exists(std::string(kHeldOutDir) + model))
                 scenes.push_back(std::string(kHeldOutDir) + model);
     }
+    for (const std::string& sequence : sequence_list(in)) scenes.push_back(sequence);
     return scenes;
 }
 
@@ -178,6 +211,48 @@ Status render_scene(server::Renderer& renderer, const std::string& scene_name, i
         reprise::to_display(truth.color.view(), out.truth[j].view());
         std::fprintf(stderr, "\r[fruc] %s: rendering truth %d/%d   ", out.name.c_str(), j,
                      out.last());
+    }
+    std::fprintf(stderr, "\n");
+    return {};
+}
+
+// A sequence folder as `--exr` writes it (and scripts/blender-scenes): DIR/input at 30 Hz,
+// DIR/truth at 30 K Hz over the same time; up to `frames` inputs.
+Status read_scene(const std::string& dir, int frames, int factor, SceneFrames& out) {
+    Sequence inputs, truths;
+    REPRISE_TRY(open_sequence(dir + "/input", inputs));
+    REPRISE_TRY(open_sequence(dir + "/truth", truths));
+    const int n =
+        std::min({frames, int(inputs.files.size()), (int(truths.files.size()) - 1) / factor + 1});
+    if (n < 2)
+        return Status::error(dir + ": " + std::to_string(inputs.files.size()) + " input and " +
+                             std::to_string(truths.files.size()) + " truth frames; x" +
+                             std::to_string(factor) + " needs 2 and " + std::to_string(factor + 1));
+    out.factor = factor;
+    out.input.resize(n);
+    out.input_shown.resize(n);
+    auto same_size = [&](const Frame& f, const std::string& path) {
+        return f.width() == out.input[0].width() && f.height() == out.input[0].height()
+                   ? Status()
+                   : Status::error(path + ": size differs from " + inputs.files[0]);
+    };
+    for (int i = 0; i < n; ++i) {
+        std::fprintf(stderr, "\r[fruc] %s: reading input %d/%d   ", out.name.c_str(), i + 1, n);
+        REPRISE_TRY(read_frame(inputs.files[i], out.input[i]));
+        REPRISE_TRY(same_size(out.input[i], inputs.files[i]));
+        out.input_shown[i].resize(out.input[i].width(), out.input[i].height());
+        visualize_color(out.input[i].color.view(), out.input_shown[i].view());
+    }
+    out.truth.assign(out.last() + 1, {});
+    Frame truth;
+    for (int j = 0; j <= out.last(); ++j) {
+        if (!out.scored(j)) continue;
+        std::fprintf(stderr, "\r[fruc] %s: reading truth %d/%d   ", out.name.c_str(), j,
+                     out.last());
+        REPRISE_TRY(read_frame(truths.files[j], truth));
+        REPRISE_TRY(same_size(truth, truths.files[j]));
+        out.truth[j].resize(truth.width(), truth.height());
+        reprise::to_display(truth.color.view(), out.truth[j].view());
     }
     std::fprintf(stderr, "\n");
     return {};
@@ -384,7 +459,7 @@ Status bench_fruc(const BenchOptions& job) {
         return Status::error("bench fruc: --repeat must be in 1..100");
     int w = 0, h = 0;
     REPRISE_TRY(parse_size(job.size, w, h));
-    const std::vector<std::string> scenes = scene_list(job.scenes);
+    const std::vector<std::string> scenes = scene_list(job.scenes, job.in);
     const std::string out_dir = job.out.empty() ? "out/bench-fruc" : job.out;
     std::error_code ec;
     fs::create_directories(out_dir, ec);
@@ -426,7 +501,7 @@ Status bench_fruc(const BenchOptions& job) {
         "cv::inpaint (Telea) of its holes. rendered-vectors: the plain use of the rendered motion "
         "anyone could write (both frames splatted one pixel each along their vectors, nearest "
         "wins, blended on the same surface, holes by Telea). Scenes marked (held) are glTF "
-        "sample models no default was tuned on.",
+        "sample models or sequence folders (--in) no default was tuned on.",
         thread_count(), job.repeat);
     report.paragraphs.push_back(text);
     std::vector<SceneSummary> summaries;
@@ -434,12 +509,16 @@ Status bench_fruc(const BenchOptions& job) {
     Status failure;
     for (const std::string& scene_name : scenes) {
         SceneFrames scene;
-        scene.name = fs::path(scene_name).stem().string();
+        const std::string source = is_sequence(scene_name) ? scene_name.substr(3) : scene_name;
+        scene.name = fs::path(source).filename().string();
+        if (!is_sequence(scene_name)) scene.name = fs::path(source).stem().string();
         const std::string scene_dir = out_dir + "/" + scene.name;
         fs::create_directories(scene_dir, ec);
         if (ec) return Status::error(scene_dir + ": cannot create the folder: " + ec.message());
-        failure = render_scene(*renderer, scene_name, job.frames, job.factor, w, h,
-                               job.exr ? scene_dir : std::string(), scene);
+        failure = is_sequence(scene_name)
+                      ? read_scene(source, job.frames, job.factor, scene)
+                      : render_scene(*renderer, scene_name, job.frames, job.factor, w, h,
+                                     job.exr ? scene_dir : std::string(), scene);
         if (!failure.ok()) break;
 
         std::vector<Run> runs;
@@ -480,7 +559,10 @@ Status bench_fruc(const BenchOptions& job) {
             if (scene_name == info.name) section.note = info.stresses;
         if (is_held_out(scene_name))
             section.note =
-                "held out: a glTF sample model no default was tuned on (" + scene_name + ")";
+                is_sequence(scene_name)
+                    ? "held out: a sequence folder (" + source + "): input/ at 30 Hz, truth/ at " +
+                          std::to_string(30 * job.factor) + " Hz"
+                    : "held out: a glTF sample model no default was tuned on (" + scene_name + ")";
         for (const Run& run : runs) {
             for (const Score& s : run.scores)
                 csv.error_row(scene.name, run.method, run.setting, s.frame, s.error, s.ms);

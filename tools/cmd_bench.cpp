@@ -168,7 +168,11 @@ int command_bench(int argc, char** argv) {
               "fruc: a few settings only (grid+pullpush, reverse+pullpush, splat+none, ...)");
     args.option("--repeat", &job.repeat,
                 "fruc, stereo, upsample: timed runs, each frame's fastest counts (default 3)");
-    args.option("--in", &job.in, "codec: also a sequence folder (EXR frames, up to --frames)");
+    args.option("--in", &job.in,
+                "codec: also a sequence folder (EXR frames, up to --frames); fruc: comma-separated "
+                "sequence folders (input/ at 30 Hz, truth/ at 30 K Hz, as --exr writes them) or "
+                "folders of them (scripts/blender-scenes), held out; alone unless --scenes is "
+                "given too");
     args.option("--threads", &job.threads, "codec: threads per codec (default 2)");
     args.option("--qps", &job.qps, "codec: reprise's qp rate points (default 22,28,34,40)");
     args.option("--speed-size", &job.speed_size,

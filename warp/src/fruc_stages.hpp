@@ -79,7 +79,7 @@ std::size_t motion_toward(const GBufferView& f, const Camera& to, float factor,
 
 // The later frame's moving pixels splatted to where they were in the earlier frame, carrying
 // their backward motion (nearest wins; NaN where none lands): the earlier frame's true forward
-// motion is its negation.
+// motion is its negation. Without a camera on b every pixel counts as moving.
 void invert_motion(const GBufferView& b, float tolerance, Image<float>& static_depth,
                    Image<glm::vec2>& inverted, Image<float>& depth);
 

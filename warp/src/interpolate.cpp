@@ -138,8 +138,9 @@ void interpolate_frame(const GBufferView& a, const GBufferView& b, float s, bool
     const WarpTarget into_out{out.color.view(), out.depth.view(), out.motion.view(),
                               scratch.side_b.covered.view()};
     GBufferView from_a = a, from_b = b;
-    const bool cameras = options.true_motion && has_projection(a.camera) &&
-                         has_projection(b.camera) && !a.depth.empty() && !b.depth.empty();
+    const bool geometry = options.true_motion && !a.depth.empty() && !b.depth.empty() &&
+                          !a.motion.empty() && !b.motion.empty();
+    const bool cameras = geometry && has_projection(a.camera) && has_projection(b.camera);
     const Camera at = cameras ? camera_between(a.camera, b.camera, s) : Camera{};
     const bool linear = cameras && motion_is_linear(b, at, 1.0f - s, options.static_tolerance) &&
                         (!use_a || motion_is_linear(a, at, -s, options.static_tolerance));
@@ -158,6 +159,22 @@ void interpolate_frame(const GBufferView& a, const GBufferView& b, float s, bool
                           options.static_tolerance, scratch.layer_depth, scratch.true_a.view());
             from_a.motion = scratch.true_a.view();
         }
+    } else if (geometry && use_a && !has_projection(b.camera)) {
+        // No cameras (Blender's passes): anything may move, so a follows b's backward motion
+        // inverted wherever some pixel of b lands, its own negated elsewhere.
+        ++counters.true_motion;
+        invert_motion(b, options.static_tolerance, scratch.layer_depth, scratch.inverted,
+                      scratch.inverted_depth);
+        scratch.true_a.resize(w, h);
+        parallel_for(0, h, [&](int y0, int y1) {
+            for (int y = y0; y < y1; ++y) {
+                const glm::vec2 *inverted = &scratch.inverted(0, y), *own = a.motion.row(y);
+                glm::vec2* out_row = &scratch.true_a(0, y);
+                for (int x = 0; x < w; ++x)
+                    out_row[x] = std::isfinite(inverted[x].x) ? inverted[x] : own[x];
+            }
+        });
+        from_a.motion = scratch.true_a.view();
     }
     warp_into(from_b, 1.0f - s, options, scratch, into_out, counters);
     if (use_a)

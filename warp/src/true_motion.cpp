@@ -71,8 +71,12 @@ void invert_motion(const GBufferView& b, float tolerance, Image<float>& static_d
     inverted.resize(w, h);
     static_depth.resize(w, h);
     // Which pixels the camera explains (`inverted` holds the unused displacements meanwhile).
-    const std::size_t moving = static_layer(b, b.camera.view, b.camera.projection, tolerance,
-                                            static_depth.view(), inverted.view());
+    std::size_t moving = std::size_t(w) * std::size_t(h);
+    if (has_projection(b.camera))
+        moving = static_layer(b, b.camera.view, b.camera.projection, tolerance, static_depth.view(),
+                              inverted.view());
+    else
+        static_depth.fill(std::numeric_limits<float>::quiet_NaN());
     inverted.fill(glm::vec2(std::numeric_limits<float>::quiet_NaN()));
     if (moving == 0) return;
     depth.assign(w, h, kInf);
