@@ -18,9 +18,9 @@ struct WarpBuffers {
 
 // Scratch for one converter: every per-frame buffer lives here.
 struct FrucScratch {
-    WarpBuffers side_a;        // interpolation: frame a warped; extrapolation: the dynamic layer
-    WarpBuffers side_b;        // interpolation: b's coverage (b is warped into the output)
-    Image<float> layer_depth;  // extrapolation: the input's depth with some pixels left out
+    WarpBuffers side_a;               // interpolation: frame a warped
+    WarpBuffers side_b;               // interpolation: b's coverage (b is warped into the output)
+    Image<float> layer_depth;         // extrapolation: the input's depth with some pixels left out
     Image<glm::vec2> layer_motion;    // and the static layer's displacement
     Image<glm::vec2> true_a, true_b;  // interpolation: motion that lands where the frame goes
     Image<glm::vec2> inverted;        // the later frame's moving pixels, at their earlier place
@@ -50,9 +50,9 @@ void interpolate_frame(const GBufferView& a, const GBufferView& b, float s, bool
                        float motion_scale, const FrucOptions& options, FrucScratch& scratch,
                        Frame& out, FrucCounters& counters);
 
-// Frame s frame periods after f (Andreev: static layer by camera-only reprojection, holes
-// filled from static neighbourhoods, dynamic objects drawn on top at extrapolated positions);
-// its backward motion per input period times motion_scale.
+// Frame s frame periods after f: static pixels (camera-only motion, Andreev's test) where the
+// camera s periods on sees them, moving ones s periods along their motion, in one warp, holes
+// filled; its backward motion per input period times motion_scale.
 void extrapolate_frame(const GBufferView& f, float s, float motion_scale,
                        const FrucOptions& options, FrucScratch& scratch, Frame& out,
                        FrucCounters& counters);
@@ -83,8 +83,8 @@ std::size_t motion_toward(const GBufferView& f, const Camera& to, float factor,
 void invert_motion(const GBufferView& b, float tolerance, Image<float>& static_depth,
                    Image<glm::vec2>& inverted, Image<float>& depth);
 
-// The same towards an explicit camera (view, projection): the static layer lands where that
-// camera sees it, moving objects go s periods along their motion (constant screen velocity).
+// The same towards an explicit camera (view, projection): static pixels land where that camera
+// sees them, moving ones go s periods along their motion (constant screen velocity).
 void extrapolate_to_camera(const GBufferView& f, const glm::mat4& future_view,
                            const glm::mat4& future_projection, float s, float motion_scale,
                            const FrucOptions& options, FrucScratch& scratch, Frame& out,

@@ -48,8 +48,9 @@ struct FrucCounters {
     std::size_t fills = 0;          // frames whose holes were filled
     std::size_t fills_skipped = 0;  // no holes: no fill
     std::size_t hole_pixels = 0;
-    std::size_t dynamic_layers = 0;   // extrapolation: frames with moving objects drawn on top
-    std::size_t dynamic_skipped = 0;  // no dynamic pixels: no dynamic layer
+    std::size_t dynamic_layers =
+        0;  // extrapolation: frames with pixels the camera does not explain
+    std::size_t dynamic_skipped = 0;  // ... without: every pixel follows the camera
     std::size_t cuts = 0;             // shot changes detected
     std::size_t grid_cells = 0;       // adaptive-grid cells drawn
     std::size_t true_motion = 0;      // in-between frames whose sides followed the true motion
