@@ -131,7 +131,7 @@ Status read_sequence(const std::string& dir, int frames, Sequence& seq) {
     const int n = std::min<int>(frames, int(files.files.size()));
     for (int i = 0; i < n; ++i) {
         Frame frame;
-        REPRISE_TRY(read_frame(files.files[i], frame));
+        REPRISE_TRY(read_frame(files, i, frame));
         if (i > 0 &&
             (frame.width() != seq.frames[0].width() || frame.height() != seq.frames[0].height()))
             return Status::error(files.files[i] + ": size differs from the first frame");

@@ -238,7 +238,7 @@ Status read_scene(const std::string& dir, int frames, int factor, SceneFrames& o
     };
     for (int i = 0; i < n; ++i) {
         std::fprintf(stderr, "\r[fruc] %s: reading input %d/%d   ", out.name.c_str(), i + 1, n);
-        REPRISE_TRY(read_frame(inputs.files[i], out.input[i]));
+        REPRISE_TRY(read_frame(inputs, i, out.input[i]));
         REPRISE_TRY(same_size(out.input[i], inputs.files[i]));
         out.input_shown[i].resize(out.input[i].width(), out.input[i].height());
         visualize_color(out.input[i].color.view(), out.input_shown[i].view());
@@ -249,7 +249,7 @@ Status read_scene(const std::string& dir, int frames, int factor, SceneFrames& o
         if (!out.scored(j)) continue;
         std::fprintf(stderr, "\r[fruc] %s: reading truth %d/%d   ", out.name.c_str(), j,
                      out.last());
-        REPRISE_TRY(read_frame(truths.files[j], truth));
+        REPRISE_TRY(read_frame(truths, j, truth));
         REPRISE_TRY(same_size(truth, truths.files[j]));
         out.truth[j].resize(truth.width(), truth.height());
         reprise::to_display(truth.color.view(), out.truth[j].view());

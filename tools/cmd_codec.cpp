@@ -132,7 +132,7 @@ Status run_encode(const EncodeJob& job, const codec::EncoderOptions& o) {
     double fps = sequence.fps > 0 ? sequence.fps : 30.0;
     const std::size_t n = sequence.files.size();
     for (std::size_t i = 0; i < n; ++i) {
-        REPRISE_TRY(read_frame(sequence.files[i], frame));
+        REPRISE_TRY(read_frame(sequence, i, frame));
         if (frame.fps <= 0) frame.fps = fps;
         if (i == 0)
             REPRISE_TRY(codec::write_stream_header(file, frame.width(), frame.height(), fps));

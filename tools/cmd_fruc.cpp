@@ -45,7 +45,7 @@ Status run_fruc(const FrucJob& job) {
     double busy_ms = 0.0;
     const std::size_t n = sequence.files.size();
     for (std::size_t i = 0; i < n; ++i) {
-        REPRISE_TRY(read_frame(sequence.files[i], in));
+        REPRISE_TRY(read_frame(sequence, i, in));
         if (in.fps <= 0) in.fps = sequence.fps;
         if (i == 0 && (in.motion.empty() || in.depth.empty())) {
             // Said once, before any work: what the input lacks and what stands in for it.

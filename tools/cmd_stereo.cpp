@@ -69,7 +69,7 @@ Status run_stereo(const StereoJob& job, const stereo::StereoRig& rig,
     std::size_t holes = 0, from_history = 0;
     for (std::size_t i = 0; i < seq.files.size(); ++i) {
         const std::string& file = seq.files[i];
-        REPRISE_TRY(read_frame(file, frame));
+        REPRISE_TRY(read_frame(seq, i, frame));
         if (frame.depth.width() != frame.width() || frame.depth.height() != frame.height())
             return Status::error(file + ": needs a depth channel (Z) of the colour's size");
         // Disparity needs the focal length: from the file's camera, else from --fov.
@@ -77,7 +77,8 @@ Status run_stereo(const StereoJob& job, const stereo::StereoRig& rig,
             if (job.fov == 0.0)
                 return Status::error(file +
                                      ": has no camera (Blender renders carry none); give "
-                                     "--fov DEG, the camera's vertical field of view");
+                                     "--fov DEG, the camera's vertical field of view, or a "
+                                     "cameras.json beside the frames");
             frame.camera.projection = glm::perspective(float(glm::radians(job.fov)),
                                                        float(frame.width()) / float(frame.height()),
                                                        frame.camera.near, frame.camera.far);

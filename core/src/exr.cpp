@@ -63,6 +63,9 @@ Status open_sequence(const std::string& path, Sequence& sequence) {
     FrameHeader header;
     REPRISE_TRY(read_frame_header(sequence.files.front(), header));
     sequence.fps = header.fps;
+    const fs::path cameras = fs::path(sequence.files.front()).parent_path() / "cameras.json";
+    if (fs::exists(cameras, ec))
+        REPRISE_TRY(read_cameras_json(cameras.string(), sequence.files, sequence.cameras));
     return {};
 }
 

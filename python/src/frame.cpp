@@ -329,7 +329,7 @@ void bind_frame(py::module_& m) {
                 Status status;
                 {
                     py::gil_scoped_release release;
-                    status = read_frame(s.files[i], f);
+                    status = read_frame(s, i, f);
                 }
                 check(status);
                 if (f.fps <= 0.0) f.fps = s.fps;

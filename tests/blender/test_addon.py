@@ -8,6 +8,7 @@ x2 and `reprise export --mp4`. The made in-between frames must beat repeating th
 by MARGIN_DB, and Blender must open a frame that reprise wrote and read the same pixels.
 """
 import csv
+import json
 import os
 import shutil
 import subprocess
@@ -110,6 +111,10 @@ made = sorted(f for f in os.listdir(made_dir) if f.endswith(".exr"))
 check(len(made) == 2 * INPUT_FRAMES - 1, "%d upconverted frames" % len(made))
 mp4 = os.path.join(work, "reprise", "x2.mp4")
 check(os.path.isfile(mp4) and os.path.getsize(mp4) > 0, "MP4 written")
+with open(os.path.join(work, "reprise", "input", "cameras.json")) as f:
+    cameras = json.load(f)["frames"]
+check(len(cameras) == INPUT_FRAMES - 1 and all(len(c["view"]) == 16 for c in cameras),
+      "cameras.json beside the input holds the cameras of the frames after the first")
 
 
 def psnr(reference, test):

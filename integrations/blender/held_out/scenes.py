@@ -3,13 +3,16 @@ primitives and procedural textures, rendered by Cycles with the Depth and Vector
 multilayer EXR. No reprise default was tuned on them.
 
     blender -b --factory-startup --python-exit-code 1 --python scenes.py -- OUT \
-        [--size 320x180] [--frames 6] [--factor 2] [--samples 32] [--scenes tumble,orbit,dolly]
+        [--size 320x180] [--frames 6] [--factor 2] [--samples 32] [--scenes tumble,orbit,dolly] \
+        [--cameras 1]
 
 Each scene is rendered twice over the same seconds: OUT/blender-<scene>/input/ at 30 Hz (frames
 inputs; their Vector pass spans 1/30 s, as in a real 30 Hz render) and OUT/blender-<scene>/truth/
-at 30 x factor Hz, the frames an upconversion must make. scripts/blender-scenes runs this.
+at 30 x factor Hz, the frames an upconversion must make; with --cameras 1 a cameras.json beside
+the frames of each (Blender's files carry no camera). scripts/blender-scenes runs this.
 """
 import argparse
+import json
 import math
 import os
 import sys
@@ -23,6 +26,7 @@ parser.add_argument("--frames", type=int, default=6, help="input frames at 30 Hz
 parser.add_argument("--factor", type=int, default=2)
 parser.add_argument("--samples", type=int, default=32)
 parser.add_argument("--scenes", default="tumble,orbit,dolly")
+parser.add_argument("--cameras", type=int, default=1, help="1: write cameras.json beside the frames")
 args = parser.parse_args(sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else [])
 width, height = (int(v) for v in args.size.split("x"))
 if args.frames < 2 or args.factor < 1 or width < 1 or height < 1:
@@ -178,6 +182,29 @@ def dolly():
     keys(cam, "location", [(0.0, -6.0, 1.6), (0.3, -6.0 + 12.0 * DURATION, 1.7)])  # 12 m/s
 
 
+def write_cameras(scene, folder):
+    """cameras.json beside the frames: Blender's files carry no camera (docs/exr_format.md)."""
+    def at(frame):
+        scene.frame_set(frame)
+        cam = scene.camera
+        flat = lambda m: [m[r][c] for c in range(4) for r in range(4)]  # column-major
+        projection = cam.calc_matrix_camera(bpy.context.evaluated_depsgraph_get(), x=width,
+                                            y=height)
+        return flat(cam.matrix_world.inverted()), flat(projection)
+    frames = []
+    for frame in range(1, LAST + 1):
+        view, projection = at(frame)
+        prev_view, prev_projection = at(frame - 1)
+        frames.append({"file": "%04d.exr" % frame, "time": (frame - 1) / scene.render.fps,
+                       "view": view, "projection": projection, "prev_view": prev_view,
+                       "prev_projection": prev_projection, "near": scene.camera.data.clip_start,
+                       "far": scene.camera.data.clip_end})
+    os.makedirs(folder, exist_ok=True)
+    with open(os.path.join(folder, "cameras.json"), "w") as f:
+        json.dump({"frames": frames}, f)
+    scene.frame_set(1)
+
+
 BUILDERS = {"tumble": tumble, "orbit": orbit, "dolly": dolly}
 for name in args.scenes.split(","):
     if name not in BUILDERS:
@@ -185,8 +212,10 @@ for name in args.scenes.split(","):
     for folder, rate in (("input", 1), ("truth", args.factor)):
         scene = clear(rate)
         BUILDERS[name]()
-        scene.render.filepath = os.path.join(os.path.abspath(args.out), "blender-" + name, folder,
-                                             "")
+        folder = os.path.join(os.path.abspath(args.out), "blender-" + name, folder)
+        scene.render.filepath = os.path.join(folder, "")
+        if args.cameras:
+            write_cameras(scene, folder)
         print("scenes.py: rendering %s/%s, %d frames at %dx%d" % (name, folder, LAST, width, height),
               flush=True)
         bpy.ops.render.render(animation=True)

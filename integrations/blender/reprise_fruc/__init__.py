@@ -4,6 +4,7 @@ A panel in Properties > Output enables the Depth and Vector passes and multilaye
 after an animation render the add-on runs `reprise fruc` on the frames Blender wrote, which
 writes the upconverted sequence (EXR frames in Blender's multilayer layout) and an MP4.
 """
+import json
 import os
 import shutil
 import subprocess
@@ -92,6 +93,7 @@ def upconvert(scene, frames):
             os.symlink(os.path.abspath(path), link)
         except OSError:
             shutil.copyfile(path, link)
+    write_cameras(scene, frames, input_dir)
     fps = scene.render.fps / scene.render.fps_base / max(1, scene.frame_step) * settings.factor
     command = [exe, "fruc", "--in", input_dir, "--out", fruc_dir,
                "--factor", str(settings.factor), "--mode", settings.mode,
@@ -111,17 +113,56 @@ def upconvert(scene, frames):
 
 
 _written = []
+_cameras = {}  # frame path -> (view, projection, near, far, time), column-major lists
+
+
+def write_cameras(scene, frames, folder):
+    """cameras.json for reprise (Blender's files carry no camera): each frame after the first
+    gets its camera and the previous frame's, which the Vector pass spans when every frame is
+    rendered (frame step 1). Without them reprise warps by the Vector pass alone."""
+    if scene.frame_step != 1 or any(path not in _cameras for path in frames):
+        return
+    entries = []
+    for previous, path in zip(frames, frames[1:]):
+        view, projection, near, far, time = _cameras[path]
+        entries.append({"file": os.path.basename(path), "time": time, "view": view,
+                        "projection": projection, "prev_view": _cameras[previous][0],
+                        "prev_projection": _cameras[previous][1], "near": near, "far": far})
+    with open(os.path.join(folder, "cameras.json"), "w") as f:
+        json.dump({"frames": entries}, f)
+
+
+def record_camera(scene, path):
+    camera = scene.camera
+    if camera is None or camera.type != "CAMERA":
+        return
+    render = scene.render
+    scale = render.resolution_percentage / 100.0
+    flat = lambda m: [m[r][c] for c in range(4) for r in range(4)]  # column-major
+    try:
+        projection = camera.calc_matrix_camera(
+            bpy.context.evaluated_depsgraph_get(), x=int(render.resolution_x * scale),
+            y=int(render.resolution_y * scale), scale_x=render.pixel_aspect_x,
+            scale_y=render.pixel_aspect_y)
+    except (RuntimeError, TypeError):
+        return  # no cameras.json then
+    time = (scene.frame_current - scene.frame_start) * render.fps_base / render.fps
+    _cameras[path] = (flat(camera.matrix_world.inverted()), flat(projection),
+                      camera.data.clip_start, camera.data.clip_end, time)
 
 
 @persistent
 def on_render_init(scene, *_):
     _written.clear()
+    _cameras.clear()
 
 
 @persistent
 def on_render_write(scene, *_):
     if scene.reprise.enabled:
-        _written.append(scene.render.frame_path(frame=scene.frame_current))
+        path = scene.render.frame_path(frame=scene.frame_current)
+        _written.append(path)
+        record_camera(scene, path)
 
 
 @persistent

@@ -1,6 +1,7 @@
 #pragma once
 // Frames as multichannel OpenEXR files and sequences as folders of them (OpenImageIO).
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "reprise/core/frame.hpp"
@@ -47,11 +48,27 @@ Status read_frame_header(const std::string& path, FrameHeader& header);
 struct Sequence {
     std::vector<std::string> files;  // sorted by name (frame_9 before frame_10)
     double fps = 0.0;                // from the first frame's header; 0 when not recorded
+    // From a cameras.json beside the frames, one per file (a default Camera where it names
+    // none); empty without one.
+    std::vector<Camera> cameras;
 };
 
 // Lists a folder of EXR frames (reprise's frame_00000.exr… or a Blender render folder), sorted
-// with digit runs compared as numbers; a single file is a sequence of one.
+// with digit runs compared as numbers; a single file is a sequence of one. A cameras.json beside
+// the frames (docs/exr_format.md) gives the cameras that the files do not carry.
 Status open_sequence(const std::string& path, Sequence& sequence);
+
+// Frame `index` of the sequence; one without a camera gets the sequence's (cameras.json).
+Status read_frame(const Sequence& sequence, std::size_t index, Frame& frame);
+
+// cameras.json: {"frames": [{"file": "0001.exr", "view": [16], "projection": [16],
+// "prev_view": [16], "prev_projection": [16], "near": n, "far": f, "time": s}, ...]}, matrices
+// column-major as in OpenGL; the cameras of `files` matched by file name.
+Status read_cameras_json(const std::string& path, const std::vector<std::string>& files,
+                         std::vector<Camera>& cameras);
+// The same on the file's text; `path` only names it in errors.
+Status parse_cameras_json(std::string_view text, const std::string& path,
+                          const std::vector<std::string>& files, std::vector<Camera>& cameras);
 
 // OpenEXR's standard camera attributes, column-vector form (the file holds their transposes):
 // worldToCamera maps to RenderMan's camera space (+x right, +y up, +z forward: the view with z
