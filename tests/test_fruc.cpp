@@ -173,9 +173,11 @@ TEST(Fruc, BadValuesNeverSpreadAndTinyImagesWork) {
 
 // Under a fast orbit the pixels move on curves, and objects that tumble or accelerate move
 // differently forwards than their backward motion says: the in-between frame follows the true
-// motion (depth + the in-between camera, the later frame's motion inverted) and is measured
-// against the linear model (the earlier frame moved along its own backward motion negated).
-TEST(FrucTrueMotion, CurvedMotionIsFollowedBetterThanLinearMotion) {
+// motion and is measured against the linear model (the earlier frame moved along its own backward
+// motion negated). With cameras: depth + the in-between camera for what the camera explains, the
+// later frame's motion inverted for the rest; without (Blender's passes): the later frame's
+// motion inverted wherever it lands.
+void expect_true_motion_beats_linear(bool cameras) {
     for (const char* scene_name : {"pan", "crossing"}) {
         server::Scene scene;
         server::CameraPath path;
@@ -186,6 +188,7 @@ TEST(FrucTrueMotion, CurvedMotionIsFollowedBetterThanLinearMotion) {
             EXPECT_TRUE(shared_renderer()
                             .render_frame(scene, path, index, fps, {.width = 320, .height = 180}, f)
                             .ok());
+            if (!cameras) f.camera = Camera{};
             return f;
         };
         const std::vector<Frame> input = {frame_at(2, 10.0), frame_at(3, 10.0)};
@@ -200,51 +203,22 @@ TEST(FrucTrueMotion, CurvedMotionIsFollowedBetterThanLinearMotion) {
             EXPECT_EQ(counters.true_motion, exact ? 1u : 0u) << "an orbit is not linear";
         }
         std::printf(
-            "[fruc] %s, orbit at 2 rad/s, 10 -> 20 Hz: true motion %.2f dB, linear %.2f dB\n",
-            scene_name, psnr[1], psnr[0]);
-        const bool pan = std::string(scene_name) == "pan";  // measured 27.49 / 25.27, 22.39 / 21.04
+            "[fruc] %s, orbit at 2 rad/s, 10 -> 20 Hz, %s cameras: true motion %.2f dB, linear "
+            "%.2f dB\n",
+            scene_name, cameras ? "with" : "without", psnr[1], psnr[0]);
+        // Measured with cameras 27.49 / 25.27 and 22.39 / 21.04, without 27.48 and 22.35.
+        const bool pan = std::string(scene_name) == "pan";
         EXPECT_GT(psnr[1], pan ? 27.0 : 22.0) << scene_name;
         EXPECT_GT(psnr[1], psnr[0] + (pan ? 1.5 : 1.0)) << scene_name;
     }
 }
 
-// Without cameras (Blender's passes) the earlier frame follows the later frame's backward motion
-// inverted wherever it lands: a tumbling object and an orbiting camera are followed better than
-// by the earlier frame's own motion negated.
+TEST(FrucTrueMotion, CurvedMotionIsFollowedBetterThanLinearMotion) {
+    expect_true_motion_beats_linear(true);
+}
+
 TEST(FrucWithoutCameras, InterpolationInvertsTheLaterMotion) {
-    for (const char* scene_name : {"pan", "crossing"}) {
-        server::Scene scene;
-        server::CameraPath path;
-        ASSERT_TRUE(server::load_scene(scene_name, scene, path).ok());
-        ASSERT_TRUE(server::parse_camera_spec("orbit:speed=2", scene, path, path).ok());
-        auto frame_at = [&](int index, double fps) {
-            Frame f;
-            EXPECT_TRUE(shared_renderer()
-                            .render_frame(scene, path, index, fps, {.width = 320, .height = 180}, f)
-                            .ok());
-            f.camera = Camera{};
-            return f;
-        };
-        const std::vector<Frame> input = {frame_at(2, 10.0), frame_at(3, 10.0)};
-        const Frame truth = frame_at(5, 20.0);
-        double psnr[2];
-        for (bool exact : {false, true}) {
-            const FrucOptions options{.mode = FrucMode::Interpolate, .true_motion = exact};
-            FrucCounters counters;
-            const std::vector<Frame> out = convert(input, 2, options, &counters);
-            ASSERT_EQ(out.size(), 3u);
-            psnr[exact] = psnr_of(truth, out[1]);
-            EXPECT_EQ(counters.true_motion, exact ? 1u : 0u);
-        }
-        std::printf(
-            "[fruc] %s without cameras, orbit at 2 rad/s, 10 -> 20 Hz: inverted motion %.2f dB, "
-            "own motion %.2f dB\n",
-            scene_name, psnr[1], psnr[0]);
-        // Measured 27.48 / 25.27 and 22.35 / 21.04: as good as with cameras (27.49, 22.39).
-        const bool pan = std::string(scene_name) == "pan";
-        EXPECT_GT(psnr[1], pan ? 27.0 : 22.0) << scene_name;
-        EXPECT_GT(psnr[1], psnr[0] + (pan ? 1.5 : 1.0)) << scene_name;
-    }
+    expect_true_motion_beats_linear(false);
 }
 
 // Renders without cameras (Blender's passes carry none): extrapolation moves every pixel along
@@ -270,9 +244,9 @@ TEST(FrucWithoutCameras, ExtrapolationFollowsTheMotionAlone) {
             "[fruc] %s x4 extrapolated: %.2f dB without cameras, %.2f dB with, %.2f dB "
             "repeating\n",
             scene, sum_without / 3, sum_with / 3, sum_repeat / 3);
-        // Measured: pan 39.11 / 39.11 / 32.79 (moving camera), crossing 42.40 / 37.11 / 33.42
-        // (still camera, moving objects).
-        EXPECT_GT(sum_without, sum_with - 3.0) << scene;
+        // Measured: pan 39.11 / 39.11 / 32.79 (moving camera), crossing 42.40 / 42.40 / 33.42
+        // (still camera, moving objects). Issue 10 asks for within 1 dB.
+        EXPECT_NEAR(sum_without / 3, sum_with / 3, 1.0) << scene;
         const bool pan = std::string(scene) == "pan";
         EXPECT_GT(sum_without, sum_repeat + 3.0 * (pan ? 6.0 : 3.0)) << scene;
     }
