@@ -19,6 +19,9 @@ import sys
 
 import bpy
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from reprise_fruc import camera_matrices  # noqa: E402 (the add-on's, shared)
+
 parser = argparse.ArgumentParser(prog="scenes.py")
 parser.add_argument("out")
 parser.add_argument("--size", default="320x180")
@@ -186,11 +189,7 @@ def write_cameras(scene, folder):
     """cameras.json beside the frames: Blender's files carry no camera (docs/exr_format.md)."""
     def at(frame):
         scene.frame_set(frame)
-        cam = scene.camera
-        flat = lambda m: [m[r][c] for c in range(4) for r in range(4)]  # column-major
-        projection = cam.calc_matrix_camera(bpy.context.evaluated_depsgraph_get(), x=width,
-                                            y=height)
-        return flat(cam.matrix_world.inverted()), flat(projection)
+        return camera_matrices(scene)
     frames = []
     for frame in range(1, LAST + 1):
         view, projection = at(frame)

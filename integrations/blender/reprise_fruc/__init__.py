@@ -132,23 +132,32 @@ def write_cameras(scene, frames, folder):
         json.dump({"frames": entries}, f)
 
 
-def record_camera(scene, path):
+def camera_matrices(scene):
+    """The scene camera's view and projection now, column-major lists as cameras.json holds
+    them, or None."""
     camera = scene.camera
     if camera is None or camera.type != "CAMERA":
-        return
+        return None
     render = scene.render
     scale = render.resolution_percentage / 100.0
-    flat = lambda m: [m[r][c] for c in range(4) for r in range(4)]  # column-major
+    flat = lambda m: [m[r][c] for c in range(4) for r in range(4)]
     try:
         projection = camera.calc_matrix_camera(
             bpy.context.evaluated_depsgraph_get(), x=int(render.resolution_x * scale),
             y=int(render.resolution_y * scale), scale_x=render.pixel_aspect_x,
             scale_y=render.pixel_aspect_y)
     except (RuntimeError, TypeError):
+        return None
+    return flat(camera.matrix_world.inverted()), flat(projection)
+
+
+def record_camera(scene, path):
+    matrices = camera_matrices(scene)
+    if matrices is None:
         return  # no cameras.json then
+    render = scene.render
     time = (scene.frame_current - scene.frame_start) * render.fps_base / render.fps
-    _cameras[path] = (flat(camera.matrix_world.inverted()), flat(projection),
-                      camera.data.clip_start, camera.data.clip_end, time)
+    _cameras[path] = matrices + (scene.camera.data.clip_start, scene.camera.data.clip_end, time)
 
 
 @persistent
