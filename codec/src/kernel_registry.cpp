@@ -1,0 +1,124 @@
+#include "reprise/codec/kernel_registry.hpp"
+
+#include <cstring>
+#include <limits>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "kernels.hpp"
+#include "reprise/core/parallel.hpp"
+
+namespace reprise::codec {
+
+namespace {
+
+using warp::KernelCase;
+using warp::KernelEntry;
+using warp::KernelInputs;
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+
+float uniform(std::mt19937& rng, float a, float b) {
+    return a + (b - a) * float(rng() >> 8) * (1.0f / 16777216.0f);
+}
+
+float worst_value(std::mt19937& rng) {
+    constexpr float values[] = {kNaN,   kInf,   -kInf, 0.0f, -0.0f, 1e30f,
+                                -1e30f, 1e-30f, -1.0f, 0.5f, 3e5f,  -3e5f};
+    return values[rng() % std::size(values)];
+}
+
+template <class T>
+std::string compare_values(const char* what, const std::vector<T>& a, const std::vector<T>& b) {
+    for (std::size_t i = 0; i < a.size(); ++i)
+        if (std::memcmp(&a[i], &b[i], sizeof(T)) != 0)
+            return std::string(what) + ": element " + std::to_string(i) + " differs";
+    return {};
+}
+
+// Catmull-Rom prediction of a plane (luma, or 4:2:0 chroma from luma motion). Random: a camera
+// pan's smooth motion with 1/64 steps and a depth edge; worst case: NaN/Inf and huge motion,
+// whole-pixel motion, the plane's value extremes.
+class PredictCase final : public KernelCase {
+public:
+    explicit PredictCase(bool subsampled) : subsampled_(subsampled) {}
+    void generate(int w, int h, KernelInputs inputs, uint32_t seed) override {
+        std::mt19937 rng(seed);
+        width_ = w, height_ = h;
+        motion_width_ = subsampled_ ? std::max(1, 2 * w - int(rng() % 2)) : w;
+        motion_height_ = subsampled_ ? 2 * h : h;
+        const bool worst = inputs == KernelInputs::WorstCase;
+        lo_ = subsampled_ ? -255 : 0;
+        plane_.resize(std::size_t(w) * h);
+        for (int16_t& v : plane_)
+            v = worst && rng() % 4 == 0 ? int16_t(rng() % 2 ? 32767 : -32768)
+                                        : int16_t(lo_ + int(rng() % uint32_t(256 - lo_)));
+        motion_.resize(std::size_t(motion_width_) * motion_height_);
+        const glm::vec2 pan{uniform(rng, -9, 9), uniform(rng, -5, 5)};
+        for (int y = 0; y < motion_height_; ++y)
+            for (int x = 0; x < motion_width_; ++x) {
+                glm::vec2 m = pan + glm::vec2(0.01f * float(x), -0.005f * float(y));
+                if (x > motion_width_ / 2) m *= 1.5f;  // a depth edge
+                if (rng() % 5 == 0) m = {std::round(m.x), std::round(m.y)};
+                if (worst && rng() % 3 == 0) m[int(rng() % 2)] = worst_value(rng);
+                motion_[std::size_t(y) * motion_width_ + x] = m;
+            }
+    }
+    void run_reference() override {
+        run_into(reference_, [](const PredictRow& r) { predict_row_reference(r, 0, r.width); });
+    }
+    void run() override { run_into(optimized_, predict_row); }
+    std::string compare() const override {
+        return compare_values("prediction", optimized_, reference_);
+    }
+
+private:
+    template <class Kernel>
+    void run_into(std::vector<int16_t>& out, Kernel kernel) {
+        out.assign(plane_.size(), 0);
+        const int s = subsampled_ ? 1 : 0;
+        parallel_for(0, height_, [&](int y0, int y1) {
+            for (int y = y0; y < y1; ++y)
+                kernel(
+                    {.reference = plane_.data(),
+                     .width = width_,
+                     .height = height_,
+                     .y = y,
+                     .motion0 = motion_.data() +
+                                std::size_t(std::min(y << s, motion_height_ - 1)) * motion_width_,
+                     .motion1 =
+                         motion_.data() +
+                         std::size_t(std::min((y << s) + s, motion_height_ - 1)) * motion_width_,
+                     .motion_width = motion_width_,
+                     .subsampled = subsampled_,
+                     .lo = lo_,
+                     .hi = 255,
+                     .out = out.data() + std::size_t(y) * width_});
+        });
+    }
+
+    bool subsampled_;
+    int width_ = 0, height_ = 0, motion_width_ = 0, motion_height_ = 0, lo_ = 0;
+    std::vector<int16_t> plane_;
+    std::vector<glm::vec2> motion_;
+    std::vector<int16_t> reference_, optimized_;
+};
+
+template <class T, auto... Args>
+std::unique_ptr<KernelCase> make() {
+    return std::make_unique<T>(Args...);
+}
+
+constexpr KernelEntry kEntries[] = {
+    {"codec prediction, luma", "bit-exact", true, make<PredictCase, false>},
+    {"codec prediction, 4:2:0 chroma", "bit-exact", true, make<PredictCase, true>},
+};
+
+}  // namespace
+
+std::span<const KernelEntry> kernel_registry() { return kEntries; }
+
+}  // namespace reprise::codec

@@ -1,0 +1,118 @@
+// The SIMD versions of kernels.hpp, compiled once per Highway target and chosen at run time.
+// Each spells out its scalar reference's operations in the same order (no FMA: the codec is
+// compiled with -ffp-contract=off), so it gives the same bits; pixels a vector cannot take (the
+// end of a row, a filter window over the plane's edge) go through the reference itself.
+#include <algorithm>
+#include <bit>
+
+#include "kernels.hpp"
+
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "simd_kernels.cpp"
+#include <hwy/foreach_target.h>  // IWYU pragma: keep
+#include <hwy/highway.h>
+
+HWY_BEFORE_NAMESPACE();
+namespace reprise::codec::HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+void PredictRowSimd(const PredictRow& r) {
+    if constexpr (std::endian::native != std::endian::little) {
+        predict_row_reference(r, 0, r.width);
+        return;
+    }
+    const hn::ScalableTag<float> df;
+    const hn::RebindToSigned<decltype(df)> di;
+    const hn::Rebind<int16_t, decltype(df)> d16;
+    using VF = hn::Vec<decltype(df)>;
+    using VI = hn::Vec<decltype(di)>;
+    const int n = int(hn::Lanes(df));
+    const VF zero = hn::Zero(df), half = hn::Set(df, 0.5f), eighth = hn::Set(df, 0.125f);
+    const VF phases = hn::Set(df, 64.0f);
+    const VF x_low = hn::Set(df, -4.0f * 64), x_high = hn::Set(df, float(r.width + 4) * 64);
+    // The row's vertical position is the same fixed_position for every lane but its motion.
+    const VF y_low = hn::Set(df, -4.0f * 64), y_high = hn::Set(df, float(r.height + 4) * 64);
+    const VF cy = hn::Set(df, float(r.y) + 0.5f);
+    const VI one = hn::Set(di, 1), two = hn::Set(di, 2), mask63 = hn::Set(di, 63);
+    const VI w_minus2 = hn::Set(di, r.width - 2), h_minus2 = hn::Set(di, r.height - 2);
+    const VI stride = hn::Set(di, r.width), round = hn::Set(di, 1 << 13);
+    const VI lo = hn::Set(di, r.lo), hi = hn::Set(di, r.hi), zero_i = hn::Zero(di);
+    const int32_t* weights = &catmull_rom_weights()[0][0];
+    const int32_t* base = reinterpret_cast<const int32_t*>(r.reference);
+
+    auto usable = [&](VF& mx, VF& my) {  // non-finite motion counts as 0
+        const auto finite = hn::And((mx - mx) == zero, (my - my) == zero);
+        mx = hn::IfThenElseZero(finite, mx);
+        my = hn::IfThenElseZero(finite, my);
+    };
+    auto fixed_position = [&](VF centre, VF m, VF low, VF high) {
+        const VF q = hn::Min(hn::Max((centre + m - half) * phases, low), high);
+        const VI t = hn::ConvertTo(di, q);
+        return t - hn::IfThenElseZero(hn::RebindMask(di, q < hn::ConvertTo(df, t)), one);
+    };
+
+    const int vector_end = std::min(r.width, r.subsampled ? r.motion_width / 2 : r.motion_width);
+    int x = 0;
+    for (; x + n <= vector_end; x += n) {
+        VF mx, my;
+        if (!r.subsampled) {
+            hn::LoadInterleaved2(df, &r.motion0[x].x, mx, my);
+            usable(mx, my);
+        } else {
+            VF ax, ay, bx, by, cx, cy2, dx, dy;
+            hn::LoadInterleaved4(df, &r.motion0[2 * x].x, ax, ay, bx, by);
+            hn::LoadInterleaved4(df, &r.motion1[2 * x].x, cx, cy2, dx, dy);
+            usable(ax, ay), usable(bx, by), usable(cx, cy2), usable(dx, dy);
+            mx = (((ax + bx) + cx) + dx) * eighth;
+            my = (((ay + by) + cy2) + dy) * eighth;
+        }
+        const VF centre = hn::Iota(df, float(x)) + half;
+        const VI qx = fixed_position(centre, mx, x_low, x_high);
+        const VI qy = fixed_position(cy, my, y_low, y_high);
+        const VI ix = hn::ShiftRight<6>(qx), iy = hn::ShiftRight<6>(qy);
+        const auto inside =
+            hn::And(hn::And(ix > zero_i, iy > zero_i), hn::And(ix < w_minus2, iy < h_minus2));
+        if (!hn::AllTrue(di, inside)) {  // a window over the edge: the reference clamps
+            predict_row_reference(r, x, x + n);
+            continue;
+        }
+        const VI px = hn::And(qx, mask63), py = hn::And(qy, mask63);
+        const VI px4 = hn::ShiftLeft<2>(px), py4 = hn::ShiftLeft<2>(py);
+        VI wx[4], wy[4];
+        for (int i = 0; i < 4; ++i) {
+            wx[i] = hn::GatherIndex(di, weights, px4 + hn::Set(di, i));
+            wy[i] = hn::GatherIndex(di, weights, py4 + hn::Set(di, i));
+        }
+        // Byte offsets of the window's top-left sample; each 32-bit gather takes two samples.
+        VI offset = hn::ShiftLeft<1>((iy - one) * stride + (ix - one));
+        const VI row_bytes = hn::Set(di, 2 * r.width);
+        VI sum = zero_i;
+        for (int j = 0; j < 4; ++j, offset = offset + row_bytes) {
+            const VI a = hn::GatherOffset(di, base, offset);
+            const VI b = hn::GatherOffset(di, base, offset + two + two);
+            const VI line =
+                wx[0] * hn::ShiftRight<16>(hn::ShiftLeft<16>(a)) + wx[1] * hn::ShiftRight<16>(a) +
+                wx[2] * hn::ShiftRight<16>(hn::ShiftLeft<16>(b)) + wx[3] * hn::ShiftRight<16>(b);
+            sum = sum + wy[j] * line;
+        }
+        const VI value = hn::ShiftRight<14>(sum + round);
+        // Whole-pixel positions (weights 0, 128, 0, 0) copy the sample unclamped.
+        const auto whole = hn::And(px == zero_i, py == zero_i);
+        const VI out = hn::IfThenElse(whole, value, hn::Min(hn::Max(value, lo), hi));
+        hn::StoreU(hn::DemoteTo(d16, out), d16, r.out + x);
+    }
+    predict_row_reference(r, x, r.width);
+}
+
+}  // namespace reprise::codec::HWY_NAMESPACE
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace reprise::codec {
+
+HWY_EXPORT(PredictRowSimd);
+
+void predict_row(const PredictRow& row) { HWY_DYNAMIC_DISPATCH(PredictRowSimd)(row); }
+
+}  // namespace reprise::codec
+#endif
