@@ -124,10 +124,11 @@ struct Workspace {
     Image<uint32_t> depth_codes, temporal_codes, depth_residuals;
     Image<float> projected_depth;
     Image<glm::vec2> base_motion, to_reference;
-    std::vector<MotionResidual> motion_targets, motion_residuals;
+    std::vector<MotionResidual> motion_residuals;
     Planes predicted;
     std::vector<uint8_t> coded_blocks[3];  // per 8x8 block of each plane: intra or with a residual
     std::vector<std::vector<uint8_t>> slice_bytes;
+    std::vector<std::vector<uint8_t>> slice_flags;  // per slice: a block row's flags
     std::vector<uint8_t> section;
 };
 

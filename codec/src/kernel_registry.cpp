@@ -107,6 +107,72 @@ private:
     std::vector<int16_t> reference_, optimized_;
 };
 
+// Camera motion of each row. Random: depths of a scene in front of both cameras with some
+// background; worst case: NaN/Inf/negative/signed-zero depths, points behind the other camera,
+// an orthographic row.
+class CameraMotionCase final : public KernelCase {
+public:
+    void generate(int w, int h, KernelInputs inputs, uint32_t seed) override {
+        std::mt19937 rng(seed);
+        width_ = w, height_ = h;
+        const bool worst = inputs == KernelInputs::WorstCase;
+        depth_.resize(std::size_t(w) * h);
+        for (float& z : depth_) {
+            z = rng() % 10 == 0 ? kInf : uniform(rng, 0.5f, 80.0f);
+            if (worst && rng() % 3 == 0) z = worst_value(rng);
+        }
+        auto v4 = [&](float range) {
+            return glm::vec4(uniform(rng, -range, range), uniform(rng, -range, range),
+                             uniform(rng, -range, range), uniform(rng, -range, range));
+        };
+        rows_.resize(std::size_t(h));
+        for (int y = 0; y < h; ++y) {
+            CameraMotionRow& r = rows_[std::size_t(y)];
+            r.a0 = v4(2.0f), r.a1 = v4(0.01f), r.b0 = v4(1.0f), r.b1 = v4(0.01f);
+            r.a0.w = uniform(rng, worst ? -1.0f : 0.5f, 2.0f);
+            r.b0.w = uniform(rng, worst ? -1.0f : 0.5f, 1.5f);
+            r.projection = glm::mat4(1.0f);
+            r.projection[0][0] = uniform(rng, 0.5f, 2.0f);
+            r.projection[1][1] = uniform(rng, 0.5f, 2.0f);
+            r.perspective = !(worst && y % 4 == 3);
+            r.projection[2][3] = r.perspective ? -1.0f : 0.0f;
+            r.projection[3][3] = r.perspective ? 0.0f : 1.0f;
+            r.projection[2][2] = -1.002f;
+            r.projection[3][2] = -0.2f;
+            for (int c = 0; c < 4; ++c) r.to_clip[c] = v4(1.5f);
+            r.far_plane = 100.0f;
+            r.y = y, r.width = w, r.height = h;
+            r.depth = depth_.data() + std::size_t(y) * w;
+        }
+    }
+    void run_reference() override {
+        run_into(reference_,
+                 [](const CameraMotionRow& r) { camera_motion_row_reference(r, 0, r.width); });
+    }
+    void run() override { run_into(optimized_, camera_motion_row); }
+    std::string compare() const override {
+        return compare_values("motion", optimized_, reference_);
+    }
+
+private:
+    template <class Kernel>
+    void run_into(std::vector<glm::vec2>& out, Kernel kernel) {
+        out.assign(depth_.size(), glm::vec2(0.0f));
+        parallel_for(0, height_, [&](int y0, int y1) {
+            for (int y = y0; y < y1; ++y) {
+                CameraMotionRow r = rows_[std::size_t(y)];
+                r.out = out.data() + std::size_t(y) * width_;
+                kernel(r);
+            }
+        });
+    }
+
+    int width_ = 0, height_ = 0;
+    std::vector<float> depth_;
+    std::vector<CameraMotionRow> rows_;
+    std::vector<glm::vec2> reference_, optimized_;
+};
+
 template <class T, auto... Args>
 std::unique_ptr<KernelCase> make() {
     return std::make_unique<T>(Args...);
@@ -115,6 +181,7 @@ std::unique_ptr<KernelCase> make() {
 constexpr KernelEntry kEntries[] = {
     {"codec prediction, luma", "bit-exact", true, make<PredictCase, false>},
     {"codec prediction, 4:2:0 chroma", "bit-exact", true, make<PredictCase, true>},
+    {"codec camera motion", "bit-exact", true, make<CameraMotionCase>},
 };
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 
+#include <glm/mat4x4.hpp>
 #include <glm/vec2.hpp>
 #include <glm/vec4.hpp>
 
@@ -32,5 +33,22 @@ void predict_row(const PredictRow& row);
 
 // Catmull-Rom weights per 1/64 phase, in 1/128, summing to 128 ([phase][tap]).
 const int32_t (&catmull_rom_weights())[64][4];
+
+// Camera motion of one row (geometry.cpp, camera_motion): under perspective a pixel's clip
+// position in the other camera is (a0 + x a1) + z (b0 + x b1) for finite depth z >= 0; other
+// pixels (background, negative or NaN depth, orthographic) unproject through `projection` and
+// go through `to_clip`. Out: the motion to the other camera's pixel, NaN where the point is
+// behind it or has no depth.
+struct CameraMotionRow {
+    glm::vec4 a0, a1, b0, b1;
+    glm::mat4 projection, to_clip;
+    bool perspective;
+    float far_plane;
+    int y, width, height;
+    const float* depth;
+    glm::vec2* out;
+};
+void camera_motion_row_reference(const CameraMotionRow& row, int x_begin, int x_end);
+void camera_motion_row(const CameraMotionRow& row);
 
 }  // namespace reprise::codec

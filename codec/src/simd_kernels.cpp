@@ -4,6 +4,7 @@
 // end of a row, a filter window over the plane's edge) go through the reference itself.
 #include <algorithm>
 #include <bit>
+#include <limits>
 
 #include "kernels.hpp"
 
@@ -104,6 +105,44 @@ void PredictRowSimd(const PredictRow& r) {
     predict_row_reference(r, x, r.width);
 }
 
+void CameraMotionRowSimd(const CameraMotionRow& r) {
+    if (!r.perspective) {
+        camera_motion_row_reference(r, 0, r.width);
+        return;
+    }
+    const hn::ScalableTag<float> df;
+    using VF = hn::Vec<decltype(df)>;
+    const int n = int(hn::Lanes(df));
+    auto splat = [&](float v) { return hn::Set(df, v); };
+    const VF a0x = splat(r.a0.x), a0y = splat(r.a0.y), a0w = splat(r.a0.w);
+    const VF a1x = splat(r.a1.x), a1y = splat(r.a1.y), a1w = splat(r.a1.w);
+    const VF b0x = splat(r.b0.x), b0y = splat(r.b0.y), b0w = splat(r.b0.w);
+    const VF b1x = splat(r.b1.x), b1y = splat(r.b1.y), b1w = splat(r.b1.w);
+    const VF zero = hn::Zero(df), half = splat(0.5f), one = splat(1.0f);
+    const VF inf = splat(std::numeric_limits<float>::infinity());
+    const VF nan = splat(std::numeric_limits<float>::quiet_NaN());
+    const VF fw = splat(float(r.width)), fh = splat(float(r.height));
+    const VF cy = splat(float(r.y) + 0.5f);
+    int x = 0;
+    for (; x + n <= r.width; x += n) {
+        const VF d = hn::LoadU(df, r.depth + x);
+        if (!hn::AllTrue(df, hn::And(d >= zero, d < inf))) {  // background, NaN, negative
+            camera_motion_row_reference(r, x, x + n);
+            continue;
+        }
+        const VF fx = hn::Iota(df, float(x));
+        const VF cx = (a0x + fx * a1x) + d * (b0x + fx * b1x);
+        const VF cyc = (a0y + fx * a1y) + d * (b0y + fx * b1y);
+        const VF cw = (a0w + fx * a1w) + d * (b0w + fx * b1w);
+        const auto ahead = cw > zero;
+        const VF px = (cx / cw + one) * half * fw;
+        const VF py = (one - cyc / cw) * half * fh;
+        hn::StoreInterleaved2(hn::IfThenElse(ahead, px - (fx + half), nan),
+                              hn::IfThenElse(ahead, py - cy, nan), df, &r.out[x].x);
+    }
+    camera_motion_row_reference(r, x, r.width);
+}
+
 }  // namespace reprise::codec::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
 
@@ -112,7 +151,13 @@ namespace reprise::codec {
 
 HWY_EXPORT(PredictRowSimd);
 
+HWY_EXPORT(CameraMotionRowSimd);
+
 void predict_row(const PredictRow& row) { HWY_DYNAMIC_DISPATCH(PredictRowSimd)(row); }
+
+void camera_motion_row(const CameraMotionRow& row) {
+    HWY_DYNAMIC_DISPATCH(CameraMotionRowSimd)(row);
+}
 
 }  // namespace reprise::codec
 #endif
