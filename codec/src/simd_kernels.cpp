@@ -123,18 +123,36 @@ void CameraMotionRowSimd(const CameraMotionRow& r) {
     const VF nan = splat(std::numeric_limits<float>::quiet_NaN());
     const VF fw = splat(float(r.width)), fh = splat(float(r.height));
     const VF cy = splat(float(r.y) + 0.5f);
+    // Background (depth +inf): the direction ((x_ndc wc + p20) / p00, (y_ndc wc + p21) / p11,
+    // -1, 0) with wc = -p23, through to_clip as glm multiplies (m0 v0 + m1 v1) + (m2 v2 + m3 v3).
+    const glm::mat4& P = r.projection;
+    const glm::mat4& M = r.to_clip;
+    const VF wc = splat(-P[2][3]), two = splat(2.0f), minus_one = splat(-1.0f);
+    const VF bg_y =
+        (splat(1.0f - 2.0f * (float(r.y) + 0.5f) / float(r.height)) * wc + splat(P[2][1])) /
+        splat(P[1][1]);
+    auto bg_clip = [&](int c, VF bg_x) {
+        return (splat(M[0][c]) * bg_x + splat(M[1][c]) * bg_y) +
+               (splat(M[2][c]) * minus_one + splat(M[3][c]) * zero);
+    };
     int x = 0;
     for (; x + n <= r.width; x += n) {
         const VF d = hn::LoadU(df, r.depth + x);
-        if (!hn::AllTrue(df, hn::And(d >= zero, d < inf))) {  // background, NaN, negative
-            camera_motion_row_reference(r, x, x + n);
-            continue;
-        }
+        const auto finite = hn::And(d >= zero, d < inf);
+        const auto background = d == inf;
         const VF fx = hn::Iota(df, float(x));
-        const VF cx = (a0x + fx * a1x) + d * (b0x + fx * b1x);
-        const VF cyc = (a0y + fx * a1y) + d * (b0y + fx * b1y);
-        const VF cw = (a0w + fx * a1w) + d * (b0w + fx * b1w);
-        const auto ahead = cw > zero;
+        VF cx = (a0x + fx * a1x) + d * (b0x + fx * b1x);
+        VF cyc = (a0y + fx * a1y) + d * (b0y + fx * b1y);
+        VF cw = (a0w + fx * a1w) + d * (b0w + fx * b1w);
+        if (!hn::AllFalse(df, background)) {
+            const VF x_ndc = two * (fx + half) / fw - one;
+            const VF bg_x = (x_ndc * wc + splat(P[2][0])) / splat(P[0][0]);
+            cx = hn::IfThenElse(background, bg_clip(0, bg_x), cx);
+            cyc = hn::IfThenElse(background, bg_clip(1, bg_x), cyc);
+            cw = hn::IfThenElse(background, bg_clip(3, bg_x), cw);
+        }
+        // NaN and negative depths have no point: NaN, as for points behind the camera.
+        const auto ahead = hn::And(hn::Or(finite, background), cw > zero);
         const VF px = (cx / cw + one) * half * fw;
         const VF py = (one - cyc / cw) * half * fh;
         hn::StoreInterleaved2(hn::IfThenElse(ahead, px - (fx + half), nan),
