@@ -1,5 +1,6 @@
 #include "reprise/codec/kernel_registry.hpp"
 
+#include <cmath>
 #include <cstring>
 #include <limits>
 #include <memory>
@@ -173,6 +174,112 @@ private:
     std::vector<glm::vec2> reference_, optimized_;
 };
 
+// Colour to YCoCg-R planes. Random: linear colour over [0, 1.2] (codes near 0 and above 255
+// included); worst case: NaN, Inf, negative, denormal and values just around the thresholds.
+class ToPlanesCase final : public KernelCase {
+public:
+    void generate(int w, int h, KernelInputs inputs, uint32_t seed) override {
+        std::mt19937 rng(seed);
+        width_ = w, height_ = h;
+        color_.resize(std::size_t(w) * h);
+        const float* thresholds = srgb_tables().thresholds;
+        for (glm::vec4& c : color_)
+            for (int k = 0; k < 4; ++k) {
+                float v = uniform(rng, 0.0f, 1.2f);
+                if (rng() % 4 == 0) v = v * v * v * 0.01f;  // the steep part near black
+                if (inputs == KernelInputs::WorstCase && rng() % 2) {
+                    const float t = thresholds[rng() % 255];
+                    const float choices[] = {
+                        worst_value(rng),        t,    std::nextafter(t, 0.0f),
+                        std::nextafter(t, 2.0f), 1.0f, std::nextafter(1.0f, 0.0f)};
+                    v = choices[rng() % std::size(choices)];
+                }
+                c[k] = v;
+            }
+    }
+    void run_reference() override {
+        run_into(reference_, [](const ToPlanesRow& r) { to_planes_row_reference(r, 0, r.width); });
+    }
+    void run() override { run_into(optimized_, to_planes_row); }
+    std::string compare() const override {
+        return compare_values("planes", optimized_, reference_);
+    }
+
+private:
+    template <class Kernel>
+    void run_into(std::vector<int16_t>& out, Kernel kernel) {
+        const std::size_t n = color_.size();
+        out.assign(3 * n, 0);
+        parallel_for(0, height_, [&](int y0, int y1) {
+            for (int y = y0; y < y1; ++y) {
+                const std::size_t o = std::size_t(y) * width_;
+                kernel({.color = color_.data() + o,
+                        .width = width_,
+                        .y = out.data() + o,
+                        .co = out.data() + n + o,
+                        .cg = out.data() + 2 * n + o});
+            }
+        });
+    }
+
+    int width_ = 0, height_ = 0;
+    std::vector<glm::vec4> color_;
+    std::vector<int16_t> reference_, optimized_;
+};
+
+// YCoCg-R planes to linear colour. Random: the codec's value ranges; worst case: values beyond
+// them (every clamp) and NaN/Inf depths.
+class FromPlanesCase final : public KernelCase {
+public:
+    void generate(int w, int h, KernelInputs inputs, uint32_t seed) override {
+        std::mt19937 rng(seed);
+        width_ = w, height_ = h;
+        const bool worst = inputs == KernelInputs::WorstCase;
+        const std::size_t n = std::size_t(w) * h;
+        planes_.resize(3 * n);
+        depth_.resize(n);
+        for (std::size_t i = 0; i < n; ++i) {
+            const int range = worst ? 2000 : 256;
+            planes_[i] = int16_t(int(rng() % uint32_t(range)) - (worst ? 1000 : 0));
+            planes_[n + i] = int16_t(int(rng() % uint32_t(2 * range)) - range);
+            planes_[2 * n + i] = int16_t(int(rng() % uint32_t(2 * range)) - range);
+            depth_[i] = rng() % 8 == 0 ? kInf : uniform(rng, 0.1f, 50.0f);
+            if (worst && rng() % 3 == 0) depth_[i] = worst_value(rng);
+        }
+    }
+    void run_reference() override {
+        run_into(reference_,
+                 [](const FromPlanesRow& r) { from_planes_row_reference(r, 0, r.width); });
+    }
+    void run() override { run_into(optimized_, from_planes_row); }
+    std::string compare() const override {
+        return compare_values("colour", optimized_, reference_);
+    }
+
+private:
+    template <class Kernel>
+    void run_into(std::vector<glm::vec4>& out, Kernel kernel) {
+        const std::size_t n = depth_.size();
+        out.assign(n, glm::vec4(0.0f));
+        parallel_for(0, height_, [&](int y0, int y1) {
+            for (int y = y0; y < y1; ++y) {
+                const std::size_t o = std::size_t(y) * width_;
+                kernel({.y = planes_.data() + o,
+                        .co = planes_.data() + n + o,
+                        .cg = planes_.data() + 2 * n + o,
+                        .depth = y % 2 ? depth_.data() + o : nullptr,
+                        .width = width_,
+                        .out = out.data() + o});
+            }
+        });
+    }
+
+    int width_ = 0, height_ = 0;
+    std::vector<int16_t> planes_;
+    std::vector<float> depth_;
+    std::vector<glm::vec4> reference_, optimized_;
+};
+
 template <class T, auto... Args>
 std::unique_ptr<KernelCase> make() {
     return std::make_unique<T>(Args...);
@@ -182,6 +289,8 @@ constexpr KernelEntry kEntries[] = {
     {"codec prediction, luma", "bit-exact", true, make<PredictCase, false>},
     {"codec prediction, 4:2:0 chroma", "bit-exact", true, make<PredictCase, true>},
     {"codec camera motion", "bit-exact", true, make<CameraMotionCase>},
+    {"codec colour to YCoCg-R", "bit-exact", true, make<ToPlanesCase>},
+    {"codec YCoCg-R to colour", "bit-exact", true, make<FromPlanesCase>},
 };
 
 }  // namespace

@@ -51,4 +51,38 @@ struct CameraMotionRow {
 void camera_motion_row_reference(const CameraMotionRow& row, int x_begin, int x_end);
 void camera_motion_row(const CameraMotionRow& row);
 
+// Colour conversion of one row into YCoCg-R: linear RGB -> 8-bit sRGB codes (colour.cpp's
+// table and thresholds) -> y, co, cg.
+struct ToPlanesRow {
+    const glm::vec4* color;
+    int width;
+    int16_t* y;
+    int16_t* co;
+    int16_t* cg;
+};
+void to_planes_row_reference(const ToPlanesRow& row, int x_begin, int x_end);
+void to_planes_row(const ToPlanesRow& row);
+// The 8-bit code's table: start[i] is the code of i / kSrgbSteps, thresholds[k] the linear
+// value where code k + 1 begins.
+inline constexpr int kSrgbSteps = 4096;
+struct SrgbTables {
+    int32_t start[kSrgbSteps + 1];
+    float thresholds[256];  // [255] = +inf
+    float to_linear[256];
+};
+const SrgbTables& srgb_tables();
+
+// One row of YCoCg-R (chroma at full resolution) -> linear RGB; alpha 0 where the depth is
+// not finite (no depth: 1).
+struct FromPlanesRow {
+    const int16_t* y;
+    const int16_t* co;
+    const int16_t* cg;
+    const float* depth;  // null without depth
+    int width;
+    glm::vec4* out;
+};
+void from_planes_row_reference(const FromPlanesRow& row, int x_begin, int x_end);
+void from_planes_row(const FromPlanesRow& row);
+
 }  // namespace reprise::codec

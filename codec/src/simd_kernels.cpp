@@ -161,6 +161,74 @@ void CameraMotionRowSimd(const CameraMotionRow& r) {
     camera_motion_row_reference(r, x, r.width);
 }
 
+void ToPlanesRowSimd(const ToPlanesRow& r) {
+    const hn::ScalableTag<float> df;
+    const hn::RebindToSigned<decltype(df)> di;
+    const hn::Rebind<int16_t, decltype(df)> d16;
+    using VF = hn::Vec<decltype(df)>;
+    using VI = hn::Vec<decltype(di)>;
+    const int n = int(hn::Lanes(df));
+    const SrgbTables& t = srgb_tables();
+    const VF zero = hn::Zero(df), one = hn::Set(df, 1.0f), steps = hn::Set(df, float(kSrgbSteps));
+    const VI zero_i = hn::Zero(di), one_i = hn::Set(di, 1), top = hn::Set(di, 255);
+    auto code = [&](VF v) {
+        const auto positive = v > zero, saturated = v >= one;
+        const VF inside = hn::IfThenElseZero(hn::AndNot(saturated, positive), v);
+        VI c = hn::GatherIndex(di, t.start, hn::ConvertTo(di, inside * steps));
+        for (;;) {  // up the thresholds (thresholds[255] = +inf stops every lane)
+            const auto up = hn::RebindMask(di, inside >= hn::GatherIndex(df, t.thresholds, c));
+            if (hn::AllFalse(di, up)) break;
+            c = c + hn::IfThenElseZero(up, one_i);
+        }
+        return hn::IfThenElse(hn::RebindMask(di, saturated), top,
+                              hn::IfThenElse(hn::RebindMask(di, positive), c, zero_i));
+    };
+    int x = 0;
+    for (; x + n <= r.width; x += n) {
+        VF red, green, blue, alpha;
+        hn::LoadInterleaved4(df, &r.color[x].x, red, green, blue, alpha);
+        const VI R = code(red), G = code(green), B = code(blue);
+        const VI co = R - B;
+        const VI tt = B + hn::ShiftRight<1>(co);
+        const VI cg = G - tt;
+        hn::StoreU(hn::DemoteTo(d16, tt + hn::ShiftRight<1>(cg)), d16, r.y + x);
+        hn::StoreU(hn::DemoteTo(d16, co), d16, r.co + x);
+        hn::StoreU(hn::DemoteTo(d16, cg), d16, r.cg + x);
+    }
+    to_planes_row_reference(r, x, r.width);
+}
+
+void FromPlanesRowSimd(const FromPlanesRow& r) {
+    const hn::ScalableTag<float> df;
+    const hn::RebindToSigned<decltype(df)> di;
+    const hn::Rebind<int16_t, decltype(df)> d16;
+    using VF = hn::Vec<decltype(df)>;
+    using VI = hn::Vec<decltype(di)>;
+    const int n = int(hn::Lanes(df));
+    const float* lut = srgb_tables().to_linear;
+    const VI zero_i = hn::Zero(di), top = hn::Set(di, 255);
+    const VF zero = hn::Zero(df), one = hn::Set(df, 1.0f);
+    auto clamp = [&](VI v) { return hn::Min(hn::Max(v, zero_i), top); };
+    int x = 0;
+    for (; x + n <= r.width; x += n) {
+        const VI y = hn::PromoteTo(di, hn::LoadU(d16, r.y + x));
+        const VI co = hn::PromoteTo(di, hn::LoadU(d16, r.co + x));
+        const VI cg = hn::PromoteTo(di, hn::LoadU(d16, r.cg + x));
+        const VI tt = y - hn::ShiftRight<1>(cg);
+        const VI G = clamp(cg + tt);
+        const VI B = clamp(tt - hn::ShiftRight<1>(co));
+        const VI R = clamp(tt - hn::ShiftRight<1>(co) + co);
+        VF alpha = one;
+        if (r.depth) {
+            const VF d = hn::LoadU(df, r.depth + x);
+            alpha = hn::IfThenElseZero((d - d) == zero, one);
+        }
+        hn::StoreInterleaved4(hn::GatherIndex(df, lut, R), hn::GatherIndex(df, lut, G),
+                              hn::GatherIndex(df, lut, B), alpha, df, &r.out[x].x);
+    }
+    from_planes_row_reference(r, x, r.width);
+}
+
 }  // namespace reprise::codec::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
 
@@ -170,6 +238,12 @@ namespace reprise::codec {
 HWY_EXPORT(PredictRowSimd);
 
 HWY_EXPORT(CameraMotionRowSimd);
+HWY_EXPORT(ToPlanesRowSimd);
+HWY_EXPORT(FromPlanesRowSimd);
+
+void to_planes_row(const ToPlanesRow& row) { HWY_DYNAMIC_DISPATCH(ToPlanesRowSimd)(row); }
+
+void from_planes_row(const FromPlanesRow& row) { HWY_DYNAMIC_DISPATCH(FromPlanesRowSimd)(row); }
 
 void predict_row(const PredictRow& row) { HWY_DYNAMIC_DISPATCH(PredictRowSimd)(row); }
 
