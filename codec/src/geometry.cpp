@@ -143,32 +143,62 @@ void reproject_depth(const Camera& from, ImageView<const float> depth, const Cam
     parallel_for(0, h, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y) std::fill(out.row(y), out.row(y) + w, kNan);
     });
-    const Unprojector un = unprojector(from, w, h);
     const glm::mat4 to_camera = between(from.view, to.view);
     const glm::mat4 to_clip = glm::mat4(glm::dmat4(to.projection) * glm::dmat4(to_camera));
     // Each pixel keeps the nearest landing (NaN: none), whatever order they land in: rows are
     // projected in parallel and a landing takes its slot by compare-and-swap.
+    float* slots = out.data;
+    REPRISE_ASSERT(out.stride == w);
     parallel_for(0, h, [&](int y0, int y1) {
-        for (int y = y0; y < y1; ++y) {
-            const float* z = depth.row(y);
-            for (int x = 0; x < w; ++x) {
-                glm::vec4 point;
-                if (!(z[x] < kInf) || !un.point(x, y, z[x], point)) continue;
-                const glm::vec4 clip = to_clip * point;
-                if (!(clip.w > 0.0f)) continue;
-                const float px = (clip.x / clip.w + 1.0f) * 0.5f * float(w);
-                const float py = (1.0f - clip.y / clip.w) * 0.5f * float(h);
-                if (!(px >= 0.0f && py >= 0.0f && px < float(w) && py < float(h))) continue;
-                const float tz = -(to_camera * point).z;
-                if (!(tz > 0.0f)) continue;
-                std::atomic_ref<float> slot(out(int(px), int(py)));
-                float held = slot.load(std::memory_order_relaxed);
-                while (!(tz >= held) &&
-                       !slot.compare_exchange_weak(held, tz, std::memory_order_relaxed)) {
+        constexpr int kChunk = 256;
+        int32_t slot[kChunk];
+        float tz[kChunk];
+        for (int y = y0; y < y1; ++y)
+            for (int x0 = 0; x0 < w; x0 += kChunk) {
+                const int n = std::min(kChunk, w - x0);
+                forward_row({.projection = from.projection,
+                             .to_clip = to_clip,
+                             .to_camera = to_camera,
+                             .x0 = x0,
+                             .y = y,
+                             .count = n,
+                             .width = w,
+                             .height = h,
+                             .depth = depth.row(y) + x0,
+                             .slot = slot,
+                             .z = tz});
+                for (int i = 0; i < n; ++i) {
+                    if (slot[i] < 0) continue;
+                    std::atomic_ref<float> target(slots[slot[i]]);
+                    float held = target.load(std::memory_order_relaxed);
+                    while (!(tz[i] >= held) &&
+                           !target.compare_exchange_weak(held, tz[i], std::memory_order_relaxed)) {
+                    }
                 }
             }
-        }
     });
+}
+
+void forward_row_reference(const ForwardRow& r, int i_begin, int i_end) {
+    const Unprojector un{r.projection, r.projection[2][3] != 0.0f, 1e6f, float(r.width),
+                         float(r.height)};
+    const int w = r.width, h = r.height;
+    for (int i = i_begin; i < i_end; ++i) {
+        const int x = r.x0 + i;
+        r.slot[i] = -1;
+        const float z = r.depth[i];
+        glm::vec4 point;
+        if (!(z < kInf) || !un.point(x, r.y, z, point)) continue;
+        const glm::vec4 clip = r.to_clip * point;
+        if (!(clip.w > 0.0f)) continue;
+        const float px = (clip.x / clip.w + 1.0f) * 0.5f * float(w);
+        const float py = (1.0f - clip.y / clip.w) * 0.5f * float(h);
+        if (!(px >= 0.0f && py >= 0.0f && px < float(w) && py < float(h))) continue;
+        const float tz = -(r.to_camera * point).z;
+        if (!(tz > 0.0f)) continue;
+        r.slot[i] = int32_t(py) * w + int32_t(px);
+        r.z[i] = tz;
+    }
 }
 
 namespace {

@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include <glm/gtc/matrix_transform.hpp>
+
 #include "kernels.hpp"
 #include "reprise/core/parallel.hpp"
 
@@ -280,6 +282,81 @@ private:
     std::vector<glm::vec4> reference_, optimized_;
 };
 
+// Forward projection of depth into another camera. Random: a scene in front of both cameras
+// (perspective or orthographic) with background; worst case: NaN/Inf/negative/signed-zero
+// depths and a camera that moved far forward, so that points fall behind it.
+class ForwardCase final : public KernelCase {
+public:
+    void generate(int w, int h, KernelInputs inputs, uint32_t seed) override {
+        std::mt19937 rng(seed);
+        width_ = w, height_ = h;
+        const bool worst = inputs == KernelInputs::WorstCase;
+        depth_.resize(std::size_t(w) * h);
+        for (float& z : depth_) {
+            z = rng() % 10 == 0 ? kInf : uniform(rng, 0.2f, 60.0f);
+            if (worst && rng() % 3 == 0) z = worst_value(rng);
+        }
+        const bool ortho = seed % 3 == 0;
+        projection_ =
+            ortho ? glm::ortho(-4.0f, 4.0f, -3.0f, 3.0f, 0.1f, 50.0f)
+                  : glm::perspective(uniform(rng, 0.5f, 1.5f), float(w) / float(h), 0.1f, 100.0f);
+        const float forward = worst ? uniform(rng, 5.0f, 30.0f) : uniform(rng, -0.3f, 0.3f);
+        to_camera_ = glm::rotate(
+            glm::translate(glm::mat4(1.0f), glm::vec3(uniform(rng, -0.5f, 0.5f),
+                                                      uniform(rng, -0.2f, 0.2f), forward)),
+            uniform(rng, -0.1f, 0.1f), glm::vec3(0, 1, 0));
+        to_clip_ = projection_ * to_camera_;
+    }
+    void run_reference() override {
+        run_into(reference_, [](const ForwardRow& r) { forward_row_reference(r, 0, r.count); });
+    }
+    void run() override { run_into(optimized_, forward_row); }
+    std::string compare() const override {
+        for (std::size_t i = 0; i < reference_.slot.size(); ++i) {
+            if (optimized_.slot[i] != reference_.slot[i])
+                return "pixel " + std::to_string(i) + " lands at " +
+                       std::to_string(optimized_.slot[i]) + ", reference " +
+                       std::to_string(reference_.slot[i]);
+            if (reference_.slot[i] >= 0 &&
+                std::memcmp(&optimized_.z[i], &reference_.z[i], sizeof(float)) != 0)
+                return "pixel " + std::to_string(i) + ": depth differs";
+        }
+        return {};
+    }
+
+private:
+    struct Output {
+        std::vector<int32_t> slot;
+        std::vector<float> z;
+    };
+    template <class Kernel>
+    void run_into(Output& out, Kernel kernel) {
+        out.slot.assign(depth_.size(), 0);
+        out.z.assign(depth_.size(), 0.0f);
+        parallel_for(0, height_, [&](int y0, int y1) {
+            for (int y = y0; y < y1; ++y) {
+                const std::size_t o = std::size_t(y) * width_;
+                kernel({.projection = projection_,
+                        .to_clip = to_clip_,
+                        .to_camera = to_camera_,
+                        .x0 = 0,
+                        .y = y,
+                        .count = width_,
+                        .width = width_,
+                        .height = height_,
+                        .depth = depth_.data() + o,
+                        .slot = out.slot.data() + o,
+                        .z = out.z.data() + o});
+            }
+        });
+    }
+
+    int width_ = 0, height_ = 0;
+    std::vector<float> depth_;
+    glm::mat4 projection_{1.0f}, to_clip_{1.0f}, to_camera_{1.0f};
+    Output reference_, optimized_;
+};
+
 template <class T, auto... Args>
 std::unique_ptr<KernelCase> make() {
     return std::make_unique<T>(Args...);
@@ -289,6 +366,7 @@ constexpr KernelEntry kEntries[] = {
     {"codec prediction, luma", "bit-exact", true, make<PredictCase, false>},
     {"codec prediction, 4:2:0 chroma", "bit-exact", true, make<PredictCase, true>},
     {"codec camera motion", "bit-exact", true, make<CameraMotionCase>},
+    {"codec depth forward projection", "bit-exact", true, make<ForwardCase>},
     {"codec colour to YCoCg-R", "bit-exact", true, make<ToPlanesCase>},
     {"codec YCoCg-R to colour", "bit-exact", true, make<FromPlanesCase>},
 };

@@ -229,6 +229,49 @@ void FromPlanesRowSimd(const FromPlanesRow& r) {
     from_planes_row_reference(r, x, r.width);
 }
 
+void ForwardRowSimd(const ForwardRow& r) {
+    const hn::ScalableTag<float> df;
+    const hn::RebindToSigned<decltype(df)> di;
+    using VF = hn::Vec<decltype(df)>;
+    const int n = int(hn::Lanes(df));
+    auto splat = [&](float v) { return hn::Set(df, v); };
+    const glm::mat4& P = r.projection;
+    const glm::mat4& M = r.to_clip;
+    const glm::mat4& C = r.to_camera;
+    const VF zero = hn::Zero(df), half = splat(0.5f), one = splat(1.0f), two = splat(2.0f);
+    const VF inf = splat(std::numeric_limits<float>::infinity());
+    const VF fw = splat(float(r.width)), fh = splat(float(r.height));
+    const VF y_ndc = splat(1.0f - 2.0f * (float(r.y) + 0.5f) / float(r.height));
+    const auto width_i = hn::Set(di, r.width), none = hn::Set(di, -1);
+    // Row c of a glm matrix times (vx, vy, zv, 1), summed as glm sums it.
+    auto times = [&](const glm::mat4& m, int c, VF vx, VF vy, VF zv) {
+        return (splat(m[0][c]) * vx + splat(m[1][c]) * vy) +
+               (splat(m[2][c]) * zv + splat(m[3][c]) * one);
+    };
+    int i = 0;
+    for (; i + n <= r.count; i += n) {
+        const VF z = hn::LoadU(df, r.depth + i);
+        const auto has_point = hn::And(z < inf, z >= zero);
+        const VF fx = hn::Iota(df, float(r.x0 + i));
+        const VF x_ndc = two * (fx + half) / fw - one;
+        const VF zv = hn::Neg(z);
+        const VF wc = splat(P[2][3]) * zv + splat(P[3][3]);
+        const VF vx = (x_ndc * wc - splat(P[2][0]) * zv - splat(P[3][0])) / splat(P[0][0]);
+        const VF vy = (y_ndc * wc - splat(P[2][1]) * zv - splat(P[3][1])) / splat(P[1][1]);
+        const VF cx = times(M, 0, vx, vy, zv), cy = times(M, 1, vx, vy, zv);
+        const VF cw = times(M, 3, vx, vy, zv);
+        const VF px = (cx / cw + one) * half * fw;
+        const VF py = (one - cy / cw) * half * fh;
+        const VF tz = hn::Neg(times(C, 2, vx, vy, zv));
+        const auto inside = hn::And(hn::And(px >= zero, py >= zero), hn::And(px < fw, py < fh));
+        const auto lands = hn::And(hn::And(has_point, cw > zero), hn::And(inside, tz > zero));
+        const auto slot = hn::ConvertTo(di, py) * width_i + hn::ConvertTo(di, px);
+        hn::StoreU(hn::IfThenElse(hn::RebindMask(di, lands), slot, none), di, r.slot + i);
+        hn::StoreU(tz, df, r.z + i);
+    }
+    forward_row_reference(r, i, r.count);
+}
+
 }  // namespace reprise::codec::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
 
@@ -240,6 +283,9 @@ HWY_EXPORT(PredictRowSimd);
 HWY_EXPORT(CameraMotionRowSimd);
 HWY_EXPORT(ToPlanesRowSimd);
 HWY_EXPORT(FromPlanesRowSimd);
+HWY_EXPORT(ForwardRowSimd);
+
+void forward_row(const ForwardRow& row) { HWY_DYNAMIC_DISPATCH(ForwardRowSimd)(row); }
 
 void to_planes_row(const ToPlanesRow& row) { HWY_DYNAMIC_DISPATCH(ToPlanesRowSimd)(row); }
 
