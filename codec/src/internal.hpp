@@ -6,6 +6,7 @@
 
 #include "range_coder.hpp"
 #include "reprise/codec/codec.hpp"
+#include "reprise/core/byte_io.hpp"
 
 namespace reprise::codec {
 
@@ -71,7 +72,6 @@ void write_packet(const PacketHeader& header, std::span<const uint8_t> payload,
 Status parse_packet(std::span<const uint8_t> packet, PacketHeader& header,
                     std::span<const uint8_t>& payload);
 void write_params(const SequenceParams& sp, std::vector<uint8_t>& out);
-class ByteReader;
 Status read_params(ByteReader& r, SequenceParams& sp);
 int default_slices(int height);
 
