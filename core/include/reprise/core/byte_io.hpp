@@ -53,7 +53,11 @@ class ByteWriter : public LittleEndianWriter<ByteWriter> {
 public:
     explicit ByteWriter(std::vector<uint8_t>& out) : out_(out) {}
     std::size_t size() const { return out_.size(); }  // of the whole vector
-    void put(const uint8_t* p, std::size_t n) { out_.insert(out_.end(), p, p + n); }
+    void put(const uint8_t* p, std::size_t n) {
+        const std::size_t at = out_.size();
+        out_.resize(at + n);
+        if (n) std::memcpy(out_.data() + at, p, n);
+    }
 
 private:
     std::vector<uint8_t>& out_;
