@@ -152,7 +152,12 @@ void encode_slice(SliceJob& j, std::vector<uint8_t>& bytes, std::vector<uint8_t>
             uint64_t cost = 0;
             bool spatial_known = false;
             if (inter) {
-                for (int y = by; y < by + bh; ++y)
+                // Most blocks of a moving camera's depth are predicted exactly (no code equals
+                // kNoPrediction): a plain comparison finds them.
+                bool exact = true;
+                for (int y = by; y < by + bh && exact; ++y)
+                    exact = std::equal(&j.codes(bx, y), &j.codes(bx, y) + bw, &j.temporal(bx, y));
+                for (int y = by; y < by + bh && !exact; ++y)
                     for (int x = bx; x < bx + bw; ++x) {
                         uint32_t p = j.temporal(x, y);
                         if (p == kNoPrediction) p = spatial(j, x, y);
@@ -178,12 +183,13 @@ void encode_slice(SliceJob& j, std::vector<uint8_t>& bytes, std::vector<uint8_t>
             rc.bit(m.zero_block[use_temporal], cost == 0);
             j.zero_blocks += cost == 0;
             block_flags[b] = uint8_t(use_temporal) | uint8_t(cost == 0) << 1;
+            if (cost == 0) {
+                for (int y = by; y < by + bh; ++y)
+                    std::fill(&j.residuals(bx, y), &j.residuals(bx, y) + bw, 0u);
+                continue;
+            }
             for (int y = by; y < by + bh; ++y)
                 for (int x = bx; x < bx + bw; ++x) {
-                    if (cost == 0) {
-                        j.residuals(x, y) = 0;
-                        continue;
-                    }
                     uint32_t p = use_temporal ? j.temporal(x, y) : kNoPrediction;
                     if (p == kNoPrediction)
                         p = spatial_known ? spatial_codes[(y - by) * kBlock + (x - bx)]
@@ -192,11 +198,12 @@ void encode_slice(SliceJob& j, std::vector<uint8_t>& bytes, std::vector<uint8_t>
                 }
         }
         for (int y = by; y < by + bh; ++y)
-            for (int x = 0; x < j.width; ++x) {
-                const uint8_t flags = block_flags[x / kBlock];
+            for (int b = 0; b < blocks; ++b) {
+                const uint8_t flags = block_flags[b];
                 if (flags & 2) continue;
-                encode_int(rc, m.residual[flags & 1][residual_context(j, x, y)],
-                           int64_t(int32_t(j.residuals(x, y))));
+                for (int x = b * kBlock; x < std::min(j.width, (b + 1) * kBlock); ++x)
+                    encode_int(rc, m.residual[flags & 1][residual_context(j, x, y)],
+                               int64_t(int32_t(j.residuals(x, y))));
             }
     }
     rc.finish();
