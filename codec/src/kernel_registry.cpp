@@ -64,8 +64,8 @@ public:
         for (int y = 0; y < motion_height_; ++y)
             for (int x = 0; x < motion_width_; ++x) {
                 glm::vec2 m = pan + glm::vec2(0.01f * float(x), -0.005f * float(y));
-                if (x > motion_width_ / 2) m *= 1.5f;  // a depth edge
-                if (rng() % 5 == 0) m = {std::round(m.x), std::round(m.y)};
+                if (x > motion_width_ / 2) m *= 1.5f;                    // a depth edge
+                if (y % 4 == 1) m = {std::round(m.x), std::round(m.y)};  // whole pixels
                 if (worst && rng() % 3 == 0) m[int(rng() % 2)] = worst_value(rng);
                 motion_[std::size_t(y) * motion_width_ + x] = m;
             }

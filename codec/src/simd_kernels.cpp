@@ -84,17 +84,32 @@ void PredictRowSimd(const PredictRow& r) {
             wx[i] = hn::GatherIndex(di, weights, px4 + hn::Set(di, i));
             wy[i] = hn::GatherIndex(di, weights, py4 + hn::Set(di, i));
         }
-        // Byte offsets of the window's top-left sample; each 32-bit gather takes two samples.
-        VI offset = hn::ShiftLeft<1>((iy - one) * stride + (ix - one));
-        const VI row_bytes = hn::Set(di, 2 * r.width);
         VI sum = zero_i;
-        for (int j = 0; j < 4; ++j, offset = offset + row_bytes) {
-            const VI a = hn::GatherOffset(di, base, offset);
-            const VI b = hn::GatherOffset(di, base, offset + two + two);
-            const VI line =
-                wx[0] * hn::ShiftRight<16>(hn::ShiftLeft<16>(a)) + wx[1] * hn::ShiftRight<16>(a) +
-                wx[2] * hn::ShiftRight<16>(hn::ShiftLeft<16>(b)) + wx[3] * hn::ShiftRight<16>(b);
-            sum = sum + wy[j] * line;
+        const int ix0 = hn::GetLane(ix), iy0 = hn::GetLane(iy);
+        if (hn::AllTrue(di, hn::And(ix == hn::Iota(di, ix0), iy == hn::Set(di, iy0)))) {
+            // Adjacent windows (the usual case: motion changes slowly along a row): each tap's
+            // samples are one contiguous load.
+            const int16_t* row = r.reference + std::size_t(iy0 - 1) * r.width + (ix0 - 1);
+            for (int j = 0; j < 4; ++j, row += r.width) {
+                const VI line = wx[0] * hn::PromoteTo(di, hn::LoadU(d16, row)) +
+                                wx[1] * hn::PromoteTo(di, hn::LoadU(d16, row + 1)) +
+                                wx[2] * hn::PromoteTo(di, hn::LoadU(d16, row + 2)) +
+                                wx[3] * hn::PromoteTo(di, hn::LoadU(d16, row + 3));
+                sum = sum + wy[j] * line;
+            }
+        } else {
+            // Byte offsets of each window's top-left sample; a 32-bit gather takes two samples.
+            VI offset = hn::ShiftLeft<1>((iy - one) * stride + (ix - one));
+            const VI row_bytes = hn::Set(di, 2 * r.width);
+            for (int j = 0; j < 4; ++j, offset = offset + row_bytes) {
+                const VI a = hn::GatherOffset(di, base, offset);
+                const VI b = hn::GatherOffset(di, base, offset + two + two);
+                const VI line = wx[0] * hn::ShiftRight<16>(hn::ShiftLeft<16>(a)) +
+                                wx[1] * hn::ShiftRight<16>(a) +
+                                wx[2] * hn::ShiftRight<16>(hn::ShiftLeft<16>(b)) +
+                                wx[3] * hn::ShiftRight<16>(b);
+                sum = sum + wy[j] * line;
+            }
         }
         const VI value = hn::ShiftRight<14>(sum + round);
         // Whole-pixel positions (weights 0, 128, 0, 0) copy the sample unclamped.
