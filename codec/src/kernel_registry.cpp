@@ -357,6 +357,60 @@ private:
     Output reference_, optimized_;
 };
 
+// The motion residual test, row by row. Random: the renderer's motion equal to the camera's, or
+// off by less than, about, or more than 1/16 pixel (only some rows differ); worst case: NaN/Inf
+// on either side and differences beyond the residual's range.
+class MotionResidualCase final : public KernelCase {
+public:
+    void generate(int w, int h, KernelInputs inputs, uint32_t seed) override {
+        std::mt19937 rng(seed);
+        width_ = w, height_ = h;
+        const bool worst = inputs == KernelInputs::WorstCase;
+        source_.resize(std::size_t(w) * h);
+        base_.resize(source_.size());
+        for (int y = 0; y < h; ++y) {
+            const float spread = y % 3 == 0 ? 0.0f : y % 3 == 1 ? 0.0624f : 0.5f;
+            for (int x = 0; x < w; ++x) {
+                const std::size_t i = std::size_t(y) * w + x;
+                base_[i] = {uniform(rng, -30, 30), uniform(rng, -30, 30)};
+                source_[i] = base_[i];
+                if (rng() % 4 == 0)
+                    source_[i] +=
+                        glm::vec2(uniform(rng, -spread, spread), uniform(rng, -spread, spread));
+                if (worst && rng() % 4 == 0) {
+                    glm::vec2& v = rng() % 2 ? source_[i] : base_[i];
+                    v[int(rng() % 2)] = worst_value(rng);
+                }
+            }
+        }
+    }
+    void run_reference() override {
+        run_into(reference_, [](const MotionResidualRow& r) {
+            return motion_residual_row_reference(r, 0, r.width);
+        });
+    }
+    void run() override { run_into(optimized_, motion_residual_row); }
+    std::string compare() const override {
+        return compare_values("row needs a residual", optimized_, reference_);
+    }
+
+private:
+    template <class Kernel>
+    void run_into(std::vector<uint8_t>& out, Kernel kernel) {
+        out.assign(std::size_t(height_), 0);
+        parallel_for(0, height_, [&](int y0, int y1) {
+            for (int y = y0; y < y1; ++y) {
+                const std::size_t o = std::size_t(y) * width_;
+                out[std::size_t(y)] = kernel({source_.data() + o, base_.data() + o, width_});
+            }
+        });
+    }
+
+    int width_ = 0, height_ = 0;
+    std::vector<glm::vec2> source_, base_;
+    std::vector<uint8_t> reference_, optimized_;
+};
+
 template <class T, auto... Args>
 std::unique_ptr<KernelCase> make() {
     return std::make_unique<T>(Args...);
@@ -367,6 +421,7 @@ constexpr KernelEntry kEntries[] = {
     {"codec prediction, 4:2:0 chroma", "bit-exact", true, make<PredictCase, true>},
     {"codec camera motion", "bit-exact", true, make<CameraMotionCase>},
     {"codec depth forward projection", "bit-exact", true, make<ForwardCase>},
+    {"codec motion residual test", "bit-exact", true, make<MotionResidualCase>},
     {"codec colour to YCoCg-R", "bit-exact", true, make<ToPlanesCase>},
     {"codec YCoCg-R to colour", "bit-exact", true, make<FromPlanesCase>},
 };

@@ -99,4 +99,14 @@ struct ForwardRow {
 void forward_row_reference(const ForwardRow& row, int i_begin, int i_end);
 void forward_row(const ForwardRow& row);
 
+// Whether any pixel of a row needs a motion residual (motion.cpp): the renderer's motion differs
+// from the camera motion by 1/16 pixel or more, or exactly one of them is not finite.
+struct MotionResidualRow {
+    const glm::vec2* source;
+    const glm::vec2* base;
+    int width;
+};
+bool motion_residual_row_reference(const MotionResidualRow& row, int x_begin, int x_end);
+bool motion_residual_row(const MotionResidualRow& row);
+
 }  // namespace reprise::codec

@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "internal.hpp"
+#include "kernels.hpp"
 #include "slices.hpp"
 
 namespace reprise::codec {
@@ -80,6 +81,16 @@ inline Residual neighbour_prediction(const SliceJob& j, int x, int y) {
     if (top && !top->zero() && !top->invalid) return *top;
     return {};
 }
+
+}  // namespace
+
+bool motion_residual_row_reference(const MotionResidualRow& r, int x_begin, int x_end) {
+    for (int x = x_begin; x < x_end; ++x)
+        if (!residual_of(r.source[x], r.base[x]).zero()) return true;
+    return false;
+}
+
+namespace {
 
 template <bool Encode, class Coder>
 bool code_slice(SliceJob& j, Coder& rc) {
@@ -184,16 +195,13 @@ void encode_motion(const FrameContext& fc, const Camera& camera, ImageView<const
     if (!source.empty())
         parallel_for(0, h, [&](int y0, int y1) {
             for (int y = y0; y < y1 && !any.load(std::memory_order_relaxed); ++y)
-                for (int x = 0; x < w; ++x)
-                    if (!residual_of(source(x, y), base(x, y)).zero()) {
-                        any.store(true, std::memory_order_relaxed);
-                        break;
-                    }
+                if (motion_residual_row({source.row(y), base.data() + std::size_t(y) * w, w}))
+                    any.store(true, std::memory_order_relaxed);
         });
     ByteWriter wr(bytes);
     wr.u8(any ? 0 : kNoResidual);
     if (!any) {
-        std::copy(base.data(), base.data() + base.pixel_count(), out.data());
+        std::swap(out, base);  // the camera motion is the motion (base is remade every frame)
     } else {
         std::vector<Residual>& residuals = fc.work->motion_residuals;
         residuals.resize(std::size_t(w) * h);
@@ -222,7 +230,7 @@ Status decode_motion(const FrameContext& fc, const Camera& camera, ImageView<con
         return Status::error("motion section: unknown flags " + std::to_string(flags));
     if (flags & kNoResidual) {
         if (r.remaining()) return Status::error("motion section: bytes after a no-residual flag");
-        std::copy(base.data(), base.data() + base.pixel_count(), out.data());
+        std::swap(out, base);  // the camera motion is the motion (base is remade every frame)
     } else {
         std::vector<std::span<const uint8_t>> slices;
         if (!read_slices(r, sp.slices, slices)) return Status::error(r.error());

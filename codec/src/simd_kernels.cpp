@@ -287,6 +287,34 @@ void ForwardRowSimd(const ForwardRow& r) {
     forward_row_reference(r, i, r.count);
 }
 
+bool MotionResidualRowSimd(const MotionResidualRow& r) {
+    const hn::ScalableTag<float> df;
+    using VF = hn::Vec<decltype(df)>;
+    const int n = int(hn::Lanes(df));
+    const VF zero = hn::Zero(df), half = hn::Set(df, 0.5f), one = hn::Set(df, 1.0f);
+    const VF eight = hn::Set(df, 8.0f), limit = hn::Set(df, float(1 << 24));
+    // floor(clamp(v) + 0.5) == 0, as residual_of rounds
+    auto rounds_to_zero = [&](VF v) {
+        const VF t = hn::Min(hn::Max(v, hn::Neg(limit)), limit) + half;
+        return hn::And(t >= zero, t < one);
+    };
+    int x = 0;
+    for (; x + n <= r.width; x += n) {
+        VF sx, sy, bx, by;
+        hn::LoadInterleaved2(df, &r.source[x].x, sx, sy);
+        hn::LoadInterleaved2(df, &r.base[x].x, bx, by);
+        const auto source_finite = hn::And((sx - sx) == zero, (sy - sy) == zero);
+        const auto base_finite = hn::And((bx - bx) == zero, (by - by) == zero);
+        const VF dx = (sx - hn::IfThenElseZero(base_finite, bx)) * eight;
+        const VF dy = (sy - hn::IfThenElseZero(base_finite, by)) * eight;
+        const auto zero_residual =
+            hn::Or(hn::And(source_finite, hn::And(rounds_to_zero(dx), rounds_to_zero(dy))),
+                   hn::AndNot(source_finite, hn::Not(base_finite)));
+        if (!hn::AllTrue(df, zero_residual)) return true;
+    }
+    return motion_residual_row_reference(r, x, r.width);
+}
+
 }  // namespace reprise::codec::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
 
@@ -299,6 +327,11 @@ HWY_EXPORT(CameraMotionRowSimd);
 HWY_EXPORT(ToPlanesRowSimd);
 HWY_EXPORT(FromPlanesRowSimd);
 HWY_EXPORT(ForwardRowSimd);
+HWY_EXPORT(MotionResidualRowSimd);
+
+bool motion_residual_row(const MotionResidualRow& row) {
+    return HWY_DYNAMIC_DISPATCH(MotionResidualRowSimd)(row);
+}
 
 void forward_row(const ForwardRow& row) { HWY_DYNAMIC_DISPATCH(ForwardRowSimd)(row); }
 
