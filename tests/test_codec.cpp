@@ -11,6 +11,7 @@
 #include "../codec/src/range_coder.hpp"
 #include "../codec/src/transform.hpp"
 #include "reprise/codec/codec.hpp"
+#include "reprise/core/simd.hpp"
 #include "reprise/server/builtin_scenes.hpp"
 #include "reprise/server/renderer.hpp"
 #include "support/frames.hpp"
@@ -201,6 +202,32 @@ TEST(Codec, RenderedSceneDecodesBitIdenticalWithLosslessDepth) {
     EXPECT_EQ(coded.packets[0].type, PacketType::Key);
     for (std::size_t i = 1; i < coded.packets.size(); ++i)
         EXPECT_EQ(coded.packets[i].type, PacketType::Inter);
+}
+
+// The SIMD kernels give their references' bits: a stream encoded at the best SIMD level is the
+// one the portable (lowest) level encodes, and either level decodes it to the encoder's pictures.
+TEST(Codec, SimdAndScalarLevelsCodeTheSameStream) {
+    const auto frames = render("pan", 5, 200, 120);
+    const std::vector<simd::Target> targets = simd::available_targets();
+    ASSERT_FALSE(targets.empty());
+    struct RestoreTarget {
+        ~RestoreTarget() { simd::force_target(0); }
+    } restore;
+    const Coded best = encode_all(frames, {.qp = 30});
+    simd::force_target(targets.back().bits);
+    const Coded portable = encode_all(frames, {.qp = 30});
+    const auto decoded_portable = decode_all(best.packets);
+    simd::force_target(0);
+    const auto decoded_best = decode_all(portable.packets);
+    ASSERT_EQ(best.packets.size(), portable.packets.size());
+    ASSERT_EQ(decoded_portable.size(), frames.size());
+    ASSERT_EQ(decoded_best.size(), frames.size());
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+        EXPECT_EQ(best.packets[i].data, portable.packets[i].data)
+            << "frame " << i << ", " << targets.front().name << " against " << targets.back().name;
+        EXPECT_TRUE(same_frame(decoded_portable[i], best.reconstructions[i])) << "frame " << i;
+        EXPECT_TRUE(same_frame(decoded_best[i], portable.reconstructions[i])) << "frame " << i;
+    }
 }
 
 // 4:2:0 halves chroma resolution: on a 160x96 render the cap is 32.5 dB even at qp 0 (43 dB at

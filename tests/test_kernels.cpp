@@ -5,6 +5,7 @@
 #include <utility>
 #include <vector>
 
+#include "reprise/codec/kernel_registry.hpp"
 #include "reprise/core/simd.hpp"
 #include "reprise/warp/kernel_registry.hpp"
 
@@ -33,7 +34,10 @@ TEST(Kernels, EveryLevelAgreesWithTheReference) {
     RestoreTarget restore;
     const std::vector<simd::Target> targets = simd::available_targets();
     ASSERT_GE(kernel_registry().size(), 4u);
-    for (const KernelEntry& entry : kernel_registry()) {
+    ASSERT_GE(codec::kernel_registry().size(), 2u);
+    std::vector<KernelEntry> entries(kernel_registry().begin(), kernel_registry().end());
+    entries.insert(entries.end(), codec::kernel_registry().begin(), codec::kernel_registry().end());
+    for (const KernelEntry& entry : entries) {
         std::unique_ptr<KernelCase> k = entry.make();
         uint32_t seed = 1;
         for (const KernelInputs inputs : {KernelInputs::Random, KernelInputs::WorstCase})

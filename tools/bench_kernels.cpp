@@ -12,6 +12,7 @@
 #include "args.hpp"
 #include "bench.hpp"
 #include "bench_report.hpp"
+#include "reprise/codec/kernel_registry.hpp"
 #include "reprise/core/parallel.hpp"
 #include "reprise/core/simd.hpp"
 #include "reprise/warp/kernel_registry.hpp"
@@ -57,7 +58,10 @@ Timing time_kernel(int runs, Reset&& reset, Run&& run) {
 Status bench_kernels_size(int w, int h, int runs, CsvFile& csv) {
     const std::vector<simd::Target> targets = simd::available_targets();
     Status status;
-    for (const warp::KernelEntry& entry : warp::kernel_registry()) {
+    std::vector<warp::KernelEntry> entries;
+    for (const auto registry : {warp::kernel_registry(), codec::kernel_registry()})
+        for (const warp::KernelEntry& entry : registry) entries.push_back(entry);
+    for (const warp::KernelEntry& entry : entries) {
         std::unique_ptr<warp::KernelCase> k = entry.make();
         k->generate(w, h, warp::KernelInputs::Random, 7);
         // The peer in between each kernel's runs: the machine's load moves during a run.
@@ -65,7 +69,7 @@ Status bench_kernels_size(int w, int h, int runs, CsvFile& csv) {
         const Timing reference = time_kernel(
             runs, [&] { k->reset_reference(); }, [&] { k->run_reference(); });
         auto line = [&](const char* level, const Timing& t, const char* agrees) {
-            std::printf("%-26s %-9s %9.3f %9.3f %9.2fx %9.2fx  %s\n", entry.name, level, t.best(),
+            std::printf("%-32s %-9s %9.3f %9.3f %9.2fx %9.2fx  %s\n", entry.name, level, t.best(),
                         t.median(), reference.best() / t.best(), t.best() / remap.best(), agrees);
             csv.row({entry.name, level, std::to_string(w), std::to_string(h),
                      strf("%.4f", t.best()), strf("%.4f", t.median()),
@@ -86,7 +90,7 @@ Status bench_kernels_size(int w, int h, int runs, CsvFile& csv) {
             line(entry.dispatched ? target.name : "built-in", t, difference.empty() ? "yes" : "NO");
             if (!entry.dispatched) break;  // its vector path was chosen when it was compiled
         }
-        std::printf("%-26s %-9s %9.3f %9.3f\n", "cv::remap (peer)", "", remap.best(),
+        std::printf("%-32s %-9s %9.3f %9.3f\n", "cv::remap (peer)", "", remap.best(),
                     remap.median());
     }
     return status;
@@ -105,7 +109,8 @@ Status bench_kernels(const BenchOptions& options) {
                          "kernel,target,width,height,best_ms,median_ms,speedup_vs_reference,"
                          "best_vs_remap,remap_best_ms,agrees,promise"));
     std::printf(
-        "warp kernels at every SIMD level this CPU runs (Highway runtime dispatch) against their "
+        "warp and codec kernels at every SIMD level this CPU runs (Highway runtime dispatch) "
+        "against their "
         "scalar\n"
         "reference and cv::remap (INTER_LINEAR, CV_32FC4, float maps) of an image of the same "
         "size;\n"
@@ -116,7 +121,7 @@ Status bench_kernels(const BenchOptions& options) {
     for (const std::string& size : split_list(options.sizes)) {
         int w = 0, h = 0;
         REPRISE_TRY(parse_size(size, w, h));
-        std::printf("\n%dx%d\n%-26s %-9s %9s %9s %10s %10s  %s\n", w, h, "kernel", "level", "best",
+        std::printf("\n%dx%d\n%-32s %-9s %9s %9s %10s %10s  %s\n", w, h, "kernel", "level", "best",
                     "median", "x ref", "x remap", "agrees");
         REPRISE_TRY(bench_kernels_size(w, h, options.frames, csv));
     }

@@ -1,6 +1,6 @@
 // The camera of a frame: flags for what equals the reference's camera, the rest raw.
-#include "byte_io.hpp"
 #include "internal.hpp"
+#include "reprise/core/byte_io.hpp"
 
 namespace reprise::codec {
 

@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <deque>
 
-#include "byte_io.hpp"
 #include "internal.hpp"
+#include "reprise/core/byte_io.hpp"
 
 namespace reprise::codec {
 

@@ -128,61 +128,82 @@ inline int residual_context(const SliceJob& j, int x, int y) {
     return magnitude_class(x > 0 ? j.residuals(x - 1, y) : 0, y > j.y0 ? j.residuals(x, y - 1) : 0);
 }
 
-// Cost estimate of coding a block with one predictor. The encoder knows every code up front
-// (coding is lossless), so spatial predictions are made once into `spatial_codes`.
-uint64_t block_cost(const SliceJob& j, ImageView<const uint32_t> spatial_codes, int bx, int by,
-                    int bw, int bh, bool temporal) {
-    uint64_t cost = 0;
-    for (int y = by; y < by + bh; ++y)
-        for (int x = bx; x < bx + bw; ++x) {
-            uint32_t p = temporal ? j.temporal(x, y) : kNoPrediction;
-            if (p == kNoPrediction) p = spatial_codes(x, y);
-            const int32_t r = int32_t(j.codes(x, y) - p);
-            cost += r == 0 ? 0 : 2 + 2 * uint64_t(std::bit_width(uint32_t(std::abs(int64_t(r)))));
-        }
-    return cost;
+// Cost estimate of coding a block's residuals.
+inline uint64_t residual_cost(int32_t r) {
+    return r == 0 ? 0 : 2 + 2 * uint64_t(std::bit_width(uint32_t(std::abs(int64_t(r)))));
 }
 
-void encode_slice(SliceJob& j, std::vector<uint8_t>& bytes) {
+// The encoder knows every code up front (coding is lossless), so it decides each block before
+// coding any: temporal prediction first, and the spatial one (the costly inverse-depth median)
+// only where the temporal one is not exact. Residuals of the whole block row are stored before
+// they are coded; the contexts read the same values the decoder has at that point.
+void encode_slice(SliceJob& j, std::vector<uint8_t>& bytes, std::vector<uint8_t>& block_flags) {
     RangeEncoder rc(bytes);
     Models m;
     const bool inter = !j.temporal.empty();
-    Image<uint32_t> spatial_codes(j.width, j.y1 - j.y0);
-    ImageView<uint32_t> sv = spatial_codes.view();
-    sv.data -= std::ptrdiff_t(j.y0) * sv.stride;  // addressed with frame rows
-    for (int y = j.y0; y < j.y1; ++y)
-        for (int x = 0; x < j.width; ++x) sv(x, y) = spatial(j, x, y);
-    std::vector<uint8_t> block_temporal, block_zero;
+    const int blocks = (j.width + kBlock - 1) / kBlock;
+    block_flags.resize(std::size_t(blocks));  // bit 0: temporal, bit 1: zero
+    uint32_t spatial_codes[kBlock * kBlock];
     for (int by = j.y0; by < j.y1; by += kBlock) {
         const int bh = std::min(kBlock, j.y1 - by);
-        const int blocks = (j.width + kBlock - 1) / kBlock;
-        block_temporal.assign(blocks, 0);
-        block_zero.assign(blocks, 0);
         for (int b = 0; b < blocks; ++b) {
             const int bx = b * kBlock, bw = std::min(kBlock, j.width - bx);
             bool use_temporal = false;
-            uint64_t cost = block_cost(j, sv, bx, by, bw, bh, false);
+            uint64_t cost = 0;
+            bool spatial_known = false;
             if (inter) {
-                const uint64_t t = block_cost(j, sv, bx, by, bw, bh, true);
-                use_temporal = t <= cost;
-                cost = std::min(cost, t);
-                rc.bit(m.temporal, use_temporal);
+                // Most blocks of a moving camera's depth are predicted exactly (no code equals
+                // kNoPrediction): a plain comparison finds them.
+                bool exact = true;
+                for (int y = by; y < by + bh && exact; ++y)
+                    exact = std::equal(&j.codes(bx, y), &j.codes(bx, y) + bw, &j.temporal(bx, y));
+                for (int y = by; y < by + bh && !exact; ++y)
+                    for (int x = bx; x < bx + bw; ++x) {
+                        uint32_t p = j.temporal(x, y);
+                        if (p == kNoPrediction) p = spatial(j, x, y);
+                        cost += residual_cost(int32_t(j.codes(x, y) - p));
+                    }
+                use_temporal = true;
             }
-            block_temporal[b] = use_temporal;
-            block_zero[b] = cost == 0;
+            if (!inter || cost > 0) {
+                uint64_t spatial_cost = 0;
+                for (int y = by; y < by + bh; ++y)
+                    for (int x = bx; x < bx + bw; ++x) {
+                        const uint32_t p = spatial(j, x, y);
+                        spatial_codes[(y - by) * kBlock + (x - bx)] = p;
+                        spatial_cost += residual_cost(int32_t(j.codes(x, y) - p));
+                    }
+                spatial_known = true;
+                if (!inter || spatial_cost < cost) {
+                    use_temporal = false;
+                    cost = spatial_cost;
+                }
+            }
+            if (inter) rc.bit(m.temporal, use_temporal);
             rc.bit(m.zero_block[use_temporal], cost == 0);
             j.zero_blocks += cost == 0;
+            block_flags[b] = uint8_t(use_temporal) | uint8_t(cost == 0) << 1;
+            if (cost == 0) {
+                for (int y = by; y < by + bh; ++y)
+                    std::fill(&j.residuals(bx, y), &j.residuals(bx, y) + bw, 0u);
+                continue;
+            }
+            for (int y = by; y < by + bh; ++y)
+                for (int x = bx; x < bx + bw; ++x) {
+                    uint32_t p = use_temporal ? j.temporal(x, y) : kNoPrediction;
+                    if (p == kNoPrediction)
+                        p = spatial_known ? spatial_codes[(y - by) * kBlock + (x - bx)]
+                                          : spatial(j, x, y);
+                    j.residuals(x, y) = j.codes(x, y) - p;
+                }
         }
         for (int y = by; y < by + bh; ++y)
-            for (int x = 0; x < j.width; ++x) {
-                const int b = x / kBlock;
-                uint32_t p = block_temporal[b] ? j.temporal(x, y) : kNoPrediction;
-                if (p == kNoPrediction) p = sv(x, y);
-                const uint32_t r = j.codes(x, y) - p;
-                j.residuals(x, y) = r;
-                if (block_zero[b]) continue;
-                encode_int(rc, m.residual[block_temporal[b]][residual_context(j, x, y)],
-                           int64_t(int32_t(r)));
+            for (int b = 0; b < blocks; ++b) {
+                const uint8_t flags = block_flags[b];
+                if (flags & 2) continue;
+                for (int x = b * kBlock; x < std::min(j.width, (b + 1) * kBlock); ++x)
+                    encode_int(rc, m.residual[flags & 1][residual_context(j, x, y)],
+                               int64_t(int32_t(j.residuals(x, y))));
             }
     }
     rc.finish();
@@ -308,8 +329,10 @@ void encode_depth(const FrameContext& fc, const Camera& camera, ImageView<const 
             std::size_t((w + kBlock - 1) / kBlock) * ((h + kBlock - 1) / kBlock);
     } else {
         std::vector<SliceJob> jobs = slice_jobs(sp, map, codes, temporal, residuals);
+        std::vector<std::vector<uint8_t>>& flags = fc.work->slice_flags;
+        flags.resize(std::size_t(sp.slices));
         encode_slices(sp.slices, fc.work->slice_bytes, bytes,
-                      [&](int s, std::vector<uint8_t>& b) { encode_slice(jobs[s], b); });
+                      [&](int s, std::vector<uint8_t>& b) { encode_slice(jobs[s], b, flags[s]); });
         for (const SliceJob& j : jobs) stats.depth_zero_blocks += j.zero_blocks;
     }
     stats.depth_bits += 8 * (bytes.size() - start);

@@ -6,8 +6,8 @@
 #include <deque>
 #include <set>
 
-#include "byte_io.hpp"
 #include "internal.hpp"
+#include "reprise/core/byte_io.hpp"
 
 namespace reprise::codec {
 

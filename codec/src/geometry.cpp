@@ -1,12 +1,14 @@
 // Motion and depth that the cameras explain: both sides compute them from decoded depth with the
 // same float arithmetic, so they agree bit for bit.
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <limits>
 
 #include <glm/mat4x4.hpp>
 
 #include "internal.hpp"
+#include "kernels.hpp"
 #include "reprise/core/parallel.hpp"
 
 namespace reprise::codec {
@@ -54,12 +56,42 @@ glm::mat4 between(const glm::mat4& from_view, const glm::mat4& to_view) {
 
 }  // namespace
 
+void camera_motion_row_reference(const CameraMotionRow& r, int x_begin, int x_end) {
+    const Unprojector un{r.projection, r.perspective, r.far_plane, float(r.width), float(r.height)};
+    const int w = r.width, h = r.height, y = r.y;
+    const float cy = float(y) + 0.5f;
+    for (int x = x_begin; x < x_end; ++x) {
+        const float d = r.depth[x];
+        glm::vec4 clip;
+        if (un.perspective && d >= 0.0f && d < kInf) {
+            const float fx = float(x);
+            clip = (r.a0 + fx * r.a1) + d * (r.b0 + fx * r.b1);
+        } else {
+            glm::vec4 point;
+            if (!un.point(x, y, d, point)) {
+                r.out[x] = {kNan, kNan};
+                continue;
+            }
+            clip = r.to_clip * point;
+        }
+        if (!(clip.w > 0.0f)) {
+            r.out[x] = {kNan, kNan};
+            continue;
+        }
+        const float px = (clip.x / clip.w + 1.0f) * 0.5f * float(w);
+        const float py = (1.0f - clip.y / clip.w) * 0.5f * float(h);
+        r.out[x] = {px - (float(x) + 0.5f), py - cy};
+    }
+}
+
 void camera_motion(const Camera& from, ImageView<const float> depth, const glm::mat4& to_view,
                    const glm::mat4& to_projection, ImageView<glm::vec2> out) {
     const int w = depth.width, h = depth.height;
     REPRISE_ASSERT(out.width == w && out.height == h);
     if (from.view == to_view && from.projection == to_projection) {
-        for (int y = 0; y < h; ++y) std::fill(out.row(y), out.row(y) + w, glm::vec2(0.0f));
+        parallel_for(0, h, [&](int y0, int y1) {
+            for (int y = y0; y < y1; ++y) std::fill(out.row(y), out.row(y) + w, glm::vec2(0.0f));
+        });
         return;
     }
     const Unprojector un = unprojector(from, w, h);
@@ -70,8 +102,6 @@ void camera_motion(const Camera& from, ImageView<const float> depth, const glm::
     const glm::dmat4 p(from.projection), m(to_clip);
     parallel_for(0, h, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y) {
-            const float* z = depth.row(y);
-            glm::vec2* out_row = out.row(y);
             const double y_ndc = 1.0 - 2.0 * (double(y) + 0.5) / double(h);
             // a = ((x_ndc p33 - p30) / p00, (y_ndc p33 - p31) / p11, 0, 1)
             // b = ((p20 - x_ndc p23) / p00, (p21 - y_ndc p23) / p11, -1, 0), x_ndc = 2 (x + 0.5) /
@@ -85,30 +115,19 @@ void camera_motion(const Camera& from, ImageView<const float> depth, const glm::
             const glm::dvec4 b_at0 =
                 m * glm::dvec4((p[2][0] - x0 * p[2][3]) / p[0][0], by, -1.0, 0.0);
             const glm::dvec4 b_step = m * glm::dvec4(-sx * p[2][3] / p[0][0], 0.0, 0.0, 0.0);
-            const glm::vec4 A0(a_at0), A1(a_step), B0(b_at0), B1(b_step);
-            const float cy = float(y) + 0.5f;
-            for (int x = 0; x < w; ++x) {
-                const float d = z[x];
-                glm::vec4 clip;
-                if (un.perspective && d >= 0.0f && d < kInf) {
-                    const float fx = float(x);
-                    clip = (A0 + fx * A1) + d * (B0 + fx * B1);
-                } else {
-                    glm::vec4 point;
-                    if (!un.point(x, y, d, point)) {
-                        out_row[x] = {kNan, kNan};
-                        continue;
-                    }
-                    clip = to_clip * point;
-                }
-                if (!(clip.w > 0.0f)) {
-                    out_row[x] = {kNan, kNan};
-                    continue;
-                }
-                const float px = (clip.x / clip.w + 1.0f) * 0.5f * float(w);
-                const float py = (1.0f - clip.y / clip.w) * 0.5f * float(h);
-                out_row[x] = {px - (float(x) + 0.5f), py - cy};
-            }
+            camera_motion_row({.a0 = glm::vec4(a_at0),
+                               .a1 = glm::vec4(a_step),
+                               .b0 = glm::vec4(b_at0),
+                               .b1 = glm::vec4(b_step),
+                               .projection = un.p,
+                               .to_clip = to_clip,
+                               .perspective = un.perspective,
+                               .far_plane = un.far_plane,
+                               .y = y,
+                               .width = w,
+                               .height = h,
+                               .depth = depth.row(y),
+                               .out = out.row(y)});
         }
     });
 }
@@ -121,25 +140,64 @@ void reproject_depth(const Camera& from, ImageView<const float> depth, const Cam
         for (int y = 0; y < h; ++y) std::copy(depth.row(y), depth.row(y) + w, out.row(y));
         return;
     }
-    for (int y = 0; y < h; ++y) std::fill(out.row(y), out.row(y) + w, kNan);
-    const Unprojector un = unprojector(from, w, h);
+    parallel_for(0, h, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y) std::fill(out.row(y), out.row(y) + w, kNan);
+    });
     const glm::mat4 to_camera = between(from.view, to.view);
     const glm::mat4 to_clip = glm::mat4(glm::dmat4(to.projection) * glm::dmat4(to_camera));
-    for (int y = 0; y < h; ++y) {
-        const float* z = depth.row(y);
-        for (int x = 0; x < w; ++x) {
-            glm::vec4 point;
-            if (!(z[x] < kInf) || !un.point(x, y, z[x], point)) continue;
-            const glm::vec4 clip = to_clip * point;
-            if (!(clip.w > 0.0f)) continue;
-            const float px = (clip.x / clip.w + 1.0f) * 0.5f * float(w);
-            const float py = (1.0f - clip.y / clip.w) * 0.5f * float(h);
-            if (!(px >= 0.0f && py >= 0.0f && px < float(w) && py < float(h))) continue;
-            const float tz = -(to_camera * point).z;
-            if (!(tz > 0.0f)) continue;
-            float& slot = out(int(px), int(py));
-            if (!(tz >= slot)) slot = tz;  // NaN slot: first landing wins
-        }
+    // Each pixel keeps the nearest landing (NaN: none), whatever order they land in: rows are
+    // projected in parallel and a landing takes its slot by compare-and-swap.
+    float* slots = out.data;
+    REPRISE_ASSERT(out.stride == w);
+    parallel_for(0, h, [&](int y0, int y1) {
+        constexpr int kChunk = 256;
+        int32_t slot[kChunk];
+        float tz[kChunk];
+        for (int y = y0; y < y1; ++y)
+            for (int x0 = 0; x0 < w; x0 += kChunk) {
+                const int n = std::min(kChunk, w - x0);
+                forward_row({.projection = from.projection,
+                             .to_clip = to_clip,
+                             .to_camera = to_camera,
+                             .x0 = x0,
+                             .y = y,
+                             .count = n,
+                             .width = w,
+                             .height = h,
+                             .depth = depth.row(y) + x0,
+                             .slot = slot,
+                             .z = tz});
+                for (int i = 0; i < n; ++i) {
+                    if (slot[i] < 0) continue;
+                    std::atomic_ref<float> target(slots[slot[i]]);
+                    float held = target.load(std::memory_order_relaxed);
+                    while (!(tz[i] >= held) &&
+                           !target.compare_exchange_weak(held, tz[i], std::memory_order_relaxed)) {
+                    }
+                }
+            }
+    });
+}
+
+void forward_row_reference(const ForwardRow& r, int i_begin, int i_end) {
+    const Unprojector un{r.projection, r.projection[2][3] != 0.0f, 1e6f, float(r.width),
+                         float(r.height)};
+    const int w = r.width, h = r.height;
+    for (int i = i_begin; i < i_end; ++i) {
+        const int x = r.x0 + i;
+        r.slot[i] = -1;
+        const float z = r.depth[i];
+        glm::vec4 point;
+        if (!(z < kInf) || !un.point(x, r.y, z, point)) continue;
+        const glm::vec4 clip = r.to_clip * point;
+        if (!(clip.w > 0.0f)) continue;
+        const float px = (clip.x / clip.w + 1.0f) * 0.5f * float(w);
+        const float py = (1.0f - clip.y / clip.w) * 0.5f * float(h);
+        if (!(px >= 0.0f && py >= 0.0f && px < float(w) && py < float(h))) continue;
+        const float tz = -(r.to_camera * point).z;
+        if (!(tz > 0.0f)) continue;
+        r.slot[i] = int32_t(py) * w + int32_t(px);
+        r.z[i] = tz;
     }
 }
 

@@ -6,6 +6,7 @@
 
 #include "range_coder.hpp"
 #include "reprise/codec/codec.hpp"
+#include "reprise/core/byte_io.hpp"
 
 namespace reprise::codec {
 
@@ -71,7 +72,6 @@ void write_packet(const PacketHeader& header, std::span<const uint8_t> payload,
 Status parse_packet(std::span<const uint8_t> packet, PacketHeader& header,
                     std::span<const uint8_t>& payload);
 void write_params(const SequenceParams& sp, std::vector<uint8_t>& out);
-class ByteReader;
 Status read_params(ByteReader& r, SequenceParams& sp);
 int default_slices(int height);
 
@@ -124,10 +124,11 @@ struct Workspace {
     Image<uint32_t> depth_codes, temporal_codes, depth_residuals;
     Image<float> projected_depth;
     Image<glm::vec2> base_motion, to_reference;
-    std::vector<MotionResidual> motion_targets, motion_residuals;
+    std::vector<MotionResidual> motion_residuals;
     Planes predicted;
     std::vector<uint8_t> coded_blocks[3];  // per 8x8 block of each plane: intra or with a residual
     std::vector<std::vector<uint8_t>> slice_bytes;
+    std::vector<std::vector<uint8_t>> slice_flags;  // per slice: a block row's flags
     std::vector<uint8_t> section;
 };
 

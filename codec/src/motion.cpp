@@ -2,10 +2,12 @@
 // difference (moving, skinned, morphed objects) is sent, quantised to 1/8 pixel, per 8x8 block
 // flagged, so a still world under a moving camera sends a single flag.
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 
 #include "internal.hpp"
+#include "kernels.hpp"
 #include "slices.hpp"
 
 namespace reprise::codec {
@@ -56,7 +58,7 @@ struct Models {
 struct SliceJob {
     int width, y0, y1;
     ImageView<const glm::vec2> base;
-    const Residual* targets;  // encoder only: the residual of every pixel
+    ImageView<const glm::vec2> source;  // encoder only: the renderer's motion
     ImageView<glm::vec2> out;
     Residual* residuals;  // per pixel of the frame, for contexts and prediction
     std::size_t pixels = 0;
@@ -80,6 +82,16 @@ inline Residual neighbour_prediction(const SliceJob& j, int x, int y) {
     return {};
 }
 
+}  // namespace
+
+bool motion_residual_row_reference(const MotionResidualRow& r, int x_begin, int x_end) {
+    for (int x = x_begin; x < x_end; ++x)
+        if (!residual_of(r.source[x], r.base[x]).zero()) return true;
+    return false;
+}
+
+namespace {
+
 template <bool Encode, class Coder>
 bool code_slice(SliceJob& j, Coder& rc) {
     Models m;
@@ -93,7 +105,7 @@ bool code_slice(SliceJob& j, Coder& rc) {
             if constexpr (Encode) {
                 for (int y = by; y < by + bh && !block_nonzero[b]; ++y)
                     for (int x = b * kBlock; x < std::min(j.width, (b + 1) * kBlock); ++x)
-                        if (!j.targets[std::size_t(y) * j.width + x].zero()) block_nonzero[b] = 1;
+                        if (!residual_of(j.source(x, y), j.base(x, y)).zero()) block_nonzero[b] = 1;
                 rc.bit(m.block[previous_block], block_nonzero[b]);
             } else {
                 block_nonzero[b] = uint8_t(rc.bit(m.block[previous_block]));
@@ -106,7 +118,7 @@ bool code_slice(SliceJob& j, Coder& rc) {
                 if (block_nonzero[x / kBlock]) {
                     BitModel& nz = m.nonzero[nonzero_context(j, x, y)];
                     if constexpr (Encode) {
-                        r = j.targets[std::size_t(y) * j.width + x];
+                        r = residual_of(j.source(x, y), j.base(x, y));
                         rc.bit(nz, !r.zero());
                         if (!r.zero()) {
                             rc.bit(m.invalid, r.invalid);
@@ -156,13 +168,13 @@ void base_motion(const Camera& camera, ImageView<const float> depth, int w, int 
 }
 
 std::vector<SliceJob> slice_jobs(const SequenceParams& sp, const Image<glm::vec2>& base,
-                                 const Residual* targets, Image<glm::vec2>& out,
+                                 ImageView<const glm::vec2> source, Image<glm::vec2>& out,
                                  std::vector<Residual>& residuals) {
     std::vector<SliceJob> jobs;
     for (int s = 0; s < sp.slices; ++s) {
         const int y0 = std::min(sp.height, sp.slice_begin(s) * kMb);
         const int y1 = std::min(sp.height, sp.slice_begin(s + 1) * kMb);
-        jobs.push_back({sp.width, y0, y1, base.view(), targets, out.view(), residuals.data()});
+        jobs.push_back({sp.width, y0, y1, base.view(), source, out.view(), residuals.data()});
     }
     return jobs;
 }
@@ -178,27 +190,22 @@ void encode_motion(const FrameContext& fc, const Camera& camera, ImageView<const
     base_motion(camera, depth, w, h, base);
     ensure_size(out, w, h);
     const std::size_t start = bytes.size();
-    std::vector<Residual>& targets = fc.work->motion_targets;
-    targets.resize(source.empty() ? 0 : std::size_t(w) * h);
-    std::vector<uint8_t> row_any(h, 0);
+    // Whether any pixel needs a residual; the slices recompute the residuals they code.
+    std::atomic<bool> any{false};
     if (!source.empty())
         parallel_for(0, h, [&](int y0, int y1) {
-            for (int y = y0; y < y1; ++y)
-                for (int x = 0; x < w; ++x) {
-                    const Residual r = residual_of(source(x, y), base(x, y));
-                    targets[std::size_t(y) * w + x] = r;
-                    row_any[y] |= !r.zero();
-                }
+            for (int y = y0; y < y1 && !any.load(std::memory_order_relaxed); ++y)
+                if (motion_residual_row({source.row(y), base.data() + std::size_t(y) * w, w}))
+                    any.store(true, std::memory_order_relaxed);
         });
-    const bool any = std::find(row_any.begin(), row_any.end(), 1) != row_any.end();
     ByteWriter wr(bytes);
     wr.u8(any ? 0 : kNoResidual);
     if (!any) {
-        std::copy(base.data(), base.data() + base.pixel_count(), out.data());
+        std::swap(out, base);  // the camera motion is the motion (base is remade every frame)
     } else {
         std::vector<Residual>& residuals = fc.work->motion_residuals;
         residuals.resize(std::size_t(w) * h);
-        std::vector<SliceJob> jobs = slice_jobs(sp, base, targets.data(), out, residuals);
+        std::vector<SliceJob> jobs = slice_jobs(sp, base, source, out, residuals);
         encode_slices(sp.slices, fc.work->slice_bytes, bytes, [&](int s, std::vector<uint8_t>& b) {
             RangeEncoder rc(b);
             code_slice<true>(jobs[s], rc);
@@ -223,13 +230,13 @@ Status decode_motion(const FrameContext& fc, const Camera& camera, ImageView<con
         return Status::error("motion section: unknown flags " + std::to_string(flags));
     if (flags & kNoResidual) {
         if (r.remaining()) return Status::error("motion section: bytes after a no-residual flag");
-        std::copy(base.data(), base.data() + base.pixel_count(), out.data());
+        std::swap(out, base);  // the camera motion is the motion (base is remade every frame)
     } else {
         std::vector<std::span<const uint8_t>> slices;
         if (!read_slices(r, sp.slices, slices)) return Status::error(r.error());
         std::vector<Residual>& residuals = fc.work->motion_residuals;
         residuals.resize(std::size_t(w) * h);
-        std::vector<SliceJob> jobs = slice_jobs(sp, base, nullptr, out, residuals);
+        std::vector<SliceJob> jobs = slice_jobs(sp, base, {}, out, residuals);
         REPRISE_TRY(
             decode_slices(slices, "motion section", [&](int s, std::span<const uint8_t> bytes) {
                 RangeDecoder rc(bytes);

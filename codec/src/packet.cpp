@@ -1,9 +1,9 @@
 // Packet header, key frame parameters and the .rps file container (docs/bitstream.md).
 #include <algorithm>
 
-#include "byte_io.hpp"
 #include "crc32c.hpp"
 #include "internal.hpp"
+#include "reprise/core/byte_io.hpp"
 
 namespace reprise::codec {
 

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "internal.hpp"
+#include "kernels.hpp"
 #include "reprise/core/parallel.hpp"
 
 namespace reprise::codec {
@@ -14,26 +15,23 @@ namespace {
 
 constexpr int kPhases = 64;
 
-// Catmull-Rom weights per phase, in 1/128, summing to 128.
-const std::array<std::array<int32_t, 4>, kPhases>& weights() {
-    static const auto table = [] {
-        std::array<std::array<int32_t, 4>, kPhases> t{};
+struct WeightTable {
+    int32_t w[kPhases][4];
+    WeightTable() {
         for (int p = 0; p < kPhases; ++p) {
             const double f = double(p) / kPhases, f2 = f * f, f3 = f2 * f;
-            const double w[4] = {0.5 * (-f3 + 2 * f2 - f), 0.5 * (3 * f3 - 5 * f2 + 2),
+            const double c[4] = {0.5 * (-f3 + 2 * f2 - f), 0.5 * (3 * f3 - 5 * f2 + 2),
                                  0.5 * (-3 * f3 + 4 * f2 + f), 0.5 * (f3 - f2)};
             int sum = 0, largest = 0;
             for (int i = 0; i < 4; ++i) {
-                t[p][i] = int32_t(std::lround(w[i] * 128.0));
-                sum += t[p][i];
-                if (t[p][i] > t[p][largest]) largest = i;
+                w[p][i] = int32_t(std::lround(c[i] * 128.0));
+                sum += w[p][i];
+                if (w[p][i] > w[p][largest]) largest = i;
             }
-            t[p][largest] += 128 - sum;
+            w[p][largest] += 128 - sum;
         }
-        return t;
-    }();
-    return table;
-}
+    }
+};
 
 // Sample position in 1/64 of the plane's pixels, of a pixel centre moved by m (plane pixels).
 inline int32_t fixed_position(float centre, float m, int size) {
@@ -43,27 +41,28 @@ inline int32_t fixed_position(float centre, float m, int size) {
     return t - int32_t(q < float(t));
 }
 
-inline int sample(const Image<int16_t>& ref, int32_t qx, int32_t qy, int lo, int hi) {
+inline int sample(const PredictRow& r, int32_t qx, int32_t qy) {
     const int ix = qx >> 6, iy = qy >> 6;
-    const auto& wx = weights()[qx & 63];
-    const auto& wy = weights()[qy & 63];
-    const int w = ref.width(), h = ref.height();
+    const auto& wx = catmull_rom_weights()[qx & 63];
+    const auto& wy = catmull_rom_weights()[qy & 63];
+    const int w = r.width, h = r.height;
+    const int16_t* ref = r.reference;
     if ((qx & 63) == 0 && (qy & 63) == 0)
-        return ref(std::clamp(ix, 0, w - 1), std::clamp(iy, 0, h - 1));
+        return ref[std::size_t(std::clamp(iy, 0, h - 1)) * w + std::clamp(ix, 0, w - 1)];
     int32_t sum = 0;
     if (ix >= 1 && iy >= 1 && ix + 2 < w && iy + 2 < h) {  // the whole 4x4 window inside
-        const int16_t* row = ref.data() + std::size_t(iy - 1) * w + (ix - 1);
+        const int16_t* row = ref + std::size_t(iy - 1) * w + (ix - 1);
         for (int j = 0; j < 4; ++j, row += w)
             sum += wy[j] * (wx[0] * row[0] + wx[1] * row[1] + wx[2] * row[2] + wx[3] * row[3]);
-        return std::clamp((sum + (1 << 13)) >> 14, lo, hi);
+        return std::clamp((sum + (1 << 13)) >> 14, r.lo, r.hi);
     }
     for (int j = 0; j < 4; ++j) {
-        const int16_t* row = ref.data() + std::size_t(std::clamp(iy - 1 + j, 0, h - 1)) * w;
+        const int16_t* row = ref + std::size_t(std::clamp(iy - 1 + j, 0, h - 1)) * w;
         int32_t line = 0;
         for (int i = 0; i < 4; ++i) line += wx[i] * row[std::clamp(ix - 1 + i, 0, w - 1)];
         sum += wy[j] * line;
     }
-    return std::clamp((sum + (1 << 13)) >> 14, lo, hi);
+    return std::clamp((sum + (1 << 13)) >> 14, r.lo, r.hi);
 }
 
 inline glm::vec2 usable(glm::vec2 m) {
@@ -72,34 +71,61 @@ inline glm::vec2 usable(glm::vec2 m) {
 
 }  // namespace
 
+const int32_t (&catmull_rom_weights())[64][4] {
+    static const WeightTable table;
+    return table.w;
+}
+
+void predict_row_reference(const PredictRow& r, int x_begin, int x_end) {
+    const int last = r.motion_width - 1;
+    const float cy = float(r.y) + 0.5f;
+    for (int x = x_begin; x < x_end; ++x) {
+        glm::vec2 m;
+        if (!r.subsampled) {
+            m = usable(r.motion0[std::min(x, last)]);
+        } else {  // mean of the 2x2 luma motions, in chroma pixels
+            const int a = std::min(2 * x, last), b = std::min(2 * x + 1, last);
+            m = (usable(r.motion0[a]) + usable(r.motion0[b]) + usable(r.motion1[a]) +
+                 usable(r.motion1[b])) *
+                0.125f;
+        }
+        r.out[x] = int16_t(sample(r, fixed_position(float(x) + 0.5f, m.x, r.width),
+                                  fixed_position(cy, m.y, r.height)));
+    }
+}
+
 void predict_planes(const Planes& ref, const SequenceParams& sp, ImageView<const glm::vec2> motion,
                     Planes& out) {
     const int w = sp.width, h = sp.height;
     for (int k = 0; k < 3; ++k) ensure_size(out.p[k], sp.plane_width(k), sp.plane_height(k));
-    auto motion_at = [&](int x, int y) {
-        return usable(motion(std::min(x, w - 1), std::min(y, h - 1)));
-    };
-    for (int k = 0; k < 3; ++k) {
-        const int s = sp.shift(k), pw = sp.plane_width(k), ph = sp.plane_height(k);
-        const int lo = k ? -255 : 0, hi = 255;
-        parallel_for(0, ph, [&](int y0, int y1) {
-            for (int y = y0; y < y1; ++y) {
-                int16_t* dst = out.p[k].data() + std::size_t(y) * pw;
-                for (int x = 0; x < pw; ++x) {
-                    glm::vec2 m;
-                    if (s == 0) {
-                        m = motion_at(x, y);
-                    } else {  // mean of the 2x2 luma motions, in chroma pixels
-                        m = (motion_at(2 * x, 2 * y) + motion_at(2 * x + 1, 2 * y) +
-                             motion_at(2 * x, 2 * y + 1) + motion_at(2 * x + 1, 2 * y + 1)) *
-                            0.125f;
-                    }
-                    dst[x] = int16_t(sample(ref.p[k], fixed_position(float(x) + 0.5f, m.x, pw),
-                                            fixed_position(float(y) + 0.5f, m.y, ph), lo, hi));
+    const int rows = sp.plane_height(0);
+    const int chroma_rows = sp.plane_height(1);
+    // One pass over the luma rows; each worker also makes the chroma rows its luma rows cover.
+    const int s = sp.shift(1);
+    parallel_for(0, rows >> s, [&](int r0, int r1) {
+        for (int r = r0; r < r1; ++r)
+            for (int k = 0; k < 3; ++k) {
+                if (k > 0 && r >= chroma_rows) break;
+                const int sub = sp.shift(k);
+                for (int y = sub ? r : r << s; y < (sub ? r + 1 : (r + 1) << s); ++y) {
+                    const int my = std::min(y << sub, h - 1);
+                    const PredictRow row{
+                        .reference = ref.p[k].data(),
+                        .width = ref.p[k].width(),
+                        .height = ref.p[k].height(),
+                        .y = y,
+                        .motion0 = motion.row(my),
+                        .motion1 = motion.row(std::min((y << sub) + 1, h - 1)),
+                        .motion_width = w,
+                        .subsampled = sub != 0,
+                        .lo = k ? -255 : 0,
+                        .hi = 255,
+                        .out = out.p[k].data() + std::size_t(y) * out.p[k].width(),
+                    };
+                    predict_row(row);
                 }
             }
-        });
-    }
+    });
 }
 
 }  // namespace reprise::codec

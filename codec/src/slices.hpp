@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "byte_io.hpp"
+#include "reprise/core/byte_io.hpp"
 #include "reprise/core/parallel.hpp"
 
 namespace reprise::codec {

@@ -4,62 +4,6 @@
 
 namespace reprise::net {
 
-void Writer::put(const void* p, std::size_t n) {
-    REPRISE_ASSERT(n <= out_.size() - pos_);
-    if (n) std::memcpy(out_.data() + pos_, p, n);
-    pos_ += n;
-}
-
-bool Reader::take(std::size_t n) {
-    if (failed_ || n > in_.size() - pos_) {
-        failed_ = true;
-        return false;
-    }
-    return true;
-}
-uint8_t Reader::u8() {
-    if (!take(1)) return 0;
-    return in_[pos_++];
-}
-uint16_t Reader::u16() {
-    if (!take(2)) return 0;
-    uint16_t v = uint16_t(in_[pos_] | (in_[pos_ + 1] << 8));
-    pos_ += 2;
-    return v;
-}
-uint32_t Reader::u32() {
-    if (!take(4)) return 0;
-    uint32_t v = 0;
-    for (int i = 0; i < 4; ++i) v |= uint32_t(in_[pos_ + i]) << (8 * i);
-    pos_ += 4;
-    return v;
-}
-uint64_t Reader::u64() {
-    if (!take(8)) return 0;
-    uint64_t v = 0;
-    for (int i = 0; i < 8; ++i) v |= uint64_t(in_[pos_ + i]) << (8 * i);
-    pos_ += 8;
-    return v;
-}
-float Reader::f32() {
-    uint32_t u = u32();
-    float v;
-    std::memcpy(&v, &u, 4);
-    return v;
-}
-double Reader::f64() {
-    uint64_t u = u64();
-    double v;
-    std::memcpy(&v, &u, 8);
-    return v;
-}
-std::span<const uint8_t> Reader::bytes(std::size_t n) {
-    if (!take(n)) return {};
-    auto s = in_.subspan(pos_, n);
-    pos_ += n;
-    return s;
-}
-
 void write_header(Writer& w, const DatagramHeader& header) {
     w.u8(kMagic0);
     w.u8(kMagic1);

@@ -10,6 +10,7 @@
 
 #include <glm/mat4x4.hpp>
 
+#include "reprise/core/byte_io.hpp"
 #include "reprise/core/status.hpp"
 
 namespace reprise::net {
@@ -94,65 +95,10 @@ struct FragmentMessage {
     std::span<const uint8_t> payload;
 };
 
-// Little-endian writer into a fixed buffer; overflow is a contract violation of the caller.
-class Writer {
-public:
-    explicit Writer(std::span<uint8_t> out) : out_(out) {}
-    void u8(uint8_t v) { put(&v, 1); }
-    void u16(uint16_t v) {
-        uint8_t b[2] = {uint8_t(v), uint8_t(v >> 8)};
-        put(b, 2);
-    }
-    void u32(uint32_t v) {
-        uint8_t b[4];
-        for (int i = 0; i < 4; ++i) b[i] = uint8_t(v >> (8 * i));
-        put(b, 4);
-    }
-    void u64(uint64_t v) {
-        uint8_t b[8];
-        for (int i = 0; i < 8; ++i) b[i] = uint8_t(v >> (8 * i));
-        put(b, 8);
-    }
-    void f32(float v) {
-        uint32_t u;
-        std::memcpy(&u, &v, 4);
-        u32(u);
-    }
-    void f64(double v) {
-        uint64_t u;
-        std::memcpy(&u, &v, 8);
-        u64(u);
-    }
-    void bytes(std::span<const uint8_t> b) { put(b.data(), b.size()); }
-    std::size_t size() const { return pos_; }
-    uint8_t* end() { return out_.data() + pos_; }
-
-private:
-    void put(const void* p, std::size_t n);
-    std::span<uint8_t> out_;
-    std::size_t pos_ = 0;
-};
-
-// Little-endian reader: each read checks what remains and remembers the first failure.
-class Reader {
-public:
-    explicit Reader(std::span<const uint8_t> in) : in_(in) {}
-    uint8_t u8();
-    uint16_t u16();
-    uint32_t u32();
-    uint64_t u64();
-    float f32();
-    double f64();
-    std::span<const uint8_t> bytes(std::size_t n);
-    std::size_t remaining() const { return failed_ ? 0 : in_.size() - pos_; }
-    bool ok() const { return !failed_; }
-
-private:
-    bool take(std::size_t n);
-    std::span<const uint8_t> in_;
-    std::size_t pos_ = 0;
-    bool failed_ = false;
-};
+// Little-endian writer into a fixed buffer (overflow is a contract violation of the caller) and
+// the reader that checks every length (core/byte_io.hpp).
+using Writer = FixedByteWriter;
+using Reader = ByteReader;
 
 void write_header(Writer& w, const DatagramHeader& header);
 [[nodiscard]] Status parse_header(std::span<const uint8_t> datagram, DatagramHeader& header);

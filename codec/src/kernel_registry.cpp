@@ -1,0 +1,433 @@
+#include "reprise/codec/kernel_registry.hpp"
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <memory>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "kernels.hpp"
+#include "reprise/core/parallel.hpp"
+
+namespace reprise::codec {
+
+namespace {
+
+using warp::KernelCase;
+using warp::KernelEntry;
+using warp::KernelInputs;
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+
+float uniform(std::mt19937& rng, float a, float b) {
+    return a + (b - a) * float(rng() >> 8) * (1.0f / 16777216.0f);
+}
+
+float worst_value(std::mt19937& rng) {
+    constexpr float values[] = {kNaN,   kInf,   -kInf, 0.0f, -0.0f, 1e30f,
+                                -1e30f, 1e-30f, -1.0f, 0.5f, 3e5f,  -3e5f};
+    return values[rng() % std::size(values)];
+}
+
+template <class T>
+std::string compare_values(const char* what, const std::vector<T>& a, const std::vector<T>& b) {
+    for (std::size_t i = 0; i < a.size(); ++i)
+        if (std::memcmp(&a[i], &b[i], sizeof(T)) != 0)
+            return std::string(what) + ": element " + std::to_string(i) + " differs";
+    return {};
+}
+
+// Catmull-Rom prediction of a plane (luma, or 4:2:0 chroma from luma motion). Random: a camera
+// pan's smooth motion with 1/64 steps and a depth edge; worst case: NaN/Inf and huge motion,
+// whole-pixel motion, the plane's value extremes.
+class PredictCase final : public KernelCase {
+public:
+    explicit PredictCase(bool subsampled) : subsampled_(subsampled) {}
+    void generate(int w, int h, KernelInputs inputs, uint32_t seed) override {
+        std::mt19937 rng(seed);
+        width_ = w, height_ = h;
+        motion_width_ = subsampled_ ? std::max(1, 2 * w - int(rng() % 2)) : w;
+        motion_height_ = subsampled_ ? 2 * h : h;
+        const bool worst = inputs == KernelInputs::WorstCase;
+        lo_ = subsampled_ ? -255 : 0;
+        plane_.resize(std::size_t(w) * h);
+        for (int16_t& v : plane_)
+            v = worst && rng() % 4 == 0 ? int16_t(rng() % 2 ? 32767 : -32768)
+                                        : int16_t(lo_ + int(rng() % uint32_t(256 - lo_)));
+        motion_.resize(std::size_t(motion_width_) * motion_height_);
+        const glm::vec2 pan{uniform(rng, -9, 9), uniform(rng, -5, 5)};
+        for (int y = 0; y < motion_height_; ++y)
+            for (int x = 0; x < motion_width_; ++x) {
+                glm::vec2 m = pan + glm::vec2(0.01f * float(x), -0.005f * float(y));
+                if (x > motion_width_ / 2) m *= 1.5f;                    // a depth edge
+                if (y % 4 == 1) m = {std::round(m.x), std::round(m.y)};  // whole pixels
+                if (worst && rng() % 3 == 0) m[int(rng() % 2)] = worst_value(rng);
+                motion_[std::size_t(y) * motion_width_ + x] = m;
+            }
+    }
+    void run_reference() override {
+        run_into(reference_, [](const PredictRow& r) { predict_row_reference(r, 0, r.width); });
+    }
+    void run() override { run_into(optimized_, predict_row); }
+    std::string compare() const override {
+        return compare_values("prediction", optimized_, reference_);
+    }
+
+private:
+    template <class Kernel>
+    void run_into(std::vector<int16_t>& out, Kernel kernel) {
+        out.assign(plane_.size(), 0);
+        const int s = subsampled_ ? 1 : 0;
+        parallel_for(0, height_, [&](int y0, int y1) {
+            for (int y = y0; y < y1; ++y)
+                kernel(
+                    {.reference = plane_.data(),
+                     .width = width_,
+                     .height = height_,
+                     .y = y,
+                     .motion0 = motion_.data() +
+                                std::size_t(std::min(y << s, motion_height_ - 1)) * motion_width_,
+                     .motion1 =
+                         motion_.data() +
+                         std::size_t(std::min((y << s) + s, motion_height_ - 1)) * motion_width_,
+                     .motion_width = motion_width_,
+                     .subsampled = subsampled_,
+                     .lo = lo_,
+                     .hi = 255,
+                     .out = out.data() + std::size_t(y) * width_});
+        });
+    }
+
+    bool subsampled_;
+    int width_ = 0, height_ = 0, motion_width_ = 0, motion_height_ = 0, lo_ = 0;
+    std::vector<int16_t> plane_;
+    std::vector<glm::vec2> motion_;
+    std::vector<int16_t> reference_, optimized_;
+};
+
+// Camera motion of each row. Random: depths of a scene in front of both cameras with some
+// background; worst case: NaN/Inf/negative/signed-zero depths, points behind the other camera,
+// an orthographic row.
+class CameraMotionCase final : public KernelCase {
+public:
+    void generate(int w, int h, KernelInputs inputs, uint32_t seed) override {
+        std::mt19937 rng(seed);
+        width_ = w, height_ = h;
+        const bool worst = inputs == KernelInputs::WorstCase;
+        depth_.resize(std::size_t(w) * h);
+        for (float& z : depth_) {
+            z = rng() % 10 == 0 ? kInf : uniform(rng, 0.5f, 80.0f);
+            if (worst && rng() % 3 == 0) z = worst_value(rng);
+        }
+        auto v4 = [&](float range) {
+            return glm::vec4(uniform(rng, -range, range), uniform(rng, -range, range),
+                             uniform(rng, -range, range), uniform(rng, -range, range));
+        };
+        rows_.resize(std::size_t(h));
+        for (int y = 0; y < h; ++y) {
+            CameraMotionRow& r = rows_[std::size_t(y)];
+            r.a0 = v4(2.0f), r.a1 = v4(0.01f), r.b0 = v4(1.0f), r.b1 = v4(0.01f);
+            r.a0.w = uniform(rng, worst ? -1.0f : 0.5f, 2.0f);
+            r.b0.w = uniform(rng, worst ? -1.0f : 0.5f, 1.5f);
+            r.projection = glm::mat4(1.0f);
+            r.projection[0][0] = uniform(rng, 0.5f, 2.0f);
+            r.projection[1][1] = uniform(rng, 0.5f, 2.0f);
+            r.perspective = !(worst && y % 4 == 3);
+            r.projection[2][3] = r.perspective ? -1.0f : 0.0f;
+            r.projection[3][3] = r.perspective ? 0.0f : 1.0f;
+            r.projection[2][2] = -1.002f;
+            r.projection[3][2] = -0.2f;
+            for (int c = 0; c < 4; ++c) r.to_clip[c] = v4(1.5f);
+            r.far_plane = 100.0f;
+            r.y = y, r.width = w, r.height = h;
+            r.depth = depth_.data() + std::size_t(y) * w;
+        }
+    }
+    void run_reference() override {
+        run_into(reference_,
+                 [](const CameraMotionRow& r) { camera_motion_row_reference(r, 0, r.width); });
+    }
+    void run() override { run_into(optimized_, camera_motion_row); }
+    std::string compare() const override {
+        return compare_values("motion", optimized_, reference_);
+    }
+
+private:
+    template <class Kernel>
+    void run_into(std::vector<glm::vec2>& out, Kernel kernel) {
+        out.assign(depth_.size(), glm::vec2(0.0f));
+        parallel_for(0, height_, [&](int y0, int y1) {
+            for (int y = y0; y < y1; ++y) {
+                CameraMotionRow r = rows_[std::size_t(y)];
+                r.out = out.data() + std::size_t(y) * width_;
+                kernel(r);
+            }
+        });
+    }
+
+    int width_ = 0, height_ = 0;
+    std::vector<float> depth_;
+    std::vector<CameraMotionRow> rows_;
+    std::vector<glm::vec2> reference_, optimized_;
+};
+
+// Colour to YCoCg-R planes. Random: linear colour over [0, 1.2] (codes near 0 and above 255
+// included); worst case: NaN, Inf, negative, denormal and values just around the thresholds.
+class ToPlanesCase final : public KernelCase {
+public:
+    void generate(int w, int h, KernelInputs inputs, uint32_t seed) override {
+        std::mt19937 rng(seed);
+        width_ = w, height_ = h;
+        color_.resize(std::size_t(w) * h);
+        const float* thresholds = srgb_tables().thresholds;
+        for (glm::vec4& c : color_)
+            for (int k = 0; k < 4; ++k) {
+                float v = uniform(rng, 0.0f, 1.2f);
+                if (rng() % 4 == 0) v = v * v * v * 0.01f;  // the steep part near black
+                if (inputs == KernelInputs::WorstCase && rng() % 2) {
+                    const float t = thresholds[rng() % 255];
+                    const float choices[] = {
+                        worst_value(rng),        t,    std::nextafter(t, 0.0f),
+                        std::nextafter(t, 2.0f), 1.0f, std::nextafter(1.0f, 0.0f)};
+                    v = choices[rng() % std::size(choices)];
+                }
+                c[k] = v;
+            }
+    }
+    void run_reference() override {
+        run_into(reference_, [](const ToPlanesRow& r) { to_planes_row_reference(r, 0, r.width); });
+    }
+    void run() override { run_into(optimized_, to_planes_row); }
+    std::string compare() const override {
+        return compare_values("planes", optimized_, reference_);
+    }
+
+private:
+    template <class Kernel>
+    void run_into(std::vector<int16_t>& out, Kernel kernel) {
+        const std::size_t n = color_.size();
+        out.assign(3 * n, 0);
+        parallel_for(0, height_, [&](int y0, int y1) {
+            for (int y = y0; y < y1; ++y) {
+                const std::size_t o = std::size_t(y) * width_;
+                kernel({.color = color_.data() + o,
+                        .width = width_,
+                        .y = out.data() + o,
+                        .co = out.data() + n + o,
+                        .cg = out.data() + 2 * n + o});
+            }
+        });
+    }
+
+    int width_ = 0, height_ = 0;
+    std::vector<glm::vec4> color_;
+    std::vector<int16_t> reference_, optimized_;
+};
+
+// YCoCg-R planes to linear colour. Random: the codec's value ranges; worst case: values beyond
+// them (every clamp) and NaN/Inf depths.
+class FromPlanesCase final : public KernelCase {
+public:
+    void generate(int w, int h, KernelInputs inputs, uint32_t seed) override {
+        std::mt19937 rng(seed);
+        width_ = w, height_ = h;
+        const bool worst = inputs == KernelInputs::WorstCase;
+        const std::size_t n = std::size_t(w) * h;
+        planes_.resize(3 * n);
+        depth_.resize(n);
+        for (std::size_t i = 0; i < n; ++i) {
+            const int range = worst ? 2000 : 256;
+            planes_[i] = int16_t(int(rng() % uint32_t(range)) - (worst ? 1000 : 0));
+            planes_[n + i] = int16_t(int(rng() % uint32_t(2 * range)) - range);
+            planes_[2 * n + i] = int16_t(int(rng() % uint32_t(2 * range)) - range);
+            depth_[i] = rng() % 8 == 0 ? kInf : uniform(rng, 0.1f, 50.0f);
+            if (worst && rng() % 3 == 0) depth_[i] = worst_value(rng);
+        }
+    }
+    void run_reference() override {
+        run_into(reference_,
+                 [](const FromPlanesRow& r) { from_planes_row_reference(r, 0, r.width); });
+    }
+    void run() override { run_into(optimized_, from_planes_row); }
+    std::string compare() const override {
+        return compare_values("colour", optimized_, reference_);
+    }
+
+private:
+    template <class Kernel>
+    void run_into(std::vector<glm::vec4>& out, Kernel kernel) {
+        const std::size_t n = depth_.size();
+        out.assign(n, glm::vec4(0.0f));
+        parallel_for(0, height_, [&](int y0, int y1) {
+            for (int y = y0; y < y1; ++y) {
+                const std::size_t o = std::size_t(y) * width_;
+                kernel({.y = planes_.data() + o,
+                        .co = planes_.data() + n + o,
+                        .cg = planes_.data() + 2 * n + o,
+                        .depth = y % 2 ? depth_.data() + o : nullptr,
+                        .width = width_,
+                        .out = out.data() + o});
+            }
+        });
+    }
+
+    int width_ = 0, height_ = 0;
+    std::vector<int16_t> planes_;
+    std::vector<float> depth_;
+    std::vector<glm::vec4> reference_, optimized_;
+};
+
+// Forward projection of depth into another camera. Random: a scene in front of both cameras
+// (perspective or orthographic) with background; worst case: NaN/Inf/negative/signed-zero
+// depths and a camera that moved far forward, so that points fall behind it.
+class ForwardCase final : public KernelCase {
+public:
+    void generate(int w, int h, KernelInputs inputs, uint32_t seed) override {
+        std::mt19937 rng(seed);
+        width_ = w, height_ = h;
+        const bool worst = inputs == KernelInputs::WorstCase;
+        depth_.resize(std::size_t(w) * h);
+        for (float& z : depth_) {
+            z = rng() % 10 == 0 ? kInf : uniform(rng, 0.2f, 60.0f);
+            if (worst && rng() % 3 == 0) z = worst_value(rng);
+        }
+        const bool ortho = seed % 3 == 0;
+        projection_ =
+            ortho ? glm::ortho(-4.0f, 4.0f, -3.0f, 3.0f, 0.1f, 50.0f)
+                  : glm::perspective(uniform(rng, 0.5f, 1.5f), float(w) / float(h), 0.1f, 100.0f);
+        const float forward = worst ? uniform(rng, 5.0f, 30.0f) : uniform(rng, -0.3f, 0.3f);
+        to_camera_ = glm::rotate(
+            glm::translate(glm::mat4(1.0f), glm::vec3(uniform(rng, -0.5f, 0.5f),
+                                                      uniform(rng, -0.2f, 0.2f), forward)),
+            uniform(rng, -0.1f, 0.1f), glm::vec3(0, 1, 0));
+        to_clip_ = projection_ * to_camera_;
+    }
+    void run_reference() override {
+        run_into(reference_, [](const ForwardRow& r) { forward_row_reference(r, 0, r.count); });
+    }
+    void run() override { run_into(optimized_, forward_row); }
+    std::string compare() const override {
+        for (std::size_t i = 0; i < reference_.slot.size(); ++i) {
+            if (optimized_.slot[i] != reference_.slot[i])
+                return "pixel " + std::to_string(i) + " lands at " +
+                       std::to_string(optimized_.slot[i]) + ", reference " +
+                       std::to_string(reference_.slot[i]);
+            if (reference_.slot[i] >= 0 &&
+                std::memcmp(&optimized_.z[i], &reference_.z[i], sizeof(float)) != 0)
+                return "pixel " + std::to_string(i) + ": depth differs";
+        }
+        return {};
+    }
+
+private:
+    struct Output {
+        std::vector<int32_t> slot;
+        std::vector<float> z;
+    };
+    template <class Kernel>
+    void run_into(Output& out, Kernel kernel) {
+        out.slot.assign(depth_.size(), 0);
+        out.z.assign(depth_.size(), 0.0f);
+        parallel_for(0, height_, [&](int y0, int y1) {
+            for (int y = y0; y < y1; ++y) {
+                const std::size_t o = std::size_t(y) * width_;
+                kernel({.projection = projection_,
+                        .to_clip = to_clip_,
+                        .to_camera = to_camera_,
+                        .x0 = 0,
+                        .y = y,
+                        .count = width_,
+                        .width = width_,
+                        .height = height_,
+                        .depth = depth_.data() + o,
+                        .slot = out.slot.data() + o,
+                        .z = out.z.data() + o});
+            }
+        });
+    }
+
+    int width_ = 0, height_ = 0;
+    std::vector<float> depth_;
+    glm::mat4 projection_{1.0f}, to_clip_{1.0f}, to_camera_{1.0f};
+    Output reference_, optimized_;
+};
+
+// The motion residual test, row by row. Random: the renderer's motion equal to the camera's, or
+// off by less than, about, or more than 1/16 pixel (only some rows differ); worst case: NaN/Inf
+// on either side and differences beyond the residual's range.
+class MotionResidualCase final : public KernelCase {
+public:
+    void generate(int w, int h, KernelInputs inputs, uint32_t seed) override {
+        std::mt19937 rng(seed);
+        width_ = w, height_ = h;
+        const bool worst = inputs == KernelInputs::WorstCase;
+        source_.resize(std::size_t(w) * h);
+        base_.resize(source_.size());
+        for (int y = 0; y < h; ++y) {
+            const float spread = y % 3 == 0 ? 0.0f : y % 3 == 1 ? 0.0624f : 0.5f;
+            for (int x = 0; x < w; ++x) {
+                const std::size_t i = std::size_t(y) * w + x;
+                base_[i] = {uniform(rng, -30, 30), uniform(rng, -30, 30)};
+                source_[i] = base_[i];
+                if (rng() % 4 == 0)
+                    source_[i] +=
+                        glm::vec2(uniform(rng, -spread, spread), uniform(rng, -spread, spread));
+                if (worst && rng() % 4 == 0) {
+                    glm::vec2& v = rng() % 2 ? source_[i] : base_[i];
+                    v[int(rng() % 2)] = worst_value(rng);
+                }
+            }
+        }
+    }
+    void run_reference() override {
+        run_into(reference_, [](const MotionResidualRow& r) {
+            return motion_residual_row_reference(r, 0, r.width);
+        });
+    }
+    void run() override { run_into(optimized_, motion_residual_row); }
+    std::string compare() const override {
+        return compare_values("row needs a residual", optimized_, reference_);
+    }
+
+private:
+    template <class Kernel>
+    void run_into(std::vector<uint8_t>& out, Kernel kernel) {
+        out.assign(std::size_t(height_), 0);
+        parallel_for(0, height_, [&](int y0, int y1) {
+            for (int y = y0; y < y1; ++y) {
+                const std::size_t o = std::size_t(y) * width_;
+                out[std::size_t(y)] = kernel({source_.data() + o, base_.data() + o, width_});
+            }
+        });
+    }
+
+    int width_ = 0, height_ = 0;
+    std::vector<glm::vec2> source_, base_;
+    std::vector<uint8_t> reference_, optimized_;
+};
+
+template <class T, auto... Args>
+std::unique_ptr<KernelCase> make() {
+    return std::make_unique<T>(Args...);
+}
+
+constexpr KernelEntry kEntries[] = {
+    {"codec prediction, luma", "bit-exact", true, make<PredictCase, false>},
+    {"codec prediction, 4:2:0 chroma", "bit-exact", true, make<PredictCase, true>},
+    {"codec camera motion", "bit-exact", true, make<CameraMotionCase>},
+    {"codec depth forward projection", "bit-exact", true, make<ForwardCase>},
+    {"codec motion residual test", "bit-exact", true, make<MotionResidualCase>},
+    {"codec colour to YCoCg-R", "bit-exact", true, make<ToPlanesCase>},
+    {"codec YCoCg-R to colour", "bit-exact", true, make<FromPlanesCase>},
+};
+
+}  // namespace
+
+std::span<const KernelEntry> kernel_registry() { return kEntries; }
+
+}  // namespace reprise::codec

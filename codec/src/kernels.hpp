@@ -1,0 +1,112 @@
+#pragma once
+// Row kernels with a SIMD version chosen at run time (simd_kernels.cpp, Highway) beside their
+// scalar reference (in the stage's own file). Each SIMD version gives its reference's bits: the
+// codec's encoder and decoder must agree whatever level either runs at.
+#include <cstddef>
+#include <cstdint>
+
+#include <glm/mat4x4.hpp>
+#include <glm/vec2.hpp>
+#include <glm/vec4.hpp>
+
+namespace reprise::codec {
+
+// Inter prediction of one row of a plane: pixel x fetched from the reference plane at
+// x + motion with the Catmull-Rom filter (1/64 pel, integer), clamped to [lo, hi] (whole-pixel
+// positions copy the reference as it is). Luma takes motion0[min(x, motion_width - 1)]; 4:2:0
+// chroma the mean of the 2x2 luma motions (motion0 row 2y, motion1 row 2y + 1) in chroma pixels.
+// Non-finite motion counts as 0.
+struct PredictRow {
+    const int16_t* reference;
+    int width, height;  // of the plane (and of out)
+    int y;
+    const glm::vec2* motion0;
+    const glm::vec2* motion1;  // chroma only
+    int motion_width;
+    bool subsampled;
+    int lo, hi;
+    int16_t* out;
+};
+// The reference does pixels [x_begin, x_end).
+void predict_row_reference(const PredictRow& row, int x_begin, int x_end);
+void predict_row(const PredictRow& row);
+
+// Catmull-Rom weights per 1/64 phase, in 1/128, summing to 128 ([phase][tap]).
+const int32_t (&catmull_rom_weights())[64][4];
+
+// Camera motion of one row (geometry.cpp, camera_motion): under perspective a pixel's clip
+// position in the other camera is (a0 + x a1) + z (b0 + x b1) for finite depth z >= 0; other
+// pixels (background, negative or NaN depth, orthographic) unproject through `projection` and
+// go through `to_clip`. Out: the motion to the other camera's pixel, NaN where the point is
+// behind it or has no depth.
+struct CameraMotionRow {
+    glm::vec4 a0, a1, b0, b1;
+    glm::mat4 projection, to_clip;
+    bool perspective;
+    float far_plane;
+    int y, width, height;
+    const float* depth;
+    glm::vec2* out;
+};
+void camera_motion_row_reference(const CameraMotionRow& row, int x_begin, int x_end);
+void camera_motion_row(const CameraMotionRow& row);
+
+// Colour conversion of one row into YCoCg-R: linear RGB -> 8-bit sRGB codes (colour.cpp's
+// table and thresholds) -> y, co, cg.
+struct ToPlanesRow {
+    const glm::vec4* color;
+    int width;
+    int16_t* y;
+    int16_t* co;
+    int16_t* cg;
+};
+void to_planes_row_reference(const ToPlanesRow& row, int x_begin, int x_end);
+void to_planes_row(const ToPlanesRow& row);
+// The 8-bit code's table: start[i] is the code of i / kSrgbSteps, thresholds[k] the linear
+// value where code k + 1 begins.
+inline constexpr int kSrgbSteps = 4096;
+struct SrgbTables {
+    int32_t start[kSrgbSteps + 1];
+    float thresholds[256];  // [255] = +inf
+    float to_linear[256];
+};
+const SrgbTables& srgb_tables();
+
+// One row of YCoCg-R (chroma at full resolution) -> linear RGB; alpha 0 where the depth is
+// not finite (no depth: 1).
+struct FromPlanesRow {
+    const int16_t* y;
+    const int16_t* co;
+    const int16_t* cg;
+    const float* depth;  // null without depth
+    int width;
+    glm::vec4* out;
+};
+void from_planes_row_reference(const FromPlanesRow& row, int x_begin, int x_end);
+void from_planes_row(const FromPlanesRow& row);
+
+// Forward projection of `count` pixels from (x0, y) into another camera (reproject_depth): where
+// pixel x0 + i lands (slot[i]: row-major pixel index, -1 for nowhere) and its depth there (z[i]).
+// Depth +inf, NaN or below 0 lands nowhere. Perspective or not, through `projection`.
+struct ForwardRow {
+    glm::mat4 projection, to_clip, to_camera;
+    int x0, y, count, width, height;
+    const float* depth;  // from x0
+    int32_t* slot;
+    float* z;
+};
+// The reference does pixels [i_begin, i_end) of the row.
+void forward_row_reference(const ForwardRow& row, int i_begin, int i_end);
+void forward_row(const ForwardRow& row);
+
+// Whether any pixel of a row needs a motion residual (motion.cpp): the renderer's motion differs
+// from the camera motion by 1/16 pixel or more, or exactly one of them is not finite.
+struct MotionResidualRow {
+    const glm::vec2* source;
+    const glm::vec2* base;
+    int width;
+};
+bool motion_residual_row_reference(const MotionResidualRow& row, int x_begin, int x_end);
+bool motion_residual_row(const MotionResidualRow& row);
+
+}  // namespace reprise::codec

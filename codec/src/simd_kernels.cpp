@@ -1,0 +1,349 @@
+// The SIMD versions of kernels.hpp, compiled once per Highway target and chosen at run time.
+// Each spells out its scalar reference's operations in the same order (no FMA: the codec is
+// compiled with -ffp-contract=off), so it gives the same bits; pixels a vector cannot take (the
+// end of a row, a filter window over the plane's edge) go through the reference itself.
+#include <algorithm>
+#include <bit>
+#include <limits>
+
+#include "kernels.hpp"
+
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "simd_kernels.cpp"
+#include <hwy/foreach_target.h>  // IWYU pragma: keep
+#include <hwy/highway.h>
+
+HWY_BEFORE_NAMESPACE();
+namespace reprise::codec::HWY_NAMESPACE {
+namespace hn = hwy::HWY_NAMESPACE;
+
+void PredictRowSimd(const PredictRow& r) {
+    if constexpr (std::endian::native != std::endian::little) {
+        predict_row_reference(r, 0, r.width);
+        return;
+    }
+    const hn::ScalableTag<float> df;
+    const hn::RebindToSigned<decltype(df)> di;
+    const hn::Rebind<int16_t, decltype(df)> d16;
+    using VF = hn::Vec<decltype(df)>;
+    using VI = hn::Vec<decltype(di)>;
+    const int n = int(hn::Lanes(df));
+    const VF zero = hn::Zero(df), half = hn::Set(df, 0.5f), eighth = hn::Set(df, 0.125f);
+    const VF phases = hn::Set(df, 64.0f);
+    const VF x_low = hn::Set(df, -4.0f * 64), x_high = hn::Set(df, float(r.width + 4) * 64);
+    // The row's vertical position is the same fixed_position for every lane but its motion.
+    const VF y_low = hn::Set(df, -4.0f * 64), y_high = hn::Set(df, float(r.height + 4) * 64);
+    const VF cy = hn::Set(df, float(r.y) + 0.5f);
+    const VI one = hn::Set(di, 1), two = hn::Set(di, 2), mask63 = hn::Set(di, 63);
+    const VI w_minus2 = hn::Set(di, r.width - 2), h_minus2 = hn::Set(di, r.height - 2);
+    const VI stride = hn::Set(di, r.width), round = hn::Set(di, 1 << 13);
+    const VI lo = hn::Set(di, r.lo), hi = hn::Set(di, r.hi), zero_i = hn::Zero(di);
+    const int32_t* weights = &catmull_rom_weights()[0][0];
+    const int32_t* base = reinterpret_cast<const int32_t*>(r.reference);
+
+    auto usable = [&](VF& mx, VF& my) {  // non-finite motion counts as 0
+        const auto finite = hn::And((mx - mx) == zero, (my - my) == zero);
+        mx = hn::IfThenElseZero(finite, mx);
+        my = hn::IfThenElseZero(finite, my);
+    };
+    auto fixed_position = [&](VF centre, VF m, VF low, VF high) {
+        const VF q = hn::Min(hn::Max((centre + m - half) * phases, low), high);
+        const VI t = hn::ConvertTo(di, q);
+        return t - hn::IfThenElseZero(hn::RebindMask(di, q < hn::ConvertTo(df, t)), one);
+    };
+
+    const int vector_end = std::min(r.width, r.subsampled ? r.motion_width / 2 : r.motion_width);
+    int x = 0;
+    for (; x + n <= vector_end; x += n) {
+        VF mx, my;
+        if (!r.subsampled) {
+            hn::LoadInterleaved2(df, &r.motion0[x].x, mx, my);
+            usable(mx, my);
+        } else {
+            VF ax, ay, bx, by, cx, cy2, dx, dy;
+            hn::LoadInterleaved4(df, &r.motion0[2 * x].x, ax, ay, bx, by);
+            hn::LoadInterleaved4(df, &r.motion1[2 * x].x, cx, cy2, dx, dy);
+            usable(ax, ay), usable(bx, by), usable(cx, cy2), usable(dx, dy);
+            mx = (((ax + bx) + cx) + dx) * eighth;
+            my = (((ay + by) + cy2) + dy) * eighth;
+        }
+        const VF centre = hn::Iota(df, float(x)) + half;
+        const VI qx = fixed_position(centre, mx, x_low, x_high);
+        const VI qy = fixed_position(cy, my, y_low, y_high);
+        const VI ix = hn::ShiftRight<6>(qx), iy = hn::ShiftRight<6>(qy);
+        const auto inside =
+            hn::And(hn::And(ix > zero_i, iy > zero_i), hn::And(ix < w_minus2, iy < h_minus2));
+        if (!hn::AllTrue(di, inside)) {  // a window over the edge: the reference clamps
+            predict_row_reference(r, x, x + n);
+            continue;
+        }
+        const VI px = hn::And(qx, mask63), py = hn::And(qy, mask63);
+        const VI px4 = hn::ShiftLeft<2>(px), py4 = hn::ShiftLeft<2>(py);
+        VI wx[4], wy[4];
+        for (int i = 0; i < 4; ++i) {
+            wx[i] = hn::GatherIndex(di, weights, px4 + hn::Set(di, i));
+            wy[i] = hn::GatherIndex(di, weights, py4 + hn::Set(di, i));
+        }
+        VI sum = zero_i;
+        const int ix0 = hn::GetLane(ix), iy0 = hn::GetLane(iy);
+        if (hn::AllTrue(di, hn::And(ix == hn::Iota(di, ix0), iy == hn::Set(di, iy0)))) {
+            // Adjacent windows (the usual case: motion changes slowly along a row): each tap's
+            // samples are one contiguous load.
+            const int16_t* row = r.reference + std::size_t(iy0 - 1) * r.width + (ix0 - 1);
+            for (int j = 0; j < 4; ++j, row += r.width) {
+                const VI line = wx[0] * hn::PromoteTo(di, hn::LoadU(d16, row)) +
+                                wx[1] * hn::PromoteTo(di, hn::LoadU(d16, row + 1)) +
+                                wx[2] * hn::PromoteTo(di, hn::LoadU(d16, row + 2)) +
+                                wx[3] * hn::PromoteTo(di, hn::LoadU(d16, row + 3));
+                sum = sum + wy[j] * line;
+            }
+        } else {
+            // Byte offsets of each window's top-left sample; a 32-bit gather takes two samples.
+            VI offset = hn::ShiftLeft<1>((iy - one) * stride + (ix - one));
+            const VI row_bytes = hn::Set(di, 2 * r.width);
+            for (int j = 0; j < 4; ++j, offset = offset + row_bytes) {
+                const VI a = hn::GatherOffset(di, base, offset);
+                const VI b = hn::GatherOffset(di, base, offset + two + two);
+                const VI line = wx[0] * hn::ShiftRight<16>(hn::ShiftLeft<16>(a)) +
+                                wx[1] * hn::ShiftRight<16>(a) +
+                                wx[2] * hn::ShiftRight<16>(hn::ShiftLeft<16>(b)) +
+                                wx[3] * hn::ShiftRight<16>(b);
+                sum = sum + wy[j] * line;
+            }
+        }
+        const VI value = hn::ShiftRight<14>(sum + round);
+        // Whole-pixel positions (weights 0, 128, 0, 0) copy the sample unclamped.
+        const auto whole = hn::And(px == zero_i, py == zero_i);
+        const VI out = hn::IfThenElse(whole, value, hn::Min(hn::Max(value, lo), hi));
+        hn::StoreU(hn::DemoteTo(d16, out), d16, r.out + x);
+    }
+    predict_row_reference(r, x, r.width);
+}
+
+void CameraMotionRowSimd(const CameraMotionRow& r) {
+    if (!r.perspective) {
+        camera_motion_row_reference(r, 0, r.width);
+        return;
+    }
+    const hn::ScalableTag<float> df;
+    using VF = hn::Vec<decltype(df)>;
+    const int n = int(hn::Lanes(df));
+    auto splat = [&](float v) { return hn::Set(df, v); };
+    const VF a0x = splat(r.a0.x), a0y = splat(r.a0.y), a0w = splat(r.a0.w);
+    const VF a1x = splat(r.a1.x), a1y = splat(r.a1.y), a1w = splat(r.a1.w);
+    const VF b0x = splat(r.b0.x), b0y = splat(r.b0.y), b0w = splat(r.b0.w);
+    const VF b1x = splat(r.b1.x), b1y = splat(r.b1.y), b1w = splat(r.b1.w);
+    const VF zero = hn::Zero(df), half = splat(0.5f), one = splat(1.0f);
+    const VF inf = splat(std::numeric_limits<float>::infinity());
+    const VF nan = splat(std::numeric_limits<float>::quiet_NaN());
+    const VF fw = splat(float(r.width)), fh = splat(float(r.height));
+    const VF cy = splat(float(r.y) + 0.5f);
+    // Background (depth +inf): the direction ((x_ndc wc + p20) / p00, (y_ndc wc + p21) / p11,
+    // -1, 0) with wc = -p23, through to_clip as glm multiplies (m0 v0 + m1 v1) + (m2 v2 + m3 v3).
+    const glm::mat4& P = r.projection;
+    const glm::mat4& M = r.to_clip;
+    const VF wc = splat(-P[2][3]), two = splat(2.0f), minus_one = splat(-1.0f);
+    const VF bg_y =
+        (splat(1.0f - 2.0f * (float(r.y) + 0.5f) / float(r.height)) * wc + splat(P[2][1])) /
+        splat(P[1][1]);
+    auto bg_clip = [&](int c, VF bg_x) {
+        return (splat(M[0][c]) * bg_x + splat(M[1][c]) * bg_y) +
+               (splat(M[2][c]) * minus_one + splat(M[3][c]) * zero);
+    };
+    int x = 0;
+    for (; x + n <= r.width; x += n) {
+        const VF d = hn::LoadU(df, r.depth + x);
+        const auto finite = hn::And(d >= zero, d < inf);
+        const auto background = d == inf;
+        const VF fx = hn::Iota(df, float(x));
+        VF cx = (a0x + fx * a1x) + d * (b0x + fx * b1x);
+        VF cyc = (a0y + fx * a1y) + d * (b0y + fx * b1y);
+        VF cw = (a0w + fx * a1w) + d * (b0w + fx * b1w);
+        if (!hn::AllFalse(df, background)) {
+            const VF x_ndc = two * (fx + half) / fw - one;
+            const VF bg_x = (x_ndc * wc + splat(P[2][0])) / splat(P[0][0]);
+            cx = hn::IfThenElse(background, bg_clip(0, bg_x), cx);
+            cyc = hn::IfThenElse(background, bg_clip(1, bg_x), cyc);
+            cw = hn::IfThenElse(background, bg_clip(3, bg_x), cw);
+        }
+        // NaN and negative depths have no point: NaN, as for points behind the camera.
+        const auto ahead = hn::And(hn::Or(finite, background), cw > zero);
+        const VF px = (cx / cw + one) * half * fw;
+        const VF py = (one - cyc / cw) * half * fh;
+        hn::StoreInterleaved2(hn::IfThenElse(ahead, px - (fx + half), nan),
+                              hn::IfThenElse(ahead, py - cy, nan), df, &r.out[x].x);
+    }
+    camera_motion_row_reference(r, x, r.width);
+}
+
+void ToPlanesRowSimd(const ToPlanesRow& r) {
+    const hn::ScalableTag<float> df;
+    const hn::RebindToSigned<decltype(df)> di;
+    const hn::Rebind<int16_t, decltype(df)> d16;
+    using VF = hn::Vec<decltype(df)>;
+    using VI = hn::Vec<decltype(di)>;
+    const int n = int(hn::Lanes(df));
+    const SrgbTables& t = srgb_tables();
+    const VF zero = hn::Zero(df), one = hn::Set(df, 1.0f), steps = hn::Set(df, float(kSrgbSteps));
+    const VI zero_i = hn::Zero(di), one_i = hn::Set(di, 1), top = hn::Set(di, 255);
+    auto code = [&](VF v) {
+        const auto positive = v > zero, saturated = v >= one;
+        const VF inside = hn::IfThenElseZero(hn::AndNot(saturated, positive), v);
+        VI c = hn::GatherIndex(di, t.start, hn::ConvertTo(di, inside * steps));
+        for (;;) {  // up the thresholds (thresholds[255] = +inf stops every lane)
+            const auto up = hn::RebindMask(di, inside >= hn::GatherIndex(df, t.thresholds, c));
+            if (hn::AllFalse(di, up)) break;
+            c = c + hn::IfThenElseZero(up, one_i);
+        }
+        return hn::IfThenElse(hn::RebindMask(di, saturated), top,
+                              hn::IfThenElse(hn::RebindMask(di, positive), c, zero_i));
+    };
+    int x = 0;
+    for (; x + n <= r.width; x += n) {
+        VF red, green, blue, alpha;
+        hn::LoadInterleaved4(df, &r.color[x].x, red, green, blue, alpha);
+        const VI R = code(red), G = code(green), B = code(blue);
+        const VI co = R - B;
+        const VI tt = B + hn::ShiftRight<1>(co);
+        const VI cg = G - tt;
+        hn::StoreU(hn::DemoteTo(d16, tt + hn::ShiftRight<1>(cg)), d16, r.y + x);
+        hn::StoreU(hn::DemoteTo(d16, co), d16, r.co + x);
+        hn::StoreU(hn::DemoteTo(d16, cg), d16, r.cg + x);
+    }
+    to_planes_row_reference(r, x, r.width);
+}
+
+void FromPlanesRowSimd(const FromPlanesRow& r) {
+    const hn::ScalableTag<float> df;
+    const hn::RebindToSigned<decltype(df)> di;
+    const hn::Rebind<int16_t, decltype(df)> d16;
+    using VF = hn::Vec<decltype(df)>;
+    using VI = hn::Vec<decltype(di)>;
+    const int n = int(hn::Lanes(df));
+    const float* lut = srgb_tables().to_linear;
+    const VI zero_i = hn::Zero(di), top = hn::Set(di, 255);
+    const VF zero = hn::Zero(df), one = hn::Set(df, 1.0f);
+    auto clamp = [&](VI v) { return hn::Min(hn::Max(v, zero_i), top); };
+    int x = 0;
+    for (; x + n <= r.width; x += n) {
+        const VI y = hn::PromoteTo(di, hn::LoadU(d16, r.y + x));
+        const VI co = hn::PromoteTo(di, hn::LoadU(d16, r.co + x));
+        const VI cg = hn::PromoteTo(di, hn::LoadU(d16, r.cg + x));
+        const VI tt = y - hn::ShiftRight<1>(cg);
+        const VI G = clamp(cg + tt);
+        const VI B = clamp(tt - hn::ShiftRight<1>(co));
+        const VI R = clamp(tt - hn::ShiftRight<1>(co) + co);
+        VF alpha = one;
+        if (r.depth) {
+            const VF d = hn::LoadU(df, r.depth + x);
+            alpha = hn::IfThenElseZero((d - d) == zero, one);
+        }
+        hn::StoreInterleaved4(hn::GatherIndex(df, lut, R), hn::GatherIndex(df, lut, G),
+                              hn::GatherIndex(df, lut, B), alpha, df, &r.out[x].x);
+    }
+    from_planes_row_reference(r, x, r.width);
+}
+
+void ForwardRowSimd(const ForwardRow& r) {
+    const hn::ScalableTag<float> df;
+    const hn::RebindToSigned<decltype(df)> di;
+    using VF = hn::Vec<decltype(df)>;
+    const int n = int(hn::Lanes(df));
+    auto splat = [&](float v) { return hn::Set(df, v); };
+    const glm::mat4& P = r.projection;
+    const glm::mat4& M = r.to_clip;
+    const glm::mat4& C = r.to_camera;
+    const VF zero = hn::Zero(df), half = splat(0.5f), one = splat(1.0f), two = splat(2.0f);
+    const VF inf = splat(std::numeric_limits<float>::infinity());
+    const VF fw = splat(float(r.width)), fh = splat(float(r.height));
+    const VF y_ndc = splat(1.0f - 2.0f * (float(r.y) + 0.5f) / float(r.height));
+    const auto width_i = hn::Set(di, r.width), none = hn::Set(di, -1);
+    // Row c of a glm matrix times (vx, vy, zv, 1), summed as glm sums it.
+    auto times = [&](const glm::mat4& m, int c, VF vx, VF vy, VF zv) {
+        return (splat(m[0][c]) * vx + splat(m[1][c]) * vy) +
+               (splat(m[2][c]) * zv + splat(m[3][c]) * one);
+    };
+    int i = 0;
+    for (; i + n <= r.count; i += n) {
+        const VF z = hn::LoadU(df, r.depth + i);
+        const auto has_point = hn::And(z < inf, z >= zero);
+        const VF fx = hn::Iota(df, float(r.x0 + i));
+        const VF x_ndc = two * (fx + half) / fw - one;
+        const VF zv = hn::Neg(z);
+        const VF wc = splat(P[2][3]) * zv + splat(P[3][3]);
+        const VF vx = (x_ndc * wc - splat(P[2][0]) * zv - splat(P[3][0])) / splat(P[0][0]);
+        const VF vy = (y_ndc * wc - splat(P[2][1]) * zv - splat(P[3][1])) / splat(P[1][1]);
+        const VF cx = times(M, 0, vx, vy, zv), cy = times(M, 1, vx, vy, zv);
+        const VF cw = times(M, 3, vx, vy, zv);
+        const VF px = (cx / cw + one) * half * fw;
+        const VF py = (one - cy / cw) * half * fh;
+        const VF tz = hn::Neg(times(C, 2, vx, vy, zv));
+        const auto inside = hn::And(hn::And(px >= zero, py >= zero), hn::And(px < fw, py < fh));
+        const auto lands = hn::And(hn::And(has_point, cw > zero), hn::And(inside, tz > zero));
+        const auto slot = hn::ConvertTo(di, py) * width_i + hn::ConvertTo(di, px);
+        hn::StoreU(hn::IfThenElse(hn::RebindMask(di, lands), slot, none), di, r.slot + i);
+        hn::StoreU(tz, df, r.z + i);
+    }
+    forward_row_reference(r, i, r.count);
+}
+
+bool MotionResidualRowSimd(const MotionResidualRow& r) {
+    const hn::ScalableTag<float> df;
+    using VF = hn::Vec<decltype(df)>;
+    const int n = int(hn::Lanes(df));
+    const VF zero = hn::Zero(df), half = hn::Set(df, 0.5f), one = hn::Set(df, 1.0f);
+    const VF eight = hn::Set(df, 8.0f), limit = hn::Set(df, float(1 << 24));
+    // floor(clamp(v) + 0.5) == 0, as residual_of rounds
+    auto rounds_to_zero = [&](VF v) {
+        const VF t = hn::Min(hn::Max(v, hn::Neg(limit)), limit) + half;
+        return hn::And(t >= zero, t < one);
+    };
+    int x = 0;
+    for (; x + n <= r.width; x += n) {
+        VF sx, sy, bx, by;
+        hn::LoadInterleaved2(df, &r.source[x].x, sx, sy);
+        hn::LoadInterleaved2(df, &r.base[x].x, bx, by);
+        const auto source_finite = hn::And((sx - sx) == zero, (sy - sy) == zero);
+        const auto base_finite = hn::And((bx - bx) == zero, (by - by) == zero);
+        const VF dx = (sx - hn::IfThenElseZero(base_finite, bx)) * eight;
+        const VF dy = (sy - hn::IfThenElseZero(base_finite, by)) * eight;
+        const auto zero_residual =
+            hn::Or(hn::And(source_finite, hn::And(rounds_to_zero(dx), rounds_to_zero(dy))),
+                   hn::AndNot(source_finite, hn::Not(base_finite)));
+        if (!hn::AllTrue(df, zero_residual)) return true;
+    }
+    return motion_residual_row_reference(r, x, r.width);
+}
+
+}  // namespace reprise::codec::HWY_NAMESPACE
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace reprise::codec {
+
+HWY_EXPORT(PredictRowSimd);
+
+HWY_EXPORT(CameraMotionRowSimd);
+HWY_EXPORT(ToPlanesRowSimd);
+HWY_EXPORT(FromPlanesRowSimd);
+HWY_EXPORT(ForwardRowSimd);
+HWY_EXPORT(MotionResidualRowSimd);
+
+bool motion_residual_row(const MotionResidualRow& row) {
+    return HWY_DYNAMIC_DISPATCH(MotionResidualRowSimd)(row);
+}
+
+void forward_row(const ForwardRow& row) { HWY_DYNAMIC_DISPATCH(ForwardRowSimd)(row); }
+
+void to_planes_row(const ToPlanesRow& row) { HWY_DYNAMIC_DISPATCH(ToPlanesRowSimd)(row); }
+
+void from_planes_row(const FromPlanesRow& row) { HWY_DYNAMIC_DISPATCH(FromPlanesRowSimd)(row); }
+
+void predict_row(const PredictRow& row) { HWY_DYNAMIC_DISPATCH(PredictRowSimd)(row); }
+
+void camera_motion_row(const CameraMotionRow& row) {
+    HWY_DYNAMIC_DISPATCH(CameraMotionRowSimd)(row);
+}
+
+}  // namespace reprise::codec
+#endif
