@@ -78,8 +78,7 @@ Candidate along(const GBufferView& a, const GBufferView& b, glm::vec2 q, glm::ve
 }  // namespace
 
 struct MotionRefiner::State {
-    cv::Ptr<cv::DISOpticalFlow> flow =
-        cv::DISOpticalFlow::create(cv::DISOpticalFlow::PRESET_MEDIUM);
+    cv::Ptr<cv::DISOpticalFlow> flow = cv::DISOpticalFlow::create(cv::DISOpticalFlow::PRESET_FAST);
     int tile = 16, tiles_x = 0, tiles_y = 0;
     std::vector<uint8_t> flagged;            // tiles whose sides disagree
     std::vector<int> surveyed, disagreeing;  // per tile: pixels surveyed, those that disagree
@@ -184,7 +183,8 @@ struct MotionRefiner::State {
                 {std::max(0, tiles.x0 * tile - margin), std::max(0, tiles.y0 * tile - margin),
                  std::min(w, tiles.x1 * tile + margin), std::min(h, tiles.y1 * tile + margin)});
         }
-        // Overlapping boxes become one (their tiles follow): the flow runs once per pixel.
+        // Overlapping boxes become one (their tiles follow) where that costs no more pixels
+        // than the two apart.
         for (bool merged = true; merged;) {
             merged = false;
             for (std::size_t i = 0; i < boxes.size() && !merged; ++i)
@@ -192,8 +192,10 @@ struct MotionRefiner::State {
                     if (!boxes[i].overlaps(boxes[j])) continue;
                     Box& b = boxes[i];
                     const Box& o = boxes[j];
-                    b = {std::min(b.x0, o.x0), std::min(b.y0, o.y0), std::max(b.x1, o.x1),
-                         std::max(b.y1, o.y1)};
+                    const Box both{std::min(b.x0, o.x0), std::min(b.y0, o.y0), std::max(b.x1, o.x1),
+                                   std::max(b.y1, o.y1)};
+                    if (both.area() > b.area() + o.area()) continue;
+                    b = both;
                     for (int& l : label) {
                         if (l == int(j))
                             l = int(i);

@@ -31,7 +31,7 @@ struct RefineOptions {
     int tile = 16;            // px: disagreement is decided and flow evaluated per tile
     float threshold = 0.1f;   // display-value difference (largest channel) of disagreeing sides
     float tile_share = 0.1f;  // share of a tile's surveyed pixels that must disagree
-    int margin = 24;          // px of context around the disagreeing tiles given to the flow
+    int margin = 16;          // px of context around the disagreeing tiles given to the flow
 };
 
 struct FrucOptions {
