@@ -5,6 +5,7 @@
 #include <execinfo.h>
 
 #include <atomic>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <new>
@@ -108,7 +109,8 @@ Camera camera_at(int frame) {
     return c;
 }
 
-Frame make_frame(int index) {
+// Noise (every pixel its own value), or with `smooth` a slow gradient whose warped sides agree.
+Frame make_frame(int index, bool smooth = false) {
     Frame f;
     f.color.resize(kW, kH);
     f.depth.assign(kW, kH, kDepth);
@@ -119,16 +121,21 @@ Frame make_frame(int index) {
     for (int y = 0; y < kH; ++y)
         for (int x = 0; x < kW; ++x) {
             const unsigned u = unsigned(x + kStep * index) * 2654435761u ^ unsigned(y) * 40503u;
-            const float v = float(u >> 24) / 255.0f;
+            const float v = smooth ? 0.5f + 0.4f * std::sin(0.02f * float(x + kStep * index))
+                                   : float(u >> 24) / 255.0f;
             f.color(x, y) = {v, 1.0f - v, 0.5f * v, 1.0f};
         }
     return f;
 }
 
-void run_converter(warp::FrucMode mode) {
+// Motion refinement's optical flow (OpenCV DIS) allocates inside OpenCV: `refine` runs it on
+// smooth frames, where its survey finds the sides agreeing and nothing more runs.
+void run_converter(warp::FrucMode mode, bool refine = false) {
     std::vector<Frame> inputs;
-    for (int i = 0; i < 12; ++i) inputs.push_back(make_frame(i));
-    warp::FrameRateConverter converter(2, {.mode = mode});
+    for (int i = 0; i < 12; ++i) inputs.push_back(make_frame(i, refine));
+    warp::FrucOptions options{.mode = mode};
+    options.refine.enabled = refine;
+    warp::FrameRateConverter converter(2, options);
     Frame out;
     bool ok = true;
     int made = 0;
@@ -146,6 +153,10 @@ void run_converter(warp::FrucMode mode) {
     EXPECT_EQ(made, mode == warp::FrucMode::Interpolate ? 23 : 24);
     EXPECT_EQ(converter.counters().cuts, 0u);
     EXPECT_EQ(counted, 0) << "allocations in 4 steady-state send/receive rounds";
+    if (refine) {
+        EXPECT_EQ(converter.counters().refined_frames, 0u);
+        EXPECT_EQ(converter.counters().refine_skipped, 11u);
+    }
 }
 
 }  // namespace
@@ -160,6 +171,10 @@ TEST(Allocations, CounterSeesAnAllocation) {
 
 TEST(Allocations, InterpolationSteadyStateAllocatesNothing) {
     run_converter(warp::FrucMode::Interpolate);
+}
+
+TEST(Allocations, InterpolationSurveyForRefinementAllocatesNothing) {
+    run_converter(warp::FrucMode::Interpolate, true);
 }
 
 TEST(Allocations, ExtrapolationSteadyStateAllocatesNothing) {

@@ -97,8 +97,11 @@ std::vector<std::string> scene_list(const std::string& spec, const std::string& 
 struct Setting {
     std::string method, setting;
     warp::FrucOptions options;
-    bool with_telea = false;  // also score Telea inpainting of this run's holes (fill none)
+    bool with_telea = false;   // also score Telea inpainting of this run's holes (fill none)
+    bool refine_pair = false;  // the default's refinement on/off pair: region scores for both
 };
+
+const char* const kRefineOff = "grid+pullpush-refine";  // the default without refinement
 
 std::vector<Setting> fruc_settings(bool quick) {
     std::vector<Setting> settings;
@@ -109,8 +112,17 @@ std::vector<Setting> fruc_settings(bool quick) {
         s.with_telea = !quick && mode == "interpolate" && warp_name == "grid" && fill == "none";
         settings.push_back(s);
     };
-    if (quick) {
+    // The default with and without motion refinement, both scored on the region it refines.
+    auto add_refine_pair = [&] {
         add("interpolate", "grid", "pullpush");
+        settings.back().refine_pair = true;
+        Setting off = settings.back();
+        off.setting = kRefineOff;
+        off.options.refine.enabled = false;
+        settings.push_back(off);
+    };
+    if (quick) {
+        add_refine_pair();
         add("interpolate", "reverse", "pullpush");
         add("interpolate", "splat", "none");
         add("extrapolate", "grid", "pullpush");
@@ -118,7 +130,13 @@ std::vector<Setting> fruc_settings(bool quick) {
     }
     for (const char* mode : {"interpolate", "extrapolate"})
         for (const char* warp_name : {"reverse", "splat", "grid"})
-            for (const char* fill : {"pullpush", "andreev", "none"}) add(mode, warp_name, fill);
+            for (const char* fill : {"pullpush", "andreev", "none"}) {
+                if (std::string(mode) == "interpolate" && std::string(warp_name) == "grid" &&
+                    std::string(fill) == "pullpush")
+                    add_refine_pair();
+                else
+                    add(mode, warp_name, fill);
+            }
     return settings;
 }
 
@@ -136,6 +154,13 @@ struct Run {
     double worst_psnr = INFINITY;
     Image<Rgb8> worst;                  // the lowest-PSNR frame as shown
     std::map<int, Image<Rgb8>> frames;  // peers: every scored frame, for the comparison picture
+    // The refinement pair: squared display error summed over the refined region, its pixels.
+    double region_squared = 0.0;
+    std::size_t region_pixels = 0;
+    double refine_ms = 0.0;  // the converter's refinement time per made frame
+    double region_psnr() const {
+        return region_pixels ? -10.0 * std::log10(region_squared / double(region_pixels)) : NAN;
+    }
 
     ReportPoint mean() const {
         ReportPoint p{method, setting};
@@ -154,6 +179,9 @@ struct SceneFrames {
     std::vector<Frame> input;              // 30 Hz
     std::vector<Image<Rgb8>> input_shown;  // their display values in 8 bits: the peers' input
     std::vector<Image<glm::vec3>> truth;   // display values at 30 K Hz; empty at input instants
+    // Per scored frame, where refinement found the warped sides disagreeing (the refinement
+    // pair's first run fills it; the second is scored on the same pixels).
+    std::map<int, Image<uint8_t>> regions;
     int factor = 2;
     int last() const { return (int(input.size()) - 1) * factor; }
     bool scored(int j) const { return j % factor != 0 && j > 0 && j < last(); }
@@ -179,7 +207,11 @@ Status render_scene(server::Renderer& renderer, const std::string& scene_name, i
     // A model's own camera may stand still: the held-out models are seen from an orbit.
     if (is_held_out(scene_name))
         REPRISE_TRY(server::parse_camera_spec("orbit:speed=0.5", scene, path, path));
-    const server::RenderSettings settings{.width = w, .height = h};
+    // Scenes built for heavy shading (their shadows come from its shadow map) get it.
+    const server::RenderSettings settings{
+        .width = w,
+        .height = h,
+        .shading = scene.heavy_shading ? server::Shading::Heavy : server::Shading::Lit};
     out.factor = factor;
     if (!exr_dir.empty()) {
         std::error_code ec;
@@ -260,13 +292,15 @@ Status read_scene(const std::string& dir, int frames, int factor, SceneFrames& o
 
 // Times send() alone; each frame it made gets an equal share of that time, the fastest of
 // `repeat` runs over the sequence. Frames are scored on the first run.
-Status run_ours(const SceneFrames& scene, const Setting& setting, int repeat, Run& run,
-                Run* telea) {
+Status run_ours(SceneFrames& scene, const Setting& setting, int repeat, Run& run, Run* telea) {
     const int w = scene.input[0].width(), h = scene.input[0].height();
     Frame out;
     Image<glm::vec3> display(w, h);
     Image<uint8_t> holes(w, h);
     std::map<int, double> send_ms, telea_ms;
+    Image<uint8_t> region;
+    const bool capture = setting.refine_pair && setting.options.refine.enabled;
+    if (capture) scene.regions.clear();
     for (int rep = 0; rep < repeat; ++rep) {
         warp::FrameRateConverter converter(scene.factor, setting.options);
         int index = 0;
@@ -274,6 +308,7 @@ Status run_ours(const SceneFrames& scene, const Setting& setting, int repeat, Ru
             auto start = BenchClock::now();
             REPRISE_TRY(converter.send(input));
             const double ms = ms_since(start);
+            if (capture && rep == 0) converter.refine_region(region);
             std::vector<int> made;
             while (converter.receive(out)) {
                 const int j = index++;
@@ -282,6 +317,18 @@ Status run_ours(const SceneFrames& scene, const Setting& setting, int repeat, Ru
                 if (!scene.scored(j)) continue;  // beyond the last input: no truth to compare
                 if (rep == 0 || telea) to_display(out.color.view(), display.view());
                 if (rep == 0) record(run, j, display, scene.truth[j], 0.0, false);
+                if (capture && rep == 0) scene.regions[j] = region;
+                if (setting.refine_pair && rep == 0 && scene.regions.count(j)) {
+                    const Image<uint8_t>& mask = scene.regions.at(j);
+                    std::size_t pixels = 0;
+                    for (int y = 0; y < h; ++y)
+                        for (int x = 0; x < w; ++x) pixels += mask(x, y) != 0;
+                    if (pixels > 0) {
+                        const double db = psnr(scene.truth[j].view(), display.view(), mask.view());
+                        run.region_squared += std::pow(10.0, -db / 10.0) * double(pixels);
+                        run.region_pixels += pixels;
+                    }
+                }
                 if (!telea) continue;
                 // With fill none the converter leaves holes at colour 0 and depth +inf.
                 for (int y = 0; y < h; ++y)
@@ -295,6 +342,8 @@ Status run_ours(const SceneFrames& scene, const Setting& setting, int repeat, Ru
             }
             for (int j : made) keep_fastest(send_ms, j, ms / double(made.size()));
         }
+        const warp::FrucCounters& c = converter.counters();
+        if (rep == 0 && c.outputs > 0) run.refine_ms = c.refine_ms / double(c.outputs);
     }
     for (Score& s : run.scores) s.ms = send_ms[s.frame];
     if (telea)
@@ -397,7 +446,30 @@ void progress(const std::string& scene, const Run& run) {
 struct SceneSummary {
     std::string scene;
     ReportPoint interpolation, extrapolation, ffmpeg, dis, vectors;  // empty method: not run
+    // The default (grid+pullpush) with and without refinement; region = where it refined.
+    ReportPoint refine_on, refine_off;
+    double region_on = NAN, region_off = NAN, region_share = 0.0, refine_ms = 0.0;
 };
+
+std::string refine_table(const std::vector<SceneSummary>& rows) {
+    std::string text;
+    char line[512];
+    std::snprintf(line, sizeof line, "%-24s %8s | %8s %8s %7s | %8s %8s %7s | %9s %8s %8s\n",
+                  "scene", "region %", "reg off", "reg on", "gain", "all off", "all on", "gain",
+                  "refine ms", "ms off", "ms on");
+    text += line;
+    for (const SceneSummary& r : rows) {
+        if (r.refine_on.method.empty()) continue;
+        std::snprintf(line, sizeof line,
+                      "%-24s %8.2f | %8.2f %8.2f %+7.2f | %8.2f %8.2f %+7.2f | %9.2f %8.2f %8.2f\n",
+                      r.scene.c_str(), 100.0 * r.region_share, r.region_off, r.region_on,
+                      r.region_on - r.region_off, r.refine_off.psnr, r.refine_on.psnr,
+                      r.refine_on.psnr - r.refine_off.psnr, r.refine_ms, r.refine_off.ms,
+                      r.refine_on.ms);
+        text += line;
+    }
+    return text;
+}
 
 std::string summary_table(const std::vector<SceneSummary>& rows) {
     std::string text;
@@ -583,6 +655,17 @@ Status bench_fruc(const BenchOptions& job) {
         if (interpolation) row.interpolation = interpolation->mean();
         if (extrapolation) row.extrapolation = extrapolation->mean();
         for (const Run& r : runs) {
+            if (r.method == "interpolate" && r.setting == "grid+pullpush") {
+                row.refine_on = r.mean();
+                row.region_on = r.region_psnr();
+                row.refine_ms = r.refine_ms;
+                row.region_share = double(r.region_pixels) /
+                                   (double(w) * h * std::max<std::size_t>(1, r.scores.size()));
+            }
+            if (r.setting == kRefineOff) {
+                row.refine_off = r.mean();
+                row.region_off = r.region_psnr();
+            }
             if (r.method == kFfmpeg) row.ffmpeg = r.mean();
             if (r.method == kDis) row.dis = r.mean();
             if (r.method == kVectors) row.vectors = r.mean();
@@ -612,6 +695,12 @@ Status bench_fruc(const BenchOptions& job) {
         "fruc x%d, %dx%d, %d input frames, %d scored frames per method; PSNR in dB, ms per "
         "synthesized frame; margin = best interpolation - better peer\n",
         job.factor, w, h, job.frames, synthesized);
+    const std::string refinement =
+        "\nmotion refinement (default grid+pullpush, refine on vs off): region = pixels of the "
+        "tiles where\nthe sides warped along rendered motion disagree (share of scored pixels), "
+        "PSNR there and over\nwhole frames; refine ms = survey + flow + choice per made frame\n" +
+        refine_table(summaries);
+    table += refinement;
     report.preformatted = std::string(text) + table;
     const std::string html_path = out_dir + "/index.html";
     REPRISE_TRY(write_html_report(html_path, report));

@@ -19,6 +19,7 @@ struct FrucJob {
     int factor = 2;
     std::string mode = "interpolate", warp = "grid", fill = "pullpush";
     std::string layout = "reprise";
+    std::string refine = "on";
 };
 
 Status run_fruc(const FrucJob& job) {
@@ -26,6 +27,7 @@ Status run_fruc(const FrucJob& job) {
     if (job.out.empty()) return Status::error("--out DIR is required");
     warp::FrucOptions options;
     REPRISE_TRY(parse_fruc_options(job.mode, job.warp, job.fill, options));
+    REPRISE_TRY(parse_refine(job.refine, options));
     WriteOptions write;
     if (job.layout == "blender")
         write.layout = ExrLayout::Blender;
@@ -86,6 +88,12 @@ Status run_fruc(const FrucJob& job) {
         "  done: %zu fills (%zu hole pixels), %zu dynamic layers, %zu grid cells, %zu cuts, "
         "%zu true-motion frames\n",
         c.fills, c.hole_pixels, c.dynamic_layers, c.grid_cells, c.cuts, c.true_motion);
+    if (options.mode == warp::FrucMode::Interpolate && options.refine.enabled)
+        std::printf(
+            "  refinement: %zu frames refined, %zu skipped (sides agree), %zu tiles, flow on %zu "
+            "px, %zu px refined, %.2f ms per made frame\n",
+            c.refined_frames, c.refine_skipped, c.refine_tiles, c.flow_pixels, c.refined_pixels,
+            c.outputs ? c.refine_ms / double(c.outputs) : 0.0);
     return {};
 }
 
@@ -102,6 +110,9 @@ int command_fruc(int argc, char** argv) {
     args.option("--mode", &job.mode, "interpolate | extrapolate (default interpolate)");
     args.option("--warp", &job.warp, "reverse | splat | grid (default grid)");
     args.option("--fill", &job.fill, "pullpush | andreev | none (default pullpush)");
+    args.option("--refine", &job.refine,
+                "on | off (default on): interpolation refines motion by optical flow where the "
+                "warped\nsides disagree (moving shadows, reflections, highlights)");
     args.option("--out", &job.out, "output folder");
     args.option("--layout", &job.layout,
                 "EXR channel names: reprise | blender (ViewLayer.Combined.R..., opens in "

@@ -30,4 +30,14 @@ Status parse_fruc_options(const std::string& mode, const std::string& warp_name,
     return {};
 }
 
+Status parse_refine(const std::string& refine, warp::FrucOptions& options) {
+    if (refine == "on")
+        options.refine.enabled = true;
+    else if (refine == "off")
+        options.refine.enabled = false;
+    else
+        return Status::error("--refine '" + refine + "': expected on or off");
+    return {};
+}
+
 }  // namespace reprise::cli

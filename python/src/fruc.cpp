@@ -8,8 +8,9 @@ namespace reprise::python {
 namespace {
 
 warp::FrucOptions fruc_options(const std::string& mode, const std::string& warp_method,
-                               const std::string& fill) {
+                               const std::string& fill, bool refine) {
     warp::FrucOptions o;
+    o.refine.enabled = refine;
     if (mode == "interpolate")
         o.mode = warp::FrucMode::Interpolate;
     else if (mode == "extrapolate")
@@ -37,8 +38,8 @@ warp::FrucOptions fruc_options(const std::string& mode, const std::string& warp_
 
 struct Converter {
     Converter(int factor, const std::string& mode, const std::string& warp_method,
-              const std::string& fill)
-        : converter(checked(factor), fruc_options(mode, warp_method, fill)) {}
+              const std::string& fill, bool refine)
+        : converter(checked(factor), fruc_options(mode, warp_method, fill, refine)) {}
 
     static int checked(int factor) {
         if (factor < 1 || factor > 16) value_error("factor must be in 1..16");
@@ -82,6 +83,12 @@ struct Converter {
         d["grid_cells"] = c.grid_cells;
         d["true_motion"] = c.true_motion;
         d["linear_motion"] = c.linear_motion;
+        d["refined_frames"] = c.refined_frames;
+        d["refine_skipped"] = c.refine_skipped;
+        d["refine_tiles"] = c.refine_tiles;
+        d["flow_pixels"] = c.flow_pixels;
+        d["refined_pixels"] = c.refined_pixels;
+        d["refine_ms"] = c.refine_ms;
         return d;
     }
 
@@ -95,10 +102,11 @@ void bind_fruc(py::module_& m) {
                           "Frame-rate upconversion, K output frames per input frame. "
                           "interpolate: after each frame (but the first), the K-1 frames "
                           "between it and its predecessor, then the frame itself; extrapolate: "
-                          "the frame, then K-1 frames beyond it.")
-        .def(py::init<int, const std::string&, const std::string&, const std::string&>(),
+                          "the frame, then K-1 frames beyond it. refine: optical flow where the "
+                          "rendered motion is not what is seen (moving shadows, reflections).")
+        .def(py::init<int, const std::string&, const std::string&, const std::string&, bool>(),
              py::arg("factor") = 2, py::arg("mode") = "interpolate", py::arg("warp") = "grid",
-             py::arg("fill") = "pullpush")
+             py::arg("fill") = "pullpush", py::arg("refine") = true)
         .def("send", &Converter::send, py::arg("frame"), "Feeds the next rendered frame.")
         .def("receive", &Converter::receive, "The next output frame, or None.")
         .def("convert", &Converter::convert, py::arg("frames"),

@@ -20,6 +20,9 @@ const std::vector<SceneInfo>& builtin_scenes() {
         {"cut", "an orbit with a hard camera cut at 0.5 s"},
         {"courtyard", "heavy shading: still camera, objects moving through soft shadows, 8 lights"},
         {"stroll", "heavy shading: a camera orbiting a plaza of marbled objects, 8 lights"},
+        {"shadows", "heavy shading: a moving sun sweeps shadows over a still ground, still camera"},
+        {"mirror",
+         "a spinning mirror ball under an orbit: its reflections move unlike its surface"},
     };
     return scenes;
 }
@@ -439,6 +442,60 @@ Scene stroll_scene(CameraPath& camera) {
     return std::move(b.scene);
 }
 
+// The shadows move, nothing else does: rendered motion is zero everywhere.
+Scene shadows_scene(CameraPath& camera) {
+    Builder b;
+    b.scene.name = "shadows";
+    b.scene.heavy_shading = true;
+    b.scene.light = {.direction = {-0.8f, -0.55f, -0.3f},
+                     .color = {1.3f, 1.22f, 1.08f},
+                     .ambient = {0.16f, 0.18f, 0.24f},
+                     .orbit = 0.8f};
+    int stone = b.material({0.85f, 0.82f, 0.78f}, -1, 0.1f, 16.0f);
+    int marble = b.material({0.9f, 0.88f, 0.86f}, -1, 0.3f, 32.0f);
+    int brick = b.material({0.8f, 0.5f, 0.4f}, -1, 0.1f, 16.0f);
+    b.add("ground", ground(16, 12, 4), stone, {0, 0, -1});
+    for (int i = 0; i < 3; ++i)
+        b.add("pillar" + std::to_string(i), cylinder(0.25f, 2.6f, 24), marble,
+              {-3.0f + 3.0f * float(i), 0, -3.0f + 0.8f * float(i % 2)});
+    b.add("block", box({1.0f, 1.4f, 1.0f}, 0.7f), brick, {1.6f, 0.7f, 0.6f},
+          glm::angleAxis(0.4f, glm::vec3(0, 1, 0)));
+    b.add("ball", sphere(0.5f, 24, 48), marble, {-1.8f, 0.5f, 0.8f});
+    camera = {.motion = CameraMotion::Static,
+              .target = {0, 0.3f, -1.5f},
+              .eye = {0, 5.5f, 6.5f},
+              .model = builtin_lens()};
+    return std::move(b.scene);
+}
+
+Scene mirror_scene(CameraPath& camera) {
+    Builder b;
+    b.scene.name = "mirror";
+    b.scene.light.direction = {-0.5f, -0.8f, -0.4f};
+    int floor = b.material({1, 1, 1},
+                           b.texture(tiles_texture({0.6f, 0.58f, 0.5f}, {0.35f, 0.38f, 0.42f}, 5)));
+    int crate = b.material({1, 1, 1},
+                           b.texture(noise_texture({0.6f, 0.35f, 0.2f}, {0.9f, 0.75f, 0.5f}, 6)));
+    Material chrome{.base_color = glm::vec4(0.8f, 0.8f, 0.85f, 1.0f),
+                    .specular = 1.0f,
+                    .shininess = 200.0f,
+                    .mirror = 0.9f};
+    b.scene.materials.push_back(chrome);
+    const int mirror = int(b.scene.materials.size()) - 1;
+    b.add("floor", ground(40, 40, 2), floor, {0, 0, 0});
+    // Spinning: its surface moves, what it reflects hardly does.
+    const int ball = b.add("mirror ball", sphere(1.3f, 48, 96), mirror, {0, 1.3f, 0});
+    b.spin(ball, {0, 1, 0}, 1.5f);
+    b.add("crate", box({1.0f, 1.0f, 1.0f}), crate, {2.6f, 0.5f, -1.2f},
+          glm::angleAxis(0.3f, glm::vec3(0, 1, 0)));
+    camera = {.motion = CameraMotion::Orbit,
+              .target = {0, 1.1f, 0},
+              .eye = {0, 2.0f, 5.0f},
+              .speed = 0.5f,
+              .model = builtin_lens()};
+    return std::move(b.scene);
+}
+
 }  // namespace
 
 Status load_scene(const std::string& name_or_file, Scene& scene, CameraPath& camera,
@@ -460,6 +517,10 @@ Status load_scene(const std::string& name_or_file, Scene& scene, CameraPath& cam
         scene = courtyard_scene(camera);
     else if (n == "stroll")
         scene = stroll_scene(camera);
+    else if (n == "shadows")
+        scene = shadows_scene(camera);
+    else if (n == "mirror")
+        scene = mirror_scene(camera);
     else {
         auto ext = std::filesystem::path(n).extension().string();
         if (ext != ".gltf" && ext != ".glb")

@@ -43,6 +43,7 @@ uniform bool u_textured;
 uniform bool u_lit;
 uniform float u_specular;
 uniform float u_shininess;
+uniform float u_mirror;
 uniform float u_id;
 uniform sampler2D u_texture;
 uniform float u_lod_bias;
@@ -59,6 +60,21 @@ vec2 to_pixels(vec4 clip) {  // y down, origin at the top-left corner
     vec2 ndc = clip.xy / clip.w;
     return vec2((ndc.x * 0.5 + 0.5) * u_size.x, (0.5 - ndc.y * 0.5) * u_size.y);
 }
+// What a mirror reflects: a sky with soft-edged coloured panels around the horizon over a
+// far checkered ground, so that a reflection has features to follow.
+vec3 environment(vec3 d) {
+    vec3 sky = mix(vec3(0.6, 0.72, 0.9), vec3(0.15, 0.3, 0.75), clamp(d.y, 0.0, 1.0));
+    float azimuth = atan(d.z, d.x);
+    float column = smoothstep(-0.4, 0.4, sin(10.0 * azimuth));
+    float band = smoothstep(0.0, 0.1, d.y) * (1.0 - smoothstep(0.5, 0.6, d.y));
+    vec3 panel = mix(vec3(0.95, 0.35, 0.1), vec3(0.1, 0.6, 0.3), 0.5 + 0.5 * sin(3.0 * azimuth));
+    sky = mix(sky, panel, band * column);
+    vec2 g = d.xz / max(-d.y, 0.05);
+    float checker = smoothstep(-0.3, 0.3, sin(3.0 * g.x) * sin(3.0 * g.y));
+    vec3 ground = mix(vec3(0.08, 0.07, 0.06), vec3(0.7, 0.66, 0.55), checker);
+    ground = mix(vec3(0.35, 0.32, 0.28), ground, smoothstep(-0.05, -0.3, d.y));
+    return mix(ground, sky, smoothstep(-0.02, 0.02, d.y));
+}
 void main() {
     vec3 n = dot(v_normal, v_normal) > 0.0 ? normalize(gl_FrontFacing ? v_normal : -v_normal)
                                            : vec3(0.0, 0.0, 1.0);
@@ -73,6 +89,7 @@ void main() {
         float diffuse = max(dot(n, l), 0.0);
         float highlight = diffuse > 0.0 ? pow(max(dot(n, normalize(l + v)), 0.0), u_shininess) : 0.0;
         color = base.rgb * (u_ambient + u_light_color * diffuse) + u_light_color * u_specular * highlight;
+        if (u_mirror > 0.0) color = mix(color, environment(reflect(-v, n)), u_mirror);
     }
     // Both ends through the same arithmetic, so that nothing moving gives exactly 0.
     // Pixel p samples the unjittered image at p + jitter, which is where `here` lies.

@@ -506,6 +506,12 @@ glm::vec2 lowres_jitter(int width, int height, int factor, int64_t index) {
     return (at - 0.5f) * footprint;
 }
 
+glm::vec3 light_direction_at(const Light& light, double time) {
+    if (light.orbit == 0.0f) return light.direction;
+    const float angle = float(double(light.orbit) * time);
+    return glm::angleAxis(angle, glm::vec3(0, 1, 0)) * light.direction;
+}
+
 Instant instant_on_path(const CameraPath& path, const Scene& scene, double time, int width,
                         int height) {
     return {.time = time,
@@ -591,9 +597,10 @@ Status Renderer::render(const Scene& scene, const Instant& current, const Instan
     glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(g.indices.size() * sizeof(uint32_t)),
                  g.indices.data(), GL_STREAM_DRAW);
 
+    const glm::vec3 light_direction = light_direction_at(scene.light, current.time);
     glm::mat4 light_matrix(1.0f);
     if (heavy) {
-        light_matrix = shadow_light_matrix(g.vertices, scene.light.direction);
+        light_matrix = shadow_light_matrix(g.vertices, light_direction);
         glBindFramebuffer(GL_FRAMEBUFFER, g.shadow_framebuffer);
         glViewport(0, 0, kShadowMapSize, kShadowMapSize);
         glClearDepthf(1.0f);
@@ -653,7 +660,7 @@ Status Renderer::render(const Scene& scene, const Instant& current, const Instan
                            glm::value_ptr(previous_view_projection));
         glUniform2f(g.uniform("u_size"), float(w), float(h));
         glUniform3fv(g.uniform("u_eye"), 1, glm::value_ptr(eye));
-        glUniform3fv(g.uniform("u_light_direction"), 1, glm::value_ptr(scene.light.direction));
+        glUniform3fv(g.uniform("u_light_direction"), 1, glm::value_ptr(light_direction));
         glUniform3fv(g.uniform("u_light_color"), 1, glm::value_ptr(scene.light.color));
         glUniform3fv(g.uniform("u_ambient"), 1, glm::value_ptr(scene.light.ambient));
         glUniform1i(g.uniform("u_lit"), settings.shading == Shading::Lit);
@@ -667,7 +674,7 @@ Status Renderer::render(const Scene& scene, const Instant& current, const Instan
     auto draw_all = [&](bool materials) {
         const GLint base_color = g.uniform("u_base_color"), textured = g.uniform("u_textured"),
                     specular = g.uniform("u_specular"), shininess = g.uniform("u_shininess"),
-                    id = g.uniform("u_id");
+                    mirror = g.uniform("u_mirror"), id = g.uniform("u_id");
         for (const Draw& d : g.draws) {
             const Material& m = d.material >= 0 ? scene.materials[d.material] : fallback;
             if (materials) {
@@ -677,6 +684,7 @@ Status Renderer::render(const Scene& scene, const Instant& current, const Instan
                     glBindTexture(GL_TEXTURE_2D, g.textures[m.base_color_texture]);
                 glUniform1f(specular, m.specular);
                 glUniform1f(shininess, m.shininess);
+                glUniform1f(mirror, m.mirror);
                 glUniform1f(id, d.id);
             }
             if (m.double_sided)

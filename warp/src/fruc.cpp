@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -273,6 +274,10 @@ FrameRateConverter::~FrameRateConverter() = default;
 
 const FrucCounters& FrameRateConverter::counters() const { return state_->counters; }
 
+void FrameRateConverter::refine_region(Image<uint8_t>& mask) const {
+    state_->scratch.refiner.region(mask, state_->previous.width(), state_->previous.height());
+}
+
 bool FrameRateConverter::receive(Frame& out) {
     State& st = *state_;
     if (st.ready.empty()) return false;
@@ -290,6 +295,7 @@ Status FrameRateConverter::send(const Frame& frame) {
     if (!sized(frame.depth) || !sized(frame.motion))
         return Status::error("fruc input frame: depth or motion size differs from colour");
     ++st.counters.inputs;
+    st.scratch.refiner.forget_region();
     const bool warpable = !frame.depth.empty() && !frame.motion.empty();
     const bool cut = st.has_previous && st.is_cut(frame);
     st.counters.cuts += cut;
@@ -303,6 +309,19 @@ Status FrameRateConverter::send(const Frame& frame) {
             const bool a_warpable =
                 !a.depth.empty() && !a.motion.empty() && !st.previous_starts_shot;
             const Camera a_before = State::previous_instant(a.camera, a.fps);
+            // A still pair is copied unless refinement finds its pictures differ (a moving
+            // light, say): then it is interpolated like any other.
+            bool still = false, still_refined = false;
+            if (!cut && warpable && motion_is_zero(frame)) {
+                still = true;
+                if (st.options.refine.enabled && a_warpable) {
+                    const auto start = std::chrono::steady_clock::now();
+                    still_refined = st.scratch.refiner.pictures_differ(a, frame, st.options.refine);
+                    st.counters.refine_ms += std::chrono::duration<double, std::milli>(
+                                                 std::chrono::steady_clock::now() - start)
+                                                 .count();
+                }
+            }
             for (int k = 1; k < k_max; ++k) {
                 float s = float(k) / float(k_max);
                 if (cut && !a_warpable) {
@@ -316,8 +335,9 @@ Status FrameRateConverter::send(const Frame& frame) {
                 } else if (!warpable || a.depth.empty() || a.motion.empty()) {
                     st.emit_copy(s < 0.5f ? a.view() : frame.view(), a.camera, frame.camera, fps,
                                  s);
-                } else if (motion_is_zero(frame)) {
+                } else if (still && !still_refined) {
                     ++st.counters.copied_still;
+                    st.counters.refine_skipped += st.options.refine.enabled;
                     st.emit_copy(frame, a.camera, frame.camera, fps, s);
                 } else {
                     Frame& out = st.ready.push();

@@ -181,6 +181,14 @@ void interpolate_frame(const GBufferView& a, const GBufferView& b, float s, bool
         warp_into(from_a, -s, options, scratch, wa.target(), counters);
     else
         wa.covered.fill(0);
+    const bool refine =
+        options.refine.enabled && use_a &&
+        scratch.refiner.prepare(a, b, s,
+                                {std::as_const(wa.color).view(), std::as_const(wa.depth).view(),
+                                 std::as_const(wa.covered).view()},
+                                {std::as_const(out.color).view(), std::as_const(out.depth).view(),
+                                 std::as_const(scratch.side_b.covered).view()},
+                                options.refine, counters);
     std::atomic<std::size_t> holes{0};
     parallel_for(0, h, [&](int y0, int y1) {
         std::size_t local_holes = 0;
@@ -201,6 +209,7 @@ void interpolate_frame(const GBufferView& a, const GBufferView& b, float s, bool
     });
     fill_holes(out.color.view(), scratch.valid.view(), out.depth.view(), holes.load(), options,
                scratch, counters);
+    if (refine) scratch.refiner.apply(out.color.view());
 }
 
 }  // namespace reprise::warp

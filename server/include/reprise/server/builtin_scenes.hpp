@@ -13,7 +13,8 @@ struct SceneInfo {
     const char* stresses;
 };
 
-// pan (default), fence, crossing, specular, fast, cut; courtyard and stroll (heavy shading).
+// pan (default), fence, crossing, specular, fast, cut, mirror; courtyard, stroll and shadows
+// (heavy shading).
 const std::vector<SceneInfo>& builtin_scenes();
 
 // A built-in scene by name, or a .gltf/.glb file, with the camera path it comes with.

@@ -27,6 +27,7 @@ struct Material {
     int texcoord = 0;             // which UV set the texture uses (0 or 1)
     float specular = 0.25f;       // strength of the view-dependent highlight
     float shininess = 48.0f;      // Blinn-Phong exponent
+    float mirror = 0.0f;          // 0..1: share of a procedural environment reflected (Lit)
     bool double_sided = false;
 };
 
@@ -104,7 +105,11 @@ struct Light {
     glm::vec3 direction{-0.4f, -1.0f, -0.3f};  // travel direction of the light, world space
     glm::vec3 color{2.5f, 2.4f, 2.2f};
     glm::vec3 ambient{0.25f, 0.27f, 0.32f};
+    float orbit = 0.0f;  // radians per second the direction turns about +Y (a moving sun)
 };
+
+// The light's travel direction at `time` seconds.
+glm::vec3 light_direction_at(const Light& light, double time);
 
 // A point light of the heavy shading mode (no shadow; quadratic falloff).
 struct PointLight {

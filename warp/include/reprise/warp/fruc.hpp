@@ -19,6 +19,21 @@ enum class WarpMethod {
 };
 enum class FillMethod { None, PullPush, Andreev };
 
+// Motion refinement of interpolation: rendered motion is the motion of surfaces, not of what is
+// seen on them (moving shadows, reflections, highlights). Where the two sides of an in-between
+// frame, warped along rendered motion, show the same surface (no disocclusion: both sides cover
+// it at one depth) in colours that differ, optical flow (OpenCV DIS) between the two input frames
+// is estimated on those tiles alone, and each of their pixels takes the flow's colour where the
+// flow's two sides agree better than the rendered motion's. Frames without disagreement pay one
+// survey of every 2nd pixel of every 2nd row.
+struct RefineOptions {
+    bool enabled = true;
+    int tile = 16;            // px: disagreement is decided and flow evaluated per tile
+    float threshold = 0.1f;   // display-value difference (largest channel) of disagreeing sides
+    float tile_share = 0.1f;  // share of a tile's surveyed pixels that must disagree
+    int margin = 16;          // px of context around the disagreeing tiles given to the flow
+};
+
 struct FrucOptions {
     FrucMode mode = FrucMode::Interpolate;
     WarpMethod warp = WarpMethod::Grid;
@@ -38,6 +53,7 @@ struct FrucOptions {
     // the earlier frame's moving pixels along the later frame's motion inverted. Off: the earlier
     // frame follows its own backward motion negated, both sides linearly.
     bool true_motion = true;
+    RefineOptions refine;
 };
 
 // What was done and what was left out because the frame did not need it.
@@ -55,6 +71,12 @@ struct FrucCounters {
     std::size_t grid_cells = 0;       // adaptive-grid cells drawn
     std::size_t true_motion = 0;      // in-between frames whose sides followed the true motion
     std::size_t linear_motion = 0;    // ... that did not need it: a sparse survey found it linear
+    std::size_t refined_frames = 0;   // in-between frames whose sides disagreed: flow estimated
+    std::size_t refine_skipped = 0;   // ... whose sides agreed everywhere: nothing estimated
+    std::size_t refine_tiles = 0;     // tiles whose sides disagreed
+    std::size_t flow_pixels = 0;      // pixels the flow was estimated on (boxes around the tiles)
+    std::size_t refined_pixels = 0;   // pixels that took the flow's colour
+    double refine_ms = 0.0;           // time in the survey and the refinement
 };
 
 // The camera between or beyond two instants: view matrices blended as rigid motions (rotation
@@ -76,6 +98,9 @@ public:
     bool receive(Frame& out);
 
     const FrucCounters& counters() const;
+    // The region refinement surveyed as disagreeing for the last in-between frame made (1 on the
+    // pixels of its tiles, 0 elsewhere; all 0 when none or refinement is off), sized like it.
+    void refine_region(Image<uint8_t>& mask) const;
 
 private:
     struct State;

@@ -1,0 +1,375 @@
+// Motion refinement of interpolation (RefineOptions): optical flow where the warped sides
+// disagree, used per pixel where its two sides agree better than the rendered motion's.
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <opencv2/core.hpp>
+#include <opencv2/video/tracking.hpp>
+#include <utility>
+
+#include "fruc_stages.hpp"
+#include "reprise/core/parallel.hpp"
+#include "reprise/warp/sample.hpp"
+
+namespace reprise::warp {
+
+namespace {
+
+constexpr int kSurveyStep = 2;       // the survey looks at every 2nd pixel of every 2nd row
+constexpr int kMinDisagreeing = 4;   // surveyed pixels a tile needs besides its share
+constexpr float kWinMargin = 0.01f;  // a flow candidate must beat the rendered error by this
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+// sRGB display value within about 1 % (NaN -> 0): what a viewer sees, cheaply.
+float display(float linear) {
+    const float c = linear > 0.0f ? std::min(linear, 1.0f) : 0.0f;
+    return 1.138f * std::sqrt(c) - 0.138f * c;
+}
+
+float largest_difference(glm::vec4 a, glm::vec4 b) {
+    return std::max({std::abs(display(a.r) - display(b.r)), std::abs(display(a.g) - display(b.g)),
+                     std::abs(display(a.b) - display(b.b))});
+}
+
+float mean_difference(glm::vec4 a, glm::vec4 b) {
+    return (std::abs(display(a.r) - display(b.r)) + std::abs(display(a.g) - display(b.g)) +
+            std::abs(display(a.b) - display(b.b))) *
+           (1.0f / 3.0f);
+}
+
+// The blend's test (interpolate.cpp): one surface, or background on both sides.
+bool same_surface(float za, float zb) {
+    if (std::isinf(za) && std::isinf(zb)) return true;
+    return std::abs(za - zb) <= 0.02f * std::min(za, zb);
+}
+
+uint8_t grey(glm::vec4 c) {
+    const float luma = display(0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b);
+    return uint8_t(luma * 255.0f + 0.5f);
+}
+
+struct Box {
+    int x0, y0, x1, y1;  // pixels [x0, x1) x [y0, y1)
+    int area() const { return (x1 - x0) * (y1 - y0); }
+    bool overlaps(const Box& o) const { return x0 < o.x1 && o.x0 < x1 && y0 < o.y1 && o.y0 < y1; }
+};
+
+// Both candidates' colour and error at one output pixel, or +inf error where a side falls
+// outside its frame.
+struct Candidate {
+    glm::vec4 color;
+    float error;
+};
+
+Candidate along(const GBufferView& a, const GBufferView& b, glm::vec2 q, glm::vec2 a_to_b,
+                float s) {
+    const glm::vec2 pa = q - s * a_to_b, pb = q + (1.0f - s) * a_to_b;
+    const Bilinear ta = bilinear_taps(pa.x, pa.y, a.width(), a.height());
+    const Bilinear tb = bilinear_taps(pb.x, pb.y, b.width(), b.height());
+    if (!ta.inside || !tb.inside) return {glm::vec4(0.0f), kInf};
+    const glm::vec4 ca = bilinear_fetch(a.color, ta), cb = bilinear_fetch(b.color, tb);
+    const float e = mean_difference(ca, cb);
+    if (!std::isfinite(e)) return {glm::vec4(0.0f), kInf};
+    return {(1.0f - s) * ca + s * cb, e};
+}
+
+}  // namespace
+
+struct MotionRefiner::State {
+    cv::Ptr<cv::DISOpticalFlow> flow = cv::DISOpticalFlow::create(cv::DISOpticalFlow::PRESET_FAST);
+    int tile = 16, tiles_x = 0, tiles_y = 0;
+    std::vector<uint8_t> flagged;            // tiles whose sides disagree
+    std::vector<int> surveyed, disagreeing;  // per tile: pixels surveyed, those that disagree
+    std::vector<uint8_t> wanted;             // flagged tiles and their neighbours
+    std::vector<int> label;  // tiles to decide (flagged and their neighbours): box, else -1
+    std::vector<int> stack;
+    std::vector<Box> boxes;
+    std::vector<int> decided;  // tiles whose pixels were decided (apply() visits these)
+    cv::Mat grey_a, grey_b, flow_b, flow_a;
+    // Per pixel of the boxes: the rendered motion's error (-1: not one surface on both sides) and
+    // the two flow candidates.
+    Image<float> error_rendered, error_b, error_a;
+    Image<glm::vec4> color_b, color_a, chosen_color;
+    Image<uint8_t> chosen;
+
+    void size_tiles(int w, int h, int t) {
+        tile = std::max(t, 4);
+        tiles_x = (w + tile - 1) / tile;
+        tiles_y = (h + tile - 1) / tile;
+        flagged.assign(std::size_t(tiles_x) * tiles_y, 0);
+    }
+
+    // Flags the tiles where the sides show one surface in different colours; returns how many.
+    std::size_t survey(ImageView<const glm::vec4> ca, ImageView<const float> za,
+                       ImageView<const uint8_t> covered_a, ImageView<const glm::vec4> cb,
+                       ImageView<const float> zb, ImageView<const uint8_t> covered_b,
+                       const RefineOptions& options) {
+        const int w = ca.width, h = ca.height;
+        size_tiles(w, h, options.tile);
+        std::atomic<std::size_t> total{0};
+        surveyed.assign(flagged.size(), 0);
+        disagreeing.assign(flagged.size(), 0);
+        parallel_for(
+            0, tiles_y,
+            [&](int t0, int t1) {
+                std::size_t local = 0;
+                for (int ty = t0; ty < t1; ++ty) {
+                    int* surveyed_row = surveyed.data() + std::size_t(ty) * tiles_x;
+                    int* disagreeing_row = disagreeing.data() + std::size_t(ty) * tiles_x;
+                    const int y_end = std::min(h, (ty + 1) * tile);
+                    for (int y = ty * tile + kSurveyStep / 2; y < y_end; y += kSurveyStep)
+                        for (int x = kSurveyStep / 2; x < w; x += kSurveyStep) {
+                            if (!covered_a.empty() && !(covered_a(x, y) && covered_b(x, y)))
+                                continue;
+                            if (!same_surface(za(x, y), zb(x, y))) continue;
+                            const int tx = x / tile;
+                            ++surveyed_row[tx];
+                            disagreeing_row[tx] +=
+                                largest_difference(ca(x, y), cb(x, y)) > options.threshold;
+                        }
+                    for (int tx = 0; tx < tiles_x; ++tx) {
+                        const bool disagree = disagreeing_row[tx] >= kMinDisagreeing &&
+                                              float(disagreeing_row[tx]) >=
+                                                  options.tile_share * float(surveyed_row[tx]);
+                        flagged[std::size_t(ty) * tiles_x + tx] = disagree;
+                        local += disagree;
+                    }
+                }
+                total += local;
+            },
+            1);
+        return total;
+    }
+
+    // Flagged tiles and their neighbours, in boxes (connected groups, with margin, merged where
+    // they overlap); label[] says which box decides each tile.
+    void make_boxes(int w, int h, int margin) {
+        const int n = tiles_x * tiles_y;
+        label.assign(n, -1);
+        wanted.assign(n, 0);
+        for (int ty = 0; ty < tiles_y; ++ty)
+            for (int tx = 0; tx < tiles_x; ++tx) {
+                if (!flagged[std::size_t(ty) * tiles_x + tx]) continue;
+                for (int dy = -1; dy <= 1; ++dy)
+                    for (int dx = -1; dx <= 1; ++dx) {
+                        const int x = tx + dx, y = ty + dy;
+                        if (x >= 0 && y >= 0 && x < tiles_x && y < tiles_y)
+                            wanted[std::size_t(y) * tiles_x + x] = 1;
+                    }
+            }
+        boxes.clear();
+        for (int start = 0; start < n; ++start) {
+            if (!wanted[start] || label[start] >= 0) continue;
+            const int id = int(boxes.size());
+            Box tiles{start % tiles_x, start / tiles_x, start % tiles_x + 1, start / tiles_x + 1};
+            stack.assign(1, start);
+            label[start] = id;
+            while (!stack.empty()) {
+                const int t = stack.back();
+                stack.pop_back();
+                const int tx = t % tiles_x, ty = t / tiles_x;
+                tiles = {std::min(tiles.x0, tx), std::min(tiles.y0, ty), std::max(tiles.x1, tx + 1),
+                         std::max(tiles.y1, ty + 1)};
+                const int next[4][2] = {{tx - 1, ty}, {tx + 1, ty}, {tx, ty - 1}, {tx, ty + 1}};
+                for (const auto& p : next) {
+                    if (p[0] < 0 || p[1] < 0 || p[0] >= tiles_x || p[1] >= tiles_y) continue;
+                    const int u = p[1] * tiles_x + p[0];
+                    if (wanted[u] && label[u] < 0) label[u] = id, stack.push_back(u);
+                }
+            }
+            boxes.push_back(
+                {std::max(0, tiles.x0 * tile - margin), std::max(0, tiles.y0 * tile - margin),
+                 std::min(w, tiles.x1 * tile + margin), std::min(h, tiles.y1 * tile + margin)});
+        }
+        // Overlapping boxes become one (their tiles follow) where that costs no more pixels
+        // than the two apart.
+        for (bool merged = true; merged;) {
+            merged = false;
+            for (std::size_t i = 0; i < boxes.size() && !merged; ++i)
+                for (std::size_t j = i + 1; j < boxes.size() && !merged; ++j) {
+                    if (!boxes[i].overlaps(boxes[j])) continue;
+                    Box& b = boxes[i];
+                    const Box& o = boxes[j];
+                    const Box both{std::min(b.x0, o.x0), std::min(b.y0, o.y0), std::max(b.x1, o.x1),
+                                   std::max(b.y1, o.y1)};
+                    if (both.area() > b.area() + o.area()) continue;
+                    b = both;
+                    for (int& l : label) {
+                        if (l == int(j))
+                            l = int(i);
+                        else if (l > int(j))
+                            --l;
+                    }
+                    boxes.erase(boxes.begin() + std::ptrdiff_t(j));
+                    merged = true;
+                }
+        }
+    }
+
+    void grey_crop(const GBufferView& f, const Box& box, cv::Mat& out) {
+        out.create(box.y1 - box.y0, box.x1 - box.x0, CV_8U);
+        for (int y = box.y0; y < box.y1; ++y) {
+            uint8_t* row = out.ptr<uint8_t>(y - box.y0);
+            const glm::vec4* c = f.color.row(y);
+            for (int x = box.x0; x < box.x1; ++x) row[x - box.x0] = grey(c[x]);
+        }
+    }
+
+    // DIS flow from `from` to `to` on the crops, seeded with `seed` (motion from->to, may be
+    // empty; non-finite values seed 0).
+    void estimate(const cv::Mat& from, const cv::Mat& to, ImageView<const glm::vec2> seed,
+                  float seed_sign, const Box& box, cv::Mat& flow_out) {
+        flow_out.create(from.rows, from.cols, CV_32FC2);
+        for (int y = box.y0; y < box.y1; ++y) {
+            cv::Vec2f* row = flow_out.ptr<cv::Vec2f>(y - box.y0);
+            for (int x = box.x0; x < box.x1; ++x) {
+                glm::vec2 m = seed.empty() ? glm::vec2(0.0f) : seed(x, y) * seed_sign;
+                if (!std::isfinite(m.x) || !std::isfinite(m.y)) m = glm::vec2(0.0f);
+                row[x - box.x0] = cv::Vec2f(m.x, m.y);
+            }
+        }
+        flow->calc(from, to, flow_out);
+    }
+
+    // Errors and colours of the rendered motion and both flow candidates over a box.
+    void evaluate(const GBufferView& a, const GBufferView& b, float s, const WarpedSide& side_a,
+                  const WarpedSide& side_b, const Box& box) {
+        parallel_for(box.y0, box.y1, [&](int y0, int y1) {
+            for (int y = y0; y < y1; ++y)
+                for (int x = box.x0; x < box.x1; ++x) {
+                    const glm::vec2 q(float(x) + 0.5f, float(y) + 0.5f);
+                    const bool one_surface = side_a.covered(x, y) && side_b.covered(x, y) &&
+                                             same_surface(side_a.depth(x, y), side_b.depth(x, y));
+                    error_rendered(x, y) =
+                        one_surface ? mean_difference(side_a.color(x, y), side_b.color(x, y))
+                                    : -1.0f;
+                    if (!std::isfinite(error_rendered(x, y))) error_rendered(x, y) = -1.0f;
+                    const cv::Vec2f fb = flow_b.at<cv::Vec2f>(y - box.y0, x - box.x0);
+                    const cv::Vec2f fa = flow_a.at<cv::Vec2f>(y - box.y0, x - box.x0);
+                    const Candidate cb = along(a, b, q, -glm::vec2(fb[0], fb[1]), s);
+                    const Candidate ca = along(a, b, q, glm::vec2(fa[0], fa[1]), s);
+                    error_b(x, y) = cb.error, color_b(x, y) = cb.color;
+                    error_a(x, y) = ca.error, color_a(x, y) = ca.color;
+                }
+        });
+    }
+
+    // Per pixel of the box's tiles, errors averaged over 3x3 (within the box): a flow candidate
+    // wins where it beats the rendered motion by the margin. Returns the winners.
+    std::size_t decide(const Box& box, int id) {
+        std::atomic<std::size_t> won{0};
+        parallel_for(box.y0, box.y1, [&](int y0, int y1) {
+            std::size_t local = 0;
+            for (int y = y0; y < y1; ++y)
+                for (int x = box.x0; x < box.x1; ++x) {
+                    if (label[std::size_t(y / tile) * tiles_x + x / tile] != id) continue;
+                    chosen(x, y) = 0;
+                    if (error_rendered(x, y) < 0.0f) continue;
+                    float sum[3] = {0, 0, 0};
+                    int count = 0;
+                    for (int v = std::max(box.y0, y - 1); v <= std::min(box.y1 - 1, y + 1); ++v)
+                        for (int u = std::max(box.x0, x - 1); u <= std::min(box.x1 - 1, x + 1);
+                             ++u) {
+                            if (error_rendered(u, v) < 0.0f) continue;
+                            sum[0] += error_rendered(u, v);
+                            sum[1] += error_b(u, v);
+                            sum[2] += error_a(u, v);
+                            ++count;
+                        }
+                    const float rendered = sum[0] / float(count);
+                    const bool b_better = sum[1] <= sum[2];
+                    const float best = (b_better ? sum[1] : sum[2]) / float(count);
+                    if (!(best + kWinMargin < rendered)) continue;
+                    chosen(x, y) = 1;
+                    chosen_color(x, y) = b_better ? color_b(x, y) : color_a(x, y);
+                    ++local;
+                }
+            won += local;
+        });
+        return won;
+    }
+};
+
+MotionRefiner::MotionRefiner() : state_(std::make_unique<State>()) {}
+MotionRefiner::~MotionRefiner() = default;
+
+bool MotionRefiner::prepare(const GBufferView& a, const GBufferView& b, float s,
+                            const WarpedSide& side_a, const WarpedSide& side_b,
+                            const RefineOptions& options, FrucCounters& counters) {
+    State& st = *state_;
+    const auto start = std::chrono::steady_clock::now();
+    auto finish = [&](bool apply) {
+        counters.refine_ms +=
+            std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
+                .count();
+        if (!apply) st.decided.clear();
+        return apply;
+    };
+    const int w = b.width(), h = b.height();
+    const std::size_t flagged = st.survey(side_a.color, side_a.depth, side_a.covered, side_b.color,
+                                          side_b.depth, side_b.covered, options);
+    if (flagged == 0) {
+        ++counters.refine_skipped;
+        return finish(false);
+    }
+    ++counters.refined_frames;
+    counters.refine_tiles += flagged;
+    st.make_boxes(w, h, std::max(options.margin, 0));
+    for (Image<float>* e : {&st.error_rendered, &st.error_b, &st.error_a}) e->resize(w, h);
+    for (Image<glm::vec4>* c : {&st.color_b, &st.color_a, &st.chosen_color}) c->resize(w, h);
+    st.chosen.resize(w, h);
+    std::size_t won = 0;
+    for (std::size_t i = 0; i < st.boxes.size(); ++i) {
+        const Box& box = st.boxes[i];
+        counters.flow_pixels += std::size_t(box.area());
+        st.grey_crop(a, box, st.grey_a);
+        st.grey_crop(b, box, st.grey_b);
+        // b(p) ~ a(p + flow_b): b's backward motion; a(p) ~ b(p + flow_a): a's forward motion.
+        st.estimate(st.grey_b, st.grey_a, b.motion, 1.0f, box, st.flow_b);
+        st.estimate(st.grey_a, st.grey_b, a.motion, -1.0f, box, st.flow_a);
+        st.evaluate(a, b, s, side_a, side_b, box);
+        won += st.decide(box, int(i));
+    }
+    st.decided.clear();
+    for (int t = 0; t < st.tiles_x * st.tiles_y; ++t)
+        if (st.label[t] >= 0) st.decided.push_back(t);
+    counters.refined_pixels += won;
+    return finish(won > 0);
+}
+
+void MotionRefiner::apply(ImageView<glm::vec4> color) const {
+    const State& st = *state_;
+    for (int t : st.decided) {
+        const int x0 = (t % st.tiles_x) * st.tile, y0 = (t / st.tiles_x) * st.tile;
+        const int x1 = std::min(color.width, x0 + st.tile),
+                  y1 = std::min(color.height, y0 + st.tile);
+        for (int y = y0; y < y1; ++y)
+            for (int x = x0; x < x1; ++x)
+                if (st.chosen(x, y)) color(x, y) = st.chosen_color(x, y);
+    }
+}
+
+bool MotionRefiner::pictures_differ(const GBufferView& a, const GBufferView& b,
+                                    const RefineOptions& options) {
+    return state_->survey(a.color, a.depth, {}, b.color, b.depth, {}, options) > 0;
+}
+
+void MotionRefiner::region(Image<uint8_t>& mask, int width, int height) const {
+    const State& st = *state_;
+    mask.assign(width, height, 0);
+    if (st.flagged.size() != std::size_t(st.tiles_x) * st.tiles_y) return;
+    for (int y = 0; y < height; ++y)
+        for (int x = 0; x < width; ++x) {
+            const int tx = x / st.tile, ty = y / st.tile;
+            if (tx < st.tiles_x && ty < st.tiles_y)
+                mask(x, y) = st.flagged[std::size_t(ty) * st.tiles_x + tx];
+        }
+}
+
+void MotionRefiner::forget_region() {
+    std::fill(state_->flagged.begin(), state_->flagged.end(), 0);
+}
+
+}  // namespace reprise::warp
