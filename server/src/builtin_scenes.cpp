@@ -20,6 +20,7 @@ const std::vector<SceneInfo>& builtin_scenes() {
         {"cut", "an orbit with a hard camera cut at 0.5 s"},
         {"courtyard", "heavy shading: still camera, objects moving through soft shadows, 8 lights"},
         {"stroll", "heavy shading: a camera orbiting a plaza of marbled objects, 8 lights"},
+        {"hud", "a camera pan under a UI layer (ui.* channels): a static panel, a changing bar"},
     };
     return scenes;
 }
@@ -460,7 +461,11 @@ Status load_scene(const std::string& name_or_file, Scene& scene, CameraPath& cam
         scene = courtyard_scene(camera);
     else if (n == "stroll")
         scene = stroll_scene(camera);
-    else {
+    else if (n == "hud") {
+        scene = pan_scene(camera, 3.0f);
+        scene.name = "hud";
+        scene.hud = true;
+    } else {
         auto ext = std::filesystem::path(n).extension().string();
         if (ext != ".gltf" && ext != ".glb")
             return Status::error("scene '" + n +
