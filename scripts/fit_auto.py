@@ -3,14 +3,17 @@
 `reprise bench fruc` run: fruc.csv (PSNR and ms per frame and setting) joined with
 fruc_predictors.csv (the survey of each frame). Prints the kModels table to paste.
 
-    build/tools/reprise bench fruc --scenes pan,fence,crossing,specular,fast,cut --out OUT
+    build/tools/reprise bench fruc --scenes pan,fence,crossing,specular,fast --out OUT
     scripts/fit_auto.py OUT WIDTH HEIGHT
 
-Per mode and warp, the mean squared error of display values at warp distance t is modelled as
-floor + alpha (1 - exp(-lambda v)) + beta sigma + kappa[fill] d (v, sigma, d: motion, spread and
-disoccluded fraction times t), the saturating form of Sitthi-amorn et al. 2008; lambda by a grid
-search, the rest by least squares relative to each frame's error, kept non-negative. Cost: mean
-ns per output pixel of each warp + fill."""
+Per mode, the reference setting (grid+pullpush) has the saturating error model of Sitthi-amorn
+et al. 2008: MSE of display values = floor + alpha (1 - exp(-lambda v)) + beta sigma + kappa d
+(v, sigma, d: motion, spread and disoccluded fraction times the warp distance t); floor and
+lambda by a grid search, the rest by least squares relative to each frame's MSE, kept
+non-negative. Every
+candidate's PSNR relative to the reference's on the same frame is linear in (1, v, sigma, d),
+by least squares. Cost: ns per output pixel of the warp (its cheapest fill variant's mean, as
+times are noisy) and of each fill beyond it."""
 import csv
 import math
 import sys
@@ -19,6 +22,8 @@ import numpy as np
 
 WARPS = ["reverse", "splat", "grid"]
 FILLS = ["none", "pullpush", "andreev"]
+CANDIDATES = [w + "+" + f for w in WARPS for f in FILLS]
+REFERENCE = "grid+pullpush"
 
 
 def nonnegative_lstsq(a, b):
@@ -44,57 +49,74 @@ def main():
             features[(r["scene"], int(r["frame"]), r["mode"])] = (
                 float(r["motion"]) * t, float(r["spread"]) * t,
                 min(1.0, float(r["disoccluded"]) * t))
-    rows = {}
+    psnr, ms = {}, {}  # (mode, candidate) -> {(scene, frame): value}
     with open(out + "/fruc.csv") as f:
         for r in csv.DictReader(f):
-            if r["method"] not in ("interpolate", "extrapolate"):
-                continue
-            warp, _, fill = r["setting"].partition("+")
-            if warp not in WARPS or fill not in FILLS:
+            if r["method"] not in ("interpolate", "extrapolate") or r["setting"] not in CANDIDATES:
                 continue
             key = (r["scene"], int(r["frame"]), r["method"])
             if key not in features or not math.isfinite(float(r["psnr"])):
                 continue
-            rows.setdefault((r["method"], warp), []).append(
-                (features[key], FILLS.index(fill), 10 ** (-float(r["psnr"]) / 10),
-                 float(r["ms"])))
+            psnr.setdefault((r["method"], r["setting"]), {})[key] = float(r["psnr"])
+            ms.setdefault((r["method"], r["setting"]), {})[key] = float(r["ms"])
     print("constexpr Model kModels[2] = {")
     for mode in ("interpolate", "extrapolate"):
-        errors, costs = [], []
-        for warp in WARPS:
-            data = rows.get((mode, warp), [])
-            if not data:
-                sys.exit(f"no rows for {mode} {warp}")
-            v = np.array([d[0][0] for d in data])
-            s = np.array([d[0][1] for d in data])
-            dis = np.array([d[0][2] for d in data])
-            fill = np.array([d[1] for d in data])
-            mse = np.array([d[2] for d in data])
-            weight = 1.0 / mse
-            best = None
-            for lam in np.geomspace(0.01, 10.0, 40):
-                cols = [np.ones_like(v), 1 - np.exp(-lam * v), s] + [
-                    dis * (fill == k) for k in range(3)]
-                a = np.stack(cols, 1) * weight[:, None]
-                x = nonnegative_lstsq(a, mse * weight)
-                pred = np.stack(cols, 1) @ x
+        ref = psnr[(mode, REFERENCE)]
+        keys = sorted(ref)
+        x = np.array([features[k] for k in keys])
+        v, s, d = x[:, 0], x[:, 1], x[:, 2]
+        mse = np.array([10 ** (-ref[k] / 10) for k in keys])
+        weight = 1.0 / mse
+        best = None
+        for floor in np.geomspace(1e-6, 1e-2, 25):
+            for lam in np.geomspace(0.01, 10.0, 25):
+                cols = np.stack([1 - np.exp(-lam * v), s, d], 1)
+                c = nonnegative_lstsq(cols * weight[:, None], (mse - floor) * weight)
+                pred = floor + cols @ c
                 err = np.mean(np.abs(10 * np.log10(np.maximum(pred, 1e-10) / mse)))
                 if best is None or err < best[0]:
-                    best = (err, lam, x)
-            err, lam, x = best
-            print(f"    // {mode} {warp}: {len(data)} frames, mean |error| of the predicted "
-                  f"PSNR {err:.2f} dB", file=sys.stderr)
-            errors.append(f"{{{x[0]:.3e}f, {x[1]:.3e}f, {lam:.3f}f, {x[2]:.3e}f, "
-                          f"{{{x[3]:.3e}f, {x[4]:.3e}f, {x[5]:.3e}f}}}}")
-            row = []
-            for k in range(3):
-                ms = [d[3] for d in data if d[1] == k]
-                row.append(1e6 * float(np.mean(ms)) / pixels)
-            costs.append("{" + ", ".join(f"{c:.1f}f" for c in row) + "}")
+                    best = (err, lam, np.concatenate([[floor], c]))
+        err, lam, c = best
+        print(f"    // {mode}: {len(keys)} frames; reference {REFERENCE}: mean |error| of its "
+              f"predicted PSNR {err:.2f} dB", file=sys.stderr)
+        reference = f"{{{c[0]:.3e}f, {c[1]:.3e}f, {lam:.3f}f, {c[2]:.3e}f, {c[3]:.3e}f}}"
+        deltas, right = [], 0
+        best_pred, best_true = {}, {}
+        for cand in CANDIDATES:
+            values = psnr[(mode, cand)]
+            common = [k for k in keys if k in values]
+            a = np.array([[1.0, *features[k]] for k in common])
+            b = np.array([values[k] - ref[k] for k in common])
+            if cand.endswith("+none"):
+                # Fill none differs from pull-push only where holes stay black, which the model
+                # adds itself (about 0.25 d of MSE): fitted on the hole-free predictors alone.
+                coef, *_ = np.linalg.lstsq(a[:, :3], b, rcond=None)
+                coef = np.append(coef, 0.0)
+            else:
+                coef, *_ = np.linalg.lstsq(a, b, rcond=None)
+            e = np.mean(np.abs(a @ coef - b))
+            print(f"    //   {cand}: mean |error| of its predicted difference {e:.2f} dB",
+                  file=sys.stderr)
+            deltas.append("{" + ", ".join(f"{q:.4f}f" for q in coef) + "}")
+            for k, p in zip(common, a @ coef):
+                if k not in best_pred or p > best_pred[k][0]:
+                    best_pred[k] = (p, cand)
+                if k not in best_true or values[k] - ref[k] > best_true[k][0]:
+                    best_true[k] = (values[k] - ref[k], cand)
+        right = sum(best_pred[k][1] == best_true[k][1] for k in keys)
+        print(f"    //   the best setting predicted right on {right} of {len(keys)} frames",
+              file=sys.stderr)
+        costs = []
+        for warp in WARPS:
+            means = [1e6 * float(np.mean(list(ms[(mode, warp + "+" + f)].values()))) / pixels
+                     for f in FILLS]
+            base = min(means)
+            costs.append("{" + ", ".join(f"{q:.1f}f" for q in [base] + [max(base, m) for m in
+                                                                        means[1:]]) + "}")
         print(f"    // {mode}")
-        print("    {{" + ",\n      ".join(errors) + "},")
-        print("     {" + ", ".join(costs) + "},")
-        print("     1.0f},")
+        print(f"    {{{reference},")
+        print("     {" + ",\n      ".join(deltas) + "},")
+        print("     {" + ", ".join(costs) + "}},")
     print("};")
 
 

@@ -12,35 +12,52 @@ namespace {
 
 constexpr int kStep = 8;  // the survey: every 8th pixel of every 8th row
 
-// Expected mean squared error of display values at warp distance t (input periods):
-//   floor + alpha (1 - exp(-lambda v)) + beta sigma + kappa[fill] d,
-// v = motion t, sigma = spread t, d = disoccluded t (predictors of FramePredictors). Fitted by
-// scripts/fit_auto.py to `reprise bench fruc` runs on the built-in scenes (docs/benchmarks.md).
+// The reference setting (grid+pullpush) has Sitthi-amorn's saturating error: mean squared error
+// of display values at warp distance t (input periods)
+//   floor + alpha (1 - exp(-lambda v)) + beta sigma + kappa d,
+// v = motion t, sigma = spread t, d = disoccluded t (FramePredictors). Every candidate's PSNR
+// differs from the reference's by delta . (1, v, sigma, d); a candidate without fill also leaves
+// its holes black, about 0.25 d of squared error more. Costs in ns per pixel: [warp][fill], the
+// warp alone under fill none. Fitted by scripts/fit_auto.py to a `reprise bench fruc` run
+// (640x360, x2, 18 frames of pan, fence, crossing, specular, fast; docs/benchmarks.md).
 struct ErrorModel {
-    float floor, alpha, lambda, beta;
-    float kappa[3];  // none, pullpush, andreev
+    float floor, alpha, lambda, beta, kappa;
 };
 struct Model {
-    ErrorModel error[3];    // reverse, splat, grid
-    float cost[3][3];       // ns per pixel: [warp][fill]
-    float fill_cost_holes;  // a fill runs only where there are holes: share of its cost kept
+    ErrorModel reference;
+    float delta[kAutoCandidates][4];
+    float cost[3][3];
 };
 
 // [mode] interpolate, extrapolate
 constexpr Model kModels[2] = {
     // interpolate
-    {{{1.0e-5f, 2.0e-3f, 0.05f, 1.0e-5f, {0.08f, 0.02f, 0.02f}},
-      {1.0e-5f, 4.0e-3f, 0.05f, 2.0e-5f, {0.08f, 0.03f, 0.03f}},
-      {1.0e-5f, 2.2e-3f, 0.05f, 1.0e-5f, {0.08f, 0.02f, 0.02f}}},
-     {{60.0f, 75.0f, 75.0f}, {25.0f, 40.0f, 40.0f}, {40.0f, 55.0f, 55.0f}},
-     1.0f},
+    {{1.000e-06f, 5.133e-06f, 0.010f, 0.000e+00f, 4.726e-02f},
+     {{-0.2807f, -3.8500f, 3.3938f, 0.0000f},
+      {-0.3549f, -4.2697f, 3.8679f, -30.0838f},
+      {-0.3576f, -4.3134f, 3.9236f, -39.3989f},
+      {-6.8872f, -5.5213f, 5.2639f, 0.0000f},
+      {-7.0015f, -6.6592f, 6.6162f, -165.7726f},
+      {-7.0050f, -6.6965f, 6.6643f, -173.4101f},
+      {-0.0037f, 0.1476f, -0.1502f, 0.0000f},
+      {0.0000f, 0.0000f, 0.0000f, 0.0000f},
+      {-0.0008f, -0.0099f, 0.0095f, -0.2747f}},
+     {{474.4f, 474.4f, 478.7f}, {189.1f, 189.1f, 227.6f}, {173.6f, 173.6f, 190.8f}}},
     // extrapolate
-    {{{1.0e-5f, 3.0e-3f, 0.05f, 2.0e-5f, {0.10f, 0.02f, 0.02f}},
-      {1.0e-5f, 6.0e-3f, 0.05f, 3.0e-5f, {0.10f, 0.03f, 0.03f}},
-      {1.0e-5f, 3.0e-3f, 0.05f, 2.0e-5f, {0.10f, 0.02f, 0.02f}}},
-     {{70.0f, 85.0f, 85.0f}, {25.0f, 40.0f, 40.0f}, {45.0f, 60.0f, 60.0f}},
-     1.0f},
+    {{1.000e-06f, 0.000e+00f, 0.010f, 0.000e+00f, 8.402e-02f},
+     {{-7.9086f, -3.8725f, 3.6157f, 0.0000f},
+      {1.2329f, -1.3519f, 1.4633f, -200.8446f},
+      {1.2800f, -1.6163f, 1.7114f, -209.6012f},
+      {-9.1160f, -4.9042f, 4.5932f, 0.0000f},
+      {-4.0071f, -6.1485f, 5.8470f, -120.9871f},
+      {-3.9960f, -6.3280f, 6.0150f, -125.5178f},
+      {-9.9594f, -1.2611f, 1.4581f, 0.0000f},
+      {0.0000f, 0.0000f, 0.0000f, 0.0000f},
+      {0.2602f, 0.5462f, -0.4428f, -26.5471f}},
+     {{226.9f, 245.5f, 244.4f}, {114.1f, 145.0f, 140.7f}, {107.6f, 107.6f, 118.9f}}},
 };
+
+constexpr float kBlackHoleError = 0.25f;
 
 constexpr const char* kNames[kAutoCandidates] = {
     "reverse+none",  "reverse+pullpush", "reverse+andreev", "splat+none",  "splat+pullpush",
@@ -111,17 +128,27 @@ AutoPrediction predict_candidates(const FramePredictors& p, float distance, Fruc
     const Model& model = kModels[mode == FrucMode::Interpolate ? 0 : 1];
     const float v = p.motion * distance, sigma = p.spread * distance;
     const float d = std::min(1.0f, p.disoccluded * distance);
+    const ErrorModel& e = model.reference;
+    const float mse =
+        e.floor + e.alpha * (1.0f - std::exp(-e.lambda * v)) + e.beta * sigma + e.kappa * d;
+    const float reference = -10.0f * std::log10(std::max(mse, 1e-10f));
     AutoPrediction out;
     for (int c = 0; c < kAutoCandidates; ++c) {
         const int warp = c / 3, fill = c % 3;
-        const ErrorModel& e = model.error[warp];
-        const float mse = e.floor + e.alpha * (1.0f - std::exp(-e.lambda * v)) + e.beta * sigma +
-                          e.kappa[fill] * d;
-        out.psnr[c] = -10.0f * std::log10(std::max(mse, 1e-10f));
-        // A fill costs nothing on a frame without holes.
-        const float fill_share = d > 0.0f ? 1.0f : 0.0f;
-        out.cost[c] = model.cost[warp][0] + fill_share * model.fill_cost_holes *
-                                                (model.cost[warp][fill] - model.cost[warp][0]);
+        const float* k = model.delta[c];
+        float psnr = reference + k[0] + k[1] * v + k[2] * sigma + k[3] * d;
+        if (fill == 0 && d > 0.0f) {
+            const float candidate_mse = std::pow(10.0f, -psnr / 10.0f);
+            psnr = -10.0f * std::log10(candidate_mse + kBlackHoleError * d);
+        }
+        out.psnr[c] = psnr;
+        if (fill == 1 && d == 0.0f) {
+            // No hole expected: fill none is not preferred over pull-push (which would not run),
+            // in case the sparse survey missed one.
+            out.psnr[c - 1] = std::min(out.psnr[c - 1], psnr);
+        }
+        // A fill runs only on a frame with holes.
+        out.cost[c] = model.cost[warp][d > 0.0f ? fill : 0];
     }
     return out;
 }
@@ -137,13 +164,18 @@ int choose_candidate(const AutoPrediction& prediction, WarpMethod warp, FillMeth
         if (allowed(c)) best = std::max(best, prediction.psnr[c]);
     const float target =
         options.budget_db > 0.0f ? std::min(options.budget_db, best) : best - options.slack_db;
+    // Equal cost and error (no holes expected: a fill would not run): a fill is kept, in case
+    // the sparse survey missed a hole, pull-push first.
+    constexpr int kFillPreference[3] = {0, 2, 1};  // none, pullpush, andreev
     int chosen = -1;
     for (int c = 0; c < kAutoCandidates; ++c) {
         if (!allowed(c) || prediction.psnr[c] < target) continue;
-        if (chosen < 0 || prediction.cost[c] < prediction.cost[chosen] ||
-            (prediction.cost[c] == prediction.cost[chosen] &&
-             prediction.psnr[c] > prediction.psnr[chosen]))
-            chosen = c;
+        const bool better = chosen < 0 || prediction.cost[c] < prediction.cost[chosen] ||
+                            (prediction.cost[c] == prediction.cost[chosen] &&
+                             (prediction.psnr[c] > prediction.psnr[chosen] ||
+                              (prediction.psnr[c] == prediction.psnr[chosen] &&
+                               kFillPreference[c % 3] > kFillPreference[chosen % 3])));
+        if (better) chosen = c;
     }
     REPRISE_ASSERT(chosen >= 0);
     return chosen;
