@@ -54,8 +54,8 @@ std::vector<Frame> holes_sequence() {
 
 // The candidate auto chose for each made frame (factor 2: one per input after the first), and
 // the made frames.
-std::vector<int> run_auto(const std::vector<Frame>& input, FrucMode mode,
-                          std::vector<Frame>& made, float budget_db = 0.0f) {
+std::vector<int> run_auto(const std::vector<Frame>& input, FrucMode mode, std::vector<Frame>& made,
+                          float budget_db = 0.0f) {
     FrameRateConverter converter(2, {.mode = mode,
                                      .warp = WarpMethod::Auto,
                                      .fill = FillMethod::Auto,
