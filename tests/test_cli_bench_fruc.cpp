@@ -93,6 +93,9 @@ TEST_F(CliBenchFruc, SummaryAndHtmlReport) {
     std::string summary = read_text(dir_ / "fruc_summary.csv");
     EXPECT_EQ(summary.rfind("scene,method,setting,frames,psnr,ssim,flip,ms\n", 0), 0u) << summary;
     EXPECT_NE(summary.find("pan,interpolate,grid+pullpush,2,"), std::string::npos) << summary;
+    EXPECT_NE(summary.find("pan,interpolate,auto,2,"), std::string::npos) << summary;
+    EXPECT_NE(result_.output.find("auto chose / left out"), std::string::npos) << result_.output;
+    EXPECT_TRUE(fs::exists(dir_ / "fruc_predictors.csv"));
     std::string html = read_text(dir_ / "index.html");
     ASSERT_FALSE(html.empty()) << "no index.html";
     EXPECT_NE(html.find("<svg"), std::string::npos);

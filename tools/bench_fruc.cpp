@@ -106,7 +106,7 @@ const char* const kRefineOff = "grid+pullpush-refine";  // the default without r
 std::vector<Setting> fruc_settings(bool quick) {
     std::vector<Setting> settings;
     auto add = [&](const std::string& mode, const std::string& warp_name, const std::string& fill) {
-        Setting s{mode, warp_name + "+" + fill};
+        Setting s{mode, warp_name == "auto" ? std::string("auto") : warp_name + "+" + fill};
         Status parsed = parse_fruc_options(mode, warp_name, fill, s.options);
         REPRISE_ASSERT(parsed.ok());
         s.with_telea = !quick && mode == "interpolate" && warp_name == "grid" && fill == "none";
@@ -126,9 +126,11 @@ std::vector<Setting> fruc_settings(bool quick) {
         add("interpolate", "reverse", "pullpush");
         add("interpolate", "splat", "none");
         add("extrapolate", "grid", "pullpush");
+        add("interpolate", "auto", "auto");
+        add("extrapolate", "auto", "auto");
         return settings;
     }
-    for (const char* mode : {"interpolate", "extrapolate"})
+    for (const char* mode : {"interpolate", "extrapolate"}) {
         for (const char* warp_name : {"reverse", "splat", "grid"})
             for (const char* fill : {"pullpush", "andreev", "none"}) {
                 if (std::string(mode) == "interpolate" && std::string(warp_name) == "grid" &&
@@ -137,6 +139,8 @@ std::vector<Setting> fruc_settings(bool quick) {
                 else
                     add(mode, warp_name, fill);
             }
+        add(mode, "auto", "auto");
+    }
     return settings;
 }
 
@@ -226,7 +230,10 @@ Status render_scene(server::Renderer& renderer, const std::string& scene_name, i
     for (int i = 0; i < frames; ++i) {
         REPRISE_TRY(renderer.render_frame(scene, path, i, 30.0, settings, out.input[i]));
         out.input_shown[i].resize(w, h);
-        visualize_color(out.input[i].color.view(), out.input_shown[i].view());
+        // A UI layer is scored as shown: drawn over the scene (peers get it in their input).
+        Image<glm::vec4> shown(w, h);
+        composite_ui(out.input[i].color.view(), out.input[i].ui.view(), shown.view());
+        visualize_color(shown.view(), out.input_shown[i].view());
         if (!exr_dir.empty())
             REPRISE_TRY(write_frame(frame_path(exr_dir + "/input", i), out.input[i]));
         std::fprintf(stderr, "\r[fruc] %s: rendering input %d/%d   ", out.name.c_str(), i + 1,
@@ -240,6 +247,7 @@ Status render_scene(server::Renderer& renderer, const std::string& scene_name, i
         if (!exr_dir.empty()) REPRISE_TRY(write_frame(frame_path(exr_dir + "/truth", j), truth));
         if (!out.scored(j)) continue;
         out.truth[j].resize(w, h);
+        composite_ui(truth.color.view(), truth.ui.view(), truth.color.view());
         reprise::to_display(truth.color.view(), out.truth[j].view());
         std::fprintf(stderr, "\r[fruc] %s: rendering truth %d/%d   ", out.name.c_str(), j,
                      out.last());
@@ -292,7 +300,8 @@ Status read_scene(const std::string& dir, int frames, int factor, SceneFrames& o
 
 // Times send() alone; each frame it made gets an equal share of that time, the fastest of
 // `repeat` runs over the sequence. Frames are scored on the first run.
-Status run_ours(SceneFrames& scene, const Setting& setting, int repeat, Run& run, Run* telea) {
+Status run_ours(SceneFrames& scene, const Setting& setting, int repeat, Run& run, Run* telea,
+                warp::FrucCounters& counters) {
     const int w = scene.input[0].width(), h = scene.input[0].height();
     Frame out;
     Image<glm::vec3> display(w, h);
@@ -302,7 +311,9 @@ Status run_ours(SceneFrames& scene, const Setting& setting, int repeat, Run& run
     const bool capture = setting.refine_pair && setting.options.refine.enabled;
     if (capture) scene.regions.clear();
     for (int rep = 0; rep < repeat; ++rep) {
-        warp::FrameRateConverter converter(scene.factor, setting.options);
+        warp::FrucOptions options = setting.options;
+        options.composite_ui = true;  // scored as shown
+        warp::FrameRateConverter converter(scene.factor, options);
         int index = 0;
         for (const Frame& input : scene.input) {
             auto start = BenchClock::now();
@@ -344,6 +355,7 @@ Status run_ours(SceneFrames& scene, const Setting& setting, int repeat, Run& run
         }
         const warp::FrucCounters& c = converter.counters();
         if (rep == 0 && c.outputs > 0) run.refine_ms = c.refine_ms / double(c.outputs);
+        if (rep == 0) counters = c;
     }
     for (Score& s : run.scores) s.ms = send_ms[s.frame];
     if (telea)
@@ -443,6 +455,24 @@ void progress(const std::string& scene, const Run& run) {
                  run.method.c_str(), run.setting.c_str(), p.psnr, p.ms);
 }
 
+// The auto choice's predictors for every scored frame, both modes: the fit of its models
+// (scripts/fit_auto.py) joins them with fruc.csv.
+void write_predictors(std::FILE* file, const SceneFrames& scene) {
+    for (std::size_t i = 0; i + 1 < scene.input.size(); ++i) {
+        const warp::FramePredictors later = warp::survey_predictors(scene.input[i + 1]),
+                                    earlier = warp::survey_predictors(scene.input[i]);
+        for (int k = 1; k < scene.factor; ++k) {
+            const int j = int(i) * scene.factor + k;
+            if (!scene.scored(j)) continue;
+            const float s = float(k) / float(scene.factor);
+            std::fprintf(file, "%s,%d,interpolate,%.4f,%.4f,%.4f,%.6f\n", scene.name.c_str(), j,
+                         std::min(s, 1.0f - s), later.motion, later.spread, later.disoccluded);
+            std::fprintf(file, "%s,%d,extrapolate,%.4f,%.4f,%.4f,%.6f\n", scene.name.c_str(), j, s,
+                         earlier.motion, earlier.spread, earlier.disoccluded);
+        }
+    }
+}
+
 struct SceneSummary {
     std::string scene;
     ReportPoint interpolation, extrapolation, ffmpeg, dis, vectors;  // empty method: not run
@@ -466,6 +496,64 @@ std::string refine_table(const std::vector<SceneSummary>& rows) {
                       r.region_on - r.region_off, r.refine_off.psnr, r.refine_on.psnr,
                       r.refine_on.psnr - r.refine_off.psnr, r.refine_ms, r.refine_off.ms,
                       r.refine_on.ms);
+        text += line;
+    }
+    return text;
+}
+
+// Auto against the fixed settings of its mode on one scene.
+struct AutoSummary {
+    std::string scene, mode;
+    ReportPoint automatic, best_fixed;
+    double front_gap = 0.0;  // dB under the best point (any method) no slower than auto; 0 = on it
+};
+
+AutoSummary auto_summary(const std::string& scene, const std::string& mode,
+                         const std::vector<Run>& runs) {
+    AutoSummary a{scene, mode};
+    for (const Run& r : runs)
+        if (r.method == mode && r.setting == "auto") a.automatic = r.mean();
+    const Run* best = best_of(runs, [&](const Run& r) {
+        return r.method == mode && r.setting != "auto" && r.setting != "grid+telea" &&
+               r.setting != "grid+pullpush+ui-warped";
+    });
+    if (best) a.best_fixed = best->mean();
+    for (const Run& r : runs) {
+        if (r.setting == "auto" || r.scores.empty()) continue;
+        if (r.ours() && r.method != mode) continue;
+        if (!r.ours() && mode != "interpolate") continue;
+        const ReportPoint p = r.mean();
+        if (p.ms <= a.automatic.ms) a.front_gap = std::max(a.front_gap, p.psnr - a.automatic.psnr);
+    }
+    return a;
+}
+
+std::string auto_table(const std::vector<AutoSummary>& rows) {
+    std::string text;
+    char line[400];
+    std::snprintf(line, sizeof line, "%-24s %-11s %7s %8s | %-17s %7s %8s | %6s %6s | %5s  %s\n",
+                  "scene", "auto", "PSNR", "ms", "best fixed", "PSNR", "ms", "dB", "time", "front",
+                  "within 0.3 dB of the best fixed at no more time");
+    text += line;
+    for (const AutoSummary& r : rows) {
+        if (r.automatic.method.empty() || r.best_fixed.method.empty()) continue;
+        const double gain = r.automatic.psnr - r.best_fixed.psnr;
+        const double ratio = r.automatic.ms / r.best_fixed.ms;
+        std::string verdict = gain >= -0.3 && ratio <= 1.0 ? "yes" : "no:";
+        char miss[96] = "";
+        if (gain < -0.3) {
+            std::snprintf(miss, sizeof miss, " %.2f dB short", -0.3 - gain);
+            verdict += miss;
+        }
+        if (ratio > 1.0) {
+            std::snprintf(miss, sizeof miss, " %.0f %% slower", 100.0 * (ratio - 1.0));
+            verdict += miss;
+        }
+        std::snprintf(line, sizeof line,
+                      "%-24s %-11s %7.2f %8.2f | %-17s %7.2f %8.2f | %+6.2f %5.2fx | %5.2f  %s\n",
+                      r.scene.c_str(), r.mode.c_str(), r.automatic.psnr, r.automatic.ms,
+                      r.best_fixed.setting.c_str(), r.best_fixed.psnr, r.best_fixed.ms, gain, ratio,
+                      r.front_gap, verdict.c_str());
         text += line;
     }
     return text;
@@ -549,6 +637,11 @@ Status bench_fruc(const BenchOptions& job) {
     CsvFile csv, summary_csv;
     REPRISE_TRY(csv.open(csv_path, kErrorTimeColumns));
     REPRISE_TRY(summary_csv.open(summary_path, "scene,method,setting,frames,psnr,ssim,flip,ms"));
+    CsvFile predictors_csv;
+    REPRISE_TRY(predictors_csv.open(out_dir + "/fruc_predictors.csv",
+                                    "scene,frame,mode,distance,motion,spread,disoccluded"));
+    std::map<std::string, warp::FrucCounters> auto_counts;
+    std::vector<AutoSummary> autos;
 
     Report report;
     report.title = "reprise bench fruc: frame-rate upconversion, error against run time";
@@ -592,22 +685,46 @@ Status bench_fruc(const BenchOptions& job) {
                       : render_scene(*renderer, scene_name, job.frames, job.factor, w, h,
                                      job.exr ? scene_dir : std::string(), scene);
         if (!failure.ok()) break;
+        write_predictors(predictors_csv.file(), scene);
 
         std::vector<Run> runs;
         runs.reserve(settings.size() + 3);
         for (const Setting& setting : settings) {
             runs.push_back({setting.method, setting.setting});
             Run telea{"interpolate", "grid+telea"};
+            warp::FrucCounters counters;
             failure = run_ours(scene, setting, job.repeat, runs.back(),
-                               setting.with_telea ? &telea : nullptr);
+                               setting.with_telea ? &telea : nullptr, counters);
             if (!failure.ok()) break;
             progress(scene.name, runs.back());
+            if (setting.setting == "auto")
+                std::fprintf(stderr, "[fruc] %s: %s auto chose / left out:\n%s", scene.name.c_str(),
+                             setting.method.c_str(), auto_choice_summary(counters).c_str());
+            if (setting.setting == "auto")
+                auto_counts[scene.name + " " + setting.method] = counters;
             if (setting.with_telea) {
                 runs.push_back(std::move(telea));
                 progress(scene.name, runs.back());
             }
         }
         if (!failure.ok()) break;
+        if (!scene.input[0].ui.empty()) {
+            // The same frames with the UI baked into the colour: warped along with the scene.
+            SceneFrames baked = scene;
+            for (Frame& f : baked.input) {
+                composite_ui(f.color.view(), f.ui.view(), f.color.view());
+                f.ui.clear();
+            }
+            Setting plain{"interpolate", "grid+pullpush+ui-warped"};
+            const Status parsed =
+                parse_fruc_options("interpolate", "grid", "pullpush", plain.options);
+            REPRISE_ASSERT(parsed.ok());
+            runs.push_back({plain.method, plain.setting});
+            warp::FrucCounters ignored;
+            failure = run_ours(baked, plain, job.repeat, runs.back(), nullptr, ignored);
+            if (!failure.ok()) break;
+            progress(scene.name, runs.back());
+        }
         runs.push_back({kDis, "medium"});
         run_dis(scene, job.repeat, runs.back());
         progress(scene.name, runs.back());
@@ -647,10 +764,13 @@ Status bench_fruc(const BenchOptions& job) {
 
         SceneSummary row{scene.name + (is_held_out(scene_name) ? " (held)" : "")};
         const Run* interpolation = best_of(runs, [](const Run& r) {
-            return r.method == "interpolate" && r.setting != "grid+telea";
+            return r.method == "interpolate" && r.setting != "grid+telea" && r.setting != "auto" &&
+                   r.setting != "grid+pullpush+ui-warped";
         });
-        const Run* extrapolation =
-            best_of(runs, [](const Run& r) { return r.method == "extrapolate"; });
+        const Run* extrapolation = best_of(
+            runs, [](const Run& r) { return r.method == "extrapolate" && r.setting != "auto"; });
+        for (const char* mode : {"interpolate", "extrapolate"})
+            autos.push_back(auto_summary(row.scene, mode, runs));
         const Run* peer = best_of(runs, [](const Run& r) { return !r.ours(); });
         if (interpolation) row.interpolation = interpolation->mean();
         if (extrapolation) row.extrapolation = extrapolation->mean();
@@ -686,6 +806,7 @@ Status bench_fruc(const BenchOptions& job) {
         report.sections.push_back(std::move(section));
         csv.flush();
         summary_csv.flush();
+        predictors_csv.flush();
     }
     REPRISE_TRY(failure);
 
@@ -701,6 +822,14 @@ Status bench_fruc(const BenchOptions& job) {
         "PSNR there and over\nwhole frames; refine ms = survey + flow + choice per made frame\n" +
         refine_table(summaries);
     table += refinement;
+    std::string automatic =
+        "\nauto (--warp auto --fill auto, cheapest within 0.25 dB of the best expected) against "
+        "the best fixed setting of its mode; front = dB under the best point no slower than auto "
+        "(0: on the Pareto front)\n" +
+        auto_table(autos) + "auto chose / left out (frames):\n";
+    for (const auto& [name, counters] : auto_counts)
+        automatic += "  " + name + "\n" + auto_choice_summary(counters);
+    table += automatic;
     report.preformatted = std::string(text) + table;
     const std::string html_path = out_dir + "/index.html";
     REPRISE_TRY(write_html_report(html_path, report));

@@ -84,7 +84,13 @@ Status display(const Frame& f, const std::string& file, Channel c, const Ranges&
     out.resize(f.width(), f.height());
     switch (c) {
         case Channel::Color:
-            visualize_color(f.color.view(), out.view());
+            if (f.ui.empty() || !sized(f.ui)) {
+                visualize_color(f.color.view(), out.view());
+            } else {  // the UI layer drawn over the scene, as it is shown
+                Image<glm::vec4> shown(f.width(), f.height());
+                composite_ui(f.color.view(), f.ui.view(), shown.view());
+                visualize_color(shown.view(), out.view());
+            }
             break;
         case Channel::Depth:
             visualize_depth(f.depth.view(), out.view(), r.depth);

@@ -20,6 +20,9 @@ struct FrucJob {
     std::string mode = "interpolate", warp = "grid", fill = "pullpush";
     std::string layout = "reprise";
     std::string refine = "on";
+    std::string ui;             // a UI sequence beside the input (its colour: premultiplied RGBA)
+    bool ui_composite = false;  // draw the UI into the output colour
+    double budget_db = 0.0;     // auto: the PSNR to reach (0: within slack of the best expected)
 };
 
 Status run_fruc(const FrucJob& job) {
@@ -33,8 +36,19 @@ Status run_fruc(const FrucJob& job) {
         write.layout = ExrLayout::Blender;
     else if (job.layout != "reprise")
         return Status::error("--layout must be reprise or blender, not '" + job.layout + "'");
-    Sequence sequence;
+    options.composite_ui = job.ui_composite;
+    if (job.budget_db < 0.0 || job.budget_db > 100.0)
+        return Status::error("--budget-db must be in 0..100");
+    options.auto_choice.budget_db = float(job.budget_db);
+    Sequence sequence, ui_sequence;
     REPRISE_TRY(open_sequence(job.in, sequence));
+    if (!job.ui.empty()) {
+        REPRISE_TRY(open_sequence(job.ui, ui_sequence));
+        if (ui_sequence.files.size() < sequence.files.size())
+            return Status::error("--ui " + job.ui + ": " +
+                                 std::to_string(ui_sequence.files.size()) + " frames for " +
+                                 std::to_string(sequence.files.size()) + " input frames");
+    }
     std::error_code ec;
     std::filesystem::create_directories(job.out, ec);
     if (ec) return Status::error(job.out + ": cannot create the folder: " + ec.message());
@@ -42,7 +56,7 @@ Status run_fruc(const FrucJob& job) {
     warp::FrameRateConverter converter(job.factor, options);
     FlowMotion flow;
     bool estimating = false;
-    Frame in, out;
+    Frame in, out, ui_frame;
     int written = 0;
     double busy_ms = 0.0;
     const std::size_t n = sequence.files.size();
@@ -64,6 +78,19 @@ Status run_fruc(const FrucJob& job) {
             estimating = true;
         }
         if (estimating) flow.complete(in);
+        if (!job.ui.empty()) {
+            REPRISE_TRY(read_frame(ui_sequence.files[i], ui_frame));
+            if (ui_frame.width() != in.width() || ui_frame.height() != in.height())
+                return Status::error(ui_sequence.files[i] + ": UI frame size differs from " +
+                                     sequence.files[i]);
+            std::swap(in.ui, ui_frame.color);
+        }
+        if (i == 0 && !in.ui.empty())
+            std::fprintf(stderr,
+                         "[fruc] UI layer found (%s): the scene is warped without it, each made "
+                         "frame gets the nearest input's UI unwarped%s\n",
+                         job.ui.empty() ? "ui.R ui.G ui.B ui.A channels" : job.ui.c_str(),
+                         job.ui_composite ? ", drawn into the colour" : ", in its ui channels");
         auto start = std::chrono::steady_clock::now();
         REPRISE_TRY(converter.send(in));
         busy_ms +=
@@ -94,6 +121,22 @@ Status run_fruc(const FrucJob& job) {
             "px, %zu px refined, %.2f ms per made frame\n",
             c.refined_frames, c.refine_skipped, c.refine_tiles, c.flow_pixels, c.refined_pixels,
             c.outputs ? c.refine_ms / double(c.outputs) : 0.0);
+    if (options.warp == warp::WarpMethod::Auto || options.fill == warp::FillMethod::Auto) {
+        if (job.budget_db > 0)
+            std::printf(
+                "  auto (budget %.1f dB): per candidate, frames chosen for and frames left "
+                "out of although expected higher\n",
+                job.budget_db);
+        else
+            std::printf(
+                "  auto (cheapest within %.2f dB of the best expected): per candidate, "
+                "frames chosen for and frames left out of although expected higher\n",
+                double(options.auto_choice.slack_db));
+        std::printf("%s", auto_choice_summary(c).c_str());
+    }
+    if (c.ui_frames > 0)
+        std::printf("  UI layer: %zu made frames took the nearest input's UI, unwarped\n",
+                    c.ui_frames);
     return {};
 }
 
@@ -113,10 +156,21 @@ int command_fruc(int argc, char** argv) {
     args.option("--refine", &job.refine,
                 "on | off (default on): interpolation refines motion by optical flow where the "
                 "warped\nsides disagree (moving shadows, reflections, highlights)");
+    args.option("--warp", &job.warp,
+                "reverse | splat | grid | auto (default grid; auto: chosen per frame)");
+    args.option("--fill", &job.fill, "pullpush | andreev | none | auto (default pullpush)");
+    args.option("--budget-db", &job.budget_db,
+                "auto: the PSNR (dB) a made frame should reach; the cheapest setting expected to "
+                "reach it\nis taken (default 0: the cheapest within 0.25 dB of the best expected)");
     args.option("--out", &job.out, "output folder");
     args.option("--layout", &job.layout,
                 "EXR channel names: reprise | blender (ViewLayer.Combined.R..., opens in "
                 "Blender)");
+    args.option("--ui", &job.ui,
+                "a UI/HUD sequence beside --in (colour = premultiplied RGBA), kept out of the "
+                "warp;\nframes with ui.R ui.G ui.B ui.A channels need no flag");
+    args.flag("--ui-composite", &job.ui_composite,
+              "draw the UI into the output colour (default: keep it in ui.* channels)");
     Status parsed = args.parse(argc, argv);
     if (!parsed.ok() || args.help_requested()) return report(args, parsed, {});
     if (job.in.empty()) return report(args, Status::error("fruc: --in DIR is required"), {});

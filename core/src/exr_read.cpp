@@ -26,11 +26,29 @@ namespace fs = std::filesystem;
 using OIIO::ImageSpec;
 using OIIO::TypeDesc;
 
-enum Slot { R, G, B, A, Z, MotionX, MotionY, NormalX, NormalY, NormalZ, Id, kSlots };
+enum Slot {
+    R,
+    G,
+    B,
+    A,
+    Z,
+    MotionX,
+    MotionY,
+    NormalX,
+    NormalY,
+    NormalZ,
+    Id,
+    UiR,
+    UiG,
+    UiB,
+    UiA,
+    kSlots
+};
 using Channels = std::array<int, kSlots>;  // file channel index per slot, -1 when absent
 
 constexpr std::array<const char*, kSlots> kRepriseNames = {
-    "R", "G", "B", "A", "Z", "motion.x", "motion.y", "N.X", "N.Y", "N.Z", "id"};
+    "R",   "G",   "B",  "A",    "Z",    "motion.x", "motion.y", "N.X",
+    "N.Y", "N.Z", "id", "ui.R", "ui.G", "ui.B",     "ui.A"};
 
 struct Layout {
     Channels channel;
@@ -186,7 +204,8 @@ bool parse_blender(std::string_view name, BlenderChannel& out) {
         {"Combined", "R", R},     {"Combined", "G", G},     {"Combined", "B", B},
         {"Combined", "A", A},     {"Depth", "Z", Z},        {"Vector", "X", MotionX},
         {"Vector", "Y", MotionY}, {"Normal", "X", NormalX}, {"Normal", "Y", NormalY},
-        {"Normal", "Z", NormalZ}, {"IndexOB", "X", Id},
+        {"Normal", "Z", NormalZ}, {"IndexOB", "X", Id},     {"UI", "R", UiR},
+        {"UI", "G", UiG},         {"UI", "B", UiB},         {"UI", "A", UiA},
     };
     for (std::size_t k = tokens.size() - 1; k-- > 0;) {
         for (const Pass& p : kPasses) {
@@ -227,6 +246,7 @@ bool find_blender_layout(const ImageSpec& spec, Layout& layout) {
         // Incomplete optional passes are left out.
         if (!complete(c, {MotionX, MotionY})) c[MotionX] = c[MotionY] = -1;
         if (!complete(c, {NormalX, NormalY, NormalZ})) c[NormalX] = c[NormalY] = c[NormalZ] = -1;
+        if (!complete(c, {UiR, UiG, UiB, UiA})) c[UiR] = c[UiG] = c[UiB] = c[UiA] = -1;
         const int score = (c[Z] >= 0) + (c[MotionX] >= 0) + (c[NormalX] >= 0) + (c[Id] >= 0);
         if (score > best_score) {
             best_score = score;
@@ -253,6 +273,7 @@ Status find_layout(const ImageSpec& spec, const std::string& path, Layout& layou
     };
     REPRISE_TRY(group({MotionX, MotionY}));
     REPRISE_TRY(group({NormalX, NormalY, NormalZ}));
+    REPRISE_TRY(group({UiR, UiG, UiB, UiA}));
     layout = {.channel = c, .blender = false};
     return {};
 }
@@ -381,6 +402,7 @@ Status read_frame(const std::string& path, Frame& frame) {
     fit(frame.motion, c[MotionX] >= 0, width, height);
     fit(frame.normal, c[NormalX] >= 0, width, height);
     fit(frame.id, c[Id] >= 0, width, height);
+    fit(frame.ui, c[UiR] >= 0, width, height);
 
     std::vector<Target> targets;
     for (int s = R; s <= A; ++s) add_target(targets, c[s], frame.color, s - R);
@@ -391,6 +413,7 @@ Status read_frame(const std::string& path, Frame& frame) {
     add_target(targets, c[NormalY], frame.normal, 1);
     add_target(targets, c[NormalZ], frame.normal, 2);
     add_target(targets, c[Id], frame.id, 0);
+    for (int s = UiR; s <= UiA; ++s) add_target(targets, c[s], frame.ui, s - UiR);
 
     // Read the channel range that holds every target, in the file's own types.
     int chbegin = spec.nchannels, chend = 0;

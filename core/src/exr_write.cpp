@@ -65,6 +65,11 @@ void copy_value(const unsigned char* from, unsigned char* to, Convert convert) {
     std::memcpy(to, &v, 4);
 }
 
+// The UI layer's channels in the reprise and the Blender layout.
+constexpr const char* kUiNames[2][4] = {
+    {"ui.R", "ui.G", "ui.B", "ui.A"},
+    {"ViewLayer.UI.R", "ViewLayer.UI.G", "ViewLayer.UI.B", "ViewLayer.UI.A"}};
+
 std::vector<Source> reprise_sources(const Frame& frame) {
     std::vector<Source> sources = {source("R", frame.color, 0), source("G", frame.color, 1),
                                    source("B", frame.color, 2), source("A", frame.color, 3)};
@@ -79,6 +84,8 @@ std::vector<Source> reprise_sources(const Frame& frame) {
         sources.push_back(source("N.Z", frame.normal, 2));
     }
     if (!frame.id.empty()) sources.push_back(source("id", frame.id, 0));
+    if (!frame.ui.empty())
+        for (int k = 0; k < 4; ++k) sources.push_back(source(kUiNames[0][k], frame.ui, k));
     return sources;
 }
 
@@ -104,6 +111,8 @@ std::vector<Source> blender_sources(const Frame& frame) {
     }
     if (!frame.id.empty())
         sources.push_back(source("ViewLayer.IndexOB.X", frame.id, 0, Convert::UintToFloat));
+    if (!frame.ui.empty())
+        for (int k = 0; k < 4; ++k) sources.push_back(source(kUiNames[1][k], frame.ui, k));
     return sources;
 }
 
@@ -154,6 +163,7 @@ Status write_frame(const std::string& path, const Frame& frame, const WriteOptio
     REPRISE_TRY(same_size(frame.motion, "motion"));
     REPRISE_TRY(same_size(frame.normal, "normal"));
     REPRISE_TRY(same_size(frame.id, "id"));
+    REPRISE_TRY(same_size(frame.ui, "ui"));
 
     const bool blender = options.layout == ExrLayout::Blender;
     const std::vector<Source> sources = blender ? blender_sources(frame) : reprise_sources(frame);

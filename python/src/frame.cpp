@@ -258,6 +258,7 @@ void bind_frame(py::module_& m) {
             if (!f.motion.empty()) channels += ",motion";
             if (!f.normal.empty()) channels += ",normal";
             if (!f.id.empty()) channels += ",id";
+            if (!f.ui.empty()) channels += ",ui";
             return "<reprise.Frame " + std::to_string(f.width()) + "x" +
                    std::to_string(f.height()) + " " + channels + ">";
         });
@@ -269,6 +270,8 @@ void bind_frame(py::module_& m) {
     channel(frame, "normal", &Frame::normal, Values::Finite,
             "(H, W, 3) float32 world-space normals; None when absent");
     channel(frame, "id", &Frame::id, Values::Finite, "(H, W) uint32 object ids; None when absent");
+    channel(frame, "ui", &Frame::ui, Values::Finite,
+            "(H, W, 4) float32 UI/HUD layer, premultiplied RGBA, never warped; None when absent");
 
     m.def(
         "read_frame",

@@ -23,16 +23,20 @@ warp::FrucOptions fruc_options(const std::string& mode, const std::string& warp_
         o.warp = warp::WarpMethod::Reverse;
     else if (warp_method == "splat")
         o.warp = warp::WarpMethod::Splat;
+    else if (warp_method == "auto")
+        o.warp = warp::WarpMethod::Auto;
     else
-        value_error("warp must be 'grid', 'reverse' or 'splat', got '" + warp_method + "'");
+        value_error("warp must be 'grid', 'reverse', 'splat' or 'auto', got '" + warp_method + "'");
     if (fill == "pullpush")
         o.fill = warp::FillMethod::PullPush;
     else if (fill == "andreev")
         o.fill = warp::FillMethod::Andreev;
     else if (fill == "none")
         o.fill = warp::FillMethod::None;
+    else if (fill == "auto")
+        o.fill = warp::FillMethod::Auto;
     else
-        value_error("fill must be 'pullpush', 'andreev' or 'none', got '" + fill + "'");
+        value_error("fill must be 'pullpush', 'andreev', 'none' or 'auto', got '" + fill + "'");
     return o;
 }
 
@@ -89,6 +93,14 @@ struct Converter {
         d["flow_pixels"] = c.flow_pixels;
         d["refined_pixels"] = c.refined_pixels;
         d["refine_ms"] = c.refine_ms;
+        d["ui_frames"] = c.ui_frames;
+        py::dict chosen, left_out;
+        for (int k = 0; k < warp::kAutoCandidates; ++k) {
+            chosen[warp::auto_candidate_name(k)] = c.auto_chosen[k];
+            left_out[warp::auto_candidate_name(k)] = c.auto_left_out[k];
+        }
+        d["auto_chosen"] = chosen;
+        d["auto_left_out"] = left_out;
         return d;
     }
 

@@ -109,3 +109,19 @@ def test_file_errors_carry_the_library_message(tmp_path):
     with pytest.raises(reprise.Error):
         reprise.write_frame(str(tmp_path / "no" / "such" / "dir.exr"),
                             reprise.Frame(np.zeros((2, 2, 4))))
+
+
+@pytest.mark.parametrize("layout", ["reprise", "blender"])
+def test_ui_layer_round_trip(tmp_path, small_frame, layout):
+    assert small_frame.ui is None
+    ui = np.zeros((6, 8, 4), np.float32)
+    ui[1:3, 2:5] = (0.2, 0.1, 0.0, 0.5)  # premultiplied
+    small_frame.ui = ui
+    assert "ui" in repr(small_frame)
+    path = str(tmp_path / "ui.exr")
+    reprise.write_frame(path, small_frame, layout=layout)
+    header = reprise.read_header(path)
+    assert ("ui.A" if layout == "reprise" else "ViewLayer.UI.A") in header["channels"]
+    back = reprise.read_frame(path)
+    assert np.array_equal(back.ui, ui)
+    assert np.array_equal(back.color, small_frame.color)

@@ -44,3 +44,19 @@ def test_bad_arguments_raise(pan_60):
         converter.send(None)
     with pytest.raises(TypeError):
         converter.convert([frame, None])
+
+
+def test_auto_choice_and_ui_layer(pan_60):
+    inputs = [pan_60[0].copy(), pan_60[2].copy(), pan_60[4].copy()]
+    ui = np.zeros(inputs[0].color.shape, np.float32)
+    ui[4:12, 4:40] = (0.5, 0.5, 0.5, 0.5)
+    for i, f in enumerate(inputs):
+        f.fps = 30.0
+        f.ui = ui * (i + 1) / 3
+    converter = reprise.FrameRateConverter(factor=2, warp="auto", fill="auto")
+    out = converter.convert(inputs)
+    counters = converter.counters
+    assert sum(counters["auto_chosen"].values()) == 2
+    assert counters["ui_frames"] == 2
+    # s = 1/2: the later input's UI, unwarped.
+    assert np.array_equal(out[1].ui, inputs[1].ui) and np.array_equal(out[3].ui, inputs[2].ui)

@@ -23,6 +23,7 @@ const std::vector<SceneInfo>& builtin_scenes() {
         {"shadows", "heavy shading: a moving sun sweeps shadows over a still ground, still camera"},
         {"mirror",
          "a spinning mirror ball under an orbit: its reflections move unlike its surface"},
+        {"hud", "a camera pan under a UI layer (ui.* channels): a static panel, a changing bar"},
     };
     return scenes;
 }
@@ -521,7 +522,11 @@ Status load_scene(const std::string& name_or_file, Scene& scene, CameraPath& cam
         scene = shadows_scene(camera);
     else if (n == "mirror")
         scene = mirror_scene(camera);
-    else {
+    else if (n == "hud") {
+        scene = pan_scene(camera, 3.0f);
+        scene.name = "hud";
+        scene.hud = true;
+    } else {
         auto ext = std::filesystem::path(n).extension().string();
         if (ext != ".gltf" && ext != ".glb")
             return Status::error("scene '" + n +

@@ -14,6 +14,7 @@
 #include "gbuffer_shaders.hpp"
 #include "heavy_shaders.hpp"
 #include "reprise/server/animation.hpp"
+#include "reprise/server/builtin_scenes.hpp"
 #include "reprise/server/gl_context.hpp"
 
 namespace reprise::server {
@@ -815,6 +816,10 @@ Status Renderer::render(const Scene& scene, const Instant& current, const Instan
     c.far = current.far;
     c.jitter = current.jitter;
     c.time = current.time;
+    if (scene.hud)
+        draw_hud(current.time, w, h, frame.ui);
+    else
+        frame.ui.clear();
     return {};
 }
 

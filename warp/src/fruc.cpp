@@ -32,6 +32,7 @@ public:
         ++count_;
         return f;
     }
+    Frame& back() { return slots_[(head_ + count_ - 1) % slots_.size()]; }
     void pop_into(Frame& out) {
         std::swap(out, slots_[head_]);
         head_ = (head_ + 1) % slots_.size();
@@ -140,8 +141,31 @@ struct FrameRateConverter::State {
     bool has_previous = false;
     bool previous_starts_shot = false;  // its motion reaches back into another shot: unusable
     FrameQueue ready;
+    FrucOptions chosen;  // `options` with an auto warp or fill resolved for one frame
 
     float motion_scale() const { return 1.0f / float(factor); }
+
+    bool automatic() const {
+        return options.warp == WarpMethod::Auto || options.fill == FillMethod::Auto;
+    }
+
+    // The options for one frame `distance` input periods from the frame `p` was surveyed on.
+    const FrucOptions& resolve(const FramePredictors& p, float distance, FrucMode mode) {
+        if (!automatic()) return options;
+        const AutoPrediction prediction = predict_candidates(p, distance, mode);
+        const int c = choose_candidate(prediction, options.warp, options.fill, options.auto_choice);
+        ++counters.auto_chosen[c];
+        for (int k = 0; k < kAutoCandidates; ++k) {
+            const bool allowed =
+                (options.warp == WarpMethod::Auto || auto_candidate_warp(k) == options.warp) &&
+                (options.fill == FillMethod::Auto || auto_candidate_fill(k) == options.fill);
+            counters.auto_left_out[k] += allowed && prediction.psnr[k] > prediction.psnr[c];
+        }
+        chosen = options;
+        chosen.warp = auto_candidate_warp(c);
+        chosen.fill = auto_candidate_fill(c);
+        return chosen;
+    }
 
     // A shot change between `previous` and `frame`: most of the new frame has no counterpart in
     // the old one, or what does differs in colour. Surveyed on every 4th pixel of every 4th row.
@@ -250,6 +274,27 @@ struct FrameRateConverter::State {
         out.camera = previous.camera = frame.camera;
         out.fps = frame.fps > 0 ? frame.fps * factor : 0.0;
         previous.fps = frame.fps;
+        if (frame.ui.empty())
+            previous.ui.clear();
+        else
+            copy_image(frame.ui.view(), previous.ui);
+        attach_ui(out, frame, false);
+    }
+
+    // The UI of `nearest` (an input) on a frame in the queue: in its ui channels or, with
+    // composite_ui, drawn over its colour.
+    void attach_ui(Frame& out, const Frame& nearest, bool made) {
+        if (nearest.ui.empty() || out.color.empty()) {
+            out.ui.clear();
+            return;
+        }
+        if (options.composite_ui) {
+            composite_ui(out.color.view(), nearest.ui.view(), out.color.view());
+            out.ui.clear();
+        } else {
+            copy_image(nearest.ui.view(), out.ui);
+        }
+        counters.ui_frames += made;
     }
 
     // Colour and depth of `frame` with zero motion.
@@ -294,6 +339,7 @@ Status FrameRateConverter::send(const Frame& frame) {
     };
     if (!sized(frame.depth) || !sized(frame.motion))
         return Status::error("fruc input frame: depth or motion size differs from colour");
+    if (!sized(frame.ui)) return Status::error("fruc input frame: ui size differs from colour");
     ++st.counters.inputs;
     st.scratch.refiner.forget_region();
     const bool warpable = !frame.depth.empty() && !frame.motion.empty();
@@ -303,9 +349,11 @@ Status FrameRateConverter::send(const Frame& frame) {
 
     const double fps = frame.fps;
     const float scale = st.motion_scale();
+    FramePredictors predicted;  // surveyed only for an auto choice
     if (st.options.mode == FrucMode::Interpolate) {
         if (st.has_previous) {
             const Frame& a = st.previous;
+            if (st.automatic() && warpable) predicted = survey_predictors(cut ? a : frame);
             const bool a_warpable =
                 !a.depth.empty() && !a.motion.empty() && !st.previous_starts_shot;
             const Camera a_before = State::previous_instant(a.camera, a.fps);
@@ -330,7 +378,8 @@ Status FrameRateConverter::send(const Frame& frame) {
                     // The new shot starts at the new frame: the frames before it belong to the
                     // old one, continued from its last frame alone; nothing is blended across.
                     Frame& out = st.ready.push();
-                    extrapolate_frame(a, s, scale, st.options, st.scratch, out, st.counters);
+                    extrapolate_frame(a, s, scale, st.resolve(predicted, s, FrucMode::Extrapolate),
+                                      st.scratch, out, st.counters);
                     st.finish(out, a_before, a.camera, a.fps, 1.0f + s, 1.0f + s - 1.0f / k_max);
                 } else if (!warpable || a.depth.empty() || a.motion.empty()) {
                     st.emit_copy(s < 0.5f ? a.view() : frame.view(), a.camera, frame.camera, fps,
@@ -341,15 +390,19 @@ Status FrameRateConverter::send(const Frame& frame) {
                     st.emit_copy(frame, a.camera, frame.camera, fps, s);
                 } else {
                     Frame& out = st.ready.push();
-                    interpolate_frame(a, frame, s, a_warpable, scale, st.options, st.scratch, out,
-                                      st.counters);
+                    interpolate_frame(
+                        a, frame, s, a_warpable, scale,
+                        st.resolve(predicted, std::min(s, 1.0f - s), FrucMode::Interpolate),
+                        st.scratch, out, st.counters);
                     st.finish(out, a.camera, frame.camera, fps, s, s - 1.0f / k_max);
                 }
+                st.attach_ui(st.ready.back(), s >= 0.5f ? frame : a, true);
             }
         }
         st.emit_input(frame);
     } else {
         st.emit_input(frame);
+        if (st.automatic() && warpable && !cut) predicted = survey_predictors(frame);
         const Camera before = State::previous_instant(frame.camera, fps);
         for (int k = 1; k < k_max; ++k) {
             float s = float(k) / float(k_max);
@@ -360,9 +413,11 @@ Status FrameRateConverter::send(const Frame& frame) {
                 st.emit_copy(frame, before, frame.camera, fps, 1.0f + s);
             } else {
                 Frame& out = st.ready.push();
-                extrapolate_frame(frame, s, scale, st.options, st.scratch, out, st.counters);
+                extrapolate_frame(frame, s, scale, st.resolve(predicted, s, FrucMode::Extrapolate),
+                                  st.scratch, out, st.counters);
                 st.finish(out, before, frame.camera, fps, 1.0f + s, 1.0f + s - 1.0f / k_max);
             }
+            st.attach_ui(st.ready.back(), frame, true);
         }
     }
     st.has_previous = true;

@@ -77,6 +77,8 @@ std::size_t warp_into(const GBufferView& source, float factor, const FrucOptions
             refetch(source, factor, out);
             return covered;
         }
+        case WarpMethod::Auto:  // resolved per frame by the converter
+            REPRISE_ASSERT(options.warp != WarpMethod::Auto);
     }
     return 0;
 }

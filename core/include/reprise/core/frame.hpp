@@ -12,6 +12,9 @@ struct Frame {
     Image<glm::vec2> motion;  // backward motion, pixels: p + motion = p in the previous frame
     Image<glm::vec3> normal;  // world-space unit normal (0 on background)
     Image<uint32_t> id;       // object id, 0 = background
+    // UI/HUD layer, premultiplied RGBA (EXR ui.R ui.G ui.B ui.A): drawn over the colour for
+    // display, never warped; the colour holds the scene without it.
+    Image<glm::vec4> ui;
     Camera camera;
     double fps = 0.0;  // frame rate of the sequence this frame belongs to (0 = unknown)
 
@@ -27,5 +30,10 @@ struct Frame {
 // The display value of linear light: clamp to [0, 1], then the sRGB transfer function.
 float linear_to_srgb(float linear);
 float srgb_to_linear(float encoded);
+
+// colour with the UI layer over it (premultiplied "over"): rgb = ui.rgb + (1 - ui.a) rgb,
+// a = ui.a + (1 - ui.a) a. `out` may be `color` itself; without a UI it is a copy.
+void composite_ui(ImageView<const glm::vec4> color, ImageView<const glm::vec4> ui,
+                  ImageView<glm::vec4> out);
 
 }  // namespace reprise

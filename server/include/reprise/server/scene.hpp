@@ -130,6 +130,7 @@ struct Scene {
     Light light;
     std::vector<PointLight> point_lights;  // used by Shading::Heavy only (at most 16)
     bool heavy_shading = false;            // built for Shading::Heavy (the CLI's default for it)
+    bool hud = false;  // the renderer draws the built-in HUD (draw_hud) into Frame::ui
     glm::vec3 background{0.55f, 0.70f, 0.90f};  // linear RGB of the sky (id 0)
 };
 

@@ -1,6 +1,7 @@
 #pragma once
 // Frame-rate upconversion: K output frames per rendered frame, by interpolation between the last
 // two frames or by extrapolation from the last one alone (no added latency).
+#include <array>
 #include <cstddef>
 #include <memory>
 
@@ -16,8 +17,49 @@ enum class WarpMethod {
     Reverse,  // splat motion to the new instant, then fetch colour bilinearly (both sides)
     Splat,    // forward splat of colour (2x2 footprint)
     Grid,     // adaptive-grid warp
+    Auto,     // per frame, the cheapest expected to meet AutoOptions' budget (with the fill)
 };
-enum class FillMethod { None, PullPush, Andreev };
+enum class FillMethod { None, PullPush, Andreev, Auto };
+
+// The per-frame choice of `--warp auto --fill auto`: every fixed warp x fill is a candidate, its
+// error and cost predicted from a survey of the input (FramePredictors) by models fitted to
+// measured runs (docs/benchmarks.md, "Automatic choice"). A fixed warp or fill limits the
+// candidates to those with it.
+struct AutoOptions {
+    // The PSNR (dB, display values) a made frame should reach: the cheapest candidate expected to
+    // reach it is taken, or the best expected one when none is. 0: relative to the best expected
+    // candidate of each frame, the cheapest within slack_db of it.
+    float budget_db = 0.0f;
+    float slack_db = 0.25f;
+};
+
+// What the choice knows of a frame before warping anything, from every 8th pixel of every 8th
+// row of the frame the warp starts from, per input period of motion.
+struct FramePredictors {
+    float motion = 0.0f;       // mean motion length, px
+    float spread = 0.0f;       // RMS deviation of the motion from its mean, px
+    float disoccluded = 0.0f;  // fraction of the frame uncovered across depth edges (depth-only)
+    bool any_motion = false;   // some surveyed motion is not zero
+};
+FramePredictors survey_predictors(const GBufferView& frame);
+
+// Candidates in the order reverse, splat, grid (warp) x none, pullpush, andreev (fill).
+inline constexpr int kAutoCandidates = 9;
+WarpMethod auto_candidate_warp(int candidate);
+FillMethod auto_candidate_fill(int candidate);
+const char* auto_candidate_name(int candidate);  // "grid+pullpush"
+
+// The models at `distance` input periods from the nearer input frame (interpolation) or
+// beyond it (extrapolation): expected PSNR (dB) and cost (ns per pixel) of a candidate.
+struct AutoPrediction {
+    std::array<float, kAutoCandidates> psnr{};
+    std::array<float, kAutoCandidates> cost{};
+};
+AutoPrediction predict_candidates(const FramePredictors& p, float distance, FrucMode mode);
+
+// The candidate chosen for `prediction` among those `options` allows (fixed warp or fill).
+int choose_candidate(const AutoPrediction& prediction, WarpMethod warp, FillMethod fill,
+                     const AutoOptions& options);
 
 // Motion refinement of interpolation: rendered motion is the motion of surfaces, not of what is
 // seen on them (moving shadows, reflections, highlights). Where the two sides of an in-between
@@ -54,6 +96,11 @@ struct FrucOptions {
     // frame follows its own backward motion negated, both sides linearly.
     bool true_motion = true;
     RefineOptions refine;
+    // The UI layer (Frame::ui): a made frame takes the UI of the nearest input (the later one at
+    // equal distance), never warped. Off: kept in the made frame's ui channels; on: drawn over
+    // the colour of every output (inputs too), which then carries no ui channels.
+    bool composite_ui = false;
+    AutoOptions auto_choice;  // warp or fill Auto
 };
 
 // What was done and what was left out because the frame did not need it.
@@ -77,6 +124,11 @@ struct FrucCounters {
     std::size_t flow_pixels = 0;      // pixels the flow was estimated on (boxes around the tiles)
     std::size_t refined_pixels = 0;   // pixels that took the flow's colour
     double refine_ms = 0.0;           // time in the survey and the refinement
+    std::size_t ui_frames = 0;        // made frames given the nearest input's UI layer
+    // Auto choice, per candidate (auto_candidate_name): frames it was chosen for, and frames it
+    // was left out of although expected to score higher than the choice (too costly for it).
+    std::array<std::size_t, kAutoCandidates> auto_chosen{};
+    std::array<std::size_t, kAutoCandidates> auto_left_out{};
 };
 
 // The camera between or beyond two instants: view matrices blended as rigid motions (rotation

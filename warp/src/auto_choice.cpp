@@ -1,0 +1,184 @@
+// `--warp auto --fill auto`: error and cost models per candidate setting, in the manner of
+// Sitthi-amorn et al. 2008 (error saturating exponentially with how far a value is reused, cost
+// linear in the work), evaluated at run time on predictors surveyed before warping.
+#include <algorithm>
+#include <cmath>
+
+#include "reprise/warp/fruc.hpp"
+
+namespace reprise::warp {
+
+namespace {
+
+constexpr int kStep = 8;  // the survey: every 8th pixel of every 8th row
+
+// The reference setting (grid+pullpush) has Sitthi-amorn's saturating error: mean squared error
+// of display values at warp distance t (input periods)
+//   floor + alpha (1 - exp(-lambda v)) + beta sigma + kappa d,
+// v = motion t, sigma = spread t, d = disoccluded t (FramePredictors). Every candidate's PSNR
+// differs from the reference's by delta . (1, v, sigma, d); a candidate without fill also leaves
+// its holes black, about 0.25 d of squared error more. Costs in ns per pixel: [warp][fill], the
+// warp alone under fill none. Fitted by scripts/fit_auto.py to a `reprise bench fruc` run
+// (640x360, x2, 18 frames of pan, fence, crossing, specular, fast; docs/benchmarks.md).
+struct ErrorModel {
+    float floor, alpha, lambda, beta, kappa;
+};
+struct Model {
+    ErrorModel reference;
+    float delta[kAutoCandidates][4];
+    float cost[3][3];
+};
+
+// [mode] interpolate, extrapolate
+constexpr Model kModels[2] = {
+    // interpolate
+    {{1.000e-06f, 5.133e-06f, 0.010f, 0.000e+00f, 4.726e-02f},
+     {{-0.2807f, -3.8500f, 3.3938f, 0.0000f},
+      {-0.3549f, -4.2697f, 3.8679f, -30.0838f},
+      {-0.3576f, -4.3134f, 3.9236f, -39.3989f},
+      {-6.8872f, -5.5213f, 5.2639f, 0.0000f},
+      {-7.0015f, -6.6592f, 6.6162f, -165.7726f},
+      {-7.0050f, -6.6965f, 6.6643f, -173.4101f},
+      {-0.0037f, 0.1476f, -0.1502f, 0.0000f},
+      {0.0000f, 0.0000f, 0.0000f, 0.0000f},
+      {-0.0008f, -0.0099f, 0.0095f, -0.2747f}},
+     {{474.4f, 474.4f, 478.7f}, {189.1f, 189.1f, 227.6f}, {173.6f, 173.6f, 190.8f}}},
+    // extrapolate
+    {{1.000e-06f, 0.000e+00f, 0.010f, 0.000e+00f, 8.402e-02f},
+     {{-7.9086f, -3.8725f, 3.6157f, 0.0000f},
+      {1.2329f, -1.3519f, 1.4633f, -200.8446f},
+      {1.2800f, -1.6163f, 1.7114f, -209.6012f},
+      {-9.1160f, -4.9042f, 4.5932f, 0.0000f},
+      {-4.0071f, -6.1485f, 5.8470f, -120.9871f},
+      {-3.9960f, -6.3280f, 6.0150f, -125.5178f},
+      {-9.9594f, -1.2611f, 1.4581f, 0.0000f},
+      {0.0000f, 0.0000f, 0.0000f, 0.0000f},
+      {0.2602f, 0.5462f, -0.4428f, -26.5471f}},
+     {{226.9f, 245.5f, 244.4f}, {114.1f, 145.0f, 140.7f}, {107.6f, 107.6f, 118.9f}}},
+};
+
+constexpr float kBlackHoleError = 0.25f;
+
+constexpr const char* kNames[kAutoCandidates] = {
+    "reverse+none",  "reverse+pullpush", "reverse+andreev", "splat+none",  "splat+pullpush",
+    "splat+andreev", "grid+none",        "grid+pullpush",   "grid+andreev"};
+
+bool depth_edge(float z1, float z2) {
+    const bool f1 = std::isfinite(z1), f2 = std::isfinite(z2);
+    if (f1 != f2) return true;
+    if (!f1) return false;
+    return std::max(z1, z2) > 1.1f * std::min(z1, z2);
+}
+
+}  // namespace
+
+WarpMethod auto_candidate_warp(int candidate) {
+    constexpr WarpMethod warps[3] = {WarpMethod::Reverse, WarpMethod::Splat, WarpMethod::Grid};
+    return warps[candidate / 3];
+}
+
+FillMethod auto_candidate_fill(int candidate) {
+    constexpr FillMethod fills[3] = {FillMethod::None, FillMethod::PullPush, FillMethod::Andreev};
+    return fills[candidate % 3];
+}
+
+const char* auto_candidate_name(int candidate) { return kNames[candidate]; }
+
+FramePredictors survey_predictors(const GBufferView& f) {
+    FramePredictors p;
+    const int w = f.motion.width, h = f.motion.height;
+    if (f.motion.empty()) return p;
+    double sum_length = 0.0, gaps = 0.0;
+    glm::dvec2 sum(0.0);
+    double sum_squares = 0.0;
+    std::size_t count = 0;
+    const bool depth = !f.depth.empty();
+    for (int y = kStep / 2; y < h; y += kStep)
+        for (int x = kStep / 2; x < w; x += kStep) {
+            const glm::vec2 m = f.motion(x, y);
+            if (!std::isfinite(m.x) || !std::isfinite(m.y)) continue;
+            p.any_motion |= m.x != 0.0f || m.y != 0.0f;
+            sum_length += glm::length(m);
+            sum += glm::dvec2(m);
+            sum_squares += double(m.x) * m.x + double(m.y) * m.y;
+            ++count;
+            if (!depth) continue;
+            // A depth edge to the right (below) opens or closes a gap as wide as the motions
+            // differ across it, over the kStep rows (columns) the pair stands for.
+            for (int axis = 0; axis < 2; ++axis) {
+                const int qx = x + (axis == 0 ? kStep : 0), qy = y + (axis == 1 ? kStep : 0);
+                if (qx >= w || qy >= h) continue;
+                const glm::vec2 n = f.motion(qx, qy);
+                if (!std::isfinite(n.x) || !std::isfinite(n.y)) continue;
+                if (depth_edge(f.depth(x, y), f.depth(qx, qy)))
+                    gaps += double(std::abs(m[axis] - n[axis])) * kStep;
+            }
+        }
+    if (count == 0) return p;
+    const double n = double(count);
+    const glm::dvec2 mean = sum / n;
+    p.motion = float(sum_length / n);
+    p.spread = float(std::sqrt(std::max(0.0, sum_squares / n - glm::dot(mean, mean))));
+    // Half the edges open, the other half close.
+    p.disoccluded = float(std::min(1.0, 0.5 * gaps / (n * kStep * kStep)));
+    return p;
+}
+
+AutoPrediction predict_candidates(const FramePredictors& p, float distance, FrucMode mode) {
+    const Model& model = kModels[mode == FrucMode::Interpolate ? 0 : 1];
+    const float v = p.motion * distance, sigma = p.spread * distance;
+    const float d = std::min(1.0f, p.disoccluded * distance);
+    const ErrorModel& e = model.reference;
+    const float mse =
+        e.floor + e.alpha * (1.0f - std::exp(-e.lambda * v)) + e.beta * sigma + e.kappa * d;
+    const float reference = -10.0f * std::log10(std::max(mse, 1e-10f));
+    AutoPrediction out;
+    for (int c = 0; c < kAutoCandidates; ++c) {
+        const int warp = c / 3, fill = c % 3;
+        const float* k = model.delta[c];
+        float psnr = reference + k[0] + k[1] * v + k[2] * sigma + k[3] * d;
+        if (fill == 0 && d > 0.0f) {
+            const float candidate_mse = std::pow(10.0f, -psnr / 10.0f);
+            psnr = -10.0f * std::log10(candidate_mse + kBlackHoleError * d);
+        }
+        out.psnr[c] = psnr;
+        if (fill == 1 && d == 0.0f) {
+            // No hole expected: fill none is not preferred over pull-push (which would not run),
+            // in case the sparse survey missed one.
+            out.psnr[c - 1] = std::min(out.psnr[c - 1], psnr);
+        }
+        // A fill runs only on a frame with holes.
+        out.cost[c] = model.cost[warp][d > 0.0f ? fill : 0];
+    }
+    return out;
+}
+
+int choose_candidate(const AutoPrediction& prediction, WarpMethod warp, FillMethod fill,
+                     const AutoOptions& options) {
+    auto allowed = [&](int c) {
+        return (warp == WarpMethod::Auto || auto_candidate_warp(c) == warp) &&
+               (fill == FillMethod::Auto || auto_candidate_fill(c) == fill);
+    };
+    float best = -INFINITY;
+    for (int c = 0; c < kAutoCandidates; ++c)
+        if (allowed(c)) best = std::max(best, prediction.psnr[c]);
+    const float target =
+        options.budget_db > 0.0f ? std::min(options.budget_db, best) : best - options.slack_db;
+    // Equal cost and error (no holes expected: a fill would not run): a fill is kept, in case
+    // the sparse survey missed a hole, pull-push first.
+    constexpr int kFillPreference[3] = {0, 2, 1};  // none, pullpush, andreev
+    int chosen = -1;
+    for (int c = 0; c < kAutoCandidates; ++c) {
+        if (!allowed(c) || prediction.psnr[c] < target) continue;
+        const bool better = chosen < 0 || prediction.cost[c] < prediction.cost[chosen] ||
+                            (prediction.cost[c] == prediction.cost[chosen] &&
+                             (prediction.psnr[c] > prediction.psnr[chosen] ||
+                              (prediction.psnr[c] == prediction.psnr[chosen] &&
+                               kFillPreference[c % 3] > kFillPreference[chosen % 3])));
+        if (better) chosen = c;
+    }
+    REPRISE_ASSERT(chosen >= 0);
+    return chosen;
+}
+
+}  // namespace reprise::warp
