@@ -29,34 +29,43 @@ bool motion_is_zero(const GBufferView& f) {
     return true;
 }
 
-namespace {
-
 // Reverse warp: the splat placed, at each covered pixel q, the source pixel p that lands there;
 // refine p = q - factor * motion(p) with the source's own (bilinear) motion and fetch colour
-// bilinearly there. Taps are not depth-tested: across silhouettes the blend measured closer to the
-// rendered truth than keeping either surface.
+// bicubically there. Taps are not depth-tested: across silhouettes the blend measured closer to
+// the rendered truth than keeping either surface.
+void refetch_row_reference(const RefetchRow& r, int x_begin, int x_end) {
+    const int sw = r.color.width, sh = r.color.height;
+    for (int x = x_begin; x < x_end; ++x) {
+        if (!r.covered[x]) continue;
+        const glm::vec2 q(float(x) + 0.5f, float(r.y) + 0.5f);
+        glm::vec2 p = q - r.factor * r.target_motion[x];
+        const Bilinear b = bilinear_taps(p.x, p.y, sw, sh);
+        if (!b.inside) continue;
+        const glm::vec2 m = bilinear_fetch(r.motion, b);
+        if (!std::isfinite(m.x) || !std::isfinite(m.y)) continue;
+        p = q - r.factor * m;
+        if (!(p.x >= 0.0f && p.y >= 0.0f && p.x <= float(sw) && p.y <= float(sh))) continue;
+        const glm::vec4 c = bicubic_fetch(r.color, p.x, p.y);
+        if (std::isfinite(c.r + c.g + c.b + c.a)) r.out[x] = c;
+    }
+}
+
+namespace {
+
 void refetch(const GBufferView& source, float factor, const WarpTarget& out) {
-    const int w = out.color.width, h = out.color.height;
-    const float sw = float(source.width()), sh = float(source.height());
-    parallel_for(0, h, [&](int y0, int y1) {
-        for (int y = y0; y < y1; ++y) {
-            const uint8_t* covered = out.covered.row(y);
-            const glm::vec2* motion = out.motion.row(y);
-            glm::vec4* color = out.color.row(y);
-            for (int x = 0; x < w; ++x) {
-                if (!covered[x]) continue;
-                glm::vec2 q(x + 0.5f, y + 0.5f);
-                glm::vec2 p = q - factor * motion[x];
-                Bilinear b = bilinear_taps(p.x, p.y, source.width(), source.height());
-                if (!b.inside) continue;
-                glm::vec2 m = bilinear_fetch(source.motion, b);
-                if (!std::isfinite(m.x) || !std::isfinite(m.y)) continue;
-                p = q - factor * m;
-                if (!(p.x >= 0.0f && p.y >= 0.0f && p.x <= sw && p.y <= sh)) continue;  // outside
-                glm::vec4 c = bicubic_fetch(source.color, p.x, p.y);
-                if (std::isfinite(c.r + c.g + c.b + c.a)) color[x] = c;
-            }
-        }
+    REPRISE_ASSERT(source.motion.width == source.width() &&
+                   source.motion.height == source.height());
+    REPRISE_ASSERT(double(source.width()) * source.height() < double(1 << 30));
+    parallel_for(0, out.color.height, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y)
+            refetch_row({.color = source.color,
+                         .motion = source.motion,
+                         .factor = factor,
+                         .y = y,
+                         .width = out.color.width,
+                         .covered = out.covered.row(y),
+                         .target_motion = out.motion.row(y),
+                         .out = out.color.row(y)});
     });
 }
 
