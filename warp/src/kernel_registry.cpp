@@ -546,6 +546,66 @@ private:
     ReprojectCounts optimized_, reference_;
 };
 
+class DisplacementCase final : public KernelCase {
+public:
+    void generate(int w, int h, KernelInputs inputs, uint32_t seed) override {
+        std::mt19937 rng(seed);
+        width_ = w, height_ = h;
+        const bool worst = inputs == KernelInputs::WorstCase;
+        // An eye a few centimetres aside; worst case: a target far ahead, so near points are
+        // behind it.
+        const Camera c = random_camera(rng, w, h, seed % 3 == 2, 1.0f);
+        const glm::mat4 target_view =
+            glm::translate(c.view, worst ? glm::vec3(0.3f, 0.0f, 30.0f)
+                                         : glm::vec3(uniform(rng, -0.1f, 0.1f), 0.0f, 0.0f));
+        test_.emplace(StaticReprojection(c, target_view, c.projection, w, h), w, h);
+        depth_.resize(std::size_t(w) * std::size_t(h));
+        for (float& z : depth_) {
+            z = rng() % 10 == 0 ? kInf : uniform(rng, 0.2f, 60.0f);
+            if (worst && rng() % 3 == 0)
+                z = rng() % 2 ? worst_value(rng) : -uniform(rng, 0.1f, 10.0f);
+        }
+    }
+    void run_reference() override {
+        run_into(reference_, [](const DisplacementTest& t, int y, int width, const float* d,
+                                glm::vec2* out, float* out_depth) {
+            displacement_row_reference(t, y, 0, width, d, out, out_depth);
+        });
+    }
+    void run() override { run_into(optimized_, displacement_row); }
+    std::string compare() const override {
+        std::string d =
+            compare_bits("displacement", optimized_.displacement, reference_.displacement);
+        if (d.empty()) d = compare_bits("target depth", optimized_.depth, reference_.depth);
+        return d;
+    }
+
+private:
+    struct Output {
+        std::vector<glm::vec2> displacement;
+        std::vector<float> depth;
+    };
+    template <class Kernel>
+    void run_into(Output& out, Kernel kernel) {
+        out.displacement.resize(depth_.size()), out.depth.resize(depth_.size());
+        const int w = width_;
+        parallel_for(0, height_, [&](int y0, int y1) {
+            for (int y = y0; y < y1; ++y) {
+                const std::size_t o = std::size_t(y) * std::size_t(w);
+                kernel(*test_, y, w, depth_.data() + o, out.displacement.data() + o,
+                       out.depth.data() + o);
+            }
+        });
+    }
+
+    int width_ = 0, height_ = 0;
+    std::optional<DisplacementTest> test_;
+    std::vector<float> depth_;
+    Output reference_, optimized_;
+};
+
+// ---------------------------------------------------------------------------------------------
+
 class RefetchCase final : public KernelCase {
 public:
     void generate(int w, int h, KernelInputs inputs, uint32_t seed) override {
@@ -629,6 +689,7 @@ constexpr KernelEntry kEntries[] = {
     {"pull-push coarser pull", "bit-exact", true, make<PullLevelCase>},
     {"reverse reprojection", "bit-exact", true, make<ReprojectCase>},
     {"reverse warp refetch", "bit-exact", true, make<RefetchCase>},
+    {"stereo displacement", "bit-exact", true, make<DisplacementCase>},
 };
 
 }  // namespace

@@ -76,6 +76,23 @@ struct RefetchRow {
 void refetch_row_reference(const RefetchRow& row, int x_begin, int x_end);
 void refetch_row(const RefetchRow& row);
 
+// The displacement of each pixel to a target camera for a projection without x/y coupling
+// (camera_displacement, displacement.cpp): its landing in the target minus the pixel and its
+// depth there (+inf for background); NaN where the depth is NaN or negative or the point lands
+// behind the target.
+struct DisplacementTest {
+    glm::mat4 projection, to_clip, to_view;  // P; view -> target clip; view -> target view
+    float background_zv, background_w;       // the view point of depth +inf
+    float width, height;                     // image size in pixels
+
+    DisplacementTest(const StaticReprojection& to_target, int image_width, int image_height);
+};
+// Row y; the reference does pixels [x_begin, x_end).
+void displacement_row_reference(const DisplacementTest& test, int y, int x_begin, int x_end,
+                                const float* depth, glm::vec2* displacement, float* target_depth);
+void displacement_row(const DisplacementTest& test, int y, int width, const float* depth,
+                      glm::vec2* displacement, float* target_depth);
+
 }  // namespace reprise::warp
 
 namespace reprise::warp {

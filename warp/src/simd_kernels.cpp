@@ -256,6 +256,53 @@ std::size_t PullLevelRowSimd(const PullLevelRow& r) {
 #endif
 }
 
+void DisplacementRowSimd(const DisplacementTest& t, int y, int width, const float* depth,
+                         glm::vec2* displacement, float* target_depth) {
+    const hn::ScalableTag<float> df;
+    using VF = hn::Vec<decltype(df)>;
+    const int n = int(hn::Lanes(df));
+    const glm::mat4& P = t.projection;
+    const glm::mat4& M = t.to_clip;
+    const glm::mat4& V = t.to_view;
+    auto splat = [&](float v) { return hn::Set(df, v); };
+    const VF half = splat(0.5f), one = splat(1.0f), two = splat(2.0f), zero = hn::Zero(df);
+    const VF inf = splat(std::numeric_limits<float>::infinity());
+    const VF nan = splat(std::numeric_limits<float>::quiet_NaN());
+    const VF fw = splat(t.width), fh = splat(t.height);
+    const VF background_zv = splat(t.background_zv), background_w = splat(t.background_w);
+    const float py_scalar = float(y) + 0.5f;
+    const VF py = splat(py_scalar), ny = splat(1.0f - 2.0f * py_scalar / t.height);
+    const VF lanes = hn::Iota(df, 0.0f);
+    // Row r of A times (vx, vy, zv, w), summed as transform_row does.
+    auto row = [&](const glm::mat4& A, int r, VF vx, VF vy, VF zv, VF w) {
+        return (splat(A[0][r]) * vx + splat(A[1][r]) * vy) +
+               (splat(A[2][r]) * zv + splat(A[3][r]) * w);
+    };
+    int x = 0;
+    for (; x + n <= width; x += n) {
+        const VF z = hn::LoadU(df, depth + x);
+        const VF px = (splat(float(x)) + lanes) + half;
+        const VF nx = two * px / fw - one;
+        const auto background = z == inf;
+        const VF zv = hn::IfThenElse(background, background_zv, hn::Neg(z));
+        const VF w = hn::IfThenElse(background, background_w, one);
+        const VF wc = splat(P[2][3]) * zv + splat(P[3][3]) * w;
+        const VF vx = (nx * wc - splat(P[2][0]) * zv - splat(P[3][0]) * w) / splat(P[0][0]);
+        const VF vy = (ny * wc - splat(P[2][1]) * zv - splat(P[3][1]) * w) / splat(P[1][1]);
+        const VF cw = row(M, 3, vx, vy, zv, w);
+        const VF lx = (row(M, 0, vx, vy, zv, w) / cw * half + half) * fw;
+        const VF ly = (half - half * row(M, 1, vx, vy, zv, w) / cw) * fh;
+        const VF tz = hn::Neg(row(V, 2, vx, vy, zv, w));
+        const auto ok =
+            hn::And(hn::And(z >= zero, cw > zero), hn::And((lx - lx) == zero, (ly - ly) == zero));
+        hn::StoreInterleaved2(hn::IfThenElse(ok, lx - px, nan), hn::IfThenElse(ok, ly - py, nan),
+                              df, &displacement[x].x);
+        hn::StoreU(hn::IfThenElse(ok, hn::IfThenElse(background, inf, tz), nan), df,
+                   target_depth + x);
+    }
+    if (x < width) displacement_row_reference(t, y, x, width, depth, displacement, target_depth);
+}
+
 // Positions, taps and weights in vector lanes; each pixel's 16 bicubic taps four channels a lane
 // (as bicubic_fetch sums them). Pixels whose bicubic taps reach past the border go to the
 // reference one by one.
@@ -380,6 +427,12 @@ HWY_EXPORT(StaticLayerRowSimd);
 HWY_EXPORT(PullRowSimd);
 HWY_EXPORT(PullLevelRowSimd);
 HWY_EXPORT(RefetchRowSimd);
+HWY_EXPORT(DisplacementRowSimd);
+
+void displacement_row(const DisplacementTest& test, int y, int width, const float* depth,
+                      glm::vec2* displacement, float* target_depth) {
+    HWY_DYNAMIC_DISPATCH(DisplacementRowSimd)(test, y, width, depth, displacement, target_depth);
+}
 
 void refetch_row(const RefetchRow& row) { HWY_DYNAMIC_DISPATCH(RefetchRowSimd)(row); }
 
