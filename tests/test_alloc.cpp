@@ -125,10 +125,10 @@ Frame make_frame(int index) {
     return f;
 }
 
-void run_converter(warp::FrucMode mode) {
+void run_converter(warp::FrucMode mode, warp::WarpMethod method = warp::WarpMethod::Grid) {
     std::vector<Frame> inputs;
     for (int i = 0; i < 12; ++i) inputs.push_back(make_frame(i));
-    warp::FrameRateConverter converter(2, {.mode = mode});
+    warp::FrameRateConverter converter(2, {.mode = mode, .warp = method});
     Frame out;
     bool ok = true;
     int made = 0;
@@ -160,6 +160,10 @@ TEST(Allocations, CounterSeesAnAllocation) {
 
 TEST(Allocations, InterpolationSteadyStateAllocatesNothing) {
     run_converter(warp::FrucMode::Interpolate);
+}
+
+TEST(Allocations, ReverseWarpInterpolationSteadyStateAllocatesNothing) {
+    run_converter(warp::FrucMode::Interpolate, warp::WarpMethod::Reverse);
 }
 
 TEST(Allocations, ExtrapolationSteadyStateAllocatesNothing) {

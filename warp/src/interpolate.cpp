@@ -4,6 +4,7 @@
 #include <limits>
 #include <utility>
 
+#include "band.hpp"
 #include "fruc_stages.hpp"
 #include "kernels.hpp"
 #include "reprise/core/parallel.hpp"
@@ -52,21 +53,24 @@ void refetch_row_reference(const RefetchRow& r, int x_begin, int x_end) {
 
 namespace {
 
-void refetch(const GBufferView& source, float factor, const WarpTarget& out) {
-    REPRISE_ASSERT(source.motion.width == source.width() &&
-                   source.motion.height == source.height());
-    REPRISE_ASSERT(double(source.width()) * source.height() < double(1 << 30));
-    parallel_for(0, out.color.height, [&](int y0, int y1) {
-        for (int y = y0; y < y1; ++y)
-            refetch_row({.color = source.color,
-                         .motion = source.motion,
-                         .factor = factor,
-                         .y = y,
-                         .width = out.color.width,
-                         .covered = out.covered.row(y),
-                         .target_motion = out.motion.row(y),
-                         .out = out.color.row(y)});
-    });
+struct Refetch {
+    const GBufferView& source;
+    float factor;
+};
+
+// The refetch of a band of the splat's target while it is in cache.
+void refetch_band(const Band& band, const void* context) {
+    const Refetch& r = *static_cast<const Refetch*>(context);
+    const WarpTarget& v = band.view;
+    for (int row = 0; row < v.color.height; ++row)
+        refetch_row({.color = r.source.color,
+                     .motion = r.source.motion,
+                     .factor = r.factor,
+                     .y = band.y0 + row,
+                     .width = v.color.width,
+                     .covered = v.covered.row(row),
+                     .target_motion = v.motion.row(row),
+                     .out = v.color.row(row)});
 }
 
 }  // namespace
@@ -82,9 +86,12 @@ std::size_t warp_into(const GBufferView& source, float factor, const FrucOptions
         case WarpMethod::Splat:
             return splat(source, factor, out, options.splat);
         case WarpMethod::Reverse: {
-            const std::size_t covered = splat(source, factor, out, {.footprint = 2});
-            refetch(source, factor, out);
-            return covered;
+            REPRISE_ASSERT(!out.motion.empty());
+            REPRISE_ASSERT(source.motion.width == source.width() &&
+                           source.motion.height == source.height());
+            REPRISE_ASSERT(double(source.width()) * source.height() < double(1 << 30));
+            const Refetch refetch{source, factor};
+            return splat_refined(source, factor, out, {.footprint = 2}, refetch_band, &refetch);
         }
     }
     return 0;
