@@ -130,10 +130,11 @@ Frame make_frame(int index, bool smooth = false) {
 
 // Motion refinement's optical flow (OpenCV DIS) allocates inside OpenCV: `refine` runs it on
 // smooth frames, where its survey finds the sides agreeing and nothing more runs.
-void run_converter(warp::FrucMode mode, bool refine = false) {
+void run_converter(warp::FrucMode mode, bool refine = false,
+                   warp::WarpMethod method = warp::WarpMethod::Grid) {
     std::vector<Frame> inputs;
     for (int i = 0; i < 12; ++i) inputs.push_back(make_frame(i, refine));
-    warp::FrucOptions options{.mode = mode};
+    warp::FrucOptions options{.mode = mode, .warp = method};
     options.refine.enabled = refine;
     warp::FrameRateConverter converter(2, options);
     Frame out;
@@ -175,6 +176,10 @@ TEST(Allocations, InterpolationSteadyStateAllocatesNothing) {
 
 TEST(Allocations, InterpolationSurveyForRefinementAllocatesNothing) {
     run_converter(warp::FrucMode::Interpolate, true);
+}
+
+TEST(Allocations, ReverseWarpInterpolationSteadyStateAllocatesNothing) {
+    run_converter(warp::FrucMode::Interpolate, false, warp::WarpMethod::Reverse);
 }
 
 TEST(Allocations, ExtrapolationSteadyStateAllocatesNothing) {

@@ -8,6 +8,7 @@
 #include <limits>
 #include <random>
 
+#include "reprise/core/simd.hpp"
 #include "reprise/warp/grid_warp.hpp"
 #include "support/frames.hpp"
 #include "support/warp.hpp"
@@ -340,6 +341,37 @@ TEST(GridWarp, ThreadedEqualsReferenceOnRandomFrames) {
                     g, factor, out,
                     {.depth_threshold = threshold * 0.04f, .motion_threshold = threshold});
             }
+    }
+}
+
+TEST(GridWarp, EverySimdLevelEqualsReference) {
+    struct Restore {
+        ~Restore() { simd::force_target(0); }
+    } restore;
+    std::mt19937 rng(5);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    for (const simd::Target& target : simd::available_targets()) {
+        simd::force_target(target.bits);
+        SCOPED_TRACE(target.name);
+        for (auto [w, h] : {std::pair{67, 45}, std::pair{133, 71}})
+            for (int trial = 0; trial < 3; ++trial) {
+                Frame f = trial < 2 ? scene_frame(w, h, {1.5f * trial, -0.5f}, uint32_t(trial))
+                                    : flat_frame(w, h, 1.0f, {0, 0}, uint32_t(trial + w));
+                if (trial == 2)
+                    for (int y = 0; y < h; ++y)
+                        for (int x = 0; x < w; ++x) {
+                            f.depth(x, y) = u(rng) < 0.1f ? kInf : 1.0f + float(int(u(rng) * 4));
+                            f.motion(x, y) = {(u(rng) - 0.5f) * 12.0f, (u(rng) - 0.5f) * 12.0f};
+                        }
+                for (float factor : {-0.5f, 1.0f})
+                    for (int cell : {8, 32}) {
+                        Output out(w, h);
+                        (void)warp_both(f, factor, out, {.cell = cell});
+                    }
+            }
+        Frame g = ground_frame(130, 67);
+        Output out(130, 67);
+        (void)warp_both(g, 0.37f, out);
     }
 }
 

@@ -23,6 +23,12 @@ ImageView<T> scratch_rows(std::vector<T>& pixels, int width, int rows) {
     return {pixels.data(), width, rows, width};
 }
 
+// splat() that calls refine(band, context) on each band of the target after drawing it and
+// before writing it out (its `covered` then non-zero where something landed).
+using BandRefine = void (*)(const Band& band, const void* context);
+std::size_t splat_refined(const GBufferView& source, float factor, const WarpTarget& target,
+                          const SplatOptions& options, BandRefine refine, const void* context);
+
 // Depth +inf, nothing covered.
 void clear_band(const Band& band);
 // In place: covered becomes 0/1, depths at or beyond `background_from` +inf, colour and motion

@@ -168,8 +168,8 @@ Scratch& thread_scratch() {
 
 }  // namespace
 
-std::size_t splat(const GBufferView& source, float factor, const WarpTarget& target,
-                  const SplatOptions& options) {
+std::size_t splat_refined(const GBufferView& source, float factor, const WarpTarget& target,
+                          const SplatOptions& options, BandRefine refine, const void* context) {
     const Scatter scatter = make_scatter(source, factor, target, options);
     if (target.color.empty()) return 0;
     const int sh = source.height(), width = target.color.width, height = target.color.height;
@@ -205,6 +205,7 @@ std::size_t splat(const GBufferView& source, float factor, const WarpTarget& tar
                     for (int y = 0; y < sh; ++y)
                         if (range[2 * y] < y0 + rows && range[2 * y + 1] >= y0)
                             scatter.offer_row(y, band);
+                    if (refine) refine(band, context);
                     n += copy_band(band, target, kInf);
                 }
                 covered += n;
@@ -212,6 +213,11 @@ std::size_t splat(const GBufferView& source, float factor, const WarpTarget& tar
         },
         1);
     return covered;
+}
+
+std::size_t splat(const GBufferView& source, float factor, const WarpTarget& target,
+                  const SplatOptions& options) {
+    return splat_refined(source, factor, target, options, nullptr, nullptr);
 }
 
 std::size_t splat_reference(const GBufferView& source, float factor, const WarpTarget& target,

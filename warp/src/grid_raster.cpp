@@ -1,6 +1,7 @@
 // Rasterising grid cells: two triangles per cell, integer edge functions on 1/256-px vertices,
 // attributes (depth, source position, motion) interpolated linearly, a depth test, and a
-// bilinear colour lookup in the source.
+// bilinear colour lookup in the source. Compiled once per Highway target and chosen at run time:
+// from AVX2 on, the colour of two pixels is fetched a 256-bit vector at a time (same bits).
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -10,9 +11,16 @@
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
+#include <immintrin.h>
 #endif
 
-namespace reprise::warp::grid {
+#undef HWY_TARGET_INCLUDE
+#define HWY_TARGET_INCLUDE "grid_raster.cpp"
+#include <hwy/foreach_target.h>  // IWYU pragma: keep
+#include <hwy/highway.h>
+
+HWY_BEFORE_NAMESPACE();
+namespace reprise::warp::grid::HWY_NAMESPACE {
 
 namespace {
 
@@ -339,6 +347,35 @@ private:
                 _mm_storeu_ps(&color[k + i].x,
                               _mm_add_ps(top, _mm_mul_ps(_mm_sub_ps(bottom, top), wy)));
             };
+#if HWY_TARGET <= HWY_AVX2
+            // Two pixels a 256-bit vector when every right tap is the next pixel: its top and
+            // bottom taps are one 32-byte load each.
+            if (mask == 0xf &&
+                _mm_movemask_ps(_mm_castsi128_ps(_mm_cmplt_epi32(x0, v.last_column))) == 0xf) {
+                auto pair = [&](int i, __m128 wx_i, __m128 wx_j, __m128 wy_i, __m128 wy_j) {
+                    const float* top_i = &source[offsets[i]].x;
+                    const float* top_j = &source[offsets[i + 1]].x;
+                    const __m256 t0 = _mm256_loadu_ps(top_i), t1 = _mm256_loadu_ps(top_j);
+                    const __m256 b0 = _mm256_loadu_ps(top_i + 4 * below[i]);
+                    const __m256 b1 = _mm256_loadu_ps(top_j + 4 * below[i + 1]);
+                    const __m256 a = _mm256_permute2f128_ps(t0, t1, 0x20);
+                    const __m256 b = _mm256_permute2f128_ps(t0, t1, 0x31);
+                    const __m256 c = _mm256_permute2f128_ps(b0, b1, 0x20);
+                    const __m256 e = _mm256_permute2f128_ps(b0, b1, 0x31);
+                    const __m256 wx = _mm256_set_m128(wx_j, wx_i), wy = _mm256_set_m128(wy_j, wy_i);
+                    const __m256 top = _mm256_add_ps(a, _mm256_mul_ps(_mm256_sub_ps(b, a), wx));
+                    const __m256 bottom = _mm256_add_ps(c, _mm256_mul_ps(_mm256_sub_ps(e, c), wx));
+                    _mm256_storeu_ps(
+                        &color[k + i].x,
+                        _mm256_add_ps(top, _mm256_mul_ps(_mm256_sub_ps(bottom, top), wy)));
+                };
+                pair(0, _mm_shuffle_ps(wx4, wx4, 0x00), _mm_shuffle_ps(wx4, wx4, 0x55),
+                     _mm_shuffle_ps(wy4, wy4, 0x00), _mm_shuffle_ps(wy4, wy4, 0x55));
+                pair(2, _mm_shuffle_ps(wx4, wx4, 0xaa), _mm_shuffle_ps(wx4, wx4, 0xff),
+                     _mm_shuffle_ps(wy4, wy4, 0xaa), _mm_shuffle_ps(wy4, wy4, 0xff));
+                continue;
+            }
+#endif
             if (mask == 0xf) {  // the common case, without bookkeeping
                 fetch(0, _mm_shuffle_ps(wx4, wx4, 0x00), _mm_shuffle_ps(wy4, wy4, 0x00));
                 fetch(1, _mm_shuffle_ps(wx4, wx4, 0x55), _mm_shuffle_ps(wy4, wy4, 0x55));
@@ -365,7 +402,7 @@ private:
 
 }  // namespace
 
-void draw_cell(ImageView<const glm::vec4> source, const Cell& c, const Band& band, bool simd) {
+void DrawCellSimd(ImageView<const glm::vec4> source, const Cell& c, const Band& band, bool simd) {
     int lo = c.v[0].y, hi = c.v[0].y;
     for (const Vertex& v : c.v) {
         lo = std::min(lo, v.y);
@@ -377,4 +414,17 @@ void draw_cell(ImageView<const glm::vec4> source, const Cell& c, const Band& ban
     Raster(source, band, simd).cell(c);
 }
 
+}  // namespace reprise::warp::grid::HWY_NAMESPACE
+HWY_AFTER_NAMESPACE();
+
+#if HWY_ONCE
+namespace reprise::warp::grid {
+
+HWY_EXPORT(DrawCellSimd);
+
+void draw_cell(ImageView<const glm::vec4> source, const Cell& c, const Band& band, bool simd) {
+    HWY_DYNAMIC_DISPATCH(DrawCellSimd)(source, c, band, simd);
+}
+
 }  // namespace reprise::warp::grid
+#endif

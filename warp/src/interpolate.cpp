@@ -4,6 +4,7 @@
 #include <limits>
 #include <utility>
 
+#include "band.hpp"
 #include "fruc_stages.hpp"
 #include "kernels.hpp"
 #include "reprise/core/parallel.hpp"
@@ -29,35 +30,47 @@ bool motion_is_zero(const GBufferView& f) {
     return true;
 }
 
-namespace {
-
 // Reverse warp: the splat placed, at each covered pixel q, the source pixel p that lands there;
 // refine p = q - factor * motion(p) with the source's own (bilinear) motion and fetch colour
-// bilinearly there. Taps are not depth-tested: across silhouettes the blend measured closer to the
-// rendered truth than keeping either surface.
-void refetch(const GBufferView& source, float factor, const WarpTarget& out) {
-    const int w = out.color.width, h = out.color.height;
-    const float sw = float(source.width()), sh = float(source.height());
-    parallel_for(0, h, [&](int y0, int y1) {
-        for (int y = y0; y < y1; ++y) {
-            const uint8_t* covered = out.covered.row(y);
-            const glm::vec2* motion = out.motion.row(y);
-            glm::vec4* color = out.color.row(y);
-            for (int x = 0; x < w; ++x) {
-                if (!covered[x]) continue;
-                glm::vec2 q(x + 0.5f, y + 0.5f);
-                glm::vec2 p = q - factor * motion[x];
-                Bilinear b = bilinear_taps(p.x, p.y, source.width(), source.height());
-                if (!b.inside) continue;
-                glm::vec2 m = bilinear_fetch(source.motion, b);
-                if (!std::isfinite(m.x) || !std::isfinite(m.y)) continue;
-                p = q - factor * m;
-                if (!(p.x >= 0.0f && p.y >= 0.0f && p.x <= sw && p.y <= sh)) continue;  // outside
-                glm::vec4 c = bicubic_fetch(source.color, p.x, p.y);
-                if (std::isfinite(c.r + c.g + c.b + c.a)) color[x] = c;
-            }
-        }
-    });
+// bicubically there. Taps are not depth-tested: across silhouettes the blend measured closer to
+// the rendered truth than keeping either surface.
+void refetch_row_reference(const RefetchRow& r, int x_begin, int x_end) {
+    const int sw = r.color.width, sh = r.color.height;
+    for (int x = x_begin; x < x_end; ++x) {
+        if (!r.covered[x]) continue;
+        const glm::vec2 q(float(x) + 0.5f, float(r.y) + 0.5f);
+        glm::vec2 p = q - r.factor * r.target_motion[x];
+        const Bilinear b = bilinear_taps(p.x, p.y, sw, sh);
+        if (!b.inside) continue;
+        const glm::vec2 m = bilinear_fetch(r.motion, b);
+        if (!std::isfinite(m.x) || !std::isfinite(m.y)) continue;
+        p = q - r.factor * m;
+        if (!(p.x >= 0.0f && p.y >= 0.0f && p.x <= float(sw) && p.y <= float(sh))) continue;
+        const glm::vec4 c = bicubic_fetch(r.color, p.x, p.y);
+        if (std::isfinite(c.r + c.g + c.b + c.a)) r.out[x] = c;
+    }
+}
+
+namespace {
+
+struct Refetch {
+    const GBufferView& source;
+    float factor;
+};
+
+// The refetch of a band of the splat's target while it is in cache.
+void refetch_band(const Band& band, const void* context) {
+    const Refetch& r = *static_cast<const Refetch*>(context);
+    const WarpTarget& v = band.view;
+    for (int row = 0; row < v.color.height; ++row)
+        refetch_row({.color = r.source.color,
+                     .motion = r.source.motion,
+                     .factor = r.factor,
+                     .y = band.y0 + row,
+                     .width = v.color.width,
+                     .covered = v.covered.row(row),
+                     .target_motion = v.motion.row(row),
+                     .out = v.color.row(row)});
 }
 
 }  // namespace
@@ -73,9 +86,12 @@ std::size_t warp_into(const GBufferView& source, float factor, const FrucOptions
         case WarpMethod::Splat:
             return splat(source, factor, out, options.splat);
         case WarpMethod::Reverse: {
-            const std::size_t covered = splat(source, factor, out, {.footprint = 2});
-            refetch(source, factor, out);
-            return covered;
+            REPRISE_ASSERT(!out.motion.empty());
+            REPRISE_ASSERT(source.motion.width == source.width() &&
+                           source.motion.height == source.height());
+            REPRISE_ASSERT(double(source.width()) * source.height() < double(1 << 30));
+            const Refetch refetch{source, factor};
+            return splat_refined(source, factor, out, {.footprint = 2}, refetch_band, &refetch);
         }
         case WarpMethod::Auto:  // resolved per frame by the converter
             REPRISE_ASSERT(options.warp != WarpMethod::Auto);

@@ -546,6 +546,137 @@ private:
     ReprojectCounts optimized_, reference_;
 };
 
+class DisplacementCase final : public KernelCase {
+public:
+    void generate(int w, int h, KernelInputs inputs, uint32_t seed) override {
+        std::mt19937 rng(seed);
+        width_ = w, height_ = h;
+        const bool worst = inputs == KernelInputs::WorstCase;
+        // An eye a few centimetres aside; worst case: a target far ahead, so near points are
+        // behind it.
+        const Camera c = random_camera(rng, w, h, seed % 3 == 2, 1.0f);
+        const glm::mat4 target_view =
+            glm::translate(c.view, worst ? glm::vec3(0.3f, 0.0f, 30.0f)
+                                         : glm::vec3(uniform(rng, -0.1f, 0.1f), 0.0f, 0.0f));
+        test_.emplace(StaticReprojection(c, target_view, c.projection, w, h), w, h);
+        depth_.resize(std::size_t(w) * std::size_t(h));
+        for (float& z : depth_) {
+            z = rng() % 10 == 0 ? kInf : uniform(rng, 0.2f, 60.0f);
+            if (worst && rng() % 3 == 0)
+                z = rng() % 2 ? worst_value(rng) : -uniform(rng, 0.1f, 10.0f);
+        }
+    }
+    void run_reference() override {
+        run_into(reference_, [](const DisplacementTest& t, int y, int width, const float* d,
+                                glm::vec2* out, float* out_depth) {
+            displacement_row_reference(t, y, 0, width, d, out, out_depth);
+        });
+    }
+    void run() override { run_into(optimized_, displacement_row); }
+    std::string compare() const override {
+        std::string d =
+            compare_bits("displacement", optimized_.displacement, reference_.displacement);
+        if (d.empty()) d = compare_bits("target depth", optimized_.depth, reference_.depth);
+        return d;
+    }
+
+private:
+    struct Output {
+        std::vector<glm::vec2> displacement;
+        std::vector<float> depth;
+    };
+    template <class Kernel>
+    void run_into(Output& out, Kernel kernel) {
+        out.displacement.resize(depth_.size()), out.depth.resize(depth_.size());
+        const int w = width_;
+        parallel_for(0, height_, [&](int y0, int y1) {
+            for (int y = y0; y < y1; ++y) {
+                const std::size_t o = std::size_t(y) * std::size_t(w);
+                kernel(*test_, y, w, depth_.data() + o, out.displacement.data() + o,
+                       out.depth.data() + o);
+            }
+        });
+    }
+
+    int width_ = 0, height_ = 0;
+    std::optional<DisplacementTest> test_;
+    std::vector<float> depth_;
+    Output reference_, optimized_;
+};
+
+// ---------------------------------------------------------------------------------------------
+
+class RefetchCase final : public KernelCase {
+public:
+    void generate(int w, int h, KernelInputs inputs, uint32_t seed) override {
+        std::mt19937 rng(seed);
+        const bool worst = inputs == KernelInputs::WorstCase;
+        factor_ = worst && seed % 3 == 0 ? -1e30f : uniform(rng, -1.0f, 1.0f);
+        color_.resize(w, h), motion_.resize(w, h), covered_.resize(w, h);
+        target_motion_.resize(w, h);
+        const float reach = worst ? 40.0f : 6.0f;
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                for (int c = 0; c < 4; ++c) color_(x, y)[c] = uniform(rng, 0.0f, 4.0f);
+                motion_(x, y) = {uniform(rng, -reach, reach), uniform(rng, -reach, reach)};
+                target_motion_(x, y) = {uniform(rng, -reach, reach), uniform(rng, -reach, reach)};
+                covered_(x, y) = uint8_t(rng() % 8 ? (worst ? 1 + rng() % 255 : 1) : 0);
+                if (!worst || rng() % 3) continue;
+                switch (rng() % 4) {
+                    case 0:
+                        color_(x, y)[int(rng() % 4)] = worst_value(rng);
+                        break;
+                    case 1:
+                        motion_(x, y)[int(rng() % 2)] = worst_value(rng);
+                        break;
+                    case 2:
+                        target_motion_(x, y)[int(rng() % 2)] = worst_value(rng);
+                        break;
+                    default:
+                        target_motion_(x, y) = {1e30f, -1e30f};
+                }
+            }
+    }
+    void reset() override { optimized_.assign(color_.width(), color_.height(), glm::vec4(-3.0f)); }
+    void reset_reference() override {
+        reference_.assign(color_.width(), color_.height(), glm::vec4(-3.0f));
+    }
+    void run_reference() override {
+        run_into(reference_, [](const RefetchRow& r) { refetch_row_reference(r, 0, r.width); });
+    }
+    void run() override { run_into(optimized_, refetch_row); }
+    std::string compare() const override {
+        const std::vector<glm::vec4> a(optimized_.data(),
+                                       optimized_.data() + optimized_.pixel_count());
+        const std::vector<glm::vec4> b(reference_.data(),
+                                       reference_.data() + reference_.pixel_count());
+        return compare_bits("colour", a, b);
+    }
+
+private:
+    template <class Kernel>
+    void run_into(Image<glm::vec4>& out, Kernel kernel) {
+        parallel_for(0, out.height(), [&](int y0, int y1) {
+            for (int y = y0; y < y1; ++y)
+                kernel({.color = std::as_const(color_).view(),
+                        .motion = std::as_const(motion_).view(),
+                        .factor = factor_,
+                        .y = y,
+                        .width = out.width(),
+                        .covered = &covered_(0, y),
+                        .target_motion = &target_motion_(0, y),
+                        .out = &out(0, y)});
+        });
+    }
+
+    float factor_ = 0.5f;
+    Image<glm::vec4> color_, optimized_, reference_;
+    Image<glm::vec2> motion_, target_motion_;
+    Image<uint8_t> covered_;
+};
+
+// ---------------------------------------------------------------------------------------------
+
 template <class T>
 std::unique_ptr<KernelCase> make() {
     return std::make_unique<T>();
@@ -557,6 +688,8 @@ constexpr KernelEntry kEntries[] = {
     {"pull-push first pull", "bit-exact", true, make<PullCase>},
     {"pull-push coarser pull", "bit-exact", true, make<PullLevelCase>},
     {"reverse reprojection", "bit-exact", true, make<ReprojectCase>},
+    {"reverse warp refetch", "bit-exact", true, make<RefetchCase>},
+    {"stereo displacement", "bit-exact", true, make<DisplacementCase>},
 };
 
 }  // namespace

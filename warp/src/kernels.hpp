@@ -8,6 +8,8 @@
 #include <glm/vec2.hpp>
 #include <glm/vec4.hpp>
 
+#include "reprise/core/image.hpp"
+
 namespace reprise {
 class StaticReprojection;
 }
@@ -54,6 +56,42 @@ std::size_t static_layer_row_reference(const StaticLayerTest& test, int y, int x
                                        float* depth_out, glm::vec2* motion_out);
 std::size_t static_layer_row(const StaticLayerTest& test, int y, int width, const float* depth,
                              const glm::vec2* motion, float* depth_out, glm::vec2* motion_out);
+
+// The reverse warp's refetch of one target row: at each covered pixel q the splat's motion gives
+// a first source position p = q - factor m; the source's own motion, bilinear at p, gives the
+// final p, where colour is fetched bicubically (nothing written where a position leaves the
+// source or a value is not finite). Source offsets are kept in 32-bit lanes: the source has fewer
+// than 2^30 pixels.
+struct RefetchRow {
+    ImageView<const glm::vec4> color;  // the source frame
+    ImageView<const glm::vec2> motion;
+    float factor;
+    int y;      // the target row
+    int width;  // of the target row
+    const uint8_t* covered;
+    const glm::vec2* target_motion;
+    glm::vec4* out;
+};
+// The reference does pixels [x_begin, x_end) of the row.
+void refetch_row_reference(const RefetchRow& row, int x_begin, int x_end);
+void refetch_row(const RefetchRow& row);
+
+// The displacement of each pixel to a target camera for a projection without x/y coupling
+// (camera_displacement, displacement.cpp): its landing in the target minus the pixel and its
+// depth there (+inf for background); NaN where the depth is NaN or negative or the point lands
+// behind the target.
+struct DisplacementTest {
+    glm::mat4 projection, to_clip, to_view;  // P; view -> target clip; view -> target view
+    float background_zv, background_w;       // the view point of depth +inf
+    float width, height;                     // image size in pixels
+
+    DisplacementTest(const StaticReprojection& to_target, int image_width, int image_height);
+};
+// Row y; the reference does pixels [x_begin, x_end).
+void displacement_row_reference(const DisplacementTest& test, int y, int x_begin, int x_end,
+                                const float* depth, glm::vec2* displacement, float* target_depth);
+void displacement_row(const DisplacementTest& test, int y, int width, const float* depth,
+                      glm::vec2* displacement, float* target_depth);
 
 }  // namespace reprise::warp
 

@@ -256,6 +256,166 @@ std::size_t PullLevelRowSimd(const PullLevelRow& r) {
 #endif
 }
 
+void DisplacementRowSimd(const DisplacementTest& t, int y, int width, const float* depth,
+                         glm::vec2* displacement, float* target_depth) {
+    const hn::ScalableTag<float> df;
+    using VF = hn::Vec<decltype(df)>;
+    const int n = int(hn::Lanes(df));
+    const glm::mat4& P = t.projection;
+    const glm::mat4& M = t.to_clip;
+    const glm::mat4& V = t.to_view;
+    auto splat = [&](float v) { return hn::Set(df, v); };
+    const VF half = splat(0.5f), one = splat(1.0f), two = splat(2.0f), zero = hn::Zero(df);
+    const VF inf = splat(std::numeric_limits<float>::infinity());
+    const VF nan = splat(std::numeric_limits<float>::quiet_NaN());
+    const VF fw = splat(t.width), fh = splat(t.height);
+    const VF background_zv = splat(t.background_zv), background_w = splat(t.background_w);
+    const float py_scalar = float(y) + 0.5f;
+    const VF py = splat(py_scalar), ny = splat(1.0f - 2.0f * py_scalar / t.height);
+    const VF lanes = hn::Iota(df, 0.0f);
+    // Row r of A times (vx, vy, zv, w), summed as transform_row does.
+    auto row = [&](const glm::mat4& A, int r, VF vx, VF vy, VF zv, VF w) {
+        return (splat(A[0][r]) * vx + splat(A[1][r]) * vy) +
+               (splat(A[2][r]) * zv + splat(A[3][r]) * w);
+    };
+    int x = 0;
+    for (; x + n <= width; x += n) {
+        const VF z = hn::LoadU(df, depth + x);
+        const VF px = (splat(float(x)) + lanes) + half;
+        const VF nx = two * px / fw - one;
+        const auto background = z == inf;
+        const VF zv = hn::IfThenElse(background, background_zv, hn::Neg(z));
+        const VF w = hn::IfThenElse(background, background_w, one);
+        const VF wc = splat(P[2][3]) * zv + splat(P[3][3]) * w;
+        const VF vx = (nx * wc - splat(P[2][0]) * zv - splat(P[3][0]) * w) / splat(P[0][0]);
+        const VF vy = (ny * wc - splat(P[2][1]) * zv - splat(P[3][1]) * w) / splat(P[1][1]);
+        const VF cw = row(M, 3, vx, vy, zv, w);
+        const VF lx = (row(M, 0, vx, vy, zv, w) / cw * half + half) * fw;
+        const VF ly = (half - half * row(M, 1, vx, vy, zv, w) / cw) * fh;
+        const VF tz = hn::Neg(row(V, 2, vx, vy, zv, w));
+        const auto ok =
+            hn::And(hn::And(z >= zero, cw > zero), hn::And((lx - lx) == zero, (ly - ly) == zero));
+        hn::StoreInterleaved2(hn::IfThenElse(ok, lx - px, nan), hn::IfThenElse(ok, ly - py, nan),
+                              df, &displacement[x].x);
+        hn::StoreU(hn::IfThenElse(ok, hn::IfThenElse(background, inf, tz), nan), df,
+                   target_depth + x);
+    }
+    if (x < width) displacement_row_reference(t, y, x, width, depth, displacement, target_depth);
+}
+
+// Positions, taps and weights in vector lanes; each pixel's 16 bicubic taps four channels a lane
+// (as bicubic_fetch sums them). Pixels whose bicubic taps reach past the border go to the
+// reference one by one.
+void RefetchRowSimd(const RefetchRow& r) {
+#if HWY_TARGET == HWY_SCALAR
+    refetch_row_reference(r, 0, r.width);
+#else
+    const hn::ScalableTag<float> df;
+    const hn::RebindToSigned<decltype(df)> di;
+    const hn::Rebind<uint8_t, decltype(df)> du8;
+    const hn::Full128<float> d4;
+    using VF = hn::Vec<decltype(df)>;
+    using VI = hn::Vec<decltype(di)>;
+    constexpr int kMaxLanes = 16;
+    const int n = int(hn::Lanes(df));
+    if (n > kMaxLanes) return refetch_row_reference(r, 0, r.width);
+    const int sw = r.color.width, sh = r.color.height;
+    auto splat = [&](float v) { return hn::Set(df, v); };
+    const VF zero = hn::Zero(df), half = splat(0.5f), two = splat(2.0f);
+    const VF fsw = splat(float(sw)), fsh = splat(float(sh)), factor = splat(r.factor);
+    const VF qy = splat(float(r.y) + 0.5f);
+    const VI zero_i = hn::Zero(di), one_i = hn::Set(di, 1);
+    const VI last_x = hn::Set(di, sw - 1), last_y = hn::Set(di, sh - 1);
+    const VI motion_stride = hn::Set(di, int(r.motion.stride));
+    const float* motion = &r.motion.data->x;
+    auto floor_small = [&](VF v) {  // as warp::floor_small
+        const VI i = hn::ConvertTo(di, v);
+        return hn::IfThenElse(hn::RebindMask(di, v < hn::ConvertTo(df, i)), i - one_i, i);
+    };
+    auto weights = [&](VF t, VF w[4]) {  // bicubic_fetch's, in its order
+        const VF t2 = t * t, t3 = t2 * t;
+        w[0] = half * ((hn::Neg(t3) + two * t2) - t);
+        w[1] = half * ((splat(3.0f) * t3 - splat(5.0f) * t2) + two);
+        w[2] = half * ((splat(-3.0f) * t3 + splat(4.0f) * t2) + t);
+        w[3] = half * (t3 - t2);
+    };
+    alignas(64) float wx[4][kMaxLanes], wy[4][kMaxLanes];
+    alignas(64) int32_t tap_x[kMaxLanes], tap_y[kMaxLanes];
+    int x = 0;
+    for (; x + n <= r.width; x += n) {
+        const auto covered =
+            hn::RebindMask(df, hn::PromoteTo(di, hn::LoadU(du8, r.covered + x)) != zero_i);
+        if (hn::AllFalse(df, covered)) continue;
+        VF mx, my;
+        hn::LoadInterleaved2(df, &r.target_motion[x].x, mx, my);
+        const VF qx = hn::Iota(df, float(x)) + half;
+        VF px = qx - factor * mx, py = qy - factor * my;
+        auto go = hn::And(covered,
+                          hn::And(hn::And(px >= zero, py >= zero), hn::And(px <= fsw, py <= fsh)));
+        if (hn::AllFalse(df, go)) continue;
+        // The source motion, bilinear at p (bilinear_taps + bilinear_fetch).
+        px = hn::IfThenElseZero(go, px), py = hn::IfThenElseZero(go, py);
+        const VF sx = px - half, sy = py - half;
+        const VI ix = floor_small(sx), iy = floor_small(sy);
+        const VF fx = sx - hn::ConvertTo(df, ix), fy = sy - hn::ConvertTo(df, iy);
+        const VI x0 = hn::Min(hn::Max(ix, zero_i), last_x);
+        const VI x1 = hn::Min(hn::Max(ix + one_i, zero_i), last_x);
+        const VI r0 = hn::Min(hn::Max(iy, zero_i), last_y) * motion_stride;
+        const VI r1 = hn::Min(hn::Max(iy + one_i, zero_i), last_y) * motion_stride;
+        const VI i00 = hn::ShiftLeft<1>(r0 + x0), i01 = hn::ShiftLeft<1>(r0 + x1);
+        const VI i10 = hn::ShiftLeft<1>(r1 + x0), i11 = hn::ShiftLeft<1>(r1 + x1);
+        auto lerp2 = [&](const float* base) {
+            const VF a = hn::GatherIndex(df, base, i00), b = hn::GatherIndex(df, base, i01);
+            const VF c = hn::GatherIndex(df, base, i10), d = hn::GatherIndex(df, base, i11);
+            const VF top = a + (b - a) * fx, bottom = c + (d - c) * fx;
+            return top + (bottom - top) * fy;
+        };
+        const VF smx = lerp2(motion), smy = lerp2(motion + 1);
+        go = hn::And(go, hn::And((smx - smx) == zero, (smy - smy) == zero));
+        px = qx - factor * smx, py = qy - factor * smy;
+        go = hn::And(go, hn::And(hn::And(px >= zero, py >= zero), hn::And(px <= fsw, py <= fsh)));
+        if (hn::AllFalse(df, go)) continue;
+        px = hn::IfThenElseZero(go, px), py = hn::IfThenElseZero(go, py);
+        const VF cx = px - half, cy = py - half;
+        const VI jx = floor_small(cx), jy = floor_small(cy);
+        VF w[4];
+        weights(cx - hn::ConvertTo(df, jx), w);
+        for (int k = 0; k < 4; ++k) hn::Store(w[k], df, wx[k]);
+        weights(cy - hn::ConvertTo(df, jy), w);
+        for (int k = 0; k < 4; ++k) hn::Store(w[k], df, wy[k]);
+        hn::Store(jx - one_i, di, tap_x);
+        hn::Store(jy - one_i, di, tap_y);
+        const auto inner =
+            hn::And(hn::And(hn::RebindMask(df, jx > zero_i), hn::RebindMask(df, jy > zero_i)),
+                    hn::And(hn::RebindMask(df, jx + hn::Set(di, 2) < hn::Set(di, sw)),
+                            hn::RebindMask(df, jy + hn::Set(di, 2) < hn::Set(di, sh))));
+        alignas(64) uint8_t bits[kMaxLanes / 8 + 8];
+        hn::StoreMaskBits(df, go, bits);
+        alignas(64) uint8_t inner_bits[kMaxLanes / 8 + 8];
+        hn::StoreMaskBits(df, inner, inner_bits);
+        for (int i = 0; i < n; ++i) {
+            if (!((bits[i / 8] >> (i % 8)) & 1)) continue;
+            if (!((inner_bits[i / 8] >> (i % 8)) & 1)) {
+                refetch_row_reference(r, x + i, x + i + 1);
+                continue;
+            }
+            auto acc = hn::Zero(d4);
+            for (int j = 0; j < 4; ++j) {
+                const float* row = &(r.color.row(tap_y[i] + j) + tap_x[i])->x;
+                auto line = hn::Zero(d4);
+                for (int k = 0; k < 4; ++k)
+                    line = line + hn::Set(d4, wx[k][i]) * hn::LoadU(d4, row + 4 * k);
+                acc = acc + hn::Set(d4, wy[j][i]) * line;
+            }
+            glm::vec4 c;
+            hn::StoreU(acc, d4, &c.x);
+            if (std::isfinite(c.r + c.g + c.b + c.a)) r.out[x + i] = c;
+        }
+    }
+    refetch_row_reference(r, x, r.width);
+#endif
+}
+
 }  // namespace reprise::warp::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
 
@@ -266,6 +426,15 @@ HWY_EXPORT(BlendRowSimd);
 HWY_EXPORT(StaticLayerRowSimd);
 HWY_EXPORT(PullRowSimd);
 HWY_EXPORT(PullLevelRowSimd);
+HWY_EXPORT(RefetchRowSimd);
+HWY_EXPORT(DisplacementRowSimd);
+
+void displacement_row(const DisplacementTest& test, int y, int width, const float* depth,
+                      glm::vec2* displacement, float* target_depth) {
+    HWY_DYNAMIC_DISPATCH(DisplacementRowSimd)(test, y, width, depth, displacement, target_depth);
+}
+
+void refetch_row(const RefetchRow& row) { HWY_DYNAMIC_DISPATCH(RefetchRowSimd)(row); }
 
 std::size_t pull_level_row(const PullLevelRow& row) {
     return HWY_DYNAMIC_DISPATCH(PullLevelRowSimd)(row);
