@@ -78,6 +78,9 @@ std::vector<Setting> fruc_settings(bool quick) {
     };
     if (quick) {
         add("interpolate", "grid", "pullpush");
+        // The grid's other colour fetch, beside the default one.
+        add("interpolate", warp::GridOptions{}.bicubic ? "grid-bilinear" : "grid-bicubic",
+            "pullpush");
         add("interpolate", "reverse", "pullpush");
         add("interpolate", "splat", "none");
         add("extrapolate", "grid", "pullpush");
@@ -139,14 +142,15 @@ void record(Run& run, int frame, const Image<glm::vec3>& display, const Image<gl
 }
 
 Status render_scene(server::Renderer& renderer, const std::string& scene_name, int frames,
-                    int factor, int w, int h, const std::string& exr_dir, SceneFrames& out) {
+                    int factor, int w, int h, int aa, const std::string& exr_dir,
+                    SceneFrames& out) {
     server::Scene scene;
     server::CameraPath path;
     REPRISE_TRY(server::load_scene(scene_name, scene, path));
     // A model's own camera may stand still: the held-out models are seen from an orbit.
     if (is_held_out(scene_name))
         REPRISE_TRY(server::parse_camera_spec("orbit:speed=0.5", scene, path, path));
-    const server::RenderSettings settings{.width = w, .height = h};
+    const server::RenderSettings settings{.width = w, .height = h, .aa_samples = aa};
     out.factor = factor;
     if (!exr_dir.empty()) {
         std::error_code ec;
@@ -382,6 +386,8 @@ Status bench_fruc(const BenchOptions& job) {
         return Status::error("bench fruc: --frames must be in 2..1000");
     if (job.repeat < 1 || job.repeat > 100)
         return Status::error("bench fruc: --repeat must be in 1..100");
+    if (!server::aa_samples_valid(job.aa))
+        return Status::error("bench fruc: --aa must be 1, 2, 4, 8 or 16");
     int w = 0, h = 0;
     REPRISE_TRY(parse_size(job.size, w, h));
     const std::vector<std::string> scenes = scene_list(job.scenes);
@@ -409,10 +415,12 @@ Status bench_fruc(const BenchOptions& job) {
     char text[2048];
     std::snprintf(
         text, sizeof text,
-        "x%d upconversion of %d input frames at 30 Hz (%dx%d), renderer %s. Each method's "
-        "%d in-between frames are compared with frames rendered at %d Hz (display values: "
-        "PSNR, SSIM, LDR-FLIP); the input frames passed through are not scored.",
-        job.factor, job.frames, w, h, renderer->device().c_str(), synthesized, 30 * job.factor);
+        "x%d upconversion of %d input frames at 30 Hz (%dx%d, anti-aliasing %d samples), "
+        "renderer %s. Each method's %d in-between frames are compared with frames rendered at "
+        "%d Hz (display values: PSNR, SSIM, LDR-FLIP); the input frames passed through are not "
+        "scored.",
+        job.factor, job.frames, w, h, job.aa, renderer->device().c_str(), synthesized,
+        30 * job.factor);
     report.paragraphs.push_back(text);
     std::snprintf(
         text, sizeof text,
@@ -438,7 +446,7 @@ Status bench_fruc(const BenchOptions& job) {
         const std::string scene_dir = out_dir + "/" + scene.name;
         fs::create_directories(scene_dir, ec);
         if (ec) return Status::error(scene_dir + ": cannot create the folder: " + ec.message());
-        failure = render_scene(*renderer, scene_name, job.frames, job.factor, w, h,
+        failure = render_scene(*renderer, scene_name, job.frames, job.factor, w, h, job.aa,
                                job.exr ? scene_dir : std::string(), scene);
         if (!failure.ok()) break;
 

@@ -17,8 +17,11 @@ Status parse_fruc_options(const std::string& mode, const std::string& warp_name,
         options.warp = WarpMethod::Splat;
     else if (warp_name == "grid")
         options.warp = WarpMethod::Grid;
+    else if (warp_name == "grid-bicubic" || warp_name == "grid-bilinear")
+        options.warp = WarpMethod::Grid, options.grid.bicubic = warp_name == "grid-bicubic";
     else
-        return Status::error("--warp '" + warp_name + "': expected reverse, splat or grid");
+        return Status::error("--warp '" + warp_name +
+                             "': expected reverse, splat, grid, grid-bicubic or grid-bilinear");
     if (fill == "pullpush")
         options.fill = FillMethod::PullPush;
     else if (fill == "andreev")
