@@ -202,7 +202,7 @@ TEST(AntiAliasing, LitSceneKeepsItsGBufferAndSoftensOnlyEdges) {
                 changed_at_edges);
 }
 
-TEST(AntiAliasing, HeavyShadingAndLowResolutionColourStaySingleSample) {
+TEST(AntiAliasing, HeavyShadingAndLowResolutionRendersStaySingleSample) {
     Scene scene;
     CameraPath path;
     ASSERT_TRUE(load_scene("courtyard", scene, path).ok());
@@ -227,6 +227,7 @@ TEST(AntiAliasing, HeavyShadingAndLowResolutionColourStaySingleSample) {
                                          low_single, jitter_single)
                     .ok());
     ASSERT_EQ(jitter_aa, jitter_single);
+    for (int i = 0; i < 64 * 36; ++i) ASSERT_EQ(a.color.data()[i], b.color.data()[i]);
     for (int i = 0; i < low_aa.width() * low_aa.height(); ++i)
         ASSERT_EQ(low_aa.data()[i], low_single.data()[i]);
 }

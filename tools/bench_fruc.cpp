@@ -79,7 +79,7 @@ std::vector<Setting> fruc_settings(bool quick) {
     if (quick) {
         add("interpolate", "grid", "pullpush");
         // The grid's other colour fetch, beside the default one.
-        add("interpolate", warp::GridOptions{}.bicubic ? "grid-bilinear" : "grid-bicubic",
+        add("interpolate", warp::FrucOptions{}.grid.bicubic ? "grid-bilinear" : "grid-bicubic",
             "pullpush");
         add("interpolate", "reverse", "pullpush");
         add("interpolate", "splat", "none");

@@ -260,7 +260,7 @@ int command_render(int argc, char** argv) {
     args.option("--aa", &job.aa,
                 "anti-aliased colour: 1 (off), 2, 4, 8 or 16 samples per pixel (default 4; MSAA "
                 "where the device has the count, else supersampling). Depth, motion, normals, "
-                "ids stay single samples at the pixel centre; heavy shading and --lowres colour "
+                "ids stay single samples at the pixel centre; heavy shading and --lowres renders "
                 "are single-sample");
     args.option("--out", &job.out, "output folder (required)");
     Status parsed = args.parse(argc, argv);

@@ -979,7 +979,11 @@ Status Renderer::render_lowres(const Scene& scene, const Instant& current, const
                                Frame& frame, Image<glm::vec4>& low_color, glm::vec2& jitter) {
     REPRISE_ASSERT(lowres_factor_valid(factor));
     REPRISE_TRY(check_image_size(settings.width, settings.height, "renderer"));
-    REPRISE_TRY(render(scene, current, previous, settings, frame));
+    // Single samples at full resolution too: the upsampler rebuilds the point-sampled image from
+    // jittered point samples, and that image is what its output is compared with.
+    RenderSettings full_settings = settings;
+    full_settings.aa_samples = 1;
+    REPRISE_TRY(render(scene, current, previous, full_settings, frame));
     const glm::ivec2 low = lowres_size(settings.width, settings.height, factor);
     // Relative to the unjittered full image (the full frame's own jitter, usually 0, included).
     jitter = current.jitter + lowres_jitter(settings.width, settings.height, factor, jitter_index);
@@ -988,10 +992,9 @@ Status Renderer::render_lowres(const Scene& scene, const Instant& current, const
     // The same frustum (projection of the full size) at the low size; the jitter in low pixels.
     Instant now = current;
     now.jitter = jitter / footprint;
-    RenderSettings low_settings = settings;
+    RenderSettings low_settings = full_settings;
     low_settings.width = low.x;
     low_settings.height = low.y;
-    low_settings.aa_samples = 1;  // jittered point samples, as the upsampler expects
     // Texture detail about as the full resolution picks it. (Scaling the screen derivatives
     // through textureGrad would be exact but matched the full render worse on llvmpipe: 34.3
     // against 35.4 dB for the composed 2x2 cycle of a still camera, probably anisotropy.)

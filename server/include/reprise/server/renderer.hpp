@@ -62,8 +62,8 @@ struct RenderSettings {
     // Anti-aliased colour: samples per pixel, 1 (off), 2, 4, 8 or 16, around the jittered pixel
     // centre. MSAA where the device has the count for float targets, else supersampling (one
     // jittered colour pass per sample). Depth, motion, normal, id and colour's A (coverage) stay
-    // single samples at the pixel centre. Heavy shading and the low-resolution colour of
-    // render_lowres() are single-sample whatever this says.
+    // single samples at the pixel centre. Heavy shading and render_lowres() (both its images:
+    // the upsampler rebuilds the point-sampled full image) are single-sample whatever this says.
     int aa_samples = 4;
 };
 
