@@ -79,24 +79,35 @@ double near_fraction(int x, int y) {
     return area / steps;
 }
 
-Frame render_edge(int samples, Shading shading = Shading::Unlit) {
+Frame render_edge(int samples, AntiAliasing method = AntiAliasing::Auto) {
     const Scene scene = edge_scene();
     // The content moved 1.5 px left since `before`: motion (+1.5, 0).
     Instant now = pixel_camera(0.0f), before = pixel_camera(-1.5f);
     now.time = 1.0 / 30.0;
     Frame frame;
-    Status status = shared_renderer().render(
-        scene, now, before, {.width = kW, .height = kH, .shading = shading, .aa_samples = samples},
-        frame);
+    Status status = shared_renderer().render(scene, now, before,
+                                             {.width = kW,
+                                              .height = kH,
+                                              .shading = Shading::Unlit,
+                                              .aa_samples = samples,
+                                              .aa_method = method},
+                                             frame);
     EXPECT_TRUE(status.ok()) << status.message();
     return frame;
 }
 
-class EdgeAntiAliasing : public ::testing::TestWithParam<int> {};
+struct AaCase {
+    int samples;
+    AntiAliasing method;
+};
+class EdgeAntiAliasing : public ::testing::TestWithParam<AaCase> {};
 
 TEST_P(EdgeAntiAliasing, EdgePixelsBlendTheirTwoSurfacesByCoverage) {
-    const int samples = GetParam();
-    const Frame frame = render_edge(samples);
+    const int samples = GetParam().samples;
+    const bool msaa =
+        GetParam().method == AntiAliasing::Msaa ||
+        (GetParam().method == AntiAliasing::Auto && shared_renderer().msaa_supported(samples));
+    const Frame frame = render_edge(samples, GetParam().method);
     ASSERT_EQ(frame.width(), kW);
     int edge_pixels = 0;
     double worst = 0.0;
@@ -124,12 +135,11 @@ TEST_P(EdgeAntiAliasing, EdgePixelsBlendTheirTwoSurfacesByCoverage) {
         }
     EXPECT_GE(edge_pixels, int(0.8 * kH * (1.0 - 1.0 / samples - 2.0 * kEdgeSlope)));
     std::printf("[aa] %2d samples (%s): %d edge pixels, coverage within %.4f of the area\n",
-                samples, shared_renderer().msaa_supported(samples) ? "MSAA" : "supersampling",
-                edge_pixels, worst);
+                samples, msaa ? "MSAA" : "supersampling", edge_pixels, worst);
 }
 
 TEST_P(EdgeAntiAliasing, GBufferStaysTheSingleSampleAtThePixelCentre) {
-    const Frame aa = render_edge(GetParam()), single = render_edge(1);
+    const Frame aa = render_edge(GetParam().samples, GetParam().method), single = render_edge(1);
     int near = 0, far = 0;
     for (int y = 0; y < kH; ++y)
         for (int x = 0; x < kW; ++x) {
@@ -153,8 +163,12 @@ TEST_P(EdgeAntiAliasing, GBufferStaysTheSingleSampleAtThePixelCentre) {
     EXPECT_GT(far, kW * kH / 3);
 }
 
-// 4 is MSAA on llvmpipe (its only count); 2 and 16 are supersampling there.
-INSTANTIATE_TEST_SUITE_P(Samples, EdgeAntiAliasing, ::testing::Values(2, 4, 16));
+// MSAA forced at 4x (llvmpipe's only count); Auto supersamples on llvmpipe.
+INSTANTIATE_TEST_SUITE_P(Samples, EdgeAntiAliasing,
+                         ::testing::Values(AaCase{2, AntiAliasing::Auto},
+                                           AaCase{4, AntiAliasing::Auto},
+                                           AaCase{4, AntiAliasing::Msaa},
+                                           AaCase{16, AntiAliasing::Auto}));
 
 TEST(AntiAliasing, OffGivesSingleSampleColourAndOnAgreesAwayFromEdges) {
     const Frame single = render_edge(1), aa = render_edge(4);

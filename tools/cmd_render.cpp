@@ -141,7 +141,7 @@ Status run_render(const RenderJob& job) {
     std::unique_ptr<server::Renderer> renderer;
     REPRISE_TRY(server::Renderer::create(renderer));
     const std::string aa =
-        settings.shading == server::Shading::Heavy || job.aa == 1 ? "no anti-aliasing"
+        settings.shading == server::Shading::Heavy || job.aa == 1 || job.lowres ? "no anti-aliasing"
         : renderer->msaa_supported(job.aa) ? std::to_string(job.aa) + "x MSAA"
                                            : std::to_string(job.aa) + "x supersampling";
     std::fprintf(stderr, "[render] %s, %dx%d, %d frames at %g Hz, %s, on %s\n", job.scene.c_str(),

@@ -227,6 +227,7 @@ struct Renderer::Gpu {
     GLuint msaa_framebuffer = 0, msaa_color = 0, msaa_depth = 0;
     int msaa_samples = 0, msaa_width = 0, msaa_height = 0;
     std::vector<GLint> msaa_counts;  // sample counts of RGBA32F renderbuffers on this device
+    bool software = false;           // llvmpipe or softpipe
     GLuint vertex_array = 0, vertex_buffer = 0, index_buffer = 0;
     int width = 0, height = 0;
     int cache_width = 0, cache_height = 0;
@@ -591,7 +592,9 @@ Renderer::Renderer() : gpu_(std::make_unique<Gpu>()) {}
 Renderer::~Renderer() = default;
 
 const std::string& Renderer::device() const { return gpu_->context->description(); }
-bool Renderer::msaa_supported(int samples) const { return gpu_->msaa_has(samples); }
+bool Renderer::msaa_supported(int samples) const {
+    return gpu_->msaa_has(samples) && !gpu_->software;
+}
 const ReuseStats& Renderer::reuse_stats() const { return gpu_->stats; }
 const ReuseMaps& Renderer::reuse_maps() const { return gpu_->maps; }
 void Renderer::drop_reuse_cache() { gpu_->cache_valid = false; }
@@ -627,6 +630,9 @@ Status Renderer::create(std::unique_ptr<Renderer>& renderer) {
         glGetInternalformativ(GL_RENDERBUFFER, GL_RGBA32F, GL_SAMPLES,
                               GLsizei(g.msaa_counts.size()), g.msaa_counts.data());
     while (glGetError() != GL_NO_ERROR) g.msaa_counts.clear();
+    const char* name = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+    g.software = name && (std::string(name).find("llvmpipe") != std::string::npos ||
+                          std::string(name).find("softpipe") != std::string::npos);
     renderer = std::move(r);
     return {};
 }
@@ -652,7 +658,9 @@ Status Renderer::render(const Scene& scene, const Instant& current, const Instan
         return Status::error("renderer: anti-aliasing samples " +
                              std::to_string(settings.aa_samples) + " must be 1, 2, 4, 8 or 16");
     const int aa = heavy ? 1 : settings.aa_samples;
-    const bool msaa = aa > 1 && g.msaa_has(aa);
+    const bool msaa = aa > 1 && g.msaa_has(aa) &&
+                      (settings.aa_method == AntiAliasing::Msaa ||
+                       (settings.aa_method == AntiAliasing::Auto && !g.software));
     const ReuseSettings& reuse = settings.reuse;
     const bool reusing = heavy && reuse.mode != Reuse::Off;
     if (heavy) {
