@@ -10,6 +10,7 @@
 
 #include "reprise/core/simd.hpp"
 #include "reprise/warp/grid_warp.hpp"
+#include "reprise/warp/sample.hpp"
 #include "support/frames.hpp"
 #include "support/warp.hpp"
 
@@ -437,4 +438,31 @@ TEST(GridWarp, LargeFrameRuns) {
     EXPECT_GT(s.covered, std::size_t(w - 2) * (h - 2));
     EXPECT_LE(s.covered, std::size_t(w) * h);
     EXPECT_GT(s.cells, std::size_t(w / 32) * (h / 32));
+}
+
+TEST(GridWarp, BicubicFetchSamplesTheSourceAtTheWarpedPosition) {
+    const int w = 96, h = 64;
+    const glm::vec2 shift(0.375f, -0.25f);  // half of it per factor -0.5: a sub-pixel move
+    Frame f = flat_frame(w, h, 4.0f, shift, 5);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const float v = float((x * 7 + y * 13) % 11) / 10.0f;
+            f.color(x, y) = {v, 1.0f - v, 0.5f * v, 1.0f};
+        }
+    Output bilinear(w, h), bicubic(w, h);
+    (void)warp_both(f, -0.5f, bilinear);
+    (void)warp_both(f, -0.5f, bicubic, {.bicubic = true});
+    int differ = 0;
+    for (int y = 3; y < h - 3; ++y)
+        for (int x = 3; x < w - 3; ++x) {
+            // The source point that lands on this pixel centre.
+            const glm::vec2 p = glm::vec2(x + 0.5f, y + 0.5f) + 0.5f * shift;
+            const glm::vec4 expected =
+                bicubic_fetch(ImageView<const glm::vec4>(f.color.view()), p.x, p.y);
+            ASSERT_TRUE(
+                glm::all(glm::lessThan(glm::abs(bicubic.color(x, y) - expected), glm::vec4(1e-4f))))
+                << x << "," << y;
+            differ += bicubic.color(x, y) != bilinear.color(x, y);
+        }
+    EXPECT_GT(differ, (w - 6) * (h - 6) / 2);
 }

@@ -24,6 +24,7 @@ struct BenchOptions {
     bool quick = false;  // a few settings only
     bool exr = false;    // also write the rendered input and truth as EXR
     int repeat = 3;      // timed runs; each frame's fastest counts
+    int aa = 4;          // render, fruc: anti-aliasing samples (render compares 1 with it)
     // bench codec
     std::string in;                        // a sequence folder, besides the scenes
     int threads = 2;                       // per codec

@@ -123,6 +123,9 @@ std::vector<Setting> fruc_settings(bool quick) {
     };
     if (quick) {
         add_refine_pair();
+        // The grid's other colour fetch, beside the default one.
+        add("interpolate", warp::FrucOptions{}.grid.bicubic ? "grid-bilinear" : "grid-bicubic",
+            "pullpush");
         add("interpolate", "reverse", "pullpush");
         add("interpolate", "splat", "none");
         add("extrapolate", "grid", "pullpush");
@@ -204,7 +207,8 @@ void record(Run& run, int frame, const Image<glm::vec3>& display, const Image<gl
 }
 
 Status render_scene(server::Renderer& renderer, const std::string& scene_name, int frames,
-                    int factor, int w, int h, const std::string& exr_dir, SceneFrames& out) {
+                    int factor, int w, int h, int aa, const std::string& exr_dir,
+                    SceneFrames& out) {
     server::Scene scene;
     server::CameraPath path;
     REPRISE_TRY(server::load_scene(scene_name, scene, path));
@@ -215,7 +219,8 @@ Status render_scene(server::Renderer& renderer, const std::string& scene_name, i
     const server::RenderSettings settings{
         .width = w,
         .height = h,
-        .shading = scene.heavy_shading ? server::Shading::Heavy : server::Shading::Lit};
+        .shading = scene.heavy_shading ? server::Shading::Heavy : server::Shading::Lit,
+        .aa_samples = aa};
     out.factor = factor;
     if (!exr_dir.empty()) {
         std::error_code ec;
@@ -617,6 +622,8 @@ Status bench_fruc(const BenchOptions& job) {
         return Status::error("bench fruc: --frames must be in 2..1000");
     if (job.repeat < 1 || job.repeat > 100)
         return Status::error("bench fruc: --repeat must be in 1..100");
+    if (!server::aa_samples_valid(job.aa))
+        return Status::error("bench fruc: --aa must be 1, 2, 4, 8 or 16");
     int w = 0, h = 0;
     REPRISE_TRY(parse_size(job.size, w, h));
     const std::vector<std::string> scenes = scene_list(job.scenes, job.in);
@@ -649,10 +656,12 @@ Status bench_fruc(const BenchOptions& job) {
     char text[2048];
     std::snprintf(
         text, sizeof text,
-        "x%d upconversion of %d input frames at 30 Hz (%dx%d), renderer %s. Each method's "
-        "%d in-between frames are compared with frames rendered at %d Hz (display values: "
-        "PSNR, SSIM, LDR-FLIP); the input frames passed through are not scored.",
-        job.factor, job.frames, w, h, renderer->device().c_str(), synthesized, 30 * job.factor);
+        "x%d upconversion of %d input frames at 30 Hz (%dx%d, anti-aliasing %d samples), "
+        "renderer %s. Each method's %d in-between frames are compared with frames rendered at "
+        "%d Hz (display values: PSNR, SSIM, LDR-FLIP); the input frames passed through are not "
+        "scored.",
+        job.factor, job.frames, w, h, job.aa, renderer->device().c_str(), synthesized,
+        30 * job.factor);
     report.paragraphs.push_back(text);
     std::snprintf(
         text, sizeof text,
@@ -682,7 +691,7 @@ Status bench_fruc(const BenchOptions& job) {
         if (ec) return Status::error(scene_dir + ": cannot create the folder: " + ec.message());
         failure = is_sequence(scene_name)
                       ? read_scene(source, job.frames, job.factor, scene)
-                      : render_scene(*renderer, scene_name, job.frames, job.factor, w, h,
+                      : render_scene(*renderer, scene_name, job.frames, job.factor, w, h, job.aa,
                                      job.exr ? scene_dir : std::string(), scene);
         if (!failure.ok()) break;
         write_predictors(predictors_csv.file(), scene);

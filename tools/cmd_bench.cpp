@@ -46,20 +46,33 @@ Status bench_render(const BenchJob& job) {
     auto& [scene, path, renderer] = bench;
     std::printf("renderer: %s, scene %s, %d frames per size\n", renderer->device().c_str(),
                 job.scene.c_str(), job.frames);
-    std::printf("%-11s %10s %10s\n", "size", "ms/frame", "frames/s");
+    if (!server::aa_samples_valid(job.aa))
+        return Status::error("bench render: --aa must be 1, 2, 4, 8 or 16");
+    std::printf("%-11s %-18s %10s %10s %12s\n", "size", "anti-aliasing", "ms/frame", "frames/s",
+                "x of aa 1");
     return for_each_size(job.sizes, [&](int w, int h) {
         Frame frame;
-        const server::RenderSettings settings{.width = w, .height = h};
-        REPRISE_TRY(renderer->render_frame(scene, path, 0, 30.0, settings, frame));  // warm-up
-        auto start = Clock::now();
-        for (int i = 1; i <= job.frames; ++i) {
-            REPRISE_TRY(renderer->render_frame(scene, path, i, 30.0, settings, frame));
-            std::fprintf(stderr, "\r[bench] %dx%d %d/%d", w, h, i, job.frames);
+        double single_ms = 0.0;
+        for (int aa : {1, job.aa}) {
+            if (aa == 1 && single_ms > 0.0) break;
+            const server::RenderSettings settings{.width = w, .height = h, .aa_samples = aa};
+            REPRISE_TRY(renderer->render_frame(scene, path, 0, 30.0, settings, frame));  // warm-up
+            auto start = Clock::now();
+            for (int i = 1; i <= job.frames; ++i) {
+                REPRISE_TRY(renderer->render_frame(scene, path, i, 30.0, settings, frame));
+                std::fprintf(stderr, "\r[bench] %dx%d aa %d %d/%d", w, h, aa, i, job.frames);
+            }
+            const double ms = 1e3 * seconds_since(start) / job.frames;
+            if (aa == 1) single_ms = ms;
+            const std::string method = aa == 1 ? "off"
+                                       : renderer->msaa_supported(aa)
+                                           ? std::to_string(aa) + "x MSAA"
+                                           : std::to_string(aa) + "x SSAA";
+            std::fprintf(stderr, "\r%40s\r", "");
+            std::printf("%-11s %-18s %10.1f %10.2f %12.2f\n",
+                        (std::to_string(w) + "x" + std::to_string(h)).c_str(), method.c_str(), ms,
+                        1e3 / ms, ms / single_ms);
         }
-        double s = seconds_since(start);
-        std::fprintf(stderr, "\r%40s\r", "");
-        std::printf("%-11s %10.1f %10.2f\n", (std::to_string(w) + "x" + std::to_string(h)).c_str(),
-                    1e3 * s / job.frames, job.frames / s);
         return Status{};
     });
 }
@@ -166,6 +179,9 @@ int command_bench(int argc, char** argv) {
                 "fruc, stereo, upsample: WxH (default 640x360); codec: default 1280x720");
     args.flag("--quick", &job.quick,
               "fruc: a few settings only (grid+pullpush, reverse+pullpush, splat+none, ...)");
+    args.option("--aa", &job.aa,
+                "render, fruc: anti-aliasing samples 1 (off), 2, 4, 8, 16 (default 4; render "
+                "also times 1)");
     args.option("--repeat", &job.repeat,
                 "fruc, stereo, upsample: timed runs, each frame's fastest counts (default 3)");
     args.option("--in", &job.in,

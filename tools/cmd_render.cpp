@@ -36,6 +36,7 @@ struct RenderJob {
     double stereo = 0.0;       // IPD; > 0 renders both eyes into OUT/left and OUT/right
     double convergence = 0.0;  // > 0: off-axis rig converging there
     int lowres = 0;  // 2 or 4: also colour at 1/lowres of the pixels, jittered, in OUT/lowres
+    int aa = 4;      // anti-aliasing samples per pixel, 1 = off
 };
 
 struct ReuseTotals : server::ReuseStats {
@@ -121,7 +122,9 @@ Status run_render(const RenderJob& job) {
         server::CameraPath fallback = path;
         REPRISE_TRY(server::parse_camera_spec(job.camera, scene, fallback, path));
     }
-    server::RenderSettings settings{.width = width, .height = height};
+    if (!server::aa_samples_valid(job.aa))
+        return Status::error("--aa " + std::to_string(job.aa) + " must be 1, 2, 4, 8 or 16");
+    server::RenderSettings settings{.width = width, .height = height, .aa_samples = job.aa};
     REPRISE_TRY(parse_shading(job, scene, settings));
     if (settings.reuse.mode != server::Reuse::Off && job.lowres)
         return Status::error(
@@ -137,8 +140,12 @@ Status run_render(const RenderJob& job) {
 
     std::unique_ptr<server::Renderer> renderer;
     REPRISE_TRY(server::Renderer::create(renderer));
-    std::fprintf(stderr, "[render] %s, %dx%d, %d frames at %g Hz on %s\n", job.scene.c_str(), width,
-                 height, job.frames, job.fps, renderer->device().c_str());
+    const std::string aa =
+        settings.shading == server::Shading::Heavy || job.aa == 1 || job.lowres ? "no anti-aliasing"
+        : renderer->msaa_supported(job.aa) ? std::to_string(job.aa) + "x MSAA"
+                                           : std::to_string(job.aa) + "x supersampling";
+    std::fprintf(stderr, "[render] %s, %dx%d, %d frames at %g Hz, %s, on %s\n", job.scene.c_str(),
+                 width, height, job.frames, job.fps, aa.c_str(), renderer->device().c_str());
     ReuseTotals totals;
     Frame frame, low;
     auto begin = std::chrono::steady_clock::now();
@@ -250,6 +257,11 @@ int command_render(int argc, char** argv) {
         "2|4: also colour at 1/2 (W/2 x H) or 1/4 (W/2 x H/2) of the pixels with a per-frame "
         "sub-pixel jitter, in OUT/lowres (colour only; reprise:jitter in its own pixels); "
         "OUT keeps the full-resolution G-buffer (reprise upsample)");
+    args.option("--aa", &job.aa,
+                "anti-aliased colour: 1 (off), 2, 4, 8 or 16 samples per pixel (default 4; MSAA "
+                "where the device has the count, else supersampling). Depth, motion, normals, "
+                "ids stay single samples at the pixel centre; heavy shading and --lowres renders "
+                "are single-sample");
     args.option("--out", &job.out, "output folder (required)");
     Status parsed = args.parse(argc, argv);
     if (!parsed.ok() || args.help_requested()) return report(args, parsed, {});

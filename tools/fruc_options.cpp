@@ -19,10 +19,14 @@ Status parse_fruc_options(const std::string& mode, const std::string& warp_name,
         options.warp = WarpMethod::Splat;
     else if (warp_name == "grid")
         options.warp = WarpMethod::Grid;
+    else if (warp_name == "grid-bicubic" || warp_name == "grid-bilinear")
+        options.warp = WarpMethod::Grid, options.grid.bicubic = warp_name == "grid-bicubic";
     else if (warp_name == "auto")
         options.warp = WarpMethod::Auto;
     else
-        return Status::error("--warp '" + warp_name + "': expected reverse, splat, grid or auto");
+        return Status::error("--warp '" + warp_name +
+                             "': expected reverse, splat, grid, grid-bicubic, grid-bilinear or "
+                             "auto");
     if (fill == "pullpush")
         options.fill = FillMethod::PullPush;
     else if (fill == "andreev")

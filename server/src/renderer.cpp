@@ -75,6 +75,37 @@ Status link(const char* vertex, const char* fragment, const char* what, GLuint& 
 
 constexpr int kShadowMapSize = 1024;
 
+// Supersampling's sample positions in pixels from the pixel centre (+y down): Direct3D's standard
+// 2x, 4x, 8x and 16x patterns (sixteenths of a pixel), distinct in x and in y.
+constexpr glm::vec2 kSamples2[] = {{4, 4}, {-4, -4}};
+constexpr glm::vec2 kSamples4[] = {{-2, -6}, {6, -2}, {-6, 2}, {2, 6}};
+constexpr glm::vec2 kSamples8[] = {{1, -3}, {-1, 3},  {5, 1}, {-3, -5},
+                                   {-5, 5}, {-7, -1}, {3, 7}, {7, -7}};
+constexpr glm::vec2 kSamples16[] = {{1, 1},  {-1, -3}, {-3, 2}, {4, -1}, {-5, -2}, {2, 5},
+                                    {5, 3},  {3, -5},  {-2, 6}, {0, -7}, {-4, -6}, {-6, 4},
+                                    {-8, 0}, {7, -4},  {6, 7},  {-7, -8}};
+
+const glm::vec2* supersample_positions(int samples) {
+    switch (samples) {
+        case 2:
+            return kSamples2;
+        case 4:
+            return kSamples4;
+        case 8:
+            return kSamples8;
+        case 16:
+            return kSamples16;
+    }
+    return nullptr;
+}
+
+// The jittered view-projection: pixel p samples the unjittered image at p + offset.
+glm::mat4 shifted(const glm::mat4& view_projection, glm::vec2 offset, int w, int h) {
+    return glm::translate(glm::mat4(1.0f), glm::vec3(-2.0f * offset.x / float(w),
+                                                     2.0f * offset.y / float(h), 0.0f)) *
+           view_projection;
+}
+
 // CPU time of all threads of this process (llvmpipe shades on its own threads): on a shared
 // machine it varies far less than wall time.
 double process_cpu_ms() {
@@ -192,6 +223,12 @@ struct Renderer::Gpu {
     GLuint framebuffer = 0;
     GLuint targets[3] = {};  // colour, (depth, motion, id), normal
     GLuint depth_buffer = 0;
+    // Anti-aliased colour by MSAA: a multisampled colour and depth target, resolved into
+    // targets[0] after the single-sample G-buffer pass.
+    GLuint msaa_framebuffer = 0, msaa_color = 0, msaa_depth = 0;
+    int msaa_samples = 0, msaa_width = 0, msaa_height = 0;
+    std::vector<GLint> msaa_counts;  // sample counts of RGBA32F renderbuffers on this device
+    bool software = false;           // llvmpipe or softpipe
     GLuint vertex_array = 0, vertex_buffer = 0, index_buffer = 0;
     int width = 0, height = 0;
     int cache_width = 0, cache_height = 0;
@@ -216,6 +253,9 @@ struct Renderer::Gpu {
         glDeleteTextures(3, targets);
         glDeleteRenderbuffers(1, &depth_buffer);
         glDeleteFramebuffers(1, &framebuffer);
+        glDeleteFramebuffers(1, &msaa_framebuffer);
+        glDeleteRenderbuffers(1, &msaa_color);
+        glDeleteRenderbuffers(1, &msaa_depth);
         glDeleteBuffers(1, &vertex_buffer);
         glDeleteBuffers(1, &index_buffer);
         glDeleteVertexArrays(1, &vertex_array);
@@ -328,6 +368,35 @@ struct Renderer::Gpu {
         if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
             return Status::error("OpenGL ES: the float G-buffer is not renderable on this device");
         width = w, height = h;
+        return {};
+    }
+
+    bool msaa_has(int samples) const {
+        return std::find(msaa_counts.begin(), msaa_counts.end(), samples) != msaa_counts.end();
+    }
+
+    Status prepare_msaa(int samples, int w, int h) {
+        if (samples == msaa_samples && w == msaa_width && h == msaa_height) return {};
+        if (!msaa_framebuffer) {
+            glGenFramebuffers(1, &msaa_framebuffer);
+            glGenRenderbuffers(1, &msaa_color);
+            glGenRenderbuffers(1, &msaa_depth);
+        }
+        glBindFramebuffer(GL_FRAMEBUFFER, msaa_framebuffer);
+        glBindRenderbuffer(GL_RENDERBUFFER, msaa_color);
+        glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_RGBA32F, w, h);
+        glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER,
+                                  msaa_color);
+        glBindRenderbuffer(GL_RENDERBUFFER, msaa_depth);
+        glRenderbufferStorageMultisample(GL_RENDERBUFFER, samples, GL_DEPTH_COMPONENT32F, w, h);
+        glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, msaa_depth);
+        const GLenum buffer = GL_COLOR_ATTACHMENT0;
+        glDrawBuffers(1, &buffer);
+        msaa_samples = msaa_width = msaa_height = 0;
+        if (glCheckFramebufferStatus(GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
+            return Status::error("OpenGL ES: " + std::to_string(samples) +
+                                 "x multisampled float colour is not renderable on this device");
+        msaa_samples = samples, msaa_width = w, msaa_height = h;
         return {};
     }
 
@@ -485,6 +554,10 @@ void Renderer::Gpu::read_reuse(bool reusing, const Image<uint32_t>& ids) {
     }
 }
 
+bool aa_samples_valid(int samples) {
+    return samples == 1 || supersample_positions(samples) != nullptr;
+}
+
 bool lowres_factor_valid(int factor) { return factor == 1 || factor == 2 || factor == 4; }
 
 glm::ivec2 lowres_size(int width, int height, int factor) {
@@ -526,6 +599,9 @@ Renderer::Renderer() : gpu_(std::make_unique<Gpu>()) {}
 Renderer::~Renderer() = default;
 
 const std::string& Renderer::device() const { return gpu_->context->description(); }
+bool Renderer::msaa_supported(int samples) const {
+    return gpu_->msaa_has(samples) && !gpu_->software;
+}
 const ReuseStats& Renderer::reuse_stats() const { return gpu_->stats; }
 const ReuseMaps& Renderer::reuse_maps() const { return gpu_->maps; }
 void Renderer::drop_reuse_cache() { gpu_->cache_valid = false; }
@@ -554,6 +630,16 @@ Status Renderer::create(std::unique_ptr<Renderer>& renderer) {
     if (extensions &&
         std::string(extensions).find("GL_EXT_texture_filter_anisotropic") != std::string::npos)
         glGetFloatv(0x84FF /* MAX_TEXTURE_MAX_ANISOTROPY_EXT */, &g.max_anisotropy);
+    GLint counts = 0;
+    glGetInternalformativ(GL_RENDERBUFFER, GL_RGBA32F, GL_NUM_SAMPLE_COUNTS, 1, &counts);
+    g.msaa_counts.assign(std::size_t(std::clamp(counts, 0, 32)), 0);
+    if (!g.msaa_counts.empty())
+        glGetInternalformativ(GL_RENDERBUFFER, GL_RGBA32F, GL_SAMPLES,
+                              GLsizei(g.msaa_counts.size()), g.msaa_counts.data());
+    while (glGetError() != GL_NO_ERROR) g.msaa_counts.clear();
+    const char* name = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
+    g.software = name && (std::string(name).find("llvmpipe") != std::string::npos ||
+                          std::string(name).find("softpipe") != std::string::npos);
     renderer = std::move(r);
     return {};
 }
@@ -569,14 +655,19 @@ Status Renderer::render(const Scene& scene, const Instant& current, const Instan
     g.gather(scene, current.time, previous.time);
 
     // Pixel p samples the unjittered image at p + jitter: shift the image by -jitter.
-    glm::mat4 shift = glm::translate(
-        glm::mat4(1.0f),
-        glm::vec3(-2.0f * current.jitter.x / float(w), 2.0f * current.jitter.y / float(h), 0.0f));
-    glm::mat4 view_projection = shift * current.projection * current.view;
+    const glm::mat4 unjittered = current.projection * current.view;
+    const glm::mat4 view_projection = shifted(unjittered, current.jitter, w, h);
     glm::mat4 previous_view_projection = previous.projection * previous.view;
     glm::vec3 eye = glm::vec3(glm::inverse(current.view)[3]);
 
     const bool heavy = settings.shading == Shading::Heavy;
+    if (!aa_samples_valid(settings.aa_samples))
+        return Status::error("renderer: anti-aliasing samples " +
+                             std::to_string(settings.aa_samples) + " must be 1, 2, 4, 8 or 16");
+    const int aa = heavy ? 1 : settings.aa_samples;
+    const bool msaa = aa > 1 && g.msaa_has(aa) &&
+                      (settings.aa_method == AntiAliasing::Msaa ||
+                       (settings.aa_method == AntiAliasing::Auto && !g.software));
     const ReuseSettings& reuse = settings.reuse;
     const bool reusing = heavy && reuse.mode != Reuse::Off;
     if (heavy) {
@@ -647,7 +738,6 @@ Status Renderer::render(const Scene& scene, const Instant& current, const Instan
     glDepthFunc(GL_LESS);
     glDisable(GL_BLEND);
 
-    const glm::mat4 unjittered = current.projection * current.view;
     // Everything a program of the main pass needs besides the per-draw material.
     auto use = [&](GLuint program) {
         g.active = program;
@@ -702,6 +792,53 @@ Status Renderer::render(const Scene& scene, const Instant& current, const Instan
     if (!heavy) {
         use(g.program);
         draw_all(true);
+        if (msaa) {
+            // The same draws into the multisampled target, resolved into the colour target.
+            REPRISE_TRY(g.prepare_msaa(aa, w, h));
+            glBindFramebuffer(GL_FRAMEBUFFER, g.msaa_framebuffer);
+            glClearBufferfv(GL_COLOR, 0, glm::value_ptr(sky));
+            glClear(GL_DEPTH_BUFFER_BIT);
+            draw_all(true);
+            glBindFramebuffer(GL_DRAW_FRAMEBUFFER, g.framebuffer);
+            const GLenum color_only = GL_COLOR_ATTACHMENT0;
+            glDrawBuffers(1, &color_only);
+            glBlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+            glBindFramebuffer(GL_FRAMEBUFFER, g.framebuffer);
+        } else if (aa > 1) {
+            // Supersampling: the mean of `aa` passes, each sampling around p + jitter + offset;
+            // sky where a pass drew nothing is added on read-back from the summed coverage.
+            // Each pass lays depth first, then adds the one fragment per pixel at that depth
+            // (the stencil admits a single one where coplanar surfaces tie).
+            const GLenum color_only = GL_COLOR_ATTACHMENT0;
+            glDrawBuffers(1, &color_only);
+            glClearBufferfv(GL_COLOR, 0, glm::value_ptr(zero));
+            glBlendFunc(GL_CONSTANT_ALPHA, GL_ONE);
+            glBlendColor(0.0f, 0.0f, 0.0f, 1.0f / float(aa));
+            glStencilFunc(GL_EQUAL, 0, 0xff);
+            glStencilOp(GL_KEEP, GL_KEEP, GL_INCR);
+            const GLint matrix = g.uniform("u_view_projection");
+            const glm::vec2* positions = supersample_positions(aa);
+            for (int i = 0; i < aa; ++i) {
+                const glm::mat4 sample =
+                    shifted(unjittered, current.jitter + positions[i] / 16.0f, w, h);
+                glUniformMatrix4fv(matrix, 1, GL_FALSE, glm::value_ptr(sample));
+                glDepthMask(GL_TRUE);  // glClear obeys the write mask
+                glClear(GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
+                glDepthFunc(GL_LESS);
+                glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+                draw_all(false);
+                glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+                glDepthFunc(GL_EQUAL);
+                glDepthMask(GL_FALSE);
+                glEnable(GL_STENCIL_TEST);
+                glEnable(GL_BLEND);
+                draw_all(true);
+                glDisable(GL_BLEND);
+                glDisable(GL_STENCIL_TEST);
+            }
+            glDepthFunc(GL_LESS);
+            glDepthMask(GL_TRUE);
+        }
     } else {
         // Depth pre-pass: each pixel then runs the heavy shader once.
         g.active = g.shadow_program;
@@ -760,14 +897,18 @@ Status Renderer::render(const Scene& scene, const Instant& current, const Instan
             for (int x = 0; x < w; ++x) store(x, y, row[x]);
         }
     };
-    read(0, [&](int x, int y, glm::vec4 v) { frame.color(x, y) = v; });
+    if (aa > 1 && !msaa)
+        read(0, [&](int x, int y, glm::vec4 v) {
+            frame.color(x, y) = glm::vec4(glm::vec3(v) + (1.0f - v.a) * scene.background, v.a);
+        });
+    else
+        read(0, [&](int x, int y, glm::vec4 v) { frame.color(x, y) = v; });
     read(2, [&](int x, int y, glm::vec4 v) { frame.normal(x, y) = glm::vec3(v); });
     // Background: depth +inf, motion of the point at infinity seen through this pixel, with
     // both ends projected the same way (a still camera gives exactly 0).
     // Orthographic cameras see the far plane instead (w = 1: a point, not a direction).
     const double point = current.projection[3][3] == 1.0f ? 1.0 : 0.0;
-    const glm::dmat4 unproject =
-        glm::inverse(glm::dmat4(shift * current.projection * current.view));
+    const glm::dmat4 unproject = glm::inverse(glm::dmat4(view_projection));
     auto to_pixels = [&](const glm::mat4& matrix, glm::dvec4 world, glm::dvec2& pixel) {
         glm::dvec4 clip = glm::dmat4(matrix) * world;
         pixel = {(clip.x / clip.w * 0.5 + 0.5) * w, (0.5 - 0.5 * clip.y / clip.w) * h};
@@ -794,6 +935,10 @@ Status Renderer::render(const Scene& scene, const Instant& current, const Instan
             to_pixels(unjittered, world, here) && to_pixels(previous_view_projection, world, there);
         frame.motion(x, y) = visible ? glm::vec2(there - here) : glm::vec2(nan);
     });
+    // Coverage stays the pixel centre's, as without anti-aliasing.
+    if (aa > 1)
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) frame.color(x, y).a = frame.id(x, y) != 0 ? 1.0f : 0.0f;
     if (heavy) g.read_reuse(reusing, frame.id);
     if (reusing) {
         g.cache_valid = true;
@@ -855,7 +1000,11 @@ Status Renderer::render_lowres(const Scene& scene, const Instant& current, const
                                Frame& frame, Image<glm::vec4>& low_color, glm::vec2& jitter) {
     REPRISE_ASSERT(lowres_factor_valid(factor));
     REPRISE_TRY(check_image_size(settings.width, settings.height, "renderer"));
-    REPRISE_TRY(render(scene, current, previous, settings, frame));
+    // Single samples at full resolution too: the upsampler rebuilds the point-sampled image from
+    // jittered point samples, and that image is what its output is compared with.
+    RenderSettings full_settings = settings;
+    full_settings.aa_samples = 1;
+    REPRISE_TRY(render(scene, current, previous, full_settings, frame));
     const glm::ivec2 low = lowres_size(settings.width, settings.height, factor);
     // Relative to the unjittered full image (the full frame's own jitter, usually 0, included).
     jitter = current.jitter + lowres_jitter(settings.width, settings.height, factor, jitter_index);
@@ -864,7 +1013,7 @@ Status Renderer::render_lowres(const Scene& scene, const Instant& current, const
     // The same frustum (projection of the full size) at the low size; the jitter in low pixels.
     Instant now = current;
     now.jitter = jitter / footprint;
-    RenderSettings low_settings = settings;
+    RenderSettings low_settings = full_settings;
     low_settings.width = low.x;
     low_settings.height = low.y;
     // Texture detail about as the full resolution picks it. (Scaling the screen derivatives

@@ -94,7 +94,8 @@ void size_scratch(Scratch& scratch, const Params& params, int source_width, int 
 
 // `simd` picks the vectorised span kernel (same result); it reads up to three depths past a
 // span, so band rows must be padded (scratch_rows).
-void draw_cell(ImageView<const glm::vec4> source, const Cell& cell, const Band& band, bool simd);
+void draw_cell(ImageView<const glm::vec4> source, const Cell& cell, const Band& band, bool simd,
+               bool bicubic);
 
 }  // namespace reprise::warp::grid
 

@@ -1,13 +1,15 @@
 // Rasterising grid cells: two triangles per cell, integer edge functions on 1/256-px vertices,
 // attributes (depth, source position, motion) interpolated linearly, a depth test, and a
-// bilinear colour lookup in the source. Compiled once per Highway target and chosen at run time:
-// from AVX2 on, the colour of two pixels is fetched a 256-bit vector at a time (same bits).
+// bilinear (or bicubic) colour lookup in the source. Compiled once per Highway target and chosen
+// at run time: from AVX2 on, the bilinear colour of two pixels is fetched a 256-bit vector at a
+// time (same bits).
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
 
 #include "grid_internal.hpp"
+#include "reprise/warp/sample.hpp"
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -69,8 +71,12 @@ struct Triangle {
 
 class Raster {
 public:
-    Raster(ImageView<const glm::vec4> source, const Band& band, bool simd)
-        : src_(source), band_(band), motion_(!band.view.motion.empty()), simd_(simd) {}
+    Raster(ImageView<const glm::vec4> source, const Band& band, bool simd, bool bicubic)
+        : src_(source),
+          band_(band),
+          motion_(!band.view.motion.empty()),
+          simd_(simd),
+          bicubic_(bicubic) {}
 
     void cell(const Cell& c) const {
         triangle(c.v[0], c.v[1], c.v[2], c.perspective);
@@ -246,6 +252,13 @@ private:
             // Positions are >= 0.5 here, so truncation is floor.
             const float fx = clamp_like_sse(s.sx + t.sx.gx * k, t.sx_lo, t.sx_hi) - 0.5f;
             const float fy = clamp_like_sse(s.sy + t.sy.gx * k, t.sy_lo, t.sy_hi) - 0.5f;
+            if (bicubic_) {
+                color[x] = bicubic_fetch(src_, fx + 0.5f, fy + 0.5f);
+                if (motion)
+                    motion[x] = {clamp_like_sse(s.mx + t.mx.gx * k, t.mx.lo, t.mx.hi),
+                                 clamp_like_sse(s.my + t.my.gx * k, t.my.lo, t.my.hi)};
+                continue;
+            }
             const int x0 = int(fx), y0 = int(fy);
             const float wx = fx - float(x0), wy = fy - float(y0);
             const glm::vec4* r0 = src_.row(y0) + x0;
@@ -319,6 +332,17 @@ private:
             const __m128 fy = _mm_sub_ps(
                 _mm_min_ps(_mm_max_ps(_mm_add_ps(sy0, _mm_mul_ps(v.gsy, kk)), v.sy_lo), v.sy_hi),
                 half);
+            if (bicubic_) {
+                alignas(16) float xs[4], ys[4];
+                _mm_store_ps(xs, _mm_add_ps(fx, half));
+                _mm_store_ps(ys, _mm_add_ps(fy, half));
+                while (mask) {
+                    const int i = __builtin_ctz(unsigned(mask));
+                    mask &= mask - 1;
+                    color[k + i] = bicubic_fetch(src_, xs[i], ys[i]);
+                }
+                continue;
+            }
             const __m128i x0 = _mm_cvttps_epi32(fx), y0 = _mm_cvttps_epi32(fy);
             const __m128 wx4 = _mm_sub_ps(fx, _mm_cvtepi32_ps(x0));
             const __m128 wy4 = _mm_sub_ps(fy, _mm_cvtepi32_ps(y0));
@@ -398,11 +422,13 @@ private:
     const Band& band_;
     bool motion_;
     bool simd_;
+    bool bicubic_;
 };
 
 }  // namespace
 
-void DrawCellSimd(ImageView<const glm::vec4> source, const Cell& c, const Band& band, bool simd) {
+void DrawCellSimd(ImageView<const glm::vec4> source, const Cell& c, const Band& band, bool simd,
+                  bool bicubic) {
     int lo = c.v[0].y, hi = c.v[0].y;
     for (const Vertex& v : c.v) {
         lo = std::min(lo, v.y);
@@ -411,7 +437,7 @@ void DrawCellSimd(ImageView<const glm::vec4> source, const Cell& c, const Band& 
     if (first_centre(int64_t(lo) - kOverlap) >= band.y0 + band.view.color.height ||
         last_centre(int64_t(hi) + kOverlap) < band.y0)
         return;
-    Raster(source, band, simd).cell(c);
+    Raster(source, band, simd, bicubic).cell(c);
 }
 
 }  // namespace reprise::warp::grid::HWY_NAMESPACE
@@ -422,8 +448,9 @@ namespace reprise::warp::grid {
 
 HWY_EXPORT(DrawCellSimd);
 
-void draw_cell(ImageView<const glm::vec4> source, const Cell& c, const Band& band, bool simd) {
-    HWY_DYNAMIC_DISPATCH(DrawCellSimd)(source, c, band, simd);
+void draw_cell(ImageView<const glm::vec4> source, const Cell& c, const Band& band, bool simd,
+               bool bicubic) {
+    HWY_DYNAMIC_DISPATCH(DrawCellSimd)(source, c, band, simd, bicubic);
 }
 
 }  // namespace reprise::warp::grid

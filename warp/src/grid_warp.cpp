@@ -80,7 +80,8 @@ GridStats GridWarper::run(const GBufferView& source, float factor, const WarpTar
         for (int r = 0; r < top_rows; ++r) {
             const grid::Row& row = st.rows[std::size_t(r)];
             if (row.y_hi < band.y0 || row.y_lo >= y_end) continue;
-            for (const grid::Cell& c : row.cells) grid::draw_cell(color, c, band, simd);
+            for (const grid::Cell& c : row.cells)
+                grid::draw_cell(color, c, band, simd, options.bicubic);
         }
     };
     if (!threaded) {

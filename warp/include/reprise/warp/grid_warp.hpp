@@ -17,6 +17,9 @@ struct GridOptions {
     float depth_threshold = 0.01f;  // at most 0.5
     // motion in target pixels, i.e. |factor| * |motion - predicted motion| on either axis.
     float motion_threshold = 0.25f;
+    // Colour by a Catmull-Rom (bicubic) fetch at the interpolated source position instead of a
+    // bilinear one: sharper, as the reverse warp's refetch.
+    bool bicubic = false;
 };
 
 struct GridStats {
@@ -41,9 +44,10 @@ struct GridStats {
 // interpolated perspective-correctly (1/z linearly) in cells that passed the test, linearly in
 // the smallest cells that hold an edge by the vertex test (background there as a huge finite
 // depth that loses against all geometry); colour is fetched bilinearly from the source at the
-// interpolated source position. Cell edges are pushed out by 1/16 px so that T-junctions leave no
-// hairline cracks. Cells with a vertex further than 2^20 pixels away are dropped, and so is motion
-// of 1e30 px or more. Same pixel coordinates in source and target, whose sizes may differ.
+// interpolated source position (or bicubically, `bicubic`). Cell edges are pushed out by 1/16 px so
+// that T-junctions leave no hairline cracks. Cells with a vertex further than 2^20 pixels away are
+// dropped, and so is motion of 1e30 px or more. Same pixel coordinates in source and target, whose
+// sizes may differ.
 class GridWarper {
 public:
     GridStats warp(const GBufferView& source, float factor, const WarpTarget& target,
