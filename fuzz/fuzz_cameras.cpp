@@ -8,8 +8,7 @@
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const std::vector<std::string> files = {"dir/0001.exr", "dir/0002.exr"};
     std::vector<reprise::Camera> cameras;
-    (void)reprise::parse_cameras_json(
-        std::string_view(reinterpret_cast<const char*>(data), size), "fuzz/cameras.json", files,
-        cameras);
+    (void)reprise::parse_cameras_json(std::string_view(reinterpret_cast<const char*>(data), size),
+                                      "fuzz/cameras.json", files, cameras);
     return 0;
 }

@@ -20,8 +20,7 @@ constexpr std::uintmax_t kMaxBytes = 64u << 20;
 Status matrix(const json& entry, const char* key, const std::string& where, bool required,
               glm::mat4& out, bool& found) {
     found = entry.contains(key);
-    if (!found)
-        return required ? Status::error(where + ": no \"" + key + "\"") : Status();
+    if (!found) return required ? Status::error(where + ": no \"" + key + "\"") : Status();
     const json& values = entry[key];
     if (!values.is_array() || values.size() != 16)
         return Status::error(where + ": \"" + key + "\" must hold 16 numbers (column-major)");
@@ -84,8 +83,7 @@ Status parse_cameras_json(std::string_view text, const std::string& path,
         REPRISE_TRY(number(entry, "near", where, near));
         REPRISE_TRY(number(entry, "far", where, far));
         REPRISE_TRY(number(entry, "time", where, time));
-        if (!(near > 0.0 && far > near))
-            return Status::error(where + ": needs 0 < near < far");
+        if (!(near > 0.0 && far > near)) return Status::error(where + ": needs 0 < near < far");
         if (!has_projection(camera) || glm::determinant(camera.projection) == 0.0f ||
             glm::determinant(camera.prev_projection) == 0.0f)
             return Status::error(where + ": a projection is the identity or singular");
