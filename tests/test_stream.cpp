@@ -51,6 +51,7 @@ server::StreamServerOptions server_options(uint16_t port = 0) {
             .fps = 30.0,
             .width = kWidth,
             .height = kHeight,
+            .aa_samples = 1,  // these tests are about the stream, not the renderer's cost
             .session_timeout_s = 2.0};
 }
 
@@ -104,8 +105,9 @@ double mean_psnr(const std::vector<Shown>& kept) {
         now.view = k.view;
         server::Instant before = now;
         before.time -= 1.0 / 30.0;
-        EXPECT_TRUE(
-            r->render(scene, now, before, {.width = kWidth, .height = kHeight}, truth).ok());
+        EXPECT_TRUE(r->render(scene, now, before,
+                              {.width = kWidth, .height = kHeight, .aa_samples = 1}, truth)
+                        .ok());
         to_display(truth.color.view(), a.view());
         to_display(k.color.view(), b.view());
         sum += std::min(60.0, psnr(a.view(), b.view()));

@@ -12,6 +12,7 @@
 #include "reprise/client/stream_client.hpp"
 #include "reprise/core/exr.hpp"
 #include "reprise/server/builtin_scenes.hpp"
+#include "reprise/server/renderer.hpp"
 #include "reprise/server/stream_server.hpp"
 #include "stream_window.hpp"
 
@@ -25,7 +26,8 @@ extern "C" void on_signal(int) { g_stop.store(true); }
 struct ServeJob {
     std::string scene = "pan", listen = "127.0.0.1:7000", pin, size = "640x360", mode = "full";
     double fps = 30.0, duration = 0.0;
-    int max_sessions = 4, qp = 28, bitrate = 0, fec_group = 8, metrics_port = -1, lowres = 4;
+    int max_sessions = 4, qp = 28, bitrate = 0, fec_group = 8, metrics_port = -1, lowres = 4,
+        aa = 4;
 };
 
 Status run_serve(const ServeJob& job) {
@@ -44,6 +46,8 @@ Status run_serve(const ServeJob& job) {
         return Status::error("--mode must be full or lowres");
     if (job.lowres != 2 && job.lowres != 4) return Status::error("--lowres must be 2 or 4");
     o.lowres_factor = job.lowres;
+    if (!server::aa_samples_valid(job.aa)) return Status::error("--aa must be 1, 2, 4, 8 or 16");
+    o.aa_samples = job.aa;
     o.max_sessions = job.max_sessions;
     if (job.qp < 0 || job.qp > 51) return Status::error("--qp must be 0..51");
     o.encoder.qp = job.qp;
@@ -236,6 +240,8 @@ int command_serve(int argc, char** argv) {
     args.option("--mode", &job.mode, "full (default) or lowres");
     args.option("--lowres", &job.lowres,
                 "lowres mode: 2 or 4 pixels per colour sample (default 4)");
+    args.option("--aa", &job.aa,
+                "anti-aliased colour, samples per pixel: 1 (off, fastest), 2, 4 (default), 8, 16");
     args.option("--max-sessions", &job.max_sessions, "sessions at once (default 4)");
     args.option("--qp", &job.qp, "quantiser when no --bitrate (default 28)");
     args.option("--bitrate", &job.bitrate,

@@ -392,8 +392,9 @@ struct StreamServer::State {
                                                 {.width = w, .height = h}, options.lowres_factor,
                                                 s.frames_rendered, s.frame, s.low_color, jitter));
         else
-            REPRISE_TRY(
-                renderer->render(s.scene, current, previous, {.width = w, .height = h}, s.frame));
+            REPRISE_TRY(renderer->render(
+                s.scene, current, previous,
+                {.width = w, .height = h, .aa_samples = options.aa_samples}, s.frame));
         ++s.frames_rendered;
         s.frame.fps = options.fps;
         const double render_ms = ms_since(t0);
