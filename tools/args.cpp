@@ -12,17 +12,22 @@ namespace reprise::cli {
 Args::Args(std::string command, std::string summary)
     : command_(std::move(command)), summary_(std::move(summary)) {}
 
+void Args::add(Spec spec) {
+    for (const Spec& s : options_)
+        REPRISE_ASSERT(s.name != spec.name);  // one declaration per option
+    options_.push_back(std::move(spec));
+}
 void Args::option(const std::string& name, std::string* value, const std::string& help) {
-    options_.push_back({name, Kind::String, value, help});
+    add({name, Kind::String, value, help});
 }
 void Args::option(const std::string& name, int* value, const std::string& help) {
-    options_.push_back({name, Kind::Int, value, help});
+    add({name, Kind::Int, value, help});
 }
 void Args::option(const std::string& name, double* value, const std::string& help) {
-    options_.push_back({name, Kind::Double, value, help});
+    add({name, Kind::Double, value, help});
 }
 void Args::flag(const std::string& name, bool* value, const std::string& help) {
-    options_.push_back({name, Kind::Flag, value, help});
+    add({name, Kind::Flag, value, help});
 }
 void Args::positional(const std::string& name, std::string* value, const std::string& help,
                       bool required) {

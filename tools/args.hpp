@@ -37,6 +37,8 @@ private:
         bool required = false;
         bool seen = false;
     };
+    void add(Spec spec);
+
     std::string command_, summary_;
     std::vector<Spec> options_, positionals_;
     bool help_ = false;

@@ -1,7 +1,5 @@
 // reprise bench paths — whole made frames (interpolated with the grid and the reverse warp,
 // extrapolated, the second eye) against cv::remap of the same frame, timed interleaved in one run.
-#include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <opencv2/core.hpp>
@@ -11,6 +9,7 @@
 
 #include "args.hpp"
 #include "bench.hpp"
+#include "bench_report.hpp"
 #include "reprise/core/parallel.hpp"
 #include "reprise/stereo/rig.hpp"
 #include "reprise/stereo/synthesize.hpp"
@@ -20,30 +19,11 @@ namespace reprise::cli {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-struct Times {
-    std::vector<double> ms;
-    double best() const { return *std::min_element(ms.begin(), ms.end()); }
-    double median() const {
-        std::vector<double> s = ms;
-        std::sort(s.begin(), s.end());
-        return s[s.size() / 2];
-    }
-};
-
-template <class F>
-void time_into(Times& t, F&& f) {
-    const auto start = Clock::now();
-    f();
-    t.ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
-}
-
 struct Converter {
     const char* name;
     warp::FrameRateConverter converter;
     Frame out;
-    Times times;
+    Timing times;
 };
 
 Status bench_paths_size(const BenchScene& bench, int w, int h, int timed) {
@@ -61,14 +41,22 @@ Status bench_paths_size(const BenchScene& bench, int w, int h, int timed) {
     Converter converters[] = {
         {"interpolate grid+pullpush",
          {2, {.mode = FrucMode::Interpolate, .warp = WarpMethod::Grid}}},
+        {"interpolate grid, refine off",
+         {2,
+          {.mode = FrucMode::Interpolate, .warp = WarpMethod::Grid, .refine = {.enabled = false}}}},
         {"interpolate reverse+pullpush",
          {2, {.mode = FrucMode::Interpolate, .warp = WarpMethod::Reverse}}},
+        {"interpolate reverse, refine off",
+         {2,
+          {.mode = FrucMode::Interpolate,
+           .warp = WarpMethod::Reverse,
+           .refine = {.enabled = false}}}},
         {"extrapolate grid+pullpush",
          {2, {.mode = FrucMode::Extrapolate, .warp = WarpMethod::Grid}}},
     };
     stereo::StereoSynthesizer synthesizer;
     Frame eye;
-    Times stereo_times, remap_times;
+    Timing stereo_times, remap_times;
     cv::Mat map_x(h, w, CV_32FC1), map_y(h, w, CV_32FC1);
     Image<glm::vec4> remapped(w, h);
     cv::Mat dst(h, w, CV_32FC4, remapped.data());
@@ -84,7 +72,7 @@ Status bench_paths_size(const BenchScene& bench, int w, int h, int timed) {
                 }
             };
             if (timing)
-                time_into(c.times, run);
+                time_once(c.times, run);
             else
                 run();
             REPRISE_TRY(sent);
@@ -92,7 +80,7 @@ Status bench_paths_size(const BenchScene& bench, int w, int h, int timed) {
         const stereo::EyeCameras eyes = stereo::eye_cameras(f.camera, {}, stereo::Anchor::Left);
         auto synthesize = [&] { synthesizer.synthesize(f, eyes.right, eye); };
         if (timing)
-            time_into(stereo_times, synthesize);
+            time_once(stereo_times, synthesize);
         else
             synthesize();
         // The peer: cv::remap of this frame's colour along its motion (bilinear, float maps).
@@ -108,7 +96,7 @@ Status bench_paths_size(const BenchScene& bench, int w, int h, int timed) {
             cv::remap(src, dst, map_x, map_y, cv::INTER_LINEAR, cv::BORDER_CONSTANT);
         };
         if (timing)
-            time_into(remap_times, remap);
+            time_once(remap_times, remap);
         else
             remap();
         std::fprintf(stderr, "\r[bench] %dx%d %d/%d", w, h, i + 1, timed + 2);
@@ -116,13 +104,17 @@ Status bench_paths_size(const BenchScene& bench, int w, int h, int timed) {
     std::fprintf(stderr, "\r%40s\r", "");
 
     const std::string size = std::to_string(w) + "x" + std::to_string(h);
-    auto row = [&](const char* name, const Times& t) {
-        std::printf("%-10s %-30s %9.2f %9.2f %8.2fx %8.2fx\n", size.c_str(), name, t.best(),
-                    t.median(), t.best() / remap_times.best(), t.median() / remap_times.median());
+    auto row = [&](const char* name, const Timing& t, double refine_ms) {
+        std::printf("%-10s %-32s %9.2f %9.2f %8.2fx %8.2fx %9.2f\n", size.c_str(), name, t.best(),
+                    t.median(), t.best() / remap_times.best(), t.median() / remap_times.median(),
+                    refine_ms);
     };
-    for (const Converter& c : converters) row(c.name, c.times);
-    row("stereo eye grid+pullpush", stereo_times);
-    row("cv::remap (peer)", remap_times);
+    for (const Converter& c : converters) {
+        const warp::FrucCounters& n = c.converter.counters();
+        row(c.name, c.times, n.outputs ? n.refine_ms / double(n.outputs) : 0.0);
+    }
+    row("stereo eye grid+pullpush", stereo_times, 0.0);
+    row("cv::remap (peer)", remap_times, 0.0);
     return {};
 }
 
@@ -136,18 +128,15 @@ Status bench_paths(const BenchOptions& options) {
         "whole made frames vs cv::remap (INTER_LINEAR, CV_32FC4, float maps) of the same frame, "
         "interleaved\nscene %s from frame 10, %d timed frames, %d threads (reprise) / %d (OpenCV); "
         "fruc x2: one send() + receive() per frame (the made frame, the input passed through, "
-        "the shot-change test); stereo: the right eye from the left (ipd 0.064)\n",
+        "the shot-change test; refine ms: its mean in motion refinement); stereo: the right eye "
+        "from the left (ipd 0.064)\n",
         options.scene.c_str(), options.frames, thread_count(), cv::getNumThreads());
-    std::printf("%-10s %-30s %9s %9s %9s %9s\n", "size", "path", "best ms", "median ms",
-                "best/remap", "med/remap");
-    std::size_t start = 0;
-    while (start <= options.sizes.size()) {
-        std::size_t end = options.sizes.find(',', start);
-        if (end == std::string::npos) end = options.sizes.size();
+    std::printf("%-10s %-32s %9s %9s %9s %9s %9s\n", "size", "path", "best ms", "median ms",
+                "best/remap", "med/remap", "refine ms");
+    for (const std::string& size : split_list(options.sizes)) {
         int w = 0, h = 0;
-        REPRISE_TRY(parse_size(options.sizes.substr(start, end - start), w, h));
+        REPRISE_TRY(parse_size(size, w, h));
         REPRISE_TRY(bench_paths_size(bench, w, h, options.frames));
-        start = end + 1;
     }
     return {};
 }

@@ -151,15 +151,12 @@ int command_fruc(int argc, char** argv) {
     args.option("--in", &job.in, "input sequence (folder of EXR frames)");
     args.option("--factor", &job.factor, "K, output frames per input frame (default 2)");
     args.option("--mode", &job.mode, "interpolate | extrapolate (default interpolate)");
-    args.option(
-        "--warp", &job.warp,
-        "reverse | splat | grid (default grid; grid-bicubic, grid-bilinear pick its colour fetch)");
-    args.option("--fill", &job.fill, "pullpush | andreev | none (default pullpush)");
     args.option("--refine", &job.refine,
                 "on | off (default on): interpolation refines motion by optical flow where the "
                 "warped\nsides disagree (moving shadows, reflections, highlights)");
     args.option("--warp", &job.warp,
-                "reverse | splat | grid | auto (default grid; auto: chosen per frame)");
+                "reverse | splat | grid | auto (default grid; grid-bicubic, grid-bilinear pick "
+                "its colour\nfetch; auto: chosen per frame)");
     args.option("--fill", &job.fill, "pullpush | andreev | none | auto (default pullpush)");
     args.option("--budget-db", &job.budget_db,
                 "auto: the PSNR (dB) a made frame should reach; the cheapest setting expected to "
