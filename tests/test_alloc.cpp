@@ -131,17 +131,22 @@ Frame make_frame(int index, bool smooth = false) {
 // Motion refinement's optical flow (OpenCV DIS) allocates inside OpenCV: `refine` runs it on
 // smooth frames, where its survey finds the sides agreeing and nothing more runs.
 void run_converter(warp::FrucMode mode, bool refine = false,
-                   warp::WarpMethod method = warp::WarpMethod::Grid) {
+                   warp::WarpMethod method = warp::WarpMethod::Grid, bool owned = false) {
     std::vector<Frame> inputs;
     for (int i = 0; i < 12; ++i) inputs.push_back(make_frame(i, refine));
     warp::FrucOptions options{.mode = mode, .warp = method};
     options.refine.enabled = refine;
     warp::FrameRateConverter converter(2, options);
-    Frame out;
+    Frame in, out;
     bool ok = true;
     int made = 0;
     auto feed = [&](int i) {
-        ok = ok && converter.send(inputs[std::size_t(i)]).ok();
+        if (owned) {
+            in = inputs[std::size_t(i)];  // into the buffers the converter handed back
+            ok = ok && converter.send(std::move(in)).ok();
+        } else {
+            ok = ok && converter.send(inputs[std::size_t(i)]).ok();
+        }
         while (converter.receive(out)) ++made;
     };
     // Sizes the scratch, the queue and every frame that circulates through it (queued frames
@@ -172,6 +177,11 @@ TEST(Allocations, CounterSeesAnAllocation) {
 
 TEST(Allocations, InterpolationSteadyStateAllocatesNothing) {
     run_converter(warp::FrucMode::Interpolate);
+}
+
+TEST(Allocations, OwnedFramesSteadyStateAllocatesNothing) {
+    run_converter(warp::FrucMode::Interpolate, false, warp::WarpMethod::Grid, true);
+    run_converter(warp::FrucMode::Extrapolate, false, warp::WarpMethod::Grid, true);
 }
 
 TEST(Allocations, InterpolationSurveyForRefinementAllocatesNothing) {

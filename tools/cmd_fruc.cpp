@@ -92,7 +92,7 @@ Status run_fruc(const FrucJob& job) {
                          job.ui.empty() ? "ui.R ui.G ui.B ui.A channels" : job.ui.c_str(),
                          job.ui_composite ? ", drawn into the colour" : ", in its ui channels");
         auto start = std::chrono::steady_clock::now();
-        REPRISE_TRY(converter.send(in));
+        REPRISE_TRY(converter.send(std::move(in)));  // `in` gets buffers back to read into
         busy_ms +=
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
                 .count();

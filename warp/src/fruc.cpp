@@ -233,9 +233,9 @@ struct FrameRateConverter::State {
         return c;
     }
 
-    // The input itself as an output (motion per output period) and as the next `previous`, in
-    // one pass over it.
-    void emit_input(const Frame& frame) {
+    // The input itself as an output (motion per output period) and, with keep, as the next
+    // `previous`, in one pass over it.
+    void emit_input(const Frame& frame, bool keep) {
         Frame& out = ready.push();
         const GBufferView in = frame.view();
         size_like(out.color, in.color);
@@ -243,11 +243,14 @@ struct FrameRateConverter::State {
         size_like(out.motion, in.motion);
         size_like(out.normal, in.normal);
         size_like(out.id, in.id);
-        size_like(previous.color, in.color);
-        size_like(previous.depth, in.depth);
-        size_like(previous.motion, in.motion);
-        size_like(previous.id, in.id);
-        previous.normal.clear();
+        if (keep) {
+            size_like(previous.color, in.color);
+            size_like(previous.depth, in.depth);
+            size_like(previous.motion, in.motion);
+            size_like(previous.id, in.id);
+            previous.normal.clear();
+        }
+        Frame* const kept = keep ? &previous : nullptr;
         const float scale = motion_scale();
         auto rows_of = [](const auto& view, int y0, int y1) {
             return std::pair(std::min(y0, view.height), std::min(y1, view.height));
@@ -255,11 +258,11 @@ struct FrameRateConverter::State {
         parallel_for(
             0, frame.height(),
             [&](int y0, int y1) {
-                copy_rows(in.color, out.color, y0, y1, &previous.color);
+                copy_rows(in.color, out.color, y0, y1, kept ? &kept->color : nullptr);
                 auto [d0, d1] = rows_of(in.depth, y0, y1);
-                copy_rows(in.depth, out.depth, d0, d1, &previous.depth);
+                copy_rows(in.depth, out.depth, d0, d1, kept ? &kept->depth : nullptr);
                 auto [m0, m1] = rows_of(in.motion, y0, y1);
-                copy_rows(in.motion, previous.motion, m0, m1);
+                if (kept) copy_rows(in.motion, kept->motion, m0, m1);
                 for (int y = m0; y < m1; ++y) {
                     const glm::vec2* from = in.motion.row(y);
                     glm::vec2* to = &out.motion(0, y);
@@ -268,16 +271,19 @@ struct FrameRateConverter::State {
                 auto [n0, n1] = rows_of(in.normal, y0, y1);
                 copy_rows(in.normal, out.normal, n0, n1);
                 auto [i0, i1] = rows_of(in.id, y0, y1);
-                copy_rows(in.id, out.id, i0, i1, &previous.id);
+                copy_rows(in.id, out.id, i0, i1, kept ? &kept->id : nullptr);
             },
             32);
-        out.camera = previous.camera = frame.camera;
+        out.camera = frame.camera;
         out.fps = frame.fps > 0 ? frame.fps * factor : 0.0;
-        previous.fps = frame.fps;
-        if (frame.ui.empty())
-            previous.ui.clear();
-        else
-            copy_image(frame.ui.view(), previous.ui);
+        if (keep) {
+            previous.camera = frame.camera;
+            previous.fps = frame.fps;
+            if (frame.ui.empty())
+                previous.ui.clear();
+            else
+                copy_image(frame.ui.view(), previous.ui);
+        }
         attach_ui(out, frame, false);
     }
 
@@ -330,7 +336,11 @@ bool FrameRateConverter::receive(Frame& out) {
     return true;
 }
 
-Status FrameRateConverter::send(const Frame& frame) {
+Status FrameRateConverter::send(const Frame& frame) { return send_frame(frame, nullptr); }
+
+Status FrameRateConverter::send(Frame&& frame) { return send_frame(frame, &frame); }
+
+Status FrameRateConverter::send_frame(const Frame& frame, Frame* owned) {
     State& st = *state_;
     const int w = frame.width(), h = frame.height();
     REPRISE_TRY(check_image_size(w, h, "fruc input frame"));
@@ -399,9 +409,9 @@ Status FrameRateConverter::send(const Frame& frame) {
                 st.attach_ui(st.ready.back(), s >= 0.5f ? frame : a, true);
             }
         }
-        st.emit_input(frame);
+        st.emit_input(frame, !owned);
     } else {
-        st.emit_input(frame);
+        st.emit_input(frame, !owned);
         if (st.automatic() && warpable && !cut) predicted = survey_predictors(frame);
         const Camera before = State::previous_instant(frame.camera, fps);
         for (int k = 1; k < k_max; ++k) {
@@ -420,6 +430,7 @@ Status FrameRateConverter::send(const Frame& frame) {
             st.attach_ui(st.ready.back(), frame, true);
         }
     }
+    if (owned) std::swap(st.previous, *owned);  // the caller gets the old buffers to refill
     st.has_previous = true;
     st.previous_starts_shot = cut;
     return {};

@@ -148,6 +148,9 @@ public:
     // K-1 frames beyond it. Frames must have colour; depth, motion and cameras enable warping
     // (without them the output holds the last frame).
     Status send(const Frame& frame);
+    // The same without copying the frame to keep it: its buffers become the converter's, and
+    // `frame` gets back buffers of an earlier one (contents unspecified) for the caller to refill.
+    Status send(Frame&& frame);
     // Takes the next output frame; false when the converter needs the next input.
     bool receive(Frame& out);
 
@@ -157,6 +160,8 @@ public:
     void refine_region(Image<uint8_t>& mask) const;
 
 private:
+    Status send_frame(const Frame& frame, Frame* owned);
+
     struct State;
     std::unique_ptr<State> state_;
 };
