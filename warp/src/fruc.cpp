@@ -233,16 +233,16 @@ struct FrameRateConverter::State {
         return c;
     }
 
-    // The input itself as an output (motion per output period) and, with keep, as the next
-    // `previous`, in one pass over it.
+    // The input itself as an output (colour, depth, motion per output period: what made frames
+    // carry) and, with keep, as the next `previous`, in one pass over it.
     void emit_input(const Frame& frame, bool keep) {
         Frame& out = ready.push();
         const GBufferView in = frame.view();
         size_like(out.color, in.color);
         size_like(out.depth, in.depth);
         size_like(out.motion, in.motion);
-        size_like(out.normal, in.normal);
-        size_like(out.id, in.id);
+        out.normal.clear();
+        out.id.clear();
         if (keep) {
             size_like(previous.color, in.color);
             size_like(previous.depth, in.depth);
@@ -268,10 +268,10 @@ struct FrameRateConverter::State {
                     glm::vec2* to = &out.motion(0, y);
                     for (int x = 0; x < in.motion.width; ++x) to[x] = from[x] * scale;
                 }
-                auto [n0, n1] = rows_of(in.normal, y0, y1);
-                copy_rows(in.normal, out.normal, n0, n1);
-                auto [i0, i1] = rows_of(in.id, y0, y1);
-                copy_rows(in.id, out.id, i0, i1, kept ? &kept->id : nullptr);
+                if (kept) {
+                    auto [i0, i1] = rows_of(in.id, y0, y1);
+                    copy_rows(in.id, kept->id, i0, i1);
+                }
             },
             32);
         out.camera = frame.camera;

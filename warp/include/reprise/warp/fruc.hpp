@@ -146,7 +146,8 @@ public:
     // interpolation gives, for every frame after the first, the K-1 frames between it and its
     // predecessor followed by the frame itself; extrapolation gives the frame itself followed by
     // K-1 frames beyond it. Frames must have colour; depth, motion and cameras enable warping
-    // (without them the output holds the last frame).
+    // (without them the output holds the last frame). Every output frame carries colour, depth,
+    // motion (per output period), the camera and the UI layer; normals and ids are not passed on.
     Status send(const Frame& frame);
     // The same without copying the frame to keep it: its buffers become the converter's, and
     // `frame` gets back buffers of an earlier one (contents unspecified) for the caller to refill.
