@@ -22,21 +22,33 @@ bool motion_is_linear(const GBufferView& f, const Camera& to, float factor, floa
     const StaticReprojection to_previous = camera_only_motion(f.camera, w, h);
     const StaticReprojection to_instant(f.camera, to.view, to.projection, w, h);
     const Unprojector& unproject = to_previous.unprojector();
-    for (int y = kStep / 2; y < h; y += kStep)
-        for (int x = kStep / 2; x < w; x += kStep) {
-            const glm::vec2 p(float(x) + 0.5f, float(y) + 0.5f), m = f.motion(x, y);
-            const float z = f.depth(x, y);
-            if (std::isnan(z)) continue;
-            const glm::vec4 point = unproject.point(p.x, p.y, z);
-            glm::vec2 before, landed;
-            if (!finite(m) || !to_previous.land(point, before) || !to_instant.land(point, landed))
-                return false;
-            const glm::vec2 unexplained = before - p - m, off_line = landed - (p + factor * m);
-            if (glm::dot(unexplained, unexplained) > tolerance * tolerance ||
-                glm::dot(off_line, off_line) > kDeviation * kDeviation)
-                return false;
-        }
-    return true;
+    std::atomic<bool> linear{true};
+    const int rows = (h + kStep / 2) / kStep;  // sampled rows kStep/2, kStep/2 + kStep, ...
+    parallel_for(
+        0, rows,
+        [&](int r0, int r1) {
+            for (int y = r0 * kStep + kStep / 2; y < std::min(h, r1 * kStep + kStep / 2);
+                 y += kStep) {
+                if (!linear.load(std::memory_order_relaxed)) return;
+                for (int x = kStep / 2; x < w; x += kStep) {
+                    const glm::vec2 p(float(x) + 0.5f, float(y) + 0.5f), m = f.motion(x, y);
+                    const float z = f.depth(x, y);
+                    if (std::isnan(z)) continue;
+                    const glm::vec4 point = unproject.point(p.x, p.y, z);
+                    glm::vec2 before, landed;
+                    if (!finite(m) || !to_previous.land(point, before) ||
+                        !to_instant.land(point, landed))
+                        return linear.store(false);
+                    const glm::vec2 unexplained = before - p - m,
+                                    off_line = landed - (p + factor * m);
+                    if (glm::dot(unexplained, unexplained) > tolerance * tolerance ||
+                        glm::dot(off_line, off_line) > kDeviation * kDeviation)
+                        return linear.store(false);
+                }
+            }
+        },
+        8);
+    return linear.load();
 }
 
 std::size_t motion_toward(const GBufferView& f, const Camera& to, float factor,
