@@ -38,21 +38,17 @@ Status bench_paths_size(const BenchScene& bench, int w, int h, int timed) {
     std::fprintf(stderr, "\r%40s\r", "");
 
     using warp::FrucMode, warp::WarpMethod, warp::FillMethod;
+    // The default (bicubic grid, refinement on), then what each of those costs.
+    const warp::RefineOptions off{.enabled = false};
+    const warp::GridOptions bilinear{.bicubic = false};
     Converter converters[] = {
-        {"interpolate grid+pullpush",
-         {2, {.mode = FrucMode::Interpolate, .warp = WarpMethod::Grid}}},
-        {"interpolate grid, refine off",
-         {2,
-          {.mode = FrucMode::Interpolate, .warp = WarpMethod::Grid, .refine = {.enabled = false}}}},
-        {"interpolate reverse+pullpush",
-         {2, {.mode = FrucMode::Interpolate, .warp = WarpMethod::Reverse}}},
-        {"interpolate reverse, refine off",
-         {2,
-          {.mode = FrucMode::Interpolate,
-           .warp = WarpMethod::Reverse,
-           .refine = {.enabled = false}}}},
-        {"extrapolate grid+pullpush",
-         {2, {.mode = FrucMode::Extrapolate, .warp = WarpMethod::Grid}}},
+        {"interpolate grid+pullpush", {2, {}}},
+        {"interpolate grid, refine off", {2, {.refine = off}}},
+        {"interpolate grid-bilinear, refine off", {2, {.grid = bilinear, .refine = off}}},
+        {"interpolate reverse+pullpush", {2, {.warp = WarpMethod::Reverse}}},
+        {"interpolate reverse, refine off", {2, {.warp = WarpMethod::Reverse, .refine = off}}},
+        {"extrapolate grid+pullpush", {2, {.mode = FrucMode::Extrapolate}}},
+        {"extrapolate grid-bilinear", {2, {.mode = FrucMode::Extrapolate, .grid = bilinear}}},
     };
     stereo::StereoSynthesizer synthesizer;
     Frame eye;
@@ -106,7 +102,7 @@ Status bench_paths_size(const BenchScene& bench, int w, int h, int timed) {
 
     const std::string size = std::to_string(w) + "x" + std::to_string(h);
     auto row = [&](const char* name, const Timing& t, double refine_ms) {
-        std::printf("%-10s %-32s %9.2f %9.2f %8.2fx %8.2fx %9.2f\n", size.c_str(), name, t.best(),
+        std::printf("%-10s %-38s %9.2f %9.2f %8.2fx %8.2fx %9.2f\n", size.c_str(), name, t.best(),
                     t.median(), t.best() / remap_times.best(), t.median() / remap_times.median(),
                     refine_ms);
     };
@@ -133,7 +129,7 @@ Status bench_paths(const BenchOptions& options) {
         "the shot-change test; refine ms: its mean in motion refinement); stereo: the right eye "
         "from the left (ipd 0.064)\n",
         options.scene.c_str(), options.frames, thread_count(), cv::getNumThreads());
-    std::printf("%-10s %-32s %9s %9s %9s %9s %9s\n", "size", "path", "best ms", "median ms",
+    std::printf("%-10s %-38s %9s %9s %9s %9s %9s\n", "size", "path", "best ms", "median ms",
                 "best/remap", "med/remap", "refine ms");
     for (const std::string& size : split_list(options.sizes)) {
         int w = 0, h = 0;
