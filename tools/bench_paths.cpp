@@ -2,6 +2,7 @@
 // extrapolated, the second eye) against cv::remap of the same frame, timed interleaved in one run.
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 #include <string>
@@ -52,7 +53,8 @@ Status bench_paths_size(const BenchScene& bench, int w, int h, int timed) {
     };
     stereo::StereoSynthesizer synthesizer;
     Frame eye;
-    Timing stereo_times, remap_times;
+    Timing stereo_times, remap_times, copy_times;
+    Image<glm::vec4> copied(w, h);
     cv::Mat map_x(h, w, CV_32FC1), map_y(h, w, CV_32FC1);
     Image<glm::vec4> remapped(w, h);
     cv::Mat dst(h, w, CV_32FC4, remapped.data());
@@ -96,6 +98,17 @@ Status bench_paths_size(const BenchScene& bench, int w, int h, int timed) {
             time_once(remap_times, remap);
         else
             remap();
+        // The memory floor: the colour copied once, rows in parallel (what one pass costs).
+        auto copy = [&] {
+            parallel_for(0, h, [&](int y0, int y1) {
+                std::memcpy(&copied(0, y0), &f.color(0, y0),
+                            std::size_t(y1 - y0) * std::size_t(w) * sizeof(glm::vec4));
+            });
+        };
+        if (timing)
+            time_once(copy_times, copy);
+        else
+            copy();
         std::fprintf(stderr, "\r[bench] %dx%d %d/%d", w, h, i + 1, timed + 2);
     }
     std::fprintf(stderr, "\r%40s\r", "");
@@ -112,6 +125,7 @@ Status bench_paths_size(const BenchScene& bench, int w, int h, int timed) {
     }
     row("stereo eye grid+pullpush", stereo_times, 0.0);
     row("cv::remap (peer)", remap_times, 0.0);
+    row("colour copy (memory floor)", copy_times, 0.0);
     return {};
 }
 
