@@ -31,9 +31,11 @@ struct PyScene {
     server::CameraPath path;
 };
 
-server::RenderSettings settings(int width, int height, const std::string& shading) {
+server::RenderSettings settings(int width, int height, const std::string& shading, int aa) {
     check(check_image_size(width, height, "render size"));
-    server::RenderSettings s{.width = width, .height = height};
+    if (!server::aa_samples_valid(aa))
+        value_error("aa must be 1, 2, 4, 8 or 16 samples per pixel, got " + std::to_string(aa));
+    server::RenderSettings s{.width = width, .height = height, .aa_samples = aa};
     if (shading == "lit")
         s.shading = server::Shading::Lit;
     else if (shading == "unlit")
@@ -52,25 +54,25 @@ struct PyRenderer {
 
     // GL calls stay on the thread holding the GIL: the context is current there.
     Frame render(const PyScene& s, int frame, double fps, int width, int height,
-                 const std::string& shading) {
+                 const std::string& shading, int aa) {
         check_fps(fps);
         Frame out;
-        check(renderer->render_frame(s.scene, s.path, frame, fps, settings(width, height, shading),
-                                     out));
+        check(renderer->render_frame(s.scene, s.path, frame, fps,
+                                     settings(width, height, shading, aa), out));
         return out;
     }
     std::vector<Frame> render_sequence(const PyScene& s, int frames, int start, double fps,
-                                       int width, int height, const std::string& shading) {
+                                       int width, int height, const std::string& shading, int aa) {
         if (frames < 0 || frames > 100000) value_error("frames must be in 0..100000");
         std::vector<Frame> out;
         for (int i = 0; i < frames; ++i)
-            out.push_back(render(s, start + i, fps, width, height, shading));
+            out.push_back(render(s, start + i, fps, width, height, shading, aa));
         return out;
     }
     // The scene at `time` seen by `camera`; motion towards `prev_time` with the camera's
     // previous view and projection.
     Frame render_camera(const PyScene& s, const Camera& camera, int width, int height, double time,
-                        double prev_time, const std::string& shading) {
+                        double prev_time, const std::string& shading, int aa) {
         server::Instant now{.time = time,
                             .view = camera.view,
                             .projection = camera.projection,
@@ -82,7 +84,7 @@ struct PyRenderer {
         before.view = camera.prev_view;
         before.projection = camera.prev_projection;
         Frame out;
-        check(renderer->render(s.scene, now, before, settings(width, height, shading), out));
+        check(renderer->render(s.scene, now, before, settings(width, height, shading, aa), out));
         return out;
     }
 
@@ -117,14 +119,16 @@ void bind_render(py::module_& m) {
         .def_property_readonly("device", [](const PyRenderer& r) { return r.renderer->device(); })
         .def("render", &PyRenderer::render, py::arg("scene"), py::arg("frame") = 0,
              py::arg("fps") = 30.0, py::arg("width") = 640, py::arg("height") = 360,
-             py::arg("shading") = "lit",
-             "Frame `frame` of the scene's camera path at `fps` (time = frame / fps).")
+             py::arg("shading") = "lit", py::arg("aa") = 4,
+             "Frame `frame` of the scene's camera path at `fps` (time = frame / fps); `aa` "
+             "anti-aliases colour with 1, 2, 4, 8 or 16 samples per pixel (depth, motion, "
+             "normals and ids stay single samples at the pixel centre).")
         .def("render_sequence", &PyRenderer::render_sequence, py::arg("scene"), py::arg("frames"),
              py::arg("start") = 0, py::arg("fps") = 30.0, py::arg("width") = 640,
-             py::arg("height") = 360, py::arg("shading") = "lit")
+             py::arg("height") = 360, py::arg("shading") = "lit", py::arg("aa") = 4)
         .def("render_camera", &PyRenderer::render_camera, py::arg("scene"), py::arg("camera"),
              py::arg("width") = 640, py::arg("height") = 360, py::arg("time") = 0.0,
-             py::arg("prev_time") = 0.0, py::arg("shading") = "lit",
+             py::arg("prev_time") = 0.0, py::arg("shading") = "lit", py::arg("aa") = 4,
              "The scene at `time` seen by `camera` (motion towards prev_time and its previous "
              "view).");
 }

@@ -78,3 +78,16 @@ def test_codec_streams_and_bad_packets(pan_60):
         decoder.decode(np.zeros(4, np.float32))
     with pytest.raises(ValueError):
         reprise.Encoder(qp=99)
+
+
+def test_anti_aliasing_changes_colour_only(renderer):
+    scene = reprise.Scene("fence", camera="pan")
+    single = renderer.render(scene, frame=2, aa=1, **SIZE)
+    four = renderer.render(scene, frame=2, aa=4, **SIZE)
+    np.testing.assert_array_equal(single.depth, four.depth)
+    np.testing.assert_array_equal(single.motion, four.motion)
+    # Edge pixels take a share of each surface: colour moves on the fence's edges, not inside.
+    changed = np.abs(four.color - single.color).max(axis=2) > 1e-3
+    assert 0.01 < changed.mean() < 0.6
+    with pytest.raises(ValueError, match="aa must be"):
+        renderer.render(scene, aa=3, **SIZE)
