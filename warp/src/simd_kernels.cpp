@@ -7,6 +7,7 @@
 
 #include "kernels.hpp"
 #include "reprise/warp/fill.hpp"
+#include "reprise/warp/sample.hpp"
 
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "simd_kernels.cpp"
@@ -387,6 +388,32 @@ void RefetchRowSimd(const RefetchRow& r) {
 #endif
 }
 
+void BicubicRowSimd(const BicubicRow& r) {
+#if HWY_TARGET == HWY_SCALAR
+    bicubic_row_reference(r);
+#else
+    const hn::ScalableTag<float> df;
+    const hn::Full128<float> d4;
+    const int n = int(hn::Lanes(df));
+    BicubicLanes lanes;
+    int i = 0;
+    for (; i + n <= r.count; i += n) {
+        hn::Vec<decltype(df)> x, y;
+        hn::LoadInterleaved2(df, &r.positions[i].x, x, y);
+        const auto inside = BicubicPrepare(df, x, y, r.color.width, r.color.height, lanes);
+        alignas(64) uint8_t bits[kBicubicMaxLanes / 8 + 8];
+        hn::StoreMaskBits(df, inside, bits);
+        for (int k = 0; k < n; ++k) {
+            if ((bits[k / 8] >> (k % 8)) & 1)
+                hn::StoreU(BicubicSum(r.color, lanes, k), d4, &r.out[i + k].x);
+            else
+                r.out[i + k] = bicubic_fetch(r.color, r.positions[i + k].x, r.positions[i + k].y);
+        }
+    }
+    bicubic_row_reference({r.color, r.positions + i, r.count - i, r.out + i});
+#endif
+}
+
 }  // namespace reprise::warp::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
 
@@ -399,6 +426,9 @@ HWY_EXPORT(PullRowSimd);
 HWY_EXPORT(PullLevelRowSimd);
 HWY_EXPORT(RefetchRowSimd);
 HWY_EXPORT(DisplacementRowSimd);
+HWY_EXPORT(BicubicRowSimd);
+
+void bicubic_row(const BicubicRow& row) { HWY_DYNAMIC_DISPATCH(BicubicRowSimd)(row); }
 
 void displacement_row(const DisplacementTest& test, int y, int width, const float* depth,
                       glm::vec2* displacement, float* target_depth) {
