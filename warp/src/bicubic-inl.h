@@ -10,9 +10,9 @@
 #define REPRISE_WARP_BICUBIC_INL_H_
 #endif
 
+#include <hwy/highway.h>
 #include <cstddef>
 #include <cstdint>
-#include <hwy/highway.h>
 
 #include "reprise/core/image.hpp"
 
@@ -35,8 +35,8 @@ struct BicubicLanes {
 // range); true in the lanes whose 16 taps all lie inside a width x height image.
 template <class DF>
 HWY_INLINE hwy::HWY_NAMESPACE::Mask<DF> BicubicPrepare(DF df, hwy::HWY_NAMESPACE::Vec<DF> x,
-                                                      hwy::HWY_NAMESPACE::Vec<DF> y, int width,
-                                                      int height, BicubicLanes& out) {
+                                                       hwy::HWY_NAMESPACE::Vec<DF> y, int width,
+                                                       int height, BicubicLanes& out) {
     namespace hn = hwy::HWY_NAMESPACE;
     static_assert(hn::MaxLanes(DF()) <= kBicubicMaxLanes);
     const hn::RebindToSigned<DF> di;
@@ -63,9 +63,9 @@ HWY_INLINE hwy::HWY_NAMESPACE::Mask<DF> BicubicPrepare(DF df, hwy::HWY_NAMESPACE
     hn::StoreU(iy - one, di, out.y);
     // Taps ix - 1 .. ix + 2 and iy - 1 .. iy + 2.
     const VI two_i = hn::Set(di, 2);
-    return hn::RebindMask(df, hn::And(hn::And(ix > hn::Zero(di), iy > hn::Zero(di)),
-                                      hn::And(ix + two_i < hn::Set(di, width),
-                                              iy + two_i < hn::Set(di, height))));
+    return hn::RebindMask(
+        df, hn::And(hn::And(ix > hn::Zero(di), iy > hn::Zero(di)),
+                    hn::And(ix + two_i < hn::Set(di, width), iy + two_i < hn::Set(di, height))));
 }
 
 // The lookup of lane i, whose taps lie inside `image`: bicubic_fetch's sums, the four channels of
