@@ -365,14 +365,16 @@ TEST(GridWarp, EverySimdLevelEqualsReference) {
                             f.motion(x, y) = {(u(rng) - 0.5f) * 12.0f, (u(rng) - 0.5f) * 12.0f};
                         }
                 for (float factor : {-0.5f, 1.0f})
-                    for (int cell : {8, 32}) {
-                        Output out(w, h);
-                        (void)warp_both(f, factor, out, {.cell = cell});
-                    }
+                    for (int cell : {8, 32})
+                        for (bool bicubic : {false, true}) {
+                            Output out(w, h);
+                            (void)warp_both(f, factor, out, {.cell = cell, .bicubic = bicubic});
+                        }
             }
         Frame g = ground_frame(130, 67);
         Output out(130, 67);
         (void)warp_both(g, 0.37f, out);
+        (void)warp_both(g, 0.37f, out, {.bicubic = true});
     }
 }
 

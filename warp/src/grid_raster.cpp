@@ -2,7 +2,8 @@
 // attributes (depth, source position, motion) interpolated linearly, a depth test, and a
 // bilinear (or bicubic) colour lookup in the source. Compiled once per Highway target and chosen
 // at run time: from AVX2 on, the bilinear colour of two pixels is fetched a 256-bit vector at a
-// time (same bits).
+// time, and the bicubic colour's weights are computed four pixels at a time (bicubic-inl.h, the
+// reverse warp's refetch shares it); same bits as the scalar reference either way.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -20,6 +21,8 @@
 #define HWY_TARGET_INCLUDE "grid_raster.cpp"
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
 #include <hwy/highway.h>
+
+#include "bicubic-inl.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace reprise::warp::grid::HWY_NAMESPACE {
@@ -333,14 +336,7 @@ private:
                 _mm_min_ps(_mm_max_ps(_mm_add_ps(sy0, _mm_mul_ps(v.gsy, kk)), v.sy_lo), v.sy_hi),
                 half);
             if (bicubic_) {
-                alignas(16) float xs[4], ys[4];
-                _mm_store_ps(xs, _mm_add_ps(fx, half));
-                _mm_store_ps(ys, _mm_add_ps(fy, half));
-                while (mask) {
-                    const int i = __builtin_ctz(unsigned(mask));
-                    mask &= mask - 1;
-                    color[k + i] = bicubic_fetch(src_, xs[i], ys[i]);
-                }
+                bicubic_quad(_mm_add_ps(fx, half), _mm_add_ps(fy, half), mask, color + k);
                 continue;
             }
             const __m128i x0 = _mm_cvttps_epi32(fx), y0 = _mm_cvttps_epi32(fy);
@@ -415,6 +411,40 @@ private:
                 fetch(i, _mm_set1_ps(wxs[i]), _mm_set1_ps(wys[i]));
             }
         }
+    }
+
+    // bicubic_fetch at the four positions in x, y, for the pixels in `mask`, into out[0..3]:
+    // weights in vector lanes, each pixel's taps vectorised, taps past the border by the
+    // reference.
+    void bicubic_quad(__m128 x, __m128 y, int mask, glm::vec4* out) const {
+        alignas(16) float xs[4], ys[4];
+        _mm_store_ps(xs, x);
+        _mm_store_ps(ys, y);
+#if HWY_TARGET != HWY_SCALAR
+        namespace hn = hwy::HWY_NAMESPACE;
+        using warp::HWY_NAMESPACE::BicubicLanes, warp::HWY_NAMESPACE::BicubicPrepare,
+            warp::HWY_NAMESPACE::BicubicSum;
+        const hn::Full128<float> d4;
+        BicubicLanes lanes;
+        const auto inside =
+            BicubicPrepare(d4, hn::Load(d4, xs), hn::Load(d4, ys), src_.width, src_.height, lanes);
+        uint8_t inside_bits = 0;
+        hn::StoreMaskBits(d4, inside, &inside_bits);
+        while (mask) {
+            const int i = __builtin_ctz(unsigned(mask));
+            mask &= mask - 1;
+            if ((inside_bits >> i) & 1)
+                hn::StoreU(BicubicSum(src_, lanes, i), d4, &out[i].x);
+            else
+                out[i] = bicubic_fetch(src_, xs[i], ys[i]);
+        }
+#else
+        while (mask) {
+            const int i = __builtin_ctz(unsigned(mask));
+            mask &= mask - 1;
+            out[i] = bicubic_fetch(src_, xs[i], ys[i]);
+        }
+#endif
     }
 #endif
 

@@ -51,6 +51,11 @@ void refetch_row_reference(const RefetchRow& r, int x_begin, int x_end) {
     }
 }
 
+void bicubic_row_reference(const BicubicRow& r) {
+    for (int i = 0; i < r.count; ++i)
+        r.out[i] = bicubic_fetch(r.color, r.positions[i].x, r.positions[i].y);
+}
+
 namespace {
 
 struct Refetch {

@@ -37,9 +37,11 @@ float worst_value(std::mt19937& rng) {
     return values[rng() % std::size(values)];
 }
 
-// Bitwise equality of two float arrays (NaN payloads included); names the first difference.
+// Bitwise equality of two float arrays (NaN payloads included unless `any_nan`: then a NaN
+// matches any NaN); names the first difference.
 template <class T>
-std::string compare_bits(const char* what, const std::vector<T>& a, const std::vector<T>& b) {
+std::string compare_bits(const char* what, const std::vector<T>& a, const std::vector<T>& b,
+                         bool any_nan = false) {
     const std::size_t floats = a.size() * sizeof(T) / sizeof(float);
     const auto* fa = reinterpret_cast<const uint32_t*>(a.data());
     const auto* fb = reinterpret_cast<const uint32_t*>(b.data());
@@ -48,6 +50,7 @@ std::string compare_bits(const char* what, const std::vector<T>& a, const std::v
             float va, vb;
             std::memcpy(&va, fa + i, 4);
             std::memcpy(&vb, fb + i, 4);
+            if (any_nan && std::isnan(va) && std::isnan(vb)) continue;
             return std::string(what) + ": float " + std::to_string(i) + " is " +
                    std::to_string(va) + ", reference " + std::to_string(vb);
         }
@@ -677,6 +680,74 @@ private:
 
 // ---------------------------------------------------------------------------------------------
 
+class BicubicCase final : public KernelCase {
+public:
+    void generate(int w, int h, KernelInputs inputs, uint32_t seed) override {
+        std::mt19937 rng(seed);
+        const bool worst = inputs == KernelInputs::WorstCase;
+        color_.resize(w, h), positions_.resize(w, h);
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                for (int c = 0; c < 4; ++c)
+                    color_(x, y)[c] =
+                        worst && rng() % 5 == 0 ? worst_value(rng) : uniform(rng, -0.5f, 4.0f);
+                // Near the pixel itself, as a warp reads.
+                glm::vec2 p(std::clamp(float(x) + uniform(rng, -2.5f, 3.5f), 0.0f, float(w)),
+                            std::clamp(float(y) + uniform(rng, -2.5f, 3.5f), 0.0f, float(h)));
+                if (worst && rng() % 2) {  // on and near the borders and pixel centres
+                    const float xs[] = {0.0f,
+                                        0.5f,
+                                        1.0f,
+                                        1.5f,
+                                        float(w) - 1.5f,
+                                        float(w) - 0.5f,
+                                        float(w),
+                                        std::nextafter(float(w), 0.0f),
+                                        p.x};
+                    const float ys[] = {0.0f,
+                                        0.5f,
+                                        1.5f,
+                                        2.0f,
+                                        float(h) - 2.5f,
+                                        float(h) - 0.5f,
+                                        float(h),
+                                        std::nextafter(0.5f, 1.0f),
+                                        p.y};
+                    p = {std::max(0.0f, xs[rng() % std::size(xs)]),
+                         std::max(0.0f, ys[rng() % std::size(ys)])};
+                }
+                positions_(x, y) = p;
+            }
+    }
+    void run_reference() override { run_into(reference_, bicubic_row_reference); }
+    void run() override { run_into(optimized_, bicubic_row); }
+    std::string compare() const override {
+        const std::vector<glm::vec4> a(optimized_.data(),
+                                       optimized_.data() + optimized_.pixel_count());
+        const std::vector<glm::vec4> b(reference_.data(),
+                                       reference_.data() + reference_.pixel_count());
+        return compare_bits("colour", a, b, /*any_nan=*/true);
+    }
+
+private:
+    template <class Kernel>
+    void run_into(Image<glm::vec4>& out, Kernel kernel) {
+        out.resize(color_.width(), color_.height());
+        parallel_for(0, out.height(), [&](int y0, int y1) {
+            for (int y = y0; y < y1; ++y)
+                kernel({.color = std::as_const(color_).view(),
+                        .positions = &positions_(0, y),
+                        .count = out.width(),
+                        .out = &out(0, y)});
+        });
+    }
+
+    Image<glm::vec4> color_, optimized_, reference_;
+    Image<glm::vec2> positions_;
+};
+
+// ---------------------------------------------------------------------------------------------
+
 template <class T>
 std::unique_ptr<KernelCase> make() {
     return std::make_unique<T>();
@@ -689,6 +760,7 @@ constexpr KernelEntry kEntries[] = {
     {"pull-push coarser pull", "bit-exact", true, make<PullLevelCase>},
     {"reverse reprojection", "bit-exact", true, make<ReprojectCase>},
     {"reverse warp refetch", "bit-exact", true, make<RefetchCase>},
+    {"bicubic fetch (grid, refetch)", "bit-exact (NaN: any NaN)", true, make<BicubicCase>},
     {"stereo displacement", "bit-exact", true, make<DisplacementCase>},
 };
 

@@ -76,6 +76,17 @@ struct RefetchRow {
 void refetch_row_reference(const RefetchRow& row, int x_begin, int x_end);
 void refetch_row(const RefetchRow& row);
 
+// Catmull-Rom colour lookups, bicubic_fetch at each position (inside the source: [0, width] x
+// [0, height]), made as the grid raster and the refetch make them (bicubic-inl.h).
+struct BicubicRow {
+    ImageView<const glm::vec4> color;
+    const glm::vec2* positions;
+    int count;
+    glm::vec4* out;
+};
+void bicubic_row_reference(const BicubicRow& row);
+void bicubic_row(const BicubicRow& row);
+
 // The displacement of each pixel to a target camera for a projection without x/y coupling
 // (camera_displacement, displacement.cpp): its landing in the target minus the pixel and its
 // depth there (+inf for background); NaN where the depth is NaN or negative or the point lands

@@ -7,11 +7,14 @@
 
 #include "kernels.hpp"
 #include "reprise/warp/fill.hpp"
+#include "reprise/warp/sample.hpp"
 
 #undef HWY_TARGET_INCLUDE
 #define HWY_TARGET_INCLUDE "simd_kernels.cpp"
 #include <hwy/foreach_target.h>  // IWYU pragma: keep
 #include <hwy/highway.h>
+
+#include "bicubic-inl.h"
 
 HWY_BEFORE_NAMESPACE();
 namespace reprise::warp::HWY_NAMESPACE {
@@ -303,9 +306,8 @@ void DisplacementRowSimd(const DisplacementTest& t, int y, int width, const floa
     if (x < width) displacement_row_reference(t, y, x, width, depth, displacement, target_depth);
 }
 
-// Positions, taps and weights in vector lanes; each pixel's 16 bicubic taps four channels a lane
-// (as bicubic_fetch sums them). Pixels whose bicubic taps reach past the border go to the
-// reference one by one.
+// Positions in vector lanes, then bicubic-inl.h's lookups. Pixels whose bicubic taps reach past
+// the border go to the reference one by one.
 void RefetchRowSimd(const RefetchRow& r) {
 #if HWY_TARGET == HWY_SCALAR
     refetch_row_reference(r, 0, r.width);
@@ -316,12 +318,10 @@ void RefetchRowSimd(const RefetchRow& r) {
     const hn::Full128<float> d4;
     using VF = hn::Vec<decltype(df)>;
     using VI = hn::Vec<decltype(di)>;
-    constexpr int kMaxLanes = 16;
     const int n = int(hn::Lanes(df));
-    if (n > kMaxLanes) return refetch_row_reference(r, 0, r.width);
     const int sw = r.color.width, sh = r.color.height;
     auto splat = [&](float v) { return hn::Set(df, v); };
-    const VF zero = hn::Zero(df), half = splat(0.5f), two = splat(2.0f);
+    const VF zero = hn::Zero(df), half = splat(0.5f);
     const VF fsw = splat(float(sw)), fsh = splat(float(sh)), factor = splat(r.factor);
     const VF qy = splat(float(r.y) + 0.5f);
     const VI zero_i = hn::Zero(di), one_i = hn::Set(di, 1);
@@ -332,15 +332,7 @@ void RefetchRowSimd(const RefetchRow& r) {
         const VI i = hn::ConvertTo(di, v);
         return hn::IfThenElse(hn::RebindMask(di, v < hn::ConvertTo(df, i)), i - one_i, i);
     };
-    auto weights = [&](VF t, VF w[4]) {  // bicubic_fetch's, in its order
-        const VF t2 = t * t, t3 = t2 * t;
-        w[0] = half * ((hn::Neg(t3) + two * t2) - t);
-        w[1] = half * ((splat(3.0f) * t3 - splat(5.0f) * t2) + two);
-        w[2] = half * ((splat(-3.0f) * t3 + splat(4.0f) * t2) + t);
-        w[3] = half * (t3 - t2);
-    };
-    alignas(64) float wx[4][kMaxLanes], wy[4][kMaxLanes];
-    alignas(64) int32_t tap_x[kMaxLanes], tap_y[kMaxLanes];
+    BicubicLanes lanes;
     int x = 0;
     for (; x + n <= r.width; x += n) {
         const auto covered =
@@ -375,23 +367,11 @@ void RefetchRowSimd(const RefetchRow& r) {
         px = qx - factor * smx, py = qy - factor * smy;
         go = hn::And(go, hn::And(hn::And(px >= zero, py >= zero), hn::And(px <= fsw, py <= fsh)));
         if (hn::AllFalse(df, go)) continue;
-        px = hn::IfThenElseZero(go, px), py = hn::IfThenElseZero(go, py);
-        const VF cx = px - half, cy = py - half;
-        const VI jx = floor_small(cx), jy = floor_small(cy);
-        VF w[4];
-        weights(cx - hn::ConvertTo(df, jx), w);
-        for (int k = 0; k < 4; ++k) hn::Store(w[k], df, wx[k]);
-        weights(cy - hn::ConvertTo(df, jy), w);
-        for (int k = 0; k < 4; ++k) hn::Store(w[k], df, wy[k]);
-        hn::Store(jx - one_i, di, tap_x);
-        hn::Store(jy - one_i, di, tap_y);
-        const auto inner =
-            hn::And(hn::And(hn::RebindMask(df, jx > zero_i), hn::RebindMask(df, jy > zero_i)),
-                    hn::And(hn::RebindMask(df, jx + hn::Set(di, 2) < hn::Set(di, sw)),
-                            hn::RebindMask(df, jy + hn::Set(di, 2) < hn::Set(di, sh))));
-        alignas(64) uint8_t bits[kMaxLanes / 8 + 8];
+        const auto inner = BicubicPrepare(df, hn::IfThenElseZero(go, px),
+                                          hn::IfThenElseZero(go, py), sw, sh, lanes);
+        alignas(64) uint8_t bits[kBicubicMaxLanes / 8 + 8];
         hn::StoreMaskBits(df, go, bits);
-        alignas(64) uint8_t inner_bits[kMaxLanes / 8 + 8];
+        alignas(64) uint8_t inner_bits[kBicubicMaxLanes / 8 + 8];
         hn::StoreMaskBits(df, inner, inner_bits);
         for (int i = 0; i < n; ++i) {
             if (!((bits[i / 8] >> (i % 8)) & 1)) continue;
@@ -399,20 +379,38 @@ void RefetchRowSimd(const RefetchRow& r) {
                 refetch_row_reference(r, x + i, x + i + 1);
                 continue;
             }
-            auto acc = hn::Zero(d4);
-            for (int j = 0; j < 4; ++j) {
-                const float* row = &(r.color.row(tap_y[i] + j) + tap_x[i])->x;
-                auto line = hn::Zero(d4);
-                for (int k = 0; k < 4; ++k)
-                    line = line + hn::Set(d4, wx[k][i]) * hn::LoadU(d4, row + 4 * k);
-                acc = acc + hn::Set(d4, wy[j][i]) * line;
-            }
             glm::vec4 c;
-            hn::StoreU(acc, d4, &c.x);
+            hn::StoreU(BicubicSum(r.color, lanes, i), d4, &c.x);
             if (std::isfinite(c.r + c.g + c.b + c.a)) r.out[x + i] = c;
         }
     }
     refetch_row_reference(r, x, r.width);
+#endif
+}
+
+void BicubicRowSimd(const BicubicRow& r) {
+#if HWY_TARGET == HWY_SCALAR
+    bicubic_row_reference(r);
+#else
+    const hn::ScalableTag<float> df;
+    const hn::Full128<float> d4;
+    const int n = int(hn::Lanes(df));
+    BicubicLanes lanes;
+    int i = 0;
+    for (; i + n <= r.count; i += n) {
+        hn::Vec<decltype(df)> x, y;
+        hn::LoadInterleaved2(df, &r.positions[i].x, x, y);
+        const auto inside = BicubicPrepare(df, x, y, r.color.width, r.color.height, lanes);
+        alignas(64) uint8_t bits[kBicubicMaxLanes / 8 + 8];
+        hn::StoreMaskBits(df, inside, bits);
+        for (int k = 0; k < n; ++k) {
+            if ((bits[k / 8] >> (k % 8)) & 1)
+                hn::StoreU(BicubicSum(r.color, lanes, k), d4, &r.out[i + k].x);
+            else
+                r.out[i + k] = bicubic_fetch(r.color, r.positions[i + k].x, r.positions[i + k].y);
+        }
+    }
+    bicubic_row_reference({r.color, r.positions + i, r.count - i, r.out + i});
 #endif
 }
 
@@ -428,6 +426,9 @@ HWY_EXPORT(PullRowSimd);
 HWY_EXPORT(PullLevelRowSimd);
 HWY_EXPORT(RefetchRowSimd);
 HWY_EXPORT(DisplacementRowSimd);
+HWY_EXPORT(BicubicRowSimd);
+
+void bicubic_row(const BicubicRow& row) { HWY_DYNAMIC_DISPATCH(BicubicRowSimd)(row); }
 
 void displacement_row(const DisplacementTest& test, int y, int width, const float* depth,
                       glm::vec2* displacement, float* target_depth) {
