@@ -117,10 +117,10 @@ Status run_fruc(const FrucJob& job) {
         c.fills, c.hole_pixels, c.dynamic_layers, c.grid_cells, c.cuts, c.true_motion);
     if (options.mode == warp::FrucMode::Interpolate && options.refine.enabled)
         std::printf(
-            "  refinement: %zu frames refined, %zu skipped (sides agree), %zu tiles, flow on %zu "
-            "px, %zu px refined, %.2f ms per made frame\n",
-            c.refined_frames, c.refine_skipped, c.refine_tiles, c.flow_pixels, c.refined_pixels,
-            c.outputs ? c.refine_ms / double(c.outputs) : 0.0);
+            "  refinement: %zu frames refined, %zu skipped (sides agree), %zu tiles (%zu left out "
+            "past the flow budget), flow on %zu px, %zu px refined, %.2f ms per made frame\n",
+            c.refined_frames, c.refine_skipped, c.refine_tiles, c.refine_tiles_left_out,
+            c.flow_pixels, c.refined_pixels, c.outputs ? c.refine_ms / double(c.outputs) : 0.0);
     if (options.warp == warp::WarpMethod::Auto || options.fill == warp::FillMethod::Auto) {
         if (job.budget_db > 0)
             std::printf(
