@@ -91,6 +91,7 @@ struct MotionRefiner::State {
     // and whether it was chosen.
     std::vector<glm::vec4> chosen_color;
     std::vector<uint8_t> chosen;
+    std::vector<float> disagree;               // per box: disagreeing pixels surveyed
     std::vector<std::pair<float, int>> order;  // boxes by disagreement per flow pixel
     cv::Mat grey_a, grey_b, flow_field;
     // Per pixel of the box being decided (its own size): the rendered motion's error (-1: not
@@ -218,7 +219,7 @@ struct MotionRefiner::State {
         std::size_t total = 0;
         for (const Box& box : boxes) total += std::size_t(box.area());
         if (total <= budget) return 0;
-        std::vector<float> disagree(boxes.size(), 0.0f);
+        disagree.assign(boxes.size(), 0.0f);
         for (std::size_t t = 0; t < label.size(); ++t)
             if (label[t] >= 0 && flagged[t])
                 disagree[std::size_t(label[t])] += float(disagreeing[t]);
