@@ -91,7 +91,7 @@ struct MotionRefiner::State {
     // and whether it was chosen.
     std::vector<glm::vec4> chosen_color;
     std::vector<uint8_t> chosen;
-    std::vector<float> disagree;               // per box: disagreeing pixels surveyed
+    std::vector<float> box_disagreeing;        // per box: disagreeing pixels surveyed
     std::vector<std::pair<float, int>> order;  // boxes by disagreement per flow pixel
     cv::Mat grey_a, grey_b, flow_field;
     // Per pixel of the box being decided (its own size): the rendered motion's error (-1: not
@@ -219,13 +219,13 @@ struct MotionRefiner::State {
         std::size_t total = 0;
         for (const Box& box : boxes) total += std::size_t(box.area());
         if (total <= budget) return 0;
-        disagree.assign(boxes.size(), 0.0f);
+        box_disagreeing.assign(boxes.size(), 0.0f);
         for (std::size_t t = 0; t < label.size(); ++t)
             if (label[t] >= 0 && flagged[t])
-                disagree[std::size_t(label[t])] += float(disagreeing[t]);
+                box_disagreeing[std::size_t(label[t])] += float(disagreeing[t]);
         order.clear();
         for (std::size_t i = 0; i < boxes.size(); ++i)
-            order.emplace_back(-disagree[i] / float(boxes[i].area()), int(i));
+            order.emplace_back(-box_disagreeing[i] / float(boxes[i].area()), int(i));
         std::sort(order.begin(), order.end());
         std::size_t used = 0, left_out = 0;
         for (const auto& [score, i] : order) {
