@@ -20,6 +20,7 @@ struct FrucJob {
     std::string mode = "interpolate", warp = "grid", fill = "pullpush";
     std::string layout = "reprise";
     std::string refine = "on";
+    double refine_share = 1.0;
     std::string ui;             // a UI sequence beside the input (its colour: premultiplied RGBA)
     bool ui_composite = false;  // draw the UI into the output colour
     double budget_db = 0.0;     // auto: the PSNR to reach (0: within slack of the best expected)
@@ -31,6 +32,9 @@ Status run_fruc(const FrucJob& job) {
     warp::FrucOptions options;
     REPRISE_TRY(parse_fruc_options(job.mode, job.warp, job.fill, options));
     REPRISE_TRY(parse_refine(job.refine, options));
+    if (!(job.refine_share >= 0.0 && job.refine_share <= 1.0))
+        return Status::error("--refine-share must be in 0..1");
+    options.refine.max_flow_share = float(job.refine_share);
     WriteOptions write;
     if (job.layout == "blender")
         write.layout = ExrLayout::Blender;
@@ -158,6 +162,9 @@ int command_fruc(int argc, char** argv) {
     args.option("--refine", &job.refine,
                 "on | off (default on): interpolation refines motion by optical flow where the "
                 "warped\nsides disagree (moving shadows, reflections, highlights)");
+    args.option("--refine-share", &job.refine_share,
+                "refinement: largest share of the frame's pixels the flow runs on (default 1); "
+                "the\ntiles past it are left out, those that disagree most per pixel go first");
     args.option("--warp", &job.warp,
                 "reverse | splat | grid | auto (default grid; auto: chosen per frame)");
     args.option("--fill", &job.fill, "pullpush | andreev | none | auto (default pullpush)");
