@@ -148,7 +148,7 @@ TEST(Refine, StillPairs) {
 }
 
 // The flow budget: boxes past the pixel share are left out and counted; a zero share refines
-// nothing and changes no pixel.
+// nothing and changes no pixel. Without the neighbour ring the flow runs on fewer pixels.
 TEST(Refine, FlowBudgetLeavesTilesOut) {
     const Frame a = render("mirror", 15.0, 3), b = render("mirror", 15.0, 4);
     const Made all = between(a, b, true), off = between(a, b, false);
@@ -159,6 +159,10 @@ TEST(Refine, FlowBudgetLeavesTilesOut) {
     EXPECT_LE(double(half.counters.flow_pixels), share * pixels);
     EXPECT_GT(half.counters.refine_tiles_left_out, 0u);
     EXPECT_LE(half.counters.refine_tiles_left_out, half.counters.refine_tiles);
+    const Made flagged_only = between(a, b, RefineOptions{.neighbours = false});
+    EXPECT_EQ(flagged_only.counters.refine_tiles, all.counters.refine_tiles);
+    EXPECT_LT(flagged_only.counters.flow_pixels, all.counters.flow_pixels);
+    EXPECT_GT(flagged_only.counters.refined_pixels, 0u);
     const Made none = between(a, b, RefineOptions{.max_flow_share = 0.0f});
     EXPECT_EQ(none.counters.flow_pixels, 0u);
     EXPECT_EQ(none.counters.refined_pixels, 0u);

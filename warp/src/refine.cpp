@@ -148,17 +148,18 @@ struct MotionRefiner::State {
         return total;
     }
 
-    // Flagged tiles and their neighbours, in boxes (connected groups, with margin, merged where
-    // they overlap); label[] says which box decides each tile.
-    void make_boxes(int w, int h, int margin) {
+    // Flagged tiles (and their neighbours), in boxes (connected groups, with margin, merged
+    // where they overlap); label[] says which box decides each tile.
+    void make_boxes(int w, int h, int margin, bool neighbours) {
         const int n = tiles_x * tiles_y;
         label.assign(n, -1);
         wanted.assign(n, 0);
         for (int ty = 0; ty < tiles_y; ++ty)
             for (int tx = 0; tx < tiles_x; ++tx) {
                 if (!flagged[std::size_t(ty) * tiles_x + tx]) continue;
-                for (int dy = -1; dy <= 1; ++dy)
-                    for (int dx = -1; dx <= 1; ++dx) {
+                const int ring = neighbours ? 1 : 0;
+                for (int dy = -ring; dy <= ring; ++dy)
+                    for (int dx = -ring; dx <= ring; ++dx) {
                         const int x = tx + dx, y = ty + dy;
                         if (x >= 0 && y >= 0 && x < tiles_x && y < tiles_y)
                             wanted[std::size_t(y) * tiles_x + x] = 1;
@@ -359,7 +360,7 @@ bool MotionRefiner::prepare(const GBufferView& a, const GBufferView& b, float s,
     }
     ++counters.refined_frames;
     counters.refine_tiles += flagged;
-    st.make_boxes(w, h, std::max(options.margin, 0));
+    st.make_boxes(w, h, std::max(options.margin, 0), options.neighbours);
     const double share = std::clamp(double(options.max_flow_share), 0.0, 1.0);
     counters.refine_tiles_left_out += st.keep_within(std::size_t(share * double(w) * h));
     st.decided.clear();

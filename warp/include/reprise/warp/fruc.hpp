@@ -74,6 +74,9 @@ struct RefineOptions {
     float threshold = 0.1f;   // display-value difference (largest channel) of disagreeing sides
     float tile_share = 0.1f;  // share of a tile's surveyed pixels that must disagree
     int margin = 16;          // px of context around the disagreeing tiles given to the flow
+    // Also decide the ring of tiles around the disagreeing ones: boxes 2.4x the pixels on pan at
+    // 1080p for 0.14-0.28 dB more over whole frames on pan and mirror (docs/benchmarks.md).
+    bool neighbours = true;
     // Largest share of the frame's pixels the flow runs on: the boxes that disagree most per
     // pixel go first, the tiles of the others are left out (FrucCounters::refine_tiles_left_out).
     float max_flow_share = 1.0f;
