@@ -43,9 +43,9 @@ struct Made {
 };
 
 // The frame halfway between a and b.
-Made between(const Frame& a, const Frame& b, bool refine) {
+Made between(const Frame& a, const Frame& b, const RefineOptions& refine) {
     FrucOptions options;
-    options.refine.enabled = refine;
+    options.refine = refine;
     FrameRateConverter converter(2, options);
     Made made;
     EXPECT_TRUE(converter.send(a).ok());
@@ -57,6 +57,10 @@ Made between(const Frame& a, const Frame& b, bool refine) {
     converter.refine_region(made.region);
     made.counters = converter.counters();
     return made;
+}
+
+Made between(const Frame& a, const Frame& b, bool refine) {
+    return between(a, b, RefineOptions{.enabled = refine});
 }
 
 Image<glm::vec3> shown(const Frame& f) {
@@ -141,4 +145,30 @@ TEST(Refine, StillPairs) {
     const Made off = between(a, b, false);
     EXPECT_EQ(off.counters.copied_still, 1u);
     EXPECT_EQ(off.counters.refined_frames, 0u);
+}
+
+// The flow budget: boxes past the pixel share are left out and counted; a zero share refines
+// nothing and changes no pixel. Without the neighbour ring the flow runs on fewer pixels.
+TEST(Refine, FlowBudgetLeavesTilesOut) {
+    const Frame a = render("mirror", 15.0, 3), b = render("mirror", 15.0, 4);
+    const Made all = between(a, b, true), off = between(a, b, false);
+    EXPECT_EQ(all.counters.refine_tiles_left_out, 0u);
+    const double pixels = double(kWidth) * kHeight;
+    const double share = 0.5 * double(all.counters.flow_pixels) / pixels;
+    const Made half = between(a, b, RefineOptions{.max_flow_share = float(share)});
+    EXPECT_LE(double(half.counters.flow_pixels), share * pixels);
+    EXPECT_GT(half.counters.refine_tiles_left_out, 0u);
+    EXPECT_LE(half.counters.refine_tiles_left_out, half.counters.refine_tiles);
+    const Made flagged_only = between(a, b, RefineOptions{.neighbours = false});
+    EXPECT_EQ(flagged_only.counters.refine_tiles, all.counters.refine_tiles);
+    EXPECT_LT(flagged_only.counters.flow_pixels, all.counters.flow_pixels);
+    EXPECT_GT(flagged_only.counters.refined_pixels, 0u);
+    const Made none = between(a, b, RefineOptions{.max_flow_share = 0.0f});
+    EXPECT_EQ(none.counters.flow_pixels, 0u);
+    EXPECT_EQ(none.counters.refined_pixels, 0u);
+    EXPECT_EQ(none.counters.refine_tiles_left_out, none.counters.refine_tiles);
+    EXPECT_GT(none.counters.refine_tiles, 0u);
+    for (int y = 0; y < kHeight; ++y)
+        for (int x = 0; x < kWidth; ++x)
+            ASSERT_EQ(none.frame.color(x, y), off.frame.color(x, y)) << x << "," << y;
 }

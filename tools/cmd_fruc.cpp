@@ -20,6 +20,7 @@ struct FrucJob {
     std::string mode = "interpolate", warp = "grid", fill = "pullpush";
     std::string layout = "reprise";
     std::string refine = "on";
+    double refine_share = 1.0;
     std::string ui;             // a UI sequence beside the input (its colour: premultiplied RGBA)
     bool ui_composite = false;  // draw the UI into the output colour
     double budget_db = 0.0;     // auto: the PSNR to reach (0: within slack of the best expected)
@@ -31,6 +32,9 @@ Status run_fruc(const FrucJob& job) {
     warp::FrucOptions options;
     REPRISE_TRY(parse_fruc_options(job.mode, job.warp, job.fill, options));
     REPRISE_TRY(parse_refine(job.refine, options));
+    if (!(job.refine_share >= 0.0 && job.refine_share <= 1.0))
+        return Status::error("--refine-share must be in 0..1");
+    options.refine.max_flow_share = float(job.refine_share);
     WriteOptions write;
     if (job.layout == "blender")
         write.layout = ExrLayout::Blender;
@@ -117,10 +121,10 @@ Status run_fruc(const FrucJob& job) {
         c.fills, c.hole_pixels, c.dynamic_layers, c.grid_cells, c.cuts, c.true_motion);
     if (options.mode == warp::FrucMode::Interpolate && options.refine.enabled)
         std::printf(
-            "  refinement: %zu frames refined, %zu skipped (sides agree), %zu tiles, flow on %zu "
-            "px, %zu px refined, %.2f ms per made frame\n",
-            c.refined_frames, c.refine_skipped, c.refine_tiles, c.flow_pixels, c.refined_pixels,
-            c.outputs ? c.refine_ms / double(c.outputs) : 0.0);
+            "  refinement: %zu frames refined, %zu skipped (sides agree), %zu tiles (%zu left out "
+            "past the flow budget), flow on %zu px, %zu px refined, %.2f ms per made frame\n",
+            c.refined_frames, c.refine_skipped, c.refine_tiles, c.refine_tiles_left_out,
+            c.flow_pixels, c.refined_pixels, c.outputs ? c.refine_ms / double(c.outputs) : 0.0);
     if (options.warp == warp::WarpMethod::Auto || options.fill == warp::FillMethod::Auto) {
         if (job.budget_db > 0)
             std::printf(
@@ -154,6 +158,9 @@ int command_fruc(int argc, char** argv) {
     args.option("--refine", &job.refine,
                 "on | off (default on): interpolation refines motion by optical flow where the "
                 "warped\nsides disagree (moving shadows, reflections, highlights)");
+    args.option("--refine-share", &job.refine_share,
+                "refinement: largest share of the frame's pixels the flow runs on (default 1); "
+                "the\ntiles past it are left out, those that disagree most per pixel go first");
     args.option("--warp", &job.warp,
                 "reverse | splat | grid | auto (default grid; grid-bicubic, grid-bilinear pick "
                 "its colour\nfetch; auto: chosen per frame)");

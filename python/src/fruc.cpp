@@ -90,6 +90,7 @@ struct Converter {
         d["refined_frames"] = c.refined_frames;
         d["refine_skipped"] = c.refine_skipped;
         d["refine_tiles"] = c.refine_tiles;
+        d["refine_tiles_left_out"] = c.refine_tiles_left_out;
         d["flow_pixels"] = c.flow_pixels;
         d["refined_pixels"] = c.refined_pixels;
         d["refine_ms"] = c.refine_ms;

@@ -87,12 +87,17 @@ struct MotionRefiner::State {
     std::vector<int> stack;
     std::vector<Box> boxes;
     std::vector<int> decided;  // tiles whose pixels were decided (apply() visits these)
-    cv::Mat grey_a, grey_b, flow_b, flow_a;
-    // Per pixel of the boxes: the rendered motion's error (-1: not one surface on both sides) and
-    // the two flow candidates.
-    Image<float> error_rendered, error_b, error_a;
-    Image<glm::vec4> color_b, color_a, chosen_color;
-    Image<uint8_t> chosen;
+    // Per pixel of the decided tiles (tile * tile each, in decided's order): the flow's colour,
+    // and whether it was chosen.
+    std::vector<glm::vec4> chosen_color;
+    std::vector<uint8_t> chosen;
+    std::vector<float> box_disagreeing;        // per box: disagreeing pixels surveyed
+    std::vector<std::pair<float, int>> order;  // boxes by disagreement per flow pixel
+    cv::Mat grey_a, grey_b, flow_field;
+    // Per pixel of the box being decided (its own size): the rendered motion's error (-1: not
+    // one surface on both sides), the flow's error and colour.
+    std::vector<float> error_rendered, error_flow;
+    std::vector<glm::vec4> color_flow;
 
     void size_tiles(int w, int h, int t) {
         tile = std::max(t, 4);
@@ -143,17 +148,18 @@ struct MotionRefiner::State {
         return total;
     }
 
-    // Flagged tiles and their neighbours, in boxes (connected groups, with margin, merged where
-    // they overlap); label[] says which box decides each tile.
-    void make_boxes(int w, int h, int margin) {
+    // Flagged tiles (and their neighbours), in boxes (connected groups, with margin, merged
+    // where they overlap); label[] says which box decides each tile.
+    void make_boxes(int w, int h, int margin, bool neighbours) {
         const int n = tiles_x * tiles_y;
         label.assign(n, -1);
         wanted.assign(n, 0);
         for (int ty = 0; ty < tiles_y; ++ty)
             for (int tx = 0; tx < tiles_x; ++tx) {
                 if (!flagged[std::size_t(ty) * tiles_x + tx]) continue;
-                for (int dy = -1; dy <= 1; ++dy)
-                    for (int dx = -1; dx <= 1; ++dx) {
+                const int ring = neighbours ? 1 : 0;
+                for (int dy = -ring; dy <= ring; ++dy)
+                    for (int dx = -ring; dx <= ring; ++dx) {
                         const int x = tx + dx, y = ty + dy;
                         if (x >= 0 && y >= 0 && x < tiles_x && y < tiles_y)
                             wanted[std::size_t(y) * tiles_x + x] = 1;
@@ -208,6 +214,34 @@ struct MotionRefiner::State {
         }
     }
 
+    // Keeps the boxes that disagree most per pixel of flow within `budget` pixels; the tiles of
+    // the others are not decided. Returns the flagged tiles left out.
+    std::size_t keep_within(std::size_t budget) {
+        std::size_t total = 0;
+        for (const Box& box : boxes) total += std::size_t(box.area());
+        if (total <= budget) return 0;
+        box_disagreeing.assign(boxes.size(), 0.0f);
+        for (std::size_t t = 0; t < label.size(); ++t)
+            if (label[t] >= 0 && flagged[t])
+                box_disagreeing[std::size_t(label[t])] += float(disagreeing[t]);
+        order.clear();
+        for (std::size_t i = 0; i < boxes.size(); ++i)
+            order.emplace_back(-box_disagreeing[i] / float(boxes[i].area()), int(i));
+        std::sort(order.begin(), order.end());
+        std::size_t used = 0, left_out = 0;
+        for (const auto& [score, i] : order) {
+            const std::size_t area = std::size_t(boxes[std::size_t(i)].area());
+            if (used + area <= budget) {
+                used += area;
+                continue;
+            }
+            boxes[std::size_t(i)] = {0, 0, 0, 0};
+            for (std::size_t t = 0; t < label.size(); ++t)
+                if (label[t] == i) left_out += flagged[t], label[t] = -1;
+        }
+        return left_out;
+    }
+
     void grey_crop(const GBufferView& f, const Box& box, cv::Mat& out) {
         out.create(box.y1 - box.y0, box.x1 - box.x0, CV_8U);
         for (int y = box.y0; y < box.y1; ++y) {
@@ -233,61 +267,71 @@ struct MotionRefiner::State {
         flow->calc(from, to, flow_out);
     }
 
-    // Errors and colours of the rendered motion and both flow candidates over a box.
+    // Errors of the rendered motion and the flow, and the flow's colour, over a box.
     void evaluate(const GBufferView& a, const GBufferView& b, float s, const WarpedSide& side_a,
                   const WarpedSide& side_b, const Box& box) {
+        const int bw = box.x1 - box.x0;
+        const std::size_t n = std::size_t(box.area());
+        error_rendered.resize(n), error_flow.resize(n), color_flow.resize(n);
         parallel_for(box.y0, box.y1, [&](int y0, int y1) {
-            for (int y = y0; y < y1; ++y)
+            for (int y = y0; y < y1; ++y) {
+                const cv::Vec2f* f = flow_field.ptr<cv::Vec2f>(y - box.y0);
+                const std::size_t row = std::size_t(y - box.y0) * bw;
                 for (int x = box.x0; x < box.x1; ++x) {
-                    const glm::vec2 q(float(x) + 0.5f, float(y) + 0.5f);
+                    const std::size_t i = row + std::size_t(x - box.x0);
                     const bool one_surface = side_a.covered(x, y) && side_b.covered(x, y) &&
                                              same_surface(side_a.depth(x, y), side_b.depth(x, y));
-                    error_rendered(x, y) =
-                        one_surface ? mean_difference(side_a.color(x, y), side_b.color(x, y))
-                                    : -1.0f;
-                    if (!std::isfinite(error_rendered(x, y))) error_rendered(x, y) = -1.0f;
-                    const cv::Vec2f fb = flow_b.at<cv::Vec2f>(y - box.y0, x - box.x0);
-                    const cv::Vec2f fa = flow_a.at<cv::Vec2f>(y - box.y0, x - box.x0);
-                    const Candidate cb = along(a, b, q, -glm::vec2(fb[0], fb[1]), s);
-                    const Candidate ca = along(a, b, q, glm::vec2(fa[0], fa[1]), s);
-                    error_b(x, y) = cb.error, color_b(x, y) = cb.color;
-                    error_a(x, y) = ca.error, color_a(x, y) = ca.color;
+                    const float e = one_surface
+                                        ? mean_difference(side_a.color(x, y), side_b.color(x, y))
+                                        : -1.0f;
+                    error_rendered[i] = std::isfinite(e) ? e : -1.0f;
+                    const cv::Vec2f m = f[x - box.x0];
+                    const Candidate c = along(a, b, glm::vec2(float(x) + 0.5f, float(y) + 0.5f),
+                                              -glm::vec2(m[0], m[1]), s);
+                    error_flow[i] = c.error, color_flow[i] = c.color;
                 }
+            }
         });
     }
 
-    // Per pixel of the box's tiles, errors averaged over 3x3 (within the box): a flow candidate
-    // wins where it beats the rendered motion by the margin. Returns the winners.
+    // Per pixel of the box's tiles, errors averaged over 3x3 (within the box): the flow wins
+    // where it beats the rendered motion by the margin. Writes the chosen pixels of the box's
+    // tiles (their slots of chosen, in decided's order); returns the winners.
     std::size_t decide(const Box& box, int id) {
-        std::atomic<std::size_t> won{0};
-        parallel_for(box.y0, box.y1, [&](int y0, int y1) {
-            std::size_t local = 0;
-            for (int y = y0; y < y1; ++y)
-                for (int x = box.x0; x < box.x1; ++x) {
-                    if (label[std::size_t(y / tile) * tiles_x + x / tile] != id) continue;
-                    chosen(x, y) = 0;
-                    if (error_rendered(x, y) < 0.0f) continue;
-                    float sum[3] = {0, 0, 0};
+        const int bw = box.x1 - box.x0;
+        const std::size_t area = std::size_t(tile) * tile;
+        std::size_t won = 0;
+        for (std::size_t slot = 0; slot < decided.size(); ++slot) {
+            const int t = decided[slot];
+            if (label[t] != id) continue;
+            uint8_t* pick = chosen.data() + slot * area;
+            glm::vec4* colour = chosen_color.data() + slot * area;
+            std::fill(pick, pick + area, uint8_t(0));
+            const int tx0 = (t % tiles_x) * tile, ty0 = (t / tiles_x) * tile;
+            const int tx1 = std::min(box.x1, tx0 + tile), ty1 = std::min(box.y1, ty0 + tile);
+            for (int y = ty0; y < ty1; ++y)
+                for (int x = tx0; x < tx1; ++x) {
+                    const std::size_t i = std::size_t(y - box.y0) * bw + std::size_t(x - box.x0);
+                    if (error_rendered[i] < 0.0f) continue;
+                    float rendered = 0.0f, flowed = 0.0f;
                     int count = 0;
                     for (int v = std::max(box.y0, y - 1); v <= std::min(box.y1 - 1, y + 1); ++v)
                         for (int u = std::max(box.x0, x - 1); u <= std::min(box.x1 - 1, x + 1);
                              ++u) {
-                            if (error_rendered(u, v) < 0.0f) continue;
-                            sum[0] += error_rendered(u, v);
-                            sum[1] += error_b(u, v);
-                            sum[2] += error_a(u, v);
+                            const std::size_t j =
+                                std::size_t(v - box.y0) * bw + std::size_t(u - box.x0);
+                            if (error_rendered[j] < 0.0f) continue;
+                            rendered += error_rendered[j];
+                            flowed += error_flow[j];
                             ++count;
                         }
-                    const float rendered = sum[0] / float(count);
-                    const bool b_better = sum[1] <= sum[2];
-                    const float best = (b_better ? sum[1] : sum[2]) / float(count);
-                    if (!(best + kWinMargin < rendered)) continue;
-                    chosen(x, y) = 1;
-                    chosen_color(x, y) = b_better ? color_b(x, y) : color_a(x, y);
-                    ++local;
+                    if (!(flowed / float(count) + kWinMargin < rendered / float(count))) continue;
+                    const std::size_t k = std::size_t(y - ty0) * tile + std::size_t(x - tx0);
+                    pick[k] = 1;
+                    colour[k] = color_flow[i];
+                    ++won;
                 }
-            won += local;
-        });
+        }
         return won;
     }
 };
@@ -316,38 +360,46 @@ bool MotionRefiner::prepare(const GBufferView& a, const GBufferView& b, float s,
     }
     ++counters.refined_frames;
     counters.refine_tiles += flagged;
-    st.make_boxes(w, h, std::max(options.margin, 0));
-    for (Image<float>* e : {&st.error_rendered, &st.error_b, &st.error_a}) e->resize(w, h);
-    for (Image<glm::vec4>* c : {&st.color_b, &st.color_a, &st.chosen_color}) c->resize(w, h);
-    st.chosen.resize(w, h);
-    std::size_t won = 0;
-    for (std::size_t i = 0; i < st.boxes.size(); ++i) {
-        const Box& box = st.boxes[i];
-        counters.flow_pixels += std::size_t(box.area());
-        st.grey_crop(a, box, st.grey_a);
-        st.grey_crop(b, box, st.grey_b);
-        // b(p) ~ a(p + flow_b): b's backward motion; a(p) ~ b(p + flow_a): a's forward motion.
-        st.estimate(st.grey_b, st.grey_a, b.motion, 1.0f, box, st.flow_b);
-        st.estimate(st.grey_a, st.grey_b, a.motion, -1.0f, box, st.flow_a);
-        st.evaluate(a, b, s, side_a, side_b, box);
-        won += st.decide(box, int(i));
-    }
+    st.make_boxes(w, h, std::max(options.margin, 0), options.neighbours);
+    const double share = std::clamp(double(options.max_flow_share), 0.0, 1.0);
+    counters.refine_tiles_left_out += st.keep_within(std::size_t(share * double(w) * h));
     st.decided.clear();
     for (int t = 0; t < st.tiles_x * st.tiles_y; ++t)
         if (st.label[t] >= 0) st.decided.push_back(t);
+    const std::size_t tile_area = std::size_t(st.tile) * st.tile;
+    st.chosen.resize(st.decided.size() * tile_area);
+    st.chosen_color.resize(st.decided.size() * tile_area);
+    std::size_t won = 0;
+    for (std::size_t i = 0; i < st.boxes.size(); ++i) {
+        const Box& box = st.boxes[i];
+        if (box.area() == 0) continue;
+        counters.flow_pixels += std::size_t(box.area());
+        st.grey_crop(a, box, st.grey_a);
+        st.grey_crop(b, box, st.grey_b);
+        // b(p) ~ a(p + flow): b's backward motion, followed from the in-between instant.
+        st.estimate(st.grey_b, st.grey_a, b.motion, 1.0f, box, st.flow_field);
+        st.evaluate(a, b, s, side_a, side_b, box);
+        won += st.decide(box, int(i));
+    }
     counters.refined_pixels += won;
     return finish(won > 0);
 }
 
 void MotionRefiner::apply(ImageView<glm::vec4> color) const {
     const State& st = *state_;
-    for (int t : st.decided) {
+    const std::size_t area = std::size_t(st.tile) * st.tile;
+    for (std::size_t slot = 0; slot < st.decided.size(); ++slot) {
+        const int t = st.decided[slot];
         const int x0 = (t % st.tiles_x) * st.tile, y0 = (t / st.tiles_x) * st.tile;
         const int x1 = std::min(color.width, x0 + st.tile),
                   y1 = std::min(color.height, y0 + st.tile);
+        const uint8_t* pick = st.chosen.data() + slot * area;
+        const glm::vec4* colour = st.chosen_color.data() + slot * area;
         for (int y = y0; y < y1; ++y)
-            for (int x = x0; x < x1; ++x)
-                if (st.chosen(x, y)) color(x, y) = st.chosen_color(x, y);
+            for (int x = x0; x < x1; ++x) {
+                const std::size_t k = std::size_t(y - y0) * st.tile + std::size_t(x - x0);
+                if (pick[k]) color(x, y) = colour[k];
+            }
     }
 }
 

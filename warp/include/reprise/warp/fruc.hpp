@@ -74,6 +74,12 @@ struct RefineOptions {
     float threshold = 0.1f;   // display-value difference (largest channel) of disagreeing sides
     float tile_share = 0.1f;  // share of a tile's surveyed pixels that must disagree
     int margin = 16;          // px of context around the disagreeing tiles given to the flow
+    // Also decide the ring of tiles around the disagreeing ones: boxes 2.4x the pixels on pan at
+    // 1080p for 0.14-0.28 dB more over whole frames on pan and mirror (docs/benchmarks.md).
+    bool neighbours = true;
+    // Largest share of the frame's pixels the flow runs on: the boxes that disagree most per
+    // pixel go first, the tiles of the others are left out (FrucCounters::refine_tiles_left_out).
+    float max_flow_share = 1.0f;
 };
 
 struct FrucOptions {
@@ -123,10 +129,11 @@ struct FrucCounters {
     std::size_t refined_frames = 0;   // in-between frames whose sides disagreed: flow estimated
     std::size_t refine_skipped = 0;   // ... whose sides agreed everywhere: nothing estimated
     std::size_t refine_tiles = 0;     // tiles whose sides disagreed
-    std::size_t flow_pixels = 0;      // pixels the flow was estimated on (boxes around the tiles)
-    std::size_t refined_pixels = 0;   // pixels that took the flow's colour
-    double refine_ms = 0.0;           // time in the survey and the refinement
-    std::size_t ui_frames = 0;        // made frames given the nearest input's UI layer
+    std::size_t refine_tiles_left_out = 0;  // ... not refined: past RefineOptions::max_flow_share
+    std::size_t flow_pixels = 0;     // pixels the flow was estimated on (boxes around the tiles)
+    std::size_t refined_pixels = 0;  // pixels that took the flow's colour
+    double refine_ms = 0.0;          // time in the survey and the refinement
+    std::size_t ui_frames = 0;       // made frames given the nearest input's UI layer
     // Auto choice, per candidate (auto_candidate_name): frames it was chosen for, and frames it
     // was left out of although expected to score higher than the choice (too costly for it).
     std::array<std::size_t, kAutoCandidates> auto_chosen{};
