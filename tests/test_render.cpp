@@ -89,6 +89,27 @@ TEST(Render, StaticCameraAndSceneGiveExactlyZeroMotion) {
     EXPECT_GT(geometry, 160 * 90 / 2);
 }
 
+TEST(Render, ASceneMadeWhereAnotherWasGetsItsOwnTextures) {
+    // A scene assigned over one drawn before keeps its storage (the texture pixels where the old
+    // ones were): it is drawn with its own textures, not the ones the renderer still holds.
+    const RenderSettings size{.width = 96, .height = 54};
+    Scene reused, other, fence;
+    CameraPath path, fence_path;
+    Frame old_frame, drawn, fresh;
+    ASSERT_TRUE(load_scene("pan", reused, path).ok());
+    ASSERT_TRUE(load_scene("fence", fence, fence_path).ok());
+    ASSERT_NE(reused.revision, fence.revision);
+    ASSERT_TRUE(shared_renderer().render_frame(reused, path, 2, 30.0, size, old_frame).ok());
+    const void* storage = reused.textures.front().pixels.data();
+    reused = fence;
+    EXPECT_EQ(reused.textures.front().pixels.data(), storage) << "the case this test is about";
+    ASSERT_TRUE(shared_renderer().render_frame(reused, fence_path, 2, 30.0, size, drawn).ok());
+    ASSERT_TRUE(load_scene("pan", other, path).ok());
+    ASSERT_TRUE(shared_renderer().render_frame(other, path, 2, 30.0, size, old_frame).ok());
+    ASSERT_TRUE(shared_renderer().render_frame(fence, fence_path, 2, 30.0, size, fresh).ok());
+    EXPECT_EQ(drawn.color, fresh.color);
+}
+
 TEST(Render, SidewaysTranslationMovesContentExactlyKPixelsPerFrame) {
     // Camera at the origin looking down -z at a plane 10 units away, moving left so that the
     // content moves k pixels to the right per frame: motion (-k, 0) everywhere.

@@ -216,7 +216,7 @@ struct Renderer::Gpu {
     bool cache_valid = false;  // the other slot holds the frame rendered at cache_time/view
     double cache_time = 0.0;
     glm::mat4 cache_view{0.0f};
-    const Scene* cache_scene = nullptr;
+    std::uint64_t cache_scene = 0;  // its revision
     int reuse_frame = 0;
     ReuseStats stats;
     ReuseMaps maps;
@@ -234,8 +234,8 @@ struct Renderer::Gpu {
     int cache_width = 0, cache_height = 0;
     float max_anisotropy = 0.0f;
     Frame lowres_scratch;  // the low-resolution render of render_frame_lowres
-    // Textures of the scene last drawn, recognised by its address and its texture storage.
-    const Scene* scene = nullptr;
+    // Textures of the scene last drawn, recognised by its revision and its texture storage.
+    std::uint64_t scene_revision = 0;
     const void* scene_texture_data = nullptr;
     std::vector<GLuint> textures;
     // Per-frame scratch, kept between frames.
@@ -402,7 +402,8 @@ struct Renderer::Gpu {
 
     void upload_textures(const Scene& s) {
         const void* data = s.textures.empty() ? nullptr : s.textures.front().pixels.data();
-        if (scene == &s && scene_texture_data == data && textures.size() == s.textures.size())
+        if (scene_revision == s.revision && scene_texture_data == data &&
+            textures.size() == s.textures.size())
             return;
         glDeleteTextures(GLsizei(textures.size()), textures.data());
         textures.assign(s.textures.size(), 0);
@@ -425,7 +426,7 @@ struct Renderer::Gpu {
                 glTexParameterf(GL_TEXTURE_2D, 0x84FE /* TEXTURE_MAX_ANISOTROPY_EXT */,
                                 std::min(8.0f, max_anisotropy));
         }
-        scene = &s;
+        scene_revision = s.revision;
         scene_texture_data = data;
     }
 
@@ -678,8 +679,9 @@ Status Renderer::render(const Scene& scene, const Instant& current, const Instan
             g.cache_width = w, g.cache_height = h;
         }
     }
-    const bool cache_usable = reusing && g.cache_valid && !current.cut && g.cache_scene == &scene &&
-                              previous.time == g.cache_time && previous.view == g.cache_view;
+    const bool cache_usable = reusing && g.cache_valid && !current.cut &&
+                              g.cache_scene == scene.revision && previous.time == g.cache_time &&
+                              previous.view == g.cache_view;
 
     glBindVertexArray(g.vertex_array);
     glBindBuffer(GL_ARRAY_BUFFER, g.vertex_buffer);
@@ -944,7 +946,7 @@ Status Renderer::render(const Scene& scene, const Instant& current, const Instan
         g.cache_valid = true;
         g.cache_time = current.time;
         g.cache_view = current.view;
-        g.cache_scene = &scene;
+        g.cache_scene = scene.revision;
         g.cache_slot ^= 1;
         ++g.reuse_frame;
     }

@@ -1,6 +1,7 @@
 #pragma once
 // A renderable scene: the part of glTF 2.0 that reprise draws, also built in code for the
 // built-in scenes. Everything here has been validated: indices are in range, values finite.
+#include <atomic>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -132,6 +133,16 @@ struct Scene {
     bool heavy_shading = false;            // built for Shading::Heavy (the CLI's default for it)
     bool hud = false;  // the renderer draws the built-in HUD (draw_hud) into Frame::ui
     glm::vec3 background{0.55f, 0.70f, 0.90f};  // linear RGB of the sky (id 0)
+    // Unique to each scene made (copies share it), never reused: how a renderer knows the
+    // textures and caches it holds are this scene's (an address can belong to another scene
+    // later). A scene's textures are not changed once it is built.
+    std::uint64_t revision = next_scene_revision();
+
+private:
+    static std::uint64_t next_scene_revision() {
+        static std::atomic<std::uint64_t> next{1};
+        return next.fetch_add(1, std::memory_order_relaxed);
+    }
 };
 
 }  // namespace reprise::server
