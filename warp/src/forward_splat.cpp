@@ -28,13 +28,6 @@ void check_target(const GBufferView& source, const WarpTarget& t) {
                    (t.motion.width == t.color.width && t.motion.height == t.color.height));
 }
 
-// Where one source pixel lands: target pixels [x0, x0 + nx) x [y0, y0 + ny), and the offset of
-// the landing point from the centre of pixel (x0, y0).
-struct Landing {
-    int x0, y0, nx, ny;
-    float ox, oy;
-};
-
 bool valid_source(float z, glm::vec2 m) {
     return z >= 0.0f && std::isfinite(m.x) && std::isfinite(m.y);  // z = +inf: background
 }
@@ -45,7 +38,7 @@ int floor_small(float v) {
     return float(i) > v ? i - 1 : i;
 }
 
-bool land(int x, int y, glm::vec2 m, float factor, int footprint, int w, int h, Landing& out) {
+bool land(int x, int y, glm::vec2 m, float factor, int footprint, int w, int h, SplatLanding& out) {
     // In the pixel-centre frame (the centre of pixel i at i).
     const float dx = (float(x) + 0.5f) + factor * m.x - 0.5f;
     const float dy = (float(y) + 0.5f) + factor * m.y - 0.5f;
@@ -74,37 +67,41 @@ uint8_t closeness(float ox, float oy) {
 
 }  // namespace
 
+void splat_pixel(const SplatScatter& s, const Band& band, const SplatLanding& l, float z,
+                 glm::vec2 m, const glm::vec4& c) {
+    const WarpTarget& v = band.view;
+    for (int j = 0; j < l.ny; ++j) {
+        const int row = l.y0 + j - band.y0;
+        if (row < 0 || row >= v.color.height) continue;
+        uint8_t* q_row = v.covered.row(row);
+        float* d_row = v.depth.row(row);
+        for (int i = 0; i < l.nx; ++i) {
+            const int tx = l.x0 + i;
+            if (tx < 0 || tx >= s.width) continue;
+            const uint8_t q = closeness(l.ox - float(i), l.oy - float(j));
+            const float stored = d_row[tx];
+            const bool wins = q_row[tx] == 0 || z < stored * s.tol_lo ||
+                              (z <= stored * s.tol_hi && q < q_row[tx]);
+            if (!wins) continue;
+            q_row[tx] = q;
+            d_row[tx] = z;
+            v.color.row(row)[tx] = c;
+            if (!v.motion.empty()) v.motion.row(row)[tx] = m;
+        }
+    }
+}
+
 void splat_row_reference(const SplatScatter& s, int y, int x_begin, int x_end, const Band& band) {
     const float* z_row = s.depth.row(y);
     const glm::vec2* m_row = s.motion.row(y);
     const glm::vec4* c_row = s.color.row(y);
-    const WarpTarget& v = band.view;
-    const int rows = v.color.height;
     for (int x = x_begin; x < x_end; ++x) {
         const float z = z_row[x];
         const glm::vec2 m = m_row[x];
         if (!valid_source(z, m)) continue;
-        Landing l;
-        if (!land(x, y, m, s.factor, s.footprint, s.width, s.height, l)) continue;
-        for (int j = 0; j < l.ny; ++j) {
-            const int row = l.y0 + j - band.y0;
-            if (row < 0 || row >= rows) continue;
-            uint8_t* q_row = v.covered.row(row);
-            float* d_row = v.depth.row(row);
-            for (int i = 0; i < l.nx; ++i) {
-                const int tx = l.x0 + i;
-                if (tx < 0 || tx >= s.width) continue;
-                const uint8_t q = closeness(l.ox - float(i), l.oy - float(j));
-                const float stored = d_row[tx];
-                const bool wins = q_row[tx] == 0 || z < stored * s.tol_lo ||
-                                  (z <= stored * s.tol_hi && q < q_row[tx]);
-                if (!wins) continue;
-                q_row[tx] = q;
-                d_row[tx] = z;
-                v.color.row(row)[tx] = c_row[x];
-                if (!v.motion.empty()) v.motion.row(row)[tx] = m;
-            }
-        }
+        SplatLanding l;
+        if (land(x, y, m, s.factor, s.footprint, s.width, s.height, l))
+            splat_pixel(s, band, l, z, m, c_row[x]);
     }
 }
 

@@ -696,7 +696,8 @@ public:
         std::vector<glm::vec2> block_motion(std::size_t((w / 16 + 1) * (h / 4 + 1)));
         std::vector<int> block_kind(block_motion.size());
         for (std::size_t b = 0; b < block_motion.size(); ++b) {
-            block_kind[b] = int(rng() % 5);
+            const int pick = int(rng() % 20);  // mostly whole runs of one motion
+            block_kind[b] = pick < 7 ? 0 : pick < 10 ? 1 : pick < 14 ? 2 : pick < 18 ? 3 : 4;
             block_motion[b] = {uniform(rng, -6.0f, 6.0f), uniform(rng, -3.0f, 3.0f)};
             if (block_kind[b] == 1) block_motion[b] = glm::round(block_motion[b]);
             if (block_kind[b] == 2) block_motion[b] = glm::vec2(0.0f);

@@ -16,6 +16,8 @@ HWY_BEFORE_NAMESPACE();
 namespace reprise::warp::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
+constexpr int kMaxLanes = HWY_MAX_BYTES / sizeof(float);
+
 void SplatRowRangeSimd(const SplatScatter& s, int y, int& lo, int& hi) {
     const hn::ScalableTag<float> df;
     using VF = hn::Vec<decltype(df)>;
@@ -70,7 +72,8 @@ void SplatRowSimd(const SplatScatter& s, int y, const Band& band) {
              high_y = hn::Set(df, float(s.height) + 0.5f);
     const VF scale = hn::Set(df, 127.0f), tol_lo = hn::Set(df, s.tol_lo),
              tol_hi = hn::Set(df, s.tol_hi);
-    const VI one_i = hn::Set(di, 1), max_i = hn::Set(di, 254), zero_i = hn::Zero(di);
+    const VI one_i = hn::Set(di, 1), two_i = hn::Set(di, 2), max_i = hn::Set(di, 254),
+             zero_i = hn::Zero(di);
     const VI lanes_i = hn::Iota(di, 0);
     const VF lanes = hn::Iota(df, 0.0f);
     const bool two = s.footprint == 2;
@@ -109,16 +112,23 @@ void SplatRowSimd(const SplatScatter& s, int y, const Band& band) {
             hn::And(hn::RebindMask(di, ok),
                     hn::And(hn::Set(di, band_last + 1) > iy, iy_last > hn::Set(di, band.y0 - 1)));
         if (hn::AllFalse(di, touches)) continue;
-        if (!hn::AllTrue(df, ok)) {
-            splat_row_reference(s, y, x, x + n, band);
-            continue;
-        }
         // Every lane lands: in one target row, on consecutive columns, inside the target?
         const int ix0 = hn::GetLane(ix), iy0 = hn::GetLane(iy);
-        const bool side_by_side =
-            hn::AllTrue(di, hn::And(iy == hn::Set(di, iy0), ix == hn::Set(di, ix0) + lanes_i));
-        if (!side_by_side || ix0 < 0 || ix0 + n + 1 > s.width) {
-            splat_row_reference(s, y, x, x + n, band);
+        if (!hn::AllTrue(df, ok) ||
+            !hn::AllTrue(di, hn::And(iy == hn::Set(di, iy0), ix == hn::Set(di, ix0) + lanes_i)) ||
+            ix0 < 0 || ix0 + n + 1 > s.width) {
+            // Otherwise the lanes that reach the band, one by one in order.
+            HWY_ALIGN int32_t xs[kMaxLanes], ys[kMaxLanes], nxs[kMaxLanes], nys[kMaxLanes];
+            HWY_ALIGN int32_t reach[kMaxLanes];
+            HWY_ALIGN float oxs[kMaxLanes], oys[kMaxLanes];
+            hn::Store(ix, di, xs), hn::Store(iy, di, ys), hn::Store(ox, df, oxs);
+            hn::Store(oy, df, oys), hn::Store(hn::IfThenElseZero(touches, one_i), di, reach);
+            hn::Store(hn::IfThenElse(hn::RebindMask(di, wide), two_i, one_i), di, nxs);
+            hn::Store(hn::IfThenElse(hn::RebindMask(di, tall), two_i, one_i), di, nys);
+            for (int k = 0; k < n; ++k)
+                if (reach[k])
+                    splat_pixel(s, band, {xs[k], ys[k], nxs[k], nys[k], oxs[k], oys[k]},
+                                z_row[x + k], s.motion.row(y)[x + k], s.color.row(y)[x + k]);
             continue;
         }
         VF cr, cg, cb, ca;

@@ -15,6 +15,17 @@ struct SplatScatter {
     int width, height;     // of the target
 };
 
+// Where one source pixel lands: target pixels [x0, x0 + nx) x [y0, y0 + ny), and the offset of
+// the landing point from the centre of pixel (x0, y0).
+struct SplatLanding {
+    int x0, y0, nx, ny;
+    float ox, oy;
+};
+// The z-test and the writes of one landed source pixel (depth z, motion m, colour c) in the
+// band's rows, in the reference's order.
+void splat_pixel(const SplatScatter& s, const Band& band, const SplatLanding& l, float z,
+                 glm::vec2 m, const glm::vec4& c);
+
 // Source pixels [x_begin, x_end) of row y offered to the band's rows, pixel by pixel in order.
 void splat_row_reference(const SplatScatter& s, int y, int x_begin, int x_end, const Band& band);
 void splat_row(const SplatScatter& s, int y, const Band& band);
