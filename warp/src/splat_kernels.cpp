@@ -50,6 +50,9 @@ void SplatRowRangeSimd(const SplatScatter& s, int y, int& lo, int& hi) {
 }
 
 void SplatRowSimd(const SplatScatter& s, int y, const Band& band) {
+#if HWY_TARGET == HWY_SCALAR  // one lane: nothing to gain over the reference
+    splat_row_reference(s, y, 0, s.depth.width, band);
+#else
     const hn::ScalableTag<float> df;
     const hn::RebindToSigned<decltype(df)> di;
     const hn::Rebind<uint8_t, decltype(df)> du8;
@@ -174,6 +177,7 @@ void SplatRowSimd(const SplatScatter& s, int y, const Band& band) {
         }
     }
     if (x < sw) splat_row_reference(s, y, x, sw, band);
+#endif
 }
 
 }  // namespace reprise::warp::HWY_NAMESPACE
