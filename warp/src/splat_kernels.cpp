@@ -2,7 +2,8 @@
 // at run time. Landing, validity and closeness are computed in lanes with the reference's
 // operations in its order (no FMA: compiled with -ffp-contract=off). Where a run of lanes lands
 // side by side in one target row (a camera pan, a rigid object, anything still), the z-test and
-// the writes are done in lanes too; every other run goes through the scalar reference.
+// the writes are done in lanes too; the lanes of any other vector go one by one through the
+// reference's scalar z-test with their lane-computed landing.
 #include <limits>
 
 #include "splat_kernels.hpp"
@@ -43,10 +44,10 @@ void SplatRowRangeSimd(const SplatScatter& s, int y, int& lo, int& hi) {
     }
     // Every folded value is finite and not NaN: the order of the fold does not matter (and floor
     // does not see the sign of a zero).
-    float mn = hn::GetLane(hn::MinOfLanes(df, dy_min)),
-          mx = hn::GetLane(hn::MaxOfLanes(df, dy_max));
-    splat_extent_reference(s, y, x, sw, mn, mx);
-    splat_rows_touched(s, mn, mx, lo, hi);
+    float lowest = hn::GetLane(hn::MinOfLanes(df, dy_min)),
+          highest = hn::GetLane(hn::MaxOfLanes(df, dy_max));
+    splat_extent_reference(s, y, x, sw, lowest, highest);
+    splat_rows_touched(s, lowest, highest, lo, hi);
 }
 
 void SplatRowSimd(const SplatScatter& s, int y, const Band& band) {
