@@ -116,7 +116,8 @@ Status bench_kernels(const BenchOptions& options) {
         "size;\n"
         "%d threads (reprise) / %d (OpenCV), best and median of %d runs, ms; random inputs.\n"
         "x ref = reference best / best; x remap = best / remap best; the reverse reprojection's\n"
-        "reference is single-threaded (the others run on the same threads as their kernels).\n",
+        "and the forward splat's references are single-threaded (the others run on the same\n"
+        "threads as their kernels).\n",
         thread_count(), cv::getNumThreads(), options.frames);
     for (const std::string& size : split_list(options.sizes)) {
         int w = 0, h = 0;

@@ -7,9 +7,9 @@
 #include <limits>
 #include <vector>
 
-#include "band.hpp"
 #include "reprise/core/parallel.hpp"
 #include "reprise/warp/splat.hpp"
+#include "splat_kernels.hpp"
 
 namespace reprise::warp {
 
@@ -28,13 +28,6 @@ void check_target(const GBufferView& source, const WarpTarget& t) {
                    (t.motion.width == t.color.width && t.motion.height == t.color.height));
 }
 
-// Where one source pixel lands: target pixels [x0, x0 + nx) x [y0, y0 + ny), and the offset of
-// the landing point from the centre of pixel (x0, y0).
-struct Landing {
-    int x0, y0, nx, ny;
-    float ox, oy;
-};
-
 bool valid_source(float z, glm::vec2 m) {
     return z >= 0.0f && std::isfinite(m.x) && std::isfinite(m.y);  // z = +inf: background
 }
@@ -45,7 +38,7 @@ int floor_small(float v) {
     return float(i) > v ? i - 1 : i;
 }
 
-bool land(int x, int y, glm::vec2 m, float factor, int footprint, int w, int h, Landing& out) {
+bool land(int x, int y, glm::vec2 m, float factor, int footprint, int w, int h, SplatLanding& out) {
     // In the pixel-centre frame (the centre of pixel i at i).
     const float dx = (float(x) + 0.5f) + factor * m.x - 0.5f;
     const float dy = (float(y) + 0.5f) + factor * m.y - 0.5f;
@@ -72,77 +65,76 @@ uint8_t closeness(float ox, float oy) {
     return uint8_t(1 + std::min(254, int(d2 * 127.0f)));
 }
 
-struct Scatter {
-    ImageView<const glm::vec4> color;
-    ImageView<const float> depth;
-    ImageView<const glm::vec2> motion;
-    float factor;
-    int footprint;
-    float tol_lo, tol_hi;  // 1 -/+ depth tolerance
-    int width, height;     // of the target
+}  // namespace
 
-    // Offers source row y to the band's rows, pixel by pixel in order.
-    void offer_row(int y, const Band& band) const {
-        const float* z_row = depth.row(y);
-        const glm::vec2* m_row = motion.row(y);
-        const glm::vec4* c_row = color.row(y);
-        const WarpTarget& v = band.view;
-        const int rows = v.color.height;
-        for (int x = 0; x < depth.width; ++x) {
-            const float z = z_row[x];
-            const glm::vec2 m = m_row[x];
-            if (!valid_source(z, m)) continue;
-            Landing l;
-            if (!land(x, y, m, factor, footprint, width, height, l)) continue;
-            for (int j = 0; j < l.ny; ++j) {
-                const int row = l.y0 + j - band.y0;
-                if (row < 0 || row >= rows) continue;
-                uint8_t* q_row = v.covered.row(row);
-                float* d_row = v.depth.row(row);
-                for (int i = 0; i < l.nx; ++i) {
-                    const int tx = l.x0 + i;
-                    if (tx < 0 || tx >= width) continue;
-                    const uint8_t q = closeness(l.ox - float(i), l.oy - float(j));
-                    const float stored = d_row[tx];
-                    const bool wins = q_row[tx] == 0 || z < stored * tol_lo ||
-                                      (z <= stored * tol_hi && q < q_row[tx]);
-                    if (!wins) continue;
-                    q_row[tx] = q;
-                    d_row[tx] = z;
-                    v.color.row(row)[tx] = c_row[x];
-                    if (!v.motion.empty()) v.motion.row(row)[tx] = m;
-                }
-            }
+void splat_pixel(const SplatScatter& s, const Band& band, const SplatLanding& l, float z,
+                 glm::vec2 m, const glm::vec4& c) {
+    const WarpTarget& v = band.view;
+    for (int j = 0; j < l.ny; ++j) {
+        const int row = l.y0 + j - band.y0;
+        if (row < 0 || row >= v.color.height) continue;
+        uint8_t* q_row = v.covered.row(row);
+        float* d_row = v.depth.row(row);
+        for (int i = 0; i < l.nx; ++i) {
+            const int tx = l.x0 + i;
+            if (tx < 0 || tx >= s.width) continue;
+            const uint8_t q = closeness(l.ox - float(i), l.oy - float(j));
+            const float stored = d_row[tx];
+            const bool wins = q_row[tx] == 0 || z < stored * s.tol_lo ||
+                              (z <= stored * s.tol_hi && q < q_row[tx]);
+            if (!wins) continue;
+            q_row[tx] = q;
+            d_row[tx] = z;
+            v.color.row(row)[tx] = c;
+            if (!v.motion.empty()) v.motion.row(row)[tx] = m;
         }
     }
+}
 
-    // Rows of the target that source row y can touch; lo > hi when none.
-    void row_range(int y, int& lo, int& hi) const {
-        const float* z_row = depth.row(y);
-        const glm::vec2* m_row = motion.row(y);
-        float dy_min = kInf, dy_max = -kInf;
-        for (int x = 0; x < depth.width; ++x) {
-            const float dy = (float(y) + 0.5f) + factor * m_row[x].y - 0.5f;  // as in land()
-            if (!valid_source(z_row[x], m_row[x]) || !(dy > -1.5f && dy < float(height) + 0.5f))
-                continue;
-            dy_min = std::min(dy_min, dy);
-            dy_max = std::max(dy_max, dy);
-        }
-        if (dy_min > dy_max) {
-            lo = 1;
-            hi = 0;
-        } else if (footprint == 1) {
-            lo = floor_small(dy_min + 0.5f);
-            hi = floor_small(dy_max + 0.5f);
-        } else {
-            lo = floor_small(dy_min);
-            hi = -floor_small(-dy_max);
-        }
+void splat_row_reference(const SplatScatter& s, int y, int x_begin, int x_end, const Band& band) {
+    const float* z_row = s.depth.row(y);
+    const glm::vec2* m_row = s.motion.row(y);
+    const glm::vec4* c_row = s.color.row(y);
+    for (int x = x_begin; x < x_end; ++x) {
+        const float z = z_row[x];
+        const glm::vec2 m = m_row[x];
+        if (!valid_source(z, m)) continue;
+        SplatLanding l;
+        if (land(x, y, m, s.factor, s.footprint, s.width, s.height, l))
+            splat_pixel(s, band, l, z, m, c_row[x]);
     }
-};
+}
 
-Scatter make_scatter(const GBufferView& source, float factor, const WarpTarget& target,
-                     const SplatOptions& options) {
+void splat_extent_reference(const SplatScatter& s, int y, int x_begin, int x_end, float& dy_min,
+                            float& dy_max) {
+    const float* z_row = s.depth.row(y);
+    const glm::vec2* m_row = s.motion.row(y);
+    for (int x = x_begin; x < x_end; ++x) {
+        const float dy = (float(y) + 0.5f) + s.factor * m_row[x].y - 0.5f;  // as in land()
+        if (!valid_source(z_row[x], m_row[x]) || !(dy > -1.5f && dy < float(s.height) + 0.5f))
+            continue;
+        dy_min = std::min(dy_min, dy);
+        dy_max = std::max(dy_max, dy);
+    }
+}
+
+void splat_rows_touched(const SplatScatter& s, float dy_min, float dy_max, int& lo, int& hi) {
+    if (dy_min > dy_max) {
+        lo = 1;
+        hi = 0;
+    } else if (s.footprint == 1) {
+        lo = floor_small(dy_min + 0.5f);
+        hi = floor_small(dy_max + 0.5f);
+    } else {
+        lo = floor_small(dy_min);
+        hi = -floor_small(-dy_max);
+    }
+}
+
+namespace {
+
+SplatScatter make_scatter(const GBufferView& source, float factor, const WarpTarget& target,
+                          const SplatOptions& options) {
     check_target(source, target);
     REPRISE_ASSERT(options.footprint == 1 || options.footprint == 2);
     REPRISE_ASSERT(std::isfinite(factor));
@@ -170,7 +162,7 @@ Scratch& thread_scratch() {
 
 std::size_t splat_refined(const GBufferView& source, float factor, const WarpTarget& target,
                           const SplatOptions& options, BandRefine refine, const void* context) {
-    const Scatter scatter = make_scatter(source, factor, target, options);
+    const SplatScatter scatter = make_scatter(source, factor, target, options);
     if (target.color.empty()) return 0;
     const int sh = source.height(), width = target.color.width, height = target.color.height;
 
@@ -180,7 +172,7 @@ std::size_t splat_refined(const GBufferView& source, float factor, const WarpTar
     parallel_for(
         0, sh,
         [&](int a, int b) {
-            for (int y = a; y < b; ++y) scatter.row_range(y, range[2 * y], range[2 * y + 1]);
+            for (int y = a; y < b; ++y) splat_row_range(scatter, y, range[2 * y], range[2 * y + 1]);
         },
         8);
 
@@ -204,7 +196,7 @@ std::size_t splat_refined(const GBufferView& source, float factor, const WarpTar
                     clear_band(band);
                     for (int y = 0; y < sh; ++y)
                         if (range[2 * y] < y0 + rows && range[2 * y + 1] >= y0)
-                            scatter.offer_row(y, band);
+                            splat_row(scatter, y, band);
                     if (refine) refine(band, context);
                     n += copy_band(band, target, kInf);
                 }
@@ -222,11 +214,12 @@ std::size_t splat(const GBufferView& source, float factor, const WarpTarget& tar
 
 std::size_t splat_reference(const GBufferView& source, float factor, const WarpTarget& target,
                             const SplatOptions& options) {
-    const Scatter scatter = make_scatter(source, factor, target, options);
+    const SplatScatter scatter = make_scatter(source, factor, target, options);
     if (target.color.empty()) return 0;
     const Band whole{target, 0};
     clear_band(whole);
-    for (int y = 0; y < source.height(); ++y) scatter.offer_row(y, whole);
+    for (int y = 0; y < source.height(); ++y)
+        splat_row_reference(scatter, y, 0, source.width(), whole);
     return finish_band(whole, kInf);
 }
 

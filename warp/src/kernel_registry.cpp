@@ -17,6 +17,7 @@
 #include "reprise/core/frame.hpp"
 #include "reprise/core/parallel.hpp"
 #include "reprise/warp/reproject.hpp"
+#include "reprise/warp/splat.hpp"
 
 namespace reprise::warp {
 
@@ -748,6 +749,119 @@ private:
 
 // ---------------------------------------------------------------------------------------------
 
+// The forward splat (banded, threaded, its row kernels at the current level) against the scalar
+// reference, both footprints. Random: blocks of one motion each (sub-pixel, whole-pixel, still,
+// a zoom, per-pixel noise) over a few depth levels, so that runs land side by side and ties,
+// the depth tolerance and overlaps are exercised; worst case adds NaN/Inf/huge motion and depth.
+class SplatCase final : public KernelCase {
+public:
+    void generate(int w, int h, KernelInputs inputs, uint32_t seed) override {
+        std::mt19937 rng(seed);
+        const bool worst = inputs == KernelInputs::WorstCase;
+        const float factors[] = {-0.5f, 1.0f, 0.3f, -1.0f};
+        factor_ = worst && seed % 3 == 0 ? -1e30f : factors[seed % 4];
+        // Some targets of another size than the source.
+        target_w_ = seed % 5 == 4 ? w + 3 : seed % 5 == 3 ? std::max(1, w - 2) : w;
+        target_h_ = seed % 5 == 4 ? std::max(1, h - 1) : seed % 5 == 3 ? h + 9 : h;
+        source_.color.resize(w, h), source_.depth.resize(w, h), source_.motion.resize(w, h);
+        std::vector<glm::vec2> block_motion(std::size_t((w / 16 + 1) * (h / 4 + 1)));
+        std::vector<int> block_kind(block_motion.size());
+        for (std::size_t b = 0; b < block_motion.size(); ++b) {
+            const int pick = int(rng() % 20);  // mostly whole runs of one motion
+            block_kind[b] = pick < 7 ? 0 : pick < 10 ? 1 : pick < 14 ? 2 : pick < 18 ? 3 : 4;
+            block_motion[b] = {uniform(rng, -6.0f, 6.0f), uniform(rng, -3.0f, 3.0f)};
+            if (block_kind[b] == 1) block_motion[b] = glm::round(block_motion[b]);
+            if (block_kind[b] == 2) block_motion[b] = glm::vec2(0.0f);
+        }
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                const std::size_t b = std::size_t((y / 4) * (w / 16 + 1) + x / 16);
+                glm::vec2 m = block_motion[b];
+                if (block_kind[b] == 3) m += 0.05f * glm::vec2(float(x - w / 2), float(y - h / 2));
+                if (block_kind[b] == 4) m = {uniform(rng, -8.0f, 8.0f), uniform(rng, -8.0f, 8.0f)};
+                const float r = uniform(rng, 0.0f, 1.0f);
+                float z = r < 0.1f ? kInf : 1.0f + float(int(r * 4.0f));
+                if (rng() % 4 == 0) z *= uniform(rng, 0.995f, 1.005f);  // about the tolerance
+                for (int c = 0; c < 4; ++c) source_.color(x, y)[c] = uniform(rng, 0.0f, 4.0f);
+                if (worst && rng() % 3 == 0) {
+                    switch (rng() % 6) {
+                        case 0:
+                            z = worst_value(rng);
+                            break;
+                        case 1:
+                            m[int(rng() % 2)] = worst_value(rng);
+                            break;
+                        case 2:
+                            m = {1e30f, -1e30f};
+                            break;
+                        case 3:
+                            z = rng() % 2 ? 0.0f : -0.0f;
+                            break;
+                        case 4:
+                            z = rng() % 2 ? 1e30f : -uniform(rng, 0.1f, 10.0f);
+                            break;
+                        default:
+                            source_.color(x, y)[int(rng() % 4)] = worst_value(rng);
+                    }
+                }
+                source_.depth(x, y) = z, source_.motion(x, y) = m;
+            }
+    }
+    void reset() override {
+        for (Output& o : optimized_) o.start(target_w_, target_h_);
+    }
+    void reset_reference() override {
+        for (Output& o : reference_) o.start(target_w_, target_h_);
+    }
+    void run_reference() override { run_into(reference_, splat_reference); }
+    void run() override { run_into(optimized_, splat); }
+    std::string compare() const override {
+        for (int f = 0; f < 2; ++f) {
+            const Output &a = optimized_[f], &b = reference_[f];
+            const std::string footprint = "footprint " + std::to_string(f + 1) + ": ";
+            if (a.count != b.count)
+                return footprint + "covered " + std::to_string(a.count) + ", reference " +
+                       std::to_string(b.count);
+            if (!(a.covered == b.covered)) return footprint + "coverage differs";
+            std::string d = compare_bits("colour", pixels(a.color), pixels(b.color));
+            if (d.empty()) d = compare_bits("depth", pixels(a.depth), pixels(b.depth));
+            if (d.empty()) d = compare_bits("motion", pixels(a.motion), pixels(b.motion));
+            if (!d.empty()) return footprint + d;
+        }
+        return {};
+    }
+
+private:
+    struct Output {
+        Image<glm::vec4> color;
+        Image<float> depth;
+        Image<glm::vec2> motion;
+        Image<uint8_t> covered;
+        std::size_t count = 0;
+        void start(int w, int h) {  // what the splat must overwrite
+            color.assign(w, h, glm::vec4(-3.0f)), depth.assign(w, h, -3.0f);
+            motion.assign(w, h, glm::vec2(-3.0f)), covered.assign(w, h, 7);
+        }
+        WarpTarget target() { return {color.view(), depth.view(), motion.view(), covered.view()}; }
+    };
+    template <class T>
+    static std::vector<T> pixels(const Image<T>& image) {
+        return {image.data(), image.data() + image.pixel_count()};
+    }
+    template <class Kernel>
+    void run_into(Output (&out)[2], Kernel kernel) {
+        for (int f = 0; f < 2; ++f)
+            out[f].count = kernel(source_, factor_, out[f].target(), {.footprint = f + 1});
+    }
+
+    Frame source_;
+    float factor_ = -0.5f;
+    int target_w_ = 0, target_h_ = 0;
+    Output reference_[2], optimized_[2];
+};
+
+// ---------------------------------------------------------------------------------------------
+
 template <class T>
 std::unique_ptr<KernelCase> make() {
     return std::make_unique<T>();
@@ -762,6 +876,7 @@ constexpr KernelEntry kEntries[] = {
     {"reverse warp refetch", "bit-exact", true, make<RefetchCase>},
     {"bicubic fetch (grid, refetch)", "bit-exact (NaN: any NaN)", true, make<BicubicCase>},
     {"stereo displacement", "bit-exact", true, make<DisplacementCase>},
+    {"forward splat", "bit-exact", true, make<SplatCase>},
 };
 
 }  // namespace
