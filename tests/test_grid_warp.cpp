@@ -30,6 +30,7 @@ GridStats warp_both(const Frame& f, float factor, Output& out, const GridOptions
     const GridStats slow = warper.warp_reference(f, factor, ref.target(), o);
     EXPECT_EQ(fast.cells, slow.cells);
     EXPECT_EQ(fast.covered, slow.covered);
+    EXPECT_EQ(fast.nonfinite, slow.nonfinite);
     expect_same(out, ref);
     return fast;
 }
@@ -85,7 +86,19 @@ TEST(GridWarp, ZeroMotionCopiesExactly) {
         Output out(101, 67);
         const GridStats s = warp_both(f, -0.5f, out, {.min_cell = min_cell});
         EXPECT_EQ(s.covered, 101u * 67u);
+        EXPECT_EQ(s.nonfinite, 0u);
         EXPECT_TRUE(same_bits(out.color, f.color));
+        // Non-finite colour carried to the output is counted (callers sanitise only then): each
+        // such source pixel reaches at most the 4 pixels whose bilinear taps include it.
+        Frame odd = f;
+        odd.color(5, 5).w = std::numeric_limits<float>::quiet_NaN();
+        odd.color(50, 30).x = kInf;
+        odd.color(100, 66).y = -kInf;
+        Output odd_out(101, 67);
+        const std::size_t nonfinite =
+            warp_both(odd, -0.5f, odd_out, {.min_cell = min_cell}).nonfinite;
+        EXPECT_GE(nonfinite, 3u);
+        EXPECT_LE(nonfinite, 12u);
         EXPECT_EQ(out.covered, Image<uint8_t>(101, 67, 1));
         EXPECT_EQ(out.motion, Image<glm::vec2>(101, 67, glm::vec2(0.0f)));
         // Depth is interpolated between the vertices: close to the source's away from the edges.

@@ -43,7 +43,7 @@ void copy_into(Image<T>& to, ImageView<const T> from) {
 
 std::size_t StereoSynthesizer::warp_into(const GBufferView& source, const Camera& target,
                                          const StereoOptions& o, const warp::WarpTarget& into,
-                                         std::size_t& cells) {
+                                         std::size_t& cells, bool& maybe_nonfinite) {
     const int w = source.width(), h = source.height();
     displacement_.resize(w, h);
     target_depth_.resize(w, h);
@@ -53,9 +53,13 @@ std::size_t StereoSynthesizer::warp_into(const GBufferView& source, const Camera
                             .depth = target_depth_.view(),
                             .motion = displacement_.view(),
                             .camera = source.camera};
-    if (o.warp == StereoWarp::Splat) return warp::splat(moved, 1.0f, into, o.splat);
+    if (o.warp == StereoWarp::Splat) {
+        maybe_nonfinite = true;  // the splat does not count them
+        return warp::splat(moved, 1.0f, into, o.splat);
+    }
     const warp::GridStats stats = grid_.warp(moved, 1.0f, into, o.grid);
     cells += stats.cells;
+    maybe_nonfinite = maybe_nonfinite || stats.nonfinite > 0;
     return stats.covered;
 }
 
@@ -91,9 +95,10 @@ StereoStats StereoSynthesizer::synthesize(const GBufferView& rendered, const Cam
 
     out.color.resize(w, h);
     out.depth.resize(w, h);
+    bool maybe_nonfinite = false;  // else everything written is finite: no last pass needed
     stats.covered =
         warp_into(rendered, target, o, {out.color.view(), out.depth.view(), {}, covered_.view()},
-                  stats.cells);
+                  stats.cells, maybe_nonfinite);
     stats.holes = n - stats.covered;
 
     std::size_t history_holes_filled = 0;
@@ -108,7 +113,7 @@ StereoStats StereoSynthesizer::synthesize(const GBufferView& rendered, const Cam
         history_covered_.resize(w, h);
         warp_into(*history, target, o,
                   {history_color_.view(), history_depth_.view(), {}, history_covered_.view()},
-                  stats.cells);
+                  stats.cells, maybe_nonfinite);
         const bool closer = o.history_replaces && distance_between(history->camera, target) <
                                                       distance_between(rendered.camera, target);
         const float tol = o.history_depth_tolerance;
@@ -141,7 +146,9 @@ StereoStats StereoSynthesizer::synthesize(const GBufferView& rendered, const Cam
     }
     stats.filled = filled.holes - filled.unfilled;
     stats.unfilled = filled.unfilled;
-    // Whatever could not be filled (and non-finite alpha carried from the input) becomes 0.
+    // Non-finite colour carried from the input (the fill replaces RGB only) becomes 0; holes the
+    // warp left and the fill could not fill are 0 already.
+    if (!maybe_nonfinite) return stats;
     parallel_for(0, h, [&](int y0, int y1) {
         for (std::size_t i = std::size_t(y0) * w; i < std::size_t(y1) * w; ++i) {
             glm::vec4& c = out.color.data()[i];

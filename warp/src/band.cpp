@@ -2,6 +2,7 @@
 #include "band.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <limits>
@@ -14,6 +15,10 @@ namespace reprise::warp {
 
 namespace {
 constexpr float kInf = std::numeric_limits<float>::infinity();
+
+bool finite_color(const glm::vec4& c) {
+    return std::isfinite(c.x) && std::isfinite(c.y) && std::isfinite(c.z) && std::isfinite(c.w);
+}
 }  // namespace
 
 void clear_band(const Band& band) {
@@ -24,9 +29,9 @@ void clear_band(const Band& band) {
     }
 }
 
-std::size_t finish_band(const Band& band, float background_from) {
+std::size_t finish_band(const Band& band, float background_from, std::size_t* nonfinite) {
     const WarpTarget& v = band.view;
-    std::size_t count = 0;
+    std::size_t count = 0, bad = 0;
     for (int y = 0; y < v.color.height; ++y) {
         float* depth = v.depth.row(y);
         uint8_t* covered = v.covered.row(y);
@@ -35,6 +40,7 @@ std::size_t finish_band(const Band& band, float background_from) {
         for (int x = 0; x < v.color.width; ++x) {
             if (covered[x]) {
                 ++count;
+                bad += !finite_color(color[x]);
                 covered[x] = 1;
                 if (depth[x] >= background_from) depth[x] = kInf;
             } else {
@@ -43,6 +49,7 @@ std::size_t finish_band(const Band& band, float background_from) {
             }
         }
     }
+    if (nonfinite) *nonfinite += bad;
     return count;
 }
 
@@ -65,17 +72,19 @@ void put(float* p, __m128 v, bool aligned) {
 }  // namespace
 #endif
 
-std::size_t copy_band(const Band& scratch, const WarpTarget& target, float background_from) {
+std::size_t copy_band(const Band& scratch, const WarpTarget& target, float background_from,
+                      std::size_t* nonfinite) {
     const WarpTarget& s = scratch.view;
     const bool motion = !target.motion.empty();
     const int width = s.color.width;
-    std::size_t count = 0;
+    std::size_t count = 0, bad = 0;
 #if defined(__SSE2__)
     const bool color_aligned = rows_aligned(target.color),
                depth_aligned = rows_aligned(target.depth);
     const bool motion_aligned = motion && rows_aligned(target.motion);
     const __m128 background = _mm_set1_ps(background_from), inf = _mm_set1_ps(kInf);
     const __m128i zero = _mm_setzero_si128();
+    const __m128i exponent = _mm_set1_epi32(0x7f800000);  // all ones: NaN or infinity
 #endif
     for (int y = 0; y < s.color.height; ++y) {
         const int ty = scratch.y0 + y;
@@ -104,17 +113,24 @@ std::size_t copy_band(const Band& scratch, const WarpTarget& target, float backg
             const __m128 z = _mm_loadu_ps(sd + x);
             const __m128 far = _mm_cmpge_ps(z, background);
             put(td + x, _mm_or_ps(_mm_and_ps(far, inf), _mm_andnot_ps(far, z)), depth_aligned);
-            put(&tcol[x].x, _mm_and_ps(_mm_shuffle_ps(hit, hit, 0x00), _mm_loadu_ps(&scol[x].x)),
-                color_aligned);
-            put(&tcol[x + 1].x,
-                _mm_and_ps(_mm_shuffle_ps(hit, hit, 0x55), _mm_loadu_ps(&scol[x + 1].x)),
-                color_aligned);
-            put(&tcol[x + 2].x,
-                _mm_and_ps(_mm_shuffle_ps(hit, hit, 0xaa), _mm_loadu_ps(&scol[x + 2].x)),
-                color_aligned);
-            put(&tcol[x + 3].x,
-                _mm_and_ps(_mm_shuffle_ps(hit, hit, 0xff), _mm_loadu_ps(&scol[x + 3].x)),
-                color_aligned);
+            const __m128 c0 = _mm_and_ps(_mm_shuffle_ps(hit, hit, 0x00), _mm_loadu_ps(&scol[x].x)),
+                         c1 = _mm_and_ps(_mm_shuffle_ps(hit, hit, 0x55),
+                                         _mm_loadu_ps(&scol[x + 1].x)),
+                         c2 = _mm_and_ps(_mm_shuffle_ps(hit, hit, 0xaa),
+                                         _mm_loadu_ps(&scol[x + 2].x)),
+                         c3 = _mm_and_ps(_mm_shuffle_ps(hit, hit, 0xff),
+                                         _mm_loadu_ps(&scol[x + 3].x));
+            put(&tcol[x].x, c0, color_aligned);
+            put(&tcol[x + 1].x, c1, color_aligned);
+            put(&tcol[x + 2].x, c2, color_aligned);
+            put(&tcol[x + 3].x, c3, color_aligned);
+            if (nonfinite) {
+                const auto special = [&](__m128 c) {
+                    const __m128i e = _mm_and_si128(_mm_castps_si128(c), exponent);
+                    return _mm_movemask_ps(_mm_castsi128_ps(_mm_cmpeq_epi32(e, exponent))) != 0;
+                };
+                bad += special(c0) + special(c1) + special(c2) + special(c3);
+            }
             if (tm) {
                 put(&tm[x].x, _mm_and_ps(_mm_unpacklo_ps(hit, hit), _mm_loadu_ps(&sm[x].x)),
                     motion_aligned);
@@ -129,9 +145,11 @@ std::size_t copy_band(const Band& scratch, const WarpTarget& target, float backg
             tc[x] = hit ? 1 : 0;
             td[x] = sd[x] >= background_from ? kInf : sd[x];
             tcol[x] = hit ? scol[x] : glm::vec4(0.0f);
+            bad += hit && !finite_color(scol[x]);
             if (tm) tm[x] = hit ? sm[x] : glm::vec2(0.0f);
         }
     }
+    if (nonfinite) *nonfinite += bad;
 #if defined(__SSE2__)
     _mm_sfence();  // streaming stores are weakly ordered: make them visible before returning
 #endif

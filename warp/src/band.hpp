@@ -32,9 +32,11 @@ std::size_t splat_refined(const GBufferView& source, float factor, const WarpTar
 // Depth +inf, nothing covered.
 void clear_band(const Band& band);
 // In place: covered becomes 0/1, depths at or beyond `background_from` +inf, colour and motion
-// 0 where nothing landed. Returns the covered count.
-std::size_t finish_band(const Band& band, float background_from);
+// 0 where nothing landed. Returns the covered count; adds to `nonfinite`, when given, the covered
+// pixels whose colour has a NaN or infinite channel.
+std::size_t finish_band(const Band& band, float background_from, std::size_t* nonfinite = nullptr);
 // The same, written from a scratch band to its rows of `target`.
-std::size_t copy_band(const Band& scratch, const WarpTarget& target, float background_from);
+std::size_t copy_band(const Band& scratch, const WarpTarget& target, float background_from,
+                      std::size_t* nonfinite = nullptr);
 
 }  // namespace reprise::warp

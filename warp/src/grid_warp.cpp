@@ -87,19 +87,19 @@ GridStats GridWarper::run(const GBufferView& source, float factor, const WarpTar
     if (!threaded) {
         const Band whole{target, 0};
         draw(whole, false);
-        stats.covered = finish_band(whole, grid::kBackgroundFrom);
+        stats.covered = finish_band(whole, grid::kBackgroundFrom, &stats.nonfinite);
         return stats;
     }
 
     const int width = target.color.width;
     std::atomic<int> next{0};
-    std::atomic<std::size_t> covered{0};
+    std::atomic<std::size_t> covered{0}, nonfinite{0};
     parallel_for(
         0, workers,
         [&](int a, int b) {
             for (int k = a; k < b; ++k) {
                 grid::Scratch& scratch = st.scratch[std::size_t(k)];
-                std::size_t n = 0;
+                std::size_t n = 0, bad = 0;
                 for (int i = next++; i < bands; i = next++) {
                     const int y0 = i * kBandRows, rows = std::min(kBandRows, height - y0);
                     const Band band{
@@ -110,13 +110,15 @@ GridStats GridWarper::run(const GBufferView& source, float factor, const WarpTar
                          scratch_rows(scratch.covered, width, rows)},
                         y0};
                     draw(band, true);
-                    n += copy_band(band, target, grid::kBackgroundFrom);
+                    n += copy_band(band, target, grid::kBackgroundFrom, &bad);
                 }
                 covered += n;
+                nonfinite += bad;
             }
         },
         1);
     stats.covered = covered;
+    stats.nonfinite = nonfinite;
     return stats;
 }
 

@@ -62,9 +62,10 @@ public:
     ImageView<const uint8_t> coverage() const { return covered_.view(); }
 
 private:
-    // Warps `source` to `target` into `into`; returns the covered pixel count (cells in `cells`).
+    // Warps `source` to `target` into `into`; returns the covered pixel count (cells in `cells`;
+    // `maybe_nonfinite` set when covered colour may hold NaN or infinity).
     std::size_t warp_into(const GBufferView& source, const Camera& target, const StereoOptions& o,
-                          const warp::WarpTarget& into, std::size_t& cells);
+                          const warp::WarpTarget& into, std::size_t& cells, bool& maybe_nonfinite);
 
     Image<glm::vec2> displacement_;  // the source's displacement to the target, as motion
     Image<float> target_depth_;      // and its depth seen from the target

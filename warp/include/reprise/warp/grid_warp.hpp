@@ -23,8 +23,9 @@ struct GridOptions {
 };
 
 struct GridStats {
-    std::size_t cells = 0;    // cells drawn
-    std::size_t covered = 0;  // covered output pixels
+    std::size_t cells = 0;      // cells drawn
+    std::size_t covered = 0;    // covered output pixels
+    std::size_t nonfinite = 0;  // ... whose colour has a NaN or infinite channel
 };
 
 // Holds the cells and the scratch that it sizes once and reuses every frame.
