@@ -38,6 +38,24 @@ float worst_value(std::mt19937& rng) {
     return values[rng() % std::size(values)];
 }
 
+// The worst cases of every depth + motion input: kind 0 a bad depth, 1 a bad motion component,
+// 2 motion (1e30, -1e30). False for other kinds (the caller's own).
+bool spoil_depth_or_motion(std::mt19937& rng, unsigned kind, float& z, glm::vec2& m) {
+    switch (kind) {
+        case 0:
+            z = worst_value(rng);
+            return true;
+        case 1:
+            m[int(rng() % 2)] = worst_value(rng);
+            return true;
+        case 2:
+            m = {1e30f, -1e30f};
+            return true;
+        default:
+            return false;
+    }
+}
+
 // Bitwise equality of two float arrays (NaN payloads included unless `any_nan`: then a NaN
 // matches any NaN); names the first difference.
 template <class T>
@@ -222,22 +240,8 @@ public:
                                   ? before - p
                                   : glm::vec2(uniform(rng, -30, 30), uniform(rng, -30, 30));
                 m += glm::vec2(uniform(rng, -0.3f, 0.3f), uniform(rng, -0.3f, 0.3f));
-                if (worst && rng() % 3 == 0) {
-                    switch (rng() % 4) {
-                        case 0:
-                            z = worst_value(rng);
-                            break;
-                        case 1:
-                            m[int(rng() % 2)] = worst_value(rng);
-                            break;
-                        case 2:
-                            m = {1e30f, -1e30f};
-                            break;
-                        default:
-                            z = -uniform(rng, 0.1f, 10.0f);
-                            break;  // behind this camera
-                    }
-                }
+                if (worst && rng() % 3 == 0 && !spoil_depth_or_motion(rng, rng() % 4, z, m))
+                    z = -uniform(rng, 0.1f, 10.0f);  // behind this camera
                 depth_[i] = z, motion_[i] = m;
             }
     }
@@ -784,25 +788,15 @@ public:
                 if (rng() % 4 == 0) z *= uniform(rng, 0.995f, 1.005f);  // about the tolerance
                 for (int c = 0; c < 4; ++c) source_.color(x, y)[c] = uniform(rng, 0.0f, 4.0f);
                 if (worst && rng() % 3 == 0) {
-                    switch (rng() % 6) {
-                        case 0:
-                            z = worst_value(rng);
-                            break;
-                        case 1:
-                            m[int(rng() % 2)] = worst_value(rng);
-                            break;
-                        case 2:
-                            m = {1e30f, -1e30f};
-                            break;
-                        case 3:
-                            z = rng() % 2 ? 0.0f : -0.0f;
-                            break;
-                        case 4:
-                            z = rng() % 2 ? 1e30f : -uniform(rng, 0.1f, 10.0f);
-                            break;
-                        default:
-                            source_.color(x, y)[int(rng() % 4)] = worst_value(rng);
-                    }
+                    const unsigned kind = rng() % 6;
+                    if (kind == 3)
+                        z = rng() % 2 ? 0.0f : -0.0f;
+                    else if (kind == 4)
+                        z = rng() % 2 ? 1e30f : -uniform(rng, 0.1f, 10.0f);
+                    else if (kind == 5)
+                        source_.color(x, y)[int(rng() % 4)] = worst_value(rng);
+                    else
+                        spoil_depth_or_motion(rng, kind, z, m);
                 }
                 source_.depth(x, y) = z, source_.motion(x, y) = m;
             }
