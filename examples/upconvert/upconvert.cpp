@@ -3,6 +3,7 @@
 //   upconvert IN OUT
 #include <cstdio>
 #include <filesystem>
+#include <utility>
 
 #include "reprise/core/exr.hpp"
 #include "reprise/warp/fruc.hpp"
@@ -22,7 +23,7 @@ reprise::Status upconvert(const std::string& in_dir, const std::string& out_dir,
     for (const std::string& file : sequence.files) {
         REPRISE_TRY(reprise::read_frame(file, in));
         if (in.fps <= 0) in.fps = sequence.fps;
-        REPRISE_TRY(converter.send(in));
+        REPRISE_TRY(converter.send(std::move(in)));  // kept, not copied; `in` gets buffers back
         while (converter.receive(out))
             REPRISE_TRY(reprise::write_frame(reprise::frame_path(out_dir, written++), out));
     }

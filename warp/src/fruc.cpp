@@ -234,8 +234,8 @@ struct FrameRateConverter::State {
     }
 
     // The input itself as an output (colour, depth, motion per output period: what made frames
-    // carry) and, with keep, as the next `previous`, in one pass over it.
-    void emit_input(const Frame& frame, bool keep) {
+    // carry) and, when `kept` is given, copied there as the next previous frame, in one pass.
+    void emit_input(const Frame& frame, Frame* kept) {
         Frame& out = ready.push();
         const GBufferView in = frame.view();
         size_like(out.color, in.color);
@@ -243,14 +243,13 @@ struct FrameRateConverter::State {
         size_like(out.motion, in.motion);
         out.normal.clear();
         out.id.clear();
-        if (keep) {
-            size_like(previous.color, in.color);
-            size_like(previous.depth, in.depth);
-            size_like(previous.motion, in.motion);
-            size_like(previous.id, in.id);
-            previous.normal.clear();
+        if (kept) {
+            size_like(kept->color, in.color);
+            size_like(kept->depth, in.depth);
+            size_like(kept->motion, in.motion);
+            size_like(kept->id, in.id);
+            kept->normal.clear();
         }
-        Frame* const kept = keep ? &previous : nullptr;
         const float scale = motion_scale();
         auto rows_of = [](const auto& view, int y0, int y1) {
             return std::pair(std::min(y0, view.height), std::min(y1, view.height));
@@ -276,13 +275,13 @@ struct FrameRateConverter::State {
             32);
         out.camera = frame.camera;
         out.fps = frame.fps > 0 ? frame.fps * factor : 0.0;
-        if (keep) {
-            previous.camera = frame.camera;
-            previous.fps = frame.fps;
+        if (kept) {
+            kept->camera = frame.camera;
+            kept->fps = frame.fps;
             if (frame.ui.empty())
-                previous.ui.clear();
+                kept->ui.clear();
             else
-                copy_image(frame.ui.view(), previous.ui);
+                copy_image(frame.ui.view(), kept->ui);
         }
         attach_ui(out, frame, false);
     }
@@ -409,9 +408,9 @@ Status FrameRateConverter::send_frame(const Frame& frame, Frame* owned) {
                 st.attach_ui(st.ready.back(), s >= 0.5f ? frame : a, true);
             }
         }
-        st.emit_input(frame, !owned);
+        st.emit_input(frame, owned ? nullptr : &st.previous);
     } else {
-        st.emit_input(frame, !owned);
+        st.emit_input(frame, owned ? nullptr : &st.previous);
         if (st.automatic() && warpable && !cut) predicted = survey_predictors(frame);
         const Camera before = State::previous_instant(frame.camera, fps);
         for (int k = 1; k < k_max; ++k) {
