@@ -1,5 +1,6 @@
 #include "args.hpp"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -40,6 +41,19 @@ bool Args::given(const std::string& name) const {
     for (const Spec& s : positionals_)
         if (s.name == name) return s.seen;
     return false;
+}
+
+std::string Args::given_line(const std::vector<std::string>& leave_out) const {
+    std::vector<std::string> options;
+    for (const Spec& s : options_)
+        if (s.seen && std::find(leave_out.begin(), leave_out.end(), s.name) == leave_out.end())
+            options.push_back(s.kind == Kind::Flag ? s.name : s.name + " " + s.text);
+    std::sort(options.begin(), options.end());
+    std::string line = command_;
+    for (const Spec& s : positionals_)
+        if (s.seen) line += " " + s.text;
+    for (const std::string& option : options) line += " " + option;
+    return line;
 }
 
 static Status assign(const std::string& command, const std::string& name, int kind, void* target,
@@ -95,6 +109,7 @@ Status Args::parse(int argc, char** argv) {
                 if (i + 1 >= argc) return Status::error(command_ + ": " + arg + " needs a value");
                 value = argv[++i];
             }
+            spec->text = value;
             REPRISE_TRY(assign(command_, arg, int(spec->kind), spec->target, value));
             continue;
         }
@@ -102,6 +117,7 @@ Status Args::parse(int argc, char** argv) {
             return Status::error(command_ + ": unexpected argument '" + arg + "'");
         Spec& spec = positionals_[next_positional++];
         spec.seen = true;
+        spec.text = arg;
         *static_cast<std::string*>(spec.target) = arg;
     }
     for (const Spec& s : positionals_)

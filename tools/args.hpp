@@ -25,6 +25,9 @@ public:
     Status parse(int argc, char** argv);
     bool help_requested() const { return help_; }
     bool given(const std::string& name) const;
+    // The options given, sorted, as "--name value" (flags bare), leaving out `leave_out`: what a
+    // run was asked to do, compared when it is resumed.
+    std::string given_line(const std::vector<std::string>& leave_out) const;
     std::string usage() const;
 
 private:
@@ -36,6 +39,7 @@ private:
         std::string help;
         bool required = false;
         bool seen = false;
+        std::string text;  // as given
     };
     void add(Spec spec);
 

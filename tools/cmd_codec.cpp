@@ -6,6 +6,7 @@
 
 #include "args.hpp"
 #include "commands.hpp"
+#include "outputs.hpp"
 #include "reprise/codec/codec.hpp"
 #include "reprise/core/exr.hpp"
 
@@ -34,16 +35,14 @@ Status read_file(const std::string& path, std::vector<uint8_t>& bytes) {
 }
 
 Status write_file(const std::string& path, const std::vector<uint8_t>& bytes) {
-    const std::string temp = path + ".partial";
+    bool written = false;
     {
-        std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-        if (!out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size())))
-            return Status::error(path + ": cannot write");
+        std::ofstream out(partial_path(path), std::ios::binary | std::ios::trunc);
+        written =
+            out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size())) &&
+            out.flush();
     }
-    std::error_code ec;
-    std::filesystem::rename(temp, path, ec);
-    if (ec) return Status::error(path + ": " + ec.message());
-    return {};
+    return commit_partial(path, written);
 }
 
 Status parse_depth_mode(const std::string& text, codec::EncoderOptions& o) {
@@ -51,12 +50,12 @@ Status parse_depth_mode(const std::string& text, codec::EncoderOptions& o) {
         o.depth = codec::DepthMode::Lossless;
     } else if (text == "none") {
         o.depth = codec::DepthMode::None;
-    } else if (text.rfind("bounded", 0) == 0) {
+    } else if (text == "bounded" || text.starts_with("bounded:")) {
         o.depth = codec::DepthMode::Bounded;
-        if (text.size() > 8 && text[7] == ':') {
+        if (text != "bounded") {
             char* end = nullptr;
             o.depth_error = std::strtof(text.c_str() + 8, &end);
-            if (*end || !(o.depth_error >= 1e-7f && o.depth_error <= 0.1f))
+            if (text.size() == 8 || *end || !(o.depth_error >= 1e-7f && o.depth_error <= 0.1f))
                 return Status::error("encode: --depth " + text +
                                      ": the bound must be a number in 1e-7..0.1");
         }
@@ -94,7 +93,8 @@ void print_stats(const codec::StreamStats& s, double fps) {
 
 struct EncodeJob {
     std::string in, out, chroma = "420", depth = "lossless";
-    int qp = 28, quality = -1, bitrate = 0, keyint = 0, skip = 2;
+    int qp = 28, quality = 0, bitrate = 0, keyint = 0, skip = 2;
+    bool quality_given = false, overwrite_inputs = false;
 };
 
 // Bad option values are argument errors (exit 2), checked before anything is read.
@@ -102,8 +102,9 @@ Status encoder_options(const EncodeJob& job, codec::EncoderOptions& o) {
     if (job.in.empty()) return Status::error("encode: --in DIR is required");
     if (job.out.empty()) return Status::error("encode: --out FILE.rps is required");
     o.qp = job.qp;
-    if (job.quality >= 0) {
-        if (job.quality > 100) return Status::error("encode: --quality must be in 0..100");
+    if (job.quality_given) {
+        if (job.quality < 0 || job.quality > 100)
+            return Status::error("encode: --quality must be in 0..100");
         o.qp = (51 * (100 - job.quality) + 50) / 100;
     }
     if (o.qp < 0 || o.qp > 51) return Status::error("encode: --qp must be in 0..51");
@@ -123,8 +124,14 @@ Status encoder_options(const EncodeJob& job, codec::EncoderOptions& o) {
 }
 
 Status run_encode(const EncodeJob& job, const codec::EncoderOptions& o) {
+    std::error_code ec;
+    if (std::filesystem::is_directory(job.out, ec))
+        return Status::error("--out " + job.out + " is a folder; the stream is one file (.rps)");
+    REPRISE_TRY(check_output("--out", job.out, false,
+                             {.inputs = {job.in}, .overwrite_inputs = job.overwrite_inputs}));
     Sequence sequence;
     REPRISE_TRY(open_sequence(job.in, sequence));
+    REPRISE_TRY(check_one_size(sequence, "encode"));
     codec::Encoder encoder(o);
     std::vector<uint8_t> file;
     Frame frame;
@@ -156,17 +163,17 @@ Status run_encode(const EncodeJob& job, const codec::EncoderOptions& o) {
     return {};
 }
 
-Status run_decode(const std::string& in, const std::string& out) {
+Status run_decode(const std::string& in, const std::string& out, bool overwrite_inputs) {
     if (out.empty()) return Status::error("--out DIR is required");
+    OutputFolder output;
+    REPRISE_TRY(output.open(out, {.inputs = {in}, .overwrite_inputs = overwrite_inputs},
+                            "decode " + in, false));
     std::vector<uint8_t> bytes;
     REPRISE_TRY(read_file(in, bytes));
     codec::StreamInfo info;
     std::vector<std::span<const uint8_t>> packets;
     const Status split = codec::split_stream(bytes, info, packets);
     if (!split.ok()) return Status::error(in + ": " + split.message());
-    std::error_code ec;
-    std::filesystem::create_directories(out, ec);
-    if (ec) return Status::error(out + ": cannot create the folder: " + ec.message());
     codec::Decoder decoder;
     int written = 0, failed = 0;
     double busy_ms = 0.0;
@@ -183,10 +190,11 @@ Status run_decode(const std::string& in, const std::string& out) {
                 first_error = in + ": packet " + std::to_string(i) + ": " + s.message();
         }
         while (decoder.receive_frame(frame) == codec::Result::Ok)
-            REPRISE_TRY(write_frame(frame_path(out, written++), frame));
+            REPRISE_TRY(output.write(written++, frame));
         std::fprintf(stderr, "\r[decode] %zu/%zu packets, %d frames written", i + 1, packets.size(),
                      written);
     }
+    REPRISE_TRY(output.finish());
     std::fprintf(stderr, "\n");
     std::printf("decoded %d frames of %zu packets into %s, %.2f ms per frame (without file I/O)\n",
                 written, packets.size(), out.c_str(), busy_ms / double(std::max(1, written)));
@@ -257,8 +265,11 @@ int command_encode(int argc, char** argv) {
                 "lossless | bounded[:E] (relative error E, default 1e-4) | none");
     args.option("--skip", &job.skip,
                 "blocks within this many 8-bit levels of their prediction are skipped (default 2)");
+    args.flag("--overwrite-inputs", &job.overwrite_inputs,
+              "allow --out to replace an input file (written after all are read)");
     const Status parsed = args.parse(argc, argv);
     if (!parsed.ok() || args.help_requested()) return report(args, parsed, {});
+    job.quality_given = args.given("--quality");
     codec::EncoderOptions options;
     const Status checked = encoder_options(job, options);
     if (!checked.ok()) return report(args, checked, {});
@@ -267,14 +278,17 @@ int command_encode(int argc, char** argv) {
 
 int command_decode(int argc, char** argv) {
     std::string in, out;
+    bool overwrite_inputs = false;
     Args args(
         "decode",
         "Decodes a reprise stream (.rps) into an EXR sequence (colour, depth, motion, camera).");
     args.positional("FILE", &in, "the .rps stream");
     args.option("--out", &out, "output folder");
+    args.flag("--overwrite-inputs", &overwrite_inputs,
+              "allow --out to be the folder of the stream (written after it is read)");
     const Status parsed = args.parse(argc, argv);
     if (!parsed.ok() || args.help_requested()) return report(args, parsed, {});
-    return report(args, parsed, run_decode(in, out));
+    return report(args, parsed, run_decode(in, out, overwrite_inputs));
 }
 
 }  // namespace reprise::cli

@@ -8,6 +8,7 @@
 
 #include "args.hpp"
 #include "commands.hpp"
+#include "outputs.hpp"
 #include "reprise/core/exr.hpp"
 #include "reprise/core/video.hpp"
 #include "reprise/core/visualize.hpp"
@@ -282,6 +283,9 @@ Status export_stereo(const Options& o, stereo::Layout layout) {
 }
 
 Status run(const Options& o, Channel channel) {
+    const bool mp4 = !o.mp4.empty();
+    REPRISE_TRY(check_output(mp4 ? "--mp4" : "--png", mp4 ? o.mp4 : o.png, false,
+                             {.inputs = {o.dir}, .overwrite_inputs = false}));
     if (!o.stereo.empty())
         return export_stereo(o, o.stereo == "sbs"  ? stereo::Layout::SideBySide
                                 : o.stereo == "tb" ? stereo::Layout::TopBottom

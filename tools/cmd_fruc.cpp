@@ -7,6 +7,7 @@
 #include "commands.hpp"
 #include "flow_motion.hpp"
 #include "fruc_options.hpp"
+#include "outputs.hpp"
 #include "reprise/core/exr.hpp"
 #include "reprise/warp/fruc.hpp"
 
@@ -24,7 +25,17 @@ struct FrucJob {
     std::string ui;             // a UI sequence beside the input (its colour: premultiplied RGBA)
     bool ui_composite = false;  // draw the UI into the output colour
     double budget_db = 0.0;     // auto: the PSNR to reach (0: within slack of the best expected)
+    bool resume = false, overwrite_inputs = false;
+    std::string line;  // the options given, recorded for --resume
 };
+
+// Resuming at output frame `on_disk` starts at the input whose pair makes it, two inputs early:
+// the converter's state (the previous frame and whether it starts a shot) comes from those.
+std::size_t resume_input(int on_disk, int factor, warp::FrucMode mode) {
+    const int first =
+        mode == warp::FrucMode::Interpolate ? (on_disk + factor - 1) / factor : on_disk / factor;
+    return std::size_t(std::max(0, first - 2));
+}
 
 Status run_fruc(const FrucJob& job) {
     if (job.factor < 1 || job.factor > 16) return Status::error("--factor must be in 1..16");
@@ -53,21 +64,27 @@ Status run_fruc(const FrucJob& job) {
                                  std::to_string(ui_sequence.files.size()) + " frames for " +
                                  std::to_string(sequence.files.size()) + " input frames");
     }
-    std::error_code ec;
-    std::filesystem::create_directories(job.out, ec);
-    if (ec) return Status::error(job.out + ": cannot create the folder: " + ec.message());
+    REPRISE_TRY(check_one_size(sequence, "fruc"));
+    OutputRules rules{.inputs = {job.in}, .overwrite_inputs = job.overwrite_inputs};
+    if (!job.ui.empty()) rules.inputs.push_back(job.ui);
+    OutputFolder output;
+    REPRISE_TRY(output.open(job.out, rules, job.line, job.resume));
+    const std::size_t first = resume_input(output.frames_on_disk(), job.factor, options.mode);
 
     warp::FrameRateConverter converter(job.factor, options);
     FlowMotion flow;
     bool estimating = false;
     Frame in, out, ui_frame;
-    int written = 0;
+    int written = int(first) * job.factor;
     double busy_ms = 0.0;
     const std::size_t n = sequence.files.size();
-    for (std::size_t i = 0; i < n; ++i) {
+    if (first > 0 || output.frames_on_disk() > 0)
+        std::fprintf(stderr, "[fruc] resuming: %d frames on disk, restarting at input %zu\n",
+                     output.frames_on_disk(), first);
+    for (std::size_t i = first; i < n; ++i) {
         REPRISE_TRY(read_frame(sequence, i, in));
         if (in.fps <= 0) in.fps = sequence.fps;
-        if (i == 0 && (in.motion.empty() || in.depth.empty())) {
+        if (i == first && (in.motion.empty() || in.depth.empty())) {
             // Said once, before any work: what the input lacks and what stands in for it.
             if (in.motion.empty())
                 std::fprintf(stderr,
@@ -89,7 +106,7 @@ Status run_fruc(const FrucJob& job) {
                                      sequence.files[i]);
             std::swap(in.ui, ui_frame.color);
         }
-        if (i == 0 && !in.ui.empty())
+        if (i == first && !in.ui.empty())
             std::fprintf(stderr,
                          "[fruc] UI layer found (%s): the scene is warped without it, each made "
                          "frame gets the nearest input's UI unwarped%s\n",
@@ -100,10 +117,10 @@ Status run_fruc(const FrucJob& job) {
         busy_ms +=
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
                 .count();
-        while (converter.receive(out))
-            REPRISE_TRY(write_frame(frame_path(job.out, written++), out, write));
+        while (converter.receive(out)) REPRISE_TRY(output.write(written++, out, write));
         std::fprintf(stderr, "\r[fruc] %zu/%zu input frames, %d written", i + 1, n, written);
     }
+    REPRISE_TRY(output.finish());
     const warp::FrucCounters& c = converter.counters();
     std::fprintf(stderr, "\n");
     std::printf("fruc %s x%d, warp %s, fill %s: %zu inputs -> %d frames in %s\n", job.mode.c_str(),
@@ -177,8 +194,13 @@ int command_fruc(int argc, char** argv) {
                 "warp;\nframes with ui.R ui.G ui.B ui.A channels need no flag");
     args.flag("--ui-composite", &job.ui_composite,
               "draw the UI into the output colour (default: keep it in ui.* channels)");
+    args.flag("--resume", &job.resume,
+              "continue an interrupted run of the same arguments from the frames in --out");
+    args.flag("--overwrite-inputs", &job.overwrite_inputs,
+              "allow --out where the inputs are (written after all are read)");
     Status parsed = args.parse(argc, argv);
     if (!parsed.ok() || args.help_requested()) return report(args, parsed, {});
+    job.line = args.given_line({"--resume"});
     if (job.in.empty()) return report(args, Status::error("fruc: --in DIR is required"), {});
     return report(args, parsed, run_fruc(job));
 }

@@ -11,6 +11,7 @@
 
 #include "args.hpp"
 #include "commands.hpp"
+#include "outputs.hpp"
 #include "reprise/core/exr.hpp"
 #include "reprise/core/metrics.hpp"
 
@@ -69,7 +70,7 @@ std::string size_text(const Frame& f) {
     return std::to_string(f.width()) + "x" + std::to_string(f.height());
 }
 
-Status run(const Options& o) {
+Status measure(const Options& o) {
     Sequence ref_seq, test_seq;
     REPRISE_TRY(open_sequence(o.ref, ref_seq));
     REPRISE_TRY(open_sequence(o.test, test_seq));
@@ -83,7 +84,9 @@ Status run(const Options& o) {
 
     std::unique_ptr<FILE, int (*)(FILE*)> csv(nullptr, &std::fclose);
     if (!o.csv.empty()) {
-        csv.reset(std::fopen(o.csv.c_str(), "w"));
+        REPRISE_TRY(check_output("--csv", o.csv, false,
+                                 {.inputs = {o.ref, o.test}, .overwrite_inputs = false}));
+        csv.reset(std::fopen(partial_path(o.csv).c_str(), "w"));
         if (!csv) return Status::error(o.csv + ": cannot open for writing");
         std::fputs("frame,psnr,ssim,flip\n", csv.get());
     }
@@ -134,9 +137,16 @@ Status run(const Options& o) {
     std::fprintf(
         stderr, "[metrics] %zu frames%s\n", n,
         counts[0] < n ? " (frames whose mask selects no pixel left out of the means)" : "");
-    if (csv && std::fclose(csv.release()) != 0)
-        return Status::error(o.csv + ": cannot finish writing");
+    if (csv) return commit_partial(o.csv, std::fclose(csv.release()) == 0);
     return {};
+}
+
+// A failed run leaves no partial CSV behind.
+Status run(const Options& o) {
+    Status status = measure(o);
+    std::error_code ignored;
+    if (!status.ok() && !o.csv.empty()) fs::remove(partial_path(o.csv), ignored);
+    return status;
 }
 
 }  // namespace

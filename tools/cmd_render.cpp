@@ -223,8 +223,9 @@ int command_render(int argc, char** argv) {
     args.option("--fps", &job.fps, "frame rate (default 30)");
     args.option("--size", &job.size, "WxH (default 640x360)");
     args.option("--camera", &job.camera,
-                "static|orbit|pan|dolly|shake|cut|gltf[:N] with ,key=value (speed, radius, "
-                "height, shake, time, angle)");
+                "KIND[:key=value,...], KIND static|orbit|pan|dolly|shake|cut, keys speed, radius, "
+                "height,\nshake, time, angle (orbit:speed=0.5,radius=3); or gltf[:N], the file's "
+                "N-th camera");
     args.flag("--unlit", &job.unlit, "base colour only (view-independent shading)");
     args.option("--shading", &job.shading,
                 "lit|unlit|heavy (default: heavy for courtyard and stroll, else lit)");

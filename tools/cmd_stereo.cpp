@@ -8,6 +8,7 @@
 
 #include "args.hpp"
 #include "commands.hpp"
+#include "outputs.hpp"
 #include "reprise/core/exr.hpp"
 #include "reprise/stereo/rig.hpp"
 #include "reprise/stereo/synthesize.hpp"
@@ -22,12 +23,15 @@ struct StereoJob {
     double convergence = 10.0;
     double fov = 0.0;  // degrees, for inputs without a camera
     bool temporal = false;
+    bool resume = false, overwrite_inputs = false;
+    std::string line;  // the options given, recorded for --resume
 };
 
 Status check(const StereoJob& j, stereo::StereoRig& rig, stereo::StereoOptions& options) {
     if (j.in.empty()) return Status::error("--in DIR is required");
     if (j.out.empty()) return Status::error("--out DIR is required");
-    if (!(std::abs(j.ipd) <= 1e6)) return Status::error("--ipd must be a finite distance");
+    if (!(j.ipd > 0.0 && j.ipd <= 1e6))
+        return Status::error("--ipd must be a positive distance (which eye is given: --eye)");
     if (!(j.convergence > 0.0 && j.convergence <= 1e30))
         return Status::error("--convergence must be a positive distance");
     if (!(j.fov >= 0.0 && j.fov < 180.0))
@@ -54,20 +58,27 @@ Status run_stereo(const StereoJob& job, const stereo::StereoRig& rig,
                   const stereo::StereoOptions& options) {
     Sequence seq;
     REPRISE_TRY(open_sequence(job.in, seq));
+    REPRISE_TRY(check_one_size(seq, "stereo"));
     const bool given_left = job.eye == "left";
-    const std::string rendered_dir = job.out + (given_left ? "/left" : "/right");
-    const std::string made_dir = job.out + (given_left ? "/right" : "/left");
-    for (const std::string& dir : {rendered_dir, made_dir}) {
-        std::error_code ec;
-        std::filesystem::create_directories(dir, ec);
-        if (ec) return Status::error(dir + ": cannot create the folder: " + ec.message());
-    }
+    const OutputRules rules{.inputs = {job.in}, .overwrite_inputs = job.overwrite_inputs};
+    OutputFolder rendered, made_eye;
+    REPRISE_TRY(check_output("--out", job.out, true, rules));
+    REPRISE_TRY(
+        rendered.open(job.out + (given_left ? "/left" : "/right"), rules, job.line, job.resume));
+    REPRISE_TRY(
+        made_eye.open(job.out + (given_left ? "/right" : "/left"), rules, job.line, job.resume));
+    // Resumed: the temporal fill reads the frame before the first missing one.
+    const int on_disk = std::min(rendered.frames_on_disk(), made_eye.frames_on_disk());
+    const std::size_t first = std::size_t(std::max(0, on_disk - (job.temporal ? 1 : 0)));
+    if (on_disk > 0)
+        std::fprintf(stderr, "[stereo] resuming: %d frames on disk, restarting at input %zu\n",
+                     on_disk, first);
     stereo::StereoSynthesizer synthesizer;
     Frame frame, previous, made;
     bool have_previous = false;
     double ms = 0.0;
     std::size_t holes = 0, from_history = 0;
-    for (std::size_t i = 0; i < seq.files.size(); ++i) {
+    for (std::size_t i = first; i < seq.files.size(); ++i) {
         const std::string& file = seq.files[i];
         REPRISE_TRY(read_frame(seq, i, frame));
         if (frame.depth.width() != frame.width() || frame.depth.height() != frame.height())
@@ -96,13 +107,15 @@ Status run_stereo(const StereoJob& job, const stereo::StereoRig& rig,
                   .count();
         holes += stats.holes;
         from_history += stats.from_history;
-        REPRISE_TRY(write_frame(frame_path(rendered_dir, int(i)), frame));
-        REPRISE_TRY(write_frame(frame_path(made_dir, int(i)), made));
+        REPRISE_TRY(rendered.write(int(i), frame));
+        REPRISE_TRY(made_eye.write(int(i), made));
         if (job.temporal) {
             std::swap(previous, frame);
             have_previous = true;
         }
     }
+    REPRISE_TRY(rendered.finish());
+    REPRISE_TRY(made_eye.finish());
     std::fprintf(
         stderr, "[stereo] %zu frames, %.2f ms per eye, %zu holes, %zu pixels from history -> %s\n",
         seq.files.size(), ms / double(seq.files.size()), holes, from_history, job.out.c_str());
@@ -130,7 +143,12 @@ int command_stereo(int argc, char** argv) {
     args.option("--warp", &job.warp, "grid|splat (default grid)");
     args.option("--fill", &job.fill, "pullpush|andreev|none (default pullpush)");
     args.flag("--temporal", &job.temporal, "fill disocclusions from the previous frame first");
+    args.flag("--resume", &job.resume,
+              "continue an interrupted run of the same arguments from the frames in --out");
+    args.flag("--overwrite-inputs", &job.overwrite_inputs,
+              "allow --out where the inputs are (written after all are read)");
     Status parsed = args.parse(argc, argv);
+    job.line = args.given_line({"--resume"});
     stereo::StereoRig rig;
     stereo::StereoOptions options;
     if (parsed.ok() && !args.help_requested()) {

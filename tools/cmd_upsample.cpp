@@ -7,6 +7,7 @@
 
 #include "args.hpp"
 #include "commands.hpp"
+#include "outputs.hpp"
 #include "reprise/core/exr.hpp"
 #include "reprise/core/metrics.hpp"
 #include "reprise/warp/upsample.hpp"
@@ -20,6 +21,8 @@ struct UpsampleJob {
     bool spatial_only = false, no_steering = false, no_id_test = false, radial = false;
     double history_weight = 1.0;
     double gamma_max = 4.0, max_history_weight = 16.0, gradient_gain = 1.0, history_clamp = 0.25;
+    bool overwrite_inputs = false;
+    std::string line;
 };
 
 Status run_upsample(const UpsampleJob& job) {
@@ -42,9 +45,10 @@ Status run_upsample(const UpsampleJob& job) {
         return Status::error(low_dir + ": " + std::to_string(low_sequence.files.size()) +
                              " low-resolution frames for " +
                              std::to_string(full_sequence.files.size()) + " full-resolution ones");
-    std::error_code ec;
-    std::filesystem::create_directories(job.out, ec);
-    if (ec) return Status::error(job.out + ": cannot create the folder: " + ec.message());
+    OutputFolder output;
+    REPRISE_TRY(output.open(job.out,
+                            {.inputs = {job.in, low_dir}, .overwrite_inputs = job.overwrite_inputs},
+                            job.line, false));
 
     warp::SpatioTemporalUpsampler upsampler({
         .history_weight = job.spatial_only ? 0.0f : float(job.history_weight),
@@ -107,9 +111,10 @@ Status run_upsample(const UpsampleJob& job) {
             ++psnr_count;
         }
         std::swap(full.color, out);
-        REPRISE_TRY(write_frame(frame_path(job.out, int(i)), full));
+        REPRISE_TRY(output.write(int(i), full));
         std::fprintf(stderr, "\r[upsample] %zu/%zu  %.2f dB", i + 1, n, p);
     }
+    REPRISE_TRY(output.finish());
     std::fprintf(stderr, "\n");
     std::printf("upsample %zu frames (%s) -> %s\n", n,
                 job.spatial_only  ? "spatial only"
@@ -160,8 +165,11 @@ int command_upsample(int argc, char** argv) {
               "the paper's radial image-space filter over the low pixel's diagonal (default: a "
               "separable tent)");
     args.flag("--no-id-test", &job.no_id_test, "ignore object ids (depth and normals only)");
+    args.flag("--overwrite-inputs", &job.overwrite_inputs,
+              "allow --out where the inputs are (written after all are read)");
     Status parsed = args.parse(argc, argv);
     if (!parsed.ok() || args.help_requested()) return report(args, parsed, {});
+    job.line = args.given_line({});
     return report(args, parsed, run_upsample(job));
 }
 

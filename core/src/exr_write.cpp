@@ -178,6 +178,8 @@ Status write_frame(const std::string& path, const Frame& frame, const WriteOptio
     spec.z_channel = frame.depth.empty() ? -1 : 4;
     if (blender) spec.attribute("BlenderMultiChannel", "Blender V2.55.1 and newer");
     spec.attribute("compression", "zip");
+    // No time of writing (OpenImageIO fills in the clock otherwise): a frame is its bytes.
+    spec.attribute("DateTime", "");
 
     const Camera& camera = frame.camera;
     set_matrix(spec, "worldToCamera", exr_world_to_camera(camera.view));

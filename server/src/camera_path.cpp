@@ -124,6 +124,9 @@ Status parse_camera_spec(const std::string& spec, const Scene& scene, const Came
     bool known = false;
     for (auto& [name, motion] : kinds)
         if (kind == name) path.motion = motion, known = true;
+    if (!known && kind.find(',') != std::string::npos)
+        return bad("parameters follow a colon: " + kind.substr(0, kind.find(',')) + ":" +
+                   kind.substr(kind.find(',') + 1));
     if (!known) return bad("unknown path (static, orbit, pan, dolly, shake, cut, gltf)");
     if (path.motion == CameraMotion::Dolly && fallback.motion != CameraMotion::Dolly)
         path.direction = glm::normalize(fallback.target - fallback.eye);
