@@ -85,7 +85,8 @@ TEST(Nonfinite, FrucEveryWarpFillAndModeEmitsFiniteAndCounts) {
                     Frame out;
                     std::size_t outputs = 0, bad = 0;
                     for (Frame& f : in) {
-                        ASSERT_TRUE((moved ? converter.send(std::move(f)) : converter.send(f)).ok());
+                        ASSERT_TRUE(
+                            (moved ? converter.send(std::move(f)) : converter.send(f)).ok());
                         while (converter.receive(out)) ++outputs, bad += nonfinite_in(out);
                     }
                     EXPECT_EQ(outputs, mode == FrucMode::Interpolate ? 5u : 6u) << what;
@@ -96,8 +97,8 @@ TEST(Nonfinite, FrucEveryWarpFillAndModeEmitsFiniteAndCounts) {
 
 TEST(Nonfinite, StereoEyeEmitsFiniteAndCounts) {
     for (stereo::StereoWarp warp : {stereo::StereoWarp::Grid, stereo::StereoWarp::Splat})
-        for (stereo::StereoFill fill :
-             {stereo::StereoFill::None, stereo::StereoFill::PullPush, stereo::StereoFill::Andreev}) {
+        for (stereo::StereoFill fill : {stereo::StereoFill::None, stereo::StereoFill::PullPush,
+                                        stereo::StereoFill::Andreev}) {
             NonfiniteCounts want;
             std::vector<Frame> in = spoiled_sequence(2, want);
             const stereo::EyeCameras eyes =

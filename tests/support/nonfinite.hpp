@@ -7,8 +7,8 @@
 
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "reprise/core/nonfinite.hpp"
 #include "frames.hpp"
+#include "reprise/core/nonfinite.hpp"
 
 namespace reprise::test {
 
@@ -17,9 +17,8 @@ inline constexpr int kW = 96, kH = 54;  // 5184 pixels, as in the issue
 inline Camera camera_at(float x) {
     Camera c;
     c.view = glm::lookAt(glm::vec3(x, 1.0f, 5.0f), glm::vec3(x, 1.0f, 0.0f), glm::vec3(0, 1, 0));
-    c.prev_view =
-        glm::lookAt(glm::vec3(x - 0.05f, 1.0f, 5.0f), glm::vec3(x - 0.05f, 1.0f, 0.0f),
-                    glm::vec3(0, 1, 0));
+    c.prev_view = glm::lookAt(glm::vec3(x - 0.05f, 1.0f, 5.0f), glm::vec3(x - 0.05f, 1.0f, 0.0f),
+                              glm::vec3(0, 1, 0));
     c.projection = glm::perspective(0.8f, float(kW) / float(kH), 0.1f, 100.0f);
     c.prev_projection = c.projection;
     return c;
@@ -77,7 +76,9 @@ inline std::vector<Frame> spoiled_sequence(int frames, NonfiniteCounts& expected
 
 inline bool finite(float v) { return std::isfinite(v); }
 inline bool finite(const glm::vec2& v) { return finite(v.x) && finite(v.y); }
-inline bool finite(const glm::vec4& v) { return finite(v.x) && finite(v.y) && finite(v.z) && finite(v.w); }
+inline bool finite(const glm::vec4& v) {
+    return finite(v.x) && finite(v.y) && finite(v.z) && finite(v.w);
+}
 
 // Non-finite values in a result (+inf depth is background and allowed).
 inline std::size_t nonfinite_in(const Frame& f) {
