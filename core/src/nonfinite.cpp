@@ -58,8 +58,9 @@ enum class Combine { Mean, Max };
 // Pull-push over the valid pixels of `image`: each level halves the last, a pixel the mean (or
 // max) of its valid children; invalid pixels then take their parent's value, from the top down.
 template <class T, class IsBad>
-std::size_t pull_push_fill(ImageView<T> image, IsBad is_bad, Combine combine, const glm::vec4& fallback,
-                   std::vector<glm::vec4>& values, std::vector<float>& weights) {
+std::size_t pull_push_fill(ImageView<T> image, IsBad is_bad, Combine combine,
+                           const glm::vec4& fallback, std::vector<glm::vec4>& values,
+                           std::vector<float>& weights) {
     const std::size_t n = count(ImageView<const T>(image), is_bad);
     if (n == 0) return 0;
     struct Level {
@@ -134,7 +135,8 @@ std::size_t pull_push_fill(ImageView<T> image, IsBad is_bad, Combine combine, co
     for (int y = 0; y < image.height; ++y)
         for (int x = 0; x < image.width; ++x)
             if (is_bad(image(x, y)))
-                image(x, y) = narrow<T>(values[first.offset + std::size_t(y / 2) * first.w + x / 2]);
+                image(x, y) =
+                    narrow<T>(values[first.offset + std::size_t(y / 2) * first.w + x / 2]);
     return n;
 }
 
@@ -169,7 +171,7 @@ std::size_t NonfiniteRepair::repair_color(ImageView<glm::vec4> color) {
 
 std::size_t NonfiniteRepair::repair_depth(ImageView<float> depth) {
     return pull_push_fill(depth, bad_depth, Combine::Max,
-                  glm::vec4(std::numeric_limits<float>::infinity()), pyramid_, weights_);
+                          glm::vec4(std::numeric_limits<float>::infinity()), pyramid_, weights_);
 }
 
 std::size_t NonfiniteRepair::repair_motion(ImageView<glm::vec2> motion) {
