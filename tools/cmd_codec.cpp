@@ -160,6 +160,9 @@ Status run_encode(const EncodeJob& job, const codec::EncoderOptions& o) {
         n, frame.width(), frame.height(), fps, job.out.c_str(), file.size(),
         busy_ms / double(std::max<std::size_t>(1, n)));
     print_stats(encoder.stats(), fps);
+    if (encoder.stats().nonfinite.total() > 0)
+        std::fprintf(stderr, "[encode] input: %s\n",
+                     describe_nonfinite(encoder.stats().nonfinite).c_str());
     return {};
 }
 

@@ -155,6 +155,8 @@ Status run_fruc(const FrucJob& job) {
                 double(options.auto_choice.slack_db));
         std::printf("%s", auto_choice_summary(c).c_str());
     }
+    if (c.nonfinite.total() > 0)
+        std::fprintf(stderr, "[fruc] input: %s\n", describe_nonfinite(c.nonfinite).c_str());
     if (c.ui_frames > 0)
         std::printf("  UI layer: %zu made frames took the nearest input's UI, unwarped\n",
                     c.ui_frames);

@@ -10,6 +10,7 @@
 #include "commands.hpp"
 #include "outputs.hpp"
 #include "reprise/core/exr.hpp"
+#include "reprise/core/nonfinite.hpp"
 #include "reprise/stereo/rig.hpp"
 #include "reprise/stereo/synthesize.hpp"
 
@@ -78,11 +79,14 @@ Status run_stereo(const StereoJob& job, const stereo::StereoRig& rig,
     bool have_previous = false;
     double ms = 0.0;
     std::size_t holes = 0, from_history = 0;
+    NonfiniteRepair repair;  // the rendered eye is written too: repaired where it is read
+    NonfiniteCounts nonfinite;
     for (std::size_t i = first; i < seq.files.size(); ++i) {
         const std::string& file = seq.files[i];
         REPRISE_TRY(read_frame(seq, i, frame));
         if (frame.depth.width() != frame.width() || frame.depth.height() != frame.height())
             return Status::error(file + ": needs a depth channel (Z) of the colour's size");
+        nonfinite += repair.repair(frame);
         // Disparity needs the focal length: from the file's camera, else from --fov.
         if (!has_projection(frame.camera)) {
             if (job.fov == 0.0)
@@ -119,6 +123,8 @@ Status run_stereo(const StereoJob& job, const stereo::StereoRig& rig,
     std::fprintf(
         stderr, "[stereo] %zu frames, %.2f ms per eye, %zu holes, %zu pixels from history -> %s\n",
         seq.files.size(), ms / double(seq.files.size()), holes, from_history, job.out.c_str());
+    if (nonfinite.total() > 0)
+        std::fprintf(stderr, "[stereo] input: %s\n", describe_nonfinite(nonfinite).c_str());
     return {};
 }
 

@@ -66,6 +66,7 @@ Status run_upsample(const UpsampleJob& job) {
     double busy_ms = 0.0, psnr_sum = 0.0;
     int psnr_count = 0;
     warp::UpsampleStats total;
+    NonfiniteRepair repair;
     const std::size_t n = full_sequence.files.size();
     for (std::size_t i = 0; i < n; ++i) {
         REPRISE_TRY(read_frame(full_sequence.files[i], full));
@@ -83,6 +84,9 @@ Status run_upsample(const UpsampleJob& job) {
         if (!std::isfinite(jitter.x) || !std::isfinite(jitter.y) || std::abs(jitter.x) > 1e4f ||
             std::abs(jitter.y) > 1e4f)
             return Status::error(low_file + ": reprise:jitter is not a finite pixel offset");
+        const std::size_t guide_depth = repair.repair_depth(full.depth.view());
+        const std::size_t guide_motion = repair.repair_motion(full.motion.view());
+        const std::size_t guide_normal = repair.repair_normal(full.normal.view());
         GBufferView guides = full.view();
         if (full.motion.width() != full.width() || full.motion.height() != full.height())
             guides.motion = {};
@@ -100,6 +104,11 @@ Status run_upsample(const UpsampleJob& job) {
         total.history_used += stats.history_used;
         total.nonfinite_samples += stats.nonfinite_samples;
         total.unresolved += stats.unresolved;
+        // The guides are written with the result: repaired here (the upsampler saw them clean).
+        NonfiniteCounts found = stats.nonfinite;
+        found.depth += guide_depth, found.motion += guide_motion, found.normal += guide_normal;
+        found.frames = found.total() > 0;
+        total.nonfinite += found;
         // The full frame's own colour, when rendered, is the truth the result is measured against.
         truth_display.resize(full.width(), full.height());
         out_display.resize(full.width(), full.height());
@@ -130,6 +139,8 @@ Status run_upsample(const UpsampleJob& job) {
         "pixels\n",
         (long long)total.history_used, (long long)total.history_rejected,
         (long long)total.nonfinite_samples, (long long)total.unresolved);
+    if (total.nonfinite.total() > 0)
+        std::fprintf(stderr, "[upsample] input: %s\n", describe_nonfinite(total.nonfinite).c_str());
     return {};
 }
 

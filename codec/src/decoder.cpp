@@ -24,6 +24,7 @@ struct Decoder::State {
     std::deque<Frame> queue;
     std::vector<Frame> spare;  // frames handed back by receive_frame, reused for output
     StreamStats stats;
+    NonfiniteRepair repair;
     Picture scratch;
     Workspace work;
 
@@ -132,6 +133,9 @@ Result Decoder::receive_frame(Frame& frame) {
     State& s = *state_;
     if (s.queue.empty()) return Result::NeedMoreData;
     std::swap(frame, s.queue.front());
+    // A stream can spell NaN (lossless depth keeps float bits): repaired on the way out only,
+    // so the references stay the encoder's.
+    s.stats.nonfinite += s.repair.repair(frame);
     // The caller's previous buffers come back for the next output (no allocation per frame).
     Frame old = std::move(s.queue.front());
     s.queue.pop_front();

@@ -37,6 +37,7 @@ struct Encoder::State {
     bool after_loss = false;
     bool key_requested = false;
     StreamStats stats, last;
+    NonfiniteRepair repair;
     int qp = 28;
     double qp_state = 28.0;
     // Reconstruction as a Frame, made on request.
@@ -116,14 +117,14 @@ int Encoder::bitrate() const { return state_->options.bitrate_kbps; }
 Encoder::Encoder(Encoder&&) noexcept = default;
 Encoder& Encoder::operator=(Encoder&&) noexcept = default;
 
-Status Encoder::send_frame(const Frame& frame) {
+Status Encoder::send_frame(const Frame& given) {
     State& s = *state_;
-    const int w = frame.color.width(), h = frame.color.height();
+    const int w = given.color.width(), h = given.color.height();
     REPRISE_TRY(check_image_size(w, h, "encoder input frame " + std::to_string(s.next_frame)));
-    if (!frame.depth.empty() && (frame.depth.width() != w || frame.depth.height() != h))
+    if (!given.depth.empty() && (given.depth.width() != w || given.depth.height() != h))
         return Status::error("encoder input frame " + std::to_string(s.next_frame) +
                              ": depth size differs from colour");
-    if (!frame.motion.empty() && (frame.motion.width() != w || frame.motion.height() != h))
+    if (!given.motion.empty() && (given.motion.width() != w || given.motion.height() != h))
         return Status::error("encoder input frame " + std::to_string(s.next_frame) +
                              ": motion size differs from colour");
     if (s.queue.size() >= kMaxQueuedPackets)
@@ -132,6 +133,9 @@ Status Encoder::send_frame(const Frame& frame) {
     if (s.options.depth == DepthMode::Bounded &&
         !(s.options.depth_error >= 1e-7f && s.options.depth_error <= 0.1f))
         return Status::error("encoder: depth error bound must lie in 1e-7..0.1");
+
+    NonfiniteCounts nonfinite;
+    const Frame& frame = s.repair.clean(given, nonfinite);
 
     SequenceParams sp;
     sp.width = w;
@@ -208,6 +212,7 @@ Status Encoder::send_frame(const Frame& frame) {
     s.started = true;
     s.next_frame++;
     fs.frames = 1;
+    fs.nonfinite = nonfinite;
     s.last = fs;
     add_stats(s.stats, fs);
     s.recon_ready = false;

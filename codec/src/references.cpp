@@ -5,6 +5,7 @@ namespace reprise::codec {
 
 void add_stats(StreamStats& total, const StreamStats& f) {
     total.frames += f.frames;
+    total.nonfinite += f.nonfinite;
     total.key_frames += f.key_frames;
     total.older_reference += f.older_reference;
     total.header_bits += f.header_bits;

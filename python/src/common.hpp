@@ -7,6 +7,7 @@
 #include <string>
 
 #include "reprise/core/frame.hpp"
+#include "reprise/core/nonfinite.hpp"
 
 namespace reprise::python {
 
@@ -16,6 +17,18 @@ namespace py = pybind11;
 struct Error : std::runtime_error {
     using std::runtime_error::runtime_error;
 };
+
+// NaN/Inf counts per channel (repaired by the library before use).
+inline py::dict nonfinite_dict(const NonfiniteCounts& c) {
+    py::dict d;
+    d["color"] = c.color;
+    d["depth"] = c.depth;
+    d["motion"] = c.motion;
+    d["normal"] = c.normal;
+    d["ui"] = c.ui;
+    d["frames"] = c.frames;
+    return d;
+}
 
 inline void check(const Status& status) {
     if (!status.ok()) throw Error(status.message());

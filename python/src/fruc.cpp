@@ -95,6 +95,7 @@ struct Converter {
         d["refined_pixels"] = c.refined_pixels;
         d["refine_ms"] = c.refine_ms;
         d["ui_frames"] = c.ui_frames;
+        d["nonfinite"] = nonfinite_dict(c.nonfinite);
         py::dict chosen, left_out;
         for (int k = 0; k < warp::kAutoCandidates; ++k) {
             chosen[warp::auto_candidate_name(k)] = c.auto_chosen[k];

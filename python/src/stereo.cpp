@@ -63,6 +63,7 @@ py::dict stats_dict(const stereo::StereoStats& s) {
     d["filled"] = s.filled;
     d["unfilled"] = s.unfilled;
     d["cells"] = s.cells;
+    d["nonfinite"] = nonfinite_dict(s.nonfinite);
     return d;
 }
 

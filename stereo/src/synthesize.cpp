@@ -63,13 +63,23 @@ std::size_t StereoSynthesizer::warp_into(const GBufferView& source, const Camera
     return stats.covered;
 }
 
-StereoStats StereoSynthesizer::synthesize(const GBufferView& rendered, const Camera& target,
+StereoStats StereoSynthesizer::synthesize(const GBufferView& given, const Camera& target,
                                           Frame& out, const StereoOptions& o,
-                                          const GBufferView* history) {
-    const int w = rendered.width(), h = rendered.height();
+                                          const GBufferView* given_history) {
+    const int w = given.width(), h = given.height();
     REPRISE_ASSERT(w > 0 && h > 0);
-    REPRISE_ASSERT(rendered.depth.width == w && rendered.depth.height == h);
+    REPRISE_ASSERT(given.depth.width == w && given.depth.height == h);
     StereoStats stats;
+    // NaN and infinities (but background depth) are repaired before anything is warped.
+    const GBufferView rendered = rendered_repair_.clean(given, stats.nonfinite);
+    GBufferView history_view;
+    const GBufferView* history = nullptr;
+    if (given_history) {
+        NonfiniteCounts found;
+        history_view = history_repair_.clean(*given_history, found);
+        history = &history_view;
+        stats.nonfinite += found;
+    }
     out.motion.clear();
     out.normal.clear();
     out.id.clear();

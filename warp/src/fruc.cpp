@@ -142,6 +142,7 @@ struct FrameRateConverter::State {
     bool previous_starts_shot = false;  // its motion reaches back into another shot: unusable
     FrameQueue ready;
     FrucOptions chosen;  // `options` with an auto warp or fill resolved for one frame
+    NonfiniteRepair nonfinite;
 
     float motion_scale() const { return 1.0f / float(factor); }
 
@@ -339,16 +340,20 @@ Status FrameRateConverter::send(const Frame& frame) { return send_frame(frame, n
 
 Status FrameRateConverter::send(Frame&& frame) { return send_frame(frame, &frame); }
 
-Status FrameRateConverter::send_frame(const Frame& frame, Frame* owned) {
+Status FrameRateConverter::send_frame(const Frame& given, Frame* owned) {
     State& st = *state_;
-    const int w = frame.width(), h = frame.height();
+    const int w = given.width(), h = given.height();
     REPRISE_TRY(check_image_size(w, h, "fruc input frame"));
     auto sized = [&](auto& image) {
         return image.empty() || (image.width() == w && image.height() == h);
     };
-    if (!sized(frame.depth) || !sized(frame.motion))
+    if (!sized(given.depth) || !sized(given.motion))
         return Status::error("fruc input frame: depth or motion size differs from colour");
-    if (!sized(frame.ui)) return Status::error("fruc input frame: ui size differs from colour");
+    if (!sized(given.ui)) return Status::error("fruc input frame: ui size differs from colour");
+    NonfiniteCounts found;
+    const Frame& frame = owned ? *owned : st.nonfinite.clean(given, found);
+    if (owned) found = st.nonfinite.repair(*owned);
+    st.counters.nonfinite += found;
     ++st.counters.inputs;
     st.scratch.refiner.forget_region();
     const bool warpable = !frame.depth.empty() && !frame.motion.empty();

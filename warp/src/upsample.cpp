@@ -228,9 +228,16 @@ SpatioTemporalUpsampler::SpatioTemporalUpsampler(UpsampleOptions options) : opti
 void SpatioTemporalUpsampler::reset() { has_history_ = false; }
 
 void SpatioTemporalUpsampler::upsample(ImageView<const glm::vec4> low_color, glm::vec2 jitter_px,
-                                       const GBufferView& full, ImageView<glm::vec4> out,
+                                       const GBufferView& given, ImageView<glm::vec4> out,
                                        UpsampleStats* stats) {
     const UpsampleOptions& o = options_;
+    // The guides with NaN and infinities (but background depth) repaired; their colour is unused.
+    GBufferView guides = given;
+    guides.color = {};
+    NonfiniteCounts nonfinite;
+    const GBufferView full = guide_repair_.clean(guides, nonfinite);
+    nonfinite.color = count_nonfinite({.color = low_color}).color;
+    nonfinite.frames = nonfinite.total() > 0;
     const int width = full.depth.width, height = full.depth.height;
     REPRISE_ASSERT(!full.depth.empty() && !low_color.empty());
     REPRISE_ASSERT(out.width == width && out.height == height);
@@ -475,7 +482,8 @@ void SpatioTemporalUpsampler::upsample(ImageView<const glm::vec4> low_color, glm
         *stats = {.history_rejected = counters.rejected,
                   .history_used = counters.used,
                   .nonfinite_samples = counters.nonfinite,
-                  .unresolved = counters.unresolved};
+                  .unresolved = counters.unresolved,
+                  .nonfinite = nonfinite};
     }
 }
 

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "reprise/core/frame.hpp"
+#include "reprise/core/nonfinite.hpp"
 
 namespace reprise::codec {
 
@@ -54,6 +55,9 @@ struct StreamStats {
     std::size_t intra_blocks = 0;            // macroblocks predicted from the current frame
     std::size_t motion_residual_pixels = 0;  // pixels whose motion the cameras do not explain
     std::size_t depth_zero_blocks = 0;       // depth blocks predicted exactly
+    // Encoder input: NaN/Inf repaired before coding (colour: holes; depth NaN/-inf and motion:
+    // unknown; reprise/core/nonfinite.hpp).
+    NonfiniteCounts nonfinite;
     std::size_t total_bits() const {
         return header_bits + camera_bits + depth_bits + motion_bits + color_bits;
     }

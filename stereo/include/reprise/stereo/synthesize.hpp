@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <memory>
 
+#include "reprise/core/nonfinite.hpp"
 #include "reprise/warp/fill.hpp"
 #include "reprise/warp/grid_warp.hpp"
 #include "reprise/warp/splat.hpp"
@@ -36,6 +37,9 @@ struct StereoStats {
     std::size_t filled = 0;        // pixels invented by the hole filler
     std::size_t unfilled = 0;      // holes left (no fill, or nothing to fill from): colour 0
     std::size_t cells = 0;         // grid cells drawn (both warps)
+    // NaN/Inf in the rendered eye and the history, repaired before warping (colour: holes;
+    // depth NaN/-inf and motion: unknown; see reprise/core/nonfinite.hpp).
+    NonfiniteCounts nonfinite;
 };
 
 // Sizes its scratch on the first frame and reuses it while the size stays the same.
@@ -77,6 +81,7 @@ private:
     warp::GridWarper grid_;
     warp::PullPush pull_push_;
     warp::AndreevInpaint andreev_;
+    NonfiniteRepair rendered_repair_, history_repair_;
 };
 
 // One-shot form (allocates its scratch per call).

@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <memory>
 
+#include "reprise/core/nonfinite.hpp"
 #include "reprise/warp/fill.hpp"
 #include "reprise/warp/grid_warp.hpp"
 #include "reprise/warp/reproject.hpp"
@@ -134,6 +135,8 @@ struct FrucCounters {
     std::size_t refined_pixels = 0;  // pixels that took the flow's colour
     double refine_ms = 0.0;          // time in the survey and the refinement
     std::size_t ui_frames = 0;       // made frames given the nearest input's UI layer
+    // NaN/Inf in the inputs, repaired before anything is warped (reprise/core/nonfinite.hpp).
+    NonfiniteCounts nonfinite;
     // Auto choice, per candidate (auto_candidate_name): frames it was chosen for, and frames it
     // was left out of although expected to score higher than the choice (too costly for it).
     std::array<std::size_t, kAutoCandidates> auto_chosen{};
@@ -155,9 +158,13 @@ public:
     // K-1 frames beyond it. Frames must have colour; depth, motion and cameras enable warping
     // (without them the output holds the last frame). Every output frame carries colour, depth,
     // motion (per output period), the camera and the UI layer; normals and ids are not passed on.
+    // NaN and infinities are counted (counters().nonfinite) and repaired first: colour as holes,
+    // depth NaN/-inf and motion as unknown; no output value is NaN or infinite but background
+    // depth (+inf).
     Status send(const Frame& frame);
     // The same without copying the frame to keep it: its buffers become the converter's, and
     // `frame` gets back buffers of an earlier one (contents unspecified) for the caller to refill.
+    // Non-finite values are repaired in place.
     Status send(Frame&& frame);
     // Takes the next output frame; false when the converter needs the next input.
     bool receive(Frame& out);
@@ -168,7 +175,7 @@ public:
     void refine_region(Image<uint8_t>& mask) const;
 
 private:
-    Status send_frame(const Frame& frame, Frame* owned);
+    Status send_frame(const Frame& given, Frame* owned);
 
     struct State;
     std::unique_ptr<State> state_;

@@ -31,6 +31,7 @@
 
 #include "reprise/core/gbuffer.hpp"
 #include "reprise/core/image.hpp"
+#include "reprise/core/nonfinite.hpp"
 
 namespace reprise::warp {
 
@@ -71,6 +72,9 @@ struct UpsampleStats {
     int64_t history_used = 0;      // pixels blended with their history
     int64_t nonfinite_samples = 0;  // low-resolution sample reads skipped for NaN/Inf colour
     int64_t unresolved = 0;         // pixels with neither a finite sample nor history (written 0)
+    // Non-finite values in: the low-resolution colour (pixels; invalid samples, skipped as above)
+    // and the guides (depth NaN/-inf, motion, normals: unknown, repaired before use).
+    NonfiniteCounts nonfinite;
 };
 
 class SpatioTemporalUpsampler {
@@ -109,6 +113,7 @@ private:
     glm::vec2 history_jitter_{0.0f};  // the full G-buffer's jitter of the history's frame
     bool history_has_ids_ = false;
     bool has_history_ = false;
+    NonfiniteRepair guide_repair_;
 };
 
 }  // namespace reprise::warp
