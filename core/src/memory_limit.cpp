@@ -41,6 +41,15 @@ Status check_memory(std::uint64_t bytes, std::string_view what) {
                          format_bytes(limit) + ", " + hint());
 }
 
+Status check_image_memory(int width, int height, std::uint64_t bytes_per_pixel,
+                          std::string_view what) {
+    REPRISE_ASSERT(width >= 0 && height >= 0);
+    const std::uint64_t bytes = std::uint64_t(width) * std::uint64_t(height) * bytes_per_pixel;
+    if (bytes <= memory_limit()) return {};
+    return check_memory(
+        bytes, std::string(what) + " " + std::to_string(width) + "x" + std::to_string(height));
+}
+
 std::string format_bytes(std::uint64_t bytes) {
     static constexpr const char* kUnits[] = {"KiB", "MiB", "GiB", "TiB", "PiB", "EiB"};
     if (bytes < 1024) return std::to_string(bytes) + (bytes == 1 ? " byte" : " bytes");
@@ -59,7 +68,9 @@ std::string format_bytes(std::uint64_t bytes) {
 
 Status parse_bytes(std::string_view text, std::uint64_t& bytes) {
     const std::string quoted = std::string(1, '\'').append(text).append(1, '\'');
-    auto bad = [&] { return Status::error(quoted + " is not a memory size (e.g. 8G, 512M or bytes)"); };
+    auto bad = [&] {
+        return Status::error(quoted + " is not a memory size (e.g. 8G, 512M or bytes)");
+    };
     double value = 0.0;
     const char* end = text.data() + text.size();
     auto [rest, ec] = std::from_chars(text.data(), end, value);

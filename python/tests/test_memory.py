@@ -57,3 +57,13 @@ def test_bad_limits_raise_value_error():
         with pytest.raises(ValueError):
             reprise.set_max_memory(bad)
     assert reprise.max_memory() == 4 << 30
+
+
+def test_fruc_and_encode_refuse_beyond_the_limit(pan_60, limit):
+    reprise.set_max_memory("1M")
+    with pytest.raises(reprise.Error, match=r"fruc 160x96: needs [0-9.]+ MiB; limit 1 MiB"):
+        reprise.FrameRateConverter(factor=2, mode="interpolate").convert(pan_60[:2])
+    with pytest.raises(reprise.Error, match=r"encode 160x96: needs [0-9.]+ MiB; limit 1 MiB"):
+        reprise.encode_stream(pan_60[:2], qp=28)
+    reprise.set_max_memory("64M")
+    assert len(reprise.encode_stream(pan_60[:2], qp=28)) >= 2

@@ -21,6 +21,11 @@ void set_memory_limit_hint(std::string hint);
 // "WHAT: needs 6.1 GiB; limit 4 GiB, --max-memory to change" when `bytes` exceeds the limit.
 Status check_memory(std::uint64_t bytes, std::string_view what);
 
+// The same for a working set of `bytes_per_pixel` over a width x height image, named
+// "WHAT WxH"; allocates nothing when it passes (per-frame paths).
+Status check_image_memory(int width, int height, std::uint64_t bytes_per_pixel,
+                          std::string_view what);
+
 // "6.1 GiB", "512 MiB", "3 KiB", "12 bytes" (binary units, one decimal where it is not whole).
 std::string format_bytes(std::uint64_t bytes);
 
