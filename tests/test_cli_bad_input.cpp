@@ -2,6 +2,7 @@
 // or a hang. Also walks every glTF file of Debian's assimp-testmodels through `reprise render`.
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -95,6 +96,56 @@ TEST(CliBadInput, BrokenFramesGetOneMessageAndStatusOne) {
     expect_clean_failure(
         run("metrics --ref " + (dir / "ok").string() + " --test " + (dir / "cut.exr").string()),
         "cut.exr", "metrics on a truncated frame");
+}
+
+// A frame file whose header claims width x height (its dataWindow patched), pixels left as they
+// were: what is read must be refused from the header, before the pixels.
+void claim_size(const fs::path& file, int32_t width, int32_t height) {
+    std::string bytes = reprise::test::read_text(file);
+    const std::string key("dataWindow\0box2i\0", 17);
+    const std::size_t at = bytes.find(key);
+    ASSERT_NE(at, std::string::npos) << file;
+    const int32_t box[4] = {0, 0, width - 1, height - 1};
+    bytes.replace(at + key.size() + 4, sizeof box, reinterpret_cast<const char*>(box), sizeof box);
+    std::ofstream(file, std::ios::binary) << bytes;
+}
+
+// Memory is bounded before it is spent: a call that would need more than --max-memory (4 GiB by
+// default) is refused with the figure, quickly, before it writes anything.
+TEST(CliBadInput, MemoryBeyondTheLimitIsRefusedWithTheFigure) {
+    const fs::path dir = scratch("memory");
+    for (const char* size : {"8192x8192", "16384x16384"}) {
+        const fs::path out = dir / size;
+        const Outcome r =
+            run("render --frames 1 --size " + std::string(size) + " --out " + out.string());
+        expect_clean_failure(r, "needs", size);
+        for (const char* word : {"GiB", "limit 4 GiB", "--max-memory", size})
+            EXPECT_NE(r.output.find(word), std::string::npos) << word << ":\n" << r.output;
+        EXPECT_FALSE(fs::exists(out)) << size << " wrote " << out;
+    }
+    const fs::path small = dir / "small";
+    // 640x360: 116 bytes a pixel, 25.5 MiB.
+    Outcome r = run("render --frames 1 --size 640x360 --max-memory 1M --out " + small.string());
+    expect_clean_failure(r, "render 640x360: needs 25.5 MiB; limit 1 MiB, --max-memory to change",
+                         "--max-memory 1M");
+    EXPECT_FALSE(fs::exists(small));
+    r = run("--max-memory=64M render --frames 1 --size 64x36 --out " + small.string());
+    EXPECT_EQ(r.status, 0) << r.output;
+    for (const char* bad : {"lots", "0", "-3G", "12Q", "nan"})
+        expect_clean_failure(
+            run("render --max-memory " + std::string(bad) + " --out " + (dir / "bad").string()),
+            "--max-memory", bad);
+    expect_clean_failure(run("render --out " + (dir / "bad").string() + " --max-memory"),
+                         "missing value", "--max-memory without a value");
+    EXPECT_FALSE(fs::exists(dir / "bad"));
+
+    // A frame whose header claims 16384x16384 (11 GiB of buffers) is refused before its pixels.
+    const fs::path claimed = small / "frame_00000.exr";
+    claim_size(claimed, 16384, 16384);
+    r = run("export " + claimed.string() + " --png " + (dir / "sheet.png").string());
+    expect_clean_failure(r, "needs", "a header claiming 16384x16384");
+    EXPECT_NE(r.output.find("16384x16384"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(dir / "sheet.png"));
 }
 
 // Every glTF file of the assimp test models either renders or fails with one message naming it.

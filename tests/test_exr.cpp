@@ -332,6 +332,29 @@ TEST_F(ExrTest, GarbageAndEmptyFilesAreErrors) {
 // came out 2818056 pixels wide and took 134 MB); a type name past OpenEXR's 31-byte limit put
 // the size field elsewhere for OpenEXR than for the check (1.7 GB); a 4x4 image in one 8192x8192
 // tile took 1.4 GB and 19 s (CI's fuzz run, 2 GB limit).
+// A real frame whose dataWindow is patched to claim 16384x16384: the frame's buffers would take
+// 11 GiB, refused from the header by the memory limit (4 GiB by default) before pixels are read.
+TEST_F(ExrTest, AFrameBeyondTheMemoryLimitIsRefusedFromItsHeader) {
+    // Large enough that OpenEXR finds its table of 16384 rows' offsets inside the file.
+    ASSERT_TRUE(write_frame(path("small.exr"), full_frame(64, 48, 2)).ok());
+    std::string bytes = test::read_text(path("small.exr"));
+    const std::string key("dataWindow\0box2i\0", 17);
+    const std::size_t at = bytes.find(key);
+    ASSERT_NE(at, std::string::npos);
+    const int32_t box[4] = {0, 0, 16383, 16383};
+    bytes.replace(at + key.size() + 4, sizeof box, reinterpret_cast<const char*>(box), sizeof box);
+    write_raw(path("claims.exr"), bytes);
+    Frame f;
+    const Status s = read_frame(path("claims.exr"), f);
+    ASSERT_FALSE(s.ok());
+    for (const char* word : {"claims.exr", "16384x16384", "needs 11 GiB; limit 4 GiB"})
+        EXPECT_NE(s.message().find(word), std::string::npos) << word << ": " << s.message();
+    EXPECT_TRUE(f.color.empty());
+    Sequence sequence;
+    ASSERT_TRUE(open_sequence(path("claims.exr"), sequence).ok());
+    EXPECT_NE(read_frame(sequence, 0, f).message().find("needs"), std::string::npos);
+}
+
 TEST_F(ExrTest, HeadersAskingForHugeAllocationsAreRefused) {
     auto attribute = [](const std::string& name, const std::string& type, int32_t size) {
         std::string bytes = name + '\0' + type + '\0';

@@ -144,6 +144,7 @@ std::string Args::usage() const {
         const char* meta = s.kind == Kind::Flag ? "" : s.kind == Kind::String ? " VALUE" : " N";
         line(s, meta);
     }
+    text += "  --max-memory SIZE       memory limit, e.g. 8G or 512M (default 4G; any command)\n";
     return text;
 }
 

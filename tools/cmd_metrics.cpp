@@ -112,6 +112,7 @@ Status measure(const Options& o) {
         test_display.resize(ref.width(), ref.height());
         to_display(ref.color.view(), ref_display.view());
         to_display(test.color.view(), test_display.view());
+        REPRISE_TRY(check_flip(ref.width(), ref.height(), o.ppd));
         ImageView<const uint8_t> m = masks.empty() ? ImageView<const uint8_t>{} : mask.view();
         const double values[3] = {
             psnr(ref_display.view(), test_display.view(), m),
@@ -168,8 +169,8 @@ int command_metrics(int argc, char** argv) {
     if (parsed.ok() && !args.help_requested()) {
         if (o.ref.empty() || o.test.empty())
             parsed = Status::error("metrics: --ref and --test are both required");
-        else if (!(o.ppd > 0.0) || o.ppd > 1e4)
-            parsed = Status::error("metrics: --ppd must be in (0, 10000]");
+        else if (Status ppd = check_flip_ppd(o.ppd); !ppd.ok())
+            parsed = Status::error("metrics: --ppd: " + ppd.message());
     }
     if (!parsed.ok() || args.help_requested()) return report(args, parsed, {});
     return report(args, parsed, run(o));

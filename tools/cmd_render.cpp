@@ -131,15 +131,15 @@ Status run_render(const RenderJob& job) {
             "--reuse and --lowres do not combine (the low-resolution pass would drop the cache)");
     if (settings.reuse.mode != server::Reuse::Off && stereo)
         return Status::error("--reuse works on one eye only (no --stereo)");
+    std::unique_ptr<server::Renderer> renderer;
+    REPRISE_TRY(server::Renderer::create(renderer));
+    REPRISE_TRY(renderer->check_settings(settings, job.lowres ? job.lowres : 1));
     std::error_code ec;
     for (const std::string& dir :
          {left_dir, stereo ? right_dir : left_dir, job.lowres ? lowres_dir : left_dir}) {
         std::filesystem::create_directories(dir, ec);
         if (ec) return Status::error(dir + ": cannot create the folder: " + ec.message());
     }
-
-    std::unique_ptr<server::Renderer> renderer;
-    REPRISE_TRY(server::Renderer::create(renderer));
     const std::string aa =
         settings.shading == server::Shading::Heavy || job.aa == 1 || job.lowres ? "no anti-aliasing"
         : renderer->msaa_supported(job.aa) ? std::to_string(job.aa) + "x MSAA"

@@ -1,8 +1,11 @@
 // reprise: one executable, one subcommand per job.
 #include <cstdio>
+#include <cstring>
+#include <string>
 #include <string_view>
 
 #include "commands.hpp"
+#include "reprise/core/memory_limit.hpp"
 
 namespace {
 
@@ -37,11 +40,49 @@ constexpr Command kCommands[] = {
 void print_usage(FILE* out) {
     std::fputs("usage: reprise COMMAND [options]   (reprise COMMAND --help for each)\n\n", out);
     for (const Command& c : kCommands) std::fprintf(out, "  %-9s %s\n", c.name, c.summary);
+    std::fputs(
+        "\nAny command takes --max-memory SIZE (8G, 512M, bytes; default 4G): what one call "
+        "may allocate,\nchecked against an estimate before allocating.\n",
+        out);
+}
+
+// Takes --max-memory SIZE (or --max-memory=SIZE) out of the arguments, wherever it stands, and
+// sets the process's memory limit. Returns false after printing the error.
+bool take_max_memory(int& argc, char** argv) {
+    reprise::set_memory_limit_hint("--max-memory to change");
+    int kept = 1;
+    for (int i = 1; i < argc; ++i) {
+        const std::string_view arg = argv[i];
+        std::string value;
+        if (arg == "--max-memory") {
+            if (i + 1 >= argc) {
+                std::fputs("reprise: --max-memory: missing value (e.g. 8G or 512M)\n", stderr);
+                return false;
+            }
+            value = argv[++i];
+        } else if (arg.starts_with("--max-memory=")) {
+            value = arg.substr(std::strlen("--max-memory="));
+        } else {
+            argv[kept++] = argv[i];
+            continue;
+        }
+        std::uint64_t bytes = 0;
+        const reprise::Status parsed = reprise::parse_bytes(value, bytes);
+        if (!parsed.ok()) {
+            std::fprintf(stderr, "reprise: --max-memory: %s\n", parsed.message().c_str());
+            return false;
+        }
+        reprise::set_memory_limit(bytes);
+    }
+    argc = kept;
+    argv[argc] = nullptr;
+    return true;
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
+    if (!take_max_memory(argc, argv)) return 2;
     if (argc < 2) {
         print_usage(stderr);
         return 2;

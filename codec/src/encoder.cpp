@@ -8,6 +8,7 @@
 
 #include "internal.hpp"
 #include "reprise/core/byte_io.hpp"
+#include "reprise/core/memory_limit.hpp"
 
 namespace reprise::codec {
 
@@ -121,6 +122,9 @@ Status Encoder::send_frame(const Frame& given) {
     State& s = *state_;
     const int w = given.color.width(), h = given.color.height();
     REPRISE_TRY(check_image_size(w, h, "encoder input frame " + std::to_string(s.next_frame)));
+    // References, predictions and residuals: `reprise encode` peaked at 120 bytes a pixel (RSS at
+    // 1920x1080 minus 960x540), 44 of them the caller's input frame.
+    REPRISE_TRY(check_image_memory(w, h, 80, "encode"));
     if (!given.depth.empty() && (given.depth.width() != w || given.depth.height() != h))
         return Status::error("encoder input frame " + std::to_string(s.next_frame) +
                              ": depth size differs from colour");

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "reprise/core/exr.hpp"
+#include "reprise/core/memory_limit.hpp"
 
 namespace reprise {
 namespace {
@@ -397,6 +398,14 @@ Status read_frame(const std::string& path, Frame& frame) {
 
     const int width = spec.width;
     const int height = spec.height;
+    // The frame's buffers, checked before any pixel is read (the header alone can claim 16384^2).
+    const std::uint64_t bytes_per_pixel =
+        sizeof(glm::vec4) + (c[Z] >= 0) * sizeof(float) + (c[MotionX] >= 0) * sizeof(glm::vec2) +
+        (c[NormalX] >= 0) * sizeof(glm::vec3) + (c[Id] >= 0) * sizeof(uint32_t) +
+        (c[UiR] >= 0) * sizeof(glm::vec4);
+    REPRISE_TRY(check_memory(
+        std::uint64_t(width) * std::uint64_t(height) * bytes_per_pixel,
+        path + ": " + std::to_string(width) + "x" + std::to_string(height) + " frame"));
     frame.color.assign(width, height, glm::vec4(0.0f, 0.0f, 0.0f, 1.0f));
     fit(frame.depth, c[Z] >= 0, width, height);
     fit(frame.motion, c[MotionX] >= 0, width, height);

@@ -2,13 +2,16 @@
 // and Fairchild, "FLIP: A Difference Evaluator for Alternating Images", HPG 2020.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <numbers>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
+#include <string>
 #include <vector>
 
 #include "reprise/core/frame.hpp"
+#include "reprise/core/memory_limit.hpp"
 #include "reprise/core/metrics.hpp"
 
 namespace reprise {
@@ -71,11 +74,19 @@ constexpr Csf kCsfAchromatic{1.0f, 0.0047f, 0.0f, 1e-5f};
 constexpr Csf kCsfRedGreen{1.0f, 0.0053f, 0.0f, 1e-5f};
 constexpr Csf kCsfBlueYellow{34.1f, 0.04f, 13.5f, 0.025f};
 
+// Filter radius (pixels) of a CSF whose widest Gaussian has width b (degrees^2).
+int csf_radius(double b_max, double ppd) {
+    constexpr double pi = std::numbers::pi;
+    return std::max(1, int(std::ceil(3.0 * std::sqrt(b_max / (2.0 * pi * pi)) * ppd)));
+}
+
+int feature_radius(double ppd) { return std::max(1, int(std::ceil(3.0 * 0.5 * kW * ppd))); }
+
 // Filters `plane` in place with the CSF, normalized to unit sum, sampled at 1/ppd degrees.
 void filter_csf(cv::Mat& plane, const Csf& csf, float ppd) {
     constexpr double pi = std::numbers::pi;
     double b_max = std::max(csf.a2 != 0.0f ? csf.b2 : 0.0f, csf.b1);
-    int radius = std::max(1, int(std::ceil(3.0 * std::sqrt(b_max / (2.0 * pi * pi)) * ppd)));
+    const int radius = csf_radius(b_max, ppd);
 
     struct Term {
         cv::Mat kernel;
@@ -113,7 +124,7 @@ struct FeatureKernels {
 
 FeatureKernels feature_kernels(float ppd) {
     double sigma = 0.5 * kW * ppd;
-    int radius = std::max(1, int(std::ceil(3.0 * sigma)));
+    int radius = feature_radius(ppd);
     int n = 2 * radius + 1;
     FeatureKernels k{cv::Mat(n, 1, CV_32F), cv::Mat(n, 1, CV_32F), cv::Mat(n, 1, CV_32F)};
     std::vector<double> g(n), d1(n), d2(n);
@@ -193,6 +204,38 @@ Prepared prepare(ImageView<const glm::vec3> display, float ppd, const FeatureKer
 
 }  // namespace
 
+static std::string number(double value) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%g", value);
+    return text;
+}
+
+Status check_flip_ppd(double pixels_per_degree) {
+    if (!(pixels_per_degree > 0.0) || pixels_per_degree > kMaxFlipPpd)
+        return Status::error("FLIP: pixels per degree " + number(pixels_per_degree) +
+                             " must be in (0, " + number(kMaxFlipPpd) + "]");
+    return {};
+}
+
+std::uint64_t flip_memory(int width, int height, double pixels_per_degree) {
+    REPRISE_ASSERT(width >= 0 && height >= 0 && check_flip_ppd(pixels_per_degree).ok());
+    // Measured peaks (RSS): 45 bytes a pixel at 67 ppd (1920x1080), plus what OpenCV's separable
+    // filters hold for a radius r: about (side + 2r) x (side + 16) floats for a few planes
+    // (934 MB for 16x16 at 1e7 ppd, r = 1.35e6). Both rounded up.
+    const std::uint64_t radius = std::max(csf_radius(kCsfBlueYellow.b1, pixels_per_degree),
+                                          feature_radius(pixels_per_degree));
+    const std::uint64_t side = std::uint64_t(std::max(width, height));
+    const std::uint64_t pixels = std::uint64_t(width) * std::uint64_t(height);
+    return pixels * 48 + (side + 2 * radius) * (side + 16) * 12;
+}
+
+Status check_flip(int width, int height, double pixels_per_degree) {
+    REPRISE_TRY(check_flip_ppd(pixels_per_degree));
+    return check_memory(flip_memory(width, height, pixels_per_degree),
+                        "FLIP " + std::to_string(width) + "x" + std::to_string(height) + " at " +
+                            number(pixels_per_degree) + " pixels per degree");
+}
+
 double flip(ImageView<const glm::vec3> reference, ImageView<const glm::vec3> test,
             ImageView<const uint8_t> mask, ImageView<float> error_map, float pixels_per_degree) {
     REPRISE_ASSERT(reference.width == test.width && reference.height == test.height);
@@ -200,7 +243,7 @@ double flip(ImageView<const glm::vec3> reference, ImageView<const glm::vec3> tes
                    (mask.width == reference.width && mask.height == reference.height));
     REPRISE_ASSERT(error_map.empty() ||
                    (error_map.width == reference.width && error_map.height == reference.height));
-    REPRISE_ASSERT(pixels_per_degree > 0.0f && std::isfinite(pixels_per_degree));
+    REPRISE_ASSERT(check_flip_ppd(pixels_per_degree).ok());
     if (reference.empty()) return std::numeric_limits<double>::quiet_NaN();
 
     const float ppd = pixels_per_degree;

@@ -117,10 +117,9 @@ void bind_metrics(py::module_& m) {
     m.def(
         "flip",
         [](const py::handle& reference, const py::handle& test, const py::handle& mask,
-           float pixels_per_degree, bool error_map) -> py::object {
-            if (!(pixels_per_degree > 0.0f) || !std::isfinite(pixels_per_degree))
-                value_error("pixels_per_degree must be > 0");
+           double pixels_per_degree, bool error_map) -> py::object {
             Inputs in(reference, test, mask);
+            check(check_flip(in.reference.width, in.reference.height, pixels_per_degree));
             py::array_t<float> map;
             ImageView<float> map_view;
             if (error_map) {
@@ -132,13 +131,13 @@ void bind_metrics(py::module_& m) {
             double mean;
             {
                 py::gil_scoped_release release;
-                mean = flip(in.reference, in.test, in.mask, map_view, pixels_per_degree);
+                mean = flip(in.reference, in.test, in.mask, map_view, float(pixels_per_degree));
             }
             if (error_map) return py::make_tuple(mean, map);
             return py::float_(mean);
         },
         py::arg("reference"), py::arg("test"), py::arg("mask") = py::none(),
-        py::arg("pixels_per_degree") = 67.0f, py::arg("error_map") = false,
+        py::arg("pixels_per_degree") = 67.0, py::arg("error_map") = false,
         "Mean LDR-FLIP of two display images; with error_map=True, (mean, per-pixel map).");
     m.def(
         "image_error",

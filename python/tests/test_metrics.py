@@ -63,5 +63,5 @@ def test_bad_masks_raise():
         reprise.ssim(image, image, mask=np.ones((4, 4), bool))
     with pytest.raises(TypeError):
         reprise.flip(image, image, mask=np.ones((8, 8), np.float32))
-    with pytest.raises(ValueError):
+    with pytest.raises(reprise.Error):  # core's check_flip_ppd, shared with the CLI's --ppd
         reprise.flip(image, image, pixels_per_degree=0.0)

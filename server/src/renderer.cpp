@@ -13,6 +13,7 @@
 
 #include "gbuffer_shaders.hpp"
 #include "heavy_shaders.hpp"
+#include "reprise/core/memory_limit.hpp"
 #include "reprise/server/animation.hpp"
 #include "reprise/server/builtin_scenes.hpp"
 #include "reprise/server/gl_context.hpp"
@@ -231,6 +232,7 @@ struct Renderer::Gpu {
     bool software = false;           // llvmpipe or softpipe
     GLuint vertex_array = 0, vertex_buffer = 0, index_buffer = 0;
     int width = 0, height = 0;
+    int max_target_size = 0;  // GL_MAX_RENDERBUFFER_SIZE and GL_MAX_TEXTURE_SIZE, the smaller
     int cache_width = 0, cache_height = 0;
     float max_anisotropy = 0.0f;
     Frame lowres_scratch;  // the low-resolution render of render_frame_lowres
@@ -335,14 +337,15 @@ struct Renderer::Gpu {
         cache_valid = false;
     }
 
+    bool uses_msaa(const RenderSettings& settings) const {
+        const int aa = settings.shading == Shading::Heavy ? 1 : settings.aa_samples;
+        return aa > 1 && msaa_has(aa) &&
+               (settings.aa_method == AntiAliasing::Msaa ||
+                (settings.aa_method == AntiAliasing::Auto && !software));
+    }
+
     Status resize(int w, int h) {
         if (w == width && h == height) return {};
-        GLint max_size = 0;
-        glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_size);
-        if (w > max_size || h > max_size)
-            return Status::error("renderer: " + std::to_string(w) + "x" + std::to_string(h) +
-                                 " exceeds this device's largest render target " +
-                                 std::to_string(max_size));
         if (!framebuffer) {
             glGenFramebuffers(1, &framebuffer);
             glGenTextures(3, targets);
@@ -600,6 +603,43 @@ Renderer::Renderer() : gpu_(std::make_unique<Gpu>()) {}
 Renderer::~Renderer() = default;
 
 const std::string& Renderer::device() const { return gpu_->context->description(); }
+std::uint64_t render_memory(const RenderSettings& settings, bool msaa, int lowres_factor) {
+    REPRISE_ASSERT(settings.width >= 0 && settings.height >= 0 &&
+                   lowres_factor_valid(lowres_factor));
+    constexpr std::uint64_t kGbuffer = 3 * 16 + 8, kReadback = 16, kFrame = 16 + 4 + 8 + 12 + 4;
+    const std::uint64_t pixels = std::uint64_t(settings.width) * std::uint64_t(settings.height);
+    std::uint64_t per_pixel = kGbuffer + kReadback + kFrame;
+    if (msaa) per_pixel += std::uint64_t(settings.aa_samples) * (16 + 4);
+    std::uint64_t fixed = 0;
+    if (settings.shading == Shading::Heavy) {
+        per_pixel += 2 * (16 + 8) + 2;  // two cache slots (term, meta), status and age maps
+        fixed += std::uint64_t(kShadowMapSize) * kShadowMapSize * 4;
+    }
+    std::uint64_t low = 0;
+    if (lowres_factor > 1) {
+        const glm::ivec2 size = lowres_size(settings.width, settings.height, lowres_factor);
+        low = std::uint64_t(size.x) * std::uint64_t(size.y) * (kFrame + 16);
+    }
+    return pixels * per_pixel + low + fixed;
+}
+
+Status Renderer::check_settings(const RenderSettings& settings, int lowres_factor) const {
+    const Gpu& g = *gpu_;
+    const std::string size = std::to_string(settings.width) + "x" + std::to_string(settings.height);
+    if (settings.width > g.max_target_size || settings.height > g.max_target_size)
+        return Status::error("render " + size +
+                             ": larger than this device's largest render target (" +
+                             std::to_string(g.max_target_size) + " pixels a side)");
+    if (!lowres_factor_valid(lowres_factor))
+        return Status::error("render: low-resolution factor " + std::to_string(lowres_factor) +
+                             " must be 2 or 4");
+    const bool msaa = g.uses_msaa(settings);
+    std::string what = "render " + size;
+    if (msaa) what += " with " + std::to_string(settings.aa_samples) + "x MSAA";
+    if (lowres_factor > 1) what += " and 1/" + std::to_string(lowres_factor) + " colour";
+    return check_memory(render_memory(settings, msaa, lowres_factor), what);
+}
+
 bool Renderer::msaa_supported(int samples) const {
     return gpu_->msaa_has(samples) && !gpu_->software;
 }
@@ -631,6 +671,10 @@ Status Renderer::create(std::unique_ptr<Renderer>& renderer) {
     if (extensions &&
         std::string(extensions).find("GL_EXT_texture_filter_anisotropic") != std::string::npos)
         glGetFloatv(0x84FF /* MAX_TEXTURE_MAX_ANISOTROPY_EXT */, &g.max_anisotropy);
+    GLint max_renderbuffer = 0, max_texture = 0;
+    glGetIntegerv(GL_MAX_RENDERBUFFER_SIZE, &max_renderbuffer);
+    glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_texture);
+    g.max_target_size = std::min(max_renderbuffer, max_texture);
     GLint counts = 0;
     glGetInternalformativ(GL_RENDERBUFFER, GL_RGBA32F, GL_NUM_SAMPLE_COUNTS, 1, &counts);
     g.msaa_counts.assign(std::size_t(std::clamp(counts, 0, 32)), 0);
@@ -650,6 +694,10 @@ Status Renderer::render(const Scene& scene, const Instant& current, const Instan
     Gpu& g = *gpu_;
     const int w = settings.width, h = settings.height;
     REPRISE_TRY(check_image_size(w, h, "renderer"));
+    if (!aa_samples_valid(settings.aa_samples))
+        return Status::error("renderer: anti-aliasing samples " +
+                             std::to_string(settings.aa_samples) + " must be 1, 2, 4, 8 or 16");
+    REPRISE_TRY(check_settings(settings));
     g.context->make_current();
     REPRISE_TRY(g.resize(w, h));
     g.upload_textures(scene);
@@ -662,13 +710,8 @@ Status Renderer::render(const Scene& scene, const Instant& current, const Instan
     glm::vec3 eye = glm::vec3(glm::inverse(current.view)[3]);
 
     const bool heavy = settings.shading == Shading::Heavy;
-    if (!aa_samples_valid(settings.aa_samples))
-        return Status::error("renderer: anti-aliasing samples " +
-                             std::to_string(settings.aa_samples) + " must be 1, 2, 4, 8 or 16");
     const int aa = heavy ? 1 : settings.aa_samples;
-    const bool msaa = aa > 1 && g.msaa_has(aa) &&
-                      (settings.aa_method == AntiAliasing::Msaa ||
-                       (settings.aa_method == AntiAliasing::Auto && !g.software));
+    const bool msaa = g.uses_msaa(settings);
     const ReuseSettings& reuse = settings.reuse;
     const bool reusing = heavy && reuse.mode != Reuse::Off;
     if (heavy) {
@@ -1002,6 +1045,7 @@ Status Renderer::render_lowres(const Scene& scene, const Instant& current, const
                                Frame& frame, Image<glm::vec4>& low_color, glm::vec2& jitter) {
     REPRISE_ASSERT(lowres_factor_valid(factor));
     REPRISE_TRY(check_image_size(settings.width, settings.height, "renderer"));
+    REPRISE_TRY(check_settings(settings, factor));
     // Single samples at full resolution too: the upsampler rebuilds the point-sampled image from
     // jittered point samples, and that image is what its output is compared with.
     RenderSettings full_settings = settings;

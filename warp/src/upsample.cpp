@@ -234,10 +234,10 @@ void SpatioTemporalUpsampler::upsample(ImageView<const glm::vec4> low_color, glm
     // The guides with NaN and infinities (but background depth) repaired; their colour is unused.
     GBufferView guides = given;
     guides.color = {};
-    NonfiniteCounts nonfinite;
-    const GBufferView full = guide_repair_.clean(guides, nonfinite);
-    nonfinite.color = count_nonfinite({.color = low_color}).color;
-    nonfinite.frames = nonfinite.total() > 0;
+    NonfiniteCounts input_nonfinite;
+    const GBufferView full = guide_repair_.clean(guides, input_nonfinite);
+    input_nonfinite.color = count_nonfinite({.color = low_color}).color;
+    input_nonfinite.frames = input_nonfinite.total() > 0;
     const int width = full.depth.width, height = full.depth.height;
     REPRISE_ASSERT(!full.depth.empty() && !low_color.empty());
     REPRISE_ASSERT(out.width == width && out.height == height);
@@ -483,7 +483,7 @@ void SpatioTemporalUpsampler::upsample(ImageView<const glm::vec4> low_color, glm
                   .history_used = counters.used,
                   .nonfinite_samples = counters.nonfinite,
                   .unresolved = counters.unresolved,
-                  .nonfinite = nonfinite};
+                  .nonfinite = input_nonfinite};
     }
 }
 

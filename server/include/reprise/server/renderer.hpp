@@ -74,6 +74,12 @@ struct RenderSettings {
 
 bool aa_samples_valid(int samples);
 
+// What rendering at these settings holds, estimated before anything is allocated (bytes a
+// pixel): the float G-buffer, three RGBA32F targets and depth-stencil (56), the read-back rows
+// (16) and the Frame (44); MSAA adds samples x 20, heavy shading its cache (50); a low-resolution
+// pass (lowres_factor 2 or 4) a second Frame and its colour at 1/factor of the pixels.
+std::uint64_t render_memory(const RenderSettings& settings, bool msaa, int lowres_factor = 1);
+
 // What reuse did in the last frame rendered with Shading::Heavy.
 struct ReuseStats {
     int64_t covered = 0;  // pixels with geometry
@@ -152,6 +158,11 @@ public:
     Status render_lowres(const Scene& scene, const Instant& current, const Instant& previous,
                          const RenderSettings& settings, int factor, int64_t jitter_index,
                          Frame& frame, Image<glm::vec4>& low_color, glm::vec2& jitter);
+
+    // Refuses, before anything is allocated, a size beyond this device's largest render target
+    // or texture, or render_memory() beyond the memory limit (reprise/core/memory_limit.hpp).
+    // Every render checks its own pass; call it first to refuse before other work.
+    Status check_settings(const RenderSettings& settings, int lowres_factor = 1) const;
 
     const std::string& device() const;
     // True when `samples` of anti-aliasing run as MSAA here (with AntiAliasing::Auto), false
