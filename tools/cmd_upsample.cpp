@@ -9,6 +9,7 @@
 #include "commands.hpp"
 #include "outputs.hpp"
 #include "reprise/core/exr.hpp"
+#include "reprise/core/memory_limit.hpp"
 #include "reprise/core/metrics.hpp"
 #include "reprise/warp/upsample.hpp"
 
@@ -70,6 +71,8 @@ Status run_upsample(const UpsampleJob& job) {
     const std::size_t n = full_sequence.files.size();
     for (std::size_t i = 0; i < n; ++i) {
         REPRISE_TRY(read_frame(full_sequence.files[i], full));
+        // History, taps, gradients and the output: measured 298 bytes a full-resolution pixel.
+        REPRISE_TRY(check_image_memory(full.width(), full.height(), 300, "upsample"));
         REPRISE_TRY(read_frame(low_sequence.files[i], low));
         const std::string& low_file = low_sequence.files[i];
         if (full.depth.empty() || full.depth.width() != full.width() ||
