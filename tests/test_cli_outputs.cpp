@@ -102,11 +102,11 @@ TEST(CliOutputs, OutputsThatWouldOverwriteInputsAreRefused) {
                    "upsample");
     expect_refused(run("encode" + in + " --out " + q(x / "frame_00002.exr")), "inside the input",
                    "encode over an input frame");
-    expect_refused(run("metrics --ref " + q(x) + " --test " + q(x) + " --csv " +
-                       q(x / "frame_00003.exr")),
-                   "inside the input", "metrics CSV over an input frame");
-    expect_refused(run("export " + q(x) + " --png " + q(x / "frame_00000.exr")),
-                   "inside the input", "export over an input frame");
+    expect_refused(
+        run("metrics --ref " + q(x) + " --test " + q(x) + " --csv " + q(x / "frame_00003.exr")),
+        "inside the input", "metrics CSV over an input frame");
+    expect_refused(run("export " + q(x) + " --png " + q(x / "frame_00000.exr")), "inside the input",
+                   "export over an input frame");
     EXPECT_EQ(differences(contents(x), before), "") << "an input changed";
 
     // Writing beside the inputs where nothing is read stays allowed: a CSV in the frame folder.
@@ -188,9 +188,9 @@ TEST(CliOutputs, StereoResumesToTheSameBytes) {
 TEST(CliOutputs, SilentlyOddInputIsRefused) {
     const fs::path dir = render("odd");
     const fs::path x = dir / "x";
-    ASSERT_EQ(run("render --scene pan --frames 1 --size 48x32 --aa 1 --out " + q(dir / "small"))
-                  .status,
-              0);
+    ASSERT_EQ(
+        run("render --scene pan --frames 1 --size 48x32 --aa 1 --out " + q(dir / "small")).status,
+        0);
     fs::copy_file(dir / "small" / "frame_00000.exr", x / "frame_00004.exr");
     const std::string in = " --in " + q(x);
     expect_refused(run("fruc" + in + " --out " + q(dir / "f")), "needs frames of one size",
@@ -205,10 +205,9 @@ TEST(CliOutputs, SilentlyOddInputIsRefused) {
                    "negative quality");
     expect_refused(run("encode" + in + " --depth bounded: --out " + q(dir / "e.rps")),
                    "bounded:", "a bound without its number");
-    expect_refused(run("encode" + in + " --depth boundedly --out " + q(dir / "e.rps")),
-                   "boundedly", "a word that starts as 'bounded'");
-    expect_refused(run("stereo" + in + " --ipd -5 --out " + q(dir / "s")), "--ipd",
-                   "negative IPD");
+    expect_refused(run("encode" + in + " --depth boundedly --out " + q(dir / "e.rps")), "boundedly",
+                   "a word that starts as 'bounded'");
+    expect_refused(run("stereo" + in + " --ipd -5 --out " + q(dir / "s")), "--ipd", "negative IPD");
     expect_refused(run("stereo" + in + " --ipd 0 --out " + q(dir / "s")), "--ipd", "zero IPD");
     fs::create_directory(dir / "stream");
     expect_refused(run("encode" + in + " --out " + q(dir / "stream")), "is a folder",
@@ -219,4 +218,42 @@ TEST(CliOutputs, SilentlyOddInputIsRefused) {
     EXPECT_NE(run("render --help").output.find("orbit:speed=0.5"), std::string::npos);
     expect_refused(run("render --camera orbit,speed=2 --out " + q(dir / "r")), "colon",
                    "a comma where the colon belongs");
+}
+
+// A killed encode leaves whole packets in a hidden partial stream (and perhaps a torn last one);
+// --resume decodes them into the encoder's state and writes the bytes of an uninterrupted encode,
+// at constant quality and under rate control alike.
+TEST(CliOutputs, KilledEncodeResumesToTheSameBytes) {
+    const fs::path dir = scratch("encode-resume");
+    const fs::path in = dir / "in";
+    ASSERT_EQ(
+        run("render --scene crossing --frames 24 --size 320x180 --aa 1 --out " + q(in)).status, 0);
+    for (const std::string options : {"--qp 30", "--bitrate 400"}) {
+        const std::string encode = "encode --in " + q(in) + " " + options;
+        const fs::path whole = dir / "whole.rps", killed = dir / "killed.rps";
+        const fs::path partial = dir / ".killed.rps.partial";
+        fs::remove(killed);
+        ASSERT_EQ(run(encode + " --out " + q(whole)).status, 0) << options;
+        const std::string stream = read_text(whole);
+        // Killed once a third of the stream is on disk, then its last bytes torn off as a write
+        // cut short would leave them.
+        const std::string wait_and_kill =
+            "sh -c \"" REPRISE_BINARY " " + encode + " --out " + q(killed) +
+            " >/dev/null 2>&1 & p=\\$!; i=0; while [ \\$(stat -c %s " + q(partial) +
+            " 2>/dev/null || echo 0) -lt " + std::to_string(stream.size() / 3) +
+            " ] && [ \\$i -lt 3000 ]; do sleep 0.01; i=\\$((i+1)); done; kill -9 \\$p; wait \\$p\"";
+        reprise::test::run_output(wait_and_kill);
+        ASSERT_FALSE(fs::exists(killed)) << options << ": the encode ended before it was killed";
+        const std::uintmax_t left = fs::file_size(partial);
+        ASSERT_GE(left, stream.size() / 3) << options;
+        ASSERT_LT(left, stream.size()) << options;
+        EXPECT_EQ(read_text(partial), stream.substr(0, left)) << options;
+        fs::resize_file(partial, left - 7);
+
+        Outcome r = run(encode + " --resume --out " + q(killed));
+        ASSERT_EQ(r.status, 0) << options << "\n" << r.output;
+        EXPECT_NE(r.output.find("torn last packet dropped"), std::string::npos) << r.output;
+        EXPECT_TRUE(read_text(killed) == stream) << options << ": the resumed stream differs";
+        EXPECT_FALSE(fs::exists(partial)) << options;
+    }
 }

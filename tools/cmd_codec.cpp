@@ -34,17 +34,6 @@ Status read_file(const std::string& path, std::vector<uint8_t>& bytes) {
     return {};
 }
 
-Status write_file(const std::string& path, const std::vector<uint8_t>& bytes) {
-    bool written = false;
-    {
-        std::ofstream out(partial_path(path), std::ios::binary | std::ios::trunc);
-        written =
-            out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size())) &&
-            out.flush();
-    }
-    return commit_partial(path, written);
-}
-
 Status parse_depth_mode(const std::string& text, codec::EncoderOptions& o) {
     if (text == "lossless") {
         o.depth = codec::DepthMode::Lossless;
@@ -94,7 +83,8 @@ void print_stats(const codec::StreamStats& s, double fps) {
 struct EncodeJob {
     std::string in, out, chroma = "420", depth = "lossless";
     int qp = 28, quality = 0, bitrate = 0, keyint = 0, skip = 2;
-    bool quality_given = false, overwrite_inputs = false;
+    bool quality_given = false, overwrite_inputs = false, resume = false;
+    std::string line;  // the options given, recorded for --resume
 };
 
 // Bad option values are argument errors (exit 2), checked before anything is read.
@@ -123,6 +113,33 @@ Status encoder_options(const EncodeJob& job, codec::EncoderOptions& o) {
     return parse_depth_mode(job.depth, o);
 }
 
+// --resume: the packets a killed encode left in `partial` (whole ones; a torn last one is
+// dropped) are decoded into the encoder's state, and `prefix` keeps their bytes.
+Status resume_stream(const EncodeJob& job, const std::string& partial, codec::Encoder& encoder,
+                     std::vector<uint8_t>& prefix, codec::StreamInfo& info, std::size_t& frames) {
+    std::error_code ec;
+    if (!std::filesystem::exists(partial, ec)) return {};
+    const std::string recorded = read_text(partial + ".run");
+    if (recorded != job.line)
+        return Status::error("--resume: " + partial + " was written by another run (" + recorded +
+                             "); resume it with the same arguments");
+    REPRISE_TRY(read_file(partial, prefix));
+    std::vector<std::span<const uint8_t>> packets;
+    const Status split = codec::split_stream(prefix, info, packets);
+    if (packets.empty()) {  // not even one whole packet: start again
+        prefix.clear();
+        return {};
+    }
+    REPRISE_TRY(encoder.resume(packets));
+    prefix.resize(std::size_t(packets.back().data() + packets.back().size() - prefix.data()));
+    frames = packets.size();
+    std::fprintf(stderr, "[encode] resuming after %zu whole packets%s\n", frames,
+                 split.ok() ? "" : " (a torn last packet dropped)");
+    return {};
+}
+
+// The stream grows in a hidden .OUT.partial beside OUT, flushed after every packet, and is renamed
+// to OUT when the last frame is in: a killed encode leaves whole packets for --resume.
 Status run_encode(const EncodeJob& job, const codec::EncoderOptions& o) {
     std::error_code ec;
     if (std::filesystem::is_directory(job.out, ec))
@@ -133,32 +150,55 @@ Status run_encode(const EncodeJob& job, const codec::EncoderOptions& o) {
     REPRISE_TRY(open_sequence(job.in, sequence));
     REPRISE_TRY(check_one_size(sequence, "encode"));
     codec::Encoder encoder(o);
-    std::vector<uint8_t> file;
+    const std::string partial = partial_path(job.out);
+    std::vector<uint8_t> prefix;
+    codec::StreamInfo resumed;
+    std::size_t first = 0;
+    if (job.resume) REPRISE_TRY(resume_stream(job, partial, encoder, prefix, resumed, first));
+    std::ofstream(partial + ".run", std::ios::trunc) << job.line;
+    std::ofstream stream(partial, std::ios::binary | std::ios::trunc);
+    std::size_t bytes = prefix.size();
+    if (!stream.write(reinterpret_cast<const char*>(prefix.data()), std::streamsize(bytes)))
+        return Status::error(job.out + ": cannot write " + partial);
+    prefix = {};
     Frame frame;
     double busy_ms = 0.0;
     double fps = sequence.fps > 0 ? sequence.fps : 30.0;
     const std::size_t n = sequence.files.size();
-    for (std::size_t i = 0; i < n; ++i) {
+    for (std::size_t i = first; i < n; ++i) {
         REPRISE_TRY(read_frame(sequence, i, frame));
         if (frame.fps <= 0) frame.fps = fps;
+        if (i == first && first > 0 &&
+            (frame.width() != resumed.width || frame.height() != resumed.height))
+            return Status::error("--resume: " + partial + " holds " +
+                                 std::to_string(resumed.width) + "x" +
+                                 std::to_string(resumed.height) + " frames, " + sequence.files[i] +
+                                 " is another size");
+        std::vector<uint8_t> out;
         if (i == 0)
-            REPRISE_TRY(codec::write_stream_header(file, frame.width(), frame.height(), fps));
+            REPRISE_TRY(codec::write_stream_header(out, frame.width(), frame.height(), fps));
         const auto start = Clock::now();
         const Status sent = encoder.send_frame(frame);
         busy_ms += ms_since(start);
         if (!sent.ok()) return Status::error(sequence.files[i] + ": " + sent.message());
         codec::Packet packet;
         while (encoder.receive_packet(packet) == codec::Result::Ok)
-            file.insert(file.end(), packet.data.begin(), packet.data.end());
-        std::fprintf(stderr, "\r[encode] %zu/%zu frames, %zu bytes", i + 1, n, file.size());
+            out.insert(out.end(), packet.data.begin(), packet.data.end());
+        if (!stream.write(reinterpret_cast<const char*>(out.data()), std::streamsize(out.size()))
+                 .flush())
+            return Status::error(job.out + ": cannot write " + partial);
+        bytes += out.size();
+        std::fprintf(stderr, "\r[encode] %zu/%zu frames, %zu bytes", i + 1, n, bytes);
     }
     std::fprintf(stderr, "\n");
-    REPRISE_TRY(write_file(job.out, file));
+    stream.close();
+    REPRISE_TRY(commit_partial(job.out, bool(stream)));
+    std::filesystem::remove(partial + ".run", ec);
     std::printf(
         "encoded %zu frames (%dx%d at %.3g fps) into %s: %zu bytes, %.2f ms per frame (without "
         "file I/O)\n",
-        n, frame.width(), frame.height(), fps, job.out.c_str(), file.size(),
-        busy_ms / double(std::max<std::size_t>(1, n)));
+        n, frame.width(), frame.height(), fps, job.out.c_str(), bytes,
+        busy_ms / double(std::max<std::size_t>(1, n - first)));
     print_stats(encoder.stats(), fps);
     if (encoder.stats().nonfinite.total() > 0)
         std::fprintf(stderr, "[encode] input: %s\n",
@@ -270,9 +310,12 @@ int command_encode(int argc, char** argv) {
                 "blocks within this many 8-bit levels of their prediction are skipped (default 2)");
     args.flag("--overwrite-inputs", &job.overwrite_inputs,
               "allow --out to replace an input file (written after all are read)");
+    args.flag("--resume", &job.resume,
+              "continue an interrupted encode of the same arguments from its partial stream");
     const Status parsed = args.parse(argc, argv);
     if (!parsed.ok() || args.help_requested()) return report(args, parsed, {});
     job.quality_given = args.given("--quality");
+    job.line = args.given_line({"--resume"});
     codec::EncoderOptions options;
     const Status checked = encoder_options(job, options);
     if (!checked.ok()) return report(args, checked, {});

@@ -82,16 +82,15 @@ Status OutputFolder::open(const std::string& dir, const OutputRules& rules, cons
     if (ec) return Status::error(dir + ": cannot create the folder: " + ec.message());
     const fs::path run_file = fs::path(dir) / kRunFile;
     if (resume) {
-        std::ifstream in(run_file);
-        std::stringstream recorded;
-        recorded << in.rdbuf();
-        if (!in && fs::exists(frame_path(dir, 0), ec))
+        const bool recorded = fs::exists(run_file, ec);
+        if (!recorded && fs::exists(frame_path(dir, 0), ec))
             return Status::error("--resume: " + dir +
                                  " holds frames but no record of the run that wrote them (" +
                                  kRunFile + ")");
-        if (in && recorded.str() != job)
+        if (recorded && read_text(run_file.string()) != job)
             return Status::error("--resume: " + dir + " was written by another run (" +
-                                 recorded.str() + "); resume it with the same arguments");
+                                 read_text(run_file.string()) +
+                                 "); resume it with the same arguments");
         while (fs::exists(frame_path(dir, on_disk_), ec)) ++on_disk_;
         // A killed write leaves its hidden temporary file behind; nothing reads it.
         for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
@@ -121,6 +120,13 @@ Status OutputFolder::finish() {
     fs::remove_all(write_dir_, ec);
     write_dir_ = dir_;
     return {};
+}
+
+std::string read_text(const std::string& path) {
+    std::ifstream in(path);
+    std::stringstream text;
+    text << in.rdbuf();
+    return text.str();
 }
 
 std::string partial_path(const std::string& path) {

@@ -47,6 +47,9 @@ private:
 std::string partial_path(const std::string& path);
 Status commit_partial(const std::string& path, bool written);
 
+// The whole of a small text file (a run record); empty when there is none.
+std::string read_text(const std::string& path);
+
 // Reads every frame's header and refuses a sequence whose frames differ in size, naming the
 // first that does: commands that make one output sequence need one size.
 Status check_one_size(const Sequence& sequence, const std::string& command);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <deque>
 
+#include "decoder_state.hpp"
 #include "internal.hpp"
 #include "reprise/core/byte_io.hpp"
 
@@ -13,23 +14,6 @@ namespace {
 constexpr std::size_t kMaxQueuedFrames = 16;
 
 }  // namespace
-
-struct Decoder::State {
-    DecoderOptions options;
-    SequenceParams sp;
-    bool started = false;
-    Picture refs[kReferences];
-    bool have_newest = false;
-    uint32_t newest = 0;
-    std::deque<Frame> queue;
-    std::vector<Frame> spare;  // frames handed back by receive_frame, reused for output
-    StreamStats stats;
-    NonfiniteRepair repair;
-    Picture scratch;
-    Workspace work;
-
-    int slot_of(uint32_t frame) const { return held_slot(refs, frame); }
-};
 
 Decoder::Decoder(const DecoderOptions& options) : state_(std::make_unique<State>()) {
     state_->options = options;

@@ -6,6 +6,7 @@
 #include <deque>
 #include <set>
 
+#include "decoder_state.hpp"
 #include "internal.hpp"
 #include "reprise/core/byte_io.hpp"
 #include "reprise/core/memory_limit.hpp"
@@ -219,6 +220,54 @@ Status Encoder::send_frame(const Frame& given) {
     fs.nonfinite = nonfinite;
     s.last = fs;
     add_stats(s.stats, fs);
+    s.recon_ready = false;
+    return {};
+}
+
+Status Encoder::resume(std::span<const std::span<const uint8_t>> packets) {
+    State& s = *state_;
+    if (s.started || s.next_frame != 0)
+        return Status::error("resume: the encoder has already encoded frames");
+    Decoder decoder;
+    Frame decoded;
+    std::vector<uint32_t> reference_of(packets.size());
+    for (uint32_t n = 0; n < packets.size(); ++n) {
+        Packet info;
+        int64_t timestamp = 0;
+        REPRISE_TRY(inspect_packet(packets[n], info, timestamp));
+        if (info.frame != n)
+            return Status::error("resume: packet " + std::to_string(n) + " holds frame " +
+                                 std::to_string(info.frame));
+        const Status sent = decoder.send_packet(packets[n]);
+        if (!sent.ok()) return Status::error("resume: " + sent.message());
+        while (decoder.receive_frame(decoded) == Result::Ok) {
+        }
+        reference_of[n] = info.reference;
+        if (info.type == PacketType::Key) s.last_key = n;
+        // Rate control as send_frame ran it, from the packet's size.
+        const Decoder::State& d = *decoder.state_;
+        const double target_bits = s.options.bitrate_kbps > 0
+                                       ? s.options.bitrate_kbps * 1000.0 / std::max(1.0, d.sp.fps)
+                                       : 0.0;
+        if (target_bits > 0) {
+            const double bits = 8.0 * double(packets[n].size());
+            s.qp_state = std::clamp(
+                s.qp_state + 0.5 * 6.0 * std::log2(std::max(bits, 1.0) / target_bits), 4.0, 51.0);
+            s.qp = int(std::lround(s.qp_state));
+        }
+    }
+    if (packets.empty()) return {};
+    Decoder::State& d = *decoder.state_;
+    s.sp = d.sp;
+    for (int i = 0; i < kReferences; ++i) {
+        std::swap(s.refs[i], d.refs[i]);
+        s.reference_of[i] = s.refs[i].held ? reference_of[s.refs[i].frame] : 0;
+        s.tainted[i] = false;
+    }
+    s.next_frame = uint32_t(packets.size());
+    s.newest = s.slot_of(s.next_frame - 1);
+    s.started = d.started;
+    s.stats = d.stats;
     s.recon_ready = false;
     return {};
 }

@@ -134,6 +134,7 @@ Status write_stream_header(std::vector<uint8_t>& out, int width, int height, dou
 
 Status split_stream(std::span<const uint8_t> file, StreamInfo& info,
                     std::vector<std::span<const uint8_t>>& packets) {
+    packets.clear();
     ByteReader r(file, "stream");
     const uint32_t magic = r.u32();
     const uint8_t version = r.u8();
@@ -148,7 +149,6 @@ Status split_stream(std::span<const uint8_t> file, StreamInfo& info,
         return Status::error("stream: version " + std::to_string(version) +
                              " (this reader reads 1)");
     REPRISE_TRY(check_image_size(info.width, info.height, "stream header"));
-    packets.clear();
     while (r.remaining()) {
         const std::size_t at = r.position();
         if (r.remaining() < kPacketHeaderSize)

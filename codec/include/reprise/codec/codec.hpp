@@ -83,6 +83,11 @@ public:
     void acknowledge(uint32_t frame);
     void report_loss(uint32_t frame);
     void request_key_frame();
+    // Continues the stream whose packets so far are `packets` (an interrupted encode): decodes
+    // them into the references and rate-control state this encoder would hold after them, so
+    // that the next send_frame writes what one encoder over the whole sequence would have.
+    // Only on an encoder that has encoded nothing; every packet must decode, frames 0, 1, ...
+    [[nodiscard]] Status resume(std::span<const std::span<const uint8_t>> packets);
     // Changes the rate-control target from the next frame on (0 = constant quality at qp); no
     // key frame is forced.
     void set_bitrate(int kbps);
@@ -127,6 +132,7 @@ public:
     struct State;
 
 private:
+    friend class Encoder;  // Encoder::resume takes the references it decoded
     std::unique_ptr<State> state_;
 };
 
@@ -141,7 +147,8 @@ struct StreamInfo {
     int width = 0, height = 0;
     double fps = 0.0;
 };
-// Splits a whole .rps file into its packets (each checked for length and CRC only).
+// Splits a whole .rps file into its packets (each checked for length and CRC only). On an
+// error `packets` holds the whole packets before the damage (a truncated tail, say).
 [[nodiscard]] Status split_stream(std::span<const uint8_t> file, StreamInfo& info,
                                   std::vector<std::span<const uint8_t>>& packets);
 
