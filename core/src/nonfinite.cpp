@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
+#include <cstdint>
 #include <cmath>
 #include <limits>
 
@@ -35,9 +37,24 @@ T narrow(const glm::vec4& v) {
         return v;
 }
 
+// Whether any of `n` floats is NaN or an infinity (+inf allowed when `positive_inf_ok`): a
+// branch-free scan of the exponent bits that the compiler vectorizes, so a clean frame costs one
+// streaming read.
+bool any_nonfinite(const float* values, std::size_t n, bool positive_inf_ok) {
+    constexpr uint32_t kExponent = 0x7f800000u, kPositiveInf = 0x7f800000u;
+    uint32_t found = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        const uint32_t bits = std::bit_cast<uint32_t>(values[i]);
+        found |= uint32_t((bits & kExponent) == kExponent) &
+                 uint32_t(!positive_inf_ok || bits != kPositiveInf);
+    }
+    return found != 0;
+}
+
 template <class T, class IsBad>
-std::size_t count(ImageView<const T> image, IsBad is_bad) {
+std::size_t count(ImageView<const T> image, IsBad is_bad, bool positive_inf_ok = false) {
     if (image.empty()) return 0;
+    constexpr std::size_t kFloats = sizeof(T) / sizeof(float);
     std::atomic<std::size_t> total{0};
     parallel_for(
         0, image.height,
@@ -45,6 +62,9 @@ std::size_t count(ImageView<const T> image, IsBad is_bad) {
             std::size_t n = 0;
             for (int y = y0; y < y1; ++y) {
                 const T* row = image.row(y);
+                if (!any_nonfinite(reinterpret_cast<const float*>(row),
+                                   std::size_t(image.width) * kFloats, positive_inf_ok))
+                    continue;
                 for (int x = 0; x < image.width; ++x) n += is_bad(row[x]);
             }
             total += n;
@@ -60,8 +80,8 @@ enum class Combine { Mean, Max };
 template <class T, class IsBad>
 std::size_t pull_push_fill(ImageView<T> image, IsBad is_bad, Combine combine,
                            const glm::vec4& fallback, std::vector<glm::vec4>& values,
-                           std::vector<float>& weights) {
-    const std::size_t n = count(ImageView<const T>(image), is_bad);
+                           std::vector<float>& weights, bool positive_inf_ok = false) {
+    const std::size_t n = count(ImageView<const T>(image), is_bad, positive_inf_ok);
     if (n == 0) return 0;
     struct Level {
         int w, h;
@@ -158,7 +178,7 @@ const auto any_bad = [](const auto& v) { return bad(v); };
 NonfiniteCounts count_nonfinite(const GBufferView& frame) {
     NonfiniteCounts c;
     c.color = count(frame.color, any_bad);
-    c.depth = count(frame.depth, bad_depth);
+    c.depth = count(frame.depth, bad_depth, true);
     c.motion = count(frame.motion, any_bad);
     c.normal = count(frame.normal, any_bad);
     c.frames = c.total() > 0;
@@ -171,7 +191,8 @@ std::size_t NonfiniteRepair::repair_color(ImageView<glm::vec4> color) {
 
 std::size_t NonfiniteRepair::repair_depth(ImageView<float> depth) {
     return pull_push_fill(depth, bad_depth, Combine::Max,
-                          glm::vec4(std::numeric_limits<float>::infinity()), pyramid_, weights_);
+                          glm::vec4(std::numeric_limits<float>::infinity()), pyramid_, weights_,
+                          true);
 }
 
 std::size_t NonfiniteRepair::repair_motion(ImageView<glm::vec2> motion) {
@@ -247,7 +268,9 @@ std::string describe_nonfinite(const NonfiniteCounts& c) {
     const auto part = [&](const char* name, std::size_t n) {
         if (n == 0) return;
         if (!parts.empty()) parts += ", ";
-        parts += name + (" " + std::to_string(n));
+        parts += name;
+        parts += ' ';
+        parts += std::to_string(n);
     };
     part("colour", c.color);
     part("depth", c.depth);
