@@ -323,42 +323,47 @@ TEST(Codec, BoundedDepthStaysWithinItsRelativeError) {
 // View depth: 1/z quantised so that a camera displaced by up to B moves no reprojected pixel by
 // more than E; background exact; encoder and decoder agree bit for bit.
 TEST(Codec, ViewDepthKeepsReprojectionWithinTheBound) {
-    const auto frames = render("crossing", 6, 160, 96);
-    for (const EncoderOptions& options :
-         {EncoderOptions{.depth = DepthMode::View},
-          EncoderOptions{
-              .depth = DepthMode::View, .view_error_px = 1.0f, .view_displacement = 0.5f}}) {
-        const Coded coded = encode_all(frames, options);
-        const auto decoded = decode_all(coded.packets);
-        ASSERT_EQ(decoded.size(), frames.size());
-        for (std::size_t i = 0; i < frames.size(); ++i) {
-            EXPECT_TRUE(same_frame(decoded[i], coded.reconstructions[i])) << "frame " << i;
-            const ViewDepthError e =
-                measure_view_depth_error(frames[i].camera, frames[i].depth.view(),
-                                         decoded[i].depth.view(), options.view_displacement);
-            EXPECT_GT(e.pixels, frames[i].depth.pixel_count() / 2);
-            EXPECT_EQ(e.background_mismatches, 0u) << "frame " << i;
-            EXPECT_LE(e.max_px, options.view_error_px) << "frame " << i;
-            EXPECT_GT(e.max_px, 0.1 * options.view_error_px) << "frame " << i << ": not lossy";
+    for (const char* scene : {"crossing", "fence"})  // still camera; orbit (temporal reprojection)
+        for (const EncoderOptions& options :
+             {EncoderOptions{.depth = DepthMode::View},
+              EncoderOptions{
+                  .depth = DepthMode::View, .view_error_px = 1.0f, .view_displacement = 0.5f}}) {
+            const auto frames = render(scene, 6, 160, 96);
+            const Coded coded = encode_all(frames, options);
+            const auto decoded = decode_all(coded.packets);
+            ASSERT_EQ(decoded.size(), frames.size());
+            for (std::size_t i = 0; i < frames.size(); ++i) {
+                SCOPED_TRACE(scene);
+                EXPECT_TRUE(same_frame(decoded[i], coded.reconstructions[i])) << "frame " << i;
+                const ViewDepthError e =
+                    measure_view_depth_error(frames[i].camera, frames[i].depth.view(),
+                                             decoded[i].depth.view(), options.view_displacement);
+                EXPECT_GT(e.pixels, frames[i].depth.pixel_count() / 2);
+                EXPECT_EQ(e.background_mismatches, 0u) << "frame " << i;
+                EXPECT_LE(e.max_px, options.view_error_px) << "frame " << i;
+                EXPECT_GT(e.max_px, 0.1 * options.view_error_px) << "frame " << i << ": not lossy";
+            }
         }
-    }
 }
 
-// Measured on crossing 160x96, 6 frames: view depth VIEW_RATIO of the lossless depth bits.
+// Measured at 160x96, 6 frames: view depth is 0.049x the lossless depth bits on crossing (still
+// camera) and 0.046x on fence (orbit).
 TEST(Codec, ViewDepthCostsAFractionOfLosslessDepth) {
-    const auto frames = render("crossing", 6, 160, 96);
-    std::size_t depth_bits[2] = {0, 0};
-    for (DepthMode mode : {DepthMode::Lossless, DepthMode::View}) {
-        Encoder encoder({.depth = mode});
-        for (const Frame& f : frames) {
-            ASSERT_TRUE(encoder.send_frame(f).ok());
-            Packet p;
-            ASSERT_EQ(encoder.receive_packet(p), Result::Ok);
+    for (auto [scene, bound] : {std::pair{"crossing", 0.1}, std::pair{"fence", 0.1}}) {
+        const auto frames = render(scene, 6, 160, 96);
+        std::size_t depth_bits[2] = {0, 0};
+        for (DepthMode mode : {DepthMode::Lossless, DepthMode::View}) {
+            Encoder encoder({.depth = mode});
+            for (const Frame& f : frames) {
+                ASSERT_TRUE(encoder.send_frame(f).ok());
+                Packet p;
+                ASSERT_EQ(encoder.receive_packet(p), Result::Ok);
+            }
+            depth_bits[mode == DepthMode::View] = encoder.stats().depth_bits;
         }
-        depth_bits[mode == DepthMode::View] = encoder.stats().depth_bits;
+        EXPECT_LE(double(depth_bits[1]), bound * double(depth_bits[0]))
+            << scene << ": " << depth_bits[1] << " against " << depth_bits[0];
     }
-    EXPECT_LE(double(depth_bits[1]), 0.5 * double(depth_bits[0]))
-        << depth_bits[1] << " against " << depth_bits[0];
 }
 
 TEST(Codec, StreamsOfAnOlderVersionAreRefused) {
