@@ -239,6 +239,10 @@ TEST(CliBenchCodec, TinySceneWritesRowsForEveryPeer) {
         300);
     ASSERT_EQ(result.status, 0) << result.output;
     EXPECT_NE(result.output.find("targets (issue 8"), std::string::npos) << result.output;
+    // View depth: the bound and the measured error, within it.
+    EXPECT_NE(result.output.find("depth to the view bound"), std::string::npos) << result.output;
+    EXPECT_NE(result.output.find("within the bound"), std::string::npos) << result.output;
+    EXPECT_EQ(result.output.find("OUTSIDE the bound"), std::string::npos) << result.output;
     std::ifstream csv(dir / "codec.csv");
     std::string line;
     std::getline(csv, line);

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "commands.hpp"
+#include "reprise/codec/codec.hpp"
 #include "reprise/core/exr.hpp"
 #include "support/cli.hpp"
 #include "support/frames.hpp"
@@ -61,7 +62,25 @@ TEST(CliCodec, EncodeDecodeInfoAndThreadCountIndependence) {
     Frame source, back;
     ASSERT_TRUE(read_frame(frame_path(frames, 3), source).ok());
     ASSERT_TRUE(read_frame(frame_path(decoded, 3), back).ok());
+    // The default depth is the view bound: 0.25 px for displacements up to 0.164, background exact.
+    const codec::ViewDepthError view = codec::measure_view_depth_error(
+        source.camera, source.depth.view(), back.depth.view(), 0.164f);
+    EXPECT_EQ(view.background_mismatches, 0u);
+    EXPECT_GT(view.pixels, 0u);
+    EXPECT_LE(view.max_px, 0.25);
+    const std::string exact = (dir / "lossless.rps").string();
+    ASSERT_EQ(
+        test::run_reprise("encode --in " + frames + " --out " + exact + " --depth lossless", 120)
+            .status,
+        0);
+    ASSERT_EQ(
+        test::run_reprise("decode " + exact + " --out " + (dir / "exact").string(), 120).status, 0);
+    ASSERT_TRUE(read_frame(frame_path((dir / "exact").string(), 3), back).ok());
     EXPECT_TRUE(test::same_bits(source.depth, back.depth));
+    EXPECT_EQ(test::run_reprise(
+                  "encode --in " + frames + " --out " + exact + " --depth view:0.5,0.2", 120)
+                  .status,
+              0);
     EXPECT_GT(test::display_psnr(source.color, back.color), 31.0);
     EXPECT_EQ(back.camera.view, source.camera.view);
 
@@ -96,5 +115,11 @@ TEST(CliCodec, EncodeDecodeInfoAndThreadCountIndependence) {
         test::run_reprise("encode --in " + frames + " --out " + one + " --depth bounded:7", 60)
             .status,
         2);
+    for (const char* mode : {"view:0", "view:", "view:0.25,", "view:0.25,-1", "view:x", "viewy"})
+        EXPECT_EQ(
+            test::run_reprise("encode --in " + frames + " --out " + one + " --depth " + mode, 60)
+                .status,
+            2)
+            << mode;
     fs::remove_all(dir);
 }

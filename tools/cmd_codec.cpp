@@ -48,9 +48,27 @@ Status parse_depth_mode(const std::string& text, codec::EncoderOptions& o) {
                 return Status::error("encode: --depth " + text +
                                      ": the bound must be a number in 1e-7..0.1");
         }
+    } else if (text == "view" || text.starts_with("view:")) {
+        o.depth = codec::DepthMode::View;
+        if (text != "view") {
+            const char* error = text.c_str() + 5;
+            char* end = nullptr;
+            o.view_error_px = std::strtof(error, &end);
+            bool parsed = end != error;
+            if (parsed && *end == ',') {
+                const char* displacement = end + 1;
+                o.view_displacement = std::strtof(displacement, &end);
+                parsed = end != displacement;
+            }
+            if (!parsed || *end || !(o.view_error_px >= 1e-3f && o.view_error_px <= 100.0f) ||
+                !(o.view_displacement > 0.0f && o.view_displacement <= 1e6f))
+                return Status::error("encode: --depth " + text +
+                                     ": expected view:E[,B] with E in 0.001..100 px and B in "
+                                     "(0, 1e6] scene units");
+        }
     } else {
         return Status::error("encode: --depth " + text +
-                             ": expected lossless, bounded[:E] or none");
+                             ": expected view[:E[,B]], lossless, bounded[:E] or none");
     }
     return {};
 }
@@ -81,7 +99,7 @@ void print_stats(const codec::StreamStats& s, double fps) {
 }
 
 struct EncodeJob {
-    std::string in, out, chroma = "420", depth = "lossless";
+    std::string in, out, chroma = "420", depth = "view";
     int qp = 28, quality = 0, bitrate = 0, keyint = 0, skip = 2;
     bool quality_given = false, overwrite_inputs = false, resume = false;
     std::string line;  // the options given, recorded for --resume
@@ -304,8 +322,11 @@ int command_encode(int argc, char** argv) {
     args.option("--keyint", &job.keyint,
                 "a key frame at least every N frames (default 0: cuts and requests only)");
     args.option("--chroma", &job.chroma, "420 | 444 (default 420)");
-    args.option("--depth", &job.depth,
-                "lossless | bounded[:E] (relative error E, default 1e-4) | none");
+    args.option(
+        "--depth", &job.depth,
+        "view[:E[,B]] (default: 1/z to within E px of reprojection, default 0.25, for camera "
+        "displacements up to B scene units, default 0.164) | lossless | bounded[:E] "
+        "(relative error E, default 1e-4) | none");
     args.option("--skip", &job.skip,
                 "blocks within this many 8-bit levels of their prediction are skipped (default 2)");
     args.flag("--overwrite-inputs", &job.overwrite_inputs,

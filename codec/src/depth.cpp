@@ -21,9 +21,14 @@ constexpr int kBlock = 8;
 constexpr uint32_t kNoPrediction = 0xFFFFFFFFu;  // no code maps here in either mode
 constexpr uint8_t kAllPredicted = 1;
 
+// View-mode codes are k = round(1/z / step) in 0..2^30 (k = 0 decodes as half a step).
+constexpr uint32_t kMaxViewCode = 1u << 30;
+
 struct Mapping {
     bool lossless;
-    double step;
+    bool view;                  // uniform in 1/z
+    double step;                // log2 step (bounded) or 1/z step (view)
+    double displacement = 0.0;  // view: the declared largest camera displacement (encoder only)
 
     uint32_t code(float z) const {
         if (lossless) {
@@ -34,9 +39,13 @@ struct Mapping {
         }
         if (z == std::numeric_limits<float>::infinity()) return kInfCode;
         if (!(z > 0.0f) || !std::isfinite(z)) return kInvalidCode;
+        if (view)
+            return uint32_t(std::min(std::nearbyint(1.0 / double(z) / step), double(kMaxViewCode)));
         const double k = std::nearbyint(exact_log2(double(z)) / step);
         return uint32_t(int32_t(std::clamp(k, -double(1 << 30), double(1 << 30))));
     }
+    // The inverse depth a view-mode code decodes to.
+    double inverse_depth(uint32_t c) const { return c == 0 ? 0.5 * step : double(c) * step; }
     float depth(uint32_t c) const {
         if (lossless) {
             const uint32_t u = (c & 0x80000000u) ? (c & 0x7FFFFFFFu) : ~c;
@@ -45,6 +54,9 @@ struct Mapping {
             return z;
         }
         if (c == kInfCode) return std::numeric_limits<float>::infinity();
+        if (view)
+            return c > kMaxViewCode ? std::numeric_limits<float>::quiet_NaN()
+                                    : float(1.0 / inverse_depth(c));
         const int32_t k = int32_t(c);
         if (k > (1 << 30) || k < -(1 << 30)) return std::numeric_limits<float>::quiet_NaN();
         return float(exact_exp2(double(k) * step));
@@ -55,7 +67,9 @@ struct Mapping {
 };
 
 Mapping mapping_of(const SequenceParams& sp) {
-    return {sp.depth == DepthMode::Lossless, sp.depth_step()};
+    const bool view = sp.depth == DepthMode::View;
+    return {sp.depth == DepthMode::Lossless, view, view ? double(sp.view_step) : sp.depth_step(),
+            double(sp.view_displacement)};
 }
 
 inline uint32_t median_edge(int64_t a, int64_t b, int64_t c) {
@@ -290,6 +304,35 @@ void depth_from_codes(const Mapping& map, const Image<uint32_t>& codes, Image<fl
     });
 }
 
+// View mode leaves the encoder a choice: any code whose inverse depth is close enough to the
+// truth keeps the reprojection error within the bound. Where the temporal or else the spatial
+// prediction is such a code, it is taken, so a block predicted within the bound has no residual.
+// The allowance shrinks by (1 - B/z)^2 for points near the camera (docs/bitstream.md).
+void choose_view_codes(SliceJob& j, ImageView<const float> source) {
+    const Mapping& map = *j.map;
+    const bool inter = !j.temporal.empty();
+    auto within = [&](uint32_t c, double w) {
+        if (c > kMaxViewCode) return false;
+        const double wc = map.inverse_depth(c);
+        const double near = std::max(0.0, 1.0 - map.displacement * std::max(w, wc));
+        return std::abs(wc - w) <= map.step * near * near;
+    };
+    for (int y = j.y0; y < j.y1; ++y)
+        for (int x = 0; x < j.width; ++x) {
+            const float z = source.empty() ? INFINITY : source(x, y);
+            uint32_t c = map.code(z);
+            if (c <= kMaxViewCode) {
+                const double w = 1.0 / double(z);
+                const uint32_t t = inter ? j.temporal(x, y) : kNoPrediction;
+                if (t != kNoPrediction && within(t, w))
+                    c = t;
+                else if (const uint32_t p = spatial(j, x, y); within(p, w))
+                    c = p;
+            }
+            j.codes(x, y) = c;
+        }
+}
+
 }  // namespace
 
 // Codes are log2(z) / step rounded: the decoded z is within 2^(step / 2) - 1 of the truth; a
@@ -312,12 +355,19 @@ void encode_depth(const FrameContext& fc, const Camera& camera, ImageView<const 
     Image<uint32_t>& residuals = fc.work->depth_residuals;
     ensure_size(codes, w, h);
     ensure_size(residuals, w, h);
-    parallel_for(0, h, [&](int y0, int y1) {
-        for (int y = y0; y < y1; ++y)
-            for (int x = 0; x < w; ++x)
-                codes(x, y) = map.code(source.empty() ? INFINITY : source(x, y));
-    });
     temporal_codes(fc, camera, map, temporal);
+    if (map.view) {
+        std::vector<SliceJob> jobs = slice_jobs(sp, map, codes, temporal, residuals);
+        parallel_for(0, sp.slices, [&](int s0, int s1) {
+            for (int s = s0; s < s1; ++s) choose_view_codes(jobs[s], source);
+        });
+    } else {
+        parallel_for(0, h, [&](int y0, int y1) {
+            for (int y = y0; y < y1; ++y)
+                for (int x = 0; x < w; ++x)
+                    codes(x, y) = map.code(source.empty() ? INFINITY : source(x, y));
+        });
+    }
     const std::size_t start = bytes.size();
     bool all_predicted = !temporal.empty();
     for (std::size_t i = 0; all_predicted && i < codes.pixel_count(); ++i)

@@ -138,6 +138,11 @@ Status Encoder::send_frame(const Frame& given) {
     if (s.options.depth == DepthMode::Bounded &&
         !(s.options.depth_error >= 1e-7f && s.options.depth_error <= 0.1f))
         return Status::error("encoder: depth error bound must lie in 1e-7..0.1");
+    if (s.options.depth == DepthMode::View &&
+        !(s.options.view_error_px >= 1e-3f && s.options.view_error_px <= 100.0f &&
+          s.options.view_displacement > 0.0f && s.options.view_displacement <= 1e6f))
+        return Status::error(
+            "encoder: view depth needs an error in 0.001..100 px and a displacement in (0, 1e6]");
 
     NonfiniteCounts nonfinite;
     const Frame& frame = s.repair.clean(given, nonfinite);
@@ -148,6 +153,12 @@ Status Encoder::send_frame(const Frame& given) {
     sp.chroma = s.options.chroma;
     sp.depth = s.options.depth;
     sp.depth_error = s.options.depth_error;
+    if (sp.depth == DepthMode::View) {
+        sp.view_error = s.options.view_error_px;
+        sp.view_displacement = s.options.view_displacement;
+        sp.view_step =
+            view_depth_step(frame.camera.projection, w, h, sp.view_error, sp.view_displacement);
+    }
     sp.slices = default_slices(h);
     sp.fps = frame.fps > 0.0 ? frame.fps : s.options.fps;
     if (s.started && !(sp == s.sp)) s.started = false;  // new parameters: a key frame

@@ -264,3 +264,31 @@ double exact_exp2(double x) {
 }
 
 }  // namespace reprise::codec
+
+namespace reprise::codec {
+
+// Shift of a pixel at normalised position p (focal lengths fx, fy in pixels) when its inverse
+// depth w becomes w' and the camera moves by t (t_z towards the scene):
+// (fx (t_z p_x - t_x), fy (t_z p_y - t_y)) (w - w') / ((1 - t_z w) (1 - t_z w')). The numerator's
+// largest norm over |t| <= B is f B sqrt(1 + |p|^2) (f = max(fx, fy)); the step is the 1/z error
+// for which that is the bound, rounded down to a power of 2^(1/8) so that small zooms keep the
+// parameters. Without a perspective projection a 90 degree horizontal field of view is assumed.
+float view_depth_step(const glm::mat4& projection, int width, int height, float error_px,
+                      float displacement) {
+    const glm::mat4& p = projection;
+    const bool perspective = p[2][3] != 0.0f && p[0][0] != 0.0f && p[1][1] != 0.0f;
+    const double sx = perspective ? std::abs(double(p[0][0])) : 1.0;
+    const double sy = perspective ? std::abs(double(p[1][1])) : double(width) / double(height);
+    const double ox = perspective ? std::abs(double(p[2][0])) : 0.0;
+    const double oy = perspective ? std::abs(double(p[2][1])) : 0.0;
+    const double focal = std::max(sx * width, sy * height) / 2.0;  // pixels
+    const double u = (1.0 + ox) / sx, v = (1.0 + oy) / sy;         // the farthest image corner
+    const double bound =
+        double(error_px) / (focal * double(displacement) * std::sqrt(1.0 + u * u + v * v));
+    const double step = std::exp2(std::floor(8.0 * std::log2(bound)) / 8.0);
+    float f = float(std::clamp(step, 1e-12, 1e6));
+    if (double(f) > step) f = std::nextafter(f, 0.0f);  // never coarser than the bound asks
+    return f;
+}
+
+}  // namespace reprise::codec

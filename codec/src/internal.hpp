@@ -12,7 +12,7 @@ namespace reprise::codec {
 
 inline constexpr uint32_t kPacketMagic = 0x544B5052;  // "RPKT"
 inline constexpr uint32_t kFileMagic = 0x53525052;    // "RPRS"
-inline constexpr uint8_t kVersion = 1;
+inline constexpr uint8_t kVersion = 2;
 inline constexpr std::size_t kPacketHeaderSize = 32;
 inline constexpr std::size_t kMaxPayload = 256u << 20;
 inline constexpr int kMaxSide = 16384;
@@ -25,6 +25,9 @@ struct SequenceParams {
     Chroma chroma = Chroma::C420;
     DepthMode depth = DepthMode::Lossless;
     float depth_error = 1e-4f;
+    // DepthMode::View: the bound E (px) and displacement B it was derived from (informative) and
+    // the 1/z quantiser step the codes use.
+    float view_error = 0.25f, view_displacement = 0.164f, view_step = 0.0f;
     int slices = 1;
     double fps = 0.0;
     bool operator==(const SequenceParams&) const = default;

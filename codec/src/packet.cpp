@@ -49,7 +49,8 @@ Status parse_packet(std::span<const uint8_t> packet, PacketHeader& h,
         return Status::error("packet header: bad magic (not a reprise packet)");
     if (version != kVersion)
         return Status::error("packet header: version " + std::to_string(version) +
-                             " (this decoder reads 1)");
+                             " (this decoder reads " + std::to_string(kVersion) +
+                             "; re-encode the stream)");
     if (type > uint8_t(PacketType::Inter))
         return Status::error("packet header: unknown type " + std::to_string(type));
     if (flags) return Status::error("packet header: reserved flags set");
@@ -89,6 +90,11 @@ void write_params(const SequenceParams& sp, std::vector<uint8_t>& out) {
     w.u8(uint8_t(sp.chroma));
     w.u8(uint8_t(sp.depth));
     w.f32(sp.depth_error);
+    if (sp.depth == DepthMode::View) {
+        w.f32(sp.view_error);
+        w.f32(sp.view_displacement);
+        w.f32(sp.view_step);
+    }
     w.u8(uint8_t(sp.slices));
     w.f64(sp.fps);
 }
@@ -98,6 +104,11 @@ Status read_params(ByteReader& r, SequenceParams& sp) {
     sp.height = r.u16();
     const uint8_t chroma = r.u8(), depth = r.u8();
     sp.depth_error = r.f32();
+    if (depth == uint8_t(DepthMode::View)) {
+        sp.view_error = r.f32();
+        sp.view_displacement = r.f32();
+        sp.view_step = r.f32();
+    }
     sp.slices = r.u8();
     sp.fps = r.f64();
     if (!r.ok()) return Status::error(r.error());
@@ -105,12 +116,14 @@ Status read_params(ByteReader& r, SequenceParams& sp) {
     if (chroma > uint8_t(Chroma::C444))
         return Status::error("key frame parameters: unknown chroma format " +
                              std::to_string(chroma));
-    if (depth > uint8_t(DepthMode::None))
+    if (depth > uint8_t(DepthMode::View))
         return Status::error("key frame parameters: unknown depth mode " + std::to_string(depth));
     sp.chroma = Chroma(chroma);
     sp.depth = DepthMode(depth);
     if (sp.depth == DepthMode::Bounded && !(sp.depth_error >= 1e-7f && sp.depth_error <= 0.1f))
         return Status::error("key frame parameters: depth error bound outside 1e-7..0.1");
+    if (sp.depth == DepthMode::View && !(sp.view_step >= 1e-12f && sp.view_step <= 1e6f))
+        return Status::error("key frame parameters: inverse depth step outside 1e-12..1e6");
     if (sp.slices < 1 || sp.slices > std::min(kMaxSlices, sp.mb_rows()))
         return Status::error("key frame parameters: " + std::to_string(sp.slices) + " slices for " +
                              std::to_string(sp.mb_rows()) + " macroblock rows");
@@ -146,8 +159,8 @@ Status split_stream(std::span<const uint8_t> file, StreamInfo& info,
     if (!r.ok()) return Status::error(r.error());
     if (magic != kFileMagic) return Status::error("stream: not a reprise stream (bad magic)");
     if (version != kVersion)
-        return Status::error("stream: version " + std::to_string(version) +
-                             " (this reader reads 1)");
+        return Status::error("stream: version " + std::to_string(version) + " (this reader reads " +
+                             std::to_string(kVersion) + "; re-encode the stream)");
     REPRISE_TRY(check_image_size(info.width, info.height, "stream header"));
     while (r.remaining()) {
         const std::size_t at = r.position();

@@ -18,6 +18,9 @@ enum class DepthMode : uint8_t {
     Lossless = 0,  // bit-exact float depth
     Bounded = 1,   // relative error of z (and of 1/z) at most depth_error
     None = 2,      // no depth: the renderer's motion is sent whole (1/8 px), predicting colour
+    // 1/z quantised uniformly, the step chosen so that moving the camera by up to
+    // view_displacement moves no reprojected pixel by more than view_error_px (docs/bitstream.md)
+    View = 3,
 };
 
 struct EncoderOptions {
@@ -28,6 +31,11 @@ struct EncoderOptions {
     Chroma chroma = Chroma::C420;
     DepthMode depth = DepthMode::Lossless;
     float depth_error = 1e-4f;  // relative bound for DepthMode::Bounded
+    // DepthMode::View: the largest reprojection error (pixels) a camera displacement of up to
+    // view_displacement (scene units; default 10 cm of extrapolation plus a 64 mm eye distance)
+    // may cause.
+    float view_error_px = 0.25f;
+    float view_displacement = 0.164f;
     // A block whose prediction error stays within this many 8-bit display levels on every
     // channel is skipped (Mueller et al. 2021: T = 8/255 stays under one JND). 0 = skip only
     // what quantises to nothing.
@@ -135,6 +143,21 @@ private:
     friend class Encoder;  // Encoder::resume takes the references it decoded
     std::unique_ptr<State> state_;
 };
+
+// What DepthMode::View promises, measured: decoded and true depth of one frame seen by `camera`
+// (perspective), each pixel reprojected into cameras translated by `displacement` scene units in
+// 28 directions (the 26 of a cube's faces, edges and corners, and the two the pixel is most
+// sensitive to); pixels the moved camera does not see in front of it are left out.
+struct ViewDepthError {
+    double max_px = 0.0;                    // largest distance between the two reprojections
+    std::size_t background_mismatches = 0;  // +inf in one and not the other
+    std::size_t pixels = 0;                 // pixels with finite depth in both
+};
+ViewDepthError measure_view_depth_error(const Camera& camera, ImageView<const float> truth,
+                                        ImageView<const float> decoded, float displacement);
+// The 1/z step DepthMode::View uses for frames of this size seen through `projection`.
+float view_depth_step(const glm::mat4& projection, int width, int height, float error_px,
+                      float displacement);
 
 // Checks one packet (length, version, CRC) and reads its header into `info` (data left empty).
 [[nodiscard]] Status inspect_packet(std::span<const uint8_t> packet, Packet& info,
