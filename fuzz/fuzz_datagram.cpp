@@ -23,6 +23,7 @@ void parse_all(std::span<const uint8_t> m) {
     LossReportMessage loss;
     ReceiverReportMessage report;
     FragmentMessage fragment;
+    TicketMessage ticket;
     std::string text;
     (void)parse(m, start);
     (void)parse(m, info);
@@ -31,6 +32,7 @@ void parse_all(std::span<const uint8_t> m) {
     (void)parse(m, loss);
     (void)parse(m, report);
     (void)parse(m, fragment);
+    (void)parse(m, ticket);
     (void)parse_error(m, text);
 }
 
@@ -45,6 +47,9 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, std::size_t size) {
     (void)parse_header(input, header);
     std::vector<uint8_t> reply;
     PendingHandshake pending;
+    bool has_ticket = false;
+    std::array<uint8_t, kTicketIdSize> ticket_id{};
+    (void)client_hello_ticket(input, has_ticket, ticket_id);
     if (answer_client_hello("1234", input, reply, pending).ok())
         (void)check_client_finish(pending, input);
     ClientHandshake client;

@@ -4,8 +4,11 @@
 
 #include <unistd.h>
 
+#include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <thread>
+#include <vector>
 
 #include "support/cli.hpp"
 
@@ -17,15 +20,19 @@ TEST(CliStream, ServeAndConnectWriteDisplayedFrames) {
     const fs::path out =
         reprise::test::fresh_directory(fs::temp_directory_path() / "reprise-cli-stream");
     const std::string port = std::to_string(20000 + getpid() % 20000);
+    // The PIN from the environment for the server and from a file for the client (never argv).
+    ::setenv("REPRISE_PIN", "778899", 1);
+    const fs::path pin_file = out / "pin.txt";
+    std::ofstream(pin_file) << "778899\n";
     Outcome served;
     std::thread server([&] {
-        served = run_reprise(
-            "serve --listen 127.0.0.1:" + port + " --pin 7788 --size 96x64 --duration 7", 60);
+        served = run_reprise("serve --listen 127.0.0.1:" + port + " --size 96x64 --duration 7", 60);
     });
     const Outcome connected =
-        run_reprise("connect 127.0.0.1:" + port +
-                        " --pin 7788 --display-rate 30 --duration 3 --out " + out.string(),
+        run_reprise("connect 127.0.0.1:" + port + " --pin-file " + pin_file.string() +
+                        " --display-rate 30 --duration 3 --out " + out.string(),
                     60);
+    ::unsetenv("REPRISE_PIN");
     server.join();
     EXPECT_EQ(connected.status, 0) << connected.output;
     EXPECT_EQ(served.status, 0) << served.output;
@@ -42,11 +49,58 @@ TEST(CliStream, BadArgumentsAreRefused) {
         EXPECT_NE(r.output.find(mention), std::string::npos) << args << ":\n" << r.output;
     };
     expect_refused("serve --listen 127.0.0.1:0", "--pin");
-    expect_refused("serve --pin 1 --mode sideways", "--mode");
-    expect_refused("serve --pin 1 --lowres 3 --mode lowres", "--lowres");
-    expect_refused("serve --pin 1 --listen nowhere", "HOST:PORT");
-    expect_refused("connect 127.0.0.1:9 --pin 1 --scene ../../etc/passwd --duration 1",
+    expect_refused("serve --pin 123456 --mode sideways", "--mode");
+    expect_refused("serve --pin 123456 --lowres 3 --mode lowres", "--lowres");
+    expect_refused("serve --pin 123456 --listen nowhere", "HOST:PORT");
+    expect_refused("connect 127.0.0.1:9 --pin 123456 --scene ../../etc/passwd --duration 1",
                    "never a path");
-    expect_refused("connect 127.0.0.1 --pin 1", "HOST:PORT");
+    expect_refused("connect 127.0.0.1 --pin 123456", "HOST:PORT");
     expect_refused("connect 127.0.0.1:9", "--pin");
+    // Short PINs only when asked for; one source of the PIN at a time.
+    expect_refused("serve --listen 127.0.0.1:0 --pin 1234 --duration 1", "--allow-weak-pin");
+    expect_refused("connect 127.0.0.1:9 --pin 1234 --duration 1", "--allow-weak-pin");
+    expect_refused("serve --pin 123456 --pin-file /nonexistent/pin --duration 1", "--pin-file");
+    expect_refused("connect 127.0.0.1:9 --pin-file /nonexistent/pin --duration 1", "--pin-file");
+    // Durations and ports out of range are refused, not read as "forever" or "off".
+    expect_refused("serve --listen 127.0.0.1:0 --pin 123456 --duration 0", "--duration");
+    expect_refused("serve --listen 127.0.0.1:0 --pin 123456 --duration -3", "--duration");
+    expect_refused("serve --listen 127.0.0.1:0 --pin 123456 --duration 1 --metrics-port -5",
+                   "--metrics-port");
+    expect_refused("connect 127.0.0.1:9 --pin 123456 --duration 0", "--duration");
+}
+
+TEST(CliStream, WeakPinIsAllowedOnRequestAndListeningBeyondLoopbackWarns) {
+    const Outcome weak = run_reprise(
+        "serve --listen 127.0.0.1:0 --pin 1234 --allow-weak-pin --size 32x32 "
+        "--duration 0.3",
+        30);
+    EXPECT_EQ(weak.status, 0) << weak.output;
+    // 192.0.2.1 (TEST-NET-1) is not this machine's: the bind fails after the warning, and nothing
+    // leaves loopback.
+    const Outcome wide =
+        run_reprise("serve --listen 192.0.2.1:0 --pin 123456 --size 32x32 --duration 0.3", 30);
+    EXPECT_NE(wide.output.find("warning: listening on 192.0.2.1"), std::string::npos)
+        << wide.output;
+}
+
+TEST(CliStream, AStreamFileWithReservedHeaderBytesSetIsRefused) {
+    const fs::path dir =
+        reprise::test::fresh_directory(fs::temp_directory_path() / "reprise-cli-reserved");
+    std::vector<uint8_t> header = {'R', 'P', 'R', 'S', 1, 0, 0, 0, 16, 0, 0, 0,
+                                   16,  0,   0,   0,   0, 0, 0, 0, 0,  0, 0, 0};
+    auto write = [&](const fs::path& p) {
+        std::ofstream(p, std::ios::binary)
+            .write(reinterpret_cast<const char*>(header.data()), std::streamsize(header.size()));
+    };
+    write(dir / "clean.rps");
+    const Outcome clean = run_reprise("info " + (dir / "clean.rps").string(), 30);
+    EXPECT_EQ(clean.status, 0) << clean.output;
+    for (std::size_t at : {5, 6, 7}) {
+        header[5] = header[6] = header[7] = 0;
+        header[at] = 1;
+        write(dir / "reserved.rps");
+        const Outcome r = run_reprise("info " + (dir / "reserved.rps").string(), 30);
+        EXPECT_EQ(r.status, 1) << r.output;
+        EXPECT_NE(r.output.find("reserved"), std::string::npos) << r.output;
+    }
 }

@@ -5,6 +5,7 @@
 
 #include "reprise/net/fault_injector.hpp"
 #include "reprise/net/fragment.hpp"
+#include "reprise/net/guess_budget.hpp"
 #include "reprise/net/rate_limiter.hpp"
 #include "reprise/net/secure.hpp"
 #include "reprise/net/udp.hpp"
@@ -315,4 +316,58 @@ TEST(NetUdp, EndpointsParseAndOnlyLoopbackIsLoopback) {
     EXPECT_FALSE(parse_endpoint("127.0.0.1", e).ok());
     EXPECT_FALSE(parse_endpoint("127.0.0.1:70000", e).ok());
     EXPECT_FALSE(parse_endpoint("example:80", e).ok());
+}
+
+TEST(NetGuessBudget, AnHourOfGuessingFromEverywhereGetsAtMost124Guesses) {
+    GuessBudget b;
+    int answered = 0;
+    for (int64_t t = 0; t < int64_t(3600) * 1'000'000; t += 10'000) answered += b.start(t);
+    EXPECT_LE(answered, 124);  // docs/protocol.md: a burst of 4, then one per 30 s at most
+    EXPECT_GE(answered, 100);
+    // A confirmed handshake gives its token back and ends the back-off.
+    GuessBudget c;
+    ASSERT_TRUE(c.start(0));
+    c.confirmed(0);
+    int at_once = 0;
+    for (int i = 0; i < 10; ++i) at_once += c.start(0);
+    EXPECT_EQ(at_once, 4);
+    EXPECT_EQ(c.interval_s(), 16.0);
+}
+
+TEST(NetHandshake, ATicketReplacesThePinAndPaddingMustBeZero) {
+    ResumptionTicket ticket;
+    for (std::size_t i = 0; i < ticket.id.size(); ++i) ticket.id[i] = uint8_t(i + 1);
+    for (std::size_t i = 0; i < ticket.secret.size(); ++i) ticket.secret[i] = uint8_t(3 * i);
+    ticket.valid = true;
+    ClientHandshake client;
+    std::vector<uint8_t> hello, server_hello, finish;
+    client.start("123456", hello, &ticket);
+    ASSERT_EQ(hello.size(), kClientHelloSize);
+    bool has_ticket = false;
+    std::array<uint8_t, kTicketIdSize> id{};
+    ASSERT_TRUE(client_hello_ticket(hello, has_ticket, id).ok());
+    EXPECT_TRUE(has_ticket);
+    EXPECT_EQ(id, ticket.id);
+    PendingHandshake pending;
+    SessionKeys keys;
+    ASSERT_TRUE(answer_client_hello("123456", hello, server_hello, pending).ok());
+    EXPECT_FALSE(client.finish(server_hello, finish, keys).ok()) << "the PIN is not the key";
+    ASSERT_TRUE(answer_client_hello(ticket.secret_text(), hello, server_hello, pending).ok());
+    ASSERT_TRUE(client.finish(server_hello, finish, keys).ok());
+    EXPECT_TRUE(check_client_finish(pending, finish).ok());
+    // Without a ticket the padding is zero; anything else there is refused.
+    ClientHandshake plain;
+    plain.start("123456", hello);
+    ASSERT_TRUE(client_hello_ticket(hello, has_ticket, id).ok());
+    EXPECT_FALSE(has_ticket);
+    hello.back() = 1;
+    EXPECT_FALSE(client_hello_ticket(hello, has_ticket, id).ok());
+    // The Ticket message round-trips and refuses truncation.
+    TicketMessage m{.id = ticket.id, .secret = ticket.secret}, back;
+    std::vector<uint8_t> plain_text(kMaxPlaintext);
+    plain_text.resize(encode(m, plain_text));
+    ASSERT_TRUE(parse(plain_text, back).ok());
+    EXPECT_EQ(back.secret, m.secret);
+    plain_text.pop_back();
+    EXPECT_FALSE(parse(plain_text, back).ok());
 }

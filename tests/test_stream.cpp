@@ -47,7 +47,7 @@ struct RunningServer {
 server::StreamServerOptions server_options(uint16_t port = 0) {
     return {.scene = "pan",
             .listen = {0x7f000001u, port},
-            .secret = "2468",
+            .secret = "246813",
             .fps = 30.0,
             .width = kWidth,
             .height = kHeight,
@@ -118,7 +118,7 @@ double mean_psnr(const std::vector<Shown>& kept) {
 std::unique_ptr<client::StreamClient> make_client(const net::Endpoint& at,
                                                   client::StreamClientOptions o = {}) {
     o.server = at;
-    if (o.secret.empty()) o.secret = "2468";
+    if (o.secret.empty()) o.secret = "246813";
     std::unique_ptr<client::StreamClient> c;
     Status s = client::StreamClient::create(o, c);
     EXPECT_TRUE(s.ok()) << s.message();
@@ -324,10 +324,10 @@ TEST(Stream, BadDatagramsAreDroppedWhileAnotherClientIsServed) {
     std::vector<uint8_t> truncated = {'R', 'P', 1, 1, 0, 0};
     attacker.socket.send_to(truncated, srv.at());  // truncated
     // Wrong PIN: the server answers the hello, the attacker cannot confirm; a forged finish fails.
-    EXPECT_FALSE(attacker.handshake("1111"));
+    EXPECT_FALSE(attacker.handshake("111111"));
     // A sealed datagram for no session, and one from a real session replayed.
     RawPeer honest(srv.at());
-    ASSERT_TRUE(honest.handshake("2468"));
+    ASSERT_TRUE(honest.handshake("246813"));
     const auto start_message = honest.seal(net::StartMessage{});
     honest.socket.send_to(start_message, srv.at());
     honest.socket.send_to(start_message, srv.at());  // replayed
@@ -380,7 +380,7 @@ TEST(Stream, ClientReconnectsAfterServerRestartAndServerServesANewClient) {
 
 TEST(Stream, WrongPinAndUnknownSceneAreRefusedAtTheClient) {
     RunningServer srv(server_options());
-    auto wrong = make_client(srv.at(), {.secret = "0000", .max_auth_failures = 1});
+    auto wrong = make_client(srv.at(), {.secret = "000000", .max_auth_failures = 1});
     Status s;
     const int64_t end = net::now_us() + 3'000'000;
     while (s.ok() && net::now_us() < end) {
@@ -390,7 +390,7 @@ TEST(Stream, WrongPinAndUnknownSceneAreRefusedAtTheClient) {
     EXPECT_FALSE(s.ok());
     EXPECT_NE(s.message().find("wrong PIN"), std::string::npos) << s.message();
 
-    auto unknown = make_client(srv.at(), {.secret = "2468", .scene = "nosuchscene"});
+    auto unknown = make_client(srv.at(), {.secret = "246813", .scene = "nosuchscene"});
     s = {};
     const int64_t end2 = net::now_us() + 3'000'000;
     while (s.ok() && net::now_us() < end2) {
@@ -407,7 +407,7 @@ TEST(Stream, AClientThatStopsReadingKeepsServerMemoryBounded) {
     o.send_queue_bytes = 256 * 1024;
     RunningServer srv(o);
     RawPeer silent(srv.at());
-    ASSERT_TRUE(silent.handshake("2468"));
+    ASSERT_TRUE(silent.handshake("246813"));
     silent.socket.send_to(silent.seal(net::StartMessage{}), srv.at());
     silent.socket.send_to(silent.seal(net::PoseMessage{.sequence = 1}), srv.at());
     // It never reads and never acknowledges; a normal client streams beside it.
@@ -420,4 +420,126 @@ TEST(Stream, AClientThatStopsReadingKeepsServerMemoryBounded) {
     EXPECT_TRUE(eventually([&] { return srv.server->stats().sessions == 0; },
                            [] { std::this_thread::sleep_for(std::chrono::milliseconds(10)); }));
     EXPECT_LE(srv.server->stats().max_queue_bytes, o.send_queue_bytes);
+}
+
+TEST(Stream, NoReplyToAnUnauthenticatedSourceIsLargerThanItsRequest) {
+    RunningServer srv(server_options());
+    RawPeer peer(srv.at());
+    net::ClientHandshake handshake;
+    std::vector<uint8_t> hello, reply;
+    handshake.start("246813", hello);
+    peer.socket.send_to(hello, srv.at());
+    ASSERT_TRUE(peer.receive_within(2'000'000, reply));
+    EXPECT_LE(reply.size(), hello.size());
+    // The short resend (header and the pending connection id only) gets nothing back.
+    const std::vector<uint8_t> short_resend(hello.begin(), hello.begin() + net::kHeaderSize);
+    for (int i = 0; i < 20; ++i) peer.socket.send_to(short_resend, srv.at());
+    EXPECT_FALSE(peer.receive_within(300'000, reply)) << reply.size() << " bytes came back";
+    // The whole hello repeated still gets the stored answer.
+    peer.socket.send_to(hello, srv.at());
+    ASSERT_TRUE(peer.receive_within(2'000'000, reply));
+    EXPECT_EQ(reply.size(), net::kServerHelloSize);
+    // Every unauthenticated datagram type and size, for the pending connection and another.
+    const uint64_t connections[] = {handshake.connection(), 0x1234567890abcdefu};
+    for (uint64_t connection : connections)
+        for (int type = 0; type <= 8; ++type)
+            for (std::size_t size : {12, 13, 44, 76, 108, 127, 128, 129, 300, 1200}) {
+                std::vector<uint8_t> d(size, 0);
+                if (size == net::kClientHelloSize && type == 1)
+                    d = hello;
+                else {
+                    net::Writer w(d);
+                    w.u8('R'), w.u8('P'), w.u8(1), w.u8(uint8_t(type)), w.u64(connection);
+                }
+                peer.socket.send_to(d, srv.at());
+                std::size_t replied = 0;
+                while (peer.receive_within(15'000, reply)) replied += reply.size();
+                EXPECT_LE(replied, size) << "type " << type << ", " << size << " bytes";
+            }
+}
+
+// 40 source ports guess the PIN as fast as they can for 3 s, with the per-address limit lifted
+// (as if each port were another address): the PIN's budget answers at most its burst of 4; the
+// admitted session keeps streaming and a returning client (resumption ticket) gets in.
+TEST(Stream, PinGuessesFromManyPortsStayWithinTheGlobalBudget) {
+    server::StreamServerOptions so = server_options();
+    so.handshake_rate.per_source_per_second = 1e6;
+    so.handshake_rate.per_source_burst = 1e6;
+    RunningServer srv(so);
+    server::Scene scene;
+    server::CameraPath path;
+    ASSERT_TRUE(server::load_scene("pan", scene, path).ok());
+    auto pump = [&](client::StreamClient& c, const int64_t start) {
+        const double t = (net::now_us() - start) * 1e-6;
+        c.wait(2000);
+        EXPECT_TRUE(c.poll(net::now_us()).ok());
+        c.send_pose(server::camera_view(path, scene, t), t, net::now_us());
+    };
+    // A client that connected before and left: its ticket is all it keeps.
+    net::ResumptionTicket ticket;
+    {
+        auto earlier = make_client(srv.at());
+        const int64_t start = net::now_us();
+        ASSERT_TRUE(
+            eventually([&] { return earlier->ticket().valid; }, [&] { pump(*earlier, start); }));
+        ticket = earlier->ticket();
+    }
+    auto admitted = make_client(srv.at());
+    std::atomic<bool> done{false};
+    std::thread streaming([&] {
+        const int64_t start = net::now_us();
+        while (!done) pump(*admitted, start);
+    });
+    ASSERT_TRUE(eventually([&] { return admitted->stats().frames_decoded >= 5; },
+                           [] { std::this_thread::sleep_for(std::chrono::milliseconds(10)); }));
+    const std::size_t decoded_before = admitted->stats().frames_decoded;
+
+    std::vector<std::unique_ptr<RawPeer>> guessers;
+    for (int i = 0; i < 40; ++i) guessers.push_back(std::make_unique<RawPeer>(srv.at()));
+    std::size_t sent = 0, answered = 0;
+    std::unique_ptr<client::StreamClient> returning, first_time;
+    int64_t returning_connected_us = -1;
+    const int64_t attack_start = net::now_us(), attack_end = attack_start + 3'000'000;
+    std::vector<uint8_t> hello, reply;
+    net::Endpoint from;
+    while (net::now_us() < attack_end) {
+        for (auto& g : guessers) {
+            net::ClientHandshake h;
+            h.start("000000", hello);
+            g->socket.send_to(hello, srv.at());
+            ++sent;
+            while (g->socket.receive(reply, from, net::kMaxDatagram))
+                answered += reply.size() == net::kServerHelloSize;
+        }
+        if (!returning && net::now_us() > attack_start + 500'000) {
+            client::StreamClientOptions o;
+            o.ticket = ticket;
+            returning = make_client(srv.at(), o);
+            first_time = make_client(srv.at());
+        }
+        if (returning) {
+            ASSERT_TRUE(returning->poll(net::now_us()).ok());
+            ASSERT_TRUE(first_time->poll(net::now_us()).ok());
+            if (returning->connected() && returning_connected_us < 0)
+                returning_connected_us = net::now_us();
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    const double seconds = (net::now_us() - attack_start) * 1e-6;
+    const std::size_t decoded_during = admitted->stats().frames_decoded - decoded_before;
+    done = true;
+    streaming.join();
+    std::printf(
+        "[stream] guessing: %zu hellos from 40 ports in %.1f s, %zu answered (%.2f/s), "
+        "admitted session decoded %zu frames meanwhile, returning client in after %.2f s, "
+        "a first-time client %s\n",
+        sent, seconds, answered, answered / seconds, decoded_during,
+        returning_connected_us < 0 ? -1.0 : (returning_connected_us - attack_start) * 1e-6 - 0.5,
+        first_time->connected() ? "got in" : "did not get in (documented)");
+    EXPECT_GT(sent, 1000u);
+    EXPECT_LE(answered, 4u) << "the PIN's budget: a burst of 4, then one per 16..30 s";
+    EXPECT_GT(srv.server->stats().guesses_refused, sent / 2);
+    EXPECT_GE(decoded_during, 10u) << "the admitted session kept streaming";
+    EXPECT_GE(returning_connected_us, 0) << "the returning client got in during the attack";
+    EXPECT_GE(srv.server->stats().handshakes_resumed, 1u);
 }

@@ -104,7 +104,7 @@ struct StreamBench {
     Status run_condition(const Condition& c, bool lowres) {
         server::StreamServerOptions so{.scene = options.scene,
                                        .listen = {0x7f000001u, 0},
-                                       .secret = "bench",
+                                       .secret = "bench-stream",
                                        .fps = fps,
                                        .width = width,
                                        .height = height,
@@ -119,7 +119,7 @@ struct StreamBench {
         Status served;
         std::thread thread([&] { served = srv->run(stop); });
         client::StreamClientOptions co{.server = srv->local(),
-                                       .secret = "bench",
+                                       .secret = "bench-stream",
                                        .scene = options.scene,
                                        .inject_faults = true,
                                        .uplink = c.up,

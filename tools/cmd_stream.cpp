@@ -2,6 +2,7 @@
 #include <atomic>
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -23,9 +24,44 @@ namespace {
 std::atomic<bool> g_stop{false};
 extern "C" void on_signal(int) { g_stop.store(true); }
 
+constexpr std::size_t kMinPinLength = 6;
+
+// Where the PIN comes from: --pin, --pin-file (first line) or REPRISE_PIN (argv is visible to
+// every user in `ps`; a file or the environment is not). Short PINs only with --allow-weak-pin.
+struct PinSource {
+    std::string pin, file;
+    bool allow_weak = false;
+};
+
+Status resolve_pin(const PinSource& source, std::string& pin) {
+    if (!source.pin.empty() && !source.file.empty())
+        return Status::error("--pin and --pin-file: give one of them");
+    if (!source.file.empty()) {
+        std::ifstream in(source.file);
+        if (!in) return Status::error("--pin-file " + source.file + ": cannot open");
+        std::getline(in, pin);
+        if (!pin.empty() && pin.back() == '\r') pin.pop_back();
+        if (pin.empty()) return Status::error("--pin-file " + source.file + ": first line empty");
+    } else if (!source.pin.empty()) {
+        pin = source.pin;
+    } else if (const char* env = std::getenv("REPRISE_PIN"); env && *env) {
+        pin = env;
+    } else {
+        return Status::error("--pin, --pin-file or REPRISE_PIN is required");
+    }
+    if (pin.size() > 255) return Status::error("--pin: at most 255 characters");
+    if (pin.size() < kMinPinLength && !source.allow_weak)
+        return Status::error("--pin: " + std::to_string(pin.size()) +
+                             " characters; at least 6 (or --allow-weak-pin; docs/protocol.md "
+                             "gives the guessing rate)");
+    return {};
+}
+
 struct ServeJob {
-    std::string scene = "pan", listen = "127.0.0.1:7000", pin, size = "640x360", mode = "full";
+    std::string scene = "pan", listen = "127.0.0.1:7000", size = "640x360", mode = "full";
+    PinSource pin;
     double fps = 30.0, duration = 0.0;
+    bool duration_given = false, metrics_port_given = false;
     int max_sessions = 4, qp = 28, bitrate = 0, fec_group = 8, metrics_port = -1, lowres = 4,
         aa = 4;
 };
@@ -34,8 +70,13 @@ Status run_serve(const ServeJob& job) {
     server::StreamServerOptions o;
     o.scene = job.scene;
     REPRISE_TRY(net::parse_endpoint(job.listen, o.listen));
-    o.secret = job.pin;
-    if (job.pin.empty()) return Status::error("--pin is required");
+    REPRISE_TRY(resolve_pin(job.pin, o.secret));
+    if (job.duration_given && !(job.duration > 0.0))
+        return Status::error(
+            "--duration must be more than 0 seconds (leave it out to serve "
+            "until SIGINT)");
+    if (job.metrics_port_given && (job.metrics_port < 0 || job.metrics_port > 65535))
+        return Status::error("--metrics-port must be 0..65535 (0: any free port)");
     REPRISE_TRY(parse_size(job.size, o.width, o.height));
     o.fps = job.fps;
     if (job.mode == "full")
@@ -62,6 +103,11 @@ Status run_serve(const ServeJob& job) {
     server::Scene scene;
     server::CameraPath path;
     REPRISE_TRY(server::load_scene(job.scene, scene, path));
+    if (!o.listen.loopback())
+        std::fprintf(stderr,
+                     "[serve] warning: listening on %s, beyond loopback (127.0.0.0/8): anyone "
+                     "who reaches it can guess the PIN online (docs/protocol.md, threat model)\n",
+                     o.listen.text().c_str());
     std::unique_ptr<server::StreamServer> srv;
     REPRISE_TRY(server::StreamServer::create(o, srv));
     std::fprintf(stderr, "[serve] %s on %s, %dx%d at %g Hz, %s mode%s\n", job.scene.c_str(),
@@ -93,7 +139,8 @@ Status run_serve(const ServeJob& job) {
 }
 
 struct ConnectJob {
-    std::string server, pin, scene, camera, out, poses;
+    std::string server, scene, camera, out, poses;
+    PinSource pin;
     double display_rate = 120.0, duration = 10.0;
     bool no_extrapolate = false, window = false, interactive = false;
     double loss = 0.0, delay = 0.0, jitter = 0.0;
@@ -129,8 +176,8 @@ Status read_poses(const std::string& file, std::vector<std::pair<double, glm::ma
 Status run_connect(const ConnectJob& job) {
     client::StreamClientOptions o;
     REPRISE_TRY(net::parse_endpoint(job.server, o.server));
-    if (job.pin.empty()) return Status::error("--pin is required");
-    o.secret = job.pin;
+    REPRISE_TRY(resolve_pin(job.pin, o.secret));
+    if (!(job.duration > 0.0)) return Status::error("--duration must be more than 0 seconds");
     if (!job.scene.empty() && !net::valid_scene_name(job.scene))
         return Status::error(
             "--scene '" + job.scene +
@@ -234,7 +281,12 @@ int command_serve(int argc, char** argv) {
     args.option("--scene", &job.scene,
                 "built-in scene or glTF file served by default (default pan)");
     args.option("--listen", &job.listen, "UDP address A.B.C.D:PORT (default 127.0.0.1:7000)");
-    args.option("--pin", &job.pin, "PIN or token clients must know (required; never sent)");
+    args.option("--pin", &job.pin.pin,
+                "PIN or token clients must know, at least 6 characters (never sent; visible in "
+                "ps: prefer --pin-file or REPRISE_PIN)");
+    args.option("--pin-file", &job.pin.file, "read the PIN from the first line of this file");
+    args.flag("--allow-weak-pin", &job.pin.allow_weak,
+              "accept a PIN shorter than 6 characters (guessed in hours, docs/protocol.md)");
     args.option("--fps", &job.fps, "server frame rate (default 30)");
     args.option("--size", &job.size, "WxH (default 640x360)");
     args.option("--mode", &job.mode, "full (default) or lowres");
@@ -253,6 +305,8 @@ int command_serve(int argc, char** argv) {
                 "stop after this many seconds (default: until SIGINT)");
     Status parsed = args.parse(argc, argv);
     if (!parsed.ok() || args.help_requested()) return report(args, parsed, {});
+    job.duration_given = args.given("--duration");
+    job.metrics_port_given = args.given("--metrics-port");
     return report(args, parsed, run_serve(job));
 }
 
@@ -262,7 +316,10 @@ int command_connect(int argc, char** argv) {
               "Connects to `reprise serve`, shows the stream at the display rate, extrapolated to "
               "the newest pose.");
     args.positional("HOST:PORT", &job.server, "server address");
-    args.option("--pin", &job.pin, "the server's PIN or token (required)");
+    args.option("--pin", &job.pin.pin,
+                "the server's PIN or token (or --pin-file, or REPRISE_PIN in the environment)");
+    args.option("--pin-file", &job.pin.file, "read the PIN from the first line of this file");
+    args.flag("--allow-weak-pin", &job.pin.allow_weak, "accept a PIN shorter than 6 characters");
     args.option("--scene", &job.scene, "scene from the server's catalogue (default: the server's)");
     args.option("--display-rate", &job.display_rate, "display frames per second (default 120)");
     args.option("--camera", &job.camera,

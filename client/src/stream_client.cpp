@@ -53,7 +53,17 @@ struct StreamClient::State {
     std::vector<uint8_t> datagram, plaintext, sealed, message;
     std::vector<uint32_t> abandoned;
 
-    State(const StreamClientOptions& o) : options(o), uplink(o.uplink), downlink(o.downlink) {}
+    net::ResumptionTicket ticket;  // from the newest session: the next handshake skips the PIN
+    bool resuming = false;
+
+    State(const StreamClientOptions& o)
+        : options(o), uplink(o.uplink), downlink(o.downlink), ticket(o.ticket) {}
+
+    // A ticket the server no longer knows (restarted, expired) costs one handshake time-out.
+    void forget_ticket() {
+        if (resuming) ticket.valid = false;
+        resuming = false;
+    }
 
     void transmit(std::span<const uint8_t> d, int64_t now) {
         if (options.inject_faults)
@@ -68,7 +78,8 @@ struct StreamClient::State {
     }
 
     void start_handshake(int64_t now) {
-        handshake.start(options.secret, hello);
+        resuming = ticket.valid;
+        handshake.start(options.secret, hello, resuming ? &ticket : nullptr);
         phase = Phase::HelloSent;
         phase_started_us = last_sent_hello_us = now;
         transmit(hello, now);
@@ -182,7 +193,8 @@ struct StreamClient::State {
             net::SessionKeys keys;
             if (Status s = handshake.finish(d, finish_datagram, keys); !s.ok()) {
                 if (h.connection == handshake.connection()) {
-                    ++stats.auth_failures;
+                    if (!resuming) ++stats.auth_failures;
+                    forget_ticket();
                     phase = Phase::Idle;
                 }
                 ++stats.datagrams_dropped;
@@ -236,6 +248,14 @@ struct StreamClient::State {
                 std::string text;
                 if (net::parse_error(plaintext, text).ok()) stats.refused = text;
                 phase = Phase::Idle;
+                break;
+            }
+            case net::MessageType::Ticket: {
+                net::TicketMessage m;
+                if (!net::parse(plaintext, m).ok()) return;
+                ticket.id = m.id;
+                ticket.secret = m.secret;
+                ticket.valid = true;
                 break;
             }
             case net::MessageType::Bye:
@@ -303,9 +323,10 @@ Status StreamClient::poll(int64_t now) {
             s.start_handshake(now);
             break;
         case Phase::HelloSent:
-            if (now - s.phase_started_us > kHandshakeGiveUpUs)
+            if (now - s.phase_started_us > kHandshakeGiveUpUs) {
+                s.forget_ticket();
                 s.start_handshake(now);
-            else if (now - s.last_sent_hello_us > kHelloRetryUs) {
+            } else if (now - s.last_sent_hello_us > kHelloRetryUs) {
                 s.last_sent_hello_us = now;
                 s.transmit(s.hello, now);
             }
@@ -378,6 +399,7 @@ const net::StreamInfoMessage* StreamClient::stream_info() const {
     return state_->have_info ? &state_->info : nullptr;
 }
 const StreamClientStats& StreamClient::stats() const { return state_->stats; }
+const net::ResumptionTicket& StreamClient::ticket() const { return state_->ticket; }
 const Frame* StreamClient::newest_decoded() const {
     return state_->have_decoded ? &state_->decoded : nullptr;
 }

@@ -151,8 +151,8 @@ Status split_stream(std::span<const uint8_t> file, StreamInfo& info,
     ByteReader r(file, "stream");
     const uint32_t magic = r.u32();
     const uint8_t version = r.u8();
-    r.u8();
-    r.u16();
+    const uint8_t reserved8 = r.u8();
+    const uint16_t reserved16 = r.u16();
     info.width = int(r.u32());
     info.height = int(r.u32());
     info.fps = r.f64();
@@ -161,6 +161,8 @@ Status split_stream(std::span<const uint8_t> file, StreamInfo& info,
     if (version != kVersion)
         return Status::error("stream: version " + std::to_string(version) + " (this reader reads " +
                              std::to_string(kVersion) + "; re-encode the stream)");
+    if (reserved8 || reserved16)
+        return Status::error("stream: reserved header bytes 5..7 are not 0");
     REPRISE_TRY(check_image_size(info.width, info.height, "stream header"));
     while (r.remaining()) {
         const std::size_t at = r.position();

@@ -43,6 +43,17 @@ bool HandshakeRateLimiter::allow(uint32_t address, int64_t now_us) {
     return true;
 }
 
+bool HandshakeRateLimiter::allow_source(uint32_t address, int64_t now_us) {
+    Bucket& s = source(address, now_us);
+    refill(s, options_.per_source_per_second, options_.per_source_burst, now_us);
+    if (s.tokens < 1.0) {
+        ++refused_;
+        return false;
+    }
+    s.tokens -= 1.0;
+    return true;
+}
+
 void HandshakeRateLimiter::penalise(uint32_t address, int64_t now_us) {
     Bucket& s = source(address, now_us);
     refill(s, options_.per_source_per_second, options_.per_source_burst, now_us);

@@ -2,9 +2,15 @@
 
 #include <sodium.h>
 
+#include <algorithm>
+
 namespace reprise::net {
 
 namespace {
+
+// ClientHello padding: u8 kind (0 PIN, 1 resumption), then the ticket id; zeros after.
+constexpr std::size_t kHelloPaddingAt = kHeaderSize + 32 + 32;  // 76
+constexpr uint8_t kHelloResumes = 1;
 
 constexpr char kKdfContext[crypto_kdf_CONTEXTBYTES + 1] = "reprise1";
 enum Subkey : uint64_t {
@@ -94,12 +100,17 @@ uint64_t random_u64() {
     return v;
 }
 
+void random_bytes(std::span<uint8_t> out) { randombytes_buf(out.data(), out.size()); }
+
 ClientHandshake::~ClientHandshake() { sodium_memzero(scalar_.data(), scalar_.size()); }
 
-void ClientHandshake::start(const std::string& secret, std::vector<uint8_t>& hello) {
+void ClientHandshake::start(const std::string& secret, std::vector<uint8_t>& hello,
+                            const ResumptionTicket* ticket) {
     connection_ = random_u64();
     randombytes_buf(nonce_.data(), nonce_.size());
-    REPRISE_ASSERT(generator(secret, nonce_, connection_, generator_).ok());
+    const bool resume = ticket && ticket->valid;
+    REPRISE_ASSERT(
+        generator(resume ? ticket->secret_text() : secret, nonce_, connection_, generator_).ok());
     do {
         crypto_core_ristretto255_scalar_random(scalar_.data());
     } while (crypto_scalarmult_ristretto255(share_.data(), scalar_.data(), generator_.data()) != 0);
@@ -108,6 +119,25 @@ void ClientHandshake::start(const std::string& secret, std::vector<uint8_t>& hel
     write_header(w, {.type = DatagramType::ClientHello, .connection = connection_});
     w.bytes(nonce_);
     w.bytes(share_);
+    if (resume) {
+        w.u8(kHelloResumes);
+        w.bytes(ticket->id);
+    }
+}
+
+Status client_hello_ticket(std::span<const uint8_t> client_hello, bool& has_ticket,
+                           std::array<uint8_t, kTicketIdSize>& id) {
+    if (client_hello.size() != kClientHelloSize) return Status::error("client hello: wrong size");
+    Reader r(client_hello.subspan(kHelloPaddingAt));
+    const uint8_t kind = r.u8();
+    auto ticket = r.bytes(kTicketIdSize);
+    if (kind > kHelloResumes) return Status::error("client hello: unknown kind");
+    has_ticket = kind == kHelloResumes;
+    if (has_ticket) std::copy(ticket.begin(), ticket.end(), id.begin());
+    for (std::size_t i = has_ticket ? kHelloPaddingAt + 1 + kTicketIdSize : kHelloPaddingAt;
+         i < client_hello.size(); ++i)
+        if (client_hello[i] != 0) return Status::error("client hello: padding is not zero");
+    return {};
 }
 
 Status ClientHandshake::finish(std::span<const uint8_t> server_hello,

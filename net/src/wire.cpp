@@ -1,5 +1,6 @@
 #include "reprise/net/wire.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace reprise::net {
@@ -132,6 +133,13 @@ std::size_t encode(const FragmentMessage& m, std::span<uint8_t> out) {
     w.bytes(m.payload);
     return w.size();
 }
+std::size_t encode(const TicketMessage& m, std::span<uint8_t> out) {
+    Writer w(out);
+    w.u8(uint8_t(MessageType::Ticket));
+    w.bytes(m.id);
+    w.bytes(m.secret);
+    return w.size();
+}
 std::size_t encode_empty(MessageType type, std::span<uint8_t> out) {
     Writer w(out);
     w.u8(uint8_t(type));
@@ -148,7 +156,7 @@ std::size_t encode_error(const std::string& text, std::span<uint8_t> out) {
 
 Status message_type(std::span<const uint8_t> plaintext, MessageType& type) {
     if (plaintext.empty()) return Status::error("message: empty");
-    if (plaintext[0] < 1 || plaintext[0] > 10)
+    if (plaintext[0] < 1 || plaintext[0] > uint8_t(MessageType::Ticket))
         return Status::error("message: unknown type " + std::to_string(plaintext[0]));
     type = MessageType(plaintext[0]);
     return {};
@@ -253,6 +261,15 @@ Status parse(std::span<const uint8_t> plaintext, FragmentMessage& m) {
         const unsigned groups = (m.data_count + m.group_size - 1u) / m.group_size;
         if (m.index >= groups) return Status::error("fragment: parity group beyond the packet");
     }
+    return {};
+}
+Status parse(std::span<const uint8_t> plaintext, TicketMessage& m) {
+    Reader r(plaintext);
+    REPRISE_TRY(expect(r, MessageType::Ticket, "ticket"));
+    auto id = r.bytes(kTicketIdSize), secret = r.bytes(kTicketSecretSize);
+    REPRISE_TRY(finish(r, "ticket"));
+    std::copy(id.begin(), id.end(), m.id.begin());
+    std::copy(secret.begin(), secret.end(), m.secret.begin());
     return {};
 }
 Status parse_error(std::span<const uint8_t> plaintext, std::string& text) {

@@ -9,6 +9,7 @@
 #include <sstream>
 
 #include "metrics_endpoint.hpp"
+#include "reprise/net/guess_budget.hpp"
 #include "reprise/net/secure.hpp"
 #include "reprise/server/builtin_scenes.hpp"
 #include "reprise/server/renderer.hpp"
@@ -19,6 +20,8 @@ namespace {
 
 constexpr std::size_t kMaxPending = 32;
 constexpr int64_t kPendingLifetimeUs = 5'000'000;
+constexpr std::size_t kMaxTickets = 64;
+constexpr int64_t kTicketLifetimeUs = 24 * 3600 * int64_t(1'000'000);
 constexpr int64_t kInfoIntervalUs = 500'000;
 constexpr int64_t kProbeIntervalUs =
     1'000'000;  // a stalled window still sends one frame this often
@@ -32,6 +35,14 @@ struct Pending {
     net::PendingHandshake handshake;
     std::vector<uint8_t> server_hello;
     int64_t created_us = 0;
+    bool resumed = false;  // keyed by a ticket's secret, not the PIN
+    std::array<uint8_t, net::kTicketIdSize> ticket_id{};
+};
+
+// A resumption ticket handed to an admitted client: its next handshake skips the PIN's budget.
+struct IssuedTicket {
+    net::TicketMessage ticket;
+    int64_t issued_us = 0;
 };
 
 struct Session {
@@ -60,6 +71,7 @@ struct Session {
     int bitrate_kbps = 0;
     int64_t min_rtt_us = 0;
     bool ended = false;
+    net::TicketMessage ticket;  // for the client's next handshake, sent with every StreamInfo
 
     Session(net::Endpoint p, uint64_t connection, const net::SessionKeys& keys,
             const codec::EncoderOptions& eo)
@@ -76,7 +88,9 @@ struct StreamServer::State {
     net::UdpSocket socket;
     MetricsEndpoint metrics;
     net::HandshakeRateLimiter limiter;
+    net::GuessBudget guesses;
     std::vector<Pending> pending;
+    std::vector<IssuedTicket> tickets;
     std::vector<std::unique_ptr<Session>> sessions;
     std::unique_ptr<Renderer> renderer;
     // Scratch reused every datagram and frame.
@@ -87,7 +101,8 @@ struct StreamServer::State {
     StreamServerStats stats;
     std::size_t sessions_total = 0;
 
-    explicit State(const StreamServerOptions& o) : options(o), limiter(o.handshake_rate) {}
+    explicit State(const StreamServerOptions& o)
+        : options(o), limiter(o.handshake_rate), guesses(o.guess_budget) {}
 
     void count(std::size_t StreamServerStats::*field, std::size_t n = 1) {
         std::lock_guard lock(stats_mutex);
@@ -151,10 +166,20 @@ struct StreamServer::State {
         }
     }
 
+    // Every reply to an unauthenticated source is at most as large as what it sent: the size is
+    // checked before any lookup, and a repeated hello (answered from memory) is rate limited too.
     void client_hello(std::span<const uint8_t> d, const net::DatagramHeader& h,
                       const net::Endpoint& from, int64_t now) {
+        if (d.size() != net::kClientHelloSize) {
+            count(&StreamServerStats::dropped_datagrams);
+            return;
+        }
         for (Pending& p : pending)
             if (p.handshake.connection == h.connection && p.peer == from) {
+                if (!limiter.allow_source(from.address, now)) {
+                    count(&StreamServerStats::handshakes_rate_limited);
+                    return;
+                }
                 socket.send_to(p.server_hello, from);  // a retransmitted hello gets the same answer
                 return;
             }
@@ -162,14 +187,37 @@ struct StreamServer::State {
             count(&StreamServerStats::dropped_datagrams);
             return;
         }
+        bool has_ticket = false;
+        std::array<uint8_t, net::kTicketIdSize> ticket_id{};
+        if (!net::client_hello_ticket(d, has_ticket, ticket_id).ok()) {
+            count(&StreamServerStats::dropped_datagrams);
+            return;
+        }
+        std::string ticket_secret;
+        if (has_ticket) {
+            const IssuedTicket* t = find_ticket(ticket_id, now);
+            if (!t) {
+                count(&StreamServerStats::dropped_datagrams);
+                return;
+            }
+            ticket_secret.assign(t->ticket.secret.begin(), t->ticket.secret.end());
+        } else if (!guesses.available(now)) {
+            count(&StreamServerStats::guesses_refused);
+            return;
+        }
         if (!limiter.allow(from.address, now)) {
             count(&StreamServerStats::handshakes_rate_limited);
             return;
         }
+        if (!has_ticket) guesses.start(now);  // an unfinished guess costs as a failed one
         Pending p;
         p.peer = from;
         p.created_us = now;
-        if (!net::answer_client_hello(options.secret, d, p.server_hello, p.handshake).ok()) {
+        p.resumed = has_ticket;
+        p.ticket_id = ticket_id;
+        if (!net::answer_client_hello(has_ticket ? ticket_secret : options.secret, d,
+                                      p.server_hello, p.handshake)
+                 .ok()) {
             count(&StreamServerStats::dropped_datagrams);
             return;
         }
@@ -185,6 +233,10 @@ struct StreamServer::State {
 
     void client_finish(std::span<const uint8_t> d, const net::DatagramHeader& h,
                        const net::Endpoint& from, int64_t now) {
+        if (d.size() != net::kClientFinishSize) {
+            count(&StreamServerStats::dropped_datagrams);
+            return;
+        }
         auto it = std::find_if(pending.begin(), pending.end(), [&](const Pending& p) {
             return p.handshake.connection == h.connection && p.peer == from;
         });
@@ -198,6 +250,13 @@ struct StreamServer::State {
             count(&StreamServerStats::handshakes_failed);
             return;
         }
+        if (it->resumed) {
+            std::erase_if(tickets,
+                          [&](const IssuedTicket& t) { return t.ticket.id == it->ticket_id; });
+            count(&StreamServerStats::handshakes_resumed);
+        } else {
+            guesses.confirmed(now);
+        }
         if (int(sessions.size()) >= options.max_sessions) {
             pending.erase(it);
             count(&StreamServerStats::dropped_datagrams);
@@ -209,10 +268,30 @@ struct StreamServer::State {
         auto s = std::make_unique<Session>(from, h.connection, it->handshake.keys, eo);
         s->last_heard_us = s->last_progress_us = now;
         s->bitrate_kbps = options.bitrate_kbps;
+        s->ticket = issue_ticket(now);
         pending.erase(it);
         sessions.push_back(std::move(s));
         ++sessions_total;
         count(&StreamServerStats::handshakes_ok);
+    }
+
+    const IssuedTicket* find_ticket(const std::array<uint8_t, net::kTicketIdSize>& id,
+                                    int64_t now) {
+        std::erase_if(tickets,
+                      [&](const IssuedTicket& t) { return now - t.issued_us > kTicketLifetimeUs; });
+        for (const IssuedTicket& t : tickets)
+            if (t.ticket.id == id) return &t;
+        return nullptr;
+    }
+
+    net::TicketMessage issue_ticket(int64_t now) {
+        IssuedTicket t;
+        t.issued_us = now;
+        net::random_bytes(t.ticket.id);
+        net::random_bytes(t.ticket.secret);
+        if (tickets.size() >= kMaxTickets) tickets.erase(tickets.begin());  // the oldest
+        tickets.push_back(t);
+        return t.ticket;
     }
 
     void refuse(Session& s, const std::string& why) {
@@ -247,6 +326,9 @@ struct StreamServer::State {
                                     .scene = s.scene_name};
         reply.resize(net::kMaxPlaintext);
         reply.resize(net::encode(info, reply));
+        send_message(s, reply);
+        reply.resize(net::kMaxPlaintext);
+        reply.resize(net::encode(s.ticket, reply));
         send_now(s, reply);
         s.last_info_us = now;
     }
@@ -505,6 +587,10 @@ struct StreamServer::State {
                double(st.sessions_total));
         metric("handshakes_failed_total", "counter", "Key confirmations that failed.",
                double(st.handshakes_failed));
+        metric("pin_guesses_refused_total", "counter",
+               "Client hellos refused by the PIN's guessing budget.", double(st.guesses_refused));
+        metric("handshakes_resumed_total", "counter", "Handshakes made with a resumption ticket.",
+               double(st.handshakes_resumed));
         metric("handshakes_rate_limited_total", "counter",
                "Client hellos refused by the rate limit.", double(st.handshakes_rate_limited));
         metric("dropped_datagrams_total", "counter", "Datagrams dropped unread.",

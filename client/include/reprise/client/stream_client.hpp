@@ -10,6 +10,7 @@
 #include "reprise/core/frame.hpp"
 #include "reprise/core/status.hpp"
 #include "reprise/net/fault_injector.hpp"
+#include "reprise/net/secure.hpp"
 #include "reprise/net/udp.hpp"
 #include "reprise/net/wire.hpp"
 
@@ -24,6 +25,9 @@ struct StreamClientOptions {
     net::FaultOptions uplink, downlink;
     double reconnect_after_s = 2.0;  // silence from the server that ends the connection
     int max_auth_failures = 3;       // key confirmations failed in a row before giving up
+    // From an earlier session with this server (StreamClient::ticket()): the handshake skips the
+    // PIN's guessing budget; forgotten after one unanswered handshake (docs/protocol.md).
+    net::ResumptionTicket ticket;
 };
 
 struct StreamClientStats {
@@ -68,6 +72,8 @@ public:
     const net::StreamInfoMessage* stream_info()
         const;  // null before the server described the stream
     const StreamClientStats& stats() const;
+    // The newest resumption ticket the server sent (valid once a session was admitted).
+    const net::ResumptionTicket& ticket() const;
     const Frame* newest_decoded() const;
 
     struct State;

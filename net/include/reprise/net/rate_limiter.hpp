@@ -20,6 +20,8 @@ public:
     explicit HandshakeRateLimiter(const RateLimitOptions& options = {});
     // Takes one token from the global bucket and the source's bucket; false when either is empty.
     bool allow(uint32_t address, int64_t now_us);
+    // The source's bucket only (a repeated hello answered from memory costs no new work).
+    bool allow_source(uint32_t address, int64_t now_us);
     // A failed key confirmation costs the source its whole bucket.
     void penalise(uint32_t address, int64_t now_us);
     std::size_t refused() const { return refused_; }

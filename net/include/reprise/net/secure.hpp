@@ -26,17 +26,34 @@ constexpr std::size_t kClientFinishSize = kHeaderSize + 32;           // 44
 // libsodium must be initialised once before any of this; safe to call many times.
 [[nodiscard]] Status init_crypto();
 uint64_t random_u64();
+void random_bytes(std::span<uint8_t> out);
 
 struct SessionKeys {
     Key client_to_server{};
     Key server_to_client{};
 };
 
+// A resumption ticket (docs/protocol.md, "Resumption"): the server's id for a secret it sent
+// inside an earlier session; a hello naming it runs CPace on the secret instead of the PIN.
+struct ResumptionTicket {
+    std::array<uint8_t, kTicketIdSize> id{};
+    std::array<uint8_t, kTicketSecretSize> secret{};
+    bool valid = false;
+    std::string secret_text() const { return {secret.begin(), secret.end()}; }
+};
+
+// What a ClientHello's padding says: PIN (no ticket) or the ticket id it names. Refuses a hello
+// of another size or with padding that is not zero.
+[[nodiscard]] Status client_hello_ticket(std::span<const uint8_t> client_hello, bool& has_ticket,
+                                         std::array<uint8_t, kTicketIdSize>& id);
+
 // Client side of the handshake.
 class ClientHandshake {
 public:
-    // Builds the ClientHello (kClientHelloSize bytes) for a new random connection id.
-    void start(const std::string& secret, std::vector<uint8_t>& hello);
+    // Builds the ClientHello (kClientHelloSize bytes) for a new random connection id; with a
+    // ticket, the ticket's secret replaces `secret` and its id goes into the padding.
+    void start(const std::string& secret, std::vector<uint8_t>& hello,
+               const ResumptionTicket* ticket = nullptr);
     // Checks the ServerHello's key confirmation; on success writes the ClientFinish and the keys.
     [[nodiscard]] Status finish(std::span<const uint8_t> server_hello,
                                 std::vector<uint8_t>& client_finish, SessionKeys& keys);

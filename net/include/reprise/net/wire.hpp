@@ -48,6 +48,7 @@ enum class MessageType : uint8_t {
     Fragment = 8,         // server -> client: a piece (or FEC parity) of one codec packet
     Bye = 9,              // either side: the session ends
     Error = 10,           // server -> client: why a Start was refused (text)
+    Ticket = 11,          // server -> client: resumption ticket for the next handshake
 };
 
 enum class StreamMode : uint8_t { Full = 0, LowRes = 1 };
@@ -79,6 +80,11 @@ struct ReceiverReportMessage {
     uint32_t received = 0;  // media datagrams received since the session started
     uint32_t missing = 0;   // media datagrams never received (after reordering settled)
     uint32_t rtt_us = 0;    // newest measured pose round trip (pose sampled -> frame decoded)
+};
+constexpr std::size_t kTicketIdSize = 16, kTicketSecretSize = 32;
+struct TicketMessage {
+    std::array<uint8_t, kTicketIdSize> id{};
+    std::array<uint8_t, kTicketSecretSize> secret{};
 };
 enum class FragmentKind : uint8_t { Data = 0, Parity = 1 };
 constexpr std::size_t kFragmentHeaderSize = 1 + 4 + 4 + 2 + 2 + 2 + 1 + 1 + 8;    // 25
@@ -114,6 +120,7 @@ std::size_t encode(const AckMessage& m, std::span<uint8_t> out);
 std::size_t encode(const LossReportMessage& m, std::span<uint8_t> out);
 std::size_t encode(const ReceiverReportMessage& m, std::span<uint8_t> out);
 std::size_t encode(const FragmentMessage& m, std::span<uint8_t> out);
+std::size_t encode(const TicketMessage& m, std::span<uint8_t> out);
 std::size_t encode_empty(MessageType type, std::span<uint8_t> out);  // KeyFrameRequest, Bye
 std::size_t encode_error(const std::string& text, std::span<uint8_t> out);
 
@@ -126,6 +133,7 @@ std::size_t encode_error(const std::string& text, std::span<uint8_t> out);
 [[nodiscard]] Status parse(std::span<const uint8_t> plaintext, LossReportMessage& m);
 [[nodiscard]] Status parse(std::span<const uint8_t> plaintext, ReceiverReportMessage& m);
 [[nodiscard]] Status parse(std::span<const uint8_t> plaintext, FragmentMessage& m);
+[[nodiscard]] Status parse(std::span<const uint8_t> plaintext, TicketMessage& m);
 [[nodiscard]] Status parse_error(std::span<const uint8_t> plaintext, std::string& text);
 
 }  // namespace reprise::net

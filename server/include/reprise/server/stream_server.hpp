@@ -11,6 +11,7 @@
 #include "reprise/codec/codec.hpp"
 #include "reprise/core/status.hpp"
 #include "reprise/net/fragment.hpp"
+#include "reprise/net/guess_budget.hpp"
 #include "reprise/net/rate_limiter.hpp"
 #include "reprise/net/udp.hpp"
 #include "reprise/net/wire.hpp"
@@ -41,15 +42,18 @@ struct StreamServerOptions {
     int max_in_flight_frames = 8;  // frames sent and not acknowledged before frames are skipped
     std::size_t send_queue_bytes = 1 << 20;  // per session; a frame that does not fit is skipped
     net::RateLimitOptions handshake_rate;
-    double session_timeout_s = 3.0;  // a session that sends nothing for this long ends
-    int metrics_port = -1;           // >= 0: Prometheus text on 127.0.0.1:port (0: any free port)
+    net::GuessBudgetOptions guess_budget;  // PIN guesses, all sources together
+    double session_timeout_s = 3.0;        // a session that sends nothing for this long ends
+    int metrics_port = -1;  // >= 0: Prometheus text on 127.0.0.1:port (0: any free port)
 };
 
 struct StreamServerStats {
     std::size_t sessions = 0;
     std::size_t sessions_total = 0;
     std::size_t handshakes_ok = 0, handshakes_failed = 0, handshakes_rate_limited = 0;
-    std::size_t dropped_datagrams = 0;  // garbage, truncated, oversized, unauthenticated, replayed
+    std::size_t guesses_refused = 0;     // PIN hellos refused by the guessing budget
+    std::size_t handshakes_resumed = 0;  // admitted by a resumption ticket
+    std::size_t dropped_datagrams = 0;   // garbage, truncated, oversized, unauthenticated, replayed
     std::size_t frames_sent = 0, frames_skipped = 0;
     std::size_t datagrams_sent = 0, bytes_sent = 0;
     std::size_t loss_reports = 0, key_frame_requests = 0, acks = 0;
