@@ -10,6 +10,7 @@
 #include <thread>
 #include <vector>
 
+#include "reprise/codec/codec.hpp"
 #include "support/cli.hpp"
 
 namespace fs = std::filesystem;
@@ -86,8 +87,9 @@ TEST(CliStream, WeakPinIsAllowedOnRequestAndListeningBeyondLoopbackWarns) {
 TEST(CliStream, AStreamFileWithReservedHeaderBytesSetIsRefused) {
     const fs::path dir =
         reprise::test::fresh_directory(fs::temp_directory_path() / "reprise-cli-reserved");
-    std::vector<uint8_t> header = {'R', 'P', 'R', 'S', 1, 0, 0, 0, 16, 0, 0, 0,
-                                   16,  0,   0,   0,   0, 0, 0, 0, 0,  0, 0, 0};
+    std::vector<uint8_t> header;
+    ASSERT_TRUE(reprise::codec::write_stream_header(header, 16, 16, 0.0).ok());
+    ASSERT_EQ(header.size(), 24u);
     auto write = [&](const fs::path& p) {
         std::ofstream(p, std::ios::binary)
             .write(reinterpret_cast<const char*>(header.data()), std::streamsize(header.size()));

@@ -9,8 +9,8 @@ GuessBudget::GuessBudget(const GuessBudgetOptions& options)
 
 void GuessBudget::refill(int64_t now_us) {
     if (updated_us_ >= 0 && now_us > updated_us_)
-        tokens_ = std::min(options_.burst,
-                           tokens_ + double(now_us - updated_us_) * 1e-6 / interval_s_);
+        tokens_ =
+            std::min(options_.burst, tokens_ + double(now_us - updated_us_) * 1e-6 / interval_s_);
     if (now_us > updated_us_) updated_us_ = now_us;
 }
 

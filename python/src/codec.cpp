@@ -19,7 +19,9 @@ std::span<const uint8_t> byte_span(const py::buffer& data, py::buffer_info& info
 
 codec::EncoderOptions encoder_options(int qp, int bitrate_kbps, double fps, int keyint,
                                       const std::string& chroma, const std::string& depth,
-                                      float depth_error, int skip_threshold, bool detect_cuts) {
+                                      float depth_error, float view_error_px,
+                                      float view_displacement, int skip_threshold,
+                                      bool detect_cuts) {
     if (qp < 0 || qp > 51) value_error("qp must be in 0..51");
     if (bitrate_kbps < 0) value_error("bitrate_kbps must be >= 0");
     if (!(fps > 0.0 && fps <= 10000.0)) value_error("fps must be in (0, 10000]");
@@ -30,6 +32,8 @@ codec::EncoderOptions encoder_options(int qp, int bitrate_kbps, double fps, int 
                             .fps = fps,
                             .keyint = keyint,
                             .depth_error = depth_error,
+                            .view_error_px = view_error_px,
+                            .view_displacement = view_displacement,
                             .skip_threshold = skip_threshold,
                             .detect_cuts = detect_cuts};
     if (chroma == "420")
@@ -38,14 +42,20 @@ codec::EncoderOptions encoder_options(int qp, int bitrate_kbps, double fps, int 
         o.chroma = codec::Chroma::C444;
     else
         value_error("chroma must be '420' or '444'");
-    if (depth == "lossless")
+    if (!(view_error_px >= 0.01f && view_error_px <= 16.0f))
+        value_error("view_error_px must be in [0.01, 16]");
+    if (!(view_displacement > 0.0f && view_displacement <= 1e6f))
+        value_error("view_displacement must be in (0, 1e6]");
+    if (depth == "view")
+        o.depth = codec::DepthMode::View;
+    else if (depth == "lossless")
         o.depth = codec::DepthMode::Lossless;
     else if (depth == "bounded")
         o.depth = codec::DepthMode::Bounded;
     else if (depth == "none")
         o.depth = codec::DepthMode::None;
     else
-        value_error("depth must be 'lossless', 'bounded' or 'none'");
+        value_error("depth must be 'view', 'lossless', 'bounded' or 'none'");
     return o;
 }
 
@@ -110,17 +120,19 @@ struct PyDecoder {
 void bind_codec(py::module_& m) {
     auto options_init = [](int qp, int bitrate_kbps, double fps, int keyint,
                            const std::string& chroma, const std::string& depth, float depth_error,
-                           int skip_threshold, bool detect_cuts) {
-        return std::make_unique<PyEncoder>(encoder_options(qp, bitrate_kbps, fps, keyint, chroma,
-                                                           depth, depth_error, skip_threshold,
-                                                           detect_cuts));
+                           float view_error_px, float view_displacement, int skip_threshold,
+                           bool detect_cuts) {
+        return std::make_unique<PyEncoder>(
+            encoder_options(qp, bitrate_kbps, fps, keyint, chroma, depth, depth_error,
+                            view_error_px, view_displacement, skip_threshold, detect_cuts));
     };
     py::class_<PyEncoder>(m, "Encoder",
                           "Scene-aware predictive encoder: one packet (bytes) per frame "
                           "(docs/bitstream.md).")
         .def(py::init(options_init), py::arg("qp") = 28, py::arg("bitrate_kbps") = 0,
              py::arg("fps") = 30.0, py::arg("keyint") = 0, py::arg("chroma") = "420",
-             py::arg("depth") = "lossless", py::arg("depth_error") = 1e-4f,
+             py::arg("depth") = "view", py::arg("depth_error") = 1e-4f,
+             py::arg("view_error_px") = 0.25f, py::arg("view_displacement") = 0.164f,
              py::arg("skip_threshold") = 2, py::arg("detect_cuts") = true)
         .def("encode", &PyEncoder::encode, py::arg("frame"), "The packet of the next frame.")
         .def("request_key_frame", [](PyEncoder& e) { e.encoder.request_key_frame(); })
@@ -161,12 +173,14 @@ void bind_codec(py::module_& m) {
         "encode_stream",
         [options_init](const std::vector<const Frame*>& frames, int qp, int bitrate_kbps,
                        double fps, int keyint, const std::string& chroma, const std::string& depth,
-                       float depth_error, int skip_threshold, bool detect_cuts) {
+                       float depth_error, float view_error_px, float view_displacement,
+                       int skip_threshold, bool detect_cuts) {
             if (frames.empty()) value_error("encode_stream: no frames");
             for (const Frame* f : frames)
                 if (!f) type_error("encode_stream: None in the frame list");
-            auto encoder = options_init(qp, bitrate_kbps, fps, keyint, chroma, depth, depth_error,
-                                        skip_threshold, detect_cuts);
+            auto encoder =
+                options_init(qp, bitrate_kbps, fps, keyint, chroma, depth, depth_error,
+                             view_error_px, view_displacement, skip_threshold, detect_cuts);
             std::vector<uint8_t> file;
             const double stream_fps = frames[0]->fps > 0.0 ? frames[0]->fps : fps;
             check(codec::write_stream_header(file, frames[0]->width(), frames[0]->height(),
@@ -178,8 +192,9 @@ void bind_codec(py::module_& m) {
             return py::bytes(reinterpret_cast<const char*>(file.data()), file.size());
         },
         py::arg("frames"), py::arg("qp") = 28, py::arg("bitrate_kbps") = 0, py::arg("fps") = 30.0,
-        py::arg("keyint") = 0, py::arg("chroma") = "420", py::arg("depth") = "lossless",
-        py::arg("depth_error") = 1e-4f, py::arg("skip_threshold") = 2,
+        py::arg("keyint") = 0, py::arg("chroma") = "420", py::arg("depth") = "view",
+        py::arg("depth_error") = 1e-4f, py::arg("view_error_px") = 0.25f,
+        py::arg("view_displacement") = 0.164f, py::arg("skip_threshold") = 2,
         py::arg("detect_cuts") = true,
         "A whole .rps stream (file header + packets) of the frames.");
     m.def(

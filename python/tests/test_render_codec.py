@@ -46,8 +46,9 @@ def test_bad_scenes_raise(renderer, tmp_path):
 
 
 def test_codec_round_trip(pan_60):
-    encoder = reprise.Encoder(qp=24)
-    decoder = reprise.Decoder()
+    encoder = reprise.Encoder(qp=24)  # depth="view": to the reprojection bound
+    lossless = reprise.Encoder(qp=24, depth="lossless")
+    decoder, exact = reprise.Decoder(), reprise.Decoder()
     for i, frame in enumerate(pan_60[:3]):
         packet = encoder.encode(frame)
         info = reprise.inspect_packet(packet)
@@ -55,9 +56,12 @@ def test_codec_round_trip(pan_60):
         decoded = decoder.decode(packet)
         # The decoder's output is the encoder's reconstruction, bit for bit.
         assert np.array_equal(decoded.color, encoder.reconstruction.color)
-        assert np.array_equal(decoded.depth, frame.depth)  # lossless depth
+        assert np.array_equal(decoded.depth, encoder.reconstruction.depth)
+        assert np.array_equal(np.isinf(decoded.depth), np.isinf(frame.depth))  # background exact
         assert psnr(frame, decoded) > 30.0
+        assert np.array_equal(exact.decode(lossless.encode(frame)).depth, frame.depth)
     assert encoder.stats["frames"] == 3 and encoder.stats["key_frames"] == 1
+    assert encoder.stats["depth_bits"] < 0.25 * lossless.stats["depth_bits"]
 
 
 def test_codec_streams_and_bad_packets(pan_60):

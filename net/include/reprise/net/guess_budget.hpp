@@ -9,8 +9,8 @@
 namespace reprise::net {
 
 struct GuessBudgetOptions {
-    double burst = 4.0;               // guesses after a quiet period
-    double first_interval_s = 1.0;    // one more token this often with no unconfirmed start
+    double burst = 4.0;                // guesses after a quiet period
+    double first_interval_s = 1.0;     // one more token this often with no unconfirmed start
     double longest_interval_s = 30.0;  // the back-off's cap: 120 guesses an hour
 };
 

@@ -32,9 +32,9 @@ struct StreamServerOptions {
     int aa_samples = 4;
     int max_sessions = 4;
     bool loopback_only = false;  // refuse a non-loopback listen address (tests)
-    // Depth within 0.1 % (relative) is plenty for reprojection and costs a fifth of lossless.
-    codec::EncoderOptions encoder{
-        .qp = 28, .depth = codec::DepthMode::Bounded, .depth_error = 1e-3f};
+    // Depth to the precision the client's extrapolation needs: no pixel moves by more than a
+    // quarter pixel for camera displacements up to 16.4 cm (docs/bitstream.md).
+    codec::EncoderOptions encoder{.qp = 28, .depth = codec::DepthMode::View};
     // Bitrate adaptation: > 0 starts rate control there and moves it within [min, max] by the
     // client's loss reports; 0 keeps constant quality (encoder.qp).
     int bitrate_kbps = 0, min_bitrate_kbps = 100, max_bitrate_kbps = 50000;
