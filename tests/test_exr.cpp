@@ -385,6 +385,16 @@ TEST_F(ExrTest, HeadersAskingForHugeAllocationsAreRefused) {
         {"inverted.exr", magic + data_window(-3, 6) + end + "pixels"},
         {"tiles.exr", magic + data_window(4, 4) + attribute("tiles", "tiledesc", 9) +
                           std::string("\0\x20\0\0\0\x20\0\0\0", 9) + end + "pixels"},
+
+        // OpenEXR reads a matrix at its own 64 bytes and goes on from there: the 16 declared here
+        // would put the next "attribute" inside this one (a fuzzer's 1.7 GB string, 3 KB file).
+        {"short-matrix.exr", magic + data_window(4, 4) + attribute("m", "m44f", 16) +
+                                 std::string(16, '\0') + end + "pixels"},
+        {"preview.exr", magic + data_window(4, 4) + attribute("preview", "preview", 12) +
+                            std::string("\xff\xff\0\0\xff\xff\0\0\0\0\0\0", 12) + end +
+                            "pixels"},
+        {"strings.exr", magic + data_window(4, 4) + attribute("multiView", "stringvector", 8) +
+                            std::string("\0\0\0\x70rose", 8) + end + "pixels"},
     };
     FrameHeader header;
     Frame f;

@@ -67,6 +67,42 @@ std::string type_name(TypeDesc type) {
     return type.c_str();
 }
 
+// The size OpenEXR reads for a value of a fixed-size type; -1 for the others.
+int natural_size(const std::string& type) {
+    static const std::pair<const char*, int> sizes[] = {
+        {"box2i", 16},      {"box2f", 16},        {"chromaticities", 32},
+        {"compression", 1}, {"double", 8},        {"envmap", 1},
+        {"float", 4},       {"int", 4},           {"keycode", 28},
+        {"lineOrder", 1},   {"m22f", 16},         {"m22d", 32},
+        {"m33f", 36},       {"m33d", 72},         {"m44f", 64},
+        {"m44d", 128},      {"rational", 8},      {"tiledesc", 9},
+        {"timecode", 8},    {"v2i", 8},           {"v2f", 8},
+        {"v2d", 16},        {"v3i", 12},          {"v3f", 12},
+        {"v3d", 24},        {"deepImageState", 1}};
+    for (const auto& [name, size] : sizes)
+        if (type == name) return size;
+    return -1;
+}
+
+// A preview is width, height and 4 bytes a pixel; a string vector is length-prefixed strings.
+bool sizes_inside_fit(const std::string& type, const std::vector<char>& value) {
+    auto u32 = [&](std::size_t at) {
+        uint32_t v;
+        std::memcpy(&v, value.data() + at, 4);
+        return v;
+    };
+    if (type == "preview")
+        return value.size() >= 8 && uint64_t(u32(0)) * u32(4) * 4 + 8 == value.size();
+    for (std::size_t at = 0; at < value.size();) {
+        if (value.size() - at < 4) return false;
+        const uint64_t length = u32(at);
+        at += 4;
+        if (length > value.size() - at) return false;
+        at += std::size_t(length);
+    }
+    return true;
+}
+
 // OpenEXR allocates each header attribute at its declared size before reading it, and buffers
 // for the data window's width before the size check in open_exr, so a few hundred bytes can ask
 // for gigabytes. Every attribute must fit in the file and every header must hold a dataWindow
@@ -132,6 +168,21 @@ Status check_exr_header(const std::string& path) {
         if (size < 0 || at + uint64_t(size) > file_size)
             return fail("attribute " + name + " declares " + std::to_string(size) +
                         " bytes, more than the " + std::to_string(file_size - at) + " left");
+        // OpenEXR reads a value of a known type at that type's size, whatever the declared one,
+        // and then goes on out of step with the declared sizes.
+        if (const int natural = natural_size(type); natural >= 0 && size != natural)
+            return fail("attribute " + name + " of type " + type + " declares " +
+                        std::to_string(size) + " bytes, not " + std::to_string(natural));
+        if (type == "preview" || type == "stringvector") {
+            // Sizes inside the value that OpenEXR allocates before reading: they must add up.
+            std::vector<char> value(std::size_t(size), 0);
+            file.read(value.data(), size);
+            if (!sizes_inside_fit(type, value))
+                return fail("attribute " + name + " of type " + type +
+                            ": its sizes do not add up to the " + std::to_string(size) +
+                            " bytes it declares");
+            continue;
+        }
         if (name == "dataWindow" && type == "box2i" && size == 16) {
             int32_t box[4];
             file.read(reinterpret_cast<char*>(box), 16);
