@@ -391,8 +391,7 @@ TEST_F(ExrTest, HeadersAskingForHugeAllocationsAreRefused) {
         {"short-matrix.exr", magic + data_window(4, 4) + attribute("m", "m44f", 16) +
                                  std::string(16, '\0') + end + "pixels"},
         {"preview.exr", magic + data_window(4, 4) + attribute("preview", "preview", 12) +
-                            std::string("\xff\xff\0\0\xff\xff\0\0\0\0\0\0", 12) + end +
-                            "pixels"},
+                            std::string("\xff\xff\0\0\xff\xff\0\0\0\0\0\0", 12) + end + "pixels"},
         {"strings.exr", magic + data_window(4, 4) + attribute("multiView", "stringvector", 8) +
                             std::string("\0\0\0\x70rose", 8) + end + "pixels"},
     };

@@ -138,6 +138,7 @@ Status check_exr_header(const std::string& path) {
     bool empty_header = true, data_window = false;
     int64_t image[2] = {0, 0};
     uint32_t tile[2] = {0, 0};  // 0 for scanline parts
+    int64_t channels = 0, chunk_lines = 1;
     for (;;) {
         if (!read_name(name)) return fail("truncated or overlong attribute name");
         if (name.empty()) {
@@ -151,10 +152,19 @@ Status check_exr_header(const std::string& path) {
                     return fail("tile " + std::to_string(tile[0]) + "x" + std::to_string(tile[1]) +
                                 " is larger than the " + std::to_string(image[0]) + "x" +
                                 std::to_string(image[1]) + " image");
+            // The compressor's buffers hold a chunk of rows of every channel (4 bytes a sample
+            // at most): an 8K frame of 11 channels in DWAB's 256 rows needs 90 MiB.
+            const int64_t chunk_bytes = image[0] * std::max<int64_t>(channels, 1) * 4 * chunk_lines;
+            if (chunk_bytes > (int64_t(512) << 20))
+                return fail(std::to_string(channels) + " channels of " + std::to_string(image[0]) +
+                            " pixels in chunks of " + std::to_string(chunk_lines) +
+                            " rows need more than 512 MiB of compression buffers");
             if (!multipart) return {};
             empty_header = true;
             data_window = false;
             tile[0] = tile[1] = 0;
+            channels = 0;
+            chunk_lines = 1;
             continue;
         }
         empty_header = false;
@@ -173,6 +183,37 @@ Status check_exr_header(const std::string& path) {
         if (const int natural = natural_size(type); natural >= 0 && size != natural)
             return fail("attribute " + name + " of type " + type + " declares " +
                         std::to_string(size) + " bytes, not " + std::to_string(natural));
+        if (name == "channels" && type == "chlist") {
+            // Entries are a name ended by 0 and 16 bytes; the list ends with an empty name.
+            std::vector<char> value(std::size_t(size), 0);
+            file.read(value.data(), size);
+            // OpenEXR sizes its row buffers from each channel's type and sampling.
+            std::size_t i = 0;
+            for (; i < value.size() && value[i] != 0; ++channels) {
+                while (i < value.size() && value[i] != 0) ++i;
+                int32_t entry[4];  // pixel type, linear + reserved, x and y sampling
+                if (value.size() - i < 17) return fail("channels: truncated channel list");
+                std::memcpy(entry, value.data() + i + 1, 16);
+                if (entry[0] < 0 || entry[0] > 2 || entry[2] != 1 || entry[3] != 1)
+                    return fail("channels: type " + std::to_string(entry[0]) + ", sampling " +
+                                std::to_string(entry[2]) + "x" + std::to_string(entry[3]) +
+                                " (types 0..2 and full-resolution channels only)");
+                i += 17;
+            }
+            // OpenEXR reads entries up to the empty name, whatever the declared size.
+            if (i + 1 != value.size())
+                return fail("channels: the list ends at byte " + std::to_string(i + 1) +
+                            " of the " + std::to_string(size) + " it declares");
+            continue;
+        }
+        if (name == "compression" && type == "compression" && size == 1) {
+            char method = 0;
+            file.read(&method, 1);
+            // Rows per chunk: none, RLE, ZIPS 1; ZIP, PXR24 16; PIZ, B44, B44A, DWAA 32; DWAB 256.
+            static const int kLines[] = {1, 1, 1, 16, 32, 16, 32, 32, 32, 256};
+            chunk_lines = method >= 0 && method < 10 ? kLines[int(method)] : 256;
+            continue;
+        }
         if (type == "preview" || type == "stringvector") {
             // Sizes inside the value that OpenEXR allocates before reading: they must add up.
             std::vector<char> value(std::size_t(size), 0);
