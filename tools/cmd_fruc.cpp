@@ -78,7 +78,7 @@ Status run_fruc(const FrucJob& job) {
     int written = int(first) * job.factor;
     double busy_ms = 0.0;
     const std::size_t n = sequence.files.size();
-    if (first > 0 || output.frames_on_disk() > 0)
+    if (output.frames_on_disk() > 0)
         std::fprintf(stderr, "[fruc] resuming: %d frames on disk, restarting at input %zu\n",
                      output.frames_on_disk(), first);
     for (std::size_t i = first; i < n; ++i) {

@@ -1,5 +1,6 @@
 #include "outputs.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <filesystem>
 #include <fstream>
@@ -22,12 +23,8 @@ fs::path resolved(const std::string& path) {
 }
 
 bool inside_or_same(const fs::path& path, const fs::path& folder) {
-    auto a = path.begin(), b = folder.begin();
-    for (; b != folder.end(); ++a, ++b) {
-        if (b->empty()) continue;  // a trailing separator
-        if (a == path.end() || *a != *b) return false;
-    }
-    return true;
+    const auto [f, p] = std::mismatch(folder.begin(), folder.end(), path.begin(), path.end());
+    return f == folder.end() || (f->empty() && std::next(f) == folder.end());  // "dir/"
 }
 
 // Files a sequence reader takes from a folder: frames and cameras.json.
@@ -73,7 +70,8 @@ Status OutputFolder::open(const std::string& dir, const OutputRules& rules, cons
         return Status::error("--resume and --overwrite-inputs cannot be combined");
     REPRISE_TRY(check_output("--out", dir, true, rules));
     std::error_code ec;
-    const bool staged = rules.overwrite_inputs && !check_output("--out", dir, true, {rules.inputs});
+    const bool staged =
+        rules.overwrite_inputs && !check_output("--out", dir, true, {rules.inputs}).ok();
     if (staged) {
         write_dir_ = (fs::path(dir) / kStaging).string();
         fs::remove_all(write_dir_, ec);
