@@ -27,6 +27,7 @@
 #include "reprise/codec/codec.hpp"
 #include "reprise/core/exr.hpp"
 #include "reprise/core/metrics.hpp"
+#include "reprise/core/nonfinite.hpp"
 #include "reprise/core/parallel.hpp"
 #include "reprise/server/builtin_scenes.hpp"
 #include "reprise/server/renderer.hpp"
@@ -224,7 +225,9 @@ Status run_ours(const Sequence& seq, int qp, bool bounded_depth, RunResult& tota
 struct ViewDepthRun {
     std::string scene;
     double depth_bytes = 0.0, total_bytes = 0.0, lossless_depth_bytes = NAN;
-    double max_error_px = 0.0;
+    double camera_bytes = 0.0, motion_bytes = 0.0, color_bytes = 0.0, per_pixel_motion_bytes = 0.0;
+    double max_error_px = 0.0, max_motion_error_px = 0.0;
+    std::size_t motion_models = 0, motion_own_pixels = 0, frames = 0;
     std::size_t background_mismatches = 0;
     float step = 0.0f;
 };
@@ -236,6 +239,7 @@ Status run_view_depth(const Sequence& seq, int qp, ViewDepthRun& run) {
     codec::Packet packet;
     Frame decoded;
     run.scene = seq.name;
+    run.frames = seq.frames.size();
     for (std::size_t i = 0; i < seq.frames.size(); ++i) {
         const Frame& frame = seq.frames[i];
         REPRISE_TRY(encoder.send_frame(frame));
@@ -248,9 +252,33 @@ Status run_view_depth(const Sequence& seq, int qp, ViewDepthRun& run) {
             frame.camera, frame.depth.view(), decoded.depth.view(), options.view_displacement);
         run.max_error_px = std::max(run.max_error_px, e.max_px);
         run.background_mismatches += e.background_mismatches;
-        run.depth_bytes += encoder.last_frame_stats().depth_bits / 8.0;
+        const codec::StreamStats& bits = encoder.last_frame_stats();
+        run.depth_bytes += bits.depth_bits / 8.0;
+        run.camera_bytes += bits.camera_bits / 8.0;
+        run.motion_bytes += bits.motion_bits / 8.0;
+        run.color_bytes += bits.color_bits / 8.0;
+        run.motion_models += bits.motion_models;
+        run.motion_own_pixels += bits.motion_own_pixels;
         run.total_bytes += double(packet.data.size());
+        Frame given = frame;  // the motion the encoder codes: NaN repaired at its door
+        NonfiniteRepair().repair(given);
+        for (std::size_t p = 0; p < given.motion.pixel_count() && !decoded.motion.empty(); ++p) {
+            const glm::vec2 d = decoded.motion.data()[p] - given.motion.data()[p];
+            const double err = std::sqrt(double(d.x) * d.x + double(d.y) * d.y);
+            if (std::isfinite(err))
+                run.max_motion_error_px = std::max(run.max_motion_error_px, err);
+        }
     }
+    // The same stream with every pixel's motion to 1/8 px, for what the models save.
+    codec::EncoderOptions per_pixel = options;
+    per_pixel.motion_error_px = 0.0f;
+    codec::Encoder reference(per_pixel);
+    for (const Frame& frame : seq.frames) {
+        REPRISE_TRY(reference.send_frame(frame));
+        if (reference.receive_packet(packet) != codec::Result::Ok)
+            return Status::error("reprise codec: no packet");
+    }
+    run.per_pixel_motion_bytes = reference.stats().motion_bits / 8.0;
     run.step = codec::view_depth_step(seq.frames[0].camera.projection, seq.frames[0].width(),
                                       seq.frames[0].height(), options.view_error_px,
                                       options.view_displacement);
@@ -658,6 +686,24 @@ Status bench_codec(const BenchOptions& job) {
         "%-10s %12s %12s %12s %10s %12s %12s %10s\n",
         view_defaults.view_displacement, view_defaults.view_error_px, qps[qps.size() / 2], "scene",
         "1/z step", "view bytes", "lossless", "ratio", "depth share", "max err px", "bg wrong");
+    std::string motion_text = strf(
+        "\nbits per frame by section at qp %d (depth to the view bound, motion within %.2f px: "
+        "affine models per block, pixels alone where none fits; per-pixel = every pixel to 1/8 "
+        "px)\n%-10s %9s %9s %9s %9s %9s %8s %8s %11s %9s %9s %10s\n",
+        qps[qps.size() / 2], view_defaults.motion_error_px, "scene", "total", "camera", "depth",
+        "motion", "colour", "depth%", "motion%", "per-pixel", "models", "alone px", "max err px");
+    for (const ViewDepthRun& v : view_rows) {
+        const double n = 8.0 / double(std::max<std::size_t>(1, v.frames));
+        motion_text += strf(
+            "%-10s %9.0f %9.0f %9.0f %9.0f %9.0f %7.1f%% %7.1f%% %11.0f %9.1f %9.1f %10.4f  %s\n",
+            v.scene.c_str(), v.total_bytes * n, v.camera_bytes * n, v.depth_bytes * n,
+            v.motion_bytes * n, v.color_bytes * n, 100.0 * v.depth_bytes / v.total_bytes,
+            100.0 * v.motion_bytes / v.total_bytes, v.per_pixel_motion_bytes * n,
+            double(v.motion_models) * n / 8.0, double(v.motion_own_pixels) * n / 8.0,
+            v.max_motion_error_px,
+            v.max_motion_error_px <= view_defaults.motion_error_px ? "within the bound"
+                                                                   : "OUTSIDE the bound");
+    }
     for (const ViewDepthRun& v : view_rows)
         depth_text +=
             strf("%-10s %12.3g %12.0f %12.0f %9.3fx %11.1f%% %12.4f %10zu  %s\n", v.scene.c_str(),
@@ -667,6 +713,7 @@ Status bench_codec(const BenchOptions& job) {
                  v.max_error_px <= view_defaults.view_error_px && v.background_mismatches == 0
                      ? "within the bound"
                      : "OUTSIDE the bound");
+    depth_text += motion_text;
 
     // Speed at 1080p.
     SpeedResult speed;

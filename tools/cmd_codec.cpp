@@ -89,10 +89,10 @@ void print_stats(const codec::StreamStats& s, double fps) {
     std::printf(
         "  left out: %zu of %zu colour blocks skipped (%.1f %%), %zu depth blocks predicted "
         "exactly, "
-        "motion residual on %zu pixels\n",
+        "motion beyond the cameras' on %zu pixels (%zu models, %zu pixels alone)\n",
         s.blocks_skipped, s.blocks,
         100.0 * double(s.blocks_skipped) / double(std::max<std::size_t>(1, s.blocks)),
-        s.depth_zero_blocks, s.motion_residual_pixels);
+        s.depth_zero_blocks, s.motion_residual_pixels, s.motion_models, s.motion_own_pixels);
     std::printf(
         "  %zu frames: %zu key, %zu predicted from an older reference, %zu intra macroblocks\n",
         s.frames, s.key_frames, s.older_reference, s.intra_blocks);
@@ -101,6 +101,7 @@ void print_stats(const codec::StreamStats& s, double fps) {
 struct EncodeJob {
     std::string in, out, chroma = "420", depth = "view";
     int qp = 28, quality = 0, bitrate = 0, keyint = 0, skip = 2;
+    double motion_error = 0.25;
     bool quality_given = false, overwrite_inputs = false, resume = false;
     std::string line;  // the options given, recorded for --resume
 };
@@ -122,6 +123,10 @@ Status encoder_options(const EncodeJob& job, codec::EncoderOptions& o) {
     o.bitrate_kbps = job.bitrate;
     o.keyint = job.keyint;
     o.skip_threshold = job.skip;
+    if (!(job.motion_error == 0.0 || (job.motion_error >= 0.1 && job.motion_error <= 8.0)))
+        return Status::error(
+            "encode: --motion-error must be 0 (per pixel, 1/8 px) or in 0.1..8 px");
+    o.motion_error_px = float(job.motion_error);
     if (job.chroma == "420")
         o.chroma = codec::Chroma::C420;
     else if (job.chroma == "444")
@@ -327,6 +332,9 @@ int command_encode(int argc, char** argv) {
         "view[:E[,B]] (default: 1/z to within E px of reprojection, default 0.25, for camera "
         "displacements up to B scene units, default 0.164) | lossless | bounded[:E] "
         "(relative error E, default 1e-4) | none");
+    args.option("--motion-error", &job.motion_error,
+                "largest error of the decoded motion in px: affine models per block where they "
+                "hold (default 0.25; 0: every pixel to 1/8 px)");
     args.option("--skip", &job.skip,
                 "blocks within this many 8-bit levels of their prediction are skipped (default 2)");
     args.flag("--overwrite-inputs", &job.overwrite_inputs,

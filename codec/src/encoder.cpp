@@ -6,6 +6,9 @@
 #include <deque>
 #include <set>
 
+#include <glm/geometric.hpp>
+#include <glm/matrix.hpp>
+
 #include "decoder_state.hpp"
 #include "internal.hpp"
 #include "reprise/core/byte_io.hpp"
@@ -16,6 +19,19 @@ namespace reprise::codec {
 namespace {
 
 constexpr std::size_t kMaxQueuedPackets = 16;
+
+// The view step of a new sequence: the client's, finer when the camera travels further than B
+// between frames, so that the camera motion both sides derive from decoded depth stays within the
+// motion bound (docs/bitstream.md, section 6). The travel is the key frame's; a camera that later
+// moves faster costs motion residuals.
+float sequence_view_step(const Camera& camera, int w, int h, float client, float motion_error) {
+    if (motion_error <= 0.0f) return client;
+    const glm::vec3 here = glm::vec3(glm::inverse(camera.view)[3]);
+    const glm::vec3 before = glm::vec3(glm::inverse(camera.prev_view)[3]);
+    const float travel = glm::length(here - before);
+    if (!(travel > 0.0f && travel < 1e6f)) return client;
+    return std::min(client, view_depth_step(camera.projection, w, h, motion_error, travel));
+}
 
 void append_section(std::vector<uint8_t>& payload, const std::vector<uint8_t>& section) {
     ByteWriter w(payload);
@@ -49,6 +65,8 @@ struct Encoder::State {
     Planes source_planes;
     Picture scratch;
     Workspace work;
+
+    float client_step = 0.0f;  // the view step the client's warps need (E and B)
 
     int slot_of(uint32_t frame) const { return held_slot(refs, frame); }
 
@@ -143,6 +161,9 @@ Status Encoder::send_frame(const Frame& given) {
           s.options.view_displacement > 0.0f && s.options.view_displacement <= 1e6f))
         return Status::error(
             "encoder: view depth needs an error in 0.001..100 px and a displacement in (0, 1e6]");
+    if (!(s.options.motion_error_px == 0.0f ||
+          (s.options.motion_error_px >= kMinMotionError && s.options.motion_error_px <= 8.0f)))
+        return Status::error("encoder: motion error bound must be 0 or lie in 0.1..8 px");
 
     NonfiniteCounts nonfinite;
     const Frame& frame = s.repair.clean(given, nonfinite);
@@ -153,11 +174,16 @@ Status Encoder::send_frame(const Frame& given) {
     sp.chroma = s.options.chroma;
     sp.depth = s.options.depth;
     sp.depth_error = s.options.depth_error;
+    sp.motion_error = s.options.motion_error_px;
     if (sp.depth == DepthMode::View) {
         sp.view_error = s.options.view_error_px;
         sp.view_displacement = s.options.view_displacement;
-        sp.view_step =
+        const float client =
             view_depth_step(frame.camera.projection, w, h, sp.view_error, sp.view_displacement);
+        sp.view_step = s.started && client == s.client_step
+                           ? s.sp.view_step
+                           : sequence_view_step(frame.camera, w, h, client, sp.motion_error);
+        s.client_step = client;
     }
     sp.slices = default_slices(h);
     sp.fps = frame.fps > 0.0 ? frame.fps : s.options.fps;
@@ -278,6 +304,9 @@ Status Encoder::resume(std::span<const std::span<const uint8_t>> packets) {
     s.next_frame = uint32_t(packets.size());
     s.newest = s.slot_of(s.next_frame - 1);
     s.started = d.started;
+    if (s.sp.depth == DepthMode::View && s.newest >= 0)
+        s.client_step = view_depth_step(s.refs[s.newest].camera.projection, s.sp.width, s.sp.height,
+                                        s.sp.view_error, s.sp.view_displacement);
     s.stats = d.stats;
     s.recon_ready = false;
     return {};

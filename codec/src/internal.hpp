@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "motion_models.hpp"
 #include "range_coder.hpp"
 #include "reprise/codec/codec.hpp"
 #include "reprise/core/byte_io.hpp"
@@ -12,13 +13,14 @@ namespace reprise::codec {
 
 inline constexpr uint32_t kPacketMagic = 0x544B5052;  // "RPKT"
 inline constexpr uint32_t kFileMagic = 0x53525052;    // "RPRS"
-inline constexpr uint8_t kVersion = 2;
+inline constexpr uint8_t kVersion = 3;
 inline constexpr std::size_t kPacketHeaderSize = 32;
 inline constexpr std::size_t kMaxPayload = 256u << 20;
 inline constexpr int kMaxSide = 16384;
 inline constexpr int kMaxSlices = 64;
-inline constexpr int kReferences = 4;  // pictures both sides keep
-inline constexpr int kMb = 16;         // macroblock: 16x16 luma
+inline constexpr int kReferences = 4;           // pictures both sides keep
+inline constexpr int kMb = 16;                  // macroblock: 16x16 luma
+inline constexpr float kMinMotionError = 0.1f;  // above a pixel value's 1/8 px rounding
 
 struct SequenceParams {
     int width = 0, height = 0;
@@ -28,6 +30,8 @@ struct SequenceParams {
     // DepthMode::View: the bound E (px) and displacement B it was derived from (informative) and
     // the 1/z quantiser step the codes use.
     float view_error = 0.25f, view_displacement = 0.164f, view_step = 0.0f;
+    // Largest distance (px) between decoded and source motion; 0 = per pixel to 1/8 px.
+    float motion_error = 0.25f;
     int slices = 1;
     double fps = 0.0;
     bool operator==(const SequenceParams&) const = default;
@@ -128,6 +132,7 @@ struct Workspace {
     Image<float> projected_depth;
     Image<glm::vec2> base_motion, to_reference;
     std::vector<MotionResidual> motion_residuals;
+    MotionModelScratch motion_models;
     Planes predicted;
     std::vector<uint8_t> coded_blocks[3];  // per 8x8 block of each plane: intra or with a residual
     std::vector<std::vector<uint8_t>> slice_bytes;
@@ -161,7 +166,8 @@ void encode_depth(const FrameContext& fc, const Camera& camera, ImageView<const 
 Status decode_depth(const FrameContext& fc, const Camera& camera, std::span<const uint8_t> in,
                     Image<float>& out, StreamStats& stats);
 
-// Motion: decoded motion = camera motion + residual / 8.
+// Motion: decoded motion = camera motion + residual (models within sp.motion_error, or per
+// pixel in eighths of a pixel when it is 0).
 void encode_motion(const FrameContext& fc, const Camera& camera, ImageView<const float> depth,
                    ImageView<const glm::vec2> source, Image<glm::vec2>& out,
                    std::vector<uint8_t>& bytes, StreamStats& stats);

@@ -191,17 +191,23 @@ void encode_motion(const FrameContext& fc, const Camera& camera, ImageView<const
     ensure_size(out, w, h);
     const std::size_t start = bytes.size();
     // Whether any pixel needs a residual; the slices recompute the residuals they code.
+    const bool models = sp.motion_error > 0.0f;
     std::atomic<bool> any{false};
     if (!source.empty())
         parallel_for(0, h, [&](int y0, int y1) {
             for (int y = y0; y < y1 && !any.load(std::memory_order_relaxed); ++y)
-                if (motion_residual_row({source.row(y), base.data() + std::size_t(y) * w, w}))
+                if (models
+                        ? !motion_within_bound(source, base.view(), y, sp.motion_error)
+                        : motion_residual_row({source.row(y), base.data() + std::size_t(y) * w, w}))
                     any.store(true, std::memory_order_relaxed);
         });
     ByteWriter wr(bytes);
     wr.u8(any ? 0 : kNoResidual);
     if (!any) {
         std::swap(out, base);  // the camera motion is the motion (base is remade every frame)
+    } else if (models) {
+        encode_motion_models(sp, base.view(), source, out.view(), fc.work->motion_models,
+                             fc.work->slice_bytes, bytes, stats);
     } else {
         std::vector<Residual>& residuals = fc.work->motion_residuals;
         residuals.resize(std::size_t(w) * h);
@@ -234,6 +240,12 @@ Status decode_motion(const FrameContext& fc, const Camera& camera, ImageView<con
     } else {
         std::vector<std::span<const uint8_t>> slices;
         if (!read_slices(r, sp.slices, slices)) return Status::error(r.error());
+        if (sp.motion_error > 0.0f) {
+            REPRISE_TRY(decode_motion_models(sp, base.view(), slices, out.view(),
+                                             fc.work->motion_models, stats));
+            stats.motion_bits += 8 * in.size();
+            return {};
+        }
         std::vector<Residual>& residuals = fc.work->motion_residuals;
         residuals.resize(std::size_t(w) * h);
         std::vector<SliceJob> jobs = slice_jobs(sp, base, {}, out, residuals);

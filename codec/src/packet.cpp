@@ -95,6 +95,7 @@ void write_params(const SequenceParams& sp, std::vector<uint8_t>& out) {
         w.f32(sp.view_displacement);
         w.f32(sp.view_step);
     }
+    w.f32(sp.motion_error);
     w.u8(uint8_t(sp.slices));
     w.f64(sp.fps);
 }
@@ -109,6 +110,7 @@ Status read_params(ByteReader& r, SequenceParams& sp) {
         sp.view_displacement = r.f32();
         sp.view_step = r.f32();
     }
+    sp.motion_error = r.f32();
     sp.slices = r.u8();
     sp.fps = r.f64();
     if (!r.ok()) return Status::error(r.error());
@@ -124,6 +126,9 @@ Status read_params(ByteReader& r, SequenceParams& sp) {
         return Status::error("key frame parameters: depth error bound outside 1e-7..0.1");
     if (sp.depth == DepthMode::View && !(sp.view_step >= 1e-12f && sp.view_step <= 1e6f))
         return Status::error("key frame parameters: inverse depth step outside 1e-12..1e6");
+    if (!(sp.motion_error == 0.0f ||
+          (sp.motion_error >= kMinMotionError && sp.motion_error <= 8.0f)))
+        return Status::error("key frame parameters: motion error bound outside 0.1..8 px (or 0)");
     if (sp.slices < 1 || sp.slices > std::min(kMaxSlices, sp.mb_rows()))
         return Status::error("key frame parameters: " + std::to_string(sp.slices) + " slices for " +
                              std::to_string(sp.mb_rows()) + " macroblock rows");

@@ -17,6 +17,8 @@ void add_stats(StreamStats& total, const StreamStats& f) {
     total.blocks_skipped += f.blocks_skipped;
     total.intra_blocks += f.intra_blocks;
     total.motion_residual_pixels += f.motion_residual_pixels;
+    total.motion_models += f.motion_models;
+    total.motion_own_pixels += f.motion_own_pixels;
     total.depth_zero_blocks += f.depth_zero_blocks;
 }
 

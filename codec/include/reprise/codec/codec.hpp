@@ -36,6 +36,9 @@ struct EncoderOptions {
     // may cause.
     float view_error_px = 0.25f;
     float view_displacement = 0.164f;
+    // Largest distance (px) between decoded and rendered motion: affine models per block where
+    // they hold (docs/bitstream.md). 0 = every pixel to 1/8 px. Otherwise 0.1 .. 8.
+    float motion_error_px = 0.25f;
     // A block whose prediction error stays within this many 8-bit display levels on every
     // channel is skipped (Mueller et al. 2021: T = 8/255 stays under one JND). 0 = skip only
     // what quantises to nothing.
@@ -62,6 +65,8 @@ struct StreamStats {
     std::size_t blocks_skipped = 0;          // coded as a flag only
     std::size_t intra_blocks = 0;            // macroblocks predicted from the current frame
     std::size_t motion_residual_pixels = 0;  // pixels whose motion the cameras do not explain
+    std::size_t motion_models = 0;           // affine motion models sent
+    std::size_t motion_own_pixels = 0;       // pixels whose motion no model gives, sent alone
     std::size_t depth_zero_blocks = 0;       // depth blocks predicted exactly
     // Encoder input: NaN/Inf repaired before coding (colour: holes; depth NaN/-inf and motion:
     // unknown; reprise/core/nonfinite.hpp).

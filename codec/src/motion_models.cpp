@@ -1,0 +1,445 @@
+// Motion within a bound: per 16x16 macroblock a quadtree down to 4x4 cells. A leaf says "the
+// cameras explain it" (zero), "the neighbour's affine model goes on here" (merge), "a new affine
+// model", or, for a 4x4 cell only, what each pixel is. Every decoded pixel lies within
+// motion_error px of the renderer's motion (docs/bitstream.md), so a rigid or smoothly deformed
+// object costs a few models instead of a residual per pixel.
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+
+#include "internal.hpp"
+#include "motion_models.hpp"
+#include "slices.hpp"
+
+namespace reprise::codec {
+
+namespace {
+
+constexpr int kUnit = 512;                         // model values in 1/512 px
+constexpr int kOffsetStep = 8;                     // a new model's offset in 1/64 px
+constexpr int64_t kMaxValue = int64_t(1) << 30;    // 2M px
+constexpr int64_t kMaxGradient = int64_t(1) << 16;  // 128 px per px
+constexpr int64_t kMaxSteps = int64_t(1) << 24;  // a pixel's own value, from its prediction
+constexpr int kLevels = 3;                         // nodes of 16, 8 and 4 pixels
+
+enum PixelKind : uint8_t { kZeroPixel = 0, kModelPixel = 1, kOwnPixel = 2 };
+
+inline bool finite(glm::vec2 v) { return std::isfinite(v.x) && std::isfinite(v.y); }
+inline glm::vec2 usable_base(glm::vec2 base) { return finite(base) ? base : glm::vec2(0.0f); }
+
+// What a pixel decodes to from a value in 1/512 px added to the camera motion.
+inline glm::vec2 model_output(glm::vec2 base, int64_t vx, int64_t vy) {
+    return usable_base(base) + glm::vec2(float(vx), float(vy)) * (1.0f / kUnit);
+}
+
+inline bool within(glm::vec2 source, glm::vec2 decoded, float bound) {
+    if (!finite(source) || !finite(decoded))
+        return std::isnan(source.x) && std::isnan(decoded.x);  // NaN both ways needs nothing
+    const glm::vec2 d = decoded - source;
+    return d.x * d.x + d.y * d.y <= bound * bound;
+}
+
+// Rounded half up and clamped to +-limit (NaN gives 0).
+inline int64_t clamped_round(double v, int64_t limit) {
+    if (!(std::abs(v) <= double(limit))) return std::isnan(v) ? 0 : (v < 0 ? -limit : limit);
+    return int64_t(std::floor(v + 0.5));
+}
+
+struct Models {
+    BitModel zero[kLevels][3];
+    BitModel merge[kLevels];
+    BitModel which;
+    BitModel split[kLevels - 1];
+    BitModel own_cell;
+    BitModel pixel_zero[3], pixel_model[3], pixel_which[2], invalid;
+    IntModel<20> offset[2], gradient[4], pixel[2];
+};
+
+struct Job {
+    const SequenceParams* sp;
+    int y0, y1;
+    float bound;
+    int64_t step;  // of a pixel's own value
+    ImageView<const glm::vec2> base, source;  // source: encoder only
+    ImageView<glm::vec2> out;
+    MotionModelScratch* scratch;
+    std::size_t pixels = 0, models = 0, own_pixels = 0;
+
+    int width() const { return sp->width; }
+    MotionCell* cell(int x, int y) const {
+        if (x < 0 || y < y0) return nullptr;
+        return &scratch->cells[std::size_t(y / 4) * scratch->cell_columns + x / 4];
+    }
+    uint8_t& kind(int x, int y) const { return scratch->kinds[std::size_t(y) * width() + x]; }
+    uint8_t& which(int x, int y) const { return scratch->which[std::size_t(y) * width() + x]; }
+    glm::ivec2& value(int x, int y) const { return scratch->values[std::size_t(y) * width() + x]; }
+    const MotionModel* candidate(int x, int y) const {
+        const MotionCell* c = cell(x, y);
+        return c && c->has_model ? &c->model : nullptr;
+    }
+};
+
+// A decoded value as neighbours predict from it (clamped: prediction needs no more).
+inline glm::ivec2 kept(int64_t vx, int64_t vy) {
+    return {int(std::clamp(vx, -kMaxValue, kMaxValue)), int(std::clamp(vy, -kMaxValue, kMaxValue))};
+}
+
+// A pixel's own value is a multiple of this step (1/512 px) from its prediction: at most half a
+// step per component, so within the bound.
+inline int64_t own_step(float bound) { return int64_t(std::floor(double(bound) * 512.0 * 1.38)); }
+
+inline bool same(const MotionModel& a, const MotionModel& b) {
+    return a.ax == b.ax && a.ay == b.ay && a.gxx == b.gxx && a.gxy == b.gxy && a.gyx == b.gyx &&
+           a.gyy == b.gyy && a.x0 == b.x0 && a.y0 == b.y0;
+}
+
+struct Node {
+    int x, y, w, h;
+};
+
+// Least squares of (source - camera motion) over the node as an affine field, quantised, the
+// offset coded relative to `pred`; false when a pixel is not finite or the range is exceeded.
+bool fit_model(const Job& j, const Node& n, const MotionModel& pred, MotionModel& m) {
+    const double cx = n.x + (n.w - 1) * 0.5, cy = n.y + (n.h - 1) * 0.5;
+    double mean[2] = {0, 0}, gx[2] = {0, 0}, gy[2] = {0, 0}, suu = 0, svv = 0;
+    for (int y = n.y; y < n.y + n.h; ++y)
+        for (int x = n.x; x < n.x + n.w; ++x) {
+            const glm::vec2 s = j.source(x, y);
+            if (!finite(s)) return false;
+            const glm::vec2 d = (s - usable_base(j.base(x, y))) * float(kUnit);
+            const double u = x - cx, v = y - cy;
+            mean[0] += d.x, mean[1] += d.y;
+            gx[0] += u * d.x, gx[1] += u * d.y;
+            gy[0] += v * d.x, gy[1] += v * d.y;
+            suu += u * u, svv += v * v;
+        }
+    const double count = double(n.w) * n.h;
+    auto gradient = [](double s, double norm) {
+        return norm > 0 ? clamped_round(s / norm, kMaxGradient) : int64_t(0);
+    };
+    m.gxx = gradient(gx[0], suu), m.gxy = gradient(gy[0], svv);
+    m.gyx = gradient(gx[1], suu), m.gyy = gradient(gy[1], svv);
+    m.x0 = n.x, m.y0 = n.y;
+    const double ax = mean[0] / count - m.gxx * (cx - n.x) - m.gxy * (cy - n.y);
+    const double ay = mean[1] / count - m.gyx * (cx - n.x) - m.gyy * (cy - n.y);
+    if (!(std::abs(ax) < double(kMaxValue) && std::abs(ay) < double(kMaxValue))) return false;
+    const int64_t px = pred.value_x(n.x, n.y), py = pred.value_y(n.x, n.y);
+    m.ax = px + kOffsetStep * clamped_round((ax - double(px)) / kOffsetStep, 2 * kMaxValue);
+    m.ay = py + kOffsetStep * clamped_round((ay - double(py)) / kOffsetStep, 2 * kMaxValue);
+    return std::abs(m.ax) <= kMaxValue && std::abs(m.ay) <= kMaxValue;
+}
+
+bool model_fits(const Job& j, const Node& n, const MotionModel& m) {
+    for (int y = n.y; y < n.y + n.h; ++y)
+        for (int x = n.x; x < n.x + n.w; ++x)
+            if (!within(j.source(x, y), model_output(j.base(x, y), m.value_x(x, y), m.value_y(x, y)),
+                        j.bound))
+                return false;
+    return true;
+}
+
+bool zero_fits(const Job& j, const Node& n) {
+    for (int y = n.y; y < n.y + n.h; ++y)
+        for (int x = n.x; x < n.x + n.w; ++x)
+            if (!within(j.source(x, y), j.base(x, y), j.bound)) return false;
+    return true;
+}
+
+void set_cells(const Job& j, const Node& n, const MotionModel* model, bool zero) {
+    for (int y = n.y; y < n.y + n.h; y += 4)
+        for (int x = n.x; x < n.x + n.w; x += 4) {
+            MotionCell& c = *j.cell(x, y);
+            c.has_model = model != nullptr;
+            if (model) c.model = *model;
+            c.zero = zero;
+        }
+}
+
+void apply_zero(Job& j, const Node& n) {
+    for (int y = n.y; y < n.y + n.h; ++y)
+        for (int x = n.x; x < n.x + n.w; ++x) {
+            j.out(x, y) = j.base(x, y);
+            j.kind(x, y) = kZeroPixel;
+            j.value(x, y) = {0, 0};
+        }
+    set_cells(j, n, nullptr, true);
+}
+
+void apply_model(Job& j, const Node& n, const MotionModel& m) {
+    for (int y = n.y; y < n.y + n.h; ++y)
+        for (int x = n.x; x < n.x + n.w; ++x) {
+            const int64_t vx = m.value_x(x, y), vy = m.value_y(x, y);
+            j.out(x, y) = model_output(j.base(x, y), vx, vy);
+            j.kind(x, y) = kModelPixel;
+            j.value(x, y) = kept(vx, vy);
+        }
+    j.pixels += std::size_t(n.w) * n.h;
+    set_cells(j, n, &m, false);
+}
+
+inline int pixel_context(const Job& j, int x, int y) {
+    const int left = x > 0 ? int(j.kind(x - 1, y)) : int(kZeroPixel);
+    const int top = y > j.y0 ? int(j.kind(x, y - 1)) : int(kZeroPixel);
+    return std::min(2, (left != kZeroPixel) + (top != kZeroPixel));
+}
+
+// A 4x4 cell pixel by pixel: the camera's motion, one of the node's candidate models, or its own
+// value (predicted from its neighbours).
+template <bool Encode, class Coder>
+bool code_pixels(Job& j, Models& m, const Node& n, const MotionModel* const (&cands)[2],
+                 Coder& rc) {
+    const MotionModel none;
+    const MotionModel& c = cands[0] ? *cands[0] : none;
+    for (int y = n.y; y < n.y + n.h; ++y)
+        for (int x = n.x; x < n.x + n.w; ++x) {
+            const int ctx = pixel_context(j, x, y);
+            const glm::vec2 base = j.base(x, y);
+            int64_t cx = c.value_x(x, y), cy = c.value_y(x, y);
+            PixelKind kind = kOwnPixel;
+            int which = 0;
+            const int which_ctx = x > n.x && j.kind(x - 1, y) == kModelPixel && j.which(x - 1, y);
+            if constexpr (Encode) {
+                const glm::vec2 s = j.source(x, y);
+                if (within(s, base, j.bound)) {
+                    kind = kZeroPixel;
+                } else {
+                    for (int k = 0; k < 2 && kind == kOwnPixel; ++k)
+                        if (cands[k] && within(s,
+                                               model_output(base, cands[k]->value_x(x, y),
+                                                            cands[k]->value_y(x, y)),
+                                               j.bound))
+                            kind = kModelPixel, which = k;
+                }
+                rc.bit(m.pixel_zero[ctx], kind == kZeroPixel);
+                if (kind != kZeroPixel && cands[0]) {
+                    rc.bit(m.pixel_model[ctx], kind == kModelPixel);
+                    if (kind == kModelPixel && cands[1]) rc.bit(m.pixel_which[which_ctx], which);
+                }
+            } else {
+                if (rc.bit(m.pixel_zero[ctx])) {
+                    kind = kZeroPixel;
+                } else if (cands[0] && rc.bit(m.pixel_model[ctx])) {
+                    kind = kModelPixel;
+                    which = cands[1] ? rc.bit(m.pixel_which[which_ctx]) : 0;
+                }
+            }
+            if (which) cx = cands[1]->value_x(x, y), cy = cands[1]->value_y(x, y);
+            j.which(x, y) = uint8_t(which);
+            glm::vec2 out = base;
+            if (kind == kModelPixel) out = model_output(base, cx, cy);
+            glm::ivec2 value = kind == kModelPixel ? kept(cx, cy) : glm::ivec2(0);
+            if (kind == kOwnPixel) {
+                // Predicted like a smooth field: the left pixel's value, else the above one's
+                // (when they are not the camera's), else the candidate's.
+                glm::ivec2 pred = kept(cx, cy);
+                if (x > 0 && j.kind(x - 1, y) != kZeroPixel)
+                    pred = j.value(x - 1, y);
+                else if (y > j.y0 && j.kind(x, y - 1) != kZeroPixel)
+                    pred = j.value(x, y - 1);
+                bool invalid = false;
+                int64_t kx = 0, ky = 0;
+                if constexpr (Encode) {
+                    const glm::vec2 s = j.source(x, y);
+                    invalid = !finite(s);
+                    rc.bit(m.invalid, invalid);
+                    if (!invalid) {
+                        const glm::vec2 d = (s - usable_base(base)) * float(kUnit);
+                        kx = clamped_round((double(d.x) - pred.x) / double(j.step), kMaxSteps);
+                        ky = clamped_round((double(d.y) - pred.y) / double(j.step), kMaxSteps);
+                        encode_int(rc, m.pixel[0], kx);
+                        encode_int(rc, m.pixel[1], ky);
+                    }
+                } else {
+                    invalid = rc.bit(m.invalid);
+                    if (!invalid && (!decode_int(rc, m.pixel[0], kx) ||
+                                     !decode_int(rc, m.pixel[1], ky) ||
+                                     std::abs(kx) > kMaxSteps || std::abs(ky) > kMaxSteps))
+                        return false;
+                }
+                const int64_t vx = pred.x + kx * j.step, vy = pred.y + ky * j.step;
+                out = invalid ? glm::vec2(std::numeric_limits<float>::quiet_NaN())
+                              : model_output(base, vx, vy);
+                value = invalid ? glm::ivec2(0) : kept(vx, vy);
+                ++j.own_pixels;
+            }
+            j.out(x, y) = out;
+            j.kind(x, y) = kind;
+            j.value(x, y) = value;
+            j.pixels += kind != kZeroPixel;
+        }
+    set_cells(j, n, cands[0], false);
+    return true;
+}
+
+template <bool Encode, class Coder>
+bool code_new_model(Job& j, Models& m, const Node& n, const MotionModel& pred, MotionModel& model,
+                    Coder& rc) {
+    const int64_t px = pred.value_x(n.x, n.y), py = pred.value_y(n.x, n.y);
+    int64_t d[6];
+    if constexpr (Encode) {
+        d[0] = (model.ax - px) / kOffsetStep, d[1] = (model.ay - py) / kOffsetStep;
+        d[2] = model.gxx - pred.gxx, d[3] = model.gxy - pred.gxy;
+        d[4] = model.gyx - pred.gyx, d[5] = model.gyy - pred.gyy;
+        encode_int(rc, m.offset[0], d[0]);
+        encode_int(rc, m.offset[1], d[1]);
+        for (int k = 0; k < 4; ++k) encode_int(rc, m.gradient[k], d[2 + k]);
+    } else {
+        if (!decode_int(rc, m.offset[0], d[0]) || !decode_int(rc, m.offset[1], d[1])) return false;
+        for (int k = 0; k < 4; ++k)
+            if (!decode_int(rc, m.gradient[k], d[2 + k])) return false;
+        model.ax = px + d[0] * kOffsetStep, model.ay = py + d[1] * kOffsetStep;
+        model.gxx = pred.gxx + d[2], model.gxy = pred.gxy + d[3];
+        model.gyx = pred.gyx + d[4], model.gyy = pred.gyy + d[5];
+        model.x0 = n.x, model.y0 = n.y;
+        if (std::abs(model.ax) > kMaxValue || std::abs(model.ay) > kMaxValue) return false;
+        for (int64_t g : {model.gxx, model.gxy, model.gyx, model.gyy})
+            if (std::abs(g) > kMaxGradient) return false;
+    }
+    ++j.models;
+    return true;
+}
+
+template <bool Encode, class Coder>
+bool code_node(Job& j, Models& m, Node n, int level, Coder& rc) {
+    n.w = std::min(n.w, j.width() - n.x);
+    n.h = std::min(n.h, j.y1 - n.y);
+    if (n.w <= 0 || n.h <= 0) return true;
+    const MotionCell *left = j.cell(n.x - 1, n.y), *top = j.cell(n.x, n.y - 1);
+    const int zero_ctx = (left && !left->zero) + (top && !top->zero);
+    bool zero = false;
+    if constexpr (Encode) {
+        zero = zero_fits(j, n);
+        rc.bit(m.zero[level][zero_ctx], zero);
+    } else {
+        zero = rc.bit(m.zero[level][zero_ctx]);
+    }
+    if (zero) {
+        apply_zero(j, n);
+        return true;
+    }
+    const MotionModel* cands[2] = {j.candidate(n.x - 1, n.y), j.candidate(n.x, n.y - 1)};
+    if (!cands[0]) std::swap(cands[0], cands[1]);
+    if (cands[1] && same(*cands[0], *cands[1])) cands[1] = nullptr;
+    if (cands[0]) {
+        int chosen = -1;
+        if constexpr (Encode) {
+            for (int k = 0; k < 2 && chosen < 0; ++k)
+                if (cands[k] && model_fits(j, n, *cands[k])) chosen = k;
+            rc.bit(m.merge[level], chosen >= 0);
+            if (chosen >= 0 && cands[1]) rc.bit(m.which, chosen);
+        } else if (rc.bit(m.merge[level])) {
+            chosen = cands[1] ? rc.bit(m.which) : 0;
+        }
+        if (chosen >= 0) {
+            const MotionModel merged = *cands[chosen];  // a copy: set_cells overwrites the source
+            apply_model(j, n, merged);
+            return true;
+        }
+    }
+    const MotionModel none;
+    const MotionModel& pred = cands[0] ? *cands[0] : none;
+    MotionModel model;
+    bool fits = false;
+    if constexpr (Encode) fits = fit_model(j, n, pred, model) && model_fits(j, n, model);
+    if (level < kLevels - 1) {
+        if constexpr (Encode)
+            rc.bit(m.split[level], !fits);
+        else
+            fits = !rc.bit(m.split[level]);
+        if (!fits) {
+            const int half = (kMb >> level) / 2;
+            for (int k = 0; k < 4; ++k)
+                if (!code_node<Encode>(j, m, {n.x + (k & 1) * half, n.y + (k >> 1) * half, half, half},
+                                       level + 1, rc))
+                    return false;
+            return true;
+        }
+    } else {
+        if constexpr (Encode)
+            rc.bit(m.own_cell, !fits);
+        else
+            fits = !rc.bit(m.own_cell);
+        if (!fits) return code_pixels<Encode>(j, m, n, cands, rc);
+    }
+    if (!code_new_model<Encode>(j, m, n, pred, model, rc)) return false;
+    apply_model(j, n, model);
+    return true;
+}
+
+template <bool Encode, class Coder>
+bool code_slice(Job& j, Coder& rc) {
+    Models m;
+    for (int y = j.y0; y < j.y1; y += kMb) {
+        for (int x = 0; x < j.width(); x += kMb)
+            if (!code_node<Encode>(j, m, {x, y, kMb, kMb}, 0, rc)) return false;
+        if constexpr (!Encode) {
+            if (rc.overrun() > 8) return false;
+        }
+    }
+    return true;
+}
+
+std::vector<Job> slice_jobs(const SequenceParams& sp, ImageView<const glm::vec2> base,
+                            ImageView<const glm::vec2> source, ImageView<glm::vec2> out,
+                            MotionModelScratch& scratch) {
+    scratch.cell_columns = (sp.width + 3) / 4;
+    scratch.cells.assign(std::size_t(scratch.cell_columns) * ((sp.height + 3) / 4), {});
+    scratch.kinds.resize(std::size_t(sp.width) * sp.height);
+    scratch.values.resize(std::size_t(sp.width) * sp.height);
+    scratch.which.resize(std::size_t(sp.width) * sp.height);
+    std::vector<Job> jobs;
+    for (int s = 0; s < sp.slices; ++s) {
+        const int y0 = std::min(sp.height, sp.slice_begin(s) * kMb);
+        const int y1 = std::min(sp.height, sp.slice_begin(s + 1) * kMb);
+        jobs.push_back(
+            {&sp, y0, y1, sp.motion_error, own_step(sp.motion_error), base, source, out, &scratch});
+    }
+    return jobs;
+}
+
+void add_counts(const std::vector<Job>& jobs, StreamStats& stats) {
+    for (const Job& j : jobs) {
+        stats.motion_residual_pixels += j.pixels;
+        stats.motion_models += j.models;
+        stats.motion_own_pixels += j.own_pixels;
+    }
+}
+
+}  // namespace
+
+bool motion_within_bound(ImageView<const glm::vec2> source, ImageView<const glm::vec2> base,
+                         int y, float bound) {
+    for (int x = 0; x < source.width; ++x)
+        if (!within(source(x, y), base(x, y), bound)) return false;
+    return true;
+}
+
+void encode_motion_models(const SequenceParams& sp, ImageView<const glm::vec2> base,
+                          ImageView<const glm::vec2> source, ImageView<glm::vec2> out,
+                          MotionModelScratch& scratch,
+                          std::vector<std::vector<uint8_t>>& slice_bytes,
+                          std::vector<uint8_t>& bytes, StreamStats& stats) {
+    std::vector<Job> jobs = slice_jobs(sp, base, source, out, scratch);
+    encode_slices(sp.slices, slice_bytes, bytes, [&](int s, std::vector<uint8_t>& b) {
+        RangeEncoder rc(b);
+        code_slice<true>(jobs[s], rc);
+        rc.finish();
+    });
+    add_counts(jobs, stats);
+}
+
+Status decode_motion_models(const SequenceParams& sp, ImageView<const glm::vec2> base,
+                            const std::vector<std::span<const uint8_t>>& slices,
+                            ImageView<glm::vec2> out, MotionModelScratch& scratch,
+                            StreamStats& stats) {
+    std::vector<Job> jobs = slice_jobs(sp, base, {}, out, scratch);
+    REPRISE_TRY(decode_slices(slices, "motion section", [&](int s, std::span<const uint8_t> b) {
+        RangeDecoder rc(b);
+        return code_slice<false>(jobs[s], rc);
+    }));
+    add_counts(jobs, stats);
+    return {};
+}
+
+}  // namespace reprise::codec

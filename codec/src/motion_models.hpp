@@ -1,0 +1,54 @@
+#pragma once
+// Motion coded within a bound (motion_models.cpp): affine models per quadtree node, merged from
+// neighbours, pixel values only where no model fits.
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "reprise/core/image.hpp"
+#include "reprise/core/status.hpp"
+
+namespace reprise::codec {
+
+struct SequenceParams;
+struct StreamStats;
+
+// Residual motion over the camera motion, in 1/512 px: value at the origin pixel plus a change
+// per pixel in x and in y.
+struct MotionModel {
+    int64_t ax = 0, ay = 0;
+    int64_t gxx = 0, gxy = 0, gyx = 0, gyy = 0;
+    int x0 = 0, y0 = 0;
+    int64_t value_x(int x, int y) const { return ax + gxx * (x - x0) + gxy * (y - y0); }
+    int64_t value_y(int x, int y) const { return ay + gyx * (x - x0) + gyy * (y - y0); }
+};
+
+struct MotionCell {  // one 4x4 cell: what its neighbours predict from
+    MotionModel model;
+    bool has_model = false;
+    bool zero = true;
+};
+
+struct MotionModelScratch {
+    std::vector<MotionCell> cells;
+    int cell_columns = 0;
+    std::vector<uint8_t> kinds;       // per pixel: camera motion, a model, its own value
+    std::vector<uint8_t> which;      // per pixel of a 4x4 cell coded pixel by pixel: its model
+    std::vector<glm::ivec2> values;  // per pixel: the decoded residual, 1/512 px (clamped)
+};
+
+// Whether every pixel of row y is within `bound` px of the camera motion (NaN both ways counts).
+bool motion_within_bound(ImageView<const glm::vec2> source, ImageView<const glm::vec2> base, int y,
+                         float bound);
+
+void encode_motion_models(const SequenceParams& sp, ImageView<const glm::vec2> base,
+                          ImageView<const glm::vec2> source, ImageView<glm::vec2> out,
+                          MotionModelScratch& scratch,
+                          std::vector<std::vector<uint8_t>>& slice_bytes,
+                          std::vector<uint8_t>& bytes, StreamStats& stats);
+Status decode_motion_models(const SequenceParams& sp, ImageView<const glm::vec2> base,
+                            const std::vector<std::span<const uint8_t>>& slices,
+                            ImageView<glm::vec2> out, MotionModelScratch& scratch,
+                            StreamStats& stats);
+
+}  // namespace reprise::codec
