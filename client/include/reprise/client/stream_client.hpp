@@ -39,6 +39,7 @@ struct StreamClientStats {
     std::size_t fec_recovered = 0;
     int64_t last_rtt_us = 0;  // pose sampled -> frame decoded
     std::string refused;      // the server's reason when it refused the session
+    bool server_full = false;  // refused by the server's --max-sessions (docs/protocol.md)
 };
 
 // What one display frame was made from.
