@@ -9,12 +9,12 @@
 #include <sstream>
 
 #include "metrics_endpoint.hpp"
-#include "stream_session.hpp"
-#include "stream_worker.hpp"
 #include "reprise/net/guess_budget.hpp"
 #include "reprise/net/secure.hpp"
 #include "reprise/server/builtin_scenes.hpp"
 #include "reprise/server/renderer.hpp"
+#include "stream_session.hpp"
+#include "stream_worker.hpp"
 
 namespace reprise::server {
 
@@ -119,7 +119,8 @@ struct StreamServer::State {
             if (s.net.queue_bytes + std::min(sealed_bytes, options.send_queue_bytes / 2) >
                 options.send_queue_bytes) {
                 std::lock_guard lock(s.mutex);
-                detail::push_bounded(s.box.lost, f.frame);  // the worker drains it before its next frame
+                detail::push_bounded(s.box.lost,
+                                     f.frame);  // the worker drains it before its next frame
                 ++dropped;
                 continue;
             }
@@ -153,11 +154,11 @@ struct StreamServer::State {
             return;
         }
         std::array<uint8_t, net::kRefusedSize> out;
-        const std::size_t n = net::encode(
-            net::RefusedDatagram{.connection = h.connection,
-                                 .reason = net::RefusalReason::ServerFull,
-                                 .sessions = uint8_t(options.max_sessions)},
-            out);
+        const std::size_t n =
+            net::encode(net::RefusedDatagram{.connection = h.connection,
+                                             .reason = net::RefusalReason::ServerFull,
+                                             .sessions = uint8_t(options.max_sessions)},
+                        out);
         socket.send_to(std::span<const uint8_t>(out.data(), n), from);
         count(&StreamServerStats::refused_full);
     }

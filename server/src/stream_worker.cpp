@@ -12,7 +12,8 @@ namespace reprise::server::detail {
 
 namespace {
 
-constexpr int64_t kProbeIntervalUs = 1'000'000;  // a stalled window still sends one frame this often
+constexpr int64_t kProbeIntervalUs =
+    1'000'000;  // a stalled window still sends one frame this often
 
 double ms_since(std::chrono::steady_clock::time_point t) {
     return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
@@ -60,14 +61,16 @@ void bundle_packets(std::span<const uint8_t> geometry, std::span<const uint8_t> 
 
 RenderWorker::RenderWorker(WorkerLink link)
     : link_(link),
-      ladder_(link.options.aa_samples, link.options.fps,
-              link.options.mode == net::StreamMode::Full, link.options.ladder) {
+      ladder_(link.options.aa_samples, link.options.fps, link.options.mode == net::StreamMode::Full,
+              link.options.ladder) {
     publish_level();
 }
 
 RenderWorker::~RenderWorker() { stop(); }
 
-void RenderWorker::start() { thread_ = std::thread([this] { loop(); }); }
+void RenderWorker::start() {
+    thread_ = std::thread([this] { loop(); });
+}
 
 void RenderWorker::stop() {
     {
@@ -131,10 +134,11 @@ void RenderWorker::loop() {
         if (rendered && link_.options.adapt) {
             const int before = ladder_.level();
             if (ladder_.update(cost_ms, net::now_us()))
-                std::fprintf(stderr,
-                             "[serve] frame cost %.0f ms: adaptation level %d -> %d (aa %d, %g Hz)\n",
-                             ladder_.mean_cost_ms(), before, ladder_.level(),
-                             ladder_.current().aa_samples, ladder_.current().fps);
+                std::fprintf(
+                    stderr,
+                    "[serve] frame cost %.0f ms: adaptation level %d -> %d (aa %d, %g Hz)\n",
+                    ladder_.mean_cost_ms(), before, ladder_.level(), ladder_.current().aa_samples,
+                    ladder_.current().fps);
             publish_level();
         }
         const int64_t period = int64_t(1e6 / ladder_.current().fps);

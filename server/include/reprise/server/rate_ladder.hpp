@@ -13,12 +13,12 @@ struct RateLevel {
 };
 
 struct RateLadderOptions {
-    double down_at = 0.95;       // step down when the mean cost exceeds this × the period
-    double up_below = 0.7;       // step up when the cost predicted above is below this × its period
-    int frames_to_judge = 3;     // frames measured at a level before it is judged
+    double down_at = 0.95;    // step down when the mean cost exceeds this × the period
+    double up_below = 0.7;    // step up when the cost predicted above is below this × its period
+    int frames_to_judge = 3;  // frames measured at a level before it is judged
     int64_t hold_up_us = 2'000'000;  // time at a level before stepping up; doubles when an up
                                      // step had to be taken back, at most 32 s
-    double smoothing = 0.3;      // weight of the newest cost in the running mean
+    double smoothing = 0.3;          // weight of the newest cost in the running mean
 };
 
 class RateLadder {

@@ -62,9 +62,9 @@ struct StreamServerStats {
     std::size_t dropped_datagrams = 0;   // garbage, truncated, oversized, unauthenticated, replayed
     std::size_t frames_sent = 0, frames_skipped = 0;
     std::size_t frames_encoded = 0;
-    std::size_t frames_dropped = 0;     // encoded, dropped from a full hand-over or send queue
-    std::size_t feedback_dropped = 0;   // acks or losses dropped from a full mailbox
-    std::size_t refused_full = 0;       // handshakes answered "server full" (--max-sessions)
+    std::size_t frames_dropped = 0;    // encoded, dropped from a full hand-over or send queue
+    std::size_t feedback_dropped = 0;  // acks or losses dropped from a full mailbox
+    std::size_t refused_full = 0;      // handshakes answered "server full" (--max-sessions)
     std::size_t datagrams_sent = 0, bytes_sent = 0;
     std::size_t loss_reports = 0, key_frame_requests = 0, acks = 0;
     std::size_t max_queue_bytes = 0;  // largest send queue of any session
