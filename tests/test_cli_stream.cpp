@@ -12,8 +12,8 @@
 #include <thread>
 #include <vector>
 
-#include "reprise/codec/codec.hpp"
 #include "frame_writer.hpp"
+#include "reprise/codec/codec.hpp"
 #include "support/cli.hpp"
 
 namespace fs = std::filesystem;

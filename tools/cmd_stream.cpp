@@ -136,8 +136,8 @@ Status run_serve(const ServeJob& job) {
         stderr,
         "[serve] %zu sessions, %zu frames sent, %zu skipped, %zu dropped, %.1f MB, %zu datagrams "
         "dropped, %zu refused (server full)\n",
-        st.sessions_total, st.frames_sent, st.frames_skipped, st.frames_dropped, st.bytes_sent / 1e6,
-        st.dropped_datagrams, st.refused_full);
+        st.sessions_total, st.frames_sent, st.frames_skipped, st.frames_dropped,
+        st.bytes_sent / 1e6, st.dropped_datagrams, st.refused_full);
     const double frames = double(std::max<std::size_t>(st.frames_encoded, 1));
     std::fprintf(stderr,
                  "[serve] mean render %.1f ms, encode %.1f ms; adaptation level %d of %d (aa %d, "
@@ -261,8 +261,7 @@ Status run_connect(const ConnectJob& job) {
                 const bool written = writer->submit(f, index, info.scene_time, job.display_rate);
                 log << index << ',' << info.scene_time << ',' << info.pose_us << ',' << displayed_us
                     << ',' << latency << ',' << info.source_scene_time << ','
-                    << (displayed_us - info.source_pose_us) / 1000.0 << ',' << int(written)
-                    << '\n';
+                    << (displayed_us - info.source_pose_us) / 1000.0 << ',' << int(written) << '\n';
             }
             if (window) window->show(f);
             ++index;
@@ -270,8 +269,10 @@ Status run_connect(const ConnectJob& job) {
         }));
     if (writer) {
         REPRISE_TRY(writer->finish());
-        std::fprintf(stderr, "[connect] %zu frames written to %s, %zu not written (the writer fell "
-                     "behind the display)\n", writer->written(), job.out.c_str(), writer->dropped());
+        std::fprintf(stderr,
+                     "[connect] %zu frames written to %s, %zu not written (the writer fell "
+                     "behind the display)\n",
+                     writer->written(), job.out.c_str(), writer->dropped());
     }
     const client::StreamClientStats& st = c->stats();
     std::fprintf(
