@@ -4,12 +4,15 @@
 
 #include <unistd.h>
 
+#include <atomic>
+#include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <thread>
 #include <vector>
 
+#include "frame_writer.hpp"
 #include "reprise/codec/codec.hpp"
 #include "support/cli.hpp"
 
@@ -105,4 +108,62 @@ TEST(CliStream, AStreamFileWithReservedHeaderBytesSetIsRefused) {
         EXPECT_EQ(r.status, 1) << r.output;
         EXPECT_NE(r.output.find("reserved"), std::string::npos) << r.output;
     }
+}
+
+// Issue 23: --out wrote each EXR on the display path. The writer's thread takes it; a full queue
+// drops writes (counted) and never holds the caller.
+TEST(CliStream, TheFrameWriterNeverHoldsTheDisplayLoop) {
+    const fs::path out =
+        reprise::test::fresh_directory(fs::temp_directory_path() / "reprise-frame-writer");
+    std::atomic<int> calls{0};
+    reprise::cli::FrameWriter writer(out.string(), 4,
+                                     [&](const std::string&, const reprise::Frame&) {
+                                         std::this_thread::sleep_for(std::chrono::milliseconds(50));
+                                         ++calls;
+                                         return reprise::Status{};
+                                     });
+    reprise::Frame f;
+    f.color.resize(320, 180);
+    f.depth.resize(320, 180);
+    f.motion.resize(320, 180);
+    const auto start = std::chrono::steady_clock::now();
+    std::size_t accepted = 0;
+    for (int i = 0; i < 40; ++i) accepted += writer.submit(f, i, i / 60.0, 60.0);
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    ASSERT_TRUE(writer.finish().ok());
+    // Writing on the caller's thread would take 40 × 50 ms = 2 s.
+    EXPECT_LT(seconds, 1.0);
+    EXPECT_EQ(writer.written(), accepted);
+    EXPECT_EQ(writer.written() + writer.dropped(), 40u);
+    EXPECT_GT(writer.dropped(), 0u);
+    EXPECT_EQ(calls.load(), int(accepted));
+}
+
+TEST(CliStream, ASecondClientOverMaxSessionsIsToldTheServerIsFull) {
+    const std::string port = std::to_string(20000 + (getpid() + 7) % 20000);
+    ::setenv("REPRISE_PIN", "778899", 1);
+    Outcome served, first;
+    std::thread server([&] {
+        served = run_reprise("serve --listen 127.0.0.1:" + port +
+                                 " --size 64x48 --aa 1 --max-sessions 1 --duration 8",
+                             60);
+    });
+    std::thread one([&] {
+        first = run_reprise("connect 127.0.0.1:" + port + " --display-rate 30 --duration 6", 60);
+    });
+    std::this_thread::sleep_for(std::chrono::seconds(3));
+    const auto start = std::chrono::steady_clock::now();
+    const Outcome second =
+        run_reprise("connect 127.0.0.1:" + port + " --display-rate 30 --duration 6", 60);
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    one.join();
+    server.join();
+    ::unsetenv("REPRISE_PIN");
+    EXPECT_EQ(first.status, 0) << first.output;
+    EXPECT_EQ(second.status, 1) << second.output;
+    EXPECT_NE(second.output.find("server full: 1 sessions"), std::string::npos) << second.output;
+    EXPECT_LT(seconds, 4.0) << "told, not timed out after its 6 s";
+    EXPECT_EQ(served.output.find(" 0 refused (server full)"), std::string::npos) << served.output;
 }

@@ -10,6 +10,7 @@
 
 #include "args.hpp"
 #include "commands.hpp"
+#include "frame_writer.hpp"
 #include "reprise/client/stream_client.hpp"
 #include "reprise/core/exr.hpp"
 #include "reprise/server/builtin_scenes.hpp"
@@ -61,7 +62,7 @@ struct ServeJob {
     std::string scene = "pan", listen = "127.0.0.1:7000", size = "640x360", mode = "full";
     PinSource pin;
     double fps = 30.0, duration = 0.0;
-    bool duration_given = false, metrics_port_given = false;
+    bool duration_given = false, metrics_port_given = false, no_adapt = false;
     int max_sessions = 4, qp = 28, bitrate = 0, fec_group = 8, metrics_port = -1, lowres = 4,
         aa = 4;
 };
@@ -99,6 +100,7 @@ Status run_serve(const ServeJob& job) {
         return Status::error("--fec-group must be 0..255");
     o.fec.group = job.fec_group;
     o.metrics_port = job.metrics_port;
+    o.adapt = !job.no_adapt;
     // The served scene must load before anyone connects.
     server::Scene scene;
     server::CameraPath path;
@@ -132,9 +134,17 @@ Status run_serve(const ServeJob& job) {
     const server::StreamServerStats st = srv->stats();
     std::fprintf(
         stderr,
-        "[serve] %zu sessions, %zu frames sent, %zu skipped, %.1f MB, %zu datagrams dropped\n",
-        st.sessions_total, st.frames_sent, st.frames_skipped, st.bytes_sent / 1e6,
-        st.dropped_datagrams);
+        "[serve] %zu sessions, %zu frames sent, %zu skipped, %zu dropped, %.1f MB, %zu datagrams "
+        "dropped, %zu refused (server full)\n",
+        st.sessions_total, st.frames_sent, st.frames_skipped, st.frames_dropped,
+        st.bytes_sent / 1e6, st.dropped_datagrams, st.refused_full);
+    const double frames = double(std::max<std::size_t>(st.frames_encoded, 1));
+    std::fprintf(stderr,
+                 "[serve] mean render %.1f ms, encode %.1f ms; adaptation level %d of %d (aa %d, "
+                 "%g Hz), %zu steps down, %zu up\n",
+                 st.render_ms_total / frames, st.encode_ms_total / frames, st.adapt_level,
+                 st.adapt_levels - 1, st.aa_samples, st.fps, st.adapt_steps_down,
+                 st.adapt_steps_up);
     return s;
 }
 
@@ -235,31 +245,35 @@ Status run_connect(const ConnectJob& job) {
     if (!job.out.empty()) {
         log.open(job.out + "/display.csv");
         log << "index,scene_time,pose_us,displayed_us,latency_ms,source_scene_time,source_latency_"
-               "ms\n";
+               "ms,written\n";
     }
+    // EXR writing on its own thread: the display loop only copies the frame into a free slot.
+    std::unique_ptr<FrameWriter> writer;
+    if (!job.out.empty()) writer = std::make_unique<FrameWriter>(job.out);
     int index = 0;
     double latency_sum = 0.0;
-    Status write_status;
-    Frame out;
     REPRISE_TRY(client::run_client(
         *c, job.duration, job.display_rate, pose,
         [&](const Frame& f, const client::DisplayInfo& info, int64_t displayed_us) {
             const double latency = (displayed_us - info.pose_us) / 1000.0;
             latency_sum += latency;
-            if (!job.out.empty()) {
-                out = f;
-                out.camera.time = info.scene_time;
-                out.fps = job.display_rate;
-                write_status = write_frame(frame_path(job.out, index), out);
+            if (writer) {
+                const bool written = writer->submit(f, index, info.scene_time, job.display_rate);
                 log << index << ',' << info.scene_time << ',' << info.pose_us << ',' << displayed_us
                     << ',' << latency << ',' << info.source_scene_time << ','
-                    << (displayed_us - info.source_pose_us) / 1000.0 << '\n';
+                    << (displayed_us - info.source_pose_us) / 1000.0 << ',' << int(written) << '\n';
             }
             if (window) window->show(f);
             ++index;
-            return write_status.ok() && !g_stop.load() && window_open;
+            return !g_stop.load() && window_open;
         }));
-    REPRISE_TRY(write_status);
+    if (writer) {
+        REPRISE_TRY(writer->finish());
+        std::fprintf(stderr,
+                     "[connect] %zu frames written to %s, %zu not written (the writer fell "
+                     "behind the display)\n",
+                     writer->written(), job.out.c_str(), writer->dropped());
+    }
     const client::StreamClientStats& st = c->stats();
     std::fprintf(
         stderr,
@@ -294,7 +308,10 @@ int command_serve(int argc, char** argv) {
                 "lowres mode: 2 or 4 pixels per colour sample (default 4)");
     args.option("--aa", &job.aa,
                 "anti-aliased colour, samples per pixel: 1 (off, fastest), 2, 4 (default), 8, 16");
-    args.option("--max-sessions", &job.max_sessions, "sessions at once (default 4)");
+    args.option("--max-sessions", &job.max_sessions,
+                "sessions at once; more are told \"server full\" (default 4)");
+    args.flag("--no-adapt", &job.no_adapt,
+              "keep --aa and --fps even when frames take longer than a period");
     args.option("--qp", &job.qp, "quantiser when no --bitrate (default 28)");
     args.option("--bitrate", &job.bitrate,
                 "start bitrate in kbps, adapted to loss (default 0: constant quality)");

@@ -188,6 +188,19 @@ struct StreamClient::State {
             ++stats.datagrams_dropped;
             return;
         }
+        if (h.type == net::DatagramType::Refused) {
+            // Unauthenticated, so only for the handshake under way (its random connection id).
+            net::RefusedDatagram r;
+            if ((phase == Phase::HelloSent || phase == Phase::Finished) &&
+                h.connection == handshake.connection() && net::parse(d, r).ok()) {
+                stats.server_full = true;
+                stats.refused = "server full: " + std::to_string(r.sessions) + " sessions";
+                phase = Phase::Idle;
+            } else {
+                ++stats.datagrams_dropped;
+            }
+            return;
+        }
         if (h.type == net::DatagramType::ServerHello) {
             if (phase != Phase::HelloSent) return;
             net::SessionKeys keys;

@@ -1,6 +1,8 @@
 #include "reprise/net/udp.hpp"
 
 #include <poll.h>
+#include <sys/eventfd.h>
+#include <unistd.h>
 
 #include <asio/io_context.hpp>
 #include <asio/ip/udp.hpp>
@@ -98,11 +100,27 @@ bool UdpSocket::receive(std::vector<uint8_t>& datagram, Endpoint& from, std::siz
     }
 }
 
-bool UdpSocket::wait_readable(int64_t timeout_us) {
+bool UdpSocket::wait_readable(int64_t timeout_us, Waker* waker) {
     if (!impl_->socket.is_open()) return false;
-    pollfd p{.fd = impl_->socket.native_handle(), .events = POLLIN, .revents = 0};
+    pollfd p[2] = {{.fd = impl_->socket.native_handle(), .events = POLLIN, .revents = 0},
+                   {.fd = waker ? waker->fd() : -1, .events = POLLIN, .revents = 0}};
     const int ms = int(std::clamp<int64_t>((timeout_us + 999) / 1000, 0, 1000));
-    return ::poll(&p, 1, ms) > 0;
+    const bool ready = ::poll(p, waker ? 2 : 1, ms) > 0;
+    if (waker && (p[1].revents & POLLIN)) waker->clear();
+    return ready && (p[0].revents & POLLIN);
+}
+
+Waker::Waker() : fd_(::eventfd(0, EFD_NONBLOCK | EFD_CLOEXEC)) {}
+Waker::~Waker() {
+    if (fd_ >= 0) ::close(fd_);
+}
+void Waker::wake() {
+    const uint64_t one = 1;
+    (void)!::write(fd_, &one, sizeof one);
+}
+void Waker::clear() {
+    uint64_t value;
+    (void)!::read(fd_, &value, sizeof value);
 }
 
 int64_t now_us() {

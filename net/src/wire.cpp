@@ -25,9 +25,30 @@ Status parse_header(std::span<const uint8_t> datagram, DatagramHeader& header) {
     if (version != kProtocolVersion)
         return Status::error("datagram: protocol version " + std::to_string(version) +
                              ", expected 1");
-    if (type < 1 || type > 4)
+    if (type < 1 || type > uint8_t(DatagramType::Refused))
         return Status::error("datagram: unknown type " + std::to_string(type));
     header.type = DatagramType(type);
+    return {};
+}
+
+std::size_t encode(const RefusedDatagram& d, std::span<uint8_t> out) {
+    Writer w(out);
+    write_header(w, {.type = DatagramType::Refused, .connection = d.connection});
+    w.u8(uint8_t(d.reason));
+    w.u8(d.sessions);
+    return w.size();
+}
+
+Status parse(std::span<const uint8_t> datagram, RefusedDatagram& d) {
+    DatagramHeader h;
+    REPRISE_TRY(parse_header(datagram, h));
+    if (h.type != DatagramType::Refused || datagram.size() != kRefusedSize)
+        return Status::error("refused: not a 14-byte Refused datagram");
+    if (datagram[kHeaderSize] != uint8_t(RefusalReason::ServerFull))
+        return Status::error("refused: unknown reason " + std::to_string(datagram[kHeaderSize]));
+    d.connection = h.connection;
+    d.reason = RefusalReason(datagram[kHeaderSize]);
+    d.sessions = datagram[kHeaderSize + 1];
     return {};
 }
 

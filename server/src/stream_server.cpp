@@ -13,6 +13,8 @@
 #include "reprise/net/secure.hpp"
 #include "reprise/server/builtin_scenes.hpp"
 #include "reprise/server/renderer.hpp"
+#include "stream_session.hpp"
+#include "stream_worker.hpp"
 
 namespace reprise::server {
 
@@ -23,13 +25,6 @@ constexpr int64_t kPendingLifetimeUs = 5'000'000;
 constexpr std::size_t kMaxTickets = 64;
 constexpr int64_t kTicketLifetimeUs = 24 * 3600 * int64_t(1'000'000);
 constexpr int64_t kInfoIntervalUs = 500'000;
-constexpr int64_t kProbeIntervalUs =
-    1'000'000;  // a stalled window still sends one frame this often
-
-double ms_since(std::chrono::steady_clock::time_point t) {
-    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
-}
-
 struct Pending {
     net::Endpoint peer;
     net::PendingHandshake handshake;
@@ -45,57 +40,24 @@ struct IssuedTicket {
     int64_t issued_us = 0;
 };
 
-struct Session {
-    net::Endpoint peer;
-    net::SecureChannel channel;
-    int64_t last_heard_us = 0, last_info_us = 0, last_progress_us = 0;
-    bool started = false;
-    std::string scene_name;
-    Scene scene;
-    CameraPath path;
-    bool have_pose = false;
-    net::PoseMessage pose;
-    bool rendered_before = false;
-    Instant previous;
-    codec::Encoder encoder;
-    codec::Encoder colour_encoder;  // lowres: the low-resolution colour stream
-    Frame frame, low;
-    Image<glm::vec4> low_color;
-    codec::Packet packet, colour_packet;
-    std::vector<uint8_t> bundle;
-    int64_t frames_rendered = 0;
-    std::deque<std::vector<uint8_t>> queue;  // sealed datagrams waiting for the socket
-    std::size_t queue_bytes = 0;
-    int64_t newest_sent = -1, newest_acked = -1;
-    uint32_t report_received = 0, report_missing = 0;
-    int bitrate_kbps = 0;
-    int64_t min_rtt_us = 0;
-    bool ended = false;
-    net::TicketMessage ticket;  // for the client's next handshake, sent with every StreamInfo
-
-    Session(net::Endpoint p, uint64_t connection, const net::SessionKeys& keys,
-            const codec::EncoderOptions& eo)
-        : peer(p),
-          channel(connection, keys.server_to_client, keys.client_to_server),
-          encoder(eo),
-          colour_encoder(eo) {}
-};
+using detail::Session;
 
 }  // namespace
 
 struct StreamServer::State {
     StreamServerOptions options;
     net::UdpSocket socket;
+    net::Waker waker;  // the worker wakes the network thread when it hands a frame over
     MetricsEndpoint metrics;
     net::HandshakeRateLimiter limiter;
     net::GuessBudget guesses;
     std::vector<Pending> pending;
     std::vector<IssuedTicket> tickets;
-    std::vector<std::unique_ptr<Session>> sessions;
-    std::unique_ptr<Renderer> renderer;
-    // Scratch reused every datagram and frame.
+    // Written by the network thread only, under sessions_mutex; the worker copies it per tick.
+    std::mutex sessions_mutex;
+    std::vector<std::shared_ptr<Session>> sessions;
+    // Scratch reused every datagram.
     std::vector<uint8_t> datagram, plaintext, sealed, reply;
-    std::vector<std::vector<uint8_t>> messages;
     std::vector<std::vector<uint8_t>> spare;
     mutable std::mutex stats_mutex;
     StreamServerStats stats;
@@ -109,7 +71,7 @@ struct StreamServer::State {
         stats.*field += n;
     }
 
-    void send_message(Session& s, std::span<const uint8_t> message) {
+    void send_message(Session::Net& s, std::span<const uint8_t> message) {
         s.channel.seal(message, sealed);
         std::vector<uint8_t> d;
         if (!spare.empty()) {
@@ -121,12 +83,12 @@ struct StreamServer::State {
         s.queue.push_back(std::move(d));
     }
 
-    void send_now(Session& s, std::span<const uint8_t> message) {
+    void send_now(Session::Net& s, std::span<const uint8_t> message) {
         send_message(s, message);
         flush(s);
     }
 
-    void flush(Session& s) {
+    void flush(Session::Net& s) {
         std::size_t datagrams = 0, bytes = 0;
         while (!s.queue.empty()) {
             if (!socket.send_to(s.queue.front(), s.peer)) break;
@@ -142,10 +104,63 @@ struct StreamServer::State {
         stats.bytes_sent += bytes;
     }
 
+    // Seals and queues the frames the worker handed over; a frame that would overflow the send
+    // queue is dropped and reported lost to the worker's encoders.
+    void take_frames(Session& s) {
+        std::deque<detail::EncodedFrame> frames;
+        {
+            std::lock_guard lock(s.mutex);
+            frames.swap(s.box.frames);
+        }
+        std::size_t sent = 0, dropped = 0;
+        for (detail::EncodedFrame& f : frames) {
+            const std::size_t sealed_bytes =
+                f.bytes + f.count * (net::kSealedHeaderSize + net::kAeadTagSize);
+            if (s.net.queue_bytes + std::min(sealed_bytes, options.send_queue_bytes / 2) >
+                options.send_queue_bytes) {
+                std::lock_guard lock(s.mutex);
+                detail::push_bounded(s.box.lost,
+                                     f.frame);  // the worker drains it before its next frame
+                ++dropped;
+                continue;
+            }
+            for (std::size_t i = 0; i < f.count; ++i) send_message(s.net, f.messages[i]);
+            s.net.newest_sent = f.frame;
+            ++sent;
+        }
+        if (!frames.empty()) {
+            std::lock_guard lock(s.mutex);
+            for (detail::EncodedFrame& f : frames)
+                if (s.box.spare.size() < detail::kMaxHandover + 1)
+                    s.box.spare.push_back(std::move(f));
+        }
+        std::lock_guard lock(stats_mutex);
+        stats.frames_sent += sent;
+        stats.frames_dropped += dropped;
+        stats.max_queue_bytes = std::max(stats.max_queue_bytes, s.net.queue_bytes);
+    }
+
     Session* find(uint64_t connection) {
         for (auto& s : sessions)
-            if (s->channel.connection() == connection) return s.get();
+            if (s->net.channel.connection() == connection) return s.get();
         return nullptr;
+    }
+
+    // "Server full" to an unauthenticated source: 14 bytes against its 128-byte hello or
+    // 44-byte finish (no amplification), and at most the source's handshake rate.
+    void refuse_full(const net::DatagramHeader& h, const net::Endpoint& from, int64_t now) {
+        if (!limiter.allow_source(from.address, now)) {
+            count(&StreamServerStats::handshakes_rate_limited);
+            return;
+        }
+        std::array<uint8_t, net::kRefusedSize> out;
+        const std::size_t n =
+            net::encode(net::RefusedDatagram{.connection = h.connection,
+                                             .reason = net::RefusalReason::ServerFull,
+                                             .sessions = uint8_t(options.max_sessions)},
+                        out);
+        socket.send_to(std::span<const uint8_t>(out.data(), n), from);
+        count(&StreamServerStats::refused_full);
     }
 
     void handle_datagram(std::span<const uint8_t> d, const net::Endpoint& from, int64_t now) {
@@ -183,10 +198,11 @@ struct StreamServer::State {
                 socket.send_to(p.server_hello, from);  // a retransmitted hello gets the same answer
                 return;
             }
-        if (find(h.connection) || int(sessions.size()) >= options.max_sessions) {
+        if (find(h.connection)) {
             count(&StreamServerStats::dropped_datagrams);
             return;
         }
+        if (int(sessions.size()) >= options.max_sessions) return refuse_full(h, from, now);
         bool has_ticket = false;
         std::array<uint8_t, net::kTicketIdSize> ticket_id{};
         if (!net::client_hello_ticket(d, has_ticket, ticket_id).ok()) {
@@ -259,18 +275,21 @@ struct StreamServer::State {
         }
         if (int(sessions.size()) >= options.max_sessions) {
             pending.erase(it);
-            count(&StreamServerStats::dropped_datagrams);
-            return;
+            return refuse_full(h, from, now);
         }
         codec::EncoderOptions eo = options.encoder;
         eo.fps = options.fps;
         eo.bitrate_kbps = options.bitrate_kbps;
-        auto s = std::make_unique<Session>(from, h.connection, it->handshake.keys, eo);
-        s->last_heard_us = s->last_progress_us = now;
-        s->bitrate_kbps = options.bitrate_kbps;
-        s->ticket = issue_ticket(now);
+        auto s = std::make_shared<Session>(from, h.connection, it->handshake.keys, eo);
+        s->net.last_heard_us = s->box.last_progress_us = now;
+        s->net.bitrate_kbps = s->box.bitrate_kbps = options.bitrate_kbps;
+        s->media.bitrate_kbps = options.bitrate_kbps;
+        s->net.ticket = issue_ticket(now);
         pending.erase(it);
-        sessions.push_back(std::move(s));
+        {
+            std::lock_guard lock(sessions_mutex);
+            sessions.push_back(std::move(s));
+        }
         ++sessions_total;
         count(&StreamServerStats::handshakes_ok);
     }
@@ -297,31 +316,38 @@ struct StreamServer::State {
     void refuse(Session& s, const std::string& why) {
         reply.resize(net::kMaxPlaintext);
         reply.resize(net::encode_error(why, reply));
-        send_now(s, reply);
-        s.ended = true;
+        send_now(s.net, reply);
+        s.net.ended = true;
     }
 
-    void start(Session& s, const net::StartMessage& m) {
-        if (s.started) return;
-        const std::string name = m.scene.empty() ? options.scene : m.scene;
+    // The scene is checked against the catalogue here and loaded by the worker (a glTF file may
+    // take a while); StreamInfo goes out at once.
+    void start(Session& s, const net::StartMessage& m, int64_t now) {
+        if (s.net.started) return;
         if (!m.scene.empty()) {
             const auto names = scene_catalogue();
-            if (std::find(names.begin(), names.end(), name) == names.end())
-                return refuse(s, "scene '" + name + "' is not in the catalogue");
+            if (std::find(names.begin(), names.end(), m.scene) == names.end())
+                return refuse(s, "scene '" + m.scene + "' is not in the catalogue");
         }
-        if (Status st = load_scene(name, s.scene, s.path); !st.ok())
-            return refuse(s, "scene: " + st.message());
-        s.scene_name = m.scene.empty() ? std::string("default") : m.scene;
-        s.started = true;
-        send_info(s, net_now());
+        s.net.scene_name = m.scene.empty() ? std::string("default") : m.scene;
+        s.net.started = true;
+        {
+            std::lock_guard lock(s.mutex);
+            s.box.started = true;
+            s.box.scene = m.scene;
+        }
+        send_info(s.net, now);
     }
 
-    static int64_t net_now() { return net::now_us(); }
-
-    void send_info(Session& s, int64_t now) {
+    void send_info(Session::Net& s, int64_t now) {
+        float fps;
+        {
+            std::lock_guard lock(stats_mutex);
+            fps = float(stats.fps);  // the rate adaptation's current rate
+        }
         net::StreamInfoMessage info{.width = uint16_t(options.width),
                                     .height = uint16_t(options.height),
-                                    .fps = float(options.fps),
+                                    .fps = fps,
                                     .mode = options.mode,
                                     .scene = s.scene_name};
         reply.resize(net::kMaxPlaintext);
@@ -336,67 +362,71 @@ struct StreamServer::State {
     void sealed_datagram(std::span<const uint8_t> d, const net::DatagramHeader& h,
                          const net::Endpoint& from, int64_t now) {
         Session* s = find(h.connection);
-        if (!s || !(s->peer == from) || !s->channel.open(d, plaintext).ok()) {
+        if (!s || !(s->net.peer == from) || !s->net.channel.open(d, plaintext).ok()) {
             count(&StreamServerStats::dropped_datagrams);
             return;
         }
-        s->last_heard_us = now;
+        s->net.last_heard_us = now;
         net::MessageType type;
         if (!net::message_type(plaintext, type).ok()) {
             count(&StreamServerStats::dropped_datagrams);
             return;
         }
         bool parsed = true;
+        std::size_t feedback_dropped = 0;
         switch (type) {
             case net::MessageType::Start: {
                 net::StartMessage m;
                 parsed = net::parse(plaintext, m).ok();
-                if (parsed) start(*s, m);
+                if (parsed) start(*s, m, now);
                 break;
             }
             case net::MessageType::Pose: {
                 net::PoseMessage m;
                 parsed = net::parse(plaintext, m).ok();
-                if (parsed && (!s->have_pose || m.sequence > s->pose.sequence)) {
-                    s->pose = m;
-                    s->have_pose = true;
+                std::lock_guard lock(s->mutex);
+                if (parsed && (!s->box.have_pose || m.sequence > s->box.pose.sequence)) {
+                    s->box.pose = m;
+                    s->box.have_pose = true;
                 }
                 break;
             }
             case net::MessageType::Ack: {
                 net::AckMessage m;
-                parsed = net::parse(plaintext, m).ok() && int64_t(m.frame) <= s->newest_sent;
+                parsed = net::parse(plaintext, m).ok() && int64_t(m.frame) <= s->net.newest_sent;
                 if (parsed) {
-                    s->encoder.acknowledge(m.frame);
-                    s->colour_encoder.acknowledge(m.frame);
-                    s->newest_acked = std::max<int64_t>(s->newest_acked, m.frame);
-                    s->last_progress_us = now;
-                    count(&StreamServerStats::acks);
+                    std::lock_guard lock(s->mutex);
+                    feedback_dropped += s->box.acked.size() >= detail::kMaxFeedback;
+                    detail::push_bounded(s->box.acked, m.frame);
+                    s->box.newest_acked = std::max<int64_t>(s->box.newest_acked, m.frame);
+                    s->box.last_progress_us = now;
                 }
+                if (parsed) count(&StreamServerStats::acks);
                 break;
             }
             case net::MessageType::LossReport: {
                 net::LossReportMessage m;
                 parsed = net::parse(plaintext, m).ok();
                 if (parsed) {
+                    std::lock_guard lock(s->mutex);
                     for (int i = 0; i < m.count; ++i)
-                        if (int64_t(m.frames[i]) <= s->newest_sent) {
-                            s->encoder.report_loss(m.frames[i]);
-                            s->colour_encoder.report_loss(m.frames[i]);
+                        if (int64_t(m.frames[i]) <= s->net.newest_sent) {
+                            feedback_dropped += s->box.lost.size() >= detail::kMaxFeedback;
+                            detail::push_bounded(s->box.lost, m.frames[i]);
                         }
-                    s->last_progress_us = now;
-                    count(&StreamServerStats::loss_reports);
+                    s->box.last_progress_us = now;
                 }
+                if (parsed) count(&StreamServerStats::loss_reports);
                 break;
             }
             case net::MessageType::KeyFrameRequest:
                 parsed = plaintext.size() == 1;
                 if (parsed) {
-                    s->encoder.request_key_frame();
-                    s->colour_encoder.request_key_frame();
-                    s->last_progress_us = now;
-                    count(&StreamServerStats::key_frame_requests);
+                    std::lock_guard lock(s->mutex);
+                    s->box.key_frame = true;
+                    s->box.last_progress_us = now;
                 }
+                if (parsed) count(&StreamServerStats::key_frame_requests);
                 break;
             case net::MessageType::ReceiverReport: {
                 net::ReceiverReportMessage m;
@@ -405,16 +435,18 @@ struct StreamServer::State {
                 break;
             }
             case net::MessageType::Bye:
-                s->ended = true;
+                s->net.ended = true;
                 break;
             default:
                 parsed = false;
         }
         if (!parsed) count(&StreamServerStats::dropped_datagrams);
+        if (feedback_dropped) count(&StreamServerStats::feedback_dropped, feedback_dropped);
     }
 
     // Loss over the interval since the previous report moves the rate-control target.
-    void adapt(Session& s, const net::ReceiverReportMessage& m) {
+    void adapt(Session& session, const net::ReceiverReportMessage& m) {
+        Session::Net& s = session.net;
         const uint32_t received = m.received - s.report_received,
                        missing = m.missing - s.report_missing;
         if (m.received < s.report_received || m.missing < s.report_missing) return;  // stale report
@@ -438,137 +470,12 @@ struct StreamServer::State {
                 next *= 1.05;
             s.bitrate_kbps =
                 std::clamp(int(next), options.min_bitrate_kbps, options.max_bitrate_kbps);
-            if (options.mode == net::StreamMode::LowRes) {
-                // Geometry (depth + motion) and colour share the target by their usual weights.
-                s.encoder.set_bitrate(std::max(1, s.bitrate_kbps * 2 / 3));
-                s.colour_encoder.set_bitrate(std::max(1, s.bitrate_kbps / 3));
-            } else {
-                s.encoder.set_bitrate(s.bitrate_kbps);
-            }
+            std::lock_guard lock(session.mutex);
+            session.box.bitrate_kbps = s.bitrate_kbps;  // the worker sets its encoders
         }
         std::lock_guard lock(stats_mutex);
         stats.loss = loss;
         stats.bitrate_kbps = s.bitrate_kbps;
-    }
-
-    Status produce_frame(Session& s, int64_t now) {
-        if (!s.started || !s.have_pose) return {};
-        const bool window_full = s.newest_sent - s.newest_acked >= options.max_in_flight_frames;
-        const bool probe = now - s.last_progress_us > kProbeIntervalUs;
-        if (s.queue_bytes > options.send_queue_bytes / 2 || (window_full && !probe)) {
-            count(&StreamServerStats::frames_skipped);
-            return {};
-        }
-        if (probe) s.last_progress_us = now;
-        const int w = options.width, h = options.height;
-        Instant current = instant_on_path(s.path, s.scene, s.pose.scene_time, w, h);
-        current.view = s.pose.view;
-        Instant previous = current;
-        previous.time = current.time - 1.0 / options.fps;
-        if (s.rendered_before) previous.view = s.previous.view;
-        auto t0 = std::chrono::steady_clock::now();
-        const bool lowres = options.mode == net::StreamMode::LowRes;
-        glm::vec2 jitter(0.0f);
-        if (lowres)
-            REPRISE_TRY(renderer->render_lowres(s.scene, current, previous,
-                                                {.width = w, .height = h}, options.lowres_factor,
-                                                s.frames_rendered, s.frame, s.low_color, jitter));
-        else
-            REPRISE_TRY(renderer->render(
-                s.scene, current, previous,
-                {.width = w, .height = h, .aa_samples = options.aa_samples}, s.frame));
-        ++s.frames_rendered;
-        s.frame.fps = options.fps;
-        const double render_ms = ms_since(t0);
-        s.previous = current;
-        s.rendered_before = true;
-        t0 = std::chrono::steady_clock::now();
-        if (lowres) {
-            make_colour_frame(s, jitter);
-            // The geometry stream carries no colour: a constant that every prediction matches.
-            std::fill(s.frame.color.data(), s.frame.color.data() + s.frame.color.pixel_count(),
-                      glm::vec4(0.0f));
-        }
-        REPRISE_TRY(s.encoder.send_frame(s.frame));
-        if (s.encoder.receive_packet(s.packet) != codec::Result::Ok)
-            return Status::error("encoder gave no packet");
-        std::span<const uint8_t> payload = s.packet.data;
-        if (lowres) {
-            REPRISE_TRY(s.colour_encoder.send_frame(s.low));
-            if (s.colour_encoder.receive_packet(s.colour_packet) != codec::Result::Ok)
-                return Status::error("colour encoder gave no packet");
-            REPRISE_ASSERT(s.colour_packet.frame == s.packet.frame);
-            bundle_packets(s.packet.data, s.colour_packet.data, s.bundle);
-            payload = s.bundle;
-        }
-        const double encode_ms = ms_since(t0);
-        if (payload.size() > net::kMaxPacketBytes) {
-            s.encoder.report_loss(s.packet.frame);
-            s.colour_encoder.report_loss(s.packet.frame);
-            count(&StreamServerStats::frames_skipped);
-            return {};
-        }
-        const std::size_t n = net::fragment_packet(payload, s.packet.frame, s.pose.client_time_us,
-                                                   options.fec, messages);
-        const std::size_t sealed_bytes =
-            n * (net::kSealedHeaderSize + net::kAeadTagSize) + payload.size() * 2;
-        if (s.queue_bytes + std::min(sealed_bytes, options.send_queue_bytes / 2) >
-            options.send_queue_bytes) {
-            s.encoder.report_loss(s.packet.frame);
-            s.colour_encoder.report_loss(s.packet.frame);
-            count(&StreamServerStats::frames_skipped);
-            return {};
-        }
-        for (std::size_t i = 0; i < n; ++i) send_message(s, messages[i]);
-        s.newest_sent = s.packet.frame;
-        {
-            std::lock_guard lock(stats_mutex);
-            ++stats.frames_sent;
-            stats.render_ms_total += render_ms;
-            stats.encode_ms_total += encode_ms;
-            stats.max_queue_bytes = std::max(stats.max_queue_bytes, s.queue_bytes);
-        }
-        flush(s);
-        return {};
-    }
-
-    // The low-resolution colour as a frame of its own: depth and motion taken from the full
-    // G-buffer at each low pixel's sample position (motion in low pixels), the camera's jitter
-    // in low pixels, so the colour stream predicts by reprojection like any other.
-    void make_colour_frame(Session& s, glm::vec2 jitter) {
-        const int lw = s.low_color.width(), lh = s.low_color.height();
-        const int w = s.frame.width(), h = s.frame.height();
-        const glm::vec2 footprint(float(w) / float(lw), float(h) / float(lh));
-        s.low.color.resize(lw, lh);
-        s.low.depth.resize(lw, lh);
-        s.low.motion.resize(lw, lh);
-        std::copy(s.low_color.data(), s.low_color.data() + s.low_color.pixel_count(),
-                  s.low.color.data());
-        for (int v = 0; v < lh; ++v)
-            for (int u = 0; u < lw; ++u) {
-                const int x =
-                    std::clamp(int(std::floor((u + 0.5f) * footprint.x + jitter.x)), 0, w - 1);
-                const int y =
-                    std::clamp(int(std::floor((v + 0.5f) * footprint.y + jitter.y)), 0, h - 1);
-                s.low.depth(u, v) = s.frame.depth(x, y);
-                s.low.motion(u, v) = s.frame.motion(x, y) / footprint;
-            }
-        s.low.camera = s.frame.camera;
-        s.low.camera.jitter = jitter / footprint;
-        s.low.fps = s.frame.fps;
-    }
-
-    // lowres: both codec packets of one frame in one unit (docs/protocol.md, "Low-resolution
-    // mode").
-    static void bundle_packets(std::span<const uint8_t> geometry, std::span<const uint8_t> colour,
-                               std::vector<uint8_t>& out) {
-        out.resize(1 + 4 + geometry.size() + 4 + colour.size());
-        net::Writer w(out);
-        w.u8(1);
-        w.u32(uint32_t(geometry.size()));
-        w.bytes(geometry);
-        w.u32(uint32_t(colour.size()));
-        w.bytes(colour);
     }
 
     std::string metrics_text() const {
@@ -604,9 +511,28 @@ struct StreamServer::State {
                st.bitrate_kbps);
         metric("loss_ratio", "gauge", "Media loss the newest receiver report measured.", st.loss);
         metric("encode_ms_mean", "gauge", "Mean encode time per frame.",
-               st.frames_sent ? st.encode_ms_total / double(st.frames_sent) : 0.0);
+               st.frames_encoded ? st.encode_ms_total / double(st.frames_encoded) : 0.0);
         metric("render_ms_mean", "gauge", "Mean render time per frame.",
-               st.frames_sent ? st.render_ms_total / double(st.frames_sent) : 0.0);
+               st.frames_encoded ? st.render_ms_total / double(st.frames_encoded) : 0.0);
+        metric("frames_dropped_total", "counter",
+               "Frames encoded and dropped from a full hand-over or send queue.",
+               double(st.frames_dropped));
+        metric("feedback_dropped_total", "counter",
+               "Acks or loss reports dropped from a full session mailbox.",
+               double(st.feedback_dropped));
+        metric("refused_full_total", "counter", "Handshakes refused: --max-sessions reached.",
+               double(st.refused_full));
+        metric("adapt_level", "gauge", "Rate adaptation level (0: as configured).",
+               double(st.adapt_level));
+        metric("adapt_aa_samples", "gauge", "Anti-aliasing samples rendered now.",
+               double(st.aa_samples));
+        metric("adapt_fps", "gauge", "Frame rate rendered now.", st.fps);
+        metric("adapt_frame_cost_ms", "gauge", "Mean render + encode time of a frame tick.",
+               st.frame_cost_ms);
+        metric("adapt_steps_down_total", "counter", "Rate adaptation steps down.",
+               double(st.adapt_steps_down));
+        metric("adapt_steps_up_total", "counter", "Rate adaptation steps up.",
+               double(st.adapt_steps_up));
         return o.str();
     }
 };
@@ -656,55 +582,68 @@ StreamServerStats StreamServer::stats() const {
 
 Status StreamServer::run(const std::atomic<bool>& stop) {
     State& st = *state_;
-    REPRISE_TRY(Renderer::create(st.renderer));
-    const int64_t period = int64_t(1e6 / st.options.fps);
-    int64_t next_tick = net::now_us();
+    // Render + encode on the worker; handshakes, feedback, keep-alives and sending here.
+    detail::RenderWorker worker({.options = st.options,
+                                 .sessions_mutex = st.sessions_mutex,
+                                 .sessions = st.sessions,
+                                 .stats_mutex = st.stats_mutex,
+                                 .stats = st.stats,
+                                 .waker = st.waker});
+    worker.start();
     net::Endpoint from;
-    while (!stop.load(std::memory_order_relaxed)) {
-        int64_t now = net::now_us();
-        st.socket.wait_readable(std::clamp<int64_t>(next_tick - now, 0, 5000));
-        // Bounded per pass so a flood cannot starve the frame clock.
+    while (!stop.load(std::memory_order_relaxed) && !worker.failed()) {
+        st.socket.wait_readable(10'000, &st.waker);
+        // Bounded per pass so a flood cannot starve the sessions' sending.
         for (int i = 0; i < 512 && st.socket.receive(st.datagram, from, net::kMaxDatagram); ++i)
             st.handle_datagram(st.datagram, from, net::now_us());
-        now = net::now_us();
-        if (now >= next_tick) {
-            for (auto& s : st.sessions)
-                if (Status failed = st.produce_frame(*s, now); !failed.ok()) {
-                    std::fprintf(stderr, "[serve] session %s ended: %s\n", s->peer.text().c_str(),
-                                 failed.message().c_str());
-                    s->ended = true;
-                }
-            next_tick += period;
-            if (next_tick < now) next_tick = now + period;
-        }
+        const int64_t now = net::now_us();
         for (auto& s : st.sessions) {
-            if (s->started && now - s->last_info_us > kInfoIntervalUs) st.send_info(*s, now);
-            st.flush(*s);
+            st.take_frames(*s);
+            std::string failure;
+            {
+                std::lock_guard lock(s->mutex);
+                failure = s->box.failure;
+            }
+            if (!failure.empty() && !s->net.ended) st.refuse(*s, failure);
+            if (s->net.started && now - s->net.last_info_us > kInfoIntervalUs)
+                st.send_info(s->net, now);
+            st.flush(s->net);
+            std::lock_guard lock(s->mutex);
+            s->box.queue_bytes = s->net.queue_bytes;
         }
         std::erase_if(st.pending,
                       [&](const Pending& p) { return now - p.created_us > kPendingLifetimeUs; });
         const int64_t timeout = int64_t(st.options.session_timeout_s * 1e6);
-        std::erase_if(st.sessions, [&](const std::unique_ptr<Session>& s) {
-            return s->ended || now - s->last_heard_us > timeout;
-        });
+        {
+            std::lock_guard lock(st.sessions_mutex);
+            std::erase_if(st.sessions, [&](const std::shared_ptr<Session>& s) {
+                if (!s->net.ended && now - s->net.last_heard_us <= timeout) return false;
+                std::lock_guard session_lock(s->mutex);
+                s->box.ended = true;  // the worker may still hold it for this tick
+                return true;
+            });
+        }
         {
             std::lock_guard lock(st.stats_mutex);
             st.stats.sessions = st.sessions.size();
             st.stats.sessions_total = st.sessions_total;
             for (auto& s : st.sessions)
-                st.stats.max_queue_bytes = std::max(st.stats.max_queue_bytes, s->queue_bytes);
+                st.stats.max_queue_bytes = std::max(st.stats.max_queue_bytes, s->net.queue_bytes);
         }
         if (st.metrics.is_open()) st.metrics.serve(st.metrics_text());
     }
+    worker.stop();
     // Tell the clients the session ended.
     for (auto& s : st.sessions) {
         st.reply.resize(net::kMaxPlaintext);
         st.reply.resize(net::encode_empty(net::MessageType::Bye, st.reply));
-        st.send_now(*s, st.reply);
+        st.send_now(s->net, st.reply);
     }
-    st.sessions.clear();
-    st.renderer.reset();
-    return {};
+    {
+        std::lock_guard lock(st.sessions_mutex);
+        st.sessions.clear();
+    }
+    return worker.failed() ? worker.status() : Status{};
 }
 
 }  // namespace reprise::server

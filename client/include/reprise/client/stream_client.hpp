@@ -37,8 +37,9 @@ struct StreamClientStats {
     std::size_t key_frame_requests = 0;
     std::size_t datagrams_received = 0, datagrams_dropped = 0, bytes_received = 0;
     std::size_t fec_recovered = 0;
-    int64_t last_rtt_us = 0;  // pose sampled -> frame decoded
-    std::string refused;      // the server's reason when it refused the session
+    int64_t last_rtt_us = 0;   // pose sampled -> frame decoded
+    std::string refused;       // the server's reason when it refused the session
+    bool server_full = false;  // refused by the server's --max-sessions (docs/protocol.md)
 };
 
 // What one display frame was made from.

@@ -21,6 +21,21 @@ struct Endpoint {
 // "A.B.C.D:PORT" or "localhost:PORT" (PORT 0 lets the system choose when binding).
 [[nodiscard]] Status parse_endpoint(const std::string& text, Endpoint& endpoint);
 
+// Wakes a thread waiting in UdpSocket::wait_readable from another thread (an eventfd).
+class Waker {
+public:
+    Waker();
+    ~Waker();
+    Waker(const Waker&) = delete;
+    Waker& operator=(const Waker&) = delete;
+    void wake();   // any thread
+    void clear();  // the waiting thread, after it woke
+    int fd() const { return fd_; }
+
+private:
+    int fd_ = -1;
+};
+
 class UdpSocket {
 public:
     UdpSocket();
@@ -39,8 +54,8 @@ public:
     // Receives one datagram if one is waiting (datagrams longer than `capacity` are truncated
     // and flagged by a size of capacity + 1). False when none.
     bool receive(std::vector<uint8_t>& datagram, Endpoint& from, std::size_t capacity = 2048);
-    // Waits until a datagram is readable or `timeout_us` passed.
-    bool wait_readable(int64_t timeout_us);
+    // Waits until a datagram is readable, `waker` was woken or `timeout_us` passed.
+    bool wait_readable(int64_t timeout_us, Waker* waker = nullptr);
 
 private:
     struct Impl;

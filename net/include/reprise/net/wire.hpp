@@ -28,7 +28,8 @@ enum class DatagramType : uint8_t {
     ClientHello = 1,
     ServerHello = 2,
     ClientFinish = 3,
-    Sealed = 4
+    Sealed = 4,
+    Refused = 5  // server -> client, unauthenticated: why a handshake was not admitted
 };
 
 struct DatagramHeader {
@@ -101,6 +102,16 @@ struct FragmentMessage {
     std::span<const uint8_t> payload;
 };
 
+// Refused (type 5): header, u8 reason, u8 sessions; 14 bytes, smaller than the hello or finish it
+// answers (no amplification).
+enum class RefusalReason : uint8_t { ServerFull = 1 };
+constexpr std::size_t kRefusedSize = kHeaderSize + 2;
+struct RefusedDatagram {
+    uint64_t connection = 0;
+    RefusalReason reason = RefusalReason::ServerFull;
+    uint8_t sessions = 0;  // ServerFull: the server's session limit
+};
+
 // Little-endian writer into a fixed buffer (overflow is a contract violation of the caller) and
 // the reader that checks every length (core/byte_io.hpp).
 using Writer = FixedByteWriter;
@@ -108,6 +119,9 @@ using Reader = ByteReader;
 
 void write_header(Writer& w, const DatagramHeader& header);
 [[nodiscard]] Status parse_header(std::span<const uint8_t> datagram, DatagramHeader& header);
+
+std::size_t encode(const RefusedDatagram& d, std::span<uint8_t> out);
+[[nodiscard]] Status parse(std::span<const uint8_t> datagram, RefusedDatagram& d);
 
 // Scene names: 1..32 of [a-z0-9_-] (never a path).
 bool valid_scene_name(const std::string& name);

@@ -1,7 +1,9 @@
 #pragma once
 // The streaming server: per authenticated session it renders the scene from the client's newest
 // pose at the server's rate, encodes with the scene-aware codec, fragments with FEC and sends.
-// Protocol: docs/protocol.md. One thread runs everything (the renderer's GL context lives there).
+// Protocol: docs/protocol.md. Two threads: the network thread (handshakes, acks, keep-alives,
+// sending) never waits for the render worker (renderer, encoders), which hands encoded frames
+// over through a bounded queue per session; the worker adapts AA and rate to keep up.
 #include <atomic>
 #include <cstdint>
 #include <memory>
@@ -15,6 +17,7 @@
 #include "reprise/net/rate_limiter.hpp"
 #include "reprise/net/udp.hpp"
 #include "reprise/net/wire.hpp"
+#include "reprise/server/rate_ladder.hpp"
 
 namespace reprise::server {
 
@@ -45,6 +48,9 @@ struct StreamServerOptions {
     net::GuessBudgetOptions guess_budget;  // PIN guesses, all sources together
     double session_timeout_s = 3.0;        // a session that sends nothing for this long ends
     int metrics_port = -1;  // >= 0: Prometheus text on 127.0.0.1:port (0: any free port)
+    bool adapt = true;      // step AA samples and rate down when frames take longer than a period
+    RateLadderOptions ladder;
+    double render_delay_ms = 0.0;  // tests and benchmarks: a slower renderer (added per frame)
 };
 
 struct StreamServerStats {
@@ -55,12 +61,20 @@ struct StreamServerStats {
     std::size_t handshakes_resumed = 0;  // admitted by a resumption ticket
     std::size_t dropped_datagrams = 0;   // garbage, truncated, oversized, unauthenticated, replayed
     std::size_t frames_sent = 0, frames_skipped = 0;
+    std::size_t frames_encoded = 0;
+    std::size_t frames_dropped = 0;    // encoded, dropped from a full hand-over or send queue
+    std::size_t feedback_dropped = 0;  // acks or losses dropped from a full mailbox
+    std::size_t refused_full = 0;      // handshakes answered "server full" (--max-sessions)
     std::size_t datagrams_sent = 0, bytes_sent = 0;
     std::size_t loss_reports = 0, key_frame_requests = 0, acks = 0;
     std::size_t max_queue_bytes = 0;  // largest send queue of any session
     double encode_ms_total = 0.0, render_ms_total = 0.0;
     double loss = 0.0;     // newest reported media loss fraction (any session)
     int bitrate_kbps = 0;  // newest target of the last session adapted
+    // Rate adaptation (RateLadder): the current level (0 = as configured) and what it renders.
+    int adapt_level = 0, adapt_levels = 1, aa_samples = 0;
+    double fps = 0.0, frame_cost_ms = 0.0;
+    std::size_t adapt_steps_down = 0, adapt_steps_up = 0;
 };
 
 class StreamServer {
@@ -69,7 +83,8 @@ public:
     static Status create(const StreamServerOptions& options, std::unique_ptr<StreamServer>& server);
     ~StreamServer();
 
-    // Serves until `stop` becomes true (creates the renderer on the calling thread).
+    // Serves until `stop` becomes true: the network on the calling thread, rendering and encoding
+    // on a worker thread of its own (which creates the renderer).
     Status run(const std::atomic<bool>& stop);
 
     net::Endpoint local() const;

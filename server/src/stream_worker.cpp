@@ -1,0 +1,327 @@
+#include "stream_worker.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+#include "reprise/net/fragment.hpp"
+#include "reprise/server/builtin_scenes.hpp"
+
+namespace reprise::server::detail {
+
+namespace {
+
+constexpr int64_t kProbeIntervalUs =
+    1'000'000;  // a stalled window still sends one frame this often
+
+double ms_since(std::chrono::steady_clock::time_point t) {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t).count();
+}
+
+// The low-resolution colour as a frame of its own: depth and motion taken from the full G-buffer
+// at each low pixel's sample position (motion in low pixels), the camera's jitter in low pixels,
+// so the colour stream predicts by reprojection like any other.
+void make_colour_frame(Session::Media& m, glm::vec2 jitter) {
+    const int lw = m.low_color.width(), lh = m.low_color.height();
+    const int w = m.frame.width(), h = m.frame.height();
+    const glm::vec2 footprint(float(w) / float(lw), float(h) / float(lh));
+    m.low.color.resize(lw, lh);
+    m.low.depth.resize(lw, lh);
+    m.low.motion.resize(lw, lh);
+    std::copy(m.low_color.data(), m.low_color.data() + m.low_color.pixel_count(),
+              m.low.color.data());
+    for (int v = 0; v < lh; ++v)
+        for (int u = 0; u < lw; ++u) {
+            const int x =
+                std::clamp(int(std::floor((u + 0.5f) * footprint.x + jitter.x)), 0, w - 1);
+            const int y =
+                std::clamp(int(std::floor((v + 0.5f) * footprint.y + jitter.y)), 0, h - 1);
+            m.low.depth(u, v) = m.frame.depth(x, y);
+            m.low.motion(u, v) = m.frame.motion(x, y) / footprint;
+        }
+    m.low.camera = m.frame.camera;
+    m.low.camera.jitter = jitter / footprint;
+    m.low.fps = m.frame.fps;
+}
+
+// lowres: both codec packets of one frame in one unit (docs/protocol.md, "Low-resolution mode").
+void bundle_packets(std::span<const uint8_t> geometry, std::span<const uint8_t> colour,
+                    std::vector<uint8_t>& out) {
+    out.resize(1 + 4 + geometry.size() + 4 + colour.size());
+    net::Writer w(out);
+    w.u8(1);
+    w.u32(uint32_t(geometry.size()));
+    w.bytes(geometry);
+    w.u32(uint32_t(colour.size()));
+    w.bytes(colour);
+}
+
+}  // namespace
+
+RenderWorker::RenderWorker(WorkerLink link)
+    : link_(link),
+      ladder_(link.options.aa_samples, link.options.fps, link.options.mode == net::StreamMode::Full,
+              link.options.ladder) {
+    publish_level();
+}
+
+RenderWorker::~RenderWorker() { stop(); }
+
+void RenderWorker::start() {
+    thread_ = std::thread([this] { loop(); });
+}
+
+void RenderWorker::stop() {
+    {
+        std::lock_guard lock(mutex_);
+        stop_ = true;
+    }
+    wake_.notify_all();
+    if (thread_.joinable()) thread_.join();
+}
+
+Status RenderWorker::status() const {
+    std::lock_guard lock(mutex_);
+    return failure_;
+}
+
+bool RenderWorker::sleep_until(int64_t when_us) {
+    std::unique_lock lock(mutex_);
+    const int64_t wait = std::max<int64_t>(0, when_us - net::now_us());
+    wake_.wait_for(lock, std::chrono::microseconds(wait), [&] { return stop_; });
+    return !stop_;
+}
+
+void RenderWorker::publish_level() {
+    std::lock_guard lock(link_.stats_mutex);
+    StreamServerStats& st = link_.stats;
+    st.adapt_level = ladder_.level();
+    st.adapt_levels = ladder_.levels();
+    st.aa_samples = ladder_.current().aa_samples;
+    st.fps = ladder_.current().fps;
+    st.frame_cost_ms = ladder_.mean_cost_ms();
+    st.adapt_steps_down = std::size_t(ladder_.steps_down());
+    st.adapt_steps_up = std::size_t(ladder_.steps_up());
+}
+
+void RenderWorker::loop() {
+    // The renderer's GL context lives on this thread.
+    if (Status s = Renderer::create(renderer_); !s.ok()) {
+        {
+            std::lock_guard lock(mutex_);
+            failure_ = s;
+        }
+        failed_ = true;
+        link_.waker.wake();
+        return;
+    }
+    int64_t next_tick = net::now_us();
+    while (sleep_until(next_tick)) {
+        const int64_t now = net::now_us();
+        {
+            std::lock_guard lock(link_.sessions_mutex);
+            snapshot_ = link_.sessions;
+        }
+        double cost_ms = 0.0;
+        bool rendered = false;
+        for (auto& s : snapshot_) {
+            const double ms = produce(*s, now);
+            cost_ms += ms;
+            rendered = rendered || ms > 0.0;
+        }
+        snapshot_.clear();  // a session that ended is freed here or by the network thread
+        if (rendered && link_.options.adapt) {
+            const int before = ladder_.level();
+            if (ladder_.update(cost_ms, net::now_us()))
+                std::fprintf(
+                    stderr,
+                    "[serve] frame cost %.0f ms: adaptation level %d -> %d (aa %d, %g Hz)\n",
+                    ladder_.mean_cost_ms(), before, ladder_.level(), ladder_.current().aa_samples,
+                    ladder_.current().fps);
+            publish_level();
+        }
+        const int64_t period = int64_t(1e6 / ladder_.current().fps);
+        next_tick += period;
+        const int64_t after = net::now_us();
+        if (next_tick < after) next_tick = after;  // late: the next frame at once, none queued
+    }
+    renderer_.reset();
+}
+
+double RenderWorker::produce(Session& s, int64_t now) {
+    Session::Media& m = s.media;
+    net::PoseMessage pose;
+    bool skip = false;
+    int bitrate = 0;
+    bool key_frame = false;
+    std::string scene;
+    {
+        std::lock_guard lock(s.mutex);
+        Mailbox& b = s.box;
+        if (b.ended || !b.started || !b.have_pose || !b.failure.empty()) return 0.0;
+        pose = b.pose;
+        scene = b.scene;
+        std::swap(m.acked, b.acked);
+        m.lost.insert(m.lost.end(), b.lost.begin(), b.lost.end());  // after any hand-over drops
+        b.lost.clear();
+        key_frame = b.key_frame;
+        b.key_frame = false;
+        bitrate = b.bitrate_kbps;
+        const bool window_full =
+            m.newest_encoded - b.newest_acked >= link_.options.max_in_flight_frames;
+        const bool probe = now - b.last_progress_us > kProbeIntervalUs;
+        skip = b.queue_bytes > link_.options.send_queue_bytes / 2 || (window_full && !probe);
+        if (!skip && probe) b.last_progress_us = now;
+    }
+    for (uint32_t f : m.acked) {
+        m.encoder.acknowledge(f);
+        m.colour_encoder.acknowledge(f);
+    }
+    for (uint32_t f : m.lost) {
+        m.encoder.report_loss(f);
+        m.colour_encoder.report_loss(f);
+    }
+    m.acked.clear();
+    m.lost.clear();
+    if (key_frame) {
+        m.encoder.request_key_frame();
+        m.colour_encoder.request_key_frame();
+    }
+    if (bitrate > 0 && bitrate != m.bitrate_kbps) {
+        m.bitrate_kbps = bitrate;
+        if (link_.options.mode == net::StreamMode::LowRes) {
+            // Geometry (depth + motion) and colour share the target by their usual weights.
+            m.encoder.set_bitrate(std::max(1, bitrate * 2 / 3));
+            m.colour_encoder.set_bitrate(std::max(1, bitrate / 3));
+        } else {
+            m.encoder.set_bitrate(bitrate);
+        }
+    }
+    if (!m.loaded) {
+        const std::string name = scene.empty() ? link_.options.scene : scene;
+        if (Status st = load_scene(name, m.scene, m.path); !st.ok()) {
+            std::lock_guard lock(s.mutex);
+            s.box.failure = "scene: " + st.message();
+            link_.waker.wake();
+            return 0.0;
+        }
+        m.loaded = true;
+    }
+    if (skip) {
+        std::lock_guard lock(link_.stats_mutex);
+        ++link_.stats.frames_skipped;
+        return 0.0;
+    }
+    double render_ms = 0.0, encode_ms = 0.0;
+    if (Status st = render_encode(s, pose, render_ms, encode_ms); !st.ok()) {
+        std::fprintf(stderr, "[serve] session %s ended: %s\n", s.net.peer.text().c_str(),
+                     st.message().c_str());
+        std::lock_guard lock(s.mutex);
+        s.box.failure = st.message();
+        link_.waker.wake();
+        return 0.0;
+    }
+    {
+        std::lock_guard lock(link_.stats_mutex);
+        ++link_.stats.frames_encoded;
+        link_.stats.render_ms_total += render_ms;
+        link_.stats.encode_ms_total += encode_ms;
+    }
+    return std::max(render_ms + encode_ms, 1e-3);
+}
+
+Status RenderWorker::render_encode(Session& s, const net::PoseMessage& pose, double& render_ms,
+                                   double& encode_ms) {
+    Session::Media& m = s.media;
+    const StreamServerOptions& o = link_.options;
+    const RateLevel level = ladder_.current();
+    const int w = o.width, h = o.height;
+    Instant current = instant_on_path(m.path, m.scene, pose.scene_time, w, h);
+    current.view = pose.view;
+    Instant previous = current;
+    previous.time = current.time - 1.0 / level.fps;
+    if (m.rendered_before) previous.view = m.previous.view;
+    auto t0 = std::chrono::steady_clock::now();
+    const bool lowres = o.mode == net::StreamMode::LowRes;
+    glm::vec2 jitter(0.0f);
+    if (lowres)
+        REPRISE_TRY(renderer_->render_lowres(m.scene, current, previous, {.width = w, .height = h},
+                                             o.lowres_factor, m.frames_rendered, m.frame,
+                                             m.low_color, jitter));
+    else
+        REPRISE_TRY(renderer_->render(m.scene, current, previous,
+                                      {.width = w, .height = h, .aa_samples = level.aa_samples},
+                                      m.frame));
+    if (o.render_delay_ms > 0) sleep_until(net::now_us() + int64_t(o.render_delay_ms * 1000));
+    ++m.frames_rendered;
+    m.frame.fps = level.fps;
+    render_ms = ms_since(t0);
+    m.previous = current;
+    m.rendered_before = true;
+    t0 = std::chrono::steady_clock::now();
+    if (lowres) {
+        make_colour_frame(m, jitter);
+        // The geometry stream carries no colour: a constant that every prediction matches.
+        std::fill(m.frame.color.data(), m.frame.color.data() + m.frame.color.pixel_count(),
+                  glm::vec4(0.0f));
+    }
+    REPRISE_TRY(m.encoder.send_frame(m.frame));
+    if (m.encoder.receive_packet(m.packet) != codec::Result::Ok)
+        return Status::error("encoder gave no packet");
+    std::span<const uint8_t> payload = m.packet.data;
+    if (lowres) {
+        REPRISE_TRY(m.colour_encoder.send_frame(m.low));
+        if (m.colour_encoder.receive_packet(m.colour_packet) != codec::Result::Ok)
+            return Status::error("colour encoder gave no packet");
+        REPRISE_ASSERT(m.colour_packet.frame == m.packet.frame);
+        bundle_packets(m.packet.data, m.colour_packet.data, m.bundle);
+        payload = m.bundle;
+    }
+    m.newest_encoded = m.packet.frame;
+    if (payload.size() > net::kMaxPacketBytes) {
+        m.encoder.report_loss(m.packet.frame);
+        m.colour_encoder.report_loss(m.packet.frame);
+        std::lock_guard lock(link_.stats_mutex);
+        ++link_.stats.frames_dropped;
+    } else {
+        hand_over(s, payload, pose.client_time_us);
+    }
+    encode_ms = ms_since(t0);
+    return {};
+}
+
+void RenderWorker::hand_over(Session& s, std::span<const uint8_t> payload, int64_t pose_time_us) {
+    EncodedFrame f;
+    {
+        std::lock_guard lock(s.mutex);
+        if (!s.box.spare.empty()) {
+            f = std::move(s.box.spare.back());
+            s.box.spare.pop_back();
+        }
+    }
+    f.frame = s.media.packet.frame;
+    f.count = net::fragment_packet(payload, f.frame, pose_time_us, link_.options.fec, f.messages);
+    f.bytes = 0;
+    for (std::size_t i = 0; i < f.count; ++i) f.bytes += f.messages[i].size();
+    bool dropped = false;
+    {
+        std::lock_guard lock(s.mutex);
+        if (s.box.frames.size() >= kMaxHandover) {
+            // The network thread is behind: the oldest waiting frame goes, the client never
+            // sees it, so the encoders must not predict from it.
+            s.media.lost.push_back(s.box.frames.front().frame);
+            s.box.spare.push_back(std::move(s.box.frames.front()));
+            s.box.frames.pop_front();
+            dropped = true;
+        }
+        s.box.frames.push_back(std::move(f));
+    }
+    link_.waker.wake();
+    if (dropped) {
+        std::lock_guard lock(link_.stats_mutex);
+        ++link_.stats.frames_dropped;
+    }
+}
+
+}  // namespace reprise::server::detail
