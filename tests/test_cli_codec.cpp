@@ -2,6 +2,7 @@
 // thread count, decoding gives back the encoder's pictures, and damaged files fail clearly.
 #include <gtest/gtest.h>
 
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -89,7 +90,7 @@ TEST(CliCodec, EncodeDecodeInfoAndThreadCountIndependence) {
     EXPECT_NE(info.output.find("160x96"), std::string::npos) << info.output;
     EXPECT_NE(info.output.find("key frames: 1"), std::string::npos) << info.output;
 
-    // A damaged byte in the last packet: that packet fails by name, the rest decode, exit 1.
+    // A damaged byte in the last packet: that packet is skipped by name, the rest decode, exit 1.
     std::string damaged = stream;
     damaged[damaged.size() - 5] ^= 0x40;
     const fs::path bad = dir / "bad.rps";
@@ -121,5 +122,70 @@ TEST(CliCodec, EncodeDecodeInfoAndThreadCountIndependence) {
                 .status,
             2)
             << mode;
+    fs::remove_all(dir);
+}
+
+// A damaged file: every decodable frame is written under its own number, bit-identical to the
+// undamaged decode; one line says which bytes were skipped and which frames are missing; exit 1.
+TEST(CliCodec, DecodeWritesEveryDecodableFrameOfADamagedStream) {
+    const fs::path dir = test::fresh_directory(
+        fs::temp_directory_path() / ("reprise_cli_recover_" + std::to_string(::getpid())));
+    const std::string frames = (dir / "frames").string(), rps = (dir / "s.rps").string();
+    ASSERT_EQ(test::run_command(cli::command_render, {"--scene", "crossing", "--frames", "8",
+                                                      "--size", "96x64", "--out", frames}),
+              0);
+    const test::Outcome e =
+        test::run_reprise("encode --in " + frames + " --out " + rps + " --keyint 4", 120);
+    ASSERT_EQ(e.status, 0) << e.output;
+    const std::string intact = (dir / "intact").string();
+    ASSERT_EQ(test::run_reprise("decode " + rps + " --out " + intact, 120).status, 0);
+    std::string stream = bytes_of(rps);
+    std::vector<std::size_t> offsets;  // of each packet: 32-byte header, payload length at 24
+    for (std::size_t at = 24; at + 32 <= stream.size();) {
+        offsets.push_back(at);
+        uint32_t length;
+        std::memcpy(&length, stream.data() + at + 24, 4);
+        at += 32 + length;
+    }
+    ASSERT_EQ(offsets.size(), 8u);
+    // Frame 2 damaged (3 predicted from it, 4 a key frame), the file cut inside frame 7.
+    stream[offsets[2] + 40] ^= 0x04;
+    const std::size_t cut = offsets[7] + 50;
+    stream.resize(cut);
+    const fs::path bad = dir / "bad.rps";
+    std::ofstream(bad, std::ios::binary) << stream;
+    const std::string out = (dir / "out").string();
+    const test::Outcome d = test::run_reprise("decode " + bad.string() + " --out " + out, 120);
+    EXPECT_EQ(d.status, 1) << d.output;
+    const std::string expected =
+        "damaged stream: " + std::to_string(offsets[3] - offsets[2] + 50) +
+        " bytes skipped: " + std::to_string(offsets[3] - offsets[2]) + " at byte " +
+        std::to_string(offsets[2]) + " (packet 2: CRC mismatch), 50 at byte " +
+        std::to_string(offsets[7]) +
+        " (packet header of frame 7: runs past the end of the file (payload length ";
+    EXPECT_NE(d.output.find(expected), std::string::npos) << d.output;
+    EXPECT_NE(d.output.find("frames not decoded: 2 (in the damaged bytes), 3 (reference not "
+                            "decoded), after 6 (in the damaged bytes); 5 frames decoded; 5 "
+                            "frames written to " +
+                            out + "\n"),
+              std::string::npos)
+        << d.output;
+    for (int i = 0; i < 8; ++i) {
+        const bool written = i == 0 || i == 1 || (i >= 4 && i <= 6);
+        EXPECT_EQ(fs::exists(frame_path(out, i)), written) << "frame " << i;
+        if (!written) continue;
+        Frame a, b;
+        ASSERT_TRUE(read_frame(frame_path(intact, i), a).ok());
+        ASSERT_TRUE(read_frame(frame_path(out, i), b).ok());
+        EXPECT_TRUE(test::same_bits(a.color, b.color)) << "frame " << i;
+        EXPECT_TRUE(test::same_bits(a.depth, b.depth)) << "frame " << i;
+        EXPECT_TRUE(test::same_bits(a.motion, b.motion)) << "frame " << i;
+    }
+    // `info` lists the damage.
+    const test::Outcome info = test::run_reprise("info " + bad.string(), 60);
+    EXPECT_EQ(info.status, 1) << info.output;
+    EXPECT_NE(info.output.find("damaged: 50 bytes at byte " + std::to_string(offsets[7])),
+              std::string::npos)
+        << info.output;
     fs::remove_all(dir);
 }

@@ -236,38 +236,36 @@ Status run_decode(const std::string& in, const std::string& out, bool overwrite_
                             "decode " + in, false));
     std::vector<uint8_t> bytes;
     REPRISE_TRY(read_file(in, bytes));
-    codec::StreamInfo info;
-    std::vector<std::span<const uint8_t>> packets;
-    const Status split = codec::split_stream(bytes, info, packets);
-    if (!split.ok()) return Status::error(in + ": " + split.message());
+    // Frames are named by their number in the stream: frames lost to damage leave gaps.
     codec::Decoder decoder;
-    int written = 0, failed = 0;
-    double busy_ms = 0.0;
-    std::string first_error;
-    Frame frame;
-    for (std::size_t i = 0; i < packets.size(); ++i) {
-        const auto start = Clock::now();
-        const Status s = decoder.send_packet(packets[i]);
-        busy_ms += ms_since(start);
-        if (!s.ok()) {
-            ++failed;
-            std::fprintf(stderr, "\n%s: packet %zu: %s\n", in.c_str(), i, s.message().c_str());
-            if (first_error.empty())
-                first_error = in + ": packet " + std::to_string(i) + ": " + s.message();
-        }
-        while (decoder.receive_frame(frame) == codec::Result::Ok)
-            REPRISE_TRY(output.write(written++, frame));
-        std::fprintf(stderr, "\r[decode] %zu/%zu packets, %d frames written", i + 1, packets.size(),
-                     written);
-    }
+    codec::StreamInfo info;
+    codec::StreamReport report;
+    int written = 0;
+    int64_t last = -1;
+    double sink_ms = 0.0;
+    const auto start = Clock::now();
+    const Status decoded = codec::decode_stream(
+        bytes, decoder, info, report, [&](uint32_t number, Frame& frame) -> Status {
+            const auto sink_start = Clock::now();
+            if (number > uint32_t(INT32_MAX) || int64_t(number) <= last)
+                return Status::error("frame " + std::to_string(number) + " follows frame " +
+                                     std::to_string(last) + ": no file name for it");
+            last = number;
+            REPRISE_TRY(output.write(int(number), frame));
+            std::fprintf(stderr, "\r[decode] %d frames written (frame %u)", ++written, number);
+            sink_ms += ms_since(sink_start);
+            return {};
+        });
+    const double busy_ms = ms_since(start) - sink_ms;
+    if (!decoded.ok()) return Status::error(in + ": " + decoded.message());
     REPRISE_TRY(output.finish());
     std::fprintf(stderr, "\n");
     std::printf("decoded %d frames of %zu packets into %s, %.2f ms per frame (without file I/O)\n",
-                written, packets.size(), out.c_str(), busy_ms / double(std::max(1, written)));
+                written, report.packets, out.c_str(), busy_ms / double(std::max(1, written)));
     print_stats(decoder.stats(), info.fps > 0 ? info.fps : 30.0);
-    if (failed)
-        return Status::error(std::to_string(failed) +
-                             " packets could not be decoded; first: " + first_error);
+    if (!report.ok())
+        return Status::error(in + ": " + report.summary() + "; " + std::to_string(written) +
+                             " frames written to " + out);
     return {};
 }
 
@@ -278,7 +276,8 @@ Status describe_stream(const std::string& path) {
     REPRISE_TRY(read_file(path, bytes));
     codec::StreamInfo info;
     std::vector<std::span<const uint8_t>> packets;
-    const Status split = codec::split_stream(bytes, info, packets);
+    std::vector<codec::StreamDamage> damage;
+    const Status split = codec::split_stream(bytes, info, packets, damage);
     if (!split.ok()) return Status::error(path + ": " + split.message());
     std::printf("%s: reprise stream, %dx%d, %.3g fps, %zu packets, %zu bytes\n", path.c_str(),
                 info.width, info.height, info.fps, packets.size(), bytes.size());
@@ -307,7 +306,11 @@ Status describe_stream(const std::string& path) {
         "  mean %.1f kbit/s, largest packet %zu bytes\n",
         packets.empty() ? 0.0 : 8.0 * double(bytes.size()) / double(packets.size()) * fps / 1e3,
         largest);
-    if (bad) return Status::error(path + ": " + std::to_string(bad) + " packets are damaged");
+    for (const codec::StreamDamage& d : damage)
+        std::printf("  damaged: %zu bytes at byte %zu (%s)\n", d.bytes, d.offset, d.reason.c_str());
+    if (bad || !damage.empty())
+        return Status::error(path + ": " + std::to_string(bad) + " packets and " +
+                             std::to_string(damage.size()) + " stretches of bytes are damaged");
     return {};
 }
 

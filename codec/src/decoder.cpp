@@ -123,7 +123,10 @@ Result Decoder::receive_frame(Frame& frame) {
     // The caller's previous buffers come back for the next output (no allocation per frame).
     Frame old = std::move(s.queue.front());
     s.queue.pop_front();
-    if (old.color.width() == s.sp.width && old.color.height() == s.sp.height && s.spare.size() < 2)
+    // A frame the caller moved from keeps its size but not its pixels: not reused.
+    if (old.color.width() == s.sp.width && old.color.height() == s.sp.height &&
+        old.color.pixel_count() == std::size_t(s.sp.width) * std::size_t(s.sp.height) &&
+        s.spare.size() < 2)
         s.spare.push_back(std::move(old));
     return Result::Ok;
 }

@@ -150,9 +150,55 @@ Status write_stream_header(std::vector<uint8_t>& out, int width, int height, dou
     return {};
 }
 
+namespace {
+
+// Why the bytes at `at` do not start a whole valid packet; empty when they do (its size then in
+// `size`). A CRC check is charged to `budget`.
+std::string packet_at(std::span<const uint8_t> file, std::size_t at, std::size_t& size,
+                      std::size_t& budget) {
+    const std::size_t remaining = file.size() - at;
+    const uint8_t magic[4] = {'R', 'P', 'K', 'T'};
+    if (!std::equal(file.begin() + std::ptrdiff_t(at),
+                    file.begin() + std::ptrdiff_t(at + std::min<std::size_t>(remaining, 4)), magic))
+        return "no packet header (bad magic)";
+    if (remaining < kPacketHeaderSize)
+        return "the file ends inside a packet header (" + std::to_string(remaining) + " bytes)";
+    ByteReader r(file.subspan(at + 4, kPacketHeaderSize - 4), "packet header");
+    const uint8_t version = r.u8(), type = r.u8();
+    const uint16_t flags = r.u16();
+    const uint32_t frame = r.u32();
+    (void)r.u32();
+    (void)r.u64();
+    const uint32_t length = r.u32();
+    const std::string named = "packet header of frame " + std::to_string(frame);
+    if (version != kVersion || type > uint8_t(PacketType::Inter) || flags)
+        return named + ": version, type or flags out of range";
+    if (length > kMaxPayload || length > remaining - kPacketHeaderSize)
+        return named + ": runs past the end of the file (payload length " + std::to_string(length) +
+               ", " + std::to_string(remaining - kPacketHeaderSize) + " bytes follow)";
+    size = kPacketHeaderSize + length;
+    budget -= std::min(budget, size);
+    PacketHeader h;
+    std::span<const uint8_t> payload;
+    const Status s = parse_packet(file.subspan(at, size), h, payload);
+    return s.ok() ? std::string() : s.message();
+}
+
+// The first offset from `from` where the packet magic starts, else the file's size.
+std::size_t find_magic(std::span<const uint8_t> file, std::size_t from) {
+    const uint8_t magic[4] = {'R', 'P', 'K', 'T'};
+    const auto it = std::search(file.begin() + std::ptrdiff_t(std::min(from, file.size())),
+                                file.end(), std::begin(magic), std::end(magic));
+    return std::size_t(it - file.begin());
+}
+
+}  // namespace
+
 Status split_stream(std::span<const uint8_t> file, StreamInfo& info,
-                    std::vector<std::span<const uint8_t>>& packets) {
+                    std::vector<std::span<const uint8_t>>& packets,
+                    std::vector<StreamDamage>& damage) {
     packets.clear();
+    damage.clear();
     ByteReader r(file, "stream");
     const uint32_t magic = r.u32();
     const uint8_t version = r.u8();
@@ -169,18 +215,45 @@ Status split_stream(std::span<const uint8_t> file, StreamInfo& info,
     if (reserved8 || reserved16)
         return Status::error("stream: reserved header bytes 5..7 are not 0");
     REPRISE_TRY(check_image_size(info.width, info.height, "stream header"));
-    while (r.remaining()) {
-        const std::size_t at = r.position();
-        if (r.remaining() < kPacketHeaderSize)
-            return Status::error("stream: truncated packet header at byte " + std::to_string(at));
-        ByteReader peek(file.subspan(at + 24, 4), "stream");
-        const uint32_t length = peek.u32();
-        if (length > kMaxPayload || length > r.remaining() - kPacketHeaderSize)
-            return Status::error("stream: packet at byte " + std::to_string(at) +
-                                 " runs past the end of the file");
-        packets.push_back(r.bytes(kPacketHeaderSize + length));
+    // Candidates that pass the cheap header checks cost a CRC over their claimed length: a file
+    // of false headers gets this much CRC work (a few times its size) before the walk gives up.
+    std::size_t budget = 4 * file.size() + (std::size_t(1) << 20);
+    std::size_t at = r.position();
+    while (at < file.size()) {
+        std::size_t size = 0;
+        std::string why = packet_at(file, at, size, budget);
+        if (why.empty()) {
+            packets.push_back(file.subspan(at, size));
+            at += size;
+            continue;
+        }
+        std::size_t next = at + 1;
+        for (;; ++next) {
+            next = find_magic(file, next);
+            if (next == file.size()) break;
+            if (budget == 0) {
+                why += "; gave up looking for the next packet (too many false packet headers)";
+                next = file.size();
+                break;
+            }
+            if (packet_at(file, next, size, budget).empty()) break;
+        }
+        damage.push_back({at, next - at, std::move(why)});
+        at = next;
     }
     return {};
+}
+
+Status split_stream(std::span<const uint8_t> file, StreamInfo& info,
+                    std::vector<std::span<const uint8_t>>& packets) {
+    std::vector<StreamDamage> damage;
+    REPRISE_TRY(split_stream(file, info, packets, damage));
+    if (damage.empty()) return {};
+    const StreamDamage& first = damage.front();
+    std::erase_if(packets, [&](std::span<const uint8_t> p) {
+        return std::size_t(p.data() - file.data()) > first.offset;
+    });
+    return Status::error("stream: byte " + std::to_string(first.offset) + ": " + first.reason);
 }
 
 }  // namespace reprise::codec

@@ -199,25 +199,57 @@ void bind_codec(py::module_& m) {
         "A whole .rps stream (file header + packets) of the frames.");
     m.def(
         "decode_stream",
-        [](const py::buffer& data) {
+        [error_type = py::object(m.attr("Error"))](const py::buffer& data,
+                                                   const std::string& errors) -> py::object {
+            if (errors != "raise" && errors != "return")
+                value_error("decode_stream: errors='" + errors + "': expected 'raise' or 'return'");
             py::buffer_info info;
             const std::span<const uint8_t> bytes = byte_span(data, info);
-            codec::StreamInfo stream;
-            std::vector<std::span<const uint8_t>> packets;
-            check(codec::split_stream(bytes, stream, packets));
             codec::Decoder decoder;
+            codec::StreamInfo stream;
+            codec::StreamReport report;
             std::vector<Frame> frames;
-            for (const auto& packet : packets) {
-                check(decoder.send_packet(packet));
-                Frame f;
-                while (decoder.receive_frame(f) == codec::Result::Ok) {
-                    if (f.fps <= 0.0) f.fps = stream.fps;
-                    frames.push_back(std::move(f));
-                }
+            check(codec::decode_stream(bytes, decoder, stream, report, [&](uint32_t, Frame& f) {
+                if (f.fps <= 0.0) f.fps = stream.fps;
+                frames.push_back(std::move(f));
+                return Status{};
+            }));
+            py::list found;
+            for (const codec::StreamDamage& d : report.damage) {
+                py::dict e;
+                e["kind"] = "bytes";
+                e["offset"] = d.offset;
+                e["length"] = d.bytes;
+                e["reason"] = d.reason;
+                found.append(e);
             }
-            return frames;
+            for (const codec::LostFrames& l : report.lost) {
+                py::dict e;
+                e["kind"] = "frames";
+                e["first"] = l.first;
+                e["last"] = l.open ? py::object(py::none()) : py::int_(l.last);
+                e["reason"] = l.reason;
+                found.append(e);
+            }
+            py::object decoded = py::cast(std::move(frames));
+            if (errors == "return") return py::make_tuple(decoded, found);
+            if (report.ok()) return decoded;
+            py::object error = error_type(report.summary());
+            error.attr("frames") = decoded;
+            error.attr("errors") = found;
+            PyErr_SetObject(error_type.ptr(), error.ptr());
+            throw py::error_already_set();
         },
-        py::arg("data"), "The frames of a whole .rps stream (bytes-like).");
+        py::arg("data"), py::arg("errors") = "raise",
+        "The frames of a whole .rps stream (bytes-like). Damage (a torn tail, a bad packet, "
+        "garbage between packets) does not stop the walk: every frame that can still be decoded "
+        "is, the rest are skipped (docs/bitstream.md, 'Damaged files').\n"
+        "errors='raise' (default): a damaged stream raises reprise.Error naming what was lost; "
+        "the exception's .frames holds the frames decoded and .errors what was lost.\n"
+        "errors='return': returns (frames, errors) and never raises for damage; errors is [] for "
+        "an intact stream. Each error is a dict: {'kind': 'bytes', 'offset', 'length', 'reason'} "
+        "for skipped bytes, {'kind': 'frames', 'first', 'last', 'reason'} for frames not decoded "
+        "(last None: every frame after first - 1). A bad file header raises in both modes.");
 }
 
 }  // namespace reprise::python

@@ -95,3 +95,59 @@ def test_anti_aliasing_changes_colour_only(renderer):
     assert 0.01 < changed.mean() < 0.6
     with pytest.raises(ValueError, match="aa must be"):
         renderer.render(scene, aa=3, **SIZE)
+
+
+def _packet_offsets(stream):
+    """Where each packet of a .rps file starts: a 24-byte file header, then 32-byte packet
+    headers with the payload length at byte 24."""
+    offsets, at = [], 24
+    while at + 32 <= len(stream):
+        offsets.append(at)
+        at += 32 + int.from_bytes(stream[at + 24:at + 28], "little")
+    return offsets
+
+
+def test_decode_stream_recovers_from_damage(pan_60):
+    stream = reprise.encode_stream(pan_60, qp=30, keyint=2)  # key frames 0, 2, 4
+    intact = reprise.decode_stream(stream)
+    frames, errors = reprise.decode_stream(stream, errors="return")
+    assert len(frames) == 5 and errors == []
+    at = _packet_offsets(stream)
+    assert len(at) == 5
+
+    def same(decoded, numbers):
+        assert len(decoded) == len(numbers)
+        for frame, n in zip(decoded, numbers):
+            assert np.array_equal(frame.color, intact[n].color)
+            assert np.array_equal(frame.depth, intact[n].depth)
+
+    # One flipped bit in the last packet: the first four frames survive.
+    damaged = bytearray(stream)
+    damaged[-5] ^= 0x01
+    frames, errors = reprise.decode_stream(damaged, errors="return")
+    same(frames, [0, 1, 2, 3])
+    assert errors == [
+        {"kind": "bytes", "offset": at[4], "length": len(stream) - at[4],
+         "reason": "packet 4: CRC mismatch"},
+        {"kind": "frames", "first": 4, "last": None, "reason": "in the damaged bytes"}]
+    # errors="raise" (the default) raises, and the exception carries the frames and the errors.
+    with pytest.raises(reprise.Error, match="frames not decoded: after 3") as raised:
+        reprise.decode_stream(damaged)
+    same(raised.value.frames, [0, 1, 2, 3])
+    assert raised.value.errors == errors
+
+    # Frame 1's packet damaged, garbage before frame 3, the tail torn inside frame 4.
+    damaged = bytearray(stream[:at[4] + 40])
+    damaged[at[1] + 33] ^= 0x80
+    damaged[at[3]:at[3]] = b"RPKT" + bytes(range(60))
+    frames, errors = reprise.decode_stream(bytes(damaged), errors="return")
+    same(frames, [0, 2, 3])
+    assert [(e["kind"], e.get("offset"), e.get("length")) for e in errors if e["kind"] == "bytes"] \
+        == [("bytes", at[1], at[2] - at[1]), ("bytes", at[3], 64), ("bytes", at[4] + 64, 40)]
+    assert [(e["first"], e["last"], e["reason"]) for e in errors if e["kind"] == "frames"] == [
+        (1, 1, "in the damaged bytes"), (4, None, "in the damaged bytes")]
+
+    with pytest.raises(ValueError, match="errors"):
+        reprise.decode_stream(stream, errors="ignore")
+    with pytest.raises(reprise.Error, match="not a reprise stream"):
+        reprise.decode_stream(b"XXXX" + stream[4:], errors="return")

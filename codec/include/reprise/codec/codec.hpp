@@ -4,8 +4,10 @@
 // Bitstream: docs/bitstream.md. Encoder and decoder are push/pull state machines (as dav1d).
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "reprise/core/frame.hpp"
@@ -175,9 +177,46 @@ struct StreamInfo {
     int width = 0, height = 0;
     double fps = 0.0;
 };
-// Splits a whole .rps file into its packets (each checked for length and CRC only). On an
-// error `packets` holds the whole packets before the damage (a truncated tail, say).
+// A stretch of a .rps file that does not hold a whole valid packet (docs/bitstream.md,
+// "Damaged files").
+struct StreamDamage {
+    std::size_t offset = 0;  // of its first byte in the file
+    std::size_t bytes = 0;   // skipped
+    std::string reason;      // why the bytes at `offset` are not a packet
+};
+// Splits a whole .rps file into its packets, each checked as send_packet checks its header
+// (fields, length, CRC). After damage it resynchronises on the next byte where a whole valid
+// packet starts; every skipped stretch goes to `damage`. An error only for a bad file header.
+[[nodiscard]] Status split_stream(std::span<const uint8_t> file, StreamInfo& info,
+                                  std::vector<std::span<const uint8_t>>& packets,
+                                  std::vector<StreamDamage>& damage);
+// The same, stopping at the first damage: an error naming it, with `packets` holding the whole
+// packets before it (a torn tail, say).
 [[nodiscard]] Status split_stream(std::span<const uint8_t> file, StreamInfo& info,
                                   std::vector<std::span<const uint8_t>>& packets);
+
+// Frames first..last (or first and every later one when `open`) that a damaged file lost.
+struct LostFrames {
+    uint32_t first = 0, last = 0;
+    bool open = false;
+    std::string reason;  // "in the damaged bytes", "reference not decoded", a decoder error
+};
+// What decode_stream found.
+struct StreamReport {
+    std::vector<StreamDamage> damage;
+    std::vector<LostFrames> lost;
+    std::size_t packets = 0;  // whole packets found
+    std::size_t frames = 0;   // frames decoded
+    bool ok() const { return damage.empty() && lost.empty(); }
+    // One line: the bytes skipped (where, why) and the frames not decoded (which, why).
+    std::string summary() const;
+};
+// Decodes every frame of a .rps file that damage leaves decodable: `sink` gets each one with
+// its frame number, in stream order. A frame whose reference was lost is skipped (and listed)
+// until the next key frame or a frame whose reference is held. An error for a bad file header
+// or from the sink; the losses are in `report`.
+using FrameSink = std::function<Status(uint32_t frame, Frame& decoded)>;
+[[nodiscard]] Status decode_stream(std::span<const uint8_t> file, Decoder& decoder,
+                                   StreamInfo& info, StreamReport& report, const FrameSink& sink);
 
 }  // namespace reprise::codec
