@@ -16,12 +16,12 @@ namespace reprise::codec {
 
 namespace {
 
-constexpr int kUnit = 512;                         // model values in 1/512 px
-constexpr int kOffsetStep = 8;                     // a new model's offset in 1/64 px
-constexpr int64_t kMaxValue = int64_t(1) << 30;    // 2M px
+constexpr int kUnit = 512;                          // model values in 1/512 px
+constexpr int kOffsetStep = 8;                      // a new model's offset in 1/64 px
+constexpr int64_t kMaxValue = int64_t(1) << 30;     // 2M px
 constexpr int64_t kMaxGradient = int64_t(1) << 16;  // 128 px per px
-constexpr int64_t kMaxSteps = int64_t(1) << 24;  // a pixel's own value, from its prediction
-constexpr int kLevels = 3;                         // nodes of 16, 8 and 4 pixels
+constexpr int64_t kMaxSteps = int64_t(1) << 24;     // a pixel's own value, from its prediction
+constexpr int kLevels = 3;                          // nodes of 16, 8 and 4 pixels
 
 enum PixelKind : uint8_t { kZeroPixel = 0, kModelPixel = 1, kOwnPixel = 2 };
 
@@ -60,7 +60,7 @@ struct Job {
     const SequenceParams* sp;
     int y0, y1;
     float bound;
-    int64_t step;  // of a pixel's own value
+    int64_t step;                             // of a pixel's own value
     ImageView<const glm::vec2> base, source;  // source: encoder only
     ImageView<glm::vec2> out;
     MotionModelScratch* scratch;
@@ -133,8 +133,8 @@ bool fit_model(const Job& j, const Node& n, const MotionModel& pred, MotionModel
 bool model_fits(const Job& j, const Node& n, const MotionModel& m) {
     for (int y = n.y; y < n.y + n.h; ++y)
         for (int x = n.x; x < n.x + n.w; ++x)
-            if (!within(j.source(x, y), model_output(j.base(x, y), m.value_x(x, y), m.value_y(x, y)),
-                        j.bound))
+            if (!within(j.source(x, y),
+                        model_output(j.base(x, y), m.value_x(x, y), m.value_y(x, y)), j.bound))
                 return false;
     return true;
 }
@@ -252,9 +252,9 @@ bool code_pixels(Job& j, Models& m, const Node& n, const MotionModel* const (&ca
                     }
                 } else {
                     invalid = rc.bit(m.invalid);
-                    if (!invalid && (!decode_int(rc, m.pixel[0], kx) ||
-                                     !decode_int(rc, m.pixel[1], ky) ||
-                                     std::abs(kx) > kMaxSteps || std::abs(ky) > kMaxSteps))
+                    if (!invalid &&
+                        (!decode_int(rc, m.pixel[0], kx) || !decode_int(rc, m.pixel[1], ky) ||
+                         std::abs(kx) > kMaxSteps || std::abs(ky) > kMaxSteps))
                         return false;
                 }
                 const int64_t vx = pred.x + kx * j.step, vy = pred.y + ky * j.step;
@@ -350,7 +350,8 @@ bool code_node(Job& j, Models& m, Node n, int level, Coder& rc) {
         if (!fits) {
             const int half = (kMb >> level) / 2;
             for (int k = 0; k < 4; ++k)
-                if (!code_node<Encode>(j, m, {n.x + (k & 1) * half, n.y + (k >> 1) * half, half, half},
+                if (!code_node<Encode>(j, m,
+                                       {n.x + (k & 1) * half, n.y + (k >> 1) * half, half, half},
                                        level + 1, rc))
                     return false;
             return true;
@@ -408,8 +409,8 @@ void add_counts(const std::vector<Job>& jobs, StreamStats& stats) {
 
 }  // namespace
 
-bool motion_within_bound(ImageView<const glm::vec2> source, ImageView<const glm::vec2> base,
-                         int y, float bound) {
+bool motion_within_bound(ImageView<const glm::vec2> source, ImageView<const glm::vec2> base, int y,
+                         float bound) {
     for (int x = 0; x < source.width; ++x)
         if (!within(source(x, y), base(x, y), bound)) return false;
     return true;

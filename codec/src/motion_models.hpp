@@ -32,7 +32,7 @@ struct MotionCell {  // one 4x4 cell: what its neighbours predict from
 struct MotionModelScratch {
     std::vector<MotionCell> cells;
     int cell_columns = 0;
-    std::vector<uint8_t> kinds;       // per pixel: camera motion, a model, its own value
+    std::vector<uint8_t> kinds;      // per pixel: camera motion, a model, its own value
     std::vector<uint8_t> which;      // per pixel of a 4x4 cell coded pixel by pixel: its model
     std::vector<glm::ivec2> values;  // per pixel: the decoded residual, 1/512 px (clamped)
 };

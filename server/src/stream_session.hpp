@@ -3,6 +3,7 @@
 // thread owns `net`, the render worker owns `media`; they talk only through `box` under `mutex`,
 // held for copies and swaps, never while rendering, encoding or sending. Every list is bounded.
 #include <deque>
+#include <memory>
 #include <mutex>
 #include <string>
 #include <vector>
@@ -14,6 +15,13 @@
 #include "reprise/server/scene.hpp"
 
 namespace reprise::server::detail {
+
+// A scene as the worker keeps it: one object per name, so that the renderer keeps its textures
+// while sessions showing the same scene take turns.
+struct LoadedScene {
+    Scene scene;
+    CameraPath path;
+};
 
 constexpr std::size_t kMaxFeedback = 64;  // acks or losses waiting for the worker
 constexpr std::size_t kMaxHandover = 2;   // encoded frames waiting for the network thread
@@ -64,10 +72,8 @@ struct Session {
         int64_t min_rtt_us = 0;
         net::TicketMessage ticket;  // for the client's next handshake, sent with every StreamInfo
     } net;
-    struct Media {  // render worker only
-        bool loaded = false;
-        Scene scene;
-        CameraPath path;
+    struct Media {                                 // render worker only
+        std::shared_ptr<const LoadedScene> scene;  // shared by the sessions that show it
         bool rendered_before = false;
         Instant previous;
         codec::Encoder encoder, colour_encoder;  // lowres: the low-resolution colour stream

@@ -116,6 +116,7 @@ void RenderWorker::loop() {
         link_.waker.wake();
         return;
     }
+    warm_up();
     int64_t next_tick = net::now_us();
     while (sleep_until(next_tick)) {
         const int64_t now = net::now_us();
@@ -147,6 +148,51 @@ void RenderWorker::loop() {
         if (next_tick < after) next_tick = after;  // late: the next frame at once, none queued
     }
     renderer_.reset();
+}
+
+Status RenderWorker::scene(const std::string& name, std::shared_ptr<const LoadedScene>& out) {
+    std::erase_if(scenes_, [&](const auto& entry) {  // shown by no session
+        return entry.second.use_count() == 1 && entry.first != link_.options.scene;
+    });
+    auto it = scenes_.find(name);
+    if (it == scenes_.end()) {
+        auto loaded = std::make_shared<LoadedScene>();
+        REPRISE_TRY(load_scene(name, loaded->scene, loaded->path));
+        it = scenes_.emplace(name, std::move(loaded)).first;
+    }
+    out = it->second;
+    return {};
+}
+
+// One frame of the default scene before any client: shader compilation and the first texture
+// uploads would otherwise fall on the first session's first frame (about 0.7 s on llvmpipe).
+void RenderWorker::warm_up() {
+    const StreamServerOptions& o = link_.options;
+    std::shared_ptr<const LoadedScene> loaded;
+    if (!scene(o.scene, loaded).ok()) return;  // the session reports it
+    const auto t0 = std::chrono::steady_clock::now();
+    Instant at = instant_on_path(loaded->path, loaded->scene, 0.0, o.width, o.height);
+    Instant before = at;
+    before.time -= 1.0 / o.fps;  // as a session's first frame
+    Frame frame;
+    Image<glm::vec4> low;
+    glm::vec2 jitter(0.0f);
+    const Status s = o.mode == net::StreamMode::LowRes
+                         ? renderer_->render_lowres(loaded->scene, at, before,
+                                                    {.width = o.width, .height = o.height},
+                                                    o.lowres_factor, 0, frame, low, jitter)
+                         : renderer_->render(loaded->scene, at, before,
+                                             {.width = o.width,
+                                              .height = o.height,
+                                              .aa_samples = ladder_.current().aa_samples},
+                                             frame);
+    const double render_ms = ms_since(t0);
+    const auto t1 = std::chrono::steady_clock::now();
+    codec::Encoder encoder(o.encoder);
+    codec::Packet packet;
+    if (s.ok() && encoder.send_frame(frame).ok()) encoder.receive_packet(packet);
+    std::fprintf(stderr, "[serve] warmed up: render %.0f ms, encode %.0f ms\n", render_ms,
+                 ms_since(t1));
 }
 
 double RenderWorker::produce(Session& s, int64_t now) {
@@ -198,15 +244,14 @@ double RenderWorker::produce(Session& s, int64_t now) {
             m.encoder.set_bitrate(bitrate);
         }
     }
-    if (!m.loaded) {
+    if (!m.scene) {
         const std::string name = scene.empty() ? link_.options.scene : scene;
-        if (Status st = load_scene(name, m.scene, m.path); !st.ok()) {
+        if (Status st = this->scene(name, m.scene); !st.ok()) {
             std::lock_guard lock(s.mutex);
             s.box.failure = "scene: " + st.message();
             link_.waker.wake();
             return 0.0;
         }
-        m.loaded = true;
     }
     if (skip) {
         std::lock_guard lock(link_.stats_mutex);
@@ -222,6 +267,10 @@ double RenderWorker::produce(Session& s, int64_t now) {
         link_.waker.wake();
         return 0.0;
     }
+    if (m.frames_rendered == 1)
+        std::fprintf(stderr,
+                     "[serve] session %s: first frame rendered in %.0f ms, encoded in %.0f ms\n",
+                     s.net.peer.text().c_str(), render_ms, encode_ms);
     {
         std::lock_guard lock(link_.stats_mutex);
         ++link_.stats.frames_encoded;
@@ -237,7 +286,8 @@ Status RenderWorker::render_encode(Session& s, const net::PoseMessage& pose, dou
     const StreamServerOptions& o = link_.options;
     const RateLevel level = ladder_.current();
     const int w = o.width, h = o.height;
-    Instant current = instant_on_path(m.path, m.scene, pose.scene_time, w, h);
+    const Scene& shown = m.scene->scene;
+    Instant current = instant_on_path(m.scene->path, shown, pose.scene_time, w, h);
     current.view = pose.view;
     Instant previous = current;
     previous.time = current.time - 1.0 / level.fps;
@@ -246,11 +296,11 @@ Status RenderWorker::render_encode(Session& s, const net::PoseMessage& pose, dou
     const bool lowres = o.mode == net::StreamMode::LowRes;
     glm::vec2 jitter(0.0f);
     if (lowres)
-        REPRISE_TRY(renderer_->render_lowres(m.scene, current, previous, {.width = w, .height = h},
+        REPRISE_TRY(renderer_->render_lowres(shown, current, previous, {.width = w, .height = h},
                                              o.lowres_factor, m.frames_rendered, m.frame,
                                              m.low_color, jitter));
     else
-        REPRISE_TRY(renderer_->render(m.scene, current, previous,
+        REPRISE_TRY(renderer_->render(shown, current, previous,
                                       {.width = w, .height = h, .aa_samples = level.aa_samples},
                                       m.frame));
     if (o.render_delay_ms > 0) sleep_until(net::now_us() + int64_t(o.render_delay_ms * 1000));

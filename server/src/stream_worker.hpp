@@ -3,8 +3,10 @@
 // renders and encodes one frame per started session and hands it to the network thread.
 #include <atomic>
 #include <condition_variable>
+#include <map>
 #include <memory>
 #include <mutex>
+#include <string>
 #include <thread>
 #include <vector>
 
@@ -34,6 +36,9 @@ public:
 
 private:
     void loop();
+    void warm_up();
+    // The scene of that name, loaded once and kept while a session shows it (and the default).
+    Status scene(const std::string& name, std::shared_ptr<const LoadedScene>& out);
     double produce(Session& s, int64_t now);  // render + encode ms, 0 when nothing was rendered
     Status render_encode(Session& s, const net::PoseMessage& pose, double& render_ms,
                          double& encode_ms);
@@ -45,6 +50,7 @@ private:
     RateLadder ladder_;
     std::unique_ptr<Renderer> renderer_;
     std::vector<std::shared_ptr<Session>> snapshot_;
+    std::map<std::string, std::shared_ptr<const LoadedScene>> scenes_;
     std::thread thread_;
     mutable std::mutex mutex_;  // for stop_ and failure_
     std::condition_variable wake_;
