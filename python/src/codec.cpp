@@ -20,8 +20,8 @@ std::span<const uint8_t> byte_span(const py::buffer& data, py::buffer_info& info
 codec::EncoderOptions encoder_options(int qp, int bitrate_kbps, double fps, int keyint,
                                       const std::string& chroma, const std::string& depth,
                                       float depth_error, float view_error_px,
-                                      float view_displacement, int skip_threshold,
-                                      bool detect_cuts) {
+                                      float view_displacement, float motion_error_px,
+                                      int skip_threshold, bool detect_cuts) {
     if (qp < 0 || qp > 51) value_error("qp must be in 0..51");
     if (bitrate_kbps < 0) value_error("bitrate_kbps must be >= 0");
     if (!(fps > 0.0 && fps <= 10000.0)) value_error("fps must be in (0, 10000]");
@@ -34,6 +34,7 @@ codec::EncoderOptions encoder_options(int qp, int bitrate_kbps, double fps, int 
                             .depth_error = depth_error,
                             .view_error_px = view_error_px,
                             .view_displacement = view_displacement,
+                            .motion_error_px = motion_error_px,
                             .skip_threshold = skip_threshold,
                             .detect_cuts = detect_cuts};
     if (chroma == "420")
@@ -46,6 +47,8 @@ codec::EncoderOptions encoder_options(int qp, int bitrate_kbps, double fps, int 
         value_error("view_error_px must be in [0.01, 16]");
     if (!(view_displacement > 0.0f && view_displacement <= 1e6f))
         value_error("view_displacement must be in (0, 1e6]");
+    if (!(motion_error_px == 0.0f || (motion_error_px >= 0.1f && motion_error_px <= 8.0f)))
+        value_error("motion_error_px must be 0 (every pixel to 1/8 px) or in [0.1, 8]");
     if (depth == "view")
         o.depth = codec::DepthMode::View;
     else if (depth == "lossless")
@@ -120,11 +123,11 @@ struct PyDecoder {
 void bind_codec(py::module_& m) {
     auto options_init = [](int qp, int bitrate_kbps, double fps, int keyint,
                            const std::string& chroma, const std::string& depth, float depth_error,
-                           float view_error_px, float view_displacement, int skip_threshold,
-                           bool detect_cuts) {
-        return std::make_unique<PyEncoder>(
-            encoder_options(qp, bitrate_kbps, fps, keyint, chroma, depth, depth_error,
-                            view_error_px, view_displacement, skip_threshold, detect_cuts));
+                           float view_error_px, float view_displacement, float motion_error_px,
+                           int skip_threshold, bool detect_cuts) {
+        return std::make_unique<PyEncoder>(encoder_options(
+            qp, bitrate_kbps, fps, keyint, chroma, depth, depth_error, view_error_px,
+            view_displacement, motion_error_px, skip_threshold, detect_cuts));
     };
     py::class_<PyEncoder>(m, "Encoder",
                           "Scene-aware predictive encoder: one packet (bytes) per frame "
@@ -133,7 +136,8 @@ void bind_codec(py::module_& m) {
              py::arg("fps") = 30.0, py::arg("keyint") = 0, py::arg("chroma") = "420",
              py::arg("depth") = "view", py::arg("depth_error") = 1e-4f,
              py::arg("view_error_px") = 0.25f, py::arg("view_displacement") = 0.164f,
-             py::arg("skip_threshold") = 2, py::arg("detect_cuts") = true)
+             py::arg("motion_error_px") = 0.25f, py::arg("skip_threshold") = 2,
+             py::arg("detect_cuts") = true)
         .def("encode", &PyEncoder::encode, py::arg("frame"), "The packet of the next frame.")
         .def("request_key_frame", [](PyEncoder& e) { e.encoder.request_key_frame(); })
         .def_property_readonly(
@@ -174,13 +178,13 @@ void bind_codec(py::module_& m) {
         [options_init](const std::vector<const Frame*>& frames, int qp, int bitrate_kbps,
                        double fps, int keyint, const std::string& chroma, const std::string& depth,
                        float depth_error, float view_error_px, float view_displacement,
-                       int skip_threshold, bool detect_cuts) {
+                       float motion_error_px, int skip_threshold, bool detect_cuts) {
             if (frames.empty()) value_error("encode_stream: no frames");
             for (const Frame* f : frames)
                 if (!f) type_error("encode_stream: None in the frame list");
-            auto encoder =
-                options_init(qp, bitrate_kbps, fps, keyint, chroma, depth, depth_error,
-                             view_error_px, view_displacement, skip_threshold, detect_cuts);
+            auto encoder = options_init(qp, bitrate_kbps, fps, keyint, chroma, depth, depth_error,
+                                        view_error_px, view_displacement, motion_error_px,
+                                        skip_threshold, detect_cuts);
             std::vector<uint8_t> file;
             const double stream_fps = frames[0]->fps > 0.0 ? frames[0]->fps : fps;
             check(codec::write_stream_header(file, frames[0]->width(), frames[0]->height(),
@@ -194,8 +198,8 @@ void bind_codec(py::module_& m) {
         py::arg("frames"), py::arg("qp") = 28, py::arg("bitrate_kbps") = 0, py::arg("fps") = 30.0,
         py::arg("keyint") = 0, py::arg("chroma") = "420", py::arg("depth") = "view",
         py::arg("depth_error") = 1e-4f, py::arg("view_error_px") = 0.25f,
-        py::arg("view_displacement") = 0.164f, py::arg("skip_threshold") = 2,
-        py::arg("detect_cuts") = true,
+        py::arg("view_displacement") = 0.164f, py::arg("motion_error_px") = 0.25f,
+        py::arg("skip_threshold") = 2, py::arg("detect_cuts") = true,
         "A whole .rps stream (file header + packets) of the frames.");
     m.def(
         "decode_stream",

@@ -151,3 +151,17 @@ def test_decode_stream_recovers_from_damage(pan_60):
         reprise.decode_stream(stream, errors="ignore")
     with pytest.raises(reprise.Error, match="not a reprise stream"):
         reprise.decode_stream(b"XXXX" + stream[4:], errors="return")
+
+
+def test_motion_within_its_bound(renderer):
+    frames = renderer.render_sequence(reprise.Scene("crossing"), frames=3, fps=30.0, **SIZE)
+    for bound, tolerance in ((0.25, 0.25), (0.0, np.hypot(1 / 16, 1 / 16))):
+        encoder, decoder = reprise.Encoder(motion_error_px=bound), reprise.Decoder()
+        for frame in frames:
+            decoded = decoder.decode(encoder.encode(frame))
+            assert np.array_equal(decoded.motion, encoder.reconstruction.motion)
+            finite = np.isfinite(frame.motion).all(axis=-1)
+            error = np.linalg.norm(decoded.motion - frame.motion, axis=-1)[finite]
+            assert error.max() <= tolerance + 1e-4
+    with pytest.raises(ValueError):
+        reprise.Encoder(motion_error_px=0.05)
