@@ -64,6 +64,15 @@ struct Mapping {
     uint32_t empty() const {
         return lossless ? code(std::numeric_limits<float>::infinity()) : kInfCode;
     }
+    // A code of a surface: finite positive depth (not background, not invalid).
+    bool surface(uint32_t c) const {
+        if (lossless) {
+            const float z = depth(c);
+            return z > 0.0f && z < std::numeric_limits<float>::infinity();
+        }
+        return c != kInfCode && c != kInvalidCode && c != kNoPrediction &&
+               (!view || c <= kMaxViewCode);
+    }
 };
 
 Mapping mapping_of(const SequenceParams& sp) {
@@ -87,6 +96,7 @@ inline int magnitude_class(uint32_t left, uint32_t top) {
 struct Models {
     BitModel temporal;
     BitModel zero_block[2];
+    BitModel background[4];
     IntModel<24> residual[2][4];
 };
 
@@ -97,6 +107,7 @@ struct SliceJob {
     ImageView<uint32_t> codes;           // decoder fills, encoder has them
     ImageView<const uint32_t> temporal;  // kNoPrediction where nothing landed; empty on key frames
     ImageView<uint32_t> residuals;
+    ImageView<uint32_t> predictions;  // encoder: the block's prediction of each pixel
     std::size_t zero_blocks = 0;
 };
 
@@ -138,6 +149,26 @@ inline uint32_t predict(const SliceJob& j, int x, int y, bool temporal) {
     return spatial(j, x, y);
 }
 
+// In a block with residuals, a pixel is first said to be background or not; a surface pixel whose
+// prediction is not a surface (a silhouette the prediction missed) is predicted from its nearest
+// surface neighbour instead, so an edge one pixel off costs a flag, not a jump across 2^30.
+inline uint32_t surface_prediction(const SliceJob& j, int x, int y, uint32_t p) {
+    if (j.map->surface(p)) return p;
+    const bool left = x > 0, top = y > j.y0;
+    if (left && j.map->surface(j.codes(x - 1, y))) return j.codes(x - 1, y);
+    if (top && j.map->surface(j.codes(x, y - 1))) return j.codes(x, y - 1);
+    if (top && x + 1 < j.width && j.map->surface(j.codes(x + 1, y - 1)))
+        return j.codes(x + 1, y - 1);
+    if (left && top && j.map->surface(j.codes(x - 1, y - 1))) return j.codes(x - 1, y - 1);
+    return p;
+}
+
+inline int background_context(const SliceJob& j, int x, int y, uint32_t p) {
+    const uint32_t empty = j.map->empty();
+    return (p == empty) + (x > 0 && j.codes(x - 1, y) == empty) +
+           (y > j.y0 && j.codes(x, y - 1) == empty);
+}
+
 inline int residual_context(const SliceJob& j, int x, int y) {
     return magnitude_class(x > 0 ? j.residuals(x - 1, y) : 0, y > j.y0 ? j.residuals(x, y - 1) : 0);
 }
@@ -145,6 +176,15 @@ inline int residual_context(const SliceJob& j, int x, int y) {
 // Cost estimate of coding a block's residuals.
 inline uint64_t residual_cost(int32_t r) {
     return r == 0 ? 0 : 2 + 2 * uint64_t(std::bit_width(uint32_t(std::abs(int64_t(r)))));
+}
+
+// Cost estimate of one pixel of a block with residuals (its codes to the left and above known):
+// the background flag, then the residual from the surface prediction.
+inline uint64_t pixel_cost(const SliceJob& j, int x, int y, uint32_t p) {
+    const uint32_t c = j.codes(x, y);
+    if (c == p) return 0;
+    if (c == j.map->empty()) return 1;
+    return 1 + residual_cost(int32_t(c - surface_prediction(j, x, y, p)));
 }
 
 // The encoder knows every code up front (coding is lossless), so it decides each block before
@@ -175,7 +215,7 @@ void encode_slice(SliceJob& j, std::vector<uint8_t>& bytes, std::vector<uint8_t>
                     for (int x = bx; x < bx + bw; ++x) {
                         uint32_t p = j.temporal(x, y);
                         if (p == kNoPrediction) p = spatial(j, x, y);
-                        cost += residual_cost(int32_t(j.codes(x, y) - p));
+                        cost += pixel_cost(j, x, y, p);
                     }
                 use_temporal = true;
             }
@@ -185,7 +225,7 @@ void encode_slice(SliceJob& j, std::vector<uint8_t>& bytes, std::vector<uint8_t>
                     for (int x = bx; x < bx + bw; ++x) {
                         const uint32_t p = spatial(j, x, y);
                         spatial_codes[(y - by) * kBlock + (x - bx)] = p;
-                        spatial_cost += residual_cost(int32_t(j.codes(x, y) - p));
+                        spatial_cost += pixel_cost(j, x, y, p);
                     }
                 spatial_known = true;
                 if (!inter || spatial_cost < cost) {
@@ -208,16 +248,22 @@ void encode_slice(SliceJob& j, std::vector<uint8_t>& bytes, std::vector<uint8_t>
                     if (p == kNoPrediction)
                         p = spatial_known ? spatial_codes[(y - by) * kBlock + (x - bx)]
                                           : spatial(j, x, y);
-                    j.residuals(x, y) = j.codes(x, y) - p;
+                    j.predictions(x, y) = p;
                 }
         }
         for (int y = by; y < by + bh; ++y)
             for (int b = 0; b < blocks; ++b) {
                 const uint8_t flags = block_flags[b];
                 if (flags & 2) continue;
-                for (int x = b * kBlock; x < std::min(j.width, (b + 1) * kBlock); ++x)
-                    encode_int(rc, m.residual[flags & 1][residual_context(j, x, y)],
-                               int64_t(int32_t(j.residuals(x, y))));
+                for (int x = b * kBlock; x < std::min(j.width, (b + 1) * kBlock); ++x) {
+                    const uint32_t p = j.predictions(x, y), c = j.codes(x, y);
+                    const bool background = c == j.map->empty();
+                    rc.bit(m.background[background_context(j, x, y, p)], background);
+                    j.residuals(x, y) = background ? 0 : c - surface_prediction(j, x, y, p);
+                    if (!background)
+                        encode_int(rc, m.residual[flags & 1][residual_context(j, x, y)],
+                                   int64_t(int32_t(j.residuals(x, y))));
+                }
             }
     }
     rc.finish();
@@ -241,12 +287,22 @@ bool decode_slice(SliceJob& j, std::span<const uint8_t> bytes) {
         for (int y = by; y < by + bh; ++y)
             for (int x = 0; x < j.width; ++x) {
                 const int b = x / kBlock;
+                const uint32_t p = predict(j, x, y, block_temporal[b]);
+                if (block_zero[b]) {
+                    j.residuals(x, y) = 0;
+                    j.codes(x, y) = p;
+                    continue;
+                }
+                if (rc.bit(m.background[background_context(j, x, y, p)])) {
+                    j.residuals(x, y) = 0;
+                    j.codes(x, y) = j.map->empty();
+                    continue;
+                }
                 int64_t r = 0;
-                if (!block_zero[b] &&
-                    !decode_int(rc, m.residual[block_temporal[b]][residual_context(j, x, y)], r))
+                if (!decode_int(rc, m.residual[block_temporal[b]][residual_context(j, x, y)], r))
                     return false;
                 j.residuals(x, y) = uint32_t(r);
-                j.codes(x, y) = predict(j, x, y, block_temporal[b]) + uint32_t(r);
+                j.codes(x, y) = surface_prediction(j, x, y, p) + uint32_t(r);
             }
         if (rc.overrun() > 8) return false;
     }
@@ -276,12 +332,14 @@ void temporal_codes(const FrameContext& fc, const Camera& camera, const Mapping&
 
 std::vector<SliceJob> slice_jobs(const SequenceParams& sp, const Mapping& map,
                                  Image<uint32_t>& codes, const Image<uint32_t>& temporal,
-                                 Image<uint32_t>& residuals) {
+                                 Image<uint32_t>& residuals,
+                                 Image<uint32_t>* predictions = nullptr) {
     std::vector<SliceJob> jobs;
     for (int s = 0; s < sp.slices; ++s) {
         const int y0 = std::min(sp.height, sp.slice_begin(s) * kMb);
         const int y1 = std::min(sp.height, sp.slice_begin(s + 1) * kMb);
-        jobs.push_back({&map, sp.width, y0, y1, codes.view(), temporal.view(), residuals.view()});
+        jobs.push_back({&map, sp.width, y0, y1, codes.view(), temporal.view(), residuals.view(),
+                        predictions ? predictions->view() : ImageView<uint32_t>{}});
     }
     return jobs;
 }
@@ -378,7 +436,9 @@ void encode_depth(const FrameContext& fc, const Camera& camera, ImageView<const 
         stats.depth_zero_blocks +=
             std::size_t((w + kBlock - 1) / kBlock) * ((h + kBlock - 1) / kBlock);
     } else {
-        std::vector<SliceJob> jobs = slice_jobs(sp, map, codes, temporal, residuals);
+        Image<uint32_t>& predictions = fc.work->depth_predictions;
+        ensure_size(predictions, w, h);
+        std::vector<SliceJob> jobs = slice_jobs(sp, map, codes, temporal, residuals, &predictions);
         std::vector<std::vector<uint8_t>>& flags = fc.work->slice_flags;
         flags.resize(std::size_t(sp.slices));
         encode_slices(sp.slices, fc.work->slice_bytes, bytes,

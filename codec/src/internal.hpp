@@ -128,7 +128,7 @@ struct MotionResidual {
 
 // Per-frame scratch, sized on the first frame and reused while the size stays the same.
 struct Workspace {
-    Image<uint32_t> depth_codes, temporal_codes, depth_residuals;
+    Image<uint32_t> depth_codes, temporal_codes, depth_residuals, depth_predictions;
     Image<float> projected_depth;
     Image<glm::vec2> base_motion, to_reference;
     std::vector<MotionResidual> motion_residuals;
