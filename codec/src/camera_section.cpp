@@ -1,4 +1,8 @@
-// The camera of a frame: flags for what equals the reference's camera, the rest raw.
+// The camera of a frame: flags for what equals the reference's camera; on inter frames the rest
+// as each float's bits xor the reference's (a moving camera changes low mantissa bits), raw on
+// key frames.
+#include <bit>
+
 #include "internal.hpp"
 #include "reprise/core/byte_io.hpp"
 
@@ -6,16 +10,31 @@ namespace reprise::codec {
 
 namespace {
 
-enum : uint8_t { kSamePose = 1, kPrevIsReference = 2, kSameLens = 4 };
+enum : uint8_t { kSameView = 1, kPrevIsReference = 2, kSameLens = 4, kSameProjection = 8 };
+constexpr uint8_t kAllFlags = kSameView | kPrevIsReference | kSameLens | kSameProjection;
 
-void write_mat(ByteWriter& w, const glm::mat4& m) {
+// `base`: the reference's matrix (xor-varint coding) or null (raw f32).
+void write_mat(ByteWriter& w, const glm::mat4& m, const glm::mat4* base) {
     for (int c = 0; c < 4; ++c)
-        for (int r = 0; r < 4; ++r) w.f32(m[c][r]);
+        for (int r = 0; r < 4; ++r) {
+            if (base)
+                w.varint(std::bit_cast<uint32_t>(m[c][r]) ^ std::bit_cast<uint32_t>((*base)[c][r]));
+            else
+                w.f32(m[c][r]);
+        }
 }
-glm::mat4 read_mat(ByteReader& r) {
+glm::mat4 read_mat(ByteReader& r, const glm::mat4* base) {
     glm::mat4 m;
     for (int c = 0; c < 4; ++c)
-        for (int k = 0; k < 4; ++k) m[c][k] = r.f32();
+        for (int k = 0; k < 4; ++k) {
+            if (!base) {
+                m[c][k] = r.f32();
+                continue;
+            }
+            const uint64_t v = r.varint();
+            if (v > 0xFFFFFFFFu) r.fail("a matrix element's xor is wider than 32 bits");
+            m[c][k] = std::bit_cast<float>(uint32_t(v) ^ std::bit_cast<uint32_t>((*base)[c][k]));
+        }
     return m;
 }
 bool same_lens(const Camera& a, const Camera& b) {
@@ -27,20 +46,21 @@ bool same_lens(const Camera& a, const Camera& b) {
 void encode_camera(const Camera& c, double time, const Picture* ref, std::vector<uint8_t>& out) {
     ByteWriter w(out);
     uint8_t flags = 0;
+    const glm::mat4 *view = nullptr, *projection = nullptr;
     if (ref) {
         const Camera& rc = ref->camera;
-        if (c.view == rc.view && c.projection == rc.projection) flags |= kSamePose;
+        view = &rc.view, projection = &rc.projection;
+        if (c.view == rc.view) flags |= kSameView;
+        if (c.projection == rc.projection) flags |= kSameProjection;
         if (c.prev_view == rc.view && c.prev_projection == rc.projection) flags |= kPrevIsReference;
         if (same_lens(c, rc)) flags |= kSameLens;
     }
     w.u8(flags);
-    if (!(flags & kSamePose)) {
-        write_mat(w, c.view);
-        write_mat(w, c.projection);
-    }
+    if (!(flags & kSameView)) write_mat(w, c.view, view);
+    if (!(flags & kSameProjection)) write_mat(w, c.projection, projection);
     if (!(flags & kPrevIsReference)) {
-        write_mat(w, c.prev_view);
-        write_mat(w, c.prev_projection);
+        write_mat(w, c.prev_view, view);
+        write_mat(w, c.prev_projection, projection);
     }
     if (!(flags & kSameLens)) {
         w.f32(c.near);
@@ -54,23 +74,20 @@ void encode_camera(const Camera& c, double time, const Picture* ref, std::vector
 Status decode_camera(std::span<const uint8_t> in, const Picture* ref, Camera& c, double& time) {
     ByteReader r(in, "camera section");
     const uint8_t flags = r.u8();
-    if (flags & ~uint8_t(kSamePose | kPrevIsReference | kSameLens))
+    if (flags & ~kAllFlags)
         return Status::error("camera section: unknown flags " + std::to_string(flags));
-    if ((flags & (kSamePose | kPrevIsReference | kSameLens)) && !ref)
+    if (flags && !ref)
         return Status::error("camera section: refers to the reference camera of a key frame");
-    if (flags & kSamePose) {
-        c.view = ref->camera.view;
-        c.projection = ref->camera.projection;
-    } else {
-        c.view = read_mat(r);
-        c.projection = read_mat(r);
-    }
+    const glm::mat4* view = ref ? &ref->camera.view : nullptr;
+    const glm::mat4* projection = ref ? &ref->camera.projection : nullptr;
+    c.view = flags & kSameView ? ref->camera.view : read_mat(r, view);
+    c.projection = flags & kSameProjection ? ref->camera.projection : read_mat(r, projection);
     if (flags & kPrevIsReference) {
         c.prev_view = ref->camera.view;
         c.prev_projection = ref->camera.projection;
     } else {
-        c.prev_view = read_mat(r);
-        c.prev_projection = read_mat(r);
+        c.prev_view = read_mat(r, view);
+        c.prev_projection = read_mat(r, projection);
     }
     if (flags & kSameLens) {
         c.near = ref->camera.near;
