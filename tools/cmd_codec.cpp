@@ -96,6 +96,9 @@ void print_stats(const codec::StreamStats& s, double fps) {
     std::printf(
         "  %zu frames: %zu key, %zu predicted from an older reference, %zu intra macroblocks\n",
         s.frames, s.key_frames, s.older_reference, s.intra_blocks);
+    if (s.cameras_fitted > 0)
+        std::printf("  %zu frames without a camera coded with one fitted to depth and motion\n",
+                    s.cameras_fitted);
 }
 
 struct EncodeJob {
