@@ -323,7 +323,9 @@ int command_encode(int argc, char** argv) {
         "encode",
         "Encodes an EXR sequence with reprise's scene-aware codec: each frame predicted by "
         "reprojecting\n"
-        "the previous decoded frame with the rendered depth and motion; prints bits per stream.");
+        "the previous decoded frame with the rendered depth and motion; prints bits per stream.\n"
+        "Frames without a camera (no cameras.json) are coded with one fitted to their depth and\n"
+        "motion.");
     args.option("--in", &job.in, "input sequence (folder of EXR frames)");
     args.option("--out", &job.out, "output stream (.rps)");
     args.option("--qp", &job.qp, "quantiser 0 (finest) .. 51 (default 28), constant quality");
