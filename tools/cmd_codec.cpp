@@ -96,6 +96,9 @@ void print_stats(const codec::StreamStats& s, double fps) {
     std::printf(
         "  %zu frames: %zu key, %zu predicted from an older reference, %zu intra macroblocks\n",
         s.frames, s.key_frames, s.older_reference, s.intra_blocks);
+    if (s.cameras_fitted > 0)
+        std::printf("  %zu frames without a camera coded with one fitted to depth and motion\n",
+                    s.cameras_fitted);
 }
 
 struct EncodeJob {
@@ -320,7 +323,9 @@ int command_encode(int argc, char** argv) {
         "encode",
         "Encodes an EXR sequence with reprise's scene-aware codec: each frame predicted by "
         "reprojecting\n"
-        "the previous decoded frame with the rendered depth and motion; prints bits per stream.");
+        "the previous decoded frame with the rendered depth and motion; prints bits per stream.\n"
+        "Frames without a camera (no cameras.json) are coded with one fitted to their depth and\n"
+        "motion.");
     args.option("--in", &job.in, "input sequence (folder of EXR frames)");
     args.option("--out", &job.out, "output stream (.rps)");
     args.option("--qp", &job.qp, "quantiser 0 (finest) .. 51 (default 28), constant quality");

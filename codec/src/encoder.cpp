@@ -9,6 +9,7 @@
 #include <glm/geometric.hpp>
 #include <glm/matrix.hpp>
 
+#include "camera_fit.hpp"
 #include "decoder_state.hpp"
 #include "internal.hpp"
 #include "reprise/core/byte_io.hpp"
@@ -31,6 +32,11 @@ float sequence_view_step(const Camera& camera, int w, int h, float client, float
     const float travel = glm::length(here - before);
     if (!(travel > 0.0f && travel < 1e6f)) return client;
     return std::min(client, view_depth_step(camera.projection, w, h, motion_error, travel));
+}
+
+// A default Camera: Blender's render passes without cameras.json, plain video.
+bool carries_no_camera(const Camera& c) {
+    return !has_projection(c) && c.prev_projection == glm::mat4(1.0f) && c.view == c.prev_view;
 }
 
 void append_section(std::vector<uint8_t>& payload, const std::vector<uint8_t>& section) {
@@ -68,6 +74,13 @@ struct Encoder::State {
 
     float client_step = 0.0f;  // the view step the client's warps need (E and B)
 
+    // Frames without a camera get a fitted one: poses chained from the first such frame's camera
+    // space (the previous frame's view), a lens assumed until rotation lets the fit measure it.
+    struct Chain {
+        glm::dmat4 pose{1.0};  // the previous frame's view
+        glm::mat4 lens{0.0f};  // the measured projection; 0: not yet measured
+    } chain;
+
     int slot_of(uint32_t frame) const { return held_slot(refs, frame); }
 
     // The reference for the next frame, or -1 for a key frame.
@@ -87,7 +100,41 @@ struct Encoder::State {
         return best;
     }
 
-    Status encode(const Frame& frame, int ref_slot, int qp_now, Picture& pic,
+    // The camera to code `frame` with; `next` what the next fitted frame continues from.
+    Camera camera_for(const Frame& frame, Chain& next, StreamStats& fs) const {
+        next = chain;
+        if (!options.fit_cameras || !carries_no_camera(frame.camera) || frame.depth.empty() ||
+            frame.motion.empty() || options.depth == DepthMode::None)
+            return frame.camera;
+        const int w = frame.width(), h = frame.height();
+        CameraFit fit;
+        if (chain.lens[2][3] == 0.0f) {
+            // The focal length shows in how rotation bends the motion: kept once a fit rotates
+            // the image centre by a pixel or more.
+            fit =
+                fit_camera(frame.depth.view(), frame.motion.view(), assumed_projection(w, h), true);
+            const double angle = std::acos(std::clamp(
+                (fit.relative[0][0] + fit.relative[1][1] + fit.relative[2][2] - 1.0) / 2.0, -1.0,
+                1.0));
+            if (fit.ok && 2 * fit.inliers >= fit.samples &&
+                angle * fit.projection[1][1] * h / 2.0 >= 1.0)
+                next.lens = fit.projection;
+            else
+                fit = fit_camera(frame.depth.view(), frame.motion.view(), assumed_projection(w, h),
+                                 false);
+        } else {
+            fit = fit_camera(frame.depth.view(), frame.motion.view(), chain.lens, false);
+        }
+        Camera c = frame.camera;
+        c.projection = c.prev_projection = fit.projection;
+        c.prev_view = glm::mat4(chain.pose);
+        next.pose = glm::inverse(fit.relative) * chain.pose;
+        c.view = glm::mat4(next.pose);
+        fs.cameras_fitted = fit.ok;
+        return c;
+    }
+
+    Status encode(const Frame& frame, const Camera& camera, int ref_slot, int qp_now, Picture& pic,
                   std::vector<uint8_t>& payload, StreamStats& fs, ColorEncodeResult& colour) {
         const bool key = ref_slot < 0;
         const Picture* ref = key ? nullptr : &refs[ref_slot];
@@ -96,21 +143,20 @@ struct Encoder::State {
         if (key) write_params(sp, payload);
 
         std::vector<uint8_t> section;
-        encode_camera(frame.camera, frame.camera.time, ref, section);
+        encode_camera(camera, camera.time, ref, section);
         fs.camera_bits += 8 * section.size();
         append_section(payload, section);
 
         section.clear();
-        encode_depth(fc, frame.camera, frame.depth.view(), pic.depth, section, fs);
+        encode_depth(fc, camera, frame.depth.view(), pic.depth, section, fs);
         append_section(payload, section);
 
         section.clear();
-        encode_motion(fc, frame.camera, pic.depth.view(), frame.motion.view(), pic.motion, section,
-                      fs);
+        encode_motion(fc, camera, pic.depth.view(), frame.motion.view(), pic.motion, section, fs);
         append_section(payload, section);
 
         const ImageView<const glm::vec2> motion =
-            motion_to_reference(sp, frame.camera, pic.depth, pic.motion, ref, next_frame, work);
+            motion_to_reference(sp, camera, pic.depth, pic.motion, ref, next_frame, work);
         section.clear();
         colour = encode_color(fc, source_planes, motion, qp_now, options.skip_threshold, pic.planes,
                               section, fs);
@@ -118,8 +164,8 @@ struct Encoder::State {
         // The packet header, key frame parameters and section lengths.
         fs.header_bits = 8 * (kPacketHeaderSize + payload.size()) -
                          (fs.camera_bits + fs.depth_bits + fs.motion_bits + fs.color_bits);
-        pic.camera = frame.camera;
-        pic.time = frame.camera.time;
+        pic.camera = camera;
+        pic.time = camera.time;
         pic.frame = next_frame;
         pic.held = true;
         return {};
@@ -167,6 +213,9 @@ Status Encoder::send_frame(const Frame& given) {
 
     NonfiniteCounts nonfinite;
     const Frame& frame = s.repair.clean(given, nonfinite);
+    State::Chain next_chain;
+    StreamStats fitted;
+    const Camera camera = s.camera_for(frame, next_chain, fitted);
 
     SequenceParams sp;
     sp.width = w;
@@ -179,10 +228,10 @@ Status Encoder::send_frame(const Frame& given) {
         sp.view_error = s.options.view_error_px;
         sp.view_displacement = s.options.view_displacement;
         const float client =
-            view_depth_step(frame.camera.projection, w, h, sp.view_error, sp.view_displacement);
+            view_depth_step(camera.projection, w, h, sp.view_error, sp.view_displacement);
         sp.view_step = s.started && client == s.client_step
                            ? s.sp.view_step
-                           : sequence_view_step(frame.camera, w, h, client, sp.motion_error);
+                           : sequence_view_step(camera, w, h, client, sp.motion_error);
         s.client_step = client;
     }
     sp.slices = default_slices(h);
@@ -203,7 +252,7 @@ Status Encoder::send_frame(const Frame& given) {
         fs = {};
         ColorEncodeResult colour;
         const int qp_now = std::clamp(ref < 0 ? qp - 3 : qp, 0, 51);
-        REPRISE_TRY(s.encode(frame, ref, qp_now, pic, payload, fs, colour));
+        REPRISE_TRY(s.encode(frame, camera, ref, qp_now, pic, payload, fs, colour));
         if (ref >= 0 && s.options.detect_cuts &&
             colour.intra_macroblocks * 10 > colour.macroblocks * 6) {
             ref = -1;  // a cut: most of the frame is new
@@ -228,7 +277,7 @@ Status Encoder::send_frame(const Frame& given) {
     const bool key = ref < 0;
     PacketHeader header{key ? PacketType::Key : PacketType::Inter, s.next_frame,
                         key ? s.next_frame : s.refs[ref].frame,
-                        int64_t(std::llround(frame.camera.time * 1e6))};
+                        int64_t(std::llround(camera.time * 1e6))};
     Packet packet;
     write_packet(header, payload, packet.data);
     packet.frame = header.frame;
@@ -253,7 +302,9 @@ Status Encoder::send_frame(const Frame& given) {
     s.after_loss = false;
     s.started = true;
     s.next_frame++;
+    s.chain = next_chain;
     fs.frames = 1;
+    fs.cameras_fitted = fitted.cameras_fitted;
     fs.nonfinite = nonfinite;
     s.last = fs;
     add_stats(s.stats, fs);
@@ -307,6 +358,12 @@ Status Encoder::resume(std::span<const std::span<const uint8_t>> packets) {
     if (s.sp.depth == DepthMode::View && s.newest >= 0)
         s.client_step = view_depth_step(s.refs[s.newest].camera.projection, s.sp.width, s.sp.height,
                                         s.sp.view_error, s.sp.view_displacement);
+    if (s.newest >= 0 && has_projection(s.refs[s.newest].camera)) {
+        const Camera& c = s.refs[s.newest].camera;
+        s.chain.pose = glm::dmat4(c.view);
+        if (c.projection != assumed_projection(s.sp.width, s.sp.height))
+            s.chain.lens = c.projection;
+    }
     s.stats = d.stats;
     s.recon_ready = false;
     return {};

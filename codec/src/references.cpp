@@ -20,6 +20,7 @@ void add_stats(StreamStats& total, const StreamStats& f) {
     total.motion_models += f.motion_models;
     total.motion_own_pixels += f.motion_own_pixels;
     total.depth_zero_blocks += f.depth_zero_blocks;
+    total.cameras_fitted += f.cameras_fitted;
 }
 
 int replacement_slot(const Picture (&refs)[kReferences]) {

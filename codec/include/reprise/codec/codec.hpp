@@ -46,6 +46,9 @@ struct EncoderOptions {
     // what quantises to nothing.
     int skip_threshold = 2;
     bool detect_cuts = true;  // key frame when the prediction misses most pixels
+    // Frames without a camera (identity matrices) and with depth and motion are coded with a
+    // camera fitted to them, so that only motion it does not explain is sent (docs/bitstream.md).
+    bool fit_cameras = true;
 };
 
 enum class PacketType : uint8_t { Key = 0, Inter = 1 };
@@ -70,6 +73,7 @@ struct StreamStats {
     std::size_t motion_models = 0;           // affine motion models sent
     std::size_t motion_own_pixels = 0;       // pixels whose motion no model gives, sent alone
     std::size_t depth_zero_blocks = 0;       // depth blocks predicted exactly
+    std::size_t cameras_fitted = 0;  // encoder: frames without a camera coded with a fitted one
     // Encoder input: NaN/Inf repaired before coding (colour: holes; depth NaN/-inf and motion:
     // unknown; reprise/core/nonfinite.hpp).
     NonfiniteCounts nonfinite;
