@@ -493,15 +493,18 @@ TEST(Codec, ASilhouetteOnePixelOffCostsAFlag) {
             ASSERT_TRUE(encoder.send_frame(frames[i]).ok());
             Packet p;
             ASSERT_EQ(encoder.receive_packet(p), Result::Ok);
-            if (i > 0)
+            if (i > 0) {
                 EXPECT_LE(encoder.last_frame_stats().depth_bits,
                           mode == DepthMode::View ? 600u : 2000u)
                     << "frame " << i << (mode == DepthMode::View ? " view" : " lossless");
+            }
         }
         const Image<float>& decoded = encoder.reconstruction().depth;
         for (std::size_t p = 0; p < decoded.pixel_count(); ++p)
             ASSERT_EQ(std::isinf(decoded.data()[p]), std::isinf(frames.back().depth.data()[p]));
-        if (mode == DepthMode::Lossless) EXPECT_TRUE(same_bits(decoded, frames.back().depth));
+        if (mode == DepthMode::Lossless) {
+            EXPECT_TRUE(same_bits(decoded, frames.back().depth));
+        }
     }
 }
 
