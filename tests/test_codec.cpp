@@ -16,6 +16,7 @@
 #include "reprise/core/simd.hpp"
 #include "reprise/server/builtin_scenes.hpp"
 #include "reprise/server/renderer.hpp"
+#include "support/codec.hpp"
 #include "support/frames.hpp"
 #include "support/renderer.hpp"
 
@@ -30,17 +31,7 @@ using test::kNaN;
 using test::same_bits;
 
 std::vector<Frame> render(const std::string& scene_name, int frames, int w, int h, int first = 0) {
-    server::Scene scene;
-    server::CameraPath path;
-    Status s = server::load_scene(scene_name, scene, path);
-    EXPECT_TRUE(s.ok()) << s.message();
-    std::vector<Frame> out(frames);
-    for (int i = 0; i < frames; ++i) {
-        s = test::shared_renderer().render_frame(scene, path, first + i, 30.0,
-                                                 {.width = w, .height = h}, out[i]);
-        EXPECT_TRUE(s.ok()) << s.message();
-    }
-    return out;
+    return test::render_scene(scene_name, frames, w, h, 30.0, first);
 }
 
 Camera camera_at(int w, int h, float x = 0.0f) {
@@ -52,24 +43,8 @@ Camera camera_at(int w, int h, float x = 0.0f) {
     return c;
 }
 
-struct Coded {
-    std::vector<Packet> packets;
-    std::vector<Frame> reconstructions;
-};
-
-Coded encode_all(const std::vector<Frame>& frames, const EncoderOptions& options) {
-    Coded c;
-    Encoder encoder(options);
-    for (const Frame& f : frames) {
-        Status s = encoder.send_frame(f);
-        EXPECT_TRUE(s.ok()) << s.message();
-        Packet p;
-        EXPECT_EQ(encoder.receive_packet(p), Result::Ok);
-        c.packets.push_back(std::move(p));
-        c.reconstructions.push_back(encoder.reconstruction());
-    }
-    return c;
-}
+using test::Coded;
+using test::encode_all;
 
 ::testing::AssertionResult same_frame(const Frame& a, const Frame& b) {
     if (!same_bits(a.color, b.color)) return ::testing::AssertionFailure() << "colour differs";

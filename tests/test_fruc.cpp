@@ -24,16 +24,7 @@ using test::shared_renderer;
 // Frames [first, first + count) of `scene` at `fps`.
 std::vector<Frame> render(const std::string& scene_name, double fps, int first, int count,
                           int w = 384, int h = 216) {
-    server::Scene scene;
-    server::CameraPath path;
-    EXPECT_TRUE(server::load_scene(scene_name, scene, path).ok());
-    std::vector<Frame> frames(count);
-    for (int i = 0; i < count; ++i)
-        EXPECT_TRUE(
-            shared_renderer()
-                .render_frame(scene, path, first + i, fps, {.width = w, .height = h}, frames[i])
-                .ok());
-    return frames;
+    return test::render_scene(scene_name, count, w, h, fps, first);
 }
 
 double psnr_of(const Frame& truth, const Frame& test) {

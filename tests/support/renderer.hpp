@@ -4,7 +4,10 @@
 #include <gtest/gtest.h>
 
 #include <memory>
+#include <string>
+#include <vector>
 
+#include "reprise/server/builtin_scenes.hpp"
 #include "reprise/server/renderer.hpp"
 
 namespace reprise::test {
@@ -18,6 +21,22 @@ inline server::Renderer& shared_renderer() {
         return made;
     }();
     return *renderer;
+}
+
+// Frames first .. first + count - 1 of a built-in scene (or glTF file) on its camera path.
+inline std::vector<Frame> render_scene(const std::string& name, int count, int w, int h,
+                                       double fps = 30.0, int first = 0) {
+    server::Scene scene;
+    server::CameraPath path;
+    Status s = server::load_scene(name, scene, path);
+    EXPECT_TRUE(s.ok()) << s.message();
+    std::vector<Frame> frames(count);
+    for (int i = 0; i < count; ++i) {
+        s = shared_renderer().render_frame(scene, path, first + i, fps, {.width = w, .height = h},
+                                           frames[i]);
+        EXPECT_TRUE(s.ok()) << s.message();
+    }
+    return frames;
 }
 
 }  // namespace reprise::test
