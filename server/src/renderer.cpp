@@ -14,9 +14,10 @@
 #include "gbuffer_shaders.hpp"
 #include "heavy_shaders.hpp"
 #include "reprise/core/memory_limit.hpp"
+#include "reprise/gl/context.hpp"
+#include "reprise/gl/program.hpp"
 #include "reprise/server/animation.hpp"
 #include "reprise/server/builtin_scenes.hpp"
-#include "reprise/server/gl_context.hpp"
 
 namespace reprise::server {
 
@@ -38,41 +39,6 @@ struct Draw {
     float id;
     bool mirrored;  // node transform with negative determinant flips the winding
 };
-
-Status compile(GLenum type, const char* source, GLuint& shader) {
-    shader = glCreateShader(type);
-    glShaderSource(shader, 1, &source, nullptr);
-    glCompileShader(shader);
-    GLint ok = 0;
-    glGetShaderiv(shader, GL_COMPILE_STATUS, &ok);
-    if (ok) return {};
-    char log[2048] = {};
-    glGetShaderInfoLog(shader, sizeof log, nullptr, log);
-    return Status::error(std::string("OpenGL ES: shader does not compile: ") + log);
-}
-
-Status link(const char* vertex, const char* fragment, const char* what, GLuint& program) {
-    GLuint vs = 0, fs = 0;
-    Status status = compile(GL_VERTEX_SHADER, vertex, vs);
-    if (status.ok()) status = compile(GL_FRAGMENT_SHADER, fragment, fs);
-    if (status.ok()) {
-        program = glCreateProgram();
-        glAttachShader(program, vs);
-        glAttachShader(program, fs);
-        glLinkProgram(program);
-        GLint linked = 0;
-        glGetProgramiv(program, GL_LINK_STATUS, &linked);
-        if (!linked) {
-            char log[2048] = {};
-            glGetProgramInfoLog(program, sizeof log, nullptr, log);
-            status = Status::error(std::string("OpenGL ES: the ") + what +
-                                   " program does not link: " + log);
-        }
-    }
-    glDeleteShader(vs);
-    glDeleteShader(fs);
-    return status;
-}
 
 constexpr int kShadowMapSize = 1024;
 
@@ -205,7 +171,7 @@ Status parse_refresh(const std::string& spec, ReuseSettings& reuse) {
 namespace {}  // namespace
 
 struct Renderer::Gpu {
-    std::unique_ptr<GlContext> context;
+    std::unique_ptr<gl::Context> context;
     GLuint program = 0;
     GLuint active = 0;  // the program uniform() looks names up in
     // Heavy shading: its program, the key light's shadow map and the ping-pong reuse cache.
@@ -272,13 +238,6 @@ struct Renderer::Gpu {
 
     GLint uniform(const char* name) const { return glGetUniformLocation(active, name); }
 
-    static void float_target(GLuint texture, int w, int h) {
-        glBindTexture(GL_TEXTURE_2D, texture);
-        glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA32F, w, h, 0, GL_RGBA, GL_FLOAT, nullptr);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
-        glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-    }
-
     // Programs, shadow map and cache of the heavy mode, made on first use.
     Status prepare_heavy() {
         if (heavy_program[0]) return {};
@@ -288,11 +247,11 @@ struct Renderer::Gpu {
             const std::string fragment = std::string("#version 300 es\n#define REUSE ") +
                                          (pass ? "1" : "0") + "\n#define PASS " + char('0' + pass) +
                                          "\n" + shaders::kHeavyFragment;
-            REPRISE_TRY(
-                link(vertex.c_str(), fragment.c_str(), "heavy shading", heavy_program[pass]));
+            REPRISE_TRY(gl::link_program(vertex.c_str(), fragment.c_str(), "heavy shading",
+                                         heavy_program[pass]));
         }
-        REPRISE_TRY(
-            link(shaders::kShadowVertex, shaders::kShadowFragment, "shadow map", shadow_program));
+        REPRISE_TRY(gl::link_program(shaders::kShadowVertex, shaders::kShadowFragment, "shadow map",
+                                     shadow_program));
         glGenTextures(1, &shadow_map);
         glBindTexture(GL_TEXTURE_2D, shadow_map);
         glTexImage2D(GL_TEXTURE_2D, 0, GL_DEPTH_COMPONENT32F, kShadowMapSize, kShadowMapSize, 0,
@@ -326,7 +285,7 @@ struct Renderer::Gpu {
 
     void resize_cache(int w, int h) {
         for (int i = 0; i < 2; ++i) {
-            float_target(cache_meta[i], w, h);
+            gl::allocate_texture(cache_meta[i], GL_RGBA32F, w, h);
             glBindTexture(GL_TEXTURE_2D, cache_term[i]);
             glTexImage2D(GL_TEXTURE_2D, 0, GL_RGBA16F, w, h, 0, GL_RGBA, GL_HALF_FLOAT, nullptr);
             glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
@@ -650,8 +609,8 @@ void Renderer::drop_reuse_cache() { gpu_->cache_valid = false; }
 Status Renderer::create(std::unique_ptr<Renderer>& renderer) {
     std::unique_ptr<Renderer> r(new Renderer());
     Gpu& g = *r->gpu_;
-    REPRISE_TRY(GlContext::create(g.context));
-    REPRISE_TRY(link(shaders::kVertex, shaders::kFragment, "G-buffer", g.program));
+    REPRISE_TRY(gl::Context::create(g.context));
+    REPRISE_TRY(gl::link_program(shaders::kVertex, shaders::kFragment, "G-buffer", g.program));
     glGenVertexArrays(1, &g.vertex_array);
     glGenBuffers(1, &g.vertex_buffer);
     glGenBuffers(1, &g.index_buffer);

@@ -1,14 +1,16 @@
-#include "reprise/server/gl_context.hpp"
+#include "reprise/gl/context.hpp"
 
 #include <cstdlib>
 #include <cstring>
+#include <map>
+#include <mutex>
 #include <vector>
 
 #include <EGL/egl.h>
 #include <EGL/eglext.h>
 #include <GLES3/gl32.h>
 
-namespace reprise::server {
+namespace reprise::gl {
 
 namespace {
 
@@ -49,9 +51,26 @@ EGLDisplay surfaceless_display() {
     return get_display(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
 }
 
+// EGL displays are per process and eglTerminate ends every context on one: a display is
+// terminated only when the last Context on it goes (the renderer and gpu/ each hold one).
+std::mutex display_users_mutex;
+std::map<EGLDisplay, int> display_users;
+
+void hold(EGLDisplay display) {
+    std::lock_guard lock(display_users_mutex);
+    ++display_users[display];
+}
+
+void release(EGLDisplay display) {
+    std::lock_guard lock(display_users_mutex);
+    if (--display_users[display] > 0) return;
+    display_users.erase(display);
+    eglTerminate(display);
+}
+
 }  // namespace
 
-Status GlContext::create(std::unique_ptr<GlContext>& context) {
+Status Context::create(std::unique_ptr<Context>& context) {
     const char* forced = std::getenv("REPRISE_EGL");
     std::string mode = forced ? forced : "";
     if (!mode.empty() && mode != "device" && mode != "surfaceless")
@@ -73,13 +92,17 @@ Status GlContext::create(std::unique_ptr<GlContext>& context) {
     if (display == EGL_NO_DISPLAY || !eglInitialize(display, &major, &minor))
         return Status::error("EGL: cannot initialise a display (error 0x" +
                              std::to_string(eglGetError()) + ")");
-    if (!eglBindAPI(EGL_OPENGL_ES_API)) return Status::error("EGL: OpenGL ES is not supported");
+    hold(display);
+    if (!eglBindAPI(EGL_OPENGL_ES_API)) {
+        release(display);
+        return Status::error("EGL: OpenGL ES is not supported");
+    }
     const EGLint config_attributes[] = {EGL_RENDERABLE_TYPE, EGL_OPENGL_ES3_BIT, EGL_SURFACE_TYPE,
                                         EGL_PBUFFER_BIT, EGL_NONE};
     EGLConfig config = nullptr;
     EGLint configs = 0;
     if (!eglChooseConfig(display, config_attributes, &config, 1, &configs) || configs < 1) {
-        eglTerminate(display);
+        release(display);
         return Status::error("EGL: no OpenGL ES 3 configuration");
     }
     EGLContext egl_context = EGL_NO_CONTEXT;
@@ -90,15 +113,15 @@ Status GlContext::create(std::unique_ptr<GlContext>& context) {
         if (egl_context != EGL_NO_CONTEXT) break;
     }
     if (egl_context == EGL_NO_CONTEXT) {
-        eglTerminate(display);
+        release(display);
         return Status::error("EGL: cannot create an OpenGL ES 3 context");
     }
     if (!eglMakeCurrent(display, EGL_NO_SURFACE, EGL_NO_SURFACE, egl_context)) {
         eglDestroyContext(display, egl_context);
-        eglTerminate(display);
+        release(display);
         return Status::error("EGL: cannot make the context current without a surface");
     }
-    context.reset(new GlContext());
+    context.reset(new Context());
     context->display_ = display;
     context->context_ = egl_context;
     const char* renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
@@ -120,15 +143,15 @@ Status GlContext::create(std::unique_ptr<GlContext>& context) {
     return {};
 }
 
-GlContext::~GlContext() {
+Context::~Context() {
     if (!display_) return;
     eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
     if (context_) eglDestroyContext(display_, context_);
-    eglTerminate(display_);
+    release(static_cast<EGLDisplay>(display_));
 }
 
-void GlContext::make_current() const {
+void Context::make_current() const {
     eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_);
 }
 
-}  // namespace reprise::server
+}  // namespace reprise::gl

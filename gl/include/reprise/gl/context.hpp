@@ -6,23 +6,23 @@
 
 #include "reprise/core/status.hpp"
 
-namespace reprise::server {
+namespace reprise::gl {
 
-class GlContext {
+class Context {
 public:
-    static Status create(std::unique_ptr<GlContext>& context);
-    ~GlContext();
-    GlContext(const GlContext&) = delete;
-    GlContext& operator=(const GlContext&) = delete;
+    static Status create(std::unique_ptr<Context>& context);
+    ~Context();
+    Context(const Context&) = delete;
+    Context& operator=(const Context&) = delete;
 
     void make_current() const;
     const std::string& description() const { return description_; }  // "llvmpipe (LLVM ...)"
 
 private:
-    GlContext() = default;
+    Context() = default;
     void* display_ = nullptr;
     void* context_ = nullptr;
     std::string description_;
 };
 
-}  // namespace reprise::server
+}  // namespace reprise::gl
