@@ -21,4 +21,4 @@ foreach(header ${reprise_public_headers})
 endforeach()
 add_library(reprise_header_check OBJECT ${reprise_header_sources})
 target_link_libraries(reprise_header_check PRIVATE reprise_core reprise_warp reprise_stereo
-  reprise_codec reprise_server reprise_net reprise_gl reprise_client)
+  reprise_codec reprise_server reprise_net reprise_gl reprise_gpu reprise_client)

@@ -1,10 +1,10 @@
 # `cmake --install`: headers, the module libraries, the `reprise` executable, a CMake package
-# (find_package(reprise CONFIG) -> reprise::core, ::warp, ::stereo, ::codec, ::net, ::gl, ::server, ::client) and
+# (find_package(reprise CONFIG) -> reprise::core, ::warp, ::stereo, ::codec, ::net, ::gl, ::gpu, ::server, ::client) and
 # reprise.pc for pkg-config. Included from the top-level CMakeLists.txt after every module.
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
-set(reprise_modules core warp stereo codec net gl server client)
+set(reprise_modules core warp stereo codec net gl gpu server client)
 foreach(module ${reprise_modules})
   # Each module's CMakeLists names its public include folder as a build-tree path; installed
   # consumers find the same headers under the install prefix.

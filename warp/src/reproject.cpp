@@ -29,61 +29,13 @@ constexpr float kInf = std::numeric_limits<float>::infinity();
 
 enum Outcome { Hit, Offscreen, Behind, Occluded, OtherId, Invalid, OutcomeCount };
 
-// Per-frame constants. The depth the surface point seen at pixel position (px, py) with current
-// depth z has in the previous camera is affine in (px w, py w, z, 1), with w the current clip w
-// (z for perspective, 1 for orthographic): z_expected = w (kx px + ky py + kw) + kz z + k1.
-struct Setup {
-    float kx, ky, kw, kz, k1;
-    float wz, w1;    // w = wz z + w1
-    float px0, py0;  // pixel x is seen at px = x + px0 (centre + jitter)
-    float qx0, qy0;  // and looked up in the previous image at x + qx0 + motion.x
-    float tolerance, id_tolerance;
-    bool use_ids, background;
-};
+using Setup = ReprojectSetup;
 
 Setup make_setup(const GBufferView& current, const GBufferView& previous,
                  const ReprojectOptions& options) {
-    const Camera& c = current.camera;
-    const glm::dmat4 p(c.projection);
-    // Unprojection at a known depth solves a 2x2 system for (x_view, y_view); that needs a clip w
-    // free of x_view and y_view, as perspective and orthographic projections have.
-    const double a = p[0][0], b = p[1][0], cc = p[0][1], d = p[1][1];
-    const double det = a * d - b * cc;
-    const glm::dmat4 t = glm::dmat4(c.prev_view) * glm::inverse(glm::dmat4(c.view));
-    const double m00 = d / det, m01 = -b / det, m10 = -cc / det, m11 = a / det;
-    const double u0 = t[0][2] * m00 + t[1][2] * m10, u1 = t[0][2] * m01 + t[1][2] * m11;
-    const double w = current.depth.width, h = current.depth.height;
-    double k[7] = {-2.0 * u0 / w,
-                   2.0 * u1 / h,
-                   u0 - u1,
-                   t[2][2] - u0 * p[2][0] - u1 * p[2][1],
-                   u0 * p[3][0] + u1 * p[3][1] - t[3][2],
-                   -p[2][3],
-                   p[3][3]};
-    bool usable = p[0][3] == 0.0 && p[1][3] == 0.0 && det != 0.0;
-    for (double& v : k) {
-        usable = usable && std::isfinite(v) && std::abs(v) < 1e38;
-    }
-    if (!usable) std::fill(std::begin(k), std::end(k), std::numeric_limits<double>::quiet_NaN());
-
-    Setup s{};
-    s.kx = float(k[0]);
-    s.ky = float(k[1]);
-    s.kw = float(k[2]);
-    s.kz = float(k[3]);
-    s.k1 = float(k[4]);
-    s.wz = float(k[5]);
-    s.w1 = float(k[6]);
-    const glm::vec2 j = c.jitter, pj = previous.camera.jitter;
-    s.px0 = float(0.5 + double(j.x));
-    s.py0 = float(0.5 + double(j.y));
-    s.qx0 = float(0.5 + double(j.x) - double(pj.x));
-    s.qy0 = float(0.5 + double(j.y) - double(pj.y));
-    s.tolerance = options.depth_tolerance;
-    s.id_tolerance = options.id_depth_tolerance;
-    s.use_ids = options.match_ids && !current.id.empty() && !previous.id.empty();
-    s.background = options.background;
-    return s;
+    return reproject_setup(current.camera, previous.camera, current.depth.width,
+                           current.depth.height, !current.id.empty() && !previous.id.empty(),
+                           options);
 }
 
 // Shared by both paths so that they decide alike; `row` = ky (y + py0) + kw.
@@ -177,6 +129,50 @@ inline bool fetch(const float* a, const float* b, const float* c, const float* d
 }
 
 }  // namespace
+
+ReprojectSetup reproject_setup(const Camera& c, const Camera& previous, int width, int height,
+                               bool ids, const ReprojectOptions& options) {
+    const glm::dmat4 p(c.projection);
+    // Unprojection at a known depth solves a 2x2 system for (x_view, y_view); that needs a clip w
+    // free of x_view and y_view, as perspective and orthographic projections have.
+    const double a = p[0][0], b = p[1][0], cc = p[0][1], d = p[1][1];
+    const double det = a * d - b * cc;
+    const glm::dmat4 t = glm::dmat4(c.prev_view) * glm::inverse(glm::dmat4(c.view));
+    const double m00 = d / det, m01 = -b / det, m10 = -cc / det, m11 = a / det;
+    const double u0 = t[0][2] * m00 + t[1][2] * m10, u1 = t[0][2] * m01 + t[1][2] * m11;
+    const double w = width, h = height;
+    double k[7] = {-2.0 * u0 / w,
+                   2.0 * u1 / h,
+                   u0 - u1,
+                   t[2][2] - u0 * p[2][0] - u1 * p[2][1],
+                   u0 * p[3][0] + u1 * p[3][1] - t[3][2],
+                   -p[2][3],
+                   p[3][3]};
+    bool usable = p[0][3] == 0.0 && p[1][3] == 0.0 && det != 0.0;
+    for (double& v : k) {
+        usable = usable && std::isfinite(v) && std::abs(v) < 1e38;
+    }
+    if (!usable) std::fill(std::begin(k), std::end(k), std::numeric_limits<double>::quiet_NaN());
+
+    ReprojectSetup s{};
+    s.kx = float(k[0]);
+    s.ky = float(k[1]);
+    s.kw = float(k[2]);
+    s.kz = float(k[3]);
+    s.k1 = float(k[4]);
+    s.wz = float(k[5]);
+    s.w1 = float(k[6]);
+    const glm::vec2 j = c.jitter, pj = previous.jitter;
+    s.px0 = float(0.5 + double(j.x));
+    s.py0 = float(0.5 + double(j.y));
+    s.qx0 = float(0.5 + double(j.x) - double(pj.x));
+    s.qy0 = float(0.5 + double(j.y) - double(pj.y));
+    s.tolerance = options.depth_tolerance;
+    s.id_tolerance = options.id_depth_tolerance;
+    s.use_ids = options.match_ids && ids;
+    s.background = options.background;
+    return s;
+}
 
 }  // namespace reprise::warp
 #endif  // REPRISE_WARP_REPROJECT_SHARED

@@ -51,6 +51,23 @@ struct ReprojectOptions {
     int step = 1;
 };
 
+// The per-frame constants of reproject, shared by the CPU and GPU paths so both decide alike.
+// The depth the surface point seen at pixel position (px, py) with current depth z has in the
+// previous camera is affine in (px w, py w, z, 1), with w the current clip w (z for perspective,
+// 1 for orthographic): z_expected = w (kx px + ky py + kw) + kz z + k1, w = wz z + w1. All NaN
+// for a projection reproject cannot invert (every non-background pixel is then invalid).
+struct ReprojectSetup {
+    float kx, ky, kw, kz, k1;
+    float wz, w1;
+    float px0, py0;  // pixel x is seen at px = x + px0 (centre + jitter)
+    float qx0, qy0;  // and looked up in the previous image at x + qx0 + motion.x
+    float tolerance, id_tolerance;
+    bool use_ids, background;
+};
+// `width` x `height`: the current frame; `ids`: both frames carry object ids.
+ReprojectSetup reproject_setup(const Camera& current, const Camera& previous, int width, int height,
+                               bool ids, const ReprojectOptions& options);
+
 struct ReprojectCounts {
     std::size_t hits = 0;
     std::size_t offscreen = 0;  // p + motion outside the previous image

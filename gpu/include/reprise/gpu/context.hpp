@@ -1,0 +1,66 @@
+#pragma once
+// The display-rate paths on the GPU through OpenGL ES 3.1 compute shaders: one Context owns the
+// GL context, the programs and the textures, sized once per frame size (per-frame calls allocate
+// nothing while the size stays). Two ways in: CPU images (the same G-buffer descriptor and
+// options as warp/, uploaded and downloaded) and GL textures an application already has, made in
+// this context (make_current()), written without a CPU round trip.
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "reprise/core/gbuffer.hpp"
+#include "reprise/core/status.hpp"
+#include "reprise/warp/reproject.hpp"
+
+namespace reprise::gpu {
+
+// What the last call spent, in milliseconds, each phase finished (glFinish) before the next.
+struct Timings {
+    double upload_ms = 0.0;
+    double compute_ms = 0.0;
+    double download_ms = 0.0;
+};
+
+// A G-buffer already on the GPU: texture names with their units as GBufferView's.
+struct GBufferTextures {
+    unsigned depth = 0;   // GL_R32F: linear view depth, +inf background
+    unsigned motion = 0;  // GL_RG32F: backward motion in pixels
+    unsigned id = 0;      // GL_R32UI: object ids; 0 = none
+    int width = 0;
+    int height = 0;
+    Camera camera;
+};
+
+struct ContextState;  // GL objects and scratch (private)
+
+class Context {
+public:
+    // Creates its own EGL context (gl::Context: a GPU's EGL device, else Mesa llvmpipe).
+    static Status create(std::unique_ptr<Context>& context);
+    ~Context();
+    Context(const Context&) = delete;
+    Context& operator=(const Context&) = delete;
+
+    void make_current() const;
+    const std::string& description() const;  // the GL renderer and version
+    const Timings& timings() const { return timings_; }
+
+    // warp::reproject on the GPU, for an RGBA payload (4 channels): the same lookups, depth and
+    // id tests and counts; `out` keeps its values where the lookup misses, `hit` (may be empty)
+    // gets 1 / 0 at every looked-up pixel.
+    Status reproject(const GBufferView& current, const GBufferView& previous,
+                     warp::ConstPayload previous_payload, warp::Payload out, ImageView<uint8_t> hit,
+                     const warp::ReprojectOptions& options, warp::ReprojectCounts& counts);
+    // The same on textures: `payload` and `out` GL_RGBA32F of the previous frame's and the
+    // current frame's size, `hit` GL_R32UI of the current size (0: none).
+    Status reproject(const GBufferTextures& current, const GBufferTextures& previous,
+                     unsigned payload, unsigned out, unsigned hit,
+                     const warp::ReprojectOptions& options, warp::ReprojectCounts& counts);
+
+private:
+    Context();
+    std::unique_ptr<ContextState> state_;
+    Timings timings_;
+};
+
+}  // namespace reprise::gpu

@@ -1,0 +1,111 @@
+// The GPU context: its GL context, the counters buffer, and the plumbing of uploads and downloads.
+#include <chrono>
+
+#include "reprise/gpu/context.hpp"
+#include "state.hpp"
+
+namespace reprise::gpu {
+
+Status create_programs(ContextState& state);  // one per path, linked once
+
+void Texture::ensure(GLenum new_format, int w, int h) {
+    if (name && format == new_format && width == w && height == h) return;
+    gl::immutable_texture(name, new_format, w, h);
+    format = new_format;
+    width = w;
+    height = h;
+}
+
+void upload(const Texture& texture, const void* data, std::ptrdiff_t stride) {
+    GLenum format = 0, type = 0;
+    gl::transfer_format(texture.format, format, type);
+    glBindTexture(GL_TEXTURE_2D, texture.name);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glPixelStorei(GL_UNPACK_ROW_LENGTH, GLint(stride));
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, texture.width, texture.height, format, type, data);
+    glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+}
+
+Status check_texture(unsigned name, GLenum format, int w, int h, const char* what) {
+    const std::string where =
+        std::string("gpu: texture ") + std::to_string(name) + " (" + what + ")";
+    if (!name || !glIsTexture(name)) return Status::error(where + " is not a texture");
+    glBindTexture(GL_TEXTURE_2D, name);
+    if (glGetError() != GL_NO_ERROR) return Status::error(where + " is not a 2D texture");
+    GLint width = 0, height = 0, internal = 0;
+    glGetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_WIDTH, &width);
+    glGetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_HEIGHT, &height);
+    glGetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_INTERNAL_FORMAT, &internal);
+    if (width != w || height != h)
+        return Status::error(where + " is " + std::to_string(width) + "x" + std::to_string(height) +
+                             ", expected " + std::to_string(w) + "x" + std::to_string(h));
+    if (GLenum(internal) != format) {
+        const char* expected = format == GL_RGBA32F ? "GL_RGBA32F"
+                               : format == GL_RG32F ? "GL_RG32F"
+                               : format == GL_R32F  ? "GL_R32F"
+                                                    : "GL_R32UI";
+        return Status::error(where + " has internal format 0x" + std::to_string(internal) +
+                             ", expected " + expected);
+    }
+    return {};
+}
+
+void ContextState::download(const Texture& texture, void* data, std::ptrdiff_t stride) {
+    glBindFramebuffer(GL_FRAMEBUFFER, read_framebuffer);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, texture.name, 0);
+    glPixelStorei(GL_PACK_ALIGNMENT, 1);
+    if (texture.format == GL_R32UI) {
+        hit_readback.resize(std::size_t(texture.width) * std::size_t(texture.height));
+        glReadPixels(0, 0, texture.width, texture.height, GL_RGBA_INTEGER, GL_UNSIGNED_INT,
+                     hit_readback.data());
+    } else {
+        glPixelStorei(GL_PACK_ROW_LENGTH, GLint(stride));
+        glReadPixels(0, 0, texture.width, texture.height, GL_RGBA, GL_FLOAT, data);
+        glPixelStorei(GL_PACK_ROW_LENGTH, 0);
+    }
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+}
+
+Context::Context() : state_(std::make_unique<ContextState>()) {}
+
+Context::~Context() {
+    if (!state_->gl) return;
+    state_->gl->make_current();
+    for (Texture* t : {&state_->depth, &state_->motion, &state_->id, &state_->previous_depth,
+                       &state_->previous_id, &state_->payload, &state_->out, &state_->hit})
+        glDeleteTextures(1, &t->name);
+    glDeleteSamplers(1, &state_->nearest_sampler);
+    glDeleteBuffers(1, &state_->counts_buffer);
+    glDeleteFramebuffers(1, &state_->read_framebuffer);
+    glDeleteProgram(state_->reproject_program);
+}
+
+Status Context::create(std::unique_ptr<Context>& context) {
+    std::unique_ptr<Context> made(new Context());
+    ContextState& s = *made->state_;
+    REPRISE_TRY(gl::Context::create(s.gl));
+    GLint major = 0, minor = 0;
+    glGetIntegerv(GL_MAJOR_VERSION, &major);
+    glGetIntegerv(GL_MINOR_VERSION, &minor);
+    if (major < 3 || (major == 3 && minor < 1))
+        return Status::error("gpu: OpenGL ES 3.1 (compute shaders) is needed; " +
+                             s.gl->description() + " has " + std::to_string(major) + "." +
+                             std::to_string(minor));
+    REPRISE_TRY(create_programs(s));
+    glGenBuffers(1, &s.counts_buffer);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, s.counts_buffer);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, 8 * sizeof(GLuint), nullptr, GL_DYNAMIC_READ);
+    glGenFramebuffers(1, &s.read_framebuffer);
+    glGenSamplers(1, &s.nearest_sampler);
+    glSamplerParameteri(s.nearest_sampler, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+    glSamplerParameteri(s.nearest_sampler, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    REPRISE_TRY(gl::check_errors("gpu context"));
+    context = std::move(made);
+    return {};
+}
+
+void Context::make_current() const { state_->gl->make_current(); }
+
+const std::string& Context::description() const { return state_->gl->description(); }
+
+}  // namespace reprise::gpu

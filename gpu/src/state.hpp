@@ -1,0 +1,44 @@
+#pragma once
+// What a gpu::Context owns: the GL context, programs, and textures sized once per frame size.
+#include <memory>
+#include <vector>
+
+#include <glm/vec4.hpp>
+
+#include "reprise/gl/context.hpp"
+#include "reprise/gl/program.hpp"
+#include "reprise/gpu/context.hpp"
+
+namespace reprise::gpu {
+
+// A texture reallocated only when its format or size changes.
+struct Texture {
+    GLuint name = 0;
+    GLenum format = 0;
+    int width = 0;
+    int height = 0;
+    void ensure(GLenum new_format, int w, int h);
+};
+
+// Uploads `h` rows of `w` pixels, `stride` pixels apart, into `texture` (already sized).
+void upload(const Texture& texture, const void* data, std::ptrdiff_t stride);
+
+// An error naming `what` unless texture `name` is a 2D texture of `format` and w x h.
+Status check_texture(unsigned name, GLenum format, int w, int h, const char* what);
+
+struct ContextState {
+    std::unique_ptr<gl::Context> gl;
+    GLuint reproject_program = 0;
+    GLuint nearest_sampler = 0;  // bound over the inputs: an application's filter settings
+                                 // (linear on integer or float textures) would make them incomplete
+    GLuint counts_buffer = 0;    // per-outcome counters of the last dispatch
+    GLuint read_framebuffer = 0;  // downloads: the texture read is attached here
+    Texture depth, motion, id, previous_depth, previous_id, payload, out, hit;
+    std::vector<glm::uvec4> hit_readback;  // integer downloads come as RGBA
+
+    // Reads `texture` (GL_RGBA32F into floats, GL_R32UI into hit_readback) through the
+    // framebuffer; `stride` in pixels for float targets.
+    void download(const Texture& texture, void* data, std::ptrdiff_t stride);
+};
+
+}  // namespace reprise::gpu

@@ -1,0 +1,238 @@
+// The GPU backend (OpenGL ES 3.1 compute on the renderer's EGL context kind) against the CPU
+// reference: reverse reprojection on every built-in scene, NaN/Inf input, the survey step, and
+// the texture entry point.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <memory>
+#include <vector>
+
+#include <GLES3/gl32.h>
+
+#include "reprise/gpu/context.hpp"
+#include "reprise/warp/reproject.hpp"
+#include "support/frames.hpp"
+#include "support/nonfinite.hpp"
+#include "support/renderer.hpp"
+
+namespace {
+
+using namespace reprise;
+
+constexpr int kWidth = 96, kHeight = 64;
+
+gpu::Context& shared_gpu() {
+    static std::unique_ptr<gpu::Context> context = [] {
+        std::unique_ptr<gpu::Context> made;
+        const Status status = gpu::Context::create(made);
+        if (!status.ok()) ADD_FAILURE() << status.message();
+        return made;
+    }();
+    return *context;
+}
+
+// One run of a path: its output colour, its hit mask and counts.
+struct Result {
+    Image<glm::vec4> out;
+    Image<uint8_t> hit;
+    warp::ReprojectCounts counts;
+};
+
+Result cpu_reproject(const Frame& current, const Frame& previous,
+                     const warp::ReprojectOptions& options = {}) {
+    Result r;
+    r.out.assign(current.width(), current.height(), glm::vec4(0.0f));
+    r.hit.assign(current.width(), current.height(), 7);
+    r.counts = warp::reproject(current, previous, warp::payload_of(previous.color.view()),
+                               warp::payload_of(r.out.view()), r.hit.view(), options);
+    return r;
+}
+
+Result gpu_reproject(const Frame& current, const Frame& previous,
+                     const warp::ReprojectOptions& options = {}) {
+    Result r;
+    r.out.assign(current.width(), current.height(), glm::vec4(0.0f));
+    r.hit.assign(current.width(), current.height(), 7);
+    const Status status =
+        shared_gpu().reproject(current, previous, warp::payload_of(previous.color.view()),
+                               warp::payload_of(r.out.view()), r.hit.view(), options, r.counts);
+    EXPECT_TRUE(status.ok()) << status.message();
+    return r;
+}
+
+std::size_t mask_differences(const Image<uint8_t>& a, const Image<uint8_t>& b) {
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < a.pixel_count(); ++i) n += a.data()[i] != b.data()[i];
+    return n;
+}
+
+// The tolerance: >= 50 dB on display values, holes within 0.1 % of the pixels, each
+// outcome's count too.
+void expect_equal_within_tolerance(const Result& cpu, const Result& gpu, const char* what) {
+    const std::size_t pixels = cpu.hit.pixel_count();
+    const std::size_t allowed = pixels / 1000;
+    EXPECT_LE(mask_differences(cpu.hit, gpu.hit), allowed) << what;
+    EXPECT_GE(test::display_psnr(cpu.out, gpu.out), 50.0) << what;
+    auto near = [&](std::size_t a, std::size_t b) { return (a > b ? a - b : b - a) <= allowed; };
+    EXPECT_TRUE(near(cpu.counts.hits, gpu.counts.hits)) << what;
+    EXPECT_TRUE(near(cpu.counts.offscreen, gpu.counts.offscreen)) << what;
+    EXPECT_TRUE(near(cpu.counts.behind, gpu.counts.behind)) << what;
+    EXPECT_TRUE(near(cpu.counts.occluded, gpu.counts.occluded)) << what;
+    EXPECT_TRUE(near(cpu.counts.other_id, gpu.counts.other_id)) << what;
+    EXPECT_TRUE(near(cpu.counts.invalid, gpu.counts.invalid)) << what;
+    EXPECT_EQ(gpu.counts.hits + gpu.counts.misses(), cpu.counts.hits + cpu.counts.misses()) << what;
+}
+
+TEST(Gpu, ReprojectionMatchesTheCpuOnEveryBuiltInScene) {
+    for (const server::SceneInfo& info : server::builtin_scenes()) {
+        SCOPED_TRACE(info.name);
+        const std::vector<Frame> frames =
+            test::render_scene(info.name, 2, kWidth, kHeight, 30.0, 3);
+        const Result cpu = cpu_reproject(frames[1], frames[0]);
+        const Result gpu = gpu_reproject(frames[1], frames[0]);
+        // Not vacuous: most of a frame 1/30 s on is found in the one before.
+        EXPECT_GT(cpu.counts.hits, cpu.hit.pixel_count() / 2);
+        expect_equal_within_tolerance(cpu, gpu, info.name);
+        std::printf("%-10s hits cpu %zu gpu %zu, hit masks differ at %zu, %.1f dB\n", info.name,
+                    cpu.counts.hits, gpu.counts.hits, mask_differences(cpu.hit, gpu.hit),
+                    test::display_psnr(cpu.out, gpu.out));
+    }
+}
+
+TEST(Gpu, ReprojectionWithoutIdsAndWithTheSurveyStep) {
+    std::vector<Frame> frames = test::render_scene("crossing", 2, kWidth, kHeight, 30.0, 5);
+    for (Frame& f : frames) f.id = {};
+    expect_equal_within_tolerance(cpu_reproject(frames[1], frames[0]),
+                                  gpu_reproject(frames[1], frames[0]), "no ids");
+    const warp::ReprojectOptions survey{.step = 8};
+    const Result cpu = cpu_reproject(frames[1], frames[0], survey);
+    const Result gpu = gpu_reproject(frames[1], frames[0], survey);
+    EXPECT_EQ(cpu.counts.hits + cpu.counts.misses(), std::size_t(12 * 8));
+    expect_equal_within_tolerance(cpu, gpu, "step 8");
+    // Pixels off the survey grid keep what they had (7).
+    EXPECT_EQ(gpu.hit(1, 1), 7);
+}
+
+TEST(Gpu, NonFiniteInputIsCountedAsOnTheCpu) {
+    NonfiniteCounts expected;
+    const std::vector<Frame> frames = test::spoiled_sequence(2, expected);
+    const Result cpu = cpu_reproject(frames[1], frames[0]);
+    const Result gpu = gpu_reproject(frames[1], frames[0]);
+    EXPECT_GT(cpu.counts.invalid, 0u);
+    EXPECT_EQ(gpu.counts.invalid, cpu.counts.invalid);
+    expect_equal_within_tolerance(cpu, gpu, "NaN/Inf");
+    for (std::size_t i = 0; i < gpu.out.pixel_count(); ++i)
+        ASSERT_TRUE(test::finite(gpu.out.data()[i])) << "pixel " << i;
+}
+
+// The texture entry point: the application's textures in, its textures written.
+struct Textures {
+    std::vector<GLuint> names;
+    GLuint make(GLenum format, int w, int h, GLenum pixel_format, GLenum type, const void* data) {
+        GLuint t = 0;
+        glGenTextures(1, &t);
+        glBindTexture(GL_TEXTURE_2D, t);
+        glTexStorage2D(GL_TEXTURE_2D, 1, format, w, h);
+        glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+        if (data) glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, w, h, pixel_format, type, data);
+        names.push_back(t);
+        return t;
+    }
+    gpu::GBufferTextures gbuffer(const Frame& f) {
+        const int w = f.width(), h = f.height();
+        return {.depth = make(GL_R32F, w, h, GL_RED, GL_FLOAT, f.depth.data()),
+                .motion = make(GL_RG32F, w, h, GL_RG, GL_FLOAT, f.motion.data()),
+                .id = make(GL_R32UI, w, h, GL_RED_INTEGER, GL_UNSIGNED_INT, f.id.data()),
+                .width = w,
+                .height = h,
+                .camera = f.camera};
+    }
+    ~Textures() { glDeleteTextures(GLsizei(names.size()), names.data()); }
+};
+
+TEST(Gpu, TextureEntryPointWritesTheCallersTextures) {
+    const std::vector<Frame> frames = test::render_scene("pan", 2, kWidth, kHeight, 30.0, 3);
+    const Result cpu = cpu_reproject(frames[1], frames[0]);
+    gpu::Context& context = shared_gpu();
+    context.make_current();
+    Textures t;
+    const gpu::GBufferTextures current = t.gbuffer(frames[1]), previous = t.gbuffer(frames[0]);
+    const GLuint payload =
+        t.make(GL_RGBA32F, kWidth, kHeight, GL_RGBA, GL_FLOAT, frames[0].color.data());
+    const Image<glm::vec4> zeros(kWidth, kHeight, glm::vec4(0.0f));
+    const GLuint out = t.make(GL_RGBA32F, kWidth, kHeight, GL_RGBA, GL_FLOAT, zeros.data());
+    const GLuint hit = t.make(GL_R32UI, kWidth, kHeight, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
+    Result gpu;
+    const Status status = context.reproject(current, previous, payload, out, hit, {}, gpu.counts);
+    ASSERT_TRUE(status.ok()) << status.message();
+    EXPECT_EQ(context.timings().upload_ms, 0.0);
+
+    // Read the caller's textures back here, as the application would.
+    GLuint framebuffer = 0;
+    glGenFramebuffers(1, &framebuffer);
+    glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, out, 0);
+    gpu.out.resize(kWidth, kHeight);
+    glReadPixels(0, 0, kWidth, kHeight, GL_RGBA, GL_FLOAT, gpu.out.data());
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, hit, 0);
+    std::vector<glm::uvec4> hits(std::size_t(kWidth) * kHeight);
+    glReadPixels(0, 0, kWidth, kHeight, GL_RGBA_INTEGER, GL_UNSIGNED_INT, hits.data());
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glDeleteFramebuffers(1, &framebuffer);
+    gpu.hit.resize(kWidth, kHeight);
+    for (std::size_t i = 0; i < hits.size(); ++i) gpu.hit.data()[i] = uint8_t(hits[i].x);
+    expect_equal_within_tolerance(cpu, gpu, "textures");
+}
+
+TEST(Gpu, BadTexturesAndPayloadsAreNamed) {
+    const std::vector<Frame> frames = test::render_scene("pan", 2, kWidth, kHeight, 30.0, 3);
+    gpu::Context& context = shared_gpu();
+    context.make_current();
+    Textures t;
+    const gpu::GBufferTextures current = t.gbuffer(frames[1]), previous = t.gbuffer(frames[0]);
+    const GLuint small = t.make(GL_RGBA32F, 8, 8, GL_RGBA, GL_FLOAT, nullptr);
+    const GLuint out = t.make(GL_RGBA32F, kWidth, kHeight, GL_RGBA, GL_FLOAT, nullptr);
+    warp::ReprojectCounts counts;
+    Status status = context.reproject(current, previous, small, out, 0, {}, counts);
+    EXPECT_EQ(status.message(), "gpu: texture " + std::to_string(small) +
+                                    " (previous payload) is 8x8, expected 96x64");
+    status = context.reproject(current, previous, current.depth, out, 0, {}, counts);
+    EXPECT_NE(status.message().find("(previous payload) has internal format"), std::string::npos)
+        << status.message();
+    status = context.reproject(current, previous, 4242, out, 0, {}, counts);
+    EXPECT_EQ(status.message(), "gpu: texture 4242 (previous payload) is not a texture");
+
+    std::vector<float> rgb(std::size_t(kWidth) * kHeight * 3, 0.5f);
+    std::vector<float> rgb_out(rgb.size());
+    status = context.reproject(
+        frames[1], frames[0], {rgb.data(), kWidth, kHeight, 3, std::ptrdiff_t(kWidth) * 3},
+        {rgb_out.data(), kWidth, kHeight, 3, std::ptrdiff_t(kWidth) * 3}, {}, {}, counts);
+    EXPECT_EQ(status.message(),
+              "gpu reproject: the payload has 3 channels; the GPU path takes RGBA (4)");
+}
+
+}  // namespace
+
+namespace {
+
+// The renderer and gpu/ share one EGL display: a Context that goes must not end the other's.
+TEST(Gpu, ContextsComeAndGoBesideTheRenderer) {
+    const std::vector<Frame> before = test::render_scene("pan", 1, kWidth, kHeight, 30.0, 3);
+    for (int i = 0; i < 2; ++i) {
+        std::unique_ptr<gpu::Context> another;
+        const Status status = gpu::Context::create(another);
+        ASSERT_TRUE(status.ok()) << status.message();
+    }
+    const std::vector<Frame> after = test::render_scene("pan", 1, kWidth, kHeight, 30.0, 3);
+    EXPECT_EQ(std::memcmp(before[0].color.data(), after[0].color.data(),
+                          before[0].color.pixel_count() * sizeof(glm::vec4)),
+              0);
+    // And the shared GPU context still works.
+    const std::vector<Frame> frames = test::render_scene("pan", 2, kWidth, kHeight, 30.0, 3);
+    expect_equal_within_tolerance(cpu_reproject(frames[1], frames[0]),
+                                  gpu_reproject(frames[1], frames[0]), "after");
+}
+
+}  // namespace
