@@ -7,11 +7,13 @@
 #include <cmath>
 #include <cstring>
 #include <memory>
+#include <random>
 #include <vector>
 
 #include <GLES3/gl32.h>
 
 #include "reprise/gpu/context.hpp"
+#include "reprise/warp/fill.hpp"
 #include "reprise/warp/reproject.hpp"
 #include "support/frames.hpp"
 #include "support/nonfinite.hpp"
@@ -233,6 +235,122 @@ TEST(Gpu, ContextsComeAndGoBesideTheRenderer) {
     const std::vector<Frame> frames = test::render_scene("pan", 2, kWidth, kHeight, 30.0, 3);
     expect_equal_within_tolerance(cpu_reproject(frames[1], frames[0]),
                                   gpu_reproject(frames[1], frames[0]), "after");
+}
+
+}  // namespace
+
+namespace {
+
+// Pull-push on the GPU against warp::PullPush::fill on one image: same stats, >= 50 dB, and
+// valid pixels (and every alpha) untouched.
+void expect_same_fill(const Image<glm::vec4>& color, const Image<uint8_t>& valid,
+                      const Image<float>* depth, const char* what) {
+    Image<glm::vec4> cpu = color, gpu = color;
+    warp::PullPush pull_push;
+    const warp::FillStats expected =
+        pull_push.fill(cpu.view(), valid.view(), depth ? depth->view() : ImageView<const float>{});
+    warp::FillStats got;
+    const Status status = shared_gpu().fill(gpu.view(), valid.view(),
+                                            depth ? depth->view() : ImageView<const float>{}, got);
+    ASSERT_TRUE(status.ok()) << status.message();
+    EXPECT_EQ(got.holes, expected.holes) << what;
+    EXPECT_EQ(got.unfilled, expected.unfilled) << what;
+    EXPECT_EQ(got.levels, expected.levels) << what;
+    EXPECT_GE(test::display_psnr(cpu, gpu), 50.0) << what;
+    std::size_t changed_valid = 0;
+    for (int y = 0; y < color.height(); ++y)
+        for (int x = 0; x < color.width(); ++x) {
+            const bool hole = !valid(x, y) || !test::finite(glm::vec4(glm::vec3(color(x, y)), 0));
+            changed_valid += !hole && std::memcmp(&gpu(x, y), &color(x, y), sizeof(glm::vec4));
+            changed_valid += std::memcmp(&gpu(x, y).a, &color(x, y).a, sizeof(float)) != 0 &&
+                             !std::isnan(color(x, y).a);
+        }
+    EXPECT_EQ(changed_valid, 0u) << what;
+    std::printf("%-22s holes %zu, %d levels, %.1f dB, %.1f ms\n", what, got.holes, got.levels,
+                test::display_psnr(cpu, gpu), shared_gpu().timings().compute_ms);
+}
+
+TEST(Gpu, PullPushMatchesTheCpuOnReprojectionHolesOfEveryBuiltInScene) {
+    for (const server::SceneInfo& info : server::builtin_scenes()) {
+        SCOPED_TRACE(info.name);
+        // Frames far apart: reprojection leaves disocclusions to fill.
+        std::vector<Frame> frames = test::render_scene(info.name, 1, kWidth, kHeight, 30.0, 3);
+        const std::vector<Frame> later = test::render_scene(info.name, 1, kWidth, kHeight, 30.0, 9);
+        frames.push_back(later[0]);
+        Frame& current = frames[1];
+        current.camera.prev_view = frames[0].camera.view;
+        current.camera.prev_projection = frames[0].camera.projection;
+        Result r = cpu_reproject(current, frames[0], {.match_ids = false});
+        expect_same_fill(r.out, r.hit, &current.depth, info.name);
+        expect_same_fill(r.out, r.hit, nullptr, info.name);
+    }
+}
+
+TEST(Gpu, PullPushOnSparseOddAndEmptyImages) {
+    std::mt19937 rng(5);
+    // Each new texture shape costs llvmpipe a shader compile (~1 s on a busy core): few shapes.
+    for (const auto& [w, h, share] : {std::tuple{37, 23, 0.5f}, std::tuple{96, 64, 0.002f},
+                                      std::tuple{1, 9, 0.5f}, std::tuple{16, 16, 0.0f}}) {
+        Image<glm::vec4> color(w, h);
+        Image<uint8_t> valid(w, h);
+        Image<float> depth(w, h);
+        std::uniform_real_distribution<float> u(0.0f, 1.0f);
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                color(x, y) = {u(rng), u(rng), u(rng), 1.0f};
+                valid(x, y) = u(rng) < share;
+                depth(x, y) = u(rng) < 0.5f ? 1.0f : 5.0f + u(rng);
+            }
+        if (share > 0.0f) valid(w / 2, h / 2) = 1;
+        const std::string what = std::to_string(w) + "x" + std::to_string(h);
+        expect_same_fill(color, valid, &depth, what.c_str());
+        if (w > 1) expect_same_fill(color, valid, nullptr, what.c_str());
+    }
+}
+
+TEST(Gpu, PullPushTreatsNonFiniteColourAsHoles) {
+    NonfiniteCounts expected;
+    const std::vector<Frame> frames = test::spoiled_sequence(1, expected);
+    Image<uint8_t> valid(frames[0].width(), frames[0].height(), 1);
+    expect_same_fill(frames[0].color, valid, &frames[0].depth, "NaN/Inf colour and depth");
+}
+
+TEST(Gpu, PullPushOnTexturesWritesTheOutputTexture) {
+    const std::vector<Frame> frames = test::render_scene("fence", 2, kWidth, kHeight, 30.0, 3);
+    const Result r = cpu_reproject(frames[1], frames[0]);
+    Image<glm::vec4> cpu = r.out;
+    warp::PullPush pull_push;
+    const warp::FillStats expected =
+        pull_push.fill(cpu.view(), r.hit.view(), frames[1].depth.view());
+
+    gpu::Context& context = shared_gpu();
+    context.make_current();
+    Textures t;
+    const GLuint color = t.make(GL_RGBA32F, kWidth, kHeight, GL_RGBA, GL_FLOAT, r.out.data());
+    const GLuint valid =
+        t.make(GL_R8UI, kWidth, kHeight, GL_RED_INTEGER, GL_UNSIGNED_BYTE, r.hit.data());
+    const GLuint depth = t.make(GL_R32F, kWidth, kHeight, GL_RED, GL_FLOAT, frames[1].depth.data());
+    const GLuint out = t.make(GL_RGBA32F, kWidth, kHeight, GL_RGBA, GL_FLOAT, nullptr);
+    warp::FillStats got;
+    Status status = context.fill(color, valid, depth, kWidth, kHeight, out, got);
+    ASSERT_TRUE(status.ok()) << status.message();
+    EXPECT_EQ(got.holes, expected.holes);
+    EXPECT_GT(got.holes, 0u);
+    Image<glm::vec4> gpu(kWidth, kHeight);
+    GLuint framebuffer = 0;
+    glGenFramebuffers(1, &framebuffer);
+    glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, out, 0);
+    glReadPixels(0, 0, kWidth, kHeight, GL_RGBA, GL_FLOAT, gpu.data());
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glDeleteFramebuffers(1, &framebuffer);
+    EXPECT_GE(test::display_psnr(cpu, gpu), 50.0);
+
+    status = context.fill(color, depth, 0, kWidth, kHeight, out, got);
+    EXPECT_NE(status.message().find("(valid) has internal format"), std::string::npos)
+        << status.message();
+    status = context.fill(color, valid, 0, kWidth, kHeight, color, got);
+    EXPECT_EQ(status.message(), "gpu pull-push: the output is the colour texture");
 }
 
 }  // namespace

@@ -6,7 +6,17 @@
 
 namespace reprise::gpu {
 
-Status create_programs(ContextState& state);  // one per path, linked once
+// One per path, linked once.
+Status create_programs(ContextState& state);
+Status create_fill_programs(ContextState& state);
+
+double finish_ms(std::chrono::steady_clock::time_point& since) {
+    glFinish();
+    const auto now = std::chrono::steady_clock::now();
+    const double ms = std::chrono::duration<double, std::milli>(now - since).count();
+    since = now;
+    return ms;
+}
 
 void Texture::ensure(GLenum new_format, int w, int h) {
     if (name && format == new_format && width == w && height == h) return;
@@ -72,8 +82,16 @@ Context::~Context() {
     if (!state_->gl) return;
     state_->gl->make_current();
     for (Texture* t : {&state_->depth, &state_->motion, &state_->id, &state_->previous_depth,
-                       &state_->previous_id, &state_->payload, &state_->out, &state_->hit})
+                       &state_->previous_id, &state_->payload, &state_->out, &state_->hit,
+                       &state_->color, &state_->valid})
         glDeleteTextures(1, &t->name);
+    for (auto* chain :
+         {&state_->pulled, &state_->pulled_depth, &state_->filled, &state_->filled_depth})
+        for (Texture& t : *chain) glDeleteTextures(1, &t.name);
+    for (GLuint program : {state_->pull_image_program, state_->pull_level_program,
+                           state_->push_program, state_->final_program})
+        glDeleteProgram(program);
+    glDeleteBuffers(1, &state_->fill_counts);
     glDeleteSamplers(1, &state_->nearest_sampler);
     glDeleteBuffers(1, &state_->counts_buffer);
     glDeleteFramebuffers(1, &state_->read_framebuffer);
@@ -92,6 +110,7 @@ Status Context::create(std::unique_ptr<Context>& context) {
                              s.gl->description() + " has " + std::to_string(major) + "." +
                              std::to_string(minor));
     REPRISE_TRY(create_programs(s));
+    REPRISE_TRY(create_fill_programs(s));
     glGenBuffers(1, &s.counts_buffer);
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, s.counts_buffer);
     glBufferData(GL_SHADER_STORAGE_BUFFER, 8 * sizeof(GLuint), nullptr, GL_DYNAMIC_READ);

@@ -113,14 +113,6 @@ void main() {
 
 using Clock = std::chrono::steady_clock;
 
-double finish_ms(Clock::time_point& since) {
-    glFinish();
-    const Clock::time_point now = Clock::now();
-    const double ms = std::chrono::duration<double, std::milli>(now - since).count();
-    since = now;
-    return ms;
-}
-
 // Binds the inputs and runs the shader over `width` x `height`; returns the counts.
 Status dispatch(ContextState& s, GLuint depth, GLuint motion, GLuint id, GLuint previous_depth,
                 GLuint previous_id, GLuint payload, GLuint out, GLuint hit, int width, int height,

@@ -1,5 +1,6 @@
 #pragma once
 // What a gpu::Context owns: the GL context, programs, and textures sized once per frame size.
+#include <chrono>
 #include <memory>
 #include <vector>
 
@@ -26,6 +27,9 @@ void upload(const Texture& texture, const void* data, std::ptrdiff_t stride);
 // An error naming `what` unless texture `name` is a 2D texture of `format` and w x h.
 Status check_texture(unsigned name, GLenum format, int w, int h, const char* what);
 
+// glFinish, then the milliseconds since `since`, which moves to now.
+double finish_ms(std::chrono::steady_clock::time_point& since);
+
 struct ContextState {
     std::unique_ptr<gl::Context> gl;
     GLuint reproject_program = 0;
@@ -34,6 +38,11 @@ struct ContextState {
     GLuint counts_buffer = 0;    // per-outcome counters of the last dispatch
     GLuint read_framebuffer = 0;  // downloads: the texture read is attached here
     Texture depth, motion, id, previous_depth, previous_id, payload, out, hit;
+    // Pull-push: the image's colour and valid mask, the pulled levels and the filled ones.
+    GLuint pull_image_program = 0, pull_level_program = 0, push_program = 0, final_program = 0;
+    GLuint fill_counts = 0;  // holes, then the empty pixels of each level
+    Texture color, valid;
+    std::vector<Texture> pulled, pulled_depth, filled, filled_depth;
     std::vector<glm::uvec4> hit_readback;  // integer downloads come as RGBA
 
     // Reads `texture` (GL_RGBA32F into floats, GL_R32UI into hit_readback) through the

@@ -10,6 +10,7 @@
 
 #include "reprise/core/gbuffer.hpp"
 #include "reprise/core/status.hpp"
+#include "reprise/warp/fill.hpp"
 #include "reprise/warp/reproject.hpp"
 
 namespace reprise::gpu {
@@ -56,6 +57,15 @@ public:
     Status reproject(const GBufferTextures& current, const GBufferTextures& previous,
                      unsigned payload, unsigned out, unsigned hit,
                      const warp::ReprojectOptions& options, warp::ReprojectCounts& counts);
+
+    // warp::PullPush::fill on the GPU as a mip chain: the same holes (valid == 0 or non-finite
+    // RGB), the same depth-aware pull and push, the same stats; only the RGB of holes changes.
+    Status fill(ImageView<glm::vec4> color, ImageView<const uint8_t> valid,
+                ImageView<const float> depth, warp::FillStats& stats);
+    // The same on textures: `color` GL_RGBA32F, `valid` GL_R8UI, `depth` GL_R32F (0: none), all
+    // width x height; the filled colour goes to `out` (GL_RGBA32F, not `color`).
+    Status fill(unsigned color, unsigned valid, unsigned depth, int width, int height, unsigned out,
+                warp::FillStats& stats);
 
 private:
     Context();

@@ -1,0 +1,436 @@
+// warp::PullPush on the GPU as a mip chain: one compute pass per level down (pull), one per level
+// back up (push), one into the output. Every level down to 1x1 is pulled (no read-back to stop
+// early): below the first level without an empty pixel every weight is 1 and the push leaves
+// those pixels alone, so the result is the CPU's. The arithmetic is pull_push.cpp's, in its order.
+#include <algorithm>
+#include <cstring>
+#include <string>
+
+#include "reprise/warp/fill.hpp"
+#include "state.hpp"
+
+namespace reprise::gpu {
+
+namespace {
+
+constexpr int kMaxLevels = 32;  // 2^31 pixels on a side
+
+constexpr const char* kPrelude = R"(#version 310 es
+#ifdef GL_EXT_gpu_shader5
+#extension GL_EXT_gpu_shader5 : enable
+#define PRECISE precise
+#else
+#define PRECISE
+#endif
+layout(local_size_x = 8, local_size_y = 8) in;
+layout(std430, binding = 0) buffer Counts { uint counts[]; };  // holes, then empty per level
+uniform bool use_depth;
+uniform highp float ratio;  // warp::kBackgroundDepthRatio
+uniform int level;          // the level written (pull) or read (push)
+uniform ivec2 fine_size, coarse_size;
+
+bool finite3(highp vec3 v) {
+    uvec3 e = floatBitsToUint(v) & 0x7f800000u;
+    return e.x != 0x7f800000u && e.y != 0x7f800000u && e.z != 0x7f800000u;
+}
+highp float sane_depth(highp float d) {
+    return (floatBitsToUint(d) & 0x7fffffffu) > 0x7f800000u ? uintBitsToFloat(0x7f800000u)
+                                                             : max(d, 0.0);
+}
+
+// One coarser pixel from up to four children, pull_pixel's arithmetic.
+void pull_pixel(highp vec3 p[4], highp float w[4], highp float d[4], int n, out highp vec4 result,
+                out highp float depth) {
+    highp float dmax = 0.0;
+    if (use_depth) {
+        bool any = false;
+        for (int k = 0; k < 4; ++k)
+            if (k < n && w[k] > 0.0) {
+                dmax = any ? max(dmax, d[k]) : d[k];
+                any = true;
+            }
+    }
+    PRECISE highp vec3 sum = vec3(0.0);
+    PRECISE highp float weight = 0.0;
+    for (int k = 0; k < 4; ++k)
+        if (k < n && w[k] > 0.0 && (!use_depth || d[k] * ratio >= dmax)) {
+            sum += p[k];
+            weight += w[k];
+        }
+    result = weight > 1.0 ? vec4(sum / weight, 1.0) : vec4(sum, weight);
+    depth = dmax;
+}
+
+// The bilinear taps of fine coordinate x on a coarse level of n pixels (1/4 and 3/4).
+void taps(int x, int n, out int i0, out int i1, out highp float w0, out highp float w1) {
+    int i = x >> 1;
+    if ((x & 1) != 0) {
+        i0 = i, i1 = min(i + 1, n - 1), w0 = 0.75, w1 = 0.25;
+    } else {
+        i0 = max(i - 1, 0), i1 = i, w0 = 0.25, w1 = 0.75;
+    }
+}
+
+// The filled coarse level upsampled at fine pixel p, dropping taps nearer than the farthest.
+highp vec3 upsample(highp sampler2D c, highp sampler2D d, ivec2 p, out highp float depth) {
+    int x0, x1, y0, y1;
+    highp float ax, bx, ay, by;
+    taps(p.x, coarse_size.x, x0, x1, ax, bx);
+    taps(p.y, coarse_size.y, y0, y1, ay, by);
+    ivec2 t[4] = ivec2[4](ivec2(x0, y0), ivec2(x1, y0), ivec2(x0, y1), ivec2(x1, y1));
+    highp float w[4] = float[4](ax * ay, bx * ay, ax * by, bx * by);
+    depth = 0.0;
+    if (use_depth) {
+        highp float dk[4];
+        for (int k = 0; k < 4; ++k) dk[k] = texelFetch(d, t[k], 0).r;
+        depth = max(max(dk[0], dk[1]), max(dk[2], dk[3]));
+        for (int k = 0; k < 4; ++k)
+            if (!(dk[k] * ratio >= depth)) w[k] = 0.0;
+    }
+    highp vec4 c0 = texelFetch(c, t[0], 0), c1 = texelFetch(c, t[1], 0);
+    highp vec4 c2 = texelFetch(c, t[2], 0), c3 = texelFetch(c, t[3], 0);
+    if (w[0] > 0.0 && w[1] > 0.0 && w[2] > 0.0 && w[3] > 0.0) {
+        PRECISE highp vec4 s = vec4(0.0) + c0 * w[0] + c1 * w[1] + c2 * w[2] + c3 * w[3];
+        return s.rgb;
+    }
+    PRECISE highp vec3 acc = vec3(0.0);
+    PRECISE highp float sum = 0.0;
+    highp vec4 cs[4] = vec4[4](c0, c1, c2, c3);
+    for (int k = 0; k < 4; ++k)
+        if (w[k] > 0.0) {
+            acc += cs[k].rgb * w[k];
+            sum += w[k];
+        }
+    return acc / sum;
+}
+)";
+
+// Level 0 (the image) into level 1: holes are valid == 0 or non-finite RGB.
+constexpr const char* kPullImage = R"(
+layout(binding = 0) uniform highp sampler2D color;
+layout(binding = 1) uniform highp usampler2D valid;
+layout(binding = 2) uniform highp sampler2D depth_map;
+layout(binding = 0, rgba32f) writeonly uniform highp image2D out_color;
+layout(binding = 1, r32f) writeonly uniform highp image2D out_depth;
+void main() {
+    ivec2 q = ivec2(gl_GlobalInvocationID.xy);
+    if (q.x >= coarse_size.x || q.y >= coarse_size.y) return;
+    highp vec3 p[4];
+    highp float w[4], d[4];
+    int n = 0;
+    uint holes = 0u;
+    for (int dy = 0; dy < 2; ++dy)
+        for (int dx = 0; dx < 2; ++dx) {
+            ivec2 f = 2 * q + ivec2(dx, dy);
+            if (f.x >= fine_size.x || f.y >= fine_size.y) continue;
+            highp vec3 c = texelFetch(color, f, 0).rgb;
+            bool ok = texelFetch(valid, f, 0).r != 0u && finite3(c);
+            holes += ok ? 0u : 1u;
+            p[n] = ok ? c : vec3(0.0);
+            w[n] = ok ? 1.0 : 0.0;
+            d[n] = use_depth ? sane_depth(texelFetch(depth_map, f, 0).r) : 0.0;
+            ++n;
+        }
+    highp vec4 result;
+    highp float depth;
+    pull_pixel(p, w, d, n, result, depth);
+    imageStore(out_color, q, result);
+    if (use_depth) imageStore(out_depth, q, vec4(depth));
+    if (holes > 0u) atomicAdd(counts[0], holes);
+    if (result.a < 1.0) atomicAdd(counts[1 + level], 1u);
+}
+)";
+
+// Level `level` - 1 into level `level`.
+constexpr const char* kPullLevel = R"(
+layout(binding = 0) uniform highp sampler2D fine;
+layout(binding = 2) uniform highp sampler2D fine_depth;
+layout(binding = 0, rgba32f) writeonly uniform highp image2D out_color;
+layout(binding = 1, r32f) writeonly uniform highp image2D out_depth;
+void main() {
+    ivec2 q = ivec2(gl_GlobalInvocationID.xy);
+    if (q.x >= coarse_size.x || q.y >= coarse_size.y) return;
+    highp vec3 p[4];
+    highp float w[4], d[4];
+    int n = 0;
+    for (int dy = 0; dy < 2; ++dy)
+        for (int dx = 0; dx < 2; ++dx) {
+            ivec2 f = 2 * q + ivec2(dx, dy);
+            if (f.x >= fine_size.x || f.y >= fine_size.y) continue;
+            highp vec4 c = texelFetch(fine, f, 0);
+            p[n] = c.rgb;
+            w[n] = c.a;
+            d[n] = use_depth ? texelFetch(fine_depth, f, 0).r : 0.0;
+            ++n;
+        }
+    highp vec4 result;
+    highp float depth;
+    pull_pixel(p, w, d, n, result, depth);
+    imageStore(out_color, q, result);
+    if (use_depth) imageStore(out_depth, q, vec4(depth));
+    if (result.a < 1.0) atomicAdd(counts[1 + level], 1u);
+}
+)";
+
+// The top level normalised (finish_top), or level `level` filled from the filled level above.
+constexpr const char* kPush = R"(
+layout(binding = 0) uniform highp sampler2D pulled;
+layout(binding = 1) uniform highp sampler2D coarse;
+layout(binding = 2) uniform highp sampler2D pulled_depth;
+layout(binding = 3) uniform highp sampler2D coarse_depth;
+layout(binding = 0, rgba32f) writeonly uniform highp image2D out_color;
+layout(binding = 1, r32f) writeonly uniform highp image2D out_depth;
+uniform bool top;
+void main() {
+    ivec2 q = ivec2(gl_GlobalInvocationID.xy);
+    if (q.x >= fine_size.x || q.y >= fine_size.y) return;
+    highp vec4 px = texelFetch(pulled, q, 0);
+    highp float d = use_depth ? texelFetch(pulled_depth, q, 0).r : 0.0;
+    if (top) {
+        if (px.a > 0.0 && px.a < 1.0) px = vec4(px.rgb / px.a, 1.0);
+    } else if (px.a < 1.0) {
+        highp float ud;
+        highp vec3 up = upsample(coarse, coarse_depth, q, ud);
+        if (use_depth && px.a == 0.0) d = ud;
+        PRECISE highp vec3 filled = px.rgb + (1.0 - px.a) * up;
+        px = vec4(filled, 1.0);
+    }
+    imageStore(out_color, q, px);
+    if (use_depth) imageStore(out_depth, q, vec4(d));
+}
+)";
+
+// The image's holes from filled level 1; everything else (and an image without any valid pixel,
+// `top_level` empty) copied.
+constexpr const char* kFinal = R"(
+layout(binding = 0) uniform highp sampler2D color;
+layout(binding = 1) uniform highp usampler2D valid;
+layout(binding = 2) uniform highp sampler2D coarse;
+layout(binding = 3) uniform highp sampler2D coarse_depth;
+layout(binding = 4) uniform highp sampler2D top_level;
+layout(binding = 0, rgba32f) writeonly uniform highp image2D out_color;
+uniform bool has_levels;
+void main() {
+    ivec2 q = ivec2(gl_GlobalInvocationID.xy);
+    if (q.x >= fine_size.x || q.y >= fine_size.y) return;
+    highp vec4 c = texelFetch(color, q, 0);
+    bool hole = texelFetch(valid, q, 0).r == 0u || !finite3(c.rgb);
+    if (hole && has_levels && texelFetch(top_level, ivec2(0), 0).a > 0.0) {
+        highp float ud;
+        c = vec4(upsample(coarse, coarse_depth, q, ud), c.a);
+    }
+    imageStore(out_color, q, c);
+}
+)";
+
+void set_sizes(GLuint program, int fw, int fh, int cw, int ch) {
+    glUniform2i(glGetUniformLocation(program, "fine_size"), fw, fh);
+    glUniform2i(glGetUniformLocation(program, "coarse_size"), cw, ch);
+}
+
+void bind_inputs(ContextState& s, std::initializer_list<GLuint> textures) {
+    GLuint unit = 0;
+    for (GLuint t : textures) {
+        glActiveTexture(GL_TEXTURE0 + unit);
+        glBindTexture(GL_TEXTURE_2D, t);
+        glBindSampler(unit, s.nearest_sampler);
+        ++unit;
+    }
+    glActiveTexture(GL_TEXTURE0);
+}
+
+void unbind_samplers() {
+    for (GLuint unit = 0; unit < 5; ++unit) glBindSampler(unit, 0);
+}
+
+void run(int w, int h) {
+    glDispatchCompute(GLuint((w + 7) / 8), GLuint((h + 7) / 8), 1);
+    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
+                    GL_SHADER_STORAGE_BARRIER_BIT);
+}
+
+// The chain's sizes: level s has ceil(w / 2^(s+1)) x ceil(h / 2^(s+1)) pixels, down to 1x1.
+int level_count(int w, int h) {
+    int n = 0;
+    while (w > 1 || h > 1) {
+        w = (w + 1) / 2;
+        h = (h + 1) / 2;
+        ++n;
+    }
+    return n;
+}
+
+void common_uniforms(GLuint program, bool use_depth, int level) {
+    glUseProgram(program);
+    glUniform1i(glGetUniformLocation(program, "use_depth"), use_depth);
+    glUniform1f(glGetUniformLocation(program, "ratio"), warp::kBackgroundDepthRatio);
+    glUniform1i(glGetUniformLocation(program, "level"), level);
+}
+
+// The passes over textures the caller or the CPU entry prepared; `out` gets the filled colour.
+Status fill_passes(ContextState& s, GLuint color, GLuint valid, GLuint depth, int w, int h,
+                   GLuint out, warp::FillStats& stats) {
+    const bool use_depth = depth != 0;
+    const int levels = level_count(w, h);
+    s.pulled.resize(std::size_t(levels));
+    s.pulled_depth.resize(std::size_t(levels));
+    s.filled.resize(std::size_t(levels));
+    s.filled_depth.resize(std::size_t(levels));
+    for (int l = 0, lw = w, lh = h; l < levels; ++l) {
+        lw = (lw + 1) / 2;
+        lh = (lh + 1) / 2;
+        s.pulled[l].ensure(GL_RGBA32F, lw, lh);
+        s.filled[l].ensure(GL_RGBA32F, lw, lh);
+        if (use_depth) {
+            s.pulled_depth[l].ensure(GL_R32F, lw, lh);
+            s.filled_depth[l].ensure(GL_R32F, lw, lh);
+        }
+    }
+    const GLuint zeros[kMaxLevels + 2] = {};
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, s.fill_counts);
+    glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, sizeof zeros, zeros);
+    auto depth_of = [&](std::vector<Texture>& chain, int l) {
+        return use_depth ? chain[std::size_t(l)].name : 0u;
+    };
+
+    // Pull.
+    for (int l = 0; l < levels; ++l) {
+        const Texture& target = s.pulled[std::size_t(l)];
+        const GLuint program = l == 0 ? s.pull_image_program : s.pull_level_program;
+        common_uniforms(program, use_depth, l);
+        const int fw = l == 0 ? w : s.pulled[std::size_t(l) - 1].width;
+        const int fh = l == 0 ? h : s.pulled[std::size_t(l) - 1].height;
+        set_sizes(program, fw, fh, target.width, target.height);
+        if (l == 0)
+            bind_inputs(s, {color, valid, depth});
+        else
+            bind_inputs(s, {s.pulled[std::size_t(l) - 1].name, 0, depth_of(s.pulled_depth, l - 1)});
+        glBindImageTexture(0, target.name, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+        if (use_depth)
+            glBindImageTexture(1, s.pulled_depth[std::size_t(l)].name, 0, GL_FALSE, 0,
+                               GL_WRITE_ONLY, GL_R32F);
+        run(target.width, target.height);
+    }
+    // Push, from the top.
+    for (int l = levels - 1; l >= 0; --l) {
+        const Texture& target = s.filled[std::size_t(l)];
+        const bool top = l == levels - 1;
+        common_uniforms(s.push_program, use_depth, l);
+        glUniform1i(glGetUniformLocation(s.push_program, "top"), top);
+        const Texture& coarse = s.filled[std::size_t(top ? l : l + 1)];
+        set_sizes(s.push_program, target.width, target.height, coarse.width, coarse.height);
+        bind_inputs(s, {s.pulled[std::size_t(l)].name, top ? 0u : coarse.name,
+                        depth_of(s.pulled_depth, l), top ? 0u : depth_of(s.filled_depth, l + 1)});
+        glBindImageTexture(0, target.name, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+        if (use_depth)
+            glBindImageTexture(1, s.filled_depth[std::size_t(l)].name, 0, GL_FALSE, 0,
+                               GL_WRITE_ONLY, GL_R32F);
+        run(target.width, target.height);
+    }
+    // The image's holes.
+    common_uniforms(s.final_program, use_depth, 0);
+    glUniform1i(glGetUniformLocation(s.final_program, "has_levels"), levels > 0);
+    set_sizes(s.final_program, w, h, levels ? s.filled[0].width : 1,
+              levels ? s.filled[0].height : 1);
+    bind_inputs(
+        s, {color, valid, levels ? s.filled[0].name : 0u, levels ? depth_of(s.filled_depth, 0) : 0u,
+            levels ? s.pulled[std::size_t(levels) - 1].name : 0u});
+    glBindImageTexture(0, out, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    run(w, h);
+    unbind_samplers();
+    glUseProgram(0);
+
+    GLuint n[kMaxLevels + 2] = {};
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    if (const void* mapped =
+            glMapBufferRange(GL_SHADER_STORAGE_BUFFER, 0, sizeof n, GL_MAP_READ_BIT)) {
+        std::memcpy(n, mapped, sizeof n);
+        glUnmapBuffer(GL_SHADER_STORAGE_BUFFER);
+    }
+    REPRISE_TRY(gl::check_errors("gpu pull-push"));
+    // The counts as the CPU reports them: levels pulled until one had no empty pixel.
+    stats = {.holes = n[0]};
+    const std::size_t pixels = std::size_t(w) * std::size_t(h);
+    if (stats.holes == 0) return {};
+    if (stats.holes == pixels || levels == 0) {
+        stats.unfilled = stats.holes;
+        return {};
+    }
+    stats.levels = levels;
+    for (int l = 0; l < levels; ++l)
+        if (n[1 + l] == 0) {
+            stats.levels = l + 1;
+            break;
+        }
+    return {};
+}
+
+}  // namespace
+
+Status create_fill_programs(ContextState& s) {
+    const std::string prelude = kPrelude;
+    REPRISE_TRY(
+        gl::link_compute((prelude + kPullImage).c_str(), "pull (image)", s.pull_image_program));
+    REPRISE_TRY(gl::link_compute((prelude + kPullLevel).c_str(), "pull", s.pull_level_program));
+    REPRISE_TRY(gl::link_compute((prelude + kPush).c_str(), "push", s.push_program));
+    REPRISE_TRY(gl::link_compute((prelude + kFinal).c_str(), "fill", s.final_program));
+    glGenBuffers(1, &s.fill_counts);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, s.fill_counts);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, (kMaxLevels + 2) * sizeof(GLuint), nullptr,
+                 GL_DYNAMIC_READ);
+    return {};
+}
+
+Status Context::fill(ImageView<glm::vec4> color, ImageView<const uint8_t> valid,
+                     ImageView<const float> depth, warp::FillStats& stats) {
+    REPRISE_ASSERT(valid.width == color.width && valid.height == color.height);
+    REPRISE_ASSERT(depth.empty() || (depth.width == color.width && depth.height == color.height));
+    stats = {};
+    timings_ = {};
+    const int w = color.width, h = color.height;
+    if (color.empty()) return {};
+    ContextState& s = *state_;
+    s.gl->make_current();
+    using Clock = std::chrono::steady_clock;
+    Clock::time_point t = Clock::now();
+    s.color.ensure(GL_RGBA32F, w, h);
+    s.valid.ensure(GL_R8UI, w, h);
+    s.out.ensure(GL_RGBA32F, w, h);
+    upload(s.color, color.data, color.stride);
+    upload(s.valid, valid.data, valid.stride);
+    if (!depth.empty()) {
+        s.depth.ensure(GL_R32F, w, h);
+        upload(s.depth, depth.data, depth.stride);
+    }
+    timings_.upload_ms = finish_ms(t);
+    REPRISE_TRY(fill_passes(s, s.color.name, s.valid.name, depth.empty() ? 0u : s.depth.name, w, h,
+                            s.out.name, stats));
+    timings_.compute_ms = finish_ms(t);
+    if (stats.holes > stats.unfilled) s.download(s.out, color.data, color.stride);
+    REPRISE_TRY(gl::check_errors("gpu pull-push download"));
+    timings_.download_ms = finish_ms(t);
+    return {};
+}
+
+Status Context::fill(unsigned color, unsigned valid, unsigned depth, int width, int height,
+                     unsigned out, warp::FillStats& stats) {
+    stats = {};
+    ContextState& s = *state_;
+    s.gl->make_current();
+    if (width <= 0 || height <= 0)
+        return Status::error("gpu pull-push: size " + std::to_string(width) + "x" +
+                             std::to_string(height) + " must be positive");
+    REPRISE_TRY(check_texture(color, GL_RGBA32F, width, height, "colour"));
+    REPRISE_TRY(check_texture(valid, GL_R8UI, width, height, "valid"));
+    if (depth) REPRISE_TRY(check_texture(depth, GL_R32F, width, height, "depth"));
+    REPRISE_TRY(check_texture(out, GL_RGBA32F, width, height, "output"));
+    if (out == color) return Status::error("gpu pull-push: the output is the colour texture");
+    using Clock = std::chrono::steady_clock;
+    Clock::time_point t = Clock::now();
+    timings_ = {};
+    REPRISE_TRY(fill_passes(s, color, valid, depth, width, height, out, stats));
+    timings_.compute_ms = finish_ms(t);
+    return {};
+}
+
+}  // namespace reprise::gpu
