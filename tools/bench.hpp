@@ -1,9 +1,9 @@
 #pragma once
 // Benchmarks behind `reprise bench WHAT`. Each prints its timings and, for kernels, the ratio
 // against a peer (OpenCV, ffmpeg) measured in the same run on the same input.
-#include <string>
-
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "reprise/core/status.hpp"
 #include "reprise/server/builtin_scenes.hpp"
@@ -15,8 +15,9 @@ struct BenchOptions {
     std::string scene = "pan";
     int frames = 10;  // repetitions / frames per measurement
     std::string sizes = "640x360,1920x1080";
-    std::string dir;  // where files go (default: the temp folder)
-    std::string out;  // report folder (bench fruc)
+    std::string dir;              // where files go (default: the temp folder)
+    std::string backend = "cpu";  // bench paths: cpu, or gles for the GPU stages beside the CPU
+    std::string out;              // report folder (bench fruc)
     // bench fruc
     std::string scenes;  // comma-separated; empty = every built-in scene
     int factor = 2;      // K
@@ -54,6 +55,9 @@ Status bench_fill(const BenchOptions& options);       // pull-push, Andreev vs c
 Status bench_kernels(const BenchOptions& options);
 // Whole made frames (interpolation, extrapolation, the second eye) against cv::remap, one run.
 Status bench_paths(const BenchOptions& options);
+// The GPU backend's stages beside their CPU references on `frames` (consecutive, at least 3):
+// upload, compute and download ms apart (bench paths --backend gles).
+Status bench_gles_stages(const std::vector<Frame>& frames, const std::string& size);
 // Upconversion error against run time, every setting and the peers (ffmpeg minterpolate,
 // OpenCV DIS flow, Telea): OUT/fruc.csv, OUT/fruc_summary.csv, OUT/index.html.
 Status bench_fruc(const BenchOptions& options);

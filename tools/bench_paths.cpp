@@ -27,7 +27,8 @@ struct Converter {
     Timing times;
 };
 
-Status bench_paths_size(const BenchScene& bench, int w, int h, int timed) {
+Status bench_paths_size(const BenchScene& bench, int w, int h, int timed,
+                        const std::string& backend) {
     // timed + 2 consecutive frames: the converters are fed in order, the first two untimed.
     std::vector<Frame> frames(std::size_t(timed + 2));
     for (int i = 0; i < timed + 2; ++i) {
@@ -126,12 +127,16 @@ Status bench_paths_size(const BenchScene& bench, int w, int h, int timed) {
     row("stereo eye grid+pullpush", stereo_times, 0.0);
     row("cv::remap (peer)", remap_times, 0.0);
     row("colour copy (memory floor)", copy_times, 0.0);
+    if (backend == "gles") REPRISE_TRY(bench_gles_stages(frames, size));
     return {};
 }
 
 }  // namespace
 
 Status bench_paths(const BenchOptions& options) {
+    if (options.backend != "cpu" && options.backend != "gles")
+        return Status::error("bench paths: --backend '" + options.backend +
+                             "': expected cpu or gles");
     BenchScene bench;
     REPRISE_TRY(open_bench_scene(options.scene, bench));
     cv::setNumThreads(thread_count());
@@ -148,7 +153,7 @@ Status bench_paths(const BenchOptions& options) {
     for (const std::string& size : split_list(options.sizes)) {
         int w = 0, h = 0;
         REPRISE_TRY(parse_size(size, w, h));
-        REPRISE_TRY(bench_paths_size(bench, w, h, options.frames));
+        REPRISE_TRY(bench_paths_size(bench, w, h, options.frames, options.backend));
     }
     return {};
 }

@@ -164,6 +164,9 @@ int command_bench(int argc, char** argv) {
                 "frames per size (default 10); fruc: input frames (default 20); stereo: frames per "
                 "scene (at most 5); upsample: frames per scene (default 12)");
     args.option("--sizes", &job.sizes, "comma-separated WxH list (default 640x360,1920x1080)");
+    args.option("--backend", &job.backend,
+                "paths: cpu (default), or gles for the GPU backend's stages beside the CPU's "
+                "(OpenGL ES 3.1; upload, compute, download apart)");
     args.option("--dir", &job.dir, "exr: folder for the files (default: the temp folder)");
     args.option(
         "--out", &job.out,

@@ -31,7 +31,6 @@ uniform highp float kx, ky, kw, kz, k1, wz, w1, px0, py0, qx0, qy0, tolerance, i
 uniform bool use_ids, background_hits, write_hit;
 uniform ivec2 size, previous_size;
 uniform int step;
-shared uint group_counts[6];
 
 const uint HIT = 0u, OFFSCREEN = 1u, BEHIND = 2u, OCCLUDED = 3u, OTHER_ID = 4u, INVALID = 5u;
 
@@ -95,19 +94,11 @@ uint classify(ivec2 p) {
 }
 
 void main() {
-    if (gl_LocalInvocationIndex < 6u) group_counts[gl_LocalInvocationIndex] = 0u;
-    memoryBarrierShared();
-    barrier();
     ivec2 p = ivec2(gl_GlobalInvocationID.xy) * step;
-    if (p.x < size.x && p.y < size.y) {
-        uint outcome = classify(p);
-        atomicAdd(group_counts[outcome], 1u);
-        if (write_hit) imageStore(hit_image, p, uvec4(outcome == HIT ? 1u : 0u));
-    }
-    memoryBarrierShared();
-    barrier();
-    if (gl_LocalInvocationIndex < 6u)
-        atomicAdd(counts[gl_LocalInvocationIndex], group_counts[gl_LocalInvocationIndex]);
+    if (p.x >= size.x || p.y >= size.y) return;
+    uint outcome = classify(p);
+    atomicAdd(counts[outcome], 1u);
+    if (write_hit) imageStore(hit_image, p, uvec4(outcome == HIT ? 1u : 0u));
 }
 )";
 
