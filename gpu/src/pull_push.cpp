@@ -15,14 +15,7 @@ namespace {
 
 constexpr int kMaxLevels = 32;  // 2^31 pixels on a side
 
-constexpr const char* kPrelude = R"(#version 310 es
-#ifdef GL_EXT_gpu_shader5
-#extension GL_EXT_gpu_shader5 : enable
-#define PRECISE precise
-#else
-#define PRECISE
-#endif
-layout(local_size_x = 8, local_size_y = 8) in;
+constexpr const char* kPrelude = R"(
 layout(std430, binding = 0) buffer Counts { uint counts[]; };  // holes, then empty per level
 uniform bool use_depth;
 uniform highp float ratio;  // warp::kBackgroundDepthRatio
@@ -105,45 +98,13 @@ highp vec3 upsample(highp sampler2D c, highp sampler2D d, ivec2 p, out highp flo
 }
 )";
 
-// Level 0 (the image) into level 1: holes are valid == 0 or non-finite RGB.
-constexpr const char* kPullImage = R"(
-layout(binding = 0) uniform highp sampler2D color;
-layout(binding = 1) uniform highp usampler2D valid;
-layout(binding = 2) uniform highp sampler2D depth_map;
-layout(binding = 0, rgba32f) writeonly uniform highp image2D out_color;
-layout(binding = 1, r32f) writeonly uniform highp image2D out_depth;
-void main() {
-    ivec2 q = ivec2(gl_GlobalInvocationID.xy);
-    if (q.x >= coarse_size.x || q.y >= coarse_size.y) return;
-    highp vec3 p[4];
-    highp float w[4], d[4];
-    int n = 0;
-    uint holes = 0u;
-    for (int dy = 0; dy < 2; ++dy)
-        for (int dx = 0; dx < 2; ++dx) {
-            ivec2 f = 2 * q + ivec2(dx, dy);
-            if (f.x >= fine_size.x || f.y >= fine_size.y) continue;
-            highp vec3 c = texelFetch(color, f, 0).rgb;
-            bool ok = texelFetch(valid, f, 0).r != 0u && finite3(c);
-            holes += ok ? 0u : 1u;
-            p[n] = ok ? c : vec3(0.0);
-            w[n] = ok ? 1.0 : 0.0;
-            d[n] = use_depth ? sane_depth(texelFetch(depth_map, f, 0).r) : 0.0;
-            ++n;
-        }
-    highp vec4 result;
-    highp float depth;
-    pull_pixel(p, w, d, n, result, depth);
-    imageStore(out_color, q, result);
-    if (use_depth) imageStore(out_depth, q, vec4(depth));
-    if (holes > 0u) atomicAdd(counts[0], holes);
-    if (result.a < 1.0) atomicAdd(counts[1 + level], 1u);
-}
-)";
-
-// Level `level` - 1 into level `level`.
-constexpr const char* kPullLevel = R"(
+// Level `level` - 1 into level `level`; with FROM_IMAGE the image (level 0) into level 1, where
+// holes are valid == 0 or non-finite RGB.
+constexpr const char* kPull = R"(
 layout(binding = 0) uniform highp sampler2D fine;
+#if FROM_IMAGE
+layout(binding = 1) uniform highp usampler2D valid;
+#endif
 layout(binding = 2) uniform highp sampler2D fine_depth;
 layout(binding = 0, rgba32f) writeonly uniform highp image2D out_color;
 layout(binding = 1, r32f) writeonly uniform highp image2D out_depth;
@@ -158,9 +119,16 @@ void main() {
             ivec2 f = 2 * q + ivec2(dx, dy);
             if (f.x >= fine_size.x || f.y >= fine_size.y) continue;
             highp vec4 c = texelFetch(fine, f, 0);
+#if FROM_IMAGE
+            bool ok = texelFetch(valid, f, 0).r != 0u && finite3(c.rgb);
+            p[n] = ok ? c.rgb : vec3(0.0);
+            w[n] = ok ? 1.0 : 0.0;
+            d[n] = use_depth ? sane_depth(texelFetch(fine_depth, f, 0).r) : 0.0;
+#else
             p[n] = c.rgb;
             w[n] = c.a;
             d[n] = use_depth ? texelFetch(fine_depth, f, 0).r : 0.0;
+#endif
             ++n;
         }
     highp vec4 result;
@@ -200,7 +168,8 @@ void main() {
 }
 )";
 
-// The image's holes from filled level 1; everything else (and an image without any valid pixel,
+// The image's holes (counted here: this pass runs also without levels) from filled level 1;
+// everything else (and an image without any valid pixel,
 // `top_level` empty) copied.
 constexpr const char* kFinal = R"(
 layout(binding = 0) uniform highp sampler2D color;
@@ -215,6 +184,7 @@ void main() {
     if (q.x >= fine_size.x || q.y >= fine_size.y) return;
     highp vec4 c = texelFetch(color, q, 0);
     bool hole = texelFetch(valid, q, 0).r == 0u || !finite3(c.rgb);
+    if (hole) atomicAdd(counts[0], 1u);
     if (hole && has_levels && texelFetch(top_level, ivec2(0), 0).a > 0.0) {
         highp float ud;
         c = vec4(upsample(coarse, coarse_depth, q, ud), c.a);
@@ -272,10 +242,11 @@ Status fill_passes(ContextState& s, GLuint color, GLuint valid, GLuint depth, in
                    GLuint out, warp::FillStats& stats) {
     const bool use_depth = depth != 0;
     const int levels = level_count(w, h);
-    s.pulled.resize(std::size_t(levels));
-    s.pulled_depth.resize(std::size_t(levels));
-    s.filled.resize(std::size_t(levels));
-    s.filled_depth.resize(std::size_t(levels));
+    for (auto* chain : {&s.pulled, &s.pulled_depth, &s.filled, &s.filled_depth}) {
+        for (std::size_t l = std::size_t(levels); l < chain->size(); ++l)
+            glDeleteTextures(1, &(*chain)[l].name);
+        chain->resize(std::size_t(levels));
+    }
     for (int l = 0, lw = w, lh = h; l < levels; ++l) {
         lw = (lw + 1) / 2;
         lh = (lh + 1) / 2;
@@ -368,10 +339,13 @@ Status fill_passes(ContextState& s, GLuint color, GLuint valid, GLuint depth, in
 }  // namespace
 
 Status create_fill_programs(ContextState& s) {
-    const std::string prelude = kPrelude;
-    REPRISE_TRY(
-        gl::link_compute((prelude + kPullImage).c_str(), "pull (image)", s.pull_image_program));
-    REPRISE_TRY(gl::link_compute((prelude + kPullLevel).c_str(), "pull", s.pull_level_program));
+    const std::string prelude = std::string(kComputeHeader) + kPrelude;
+    REPRISE_TRY(gl::link_compute(
+        (std::string(kComputeHeader) + "#define FROM_IMAGE 1\n" + kPrelude + kPull).c_str(),
+        "pull (image)", s.pull_image_program));
+    REPRISE_TRY(gl::link_compute(
+        (std::string(kComputeHeader) + "#define FROM_IMAGE 0\n" + kPrelude + kPull).c_str(), "pull",
+        s.pull_level_program));
     REPRISE_TRY(gl::link_compute((prelude + kPush).c_str(), "push", s.push_program));
     REPRISE_TRY(gl::link_compute((prelude + kFinal).c_str(), "fill", s.final_program));
     glGenBuffers(1, &s.fill_counts);

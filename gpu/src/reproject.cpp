@@ -3,6 +3,7 @@
 // multiply-add), the same outcomes counted per work group and then globally.
 #include <chrono>
 #include <cstring>
+#include <string>
 
 #include "state.hpp"
 
@@ -10,14 +11,7 @@ namespace reprise::gpu {
 
 namespace {
 
-constexpr const char* kReprojectShader = R"(#version 310 es
-#ifdef GL_EXT_gpu_shader5
-#extension GL_EXT_gpu_shader5 : enable
-#define PRECISE precise
-#else
-#define PRECISE
-#endif
-layout(local_size_x = 8, local_size_y = 8) in;
+constexpr const char* kReprojectShader = R"(
 layout(binding = 0) uniform highp sampler2D depth_map;
 layout(binding = 1) uniform highp sampler2D motion_map;
 layout(binding = 2) uniform highp usampler2D id_map;
@@ -163,7 +157,8 @@ Status dispatch(ContextState& s, GLuint depth, GLuint motion, GLuint id, GLuint 
 }  // namespace
 
 Status create_programs(ContextState& state) {
-    return gl::link_compute(kReprojectShader, "reprojection", state.reproject_program);
+    return gl::link_compute((std::string(kComputeHeader) + kReprojectShader).c_str(),
+                            "reprojection", state.reproject_program);
 }
 
 Status Context::reproject(const GBufferView& current, const GBufferView& previous,

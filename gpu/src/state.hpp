@@ -27,6 +27,19 @@ void upload(const Texture& texture, const void* data, std::ptrdiff_t stride);
 // An error naming `what` unless texture `name` is a 2D texture of `format` and w x h.
 Status check_texture(unsigned name, GLenum format, int w, int h, const char* what);
 
+// The first lines of every compute shader: GLSL ES 3.10, 8x8 work groups, and PRECISE
+// (GL_EXT_gpu_shader5's `precise` where offered) on what must not be fused into multiply-adds,
+// so that the GPU repeats the CPU reference's arithmetic.
+inline constexpr const char* kComputeHeader = R"(#version 310 es
+#ifdef GL_EXT_gpu_shader5
+#extension GL_EXT_gpu_shader5 : enable
+#define PRECISE precise
+#else
+#define PRECISE
+#endif
+layout(local_size_x = 8, local_size_y = 8) in;
+)";
+
 // glFinish, then the milliseconds since `since`, which moves to now.
 double finish_ms(std::chrono::steady_clock::time_point& since);
 
