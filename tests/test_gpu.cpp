@@ -138,6 +138,37 @@ TEST(Gpu, NonFiniteInputIsCountedAsOnTheCpu) {
         ASSERT_TRUE(test::finite(gpu.out.data()[i])) << "pixel " << i;
 }
 
+// Worst cases: motion of 1e30 and of a few pixels, depth 0, negative, denormal, huge and +inf,
+// projections that put points behind the previous camera, jitter on both frames.
+TEST(Gpu, ReprojectionOnExtremeValues) {
+    std::vector<Frame> frames = test::sequence(2);
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    const float depths[] = {0.0f, -1.0f, 1e-40f, 1e30f, test::kInf, 0.05f, 3.0f, 20.0f};
+    const float motions[] = {1e30f, -1e30f, 0.0f, 0.5f, -3.25f, 40.0f, 1e-7f, -0.5f};
+    for (Frame& f : frames) {
+        f.id.assign(f.width(), f.height(), 1);
+        for (int y = 0; y < f.height(); ++y)
+            for (int x = 0; x < f.width(); ++x) {
+                if (u(rng) < 0.3f) f.depth(x, y) = depths[rng() % 8];
+                if (u(rng) < 0.3f) f.motion(x, y) = {motions[rng() % 8], motions[rng() % 8]};
+                if (u(rng) < 0.05f) f.id(x, y) = 2;
+            }
+    }
+    frames[1].camera.jitter = {0.25f, -0.125f};
+    frames[0].camera.jitter = {-0.375f, 0.5f};
+    // The previous camera turned half round: much of the frame is behind it.
+    Frame turned = frames[1];
+    turned.camera.prev_view = glm::rotate(turned.camera.view, 2.5f, glm::vec3(0, 1, 0));
+    for (const Frame* current : {&frames[1], &turned}) {
+        const Result cpu = cpu_reproject(*current, frames[0]);
+        const Result gpu = gpu_reproject(*current, frames[0]);
+        EXPECT_GT(cpu.counts.invalid + cpu.counts.offscreen, 0u);
+        expect_equal_within_tolerance(cpu, gpu, "extreme values");
+    }
+    EXPECT_GT(cpu_reproject(turned, frames[0]).counts.behind, 0u);
+}
+
 // The texture entry point: the application's textures in, its textures written.
 struct Textures {
     std::vector<GLuint> names;
