@@ -1,5 +1,7 @@
 // The GPU context: its GL context, the counters buffer, and the plumbing of uploads and downloads.
 #include <chrono>
+#include <cstdio>
+#include <string>
 
 #include "reprise/gpu/context.hpp"
 #include "state.hpp"
@@ -37,25 +39,30 @@ void upload(const Texture& texture, const void* data, std::ptrdiff_t stride) {
 }
 
 Status check_texture(unsigned name, GLenum format, int w, int h, const char* what) {
-    const std::string where =
-        std::string("gpu: texture ") + std::to_string(name) + " (" + what + ")";
-    if (!name || !glIsTexture(name)) return Status::error(where + " is not a texture");
+    // The message is made only on failure: a per-frame call allocates nothing.
+    auto where = [&] {
+        return std::string("gpu: texture ") + std::to_string(name) + " (" + what + ")";
+    };
+    if (!name || !glIsTexture(name)) return Status::error(where() + " is not a texture");
     glBindTexture(GL_TEXTURE_2D, name);
-    if (glGetError() != GL_NO_ERROR) return Status::error(where + " is not a 2D texture");
+    if (glGetError() != GL_NO_ERROR) return Status::error(where() + " is not a 2D texture");
     GLint width = 0, height = 0, internal = 0;
     glGetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_WIDTH, &width);
     glGetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_HEIGHT, &height);
     glGetTexLevelParameteriv(GL_TEXTURE_2D, 0, GL_TEXTURE_INTERNAL_FORMAT, &internal);
     if (width != w || height != h)
-        return Status::error(where + " is " + std::to_string(width) + "x" + std::to_string(height) +
-                             ", expected " + std::to_string(w) + "x" + std::to_string(h));
+        return Status::error(where() + " is " + std::to_string(width) + "x" +
+                             std::to_string(height) + ", expected " + std::to_string(w) + "x" +
+                             std::to_string(h));
     if (GLenum(internal) != format) {
         const char* expected = format == GL_RGBA32F ? "GL_RGBA32F"
                                : format == GL_RG32F ? "GL_RG32F"
                                : format == GL_R32F  ? "GL_R32F"
+                               : format == GL_R8UI  ? "GL_R8UI"
                                                     : "GL_R32UI";
-        return Status::error(where + " has internal format 0x" + std::to_string(internal) +
-                             ", expected " + expected);
+        char found[16];
+        std::snprintf(found, sizeof found, "0x%04x", unsigned(internal));
+        return Status::error(where() + " has internal format " + found + ", expected " + expected);
     }
     return {};
 }
