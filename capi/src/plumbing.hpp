@@ -64,9 +64,9 @@ reprise_status init_options(const char* function, Options* options, std::size_t 
 template <class Options, class Handle>
 reprise_status check_create(const char* function, uint32_t abi_version, const Options* given,
                             Options& options, Handle** handle) {
-    REPRISE_CAPI_TRY(check_abi(function, abi_version));
     REPRISE_CAPI_TRY(check_pointer(function, handle, "the handle's out-pointer"));
     *handle = nullptr;
+    REPRISE_CAPI_TRY(check_abi(function, abi_version));
     if (given) {
         REPRISE_CAPI_TRY(check_struct_size(function, "options->struct_size", given->struct_size,
                                            sizeof(Options)));
