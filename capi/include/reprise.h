@@ -38,14 +38,15 @@ extern "C" {
  * minor be at most the library's. libreprise.so's SONAME carries the major. */
 #define REPRISE_ABI_VERSION_MAJOR 1
 #define REPRISE_ABI_VERSION_MINOR 0
-#define REPRISE_ABI_VERSION ((uint32_t)((REPRISE_ABI_VERSION_MAJOR << 16) | REPRISE_ABI_VERSION_MINOR))
+#define REPRISE_ABI_VERSION \
+    ((uint32_t)((REPRISE_ABI_VERSION_MAJOR << 16) | REPRISE_ABI_VERSION_MINOR))
 
 typedef int32_t reprise_status;
 enum {
     REPRISE_OK = 0,
     REPRISE_NEED_MORE = 1, /* nothing to receive yet: send the next input */
     REPRISE_ERROR_INVALID_ARGUMENT = -1,
-    REPRISE_ERROR_ABI_MISMATCH = -2,    /* abi_version or a struct_size the library cannot take */
+    REPRISE_ERROR_ABI_MISMATCH = -2,     /* abi_version or a struct_size the library cannot take */
     REPRISE_ERROR_BUFFER_TOO_SMALL = -3, /* the result is kept: call again with a larger buffer */
     REPRISE_ERROR_INVALID_DATA = -4,     /* a bad packet; the decoder stays usable */
     REPRISE_ERROR_OUT_OF_MEMORY = -5,
@@ -88,15 +89,15 @@ typedef struct reprise_image {
 /* The camera of one instant. Matrices are column-major as OpenGL and GLM store them: element
  * (row r, column c) at [c * 4 + r]. */
 typedef struct reprise_camera {
-    double time;               /* seconds on the animation timeline */
-    float view[16];            /* world -> camera */
-    float projection[16];      /* camera -> clip, without jitter */
-    float prev_view[16];       /* the previous frame's pair */
+    double time;          /* seconds on the animation timeline */
+    float view[16];       /* world -> camera */
+    float projection[16]; /* camera -> clip, without jitter */
+    float prev_view[16];  /* the previous frame's pair */
     float prev_projection[16];
-    float jitter[2];           /* sub-pixel offset of the rendered samples, pixels */
+    float jitter[2];             /* sub-pixel offset of the rendered samples, pixels */
     float near_plane, far_plane; /* scene units; far may be +inf */
-    int32_t valid;             /* 0: no camera (render passes without one, video): ignored */
-    int32_t reserved;          /* 0 */
+    int32_t valid;               /* 0: no camera (render passes without one, video): ignored */
+    int32_t reserved;            /* 0 */
 } reprise_camera;
 
 /* A rendered instant (input) or a made one (output): which channels each call reads or writes
@@ -105,7 +106,7 @@ typedef struct reprise_camera {
 typedef struct reprise_gbuffer {
     uint32_t struct_size; /* sizeof(reprise_gbuffer) */
     int32_t reset;        /* 1: a cut; nothing before this frame is used (history dropped) */
-    reprise_image color;  /* linear-light RGB: RGB/RGBA 32 or 16 float; A = coverage (1 when absent) */
+    reprise_image color;  /* linear-light RGB(A), 32/16 float; A = coverage, 1 if absent */
     reprise_image depth;  /* linear view depth, scene units, background +inf: R32/R16 float */
     reprise_image motion; /* backward motion, pixels: RG32/RG16 float */
     reprise_image normal; /* world-space unit normal: RGB32/RGB16 float */
@@ -123,9 +124,19 @@ typedef struct reprise_converter reprise_converter;
 typedef int32_t reprise_fruc_mode;
 enum { REPRISE_FRUC_INTERPOLATE = 0, REPRISE_FRUC_EXTRAPOLATE = 1 };
 typedef int32_t reprise_warp;
-enum { REPRISE_WARP_GRID = 0, REPRISE_WARP_REVERSE = 1, REPRISE_WARP_SPLAT = 2, REPRISE_WARP_AUTO = 3 };
+enum {
+    REPRISE_WARP_GRID = 0,
+    REPRISE_WARP_REVERSE = 1,
+    REPRISE_WARP_SPLAT = 2,
+    REPRISE_WARP_AUTO = 3
+};
 typedef int32_t reprise_fill;
-enum { REPRISE_FILL_PULLPUSH = 0, REPRISE_FILL_NONE = 1, REPRISE_FILL_ANDREEV = 2, REPRISE_FILL_AUTO = 3 };
+enum {
+    REPRISE_FILL_PULLPUSH = 0,
+    REPRISE_FILL_NONE = 1,
+    REPRISE_FILL_ANDREEV = 2,
+    REPRISE_FILL_AUTO = 3
+};
 
 typedef struct reprise_converter_options {
     uint32_t struct_size;   /* sizeof(reprise_converter_options) */
@@ -207,21 +218,21 @@ enum {
 };
 
 typedef struct reprise_encoder_options {
-    uint32_t struct_size;        /* sizeof(reprise_encoder_options) */
-    int32_t qp;                  /* quantiser 0 (finest) .. 51 (default 28) */
-    int32_t bitrate_kbps;        /* > 0: rate control to this bitrate (default 0: constant qp) */
-    int32_t keyint;              /* key frame at least every keyint frames (default 0: on cuts) */
-    double fps;                  /* when the frames carry none (default 30) */
-    int32_t chroma444;           /* 1: 4:4:4, 0: 4:2:0 (default) */
-    reprise_depth_coding depth;  /* default lossless */
-    float depth_error;           /* REPRISE_DEPTH_BOUNDED (default 1e-4) */
-    float view_error_px;         /* REPRISE_DEPTH_VIEW, pixels (default 0.25) */
-    float view_displacement;     /* REPRISE_DEPTH_VIEW, scene units (default 0.164) */
-    float motion_error_px;       /* 0 = every pixel to 1/8 px, else 0.1..8 (default 0.25) */
-    int32_t skip_threshold;      /* 8-bit display levels a skipped block may miss by (default 2) */
-    int32_t detect_cuts;         /* 1 (default): key frame when prediction misses most pixels */
-    int32_t fit_cameras;         /* 1 (default): frames without a camera get a fitted one */
-    int32_t reserved;            /* 0 */
+    uint32_t struct_size;       /* sizeof(reprise_encoder_options) */
+    int32_t qp;                 /* quantiser 0 (finest) .. 51 (default 28) */
+    int32_t bitrate_kbps;       /* > 0: rate control to this bitrate (default 0: constant qp) */
+    int32_t keyint;             /* key frame at least every keyint frames (default 0: on cuts) */
+    double fps;                 /* when the frames carry none (default 30) */
+    int32_t chroma444;          /* 1: 4:4:4, 0: 4:2:0 (default) */
+    reprise_depth_coding depth; /* default lossless */
+    float depth_error;          /* REPRISE_DEPTH_BOUNDED (default 1e-4) */
+    float view_error_px;        /* REPRISE_DEPTH_VIEW, pixels (default 0.25) */
+    float view_displacement;    /* REPRISE_DEPTH_VIEW, scene units (default 0.164) */
+    float motion_error_px;      /* 0 = every pixel to 1/8 px, else 0.1..8 (default 0.25) */
+    int32_t skip_threshold;     /* 8-bit display levels a skipped block may miss by (default 2) */
+    int32_t detect_cuts;        /* 1 (default): key frame when prediction misses most pixels */
+    int32_t fit_cameras;        /* 1 (default): frames without a camera get a fitted one */
+    int32_t reserved;           /* 0 */
 } reprise_encoder_options;
 
 REPRISE_API reprise_status reprise_encoder_options_init(reprise_encoder_options* options,

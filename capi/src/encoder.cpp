@@ -104,8 +104,8 @@ reprise_status reprise_encoder_send_frame(reprise_encoder* encoder, const repris
     return guarded(function, [&] {
         REPRISE_CAPI_TRY(check_pointer(function, encoder, "encoder"));
         bool reset = false;
-        REPRISE_CAPI_TRY(
-            read_gbuffer(function, "frame", frame, kColor | kDepth | kMotion, encoder->input, reset));
+        REPRISE_CAPI_TRY(read_gbuffer(function, "frame", frame, kColor | kDepth | kMotion,
+                                      encoder->input, reset));
         if (reset) encoder->encoder->request_key_frame();
         const Status status = encoder->encoder->send_frame(encoder->input);
         if (!status) return fail(REPRISE_ERROR_INVALID_ARGUMENT, function, status.message());

@@ -26,16 +26,26 @@ struct Format {
 
 Format describe(reprise_format format) {
     switch (format) {
-        case REPRISE_FORMAT_R32_FLOAT: return {1, Kind::Float32, "R32_FLOAT"};
-        case REPRISE_FORMAT_RG32_FLOAT: return {2, Kind::Float32, "RG32_FLOAT"};
-        case REPRISE_FORMAT_RGB32_FLOAT: return {3, Kind::Float32, "RGB32_FLOAT"};
-        case REPRISE_FORMAT_RGBA32_FLOAT: return {4, Kind::Float32, "RGBA32_FLOAT"};
-        case REPRISE_FORMAT_R16_FLOAT: return {1, Kind::Float16, "R16_FLOAT"};
-        case REPRISE_FORMAT_RG16_FLOAT: return {2, Kind::Float16, "RG16_FLOAT"};
-        case REPRISE_FORMAT_RGB16_FLOAT: return {3, Kind::Float16, "RGB16_FLOAT"};
-        case REPRISE_FORMAT_RGBA16_FLOAT: return {4, Kind::Float16, "RGBA16_FLOAT"};
-        case REPRISE_FORMAT_R32_UINT: return {1, Kind::Uint32, "R32_UINT"};
-        default: return {};
+        case REPRISE_FORMAT_R32_FLOAT:
+            return {1, Kind::Float32, "R32_FLOAT"};
+        case REPRISE_FORMAT_RG32_FLOAT:
+            return {2, Kind::Float32, "RG32_FLOAT"};
+        case REPRISE_FORMAT_RGB32_FLOAT:
+            return {3, Kind::Float32, "RGB32_FLOAT"};
+        case REPRISE_FORMAT_RGBA32_FLOAT:
+            return {4, Kind::Float32, "RGBA32_FLOAT"};
+        case REPRISE_FORMAT_R16_FLOAT:
+            return {1, Kind::Float16, "R16_FLOAT"};
+        case REPRISE_FORMAT_RG16_FLOAT:
+            return {2, Kind::Float16, "RG16_FLOAT"};
+        case REPRISE_FORMAT_RGB16_FLOAT:
+            return {3, Kind::Float16, "RGB16_FLOAT"};
+        case REPRISE_FORMAT_RGBA16_FLOAT:
+            return {4, Kind::Float16, "RGBA16_FLOAT"};
+        case REPRISE_FORMAT_R32_UINT:
+            return {1, Kind::Uint32, "R32_UINT"};
+        default:
+            return {};
     }
 }
 
@@ -47,7 +57,8 @@ struct Spec {
     bool integer;
     const char* accepted;  // for messages
 };
-constexpr Spec kColorSpec{"color", 3, 4, false, "RGB32_FLOAT, RGBA32_FLOAT, RGB16_FLOAT, RGBA16_FLOAT"};
+constexpr Spec kColorSpec{"color", 3, 4, false,
+                          "RGB32_FLOAT, RGBA32_FLOAT, RGB16_FLOAT, RGBA16_FLOAT"};
 constexpr Spec kDepthSpec{"depth", 1, 1, false, "R32_FLOAT, R16_FLOAT"};
 constexpr Spec kMotionSpec{"motion", 2, 2, false, "RG32_FLOAT, RG16_FLOAT"};
 constexpr Spec kNormalSpec{"normal", 3, 3, false, "RGB32_FLOAT, RGB16_FLOAT"};
@@ -261,19 +272,28 @@ struct OutputChannel {
     reprise_image reprise_gbuffer::*image;
 };
 constexpr OutputChannel kChannels[] = {
-    {kColorSpec, kColor, &reprise_gbuffer::color},   {kDepthSpec, kDepth, &reprise_gbuffer::depth},
-    {kMotionSpec, kMotion, &reprise_gbuffer::motion}, {kNormalSpec, kNormal, &reprise_gbuffer::normal},
-    {kIdSpec, kId, &reprise_gbuffer::id},             {kUiSpec, kUi, &reprise_gbuffer::ui},
+    {kColorSpec, kColor, &reprise_gbuffer::color},
+    {kDepthSpec, kDepth, &reprise_gbuffer::depth},
+    {kMotionSpec, kMotion, &reprise_gbuffer::motion},
+    {kNormalSpec, kNormal, &reprise_gbuffer::normal},
+    {kIdSpec, kId, &reprise_gbuffer::id},
+    {kUiSpec, kUi, &reprise_gbuffer::ui},
 };
 
 bool frame_has(const Frame& frame, unsigned bit) {
     switch (bit) {
-        case kColor: return !frame.color.empty();
-        case kDepth: return !frame.depth.empty();
-        case kMotion: return !frame.motion.empty();
-        case kNormal: return !frame.normal.empty();
-        case kId: return !frame.id.empty();
-        default: return !frame.ui.empty();
+        case kColor:
+            return !frame.color.empty();
+        case kDepth:
+            return !frame.depth.empty();
+        case kMotion:
+            return !frame.motion.empty();
+        case kNormal:
+            return !frame.normal.empty();
+        case kId:
+            return !frame.id.empty();
+        default:
+            return !frame.ui.empty();
     }
 }
 
@@ -299,9 +319,12 @@ reprise_status read_gbuffer(const char* function, const char* name, const repris
     REPRISE_CAPI_TRY(check_image(function, n, kColorSpec, given->color, 0, 0));
     const int w = given->color.width, h = given->color.height;
     read_pixels(given->color, frame.color);
-    REPRISE_CAPI_TRY(read_channel(function, n, kDepthSpec, given->depth, read & kDepth, w, h, frame.depth));
-    REPRISE_CAPI_TRY(read_channel(function, n, kMotionSpec, given->motion, read & kMotion, w, h, frame.motion));
-    REPRISE_CAPI_TRY(read_channel(function, n, kNormalSpec, given->normal, read & kNormal, w, h, frame.normal));
+    REPRISE_CAPI_TRY(
+        read_channel(function, n, kDepthSpec, given->depth, read & kDepth, w, h, frame.depth));
+    REPRISE_CAPI_TRY(
+        read_channel(function, n, kMotionSpec, given->motion, read & kMotion, w, h, frame.motion));
+    REPRISE_CAPI_TRY(
+        read_channel(function, n, kNormalSpec, given->normal, read & kNormal, w, h, frame.normal));
     REPRISE_CAPI_TRY(read_channel(function, n, kIdSpec, given->id, read & kId, w, h, frame.id));
     REPRISE_CAPI_TRY(read_channel(function, n, kUiSpec, given->ui, read & kUi, w, h, frame.ui));
     REPRISE_CAPI_TRY(read_camera(function, n, given->camera, frame.camera));
@@ -312,8 +335,8 @@ reprise_status read_gbuffer(const char* function, const char* name, const repris
     return REPRISE_OK;
 }
 
-reprise_status check_output(const char* function, const reprise_gbuffer* out, int width,
-                            int height, unsigned written) {
+reprise_status check_output(const char* function, const reprise_gbuffer* out, int width, int height,
+                            unsigned written) {
     REPRISE_CAPI_TRY(check_gbuffer_struct(function, "out", out));
     for (const OutputChannel& channel : kChannels) {
         const reprise_image& image = out->*channel.image;
@@ -380,8 +403,8 @@ extern "C" reprise_status reprise_gbuffer_init(reprise_gbuffer* gbuffer, size_t 
     return guarded("reprise_gbuffer_init", [&] {
         const char* function = "reprise_gbuffer_init";
         REPRISE_CAPI_TRY(check_pointer(function, gbuffer, "gbuffer"));
-        REPRISE_CAPI_TRY(check_struct_size(function, "struct_size", struct_size,
-                                           sizeof(reprise_gbuffer)));
+        REPRISE_CAPI_TRY(
+            check_struct_size(function, "struct_size", struct_size, sizeof(reprise_gbuffer)));
         *gbuffer = reprise_gbuffer{};
         gbuffer->struct_size = uint32_t(sizeof(reprise_gbuffer));
         return reprise_status(REPRISE_OK);

@@ -26,8 +26,8 @@ reprise_status read_gbuffer(const char* function, const char* name, const repris
 
 // Checks `out` for a width x height result: colour required, the channels in `written` optional,
 // any other channel must be absent.
-reprise_status check_output(const char* function, const reprise_gbuffer* out, int width,
-                            int height, unsigned written);
+reprise_status check_output(const char* function, const reprise_gbuffer* out, int width, int height,
+                            unsigned written);
 // Writes the channels `out` asks for (checked by check_output) and the camera and fps.
 // Channels `frame` lacks are an error, before anything is written.
 reprise_status write_gbuffer(const char* function, const Frame& frame, reprise_gbuffer* out);

@@ -19,8 +19,7 @@ reprise_status fail(reprise_status status, const char* function, const char* mes
 
 reprise_status check_abi(const char* function, uint32_t abi_version) {
     const uint32_t major = abi_version >> 16, minor = abi_version & 0xffffu;
-    if (major == REPRISE_ABI_VERSION_MAJOR && minor <= REPRISE_ABI_VERSION_MINOR)
-        return REPRISE_OK;
+    if (major == REPRISE_ABI_VERSION_MAJOR && minor <= REPRISE_ABI_VERSION_MINOR) return REPRISE_OK;
     return fail(REPRISE_ERROR_ABI_MISMATCH, function,
                 "abi_version " + std::to_string(major) + "." + std::to_string(minor) +
                     " (the caller's reprise.h) does not match the library's " +
@@ -67,15 +66,24 @@ uint32_t reprise_abi_version(void) { return REPRISE_ABI_VERSION; }
 
 const char* reprise_status_name(reprise_status status) {
     switch (status) {
-        case REPRISE_OK: return "REPRISE_OK";
-        case REPRISE_NEED_MORE: return "REPRISE_NEED_MORE";
-        case REPRISE_ERROR_INVALID_ARGUMENT: return "REPRISE_ERROR_INVALID_ARGUMENT";
-        case REPRISE_ERROR_ABI_MISMATCH: return "REPRISE_ERROR_ABI_MISMATCH";
-        case REPRISE_ERROR_BUFFER_TOO_SMALL: return "REPRISE_ERROR_BUFFER_TOO_SMALL";
-        case REPRISE_ERROR_INVALID_DATA: return "REPRISE_ERROR_INVALID_DATA";
-        case REPRISE_ERROR_OUT_OF_MEMORY: return "REPRISE_ERROR_OUT_OF_MEMORY";
-        case REPRISE_ERROR_INTERNAL: return "REPRISE_ERROR_INTERNAL";
-        default: return "unknown status";
+        case REPRISE_OK:
+            return "REPRISE_OK";
+        case REPRISE_NEED_MORE:
+            return "REPRISE_NEED_MORE";
+        case REPRISE_ERROR_INVALID_ARGUMENT:
+            return "REPRISE_ERROR_INVALID_ARGUMENT";
+        case REPRISE_ERROR_ABI_MISMATCH:
+            return "REPRISE_ERROR_ABI_MISMATCH";
+        case REPRISE_ERROR_BUFFER_TOO_SMALL:
+            return "REPRISE_ERROR_BUFFER_TOO_SMALL";
+        case REPRISE_ERROR_INVALID_DATA:
+            return "REPRISE_ERROR_INVALID_DATA";
+        case REPRISE_ERROR_OUT_OF_MEMORY:
+            return "REPRISE_ERROR_OUT_OF_MEMORY";
+        case REPRISE_ERROR_INTERNAL:
+            return "REPRISE_ERROR_INTERNAL";
+        default:
+            return "unknown status";
     }
 }
 

@@ -36,9 +36,9 @@ reprise_status guarded(const char* function, Body&& body) noexcept {
 }
 
 // Returns from the calling function when a check gave an error.
-#define REPRISE_CAPI_TRY(expr)                      \
-    do {                                            \
-        const reprise_status capi_status_ = (expr); \
+#define REPRISE_CAPI_TRY(expr)                               \
+    do {                                                     \
+        const reprise_status capi_status_ = (expr);          \
         if (capi_status_ != REPRISE_OK) return capi_status_; \
     } while (0)
 

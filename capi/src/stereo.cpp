@@ -33,8 +33,7 @@ reprise_stereo_options default_options() {
     return o;
 }
 
-reprise_status configure(const char* function, const reprise_stereo_options& o,
-                         reprise_stereo& s) {
+reprise_status configure(const char* function, const reprise_stereo_options& o, reprise_stereo& s) {
     REPRISE_CAPI_TRY(check_range(function, "options->ipd", o.ipd, 1e-6, 1e6));
     REPRISE_CAPI_TRY(check_range(function, "options->convergence", o.convergence, 1e-6, 1e9));
     REPRISE_CAPI_TRY(check_range(function, "options->rig", o.rig, 0, 1));
@@ -51,7 +50,8 @@ reprise_status configure(const char* function, const reprise_stereo_options& o,
              .convergence = o.convergence,
              .rig = o.rig == REPRISE_RIG_OFF_AXIS ? stereo::Rig::OffAxis : stereo::Rig::Parallel};
     s.rendered = o.rendered_eye == REPRISE_EYE_RIGHT ? stereo::Eye::Right : stereo::Eye::Left;
-    s.options.warp = o.warp == REPRISE_WARP_SPLAT ? stereo::StereoWarp::Splat : stereo::StereoWarp::Grid;
+    s.options.warp =
+        o.warp == REPRISE_WARP_SPLAT ? stereo::StereoWarp::Splat : stereo::StereoWarp::Grid;
     s.options.fill = fills[o.fill];
     s.temporal = o.temporal != 0;
     return REPRISE_OK;
@@ -97,7 +97,8 @@ reprise_status reprise_stereo_synthesize(reprise_stereo* stereo, const reprise_g
         if (!rendered->camera.valid || !has_projection(input.camera))
             return fail(REPRISE_ERROR_INVALID_ARGUMENT, function,
                         "rendered->camera is not valid: disparity needs the projection");
-        REPRISE_CAPI_TRY(check_output(function, eye, input.width(), input.height(), kColor | kDepth));
+        REPRISE_CAPI_TRY(
+            check_output(function, eye, input.width(), input.height(), kColor | kDepth));
         if (reset) stereo->has_previous = false;
         const stereo::EyeCameras eyes = stereo::eye_cameras(
             input.camera, stereo->rig,

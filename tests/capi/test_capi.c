@@ -13,34 +13,36 @@ enum { W = 64, H = 48, PAN = 4 };
 
 static int failures = 0;
 
-#define CHECK(cond, ...)                                                  \
-    do {                                                                  \
-        if (!(cond)) {                                                    \
+#define CHECK(cond, ...)                                                             \
+    do {                                                                             \
+        if (!(cond)) {                                                               \
             fprintf(stderr, "%s:%d: check failed: %s: ", __FILE__, __LINE__, #cond); \
-            fprintf(stderr, __VA_ARGS__);                                 \
-            fprintf(stderr, " (last error: %s)\n", reprise_last_error()); \
-            ++failures;                                                   \
-        }                                                                 \
+            fprintf(stderr, __VA_ARGS__);                                            \
+            fprintf(stderr, " (last error: %s)\n", reprise_last_error());            \
+            ++failures;                                                              \
+        }                                                                            \
     } while (0)
 
-#define EXPECT_STATUS(call, expected)                                                   \
-    do {                                                                                \
-        reprise_status got_ = (call);                                                   \
+#define EXPECT_STATUS(call, expected)                                                          \
+    do {                                                                                       \
+        reprise_status got_ = (call);                                                          \
         CHECK(got_ == (expected), "%s gave %s, expected %s", #call, reprise_status_name(got_), \
-              reprise_status_name(expected));                                           \
+              reprise_status_name(expected));                                                  \
     } while (0)
 
 /* A smooth texture, as seen with the content moved `shift` pixels right: value at column x is
  * the texture's at x - shift. */
 static float texture(double x, double y, int c) {
     const double u = x + 0.5, v = y + 0.5;
-    return (float)(0.5 + 0.3 * sin(u * 0.35 + c) * cos(v * 0.22 - c) + 0.1 * sin(u * 0.11 + v * 0.07));
+    return (float)(0.5 + 0.3 * sin(u * 0.35 + c) * cos(v * 0.22 - c) +
+                   0.1 * sin(u * 0.11 + v * 0.07));
 }
 
 static void fill_pan(float* rgb, int stride_floats, int shift) {
     for (int y = 0; y < H; ++y)
         for (int x = 0; x < W; ++x)
-            for (int c = 0; c < 3; ++c) rgb[y * stride_floats + x * 3 + c] = texture(x - shift, y, c);
+            for (int c = 0; c < 3; ++c)
+                rgb[y * stride_floats + x * 3 + c] = texture(x - shift, y, c);
 }
 
 static reprise_image image(void* data, int64_t stride, reprise_format format) {
@@ -93,8 +95,8 @@ static void test_converter_pan(void) {
     }
     reprise_converter_options options;
     EXPECT_STATUS(reprise_converter_options_init(&options, sizeof options), REPRISE_OK);
-    CHECK(options.factor == 2 && options.refine == 1, "defaults factor %d refine %d", options.factor,
-          options.refine);
+    CHECK(options.factor == 2 && options.refine == 1, "defaults factor %d refine %d",
+          options.factor, options.refine);
     reprise_converter* converter = NULL;
     EXPECT_STATUS(reprise_converter_create(REPRISE_ABI_VERSION, &options, &converter), REPRISE_OK);
     if (!converter) return;
@@ -140,8 +142,8 @@ static void test_converter_pan(void) {
                 const double psnr = pan_psnr(out_color, shift, 2 * PAN);
                 printf("converter: output %d (%s, shift %.0f px): PSNR %.2f dB, time %.4f s\n",
                        outputs, passed ? "input" : "made", shift, psnr, out.camera.time);
-                CHECK(psnr > 60.0, "output %d PSNR %.2f dB against the %.0f px shift", outputs, psnr,
-                      shift);
+                CHECK(psnr > 60.0, "output %d PSNR %.2f dB against the %.0f px shift", outputs,
+                      psnr, shift);
                 CHECK(fabs(out.camera.time - outputs / 60.0) < 1e-6, "output %d time %g", outputs,
                       out.camera.time);
                 /* Motion per output period: half the input's. */
@@ -209,13 +211,15 @@ static void test_stereo_plane(void) {
            psnr, unshifted, made_depth[H / 2 * W + W / 2]);
     CHECK(psnr > 40.0, "right eye PSNR %.2f dB", psnr);
     CHECK(psnr > unshifted + 15.0, "shifted %.2f, unshifted %.2f", psnr, unshifted);
-    CHECK(fabsf(made_depth[H / 2 * W + W / 2] - 4.0f) < 1e-3f, "depth %g", made_depth[H / 2 * W + W / 2]);
+    CHECK(fabsf(made_depth[H / 2 * W + W / 2] - 4.0f) < 1e-3f, "depth %g",
+          made_depth[H / 2 * W + W / 2]);
     /* The made eye's camera sits ipd to the right: its view translates x by -ipd. */
     CHECK(eye.camera.valid == 1 && fabsf(eye.camera.view[12] + 0.5f) < 1e-6f, "right eye view x %g",
           eye.camera.view[12]);
     /* The rendered eye without a camera has no disparity: refused, naming the field. */
     rendered.camera.valid = 0;
-    EXPECT_STATUS(reprise_stereo_synthesize(stereo, &rendered, &eye), REPRISE_ERROR_INVALID_ARGUMENT);
+    EXPECT_STATUS(reprise_stereo_synthesize(stereo, &rendered, &eye),
+                  REPRISE_ERROR_INVALID_ARGUMENT);
     CHECK(strstr(reprise_last_error(), "rendered->camera") != NULL, "message names the camera");
     reprise_stereo_destroy(stereo);
 }
@@ -254,7 +258,8 @@ static void test_codec_round_trip(void) {
                       REPRISE_ERROR_BUFFER_TOO_SMALL);
         CHECK(size > 0 && size <= sizeof packet, "packet size %zu", size);
         size_t got = 0;
-        EXPECT_STATUS(reprise_encoder_receive_packet(encoder, packet, sizeof packet, &got), REPRISE_OK);
+        EXPECT_STATUS(reprise_encoder_receive_packet(encoder, packet, sizeof packet, &got),
+                      REPRISE_OK);
         CHECK(got == size, "packet %zu bytes, announced %zu", got, size);
         EXPECT_STATUS(reprise_encoder_receive_packet(encoder, packet, sizeof packet, &got),
                       REPRISE_NEED_MORE);
@@ -288,7 +293,8 @@ static void test_abi_mismatch(void) {
     EXPECT_STATUS(reprise_converter_create(REPRISE_ABI_VERSION + (1u << 16), NULL, &converter),
                   REPRISE_ERROR_ABI_MISMATCH);
     CHECK(converter == NULL, "no handle on a mismatch");
-    CHECK(strstr(reprise_last_error(), "abi_version 2.0") != NULL, "message: %s", reprise_last_error());
+    CHECK(strstr(reprise_last_error(), "abi_version 2.0") != NULL, "message: %s",
+          reprise_last_error());
     reprise_decoder* decoder = NULL;
     EXPECT_STATUS(reprise_decoder_create(REPRISE_ABI_VERSION + 1, NULL, &decoder),
                   REPRISE_ERROR_ABI_MISMATCH);
@@ -330,21 +336,23 @@ static void test_bad_arguments(void) {
         float projection0;
         int null_color;
     } cases[] = {
-        {"stride too small", "frame->color.stride", W * 16 - 1, REPRISE_FORMAT_RGBA32_FLOAT, W, 1.0f, 0},
-        {"negative stride", "frame->color.stride", -W * 16, REPRISE_FORMAT_RGBA32_FLOAT, W, 1.0f, 0},
+        {"stride too small", "frame->color.stride", W * 16 - 1, REPRISE_FORMAT_RGBA32_FLOAT, W,
+         1.0f, 0},
+        {"negative stride", "frame->color.stride", -W * 16, REPRISE_FORMAT_RGBA32_FLOAT, W, 1.0f,
+         0},
         {"unknown format", "frame->color.format 77", W * 16, 77, W, 1.0f, 0},
         {"integer colour", "frame->color.format", W * 16, REPRISE_FORMAT_R32_UINT, W, 1.0f, 0},
-        {"depth of another size", "frame->depth is 63x48", W * 16, REPRISE_FORMAT_RGBA32_FLOAT, W - 1,
-         1.0f, 0},
-        {"NaN in the projection", "frame->camera.projection[0]", W * 16, REPRISE_FORMAT_RGBA32_FLOAT,
-         W, NAN, 0},
+        {"depth of another size", "frame->depth is 63x48", W * 16, REPRISE_FORMAT_RGBA32_FLOAT,
+         W - 1, 1.0f, 0},
+        {"NaN in the projection", "frame->camera.projection[0]", W * 16,
+         REPRISE_FORMAT_RGBA32_FLOAT, W, NAN, 0},
         {"no colour", "frame->color.data is NULL", W * 16, REPRISE_FORMAT_RGBA32_FLOAT, W, 1.0f, 1},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
         reprise_gbuffer frame;
         reprise_gbuffer_init(&frame, sizeof frame);
-        frame.color = image(cases[i].null_color ? NULL : rgba, cases[i].color_stride,
-                            cases[i].color_format);
+        frame.color =
+            image(cases[i].null_color ? NULL : rgba, cases[i].color_stride, cases[i].color_format);
         frame.depth = image(depth, W * 4, REPRISE_FORMAT_R32_FLOAT);
         frame.depth.width = cases[i].depth_width;
         frame.camera.valid = 1;
@@ -378,8 +386,9 @@ static void test_bad_arguments(void) {
     CHECK(strcmp(reprise_last_error(), "") == 0, "no error left after a success: %s",
           reprise_last_error());
     EXPECT_STATUS(reprise_decoder_send_packet(NULL, NULL, 0), REPRISE_ERROR_INVALID_ARGUMENT);
-    CHECK(strcmp(reprise_status_name(REPRISE_ERROR_ABI_MISMATCH), "REPRISE_ERROR_ABI_MISMATCH") == 0,
-          "status name");
+    CHECK(
+        strcmp(reprise_status_name(REPRISE_ERROR_ABI_MISMATCH), "REPRISE_ERROR_ABI_MISMATCH") == 0,
+        "status name");
     reprise_converter_destroy(converter);
     reprise_converter_destroy(NULL);
 }
@@ -390,7 +399,9 @@ int main(void) {
     test_codec_round_trip();
     test_abi_mismatch();
     test_bad_arguments();
-    if (failures) fprintf(stderr, "test_capi: %d checks failed\n", failures);
-    else printf("test_capi: all checks passed\n");
+    if (failures)
+        fprintf(stderr, "test_capi: %d checks failed\n", failures);
+    else
+        printf("test_capi: all checks passed\n");
     return failures ? 1 : 0;
 }

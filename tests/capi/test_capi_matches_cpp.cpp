@@ -38,8 +38,8 @@ std::vector<Frame> frames() {
 
 template <class T>
 reprise_image image_of(const Image<T>& image, reprise_format format) {
-    return {const_cast<T*>(image.data()), image.width(), image.height(),
-            int64_t(image.width() * sizeof(T)), format, 0};
+    return {const_cast<T*>(image.data()),       image.width(), image.height(),
+            int64_t(image.width() * sizeof(T)), format,        0};
 }
 
 void copy_matrix(const glm::mat4& m, float* a) { std::memcpy(a, &m[0][0], 16 * sizeof(float)); }
@@ -114,7 +114,8 @@ TEST(CapiMatchesCpp, CodecPacketsAndDecodedFramesAreTheCodecs) {
         ASSERT_EQ(reprise_encoder_send_frame(ce, &g), REPRISE_OK) << reprise_last_error();
         std::vector<uint8_t> bytes(packet.data.size() + 16);
         std::size_t size = 0;
-        ASSERT_EQ(reprise_encoder_receive_packet(ce, bytes.data(), bytes.size(), &size), REPRISE_OK);
+        ASSERT_EQ(reprise_encoder_receive_packet(ce, bytes.data(), bytes.size(), &size),
+                  REPRISE_OK);
         bytes.resize(size);
         EXPECT_EQ(bytes, packet.data) << "packet " << k;
 
