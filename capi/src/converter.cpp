@@ -76,72 +76,61 @@ extern "C" {
 
 reprise_status reprise_converter_options_init(reprise_converter_options* options,
                                               size_t struct_size) {
-    return guarded("reprise_converter_options_init", [&] {
-        return init_options("reprise_converter_options_init", options, struct_size,
-                            default_options());
-    });
+    return init_options("reprise_converter_options_init", options, struct_size, default_options());
 }
 
 reprise_status reprise_converter_create(uint32_t abi_version,
                                         const reprise_converter_options* given,
                                         reprise_converter** converter) {
     const char* function = "reprise_converter_create";
-    return guarded(function, [&] {
-        reprise_converter_options o = default_options();
-        REPRISE_CAPI_TRY(check_create(function, abi_version, given, o, converter));
-        auto made = std::make_unique<reprise_converter>();
-        REPRISE_CAPI_TRY(to_fruc_options(function, o, made->options));
-        made->factor = o.factor;
-        made->fruc = std::make_unique<warp::FrameRateConverter>(made->factor, made->options);
-        *converter = made.release();
-        return reprise_status(REPRISE_OK);
-    });
+    return create_handle(function, abi_version, given, default_options(), converter,
+                         [&](const reprise_converter_options& o, reprise_converter& made) {
+                             REPRISE_CAPI_TRY(to_fruc_options(function, o, made.options));
+                             made.factor = o.factor;
+                             made.fruc = std::make_unique<warp::FrameRateConverter>(made.factor,
+                                                                                    made.options);
+                             return reprise_status(REPRISE_OK);
+                         });
 }
 
 void reprise_converter_destroy(reprise_converter* converter) { delete converter; }
 
 reprise_status reprise_converter_send(reprise_converter* converter, const reprise_gbuffer* frame) {
     const char* function = "reprise_converter_send";
-    return guarded(function, [&] {
-        REPRISE_CAPI_TRY(check_pointer(function, converter, "converter"));
+    return with_handle(function, converter, "converter", [&](reprise_converter& c) {
         bool reset = false;
-        REPRISE_CAPI_TRY(
-            read_gbuffer(function, "frame", frame, kConverterReads, converter->input, reset));
-        if (reset) converter->fruc->start_new_shot();
-        const Status status = converter->fruc->send(std::move(converter->input));
+        REPRISE_CAPI_TRY(read_gbuffer(function, "frame", frame, kConverterReads, c.input, reset));
+        if (reset) c.fruc->start_new_shot();
+        const Status status = c.fruc->send(std::move(c.input));
         if (!status) return fail(REPRISE_ERROR_INVALID_ARGUMENT, function, status.message());
         return reprise_status(REPRISE_OK);
     });
 }
 
 reprise_status reprise_converter_flush(reprise_converter* converter) {
-    const char* function = "reprise_converter_flush";
-    return guarded(function, [&] {
-        REPRISE_CAPI_TRY(check_pointer(function, converter, "converter"));
-        Frame out;
-        while (converter->fruc->receive(out)) converter->flushed.push_back(std::move(out));
-        converter->fruc =
-            std::make_unique<warp::FrameRateConverter>(converter->factor, converter->options);
-        return reprise_status(REPRISE_OK);
-    });
+    return with_handle("reprise_converter_flush", converter, "converter",
+                       [&](reprise_converter& c) {
+                           Frame out;
+                           while (c.fruc->receive(out)) c.flushed.push_back(std::move(out));
+                           c.fruc = std::make_unique<warp::FrameRateConverter>(c.factor, c.options);
+                           return REPRISE_OK;
+                       });
 }
 
 reprise_status reprise_converter_output_size(reprise_converter* converter, int32_t* width,
                                              int32_t* height) {
     const char* function = "reprise_converter_output_size";
-    return guarded(function, [&] {
-        REPRISE_CAPI_TRY(check_pointer(function, converter, "converter"));
-        converter->pull();
-        return held_size(function, converter->next, width, height);
+    return with_handle(function, converter, "converter", [&](reprise_converter& c) {
+        c.pull();
+        return held_size(function, c.next, width, height);
     });
 }
 
 reprise_status reprise_converter_receive(reprise_converter* converter, reprise_gbuffer* out) {
     const char* function = "reprise_converter_receive";
-    return guarded(function, [&] {
-        REPRISE_CAPI_TRY(check_pointer(function, converter, "converter"));
-        converter->pull();
-        return receive_held(function, converter->next, kConverterWrites, out);
+    return with_handle(function, converter, "converter", [&](reprise_converter& c) {
+        c.pull();
+        return receive_held(function, c.next, kConverterWrites, out);
     });
 }
 

@@ -76,38 +76,31 @@ reprise_status to_encoder_options(const char* function, const reprise_encoder_op
 extern "C" {
 
 reprise_status reprise_encoder_options_init(reprise_encoder_options* options, size_t struct_size) {
-    return guarded("reprise_encoder_options_init", [&] {
-        return init_options("reprise_encoder_options_init", options, struct_size,
-                            default_options());
-    });
+    return init_options("reprise_encoder_options_init", options, struct_size, default_options());
 }
 
 reprise_status reprise_encoder_create(uint32_t abi_version, const reprise_encoder_options* given,
                                       reprise_encoder** encoder) {
     const char* function = "reprise_encoder_create";
-    return guarded(function, [&] {
-        reprise_encoder_options o = default_options();
-        REPRISE_CAPI_TRY(check_create(function, abi_version, given, o, encoder));
-        codec::EncoderOptions options;
-        REPRISE_CAPI_TRY(to_encoder_options(function, o, options));
-        auto made = std::make_unique<reprise_encoder>();
-        made->encoder = std::make_unique<codec::Encoder>(options);
-        *encoder = made.release();
-        return reprise_status(REPRISE_OK);
-    });
+    return create_handle(function, abi_version, given, default_options(), encoder,
+                         [&](const reprise_encoder_options& o, reprise_encoder& made) {
+                             codec::EncoderOptions options;
+                             REPRISE_CAPI_TRY(to_encoder_options(function, o, options));
+                             made.encoder = std::make_unique<codec::Encoder>(options);
+                             return reprise_status(REPRISE_OK);
+                         });
 }
 
 void reprise_encoder_destroy(reprise_encoder* encoder) { delete encoder; }
 
 reprise_status reprise_encoder_send_frame(reprise_encoder* encoder, const reprise_gbuffer* frame) {
     const char* function = "reprise_encoder_send_frame";
-    return guarded(function, [&] {
-        REPRISE_CAPI_TRY(check_pointer(function, encoder, "encoder"));
+    return with_handle(function, encoder, "encoder", [&](reprise_encoder& e) {
         bool reset = false;
-        REPRISE_CAPI_TRY(read_gbuffer(function, "frame", frame, kColor | kDepth | kMotion,
-                                      encoder->input, reset));
-        if (reset) encoder->encoder->request_key_frame();
-        const Status status = encoder->encoder->send_frame(encoder->input);
+        REPRISE_CAPI_TRY(
+            read_gbuffer(function, "frame", frame, kColor | kDepth | kMotion, e.input, reset));
+        if (reset) e.encoder->request_key_frame();
+        const Status status = e.encoder->send_frame(e.input);
         if (!status) return fail(REPRISE_ERROR_INVALID_ARGUMENT, function, status.message());
         return reprise_status(REPRISE_OK);
     });
@@ -116,35 +109,32 @@ reprise_status reprise_encoder_send_frame(reprise_encoder* encoder, const repris
 reprise_status reprise_encoder_receive_packet(reprise_encoder* encoder, uint8_t* data,
                                               size_t capacity, size_t* size) {
     const char* function = "reprise_encoder_receive_packet";
-    return guarded(function, [&] {
-        REPRISE_CAPI_TRY(check_pointer(function, encoder, "encoder"));
+    return with_handle(function, encoder, "encoder", [&](reprise_encoder& e) {
         REPRISE_CAPI_TRY(check_pointer(function, size, "size"));
         *size = 0;
-        if (!encoder->held) {
-            const codec::Result result = encoder->encoder->receive_packet(encoder->packet);
+        if (!e.held) {
+            const codec::Result result = e.encoder->receive_packet(e.packet);
             if (result == codec::Result::NeedMoreData) return reprise_status(REPRISE_NEED_MORE);
             if (result == codec::Result::Error)
                 return fail(REPRISE_ERROR_INTERNAL, function, "the encoder gave no packet");
-            encoder->held = true;
+            e.held = true;
         }
-        const std::vector<uint8_t>& bytes = encoder->packet.data;
+        const std::vector<uint8_t>& bytes = e.packet.data;
         *size = bytes.size();
         if (!data || capacity < bytes.size())
             return fail(REPRISE_ERROR_BUFFER_TOO_SMALL, function,
                         "the packet has " + std::to_string(bytes.size()) + " bytes, capacity is " +
                             std::to_string(data ? capacity : 0) + " (the packet is kept)");
         std::memcpy(data, bytes.data(), bytes.size());
-        encoder->held = false;
+        e.held = false;
         return reprise_status(REPRISE_OK);
     });
 }
 
 reprise_status reprise_encoder_flush(reprise_encoder* encoder) {
-    const char* function = "reprise_encoder_flush";
-    return guarded(function, [&] {
-        REPRISE_CAPI_TRY(check_pointer(function, encoder, "encoder"));
-        encoder->encoder->flush();
-        return reprise_status(REPRISE_OK);
+    return with_handle("reprise_encoder_flush", encoder, "encoder", [&](reprise_encoder& e) {
+        e.encoder->flush();
+        return REPRISE_OK;
     });
 }
 

@@ -4,6 +4,7 @@
 // caller's option structs.
 #include <cstring>
 #include <exception>
+#include <memory>
 #include <new>
 #include <string>
 
@@ -52,11 +53,13 @@ reprise_status check_struct_size(const char* function, const char* name, std::si
 template <class Options>
 reprise_status init_options(const char* function, Options* options, std::size_t struct_size,
                             Options defaults) {
-    REPRISE_CAPI_TRY(check_pointer(function, options, "options"));
-    REPRISE_CAPI_TRY(check_struct_size(function, "struct_size", struct_size, sizeof(Options)));
-    defaults.struct_size = uint32_t(sizeof(Options));
-    std::memcpy(static_cast<void*>(options), &defaults, sizeof(Options));
-    return REPRISE_OK;
+    return guarded(function, [&] {
+        REPRISE_CAPI_TRY(check_pointer(function, options, "options"));
+        REPRISE_CAPI_TRY(check_struct_size(function, "struct_size", struct_size, sizeof(Options)));
+        defaults.struct_size = uint32_t(sizeof(Options));
+        std::memcpy(static_cast<void*>(options), &defaults, sizeof(Options));
+        return reprise_status(REPRISE_OK);
+    });
 }
 
 // A create's common checks: the ABI version, the handle out-pointer and the options struct
@@ -73,6 +76,29 @@ reprise_status check_create(const char* function, uint32_t abi_version, const Op
         options = *given;
     }
     return REPRISE_OK;
+}
+
+// A create: the common checks, then `configure(options, handle)` on a new handle, which is
+// handed out only when that succeeds.
+template <class Handle, class Options, class Configure>
+reprise_status create_handle(const char* function, uint32_t abi_version, const Options* given,
+                             Options options, Handle** handle, Configure&& configure) {
+    return guarded(function, [&] {
+        REPRISE_CAPI_TRY(check_create(function, abi_version, given, options, handle));
+        auto made = std::make_unique<Handle>();
+        REPRISE_CAPI_TRY(configure(options, *made));
+        *handle = made.release();
+        return reprise_status(REPRISE_OK);
+    });
+}
+
+// A call on a handle: `body(*handle)` after checking it is not NULL (named `name`).
+template <class Handle, class Body>
+reprise_status with_handle(const char* function, Handle* handle, const char* name, Body&& body) {
+    return guarded(function, [&] {
+        REPRISE_CAPI_TRY(check_pointer(function, handle, name));
+        return reprise_status(body(*handle));
+    });
 }
 
 // Checks `value` in [lo, hi]; the message names `field`.

@@ -62,22 +62,16 @@ reprise_status configure(const char* function, const reprise_stereo_options& o, 
 extern "C" {
 
 reprise_status reprise_stereo_options_init(reprise_stereo_options* options, size_t struct_size) {
-    return guarded("reprise_stereo_options_init", [&] {
-        return init_options("reprise_stereo_options_init", options, struct_size, default_options());
-    });
+    return init_options("reprise_stereo_options_init", options, struct_size, default_options());
 }
 
 reprise_status reprise_stereo_create(uint32_t abi_version, const reprise_stereo_options* given,
                                      reprise_stereo** stereo) {
     const char* function = "reprise_stereo_create";
-    return guarded(function, [&] {
-        reprise_stereo_options o = default_options();
-        REPRISE_CAPI_TRY(check_create(function, abi_version, given, o, stereo));
-        auto made = std::make_unique<reprise_stereo>();
-        REPRISE_CAPI_TRY(configure(function, o, *made));
-        *stereo = made.release();
-        return reprise_status(REPRISE_OK);
-    });
+    return create_handle(function, abi_version, given, default_options(), stereo,
+                         [&](const reprise_stereo_options& o, reprise_stereo& made) {
+                             return configure(function, o, made);
+                         });
 }
 
 void reprise_stereo_destroy(reprise_stereo* stereo) { delete stereo; }
@@ -85,10 +79,9 @@ void reprise_stereo_destroy(reprise_stereo* stereo) { delete stereo; }
 reprise_status reprise_stereo_synthesize(reprise_stereo* stereo, const reprise_gbuffer* rendered,
                                          reprise_gbuffer* eye) {
     const char* function = "reprise_stereo_synthesize";
-    return guarded(function, [&] {
-        REPRISE_CAPI_TRY(check_pointer(function, stereo, "stereo"));
+    return with_handle(function, stereo, "stereo", [&](reprise_stereo& s) {
         bool reset = false;
-        Frame& input = stereo->input;
+        Frame& input = s.input;
         REPRISE_CAPI_TRY(
             read_gbuffer(function, "rendered", rendered, kColor | kDepth | kMotion, input, reset));
         if (input.depth.empty())
@@ -99,21 +92,19 @@ reprise_status reprise_stereo_synthesize(reprise_stereo* stereo, const reprise_g
                         "rendered->camera is not valid: disparity needs the projection");
         REPRISE_CAPI_TRY(
             check_output(function, eye, input.width(), input.height(), kColor | kDepth));
-        if (reset) stereo->has_previous = false;
+        if (reset) s.has_previous = false;
         const stereo::EyeCameras eyes = stereo::eye_cameras(
-            input.camera, stereo->rig,
-            stereo->rendered == stereo::Eye::Left ? stereo::Anchor::Left : stereo::Anchor::Right);
-        const Camera& target = eyes[stereo::other(stereo->rendered)];
-        const bool history = stereo->temporal && stereo->has_previous &&
-                             stereo->previous.width() == input.width() &&
-                             stereo->previous.height() == input.height();
-        stereo->synthesizer.synthesize(input, target, stereo->made, stereo->options,
-                                       history ? &stereo->previous : nullptr);
-        stereo->made.fps = input.fps;
-        REPRISE_CAPI_TRY(write_gbuffer(function, stereo->made, eye));
-        if (stereo->temporal) {
-            std::swap(stereo->previous, stereo->input);
-            stereo->has_previous = true;
+            input.camera, s.rig,
+            s.rendered == stereo::Eye::Left ? stereo::Anchor::Left : stereo::Anchor::Right);
+        const Camera& target = eyes[stereo::other(s.rendered)];
+        const bool history = s.temporal && s.has_previous && s.previous.width() == input.width() &&
+                             s.previous.height() == input.height();
+        s.synthesizer.synthesize(input, target, s.made, s.options, history ? &s.previous : nullptr);
+        s.made.fps = input.fps;
+        REPRISE_CAPI_TRY(write_gbuffer(function, s.made, eye));
+        if (s.temporal) {
+            std::swap(s.previous, s.input);
+            s.has_previous = true;
         }
         return reprise_status(REPRISE_OK);
     });

@@ -68,6 +68,8 @@ class CapiThroughCtypes(unittest.TestCase):
                                                        C.POINTER(C.c_size_t)]
         for name in ("converter", "encoder", "decoder"):
             getattr(lib, f"reprise_{name}_create").argtypes = [C.c_uint32, C.c_void_p, C.c_void_p]
+        for name in ("gbuffer", "converter_options"):  # size_t arguments
+            getattr(lib, f"reprise_{name}_init").argtypes = [C.c_void_p, C.c_size_t]
         cls.lib = lib
 
     def error(self):

@@ -1,13 +1,13 @@
-/* The C interface from C (reprise.h): a pan upconverted to the expected shift, the other eye of
- * a plane at the expected disparity, a codec round trip, the ABI check and bad arguments. Prints
- * each figure it checks; exits 1 on the first failure. */
+/* The C interface from C (reprise.h): a pan upconverted to the expected shift, a reported cut,
+ * the other eye of a plane at the expected disparity, a codec round trip, the ABI check and bad
+ * arguments. Prints each figure it checks; exits 1 when any check failed. */
+#include "reprise.h" /* first: the header compiles alone */
+
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-
-#include "reprise.h"
 
 enum { W = 64, H = 48, PAN = 4 };
 
@@ -165,6 +165,51 @@ static void test_converter_pan(void) {
     out.color = image(out_color, W * 16, REPRISE_FORMAT_RGBA32_FLOAT);
     EXPECT_STATUS(reprise_converter_receive(converter, &out), REPRISE_NEED_MORE);
     reprise_converter_destroy(converter);
+}
+
+/* The pan's second frame 10 % brighter: interpolation blends the two frames' colours; with
+ * reset (a cut the renderer reports) the frame between continues the first frame alone. Gives
+ * the in-between frame's PSNR against the first frame's texture moved 2 px. */
+static double in_between_after(int reset) {
+    static float rgb[H * W * 3], depth[H * W], motion[H * W * 2], made[H * W * 4];
+    for (int i = 0; i < H * W; ++i) {
+        depth[i] = 5.0f;
+        motion[2 * i] = -(float)PAN;
+        motion[2 * i + 1] = 0.0f;
+    }
+    reprise_converter* converter = NULL;
+    EXPECT_STATUS(reprise_converter_create(REPRISE_ABI_VERSION, NULL, &converter), REPRISE_OK);
+    if (!converter) return 0.0;
+    double psnr = 0.0;
+    for (int k = 0; k < 2; ++k) {
+        fill_pan(rgb, W * 3, PAN * k);
+        for (int i = 0; i < H * W * 3; ++i) rgb[i] *= k ? 1.1f : 1.0f;
+        reprise_gbuffer frame;
+        reprise_gbuffer_init(&frame, sizeof frame);
+        frame.color = image(rgb, W * 12, REPRISE_FORMAT_RGB32_FLOAT);
+        frame.depth = image(depth, W * 4, REPRISE_FORMAT_R32_FLOAT);
+        frame.motion = image(motion, W * 8, REPRISE_FORMAT_RG32_FLOAT);
+        frame.fps = 30.0;
+        frame.reset = k == 1 ? reset : 0;
+        EXPECT_STATUS(reprise_converter_send(converter, &frame), REPRISE_OK);
+        reprise_gbuffer out;
+        reprise_gbuffer_init(&out, sizeof out);
+        out.color = image(made, W * 16, REPRISE_FORMAT_RGBA32_FLOAT);
+        EXPECT_STATUS(reprise_converter_receive(converter, &out), REPRISE_OK);
+        if (k == 1) psnr = pan_psnr(made, PAN / 2.0, 2 * PAN); /* the frame between */
+    }
+    reprise_converter_destroy(converter);
+    return psnr;
+}
+
+static void test_converter_reset(void) {
+    const double blended = in_between_after(0), continued = in_between_after(1);
+    printf(
+        "converter: frame between against the first frame moved 2 px: %.2f dB blended, "
+        "%.2f dB after a reset\n",
+        blended, continued);
+    CHECK(continued > 60.0, "after a reset: %.2f dB", continued);
+    CHECK(blended < 40.0, "without: %.2f dB", blended);
 }
 
 /* A plane at depth 4 seen by the left eye; the right eye, ipd 0.5 and focal length 32 px, sees
@@ -395,6 +440,7 @@ static void test_bad_arguments(void) {
 
 int main(void) {
     test_converter_pan();
+    test_converter_reset();
     test_stereo_plane();
     test_codec_round_trip();
     test_abi_mismatch();
