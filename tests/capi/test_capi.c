@@ -56,6 +56,26 @@ static reprise_image image(void* data, int64_t stride, reprise_format format) {
     return i;
 }
 
+/* A 30 Hz frame: RGB float colour rows `rgb_stride` bytes apart, float depth and motion. */
+static reprise_gbuffer rendered_frame(float* rgb, int64_t rgb_stride, float* depth, float* motion) {
+    reprise_gbuffer frame;
+    reprise_gbuffer_init(&frame, sizeof frame);
+    frame.color = image(rgb, rgb_stride, REPRISE_FORMAT_RGB32_FLOAT);
+    frame.depth = image(depth, W * 4, REPRISE_FORMAT_R32_FLOAT);
+    frame.motion = image(motion, W * 8, REPRISE_FORMAT_RG32_FLOAT);
+    frame.fps = 30.0;
+    return frame;
+}
+
+/* Every pixel at `z` moving `dx` px right per frame (motion -dx). */
+static void fill_depth_motion(float* depth, float* motion, float z, float dx) {
+    for (int i = 0; i < H * W; ++i) {
+        depth[i] = z;
+        motion[2 * i] = -dx; /* content moving right has negative x motion */
+        motion[2 * i + 1] = 0.0f;
+    }
+}
+
 /* PSNR (dB, linear values, peak 1) of RGBA `made` against the texture at `shift`, over columns
  * margin .. W - margin. */
 static double pan_psnr(const float* made, double shift, int margin) {
@@ -88,11 +108,7 @@ static void test_converter_pan(void) {
     static float rgb[H][W * 3 + 5]; /* padded rows: a stride larger than the row */
     static float depth[H * W], motion[H * W * 2], out_color[H * W * 4], out_motion[H * W * 2];
     static uint16_t out_half[H * W * 3];
-    for (int i = 0; i < H * W; ++i) {
-        depth[i] = 5.0f;
-        motion[2 * i] = -(float)PAN; /* content moving right has negative x motion */
-        motion[2 * i + 1] = 0.0f;
-    }
+    fill_depth_motion(depth, motion, 5.0f, PAN);
     reprise_converter_options options;
     EXPECT_STATUS(reprise_converter_options_init(&options, sizeof options), REPRISE_OK);
     CHECK(options.factor == 2 && options.refine == 1, "defaults factor %d refine %d",
@@ -104,12 +120,7 @@ static void test_converter_pan(void) {
     int outputs = 0;
     for (int k = 0; k < 3; ++k) {
         fill_pan(&rgb[0][0], W * 3 + 5, PAN * k);
-        reprise_gbuffer frame;
-        EXPECT_STATUS(reprise_gbuffer_init(&frame, sizeof frame), REPRISE_OK);
-        frame.color = image(rgb, (int64_t)sizeof rgb[0], REPRISE_FORMAT_RGB32_FLOAT);
-        frame.depth = image(depth, W * 4, REPRISE_FORMAT_R32_FLOAT);
-        frame.motion = image(motion, W * 8, REPRISE_FORMAT_RG32_FLOAT);
-        frame.fps = 30.0;
+        reprise_gbuffer frame = rendered_frame(&rgb[0][0], (int64_t)sizeof rgb[0], depth, motion);
         frame.camera.time = k / 30.0;
         EXPECT_STATUS(reprise_converter_send(converter, &frame), REPRISE_OK);
         for (;;) {
@@ -172,11 +183,7 @@ static void test_converter_pan(void) {
  * the in-between frame's PSNR against the first frame's texture moved 2 px. */
 static double in_between_after(int reset) {
     static float rgb[H * W * 3], depth[H * W], motion[H * W * 2], made[H * W * 4];
-    for (int i = 0; i < H * W; ++i) {
-        depth[i] = 5.0f;
-        motion[2 * i] = -(float)PAN;
-        motion[2 * i + 1] = 0.0f;
-    }
+    fill_depth_motion(depth, motion, 5.0f, PAN);
     reprise_converter* converter = NULL;
     EXPECT_STATUS(reprise_converter_create(REPRISE_ABI_VERSION, NULL, &converter), REPRISE_OK);
     if (!converter) return 0.0;
@@ -184,12 +191,7 @@ static double in_between_after(int reset) {
     for (int k = 0; k < 2; ++k) {
         fill_pan(rgb, W * 3, PAN * k);
         for (int i = 0; i < H * W * 3; ++i) rgb[i] *= k ? 1.1f : 1.0f;
-        reprise_gbuffer frame;
-        reprise_gbuffer_init(&frame, sizeof frame);
-        frame.color = image(rgb, W * 12, REPRISE_FORMAT_RGB32_FLOAT);
-        frame.depth = image(depth, W * 4, REPRISE_FORMAT_R32_FLOAT);
-        frame.motion = image(motion, W * 8, REPRISE_FORMAT_RG32_FLOAT);
-        frame.fps = 30.0;
+        reprise_gbuffer frame = rendered_frame(rgb, W * 12, depth, motion);
         frame.reset = k == 1 ? reset : 0;
         EXPECT_STATUS(reprise_converter_send(converter, &frame), REPRISE_OK);
         reprise_gbuffer out;
@@ -290,12 +292,7 @@ static void test_codec_round_trip(void) {
     size_t total = 0;
     for (int k = 0; k < 3; ++k) {
         fill_pan(&rgb[0][0], W * 3, 2 * k);
-        reprise_gbuffer frame;
-        reprise_gbuffer_init(&frame, sizeof frame);
-        frame.color = image(rgb, W * 12, REPRISE_FORMAT_RGB32_FLOAT);
-        frame.depth = image(depth, W * 4, REPRISE_FORMAT_R32_FLOAT);
-        frame.motion = image(motion, W * 8, REPRISE_FORMAT_RG32_FLOAT);
-        frame.fps = 30.0;
+        reprise_gbuffer frame = rendered_frame(&rgb[0][0], W * 12, depth, motion);
         EXPECT_STATUS(reprise_encoder_send_frame(encoder, &frame), REPRISE_OK);
         size_t size = 0;
         /* Asked without a buffer: the size, and the packet is kept. */
