@@ -4,6 +4,7 @@
 #include "reprise.h" /* first: the header compiles alone */
 
 #include <math.h>
+#include <pthread.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -182,7 +183,7 @@ static void test_converter_pan(void) {
  * reset (a cut the renderer reports) the frame between continues the first frame alone. Gives
  * the in-between frame's PSNR against the first frame's texture moved 2 px. */
 static double in_between_after(int reset) {
-    static float rgb[H * W * 3], depth[H * W], motion[H * W * 2], made[H * W * 4];
+    float rgb[H * W * 3], depth[H * W], motion[H * W * 2], made[H * W * 4]; /* per thread */
     fill_depth_motion(depth, motion, 5.0f, PAN);
     reprise_converter* converter = NULL;
     EXPECT_STATUS(reprise_converter_create(REPRISE_ABI_VERSION, NULL, &converter), REPRISE_OK);
@@ -435,6 +436,31 @@ static void test_bad_arguments(void) {
     reprise_converter_destroy(NULL);
 }
 
+/* A failed call on another thread leaves this thread's message alone; both threads run their
+ * own converter at the same time. */
+static void* fail_and_convert(void* result) {
+    reprise_converter_send(NULL, NULL);
+    *(double*)result = in_between_after(1);
+    if (reprise_last_error()[0] != '\0') *(double*)result = -1.0; /* it succeeded last */
+    return NULL;
+}
+
+static void test_threads(void) {
+    reprise_decoder_send_packet(NULL, NULL, 0);
+    char before[256];
+    snprintf(before, sizeof before, "%s", reprise_last_error());
+    double other = 0.0;
+    pthread_t thread;
+    CHECK(pthread_create(&thread, NULL, fail_and_convert, &other) == 0, "thread");
+    const double here = in_between_after(1);
+    reprise_decoder_send_packet(NULL, NULL, 0);
+    pthread_join(thread, NULL);
+    printf("threads: two converters at once: %.2f and %.2f dB\n", here, other);
+    CHECK(here > 60.0 && other > 60.0, "concurrent converters: %.2f, %.2f dB", here, other);
+    CHECK(strcmp(reprise_last_error(), before) == 0 && strstr(before, "decoder is NULL") != NULL,
+          "this thread's message '%s', was '%s'", reprise_last_error(), before);
+}
+
 int main(void) {
     test_converter_pan();
     test_converter_reset();
@@ -442,6 +468,7 @@ int main(void) {
     test_codec_round_trip();
     test_abi_mismatch();
     test_bad_arguments();
+    test_threads();
     if (failures)
         fprintf(stderr, "test_capi: %d checks failed\n", failures);
     else
