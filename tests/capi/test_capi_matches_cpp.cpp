@@ -17,11 +17,15 @@ namespace {
 
 constexpr int kW = 64, kH = 48;
 
-// Three frames of random colour moving 3 px right per frame, seen by a perspective camera.
+// Three frames of random colour moving 3 px right per frame (wrapping around), seen by a
+// perspective camera.
 std::vector<Frame> frames() {
+    const Frame texture = test::flat_frame(kW, kH, 4.0f, {-3.0f, 0.0f}, 7);
     std::vector<Frame> out;
     for (int k = 0; k < 3; ++k) {
-        Frame f = test::flat_frame(kW, kH, 4.0f + 0.5f * k, {-3.0f, 0.0f}, 7 + k);
+        Frame f = texture;
+        for (int y = 0; y < kH; ++y)
+            for (int x = 0; x < kW; ++x) f.color(x, y) = texture.color((x - 3 * k + kW) % kW, y);
         f.depth(5, 5) = test::kInf;  // a background pixel
         f.camera.projection = glm::perspective(0.9f, float(kW) / kH, 0.1f, 100.0f);
         f.camera.prev_projection = f.camera.projection;
@@ -70,15 +74,22 @@ reprise_gbuffer output_into(Frame& f) {
     return gbuffer_of(f);
 }
 
-TEST(CapiMatchesCpp, ConverterOutputsAreTheFrameRateConverters) {
+// Without and with a reported cut before the last frame (reset = start_new_shot).
+class CapiConverter : public testing::TestWithParam<bool> {};
+
+TEST_P(CapiConverter, OutputsAreTheFrameRateConverters) {
+    const bool cut = GetParam();
     const std::vector<Frame> input = frames();
     warp::FrameRateConverter cpp(2, warp::FrucOptions{});
     reprise_converter* c = nullptr;
     ASSERT_EQ(reprise_converter_create(REPRISE_ABI_VERSION, nullptr, &c), REPRISE_OK);
     int compared = 0;
     for (const Frame& f : input) {
+        const bool reset = cut && &f == &input.back();
+        if (reset) cpp.start_new_shot();
         ASSERT_TRUE(cpp.send(f).ok());
-        const reprise_gbuffer g = gbuffer_of(f);
+        reprise_gbuffer g = gbuffer_of(f);
+        g.reset = reset;
         ASSERT_EQ(reprise_converter_send(c, &g), REPRISE_OK) << reprise_last_error();
         Frame want, got;
         while (cpp.receive(want)) {
@@ -95,8 +106,12 @@ TEST(CapiMatchesCpp, ConverterOutputsAreTheFrameRateConverters) {
         EXPECT_EQ(reprise_converter_receive(c, &out), REPRISE_NEED_MORE);
     }
     EXPECT_EQ(compared, 5);
+    // The frames move 3 px and their camera little: no cut is detected unless reported.
+    EXPECT_EQ(cpp.counters().cuts, cut ? 1u : 0u);
     reprise_converter_destroy(c);
 }
+
+INSTANTIATE_TEST_SUITE_P(CapiMatchesCpp, CapiConverter, testing::Bool());
 
 TEST(CapiMatchesCpp, CodecPacketsAndDecodedFramesAreTheCodecs) {
     const std::vector<Frame> input = frames();
