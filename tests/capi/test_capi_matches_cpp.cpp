@@ -1,5 +1,6 @@
 // The C interface gives what the C++ classes give, bit for bit: the frame-rate converter's
-// outputs, the encoder's packets and the decoder's frames, on the same synthetic frames.
+// outputs, the other eye, the encoder's packets and the decoder's frames, on the same synthetic
+// frames.
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -9,6 +10,8 @@
 
 #include "reprise.h"
 #include "reprise/codec/codec.hpp"
+#include "reprise/stereo/rig.hpp"
+#include "reprise/stereo/synthesize.hpp"
 #include "reprise/warp/fruc.hpp"
 #include "support/frames.hpp"
 
@@ -112,6 +115,23 @@ TEST_P(CapiConverter, OutputsAreTheFrameRateConverters) {
 }
 
 INSTANTIATE_TEST_SUITE_P(CapiMatchesCpp, CapiConverter, testing::Bool());
+
+TEST(CapiMatchesCpp, StereoEyeIsTheSynthesizers) {
+    const Frame left = frames()[1];
+    const stereo::EyeCameras eyes = stereo::eye_cameras(left.camera, {}, stereo::Anchor::Left);
+    Frame want, got;
+    stereo::StereoSynthesizer().synthesize(left, eyes.right, want, {});
+    reprise_stereo* s = nullptr;
+    ASSERT_EQ(reprise_stereo_create(REPRISE_ABI_VERSION, nullptr, &s), REPRISE_OK);
+    const reprise_gbuffer g = gbuffer_of(left);
+    reprise_gbuffer out = output_into(got);
+    out.motion = {};
+    ASSERT_EQ(reprise_stereo_synthesize(s, &g, &out), REPRISE_OK) << reprise_last_error();
+    EXPECT_TRUE(test::same_bits(want.color, got.color));
+    EXPECT_TRUE(test::same_bits(want.depth, got.depth));
+    EXPECT_EQ(0, std::memcmp(&eyes.right.view[0][0], out.camera.view, 64));
+    reprise_stereo_destroy(s);
+}
 
 TEST(CapiMatchesCpp, CodecPacketsAndDecodedFramesAreTheCodecs) {
     const std::vector<Frame> input = frames();
