@@ -12,9 +12,12 @@
  * right has negative x motion). Normals are world-space unit vectors, ids uint32 (0 background).
  * Cameras follow OpenGL: the camera looks down -Z, clip w = -z_view.
  *
- * Every function returns a reprise_status; on an error reprise_last_error() gives one message
- * naming the function, the field and the problem. No function throws, aborts on bad input or
- * keeps a pointer it was given past the call.
+ * Every function (but the destroys) returns a reprise_status; on an error reprise_last_error()
+ * gives one message naming the function, the field and the problem. No function throws, aborts
+ * on bad input or keeps a pointer it was given past the call.
+ *
+ * Threads: different handles may be used at the same time from different threads; one handle
+ * from one thread at a time. The last-error message is per thread.
  */
 #ifndef REPRISE_H
 #define REPRISE_H
