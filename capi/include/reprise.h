@@ -64,6 +64,12 @@ REPRISE_API const char* reprise_status_name(reprise_status status);
  * did not). Thread-local: valid until the next reprise_* call on the same thread. */
 REPRISE_API const char* reprise_last_error(void);
 
+/* What one call may allocate, in bytes (default 4 GiB; docs/memory.md): a call that would need
+ * more refuses with REPRISE_ERROR_INVALID_ARGUMENT and the figure. Process-wide, thread-safe,
+ * for calls that start afterwards; bytes > 0. */
+REPRISE_API reprise_status reprise_set_max_memory(uint64_t bytes);
+REPRISE_API uint64_t reprise_max_memory(void);
+
 /* Pixel formats: components of 32-bit float, 16-bit float (IEEE half) or 32-bit unsigned. */
 typedef int32_t reprise_format;
 enum {

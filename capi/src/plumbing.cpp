@@ -3,6 +3,9 @@
 
 #include <cmath>
 #include <cstdio>
+#include <mutex>
+
+#include "reprise/core/memory_limit.hpp"
 
 namespace reprise::capi {
 namespace {
@@ -26,6 +29,11 @@ reprise_status check_abi(const char* function, uint32_t abi_version) {
                     std::to_string(REPRISE_ABI_VERSION_MAJOR) + "." +
                     std::to_string(REPRISE_ABI_VERSION_MINOR) +
                     ": the major must be equal and the minor not newer");
+}
+
+void name_the_memory_setter() {
+    static std::once_flag once;
+    std::call_once(once, [] { set_memory_limit_hint("reprise_set_max_memory to change"); });
 }
 
 reprise_status check_pointer(const char* function, const void* pointer, const char* name) {
@@ -88,5 +96,17 @@ const char* reprise_status_name(reprise_status status) {
 }
 
 const char* reprise_last_error(void) { return reprise::capi::last_error; }
+
+reprise_status reprise_set_max_memory(uint64_t bytes) {
+    const char* function = "reprise_set_max_memory";
+    return guarded(function, [&] {
+        if (bytes == 0) return fail(REPRISE_ERROR_INVALID_ARGUMENT, function, "bytes is 0");
+        name_the_memory_setter();
+        reprise::set_memory_limit(bytes);
+        return reprise_status(REPRISE_OK);
+    });
+}
+
+uint64_t reprise_max_memory(void) { return reprise::memory_limit(); }
 
 }  // extern "C"

@@ -44,6 +44,9 @@ reprise_status guarded(const char* function, Body&& body) noexcept {
     } while (0)
 
 reprise_status check_abi(const char* function, uint32_t abi_version);
+// Once per process: the library's refusals name reprise_set_max_memory as the way to raise the
+// memory limit.
+void name_the_memory_setter();
 reprise_status check_pointer(const char* function, const void* pointer, const char* name);
 // Checks that a struct the caller filled has this library's struct_size.
 reprise_status check_struct_size(const char* function, const char* name, std::size_t given,
@@ -70,6 +73,7 @@ reprise_status check_create(const char* function, uint32_t abi_version, const Op
     REPRISE_CAPI_TRY(check_pointer(function, handle, "the handle's out-pointer"));
     *handle = nullptr;
     REPRISE_CAPI_TRY(check_abi(function, abi_version));
+    name_the_memory_setter();
     if (given) {
         REPRISE_CAPI_TRY(check_struct_size(function, "options->struct_size", given->struct_size,
                                            sizeof(Options)));

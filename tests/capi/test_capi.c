@@ -436,6 +436,27 @@ static void test_bad_arguments(void) {
     reprise_converter_destroy(NULL);
 }
 
+/* A frame that needs more than the memory limit is refused with the figure, naming the setter. */
+static void test_memory_limit(void) {
+    static float rgba[H * W * 4];
+    const uint64_t limit = reprise_max_memory();
+    CHECK(limit == ((uint64_t)4 << 30), "default limit %llu bytes", (unsigned long long)limit);
+    EXPECT_STATUS(reprise_set_max_memory(0), REPRISE_ERROR_INVALID_ARGUMENT);
+    reprise_converter* converter = NULL;
+    EXPECT_STATUS(reprise_converter_create(REPRISE_ABI_VERSION, NULL, &converter), REPRISE_OK);
+    EXPECT_STATUS(reprise_set_max_memory(64 * 1024), REPRISE_OK);
+    reprise_gbuffer frame;
+    reprise_gbuffer_init(&frame, sizeof frame);
+    frame.color = image(rgba, W * 16, REPRISE_FORMAT_RGBA32_FLOAT);
+    EXPECT_STATUS(reprise_converter_send(converter, &frame), REPRISE_ERROR_INVALID_ARGUMENT);
+    printf("memory: 64 KiB limit: %s\n", reprise_last_error());
+    CHECK(strstr(reprise_last_error(), "reprise_set_max_memory to change") != NULL, "message: %s",
+          reprise_last_error());
+    EXPECT_STATUS(reprise_set_max_memory(limit), REPRISE_OK);
+    EXPECT_STATUS(reprise_converter_send(converter, &frame), REPRISE_OK);
+    reprise_converter_destroy(converter);
+}
+
 /* A failed call on another thread leaves this thread's message alone; both threads run their
  * own converter at the same time. */
 static void* fail_and_convert(void* result) {
@@ -468,6 +489,7 @@ int main(void) {
     test_codec_round_trip();
     test_abi_mismatch();
     test_bad_arguments();
+    test_memory_limit();
     test_threads();
     if (failures)
         fprintf(stderr, "test_capi: %d checks failed\n", failures);
