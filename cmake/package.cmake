@@ -22,7 +22,8 @@ set(CPACK_PACKAGE_DESCRIPTION_SUMMARY
 set(CPACK_PACKAGE_DESCRIPTION
     "Frame-rate upconversion, the second eye of a stereo pair and a remote-rendering codec and\
  stream, made from rendered colour, depth and motion: the reprise command, C++ libraries with\
- their CMake package, the Python module and the Blender add-on.")
+ their CMake package, the C interface (reprise.h, libreprise.so), the Python module and the\
+ Blender add-on.")
 set(CPACK_PACKAGING_INSTALL_PREFIX /usr)
 set(CPACK_DEBIAN_FILE_NAME DEB-DEFAULT)
 set(CPACK_DEBIAN_PACKAGE_MAINTAINER "reprise developers <dev@reprise.invalid>")
