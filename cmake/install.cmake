@@ -1,6 +1,7 @@
 # `cmake --install`: headers, the module libraries, the `reprise` executable, a CMake package
-# (find_package(reprise CONFIG) -> reprise::core, ::warp, ::stereo, ::codec, ::net, ::gl, ::gpu, ::server, ::client) and
-# reprise.pc for pkg-config. Included from the top-level CMakeLists.txt after every module.
+# (find_package(reprise CONFIG) -> reprise::core, ::warp, ::stereo, ::codec, ::net, ::gl, ::gpu,
+# ::server, ::client, ::capi) and reprise.pc for pkg-config; with the C interface, reprise.h and
+# libreprise.so. Included from the top-level CMakeLists.txt after every module.
 include(GNUInstallDirs)
 include(CMakePackageConfigHelpers)
 
@@ -22,6 +23,13 @@ install(TARGETS ${reprise_module_targets} EXPORT repriseTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
 install(TARGETS reprise RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+if(TARGET reprise_capi)
+  set_target_properties(reprise_capi PROPERTIES EXPORT_NAME capi)
+  add_library(reprise::capi ALIAS reprise_capi)
+  install(TARGETS reprise_capi EXPORT repriseTargets
+          LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
+  install(FILES ${PROJECT_SOURCE_DIR}/capi/include/reprise.h DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
+endif()
 
 set(reprise_cmake_dir ${CMAKE_INSTALL_LIBDIR}/cmake/reprise)
 install(EXPORT repriseTargets NAMESPACE reprise:: DESTINATION ${reprise_cmake_dir})

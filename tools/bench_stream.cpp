@@ -4,8 +4,10 @@
 // was displayed against the scene rendered at the displayed poses and instants, longest freeze.
 // Peers from the same run: frame repetition (the newest decoded frame shown as it is) and the
 // video-only model (x264 zerolatency of the same full-resolution frames at crf 23 and 15, newest
-// decoded shown).
+// decoded shown), and that video turned to the display pose by rotation alone (the pose-only
+// timewarp of ALVR and Oculus Link).
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
 #include <filesystem>
@@ -91,6 +93,37 @@ ImageError mean_error(const std::vector<ImageError>& e) {
     return m;
 }
 
+// The pose-only timewarp: every display pixel's ray turned from the display camera to the source
+// camera as if it met the scene at infinity (rotation only, no depth, no translation), then
+// fetched bilinearly from the decoded video frame; rays outside it take the nearest edge pixel.
+void timewarp(const Image<Rgb8>& source, const glm::mat4& source_view, const glm::mat4& shown_view,
+              const glm::mat4& projection, Image<Rgb8>& out) {
+    const int w = source.width(), h = source.height();
+    out = Image<Rgb8>(w, h);
+    const glm::mat4 unproject = glm::inverse(projection);
+    const glm::mat3 turn = glm::mat3(source_view) * glm::transpose(glm::mat3(shown_view));
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const glm::vec2 ndc((x + 0.5f) / w * 2.0f - 1.0f, 1.0f - (y + 0.5f) / h * 2.0f);
+            const glm::vec4 far_point = unproject * glm::vec4(ndc, 1.0f, 1.0f);
+            const glm::vec3 ray = turn * (glm::vec3(far_point) / far_point.w);
+            const glm::vec4 clip = projection * glm::vec4(ray, 0.0f);
+            glm::vec2 p(float(w) / 2, float(h) / 2);
+            if (clip.w > 1e-6f)
+                p = {(clip.x / clip.w + 1.0f) * 0.5f * w, (1.0f - clip.y / clip.w) * 0.5f * h};
+            const float sx = std::clamp(p.x - 0.5f, 0.0f, w - 1.0f);
+            const float sy = std::clamp(p.y - 0.5f, 0.0f, h - 1.0f);
+            const int x0 = int(sx), y0 = int(sy);
+            const int x1 = std::min(x0 + 1, w - 1), y1 = std::min(y0 + 1, h - 1);
+            const float fx = sx - x0, fy = sy - y0;
+            const glm::vec3 top =
+                glm::mix(glm::vec3(source(x0, y0)), glm::vec3(source(x1, y0)), fx);
+            const glm::vec3 bottom =
+                glm::mix(glm::vec3(source(x0, y1)), glm::vec3(source(x1, y1)), fx);
+            out(x, y) = Rgb8(glm::clamp(glm::mix(top, bottom, fy) + 0.5f, 0.0f, 255.0f));
+        }
+}
+
 struct StreamBench {
     const BenchOptions& options;
     int width = 256, height = 144;
@@ -172,7 +205,9 @@ struct StreamBench {
                            sst.bytes_sent * 8.0 / seconds / 1000.0};
         MethodSummary repeat{c.name, "repetition", ours.kbps};
         MethodSummary video{c.name, "x264-crf23"}, video_fine{c.name, "x264-crf15"};
-        for (MethodSummary* m : {&ours, &repeat, &video, &video_fine}) {
+        MethodSummary warped{c.name, "x264-crf23+tw"};
+        const std::array<MethodSummary*, 5> all = {&ours, &repeat, &video, &video_fine, &warped};
+        for (MethodSummary* m : all) {
             m->frames_lost = cst.frames_lost;
             m->fec_recovered = cst.fec_recovered;
             m->decoded = cst.frames_decoded;
@@ -195,12 +230,12 @@ struct StreamBench {
             }
         }
         longest = std::max(longest, ticks.back().t - freeze_start);
-        for (MethodSummary* m : {&ours, &repeat, &video, &video_fine})
-            m->longest_freeze_ms = longest * 1000.0;
+        for (MethodSummary* m : all) m->longest_freeze_ms = longest * 1000.0;
         video.latency_ms = video_fine.latency_ms = repeat.latency_ms;
+        warped.latency_ms = ours.latency_ms;  // turned to each display frame's pose
 
         // The video-only peer: the same source frames (rendered at their poses) through x264.
-        const int method_count = lowres ? 1 : 4;
+        const int method_count = lowres ? 1 : int(all.size());
         std::vector<double> source_times;
         for (const Tick& k : ticks)
             if (source_times.empty() || source_times.back() != k.source_time)
@@ -230,11 +265,13 @@ struct StreamBench {
             for (const PeerFrame& p : frames) bytes += p.bytes;
             return frames.empty() ? 0.0 : bytes * 8.0 / (double(frames.size()) / fps) / 1000.0;
         };
-        video.kbps = kbps(x264);
+        video.kbps = warped.kbps = kbps(x264);
         video_fine.kbps = kbps(x264_fine);
+        const glm::mat4 projection =
+            server::instant_on_path(scene.path, scene.scene, 0.0, width, height).projection;
 
         Image<glm::vec3> reference, shown;
-        Image<Rgb8> truth_rgb(width, height);
+        Image<Rgb8> truth_rgb(width, height), turned;
         int index = 0;
         for (const Tick& k : ticks) {
             if (!k.evaluated) continue;
@@ -244,23 +281,29 @@ struct StreamBench {
             const std::size_t si =
                 std::lower_bound(source_times.begin(), source_times.end(), k.source_time) -
                 source_times.begin();
-            const Image<Rgb8>* candidates[4] = {
-                &k.ours, &k.repeated, si < x264.size() ? &x264[si].decoded : nullptr,
-                si < x264_fine.size() ? &x264_fine[si].decoded : nullptr};
-            MethodSummary* methods[4] = {&ours, &repeat, &video, &video_fine};
+            const Image<Rgb8>* video_frame = si < x264.size() ? &x264[si].decoded : nullptr;
+            if (video_frame)
+                timewarp(*video_frame,
+                         server::camera_view(scene.path, scene.scene, source_times[si]), k.view,
+                         projection, turned);
+            const std::array<const Image<Rgb8>*, 5> candidates = {
+                &k.ours, &k.repeated, video_frame,
+                si < x264_fine.size() ? &x264_fine[si].decoded : nullptr,
+                video_frame ? &turned : nullptr};
             for (int m = 0; m < method_count; ++m) {
                 if (!candidates[m]) continue;
                 from_rgb8(candidates[m]->view(), shown);
                 const ImageError e = image_error(reference.view(), shown.view());
-                methods[m]->errors.push_back(e);
-                csv.row({c.name, methods[m]->method, std::to_string(index), strf("%.4f", e.psnr),
+                all[m]->errors.push_back(e);
+                csv.row({c.name, all[m]->method, std::to_string(index), strf("%.4f", e.psnr),
                          strf("%.6f", e.ssim), strf("%.6f", e.flip),
-                         strf("%.3f", m == 0 ? (k.displayed_us - k.pose_us) / 1000.0
-                                             : (k.displayed_us - k.source_pose_us) / 1000.0)});
+                         strf("%.3f", all[m] == &ours || all[m] == &warped
+                                          ? (k.displayed_us - k.pose_us) / 1000.0
+                                          : (k.displayed_us - k.source_pose_us) / 1000.0)});
             }
             ++index;
         }
-        for (MethodSummary* m : {&ours, &repeat, &video, &video_fine}) {
+        for (MethodSummary* m : all) {
             if (lowres && m != &ours) continue;
             const ImageError e = mean_error(m->errors);
             std::printf("%-16s %-16s %9.0f %7.2f %7.4f %8.2f %8.2f %8.2f %9.0f %6zu %6zu\n",
@@ -343,7 +386,9 @@ Status bench_stream(const BenchOptions& options) {
         "video-only model): the same source frames through "
         "x264 veryfast zerolatency at crf 23 and 15, shown when our stream had them (same arrival "
         "times and losses; x264's "
-        "error propagation after a loss is not modelled, which favours it).",
+        "error propagation after a loss is not modelled, which favours it). x264-crf23+tw: the "
+        "crf 23 video turned to each display frame's pose by rotation alone (the pose-only "
+        "timewarp of ALVR and Oculus Link: no depth, no translation).",
         "Latency: pose sampled -> displayed, for reprise the pose each display frame was warped "
         "to, for the peers "
         "the pose of the frame the first time it is shown. Truth: the scene rendered at each "

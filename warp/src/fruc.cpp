@@ -141,6 +141,7 @@ struct FrameRateConverter::State {
     Frame previous;  // colour, depth, motion and ids of the last input (no normals)
     bool has_previous = false;
     bool previous_starts_shot = false;  // its motion reaches back into another shot: unusable
+    bool shot_reported = false;         // start_new_shot(): the next frame is a cut
     FrameQueue ready;
     FrucOptions chosen;  // `options` with an auto warp or fill resolved for one frame
     NonfiniteRepair nonfinite;
@@ -339,6 +340,8 @@ bool FrameRateConverter::receive(Frame& out) {
 
 Status FrameRateConverter::send(const Frame& frame) { return send_frame(frame, nullptr); }
 
+void FrameRateConverter::start_new_shot() { state_->shot_reported = true; }
+
 Status FrameRateConverter::send(Frame&& frame) { return send_frame(frame, &frame); }
 
 Status FrameRateConverter::send_frame(const Frame& given, Frame* owned) {
@@ -361,7 +364,8 @@ Status FrameRateConverter::send_frame(const Frame& given, Frame* owned) {
     ++st.counters.inputs;
     st.scratch.refiner.forget_region();
     const bool warpable = !frame.depth.empty() && !frame.motion.empty();
-    const bool cut = st.has_previous && st.is_cut(frame);
+    const bool cut = st.has_previous && (st.shot_reported || st.is_cut(frame));
+    st.shot_reported = false;
     st.counters.cuts += cut;
     const int k_max = st.factor;
 

@@ -166,6 +166,9 @@ public:
     // `frame` gets back buffers of an earlier one (contents unspecified) for the caller to refill.
     // Non-finite values are repaired in place.
     Status send(Frame&& frame);
+    // The next frame sent starts a new shot (a cut the renderer reports): it is handled as a
+    // detected cut (FrucCounters::cuts), nothing is blended across it.
+    void start_new_shot();
     // Takes the next output frame; false when the converter needs the next input.
     bool receive(Frame& out);
 

@@ -1,0 +1,53 @@
+#pragma once
+// reprise_gbuffer <-> Frame: every channel checked (pointer, size, stride, format) and converted
+// from / to the caller's pixel format; the camera between C arrays and glm.
+#include <cstdint>
+
+#include "reprise.h"
+#include "reprise/core/frame.hpp"
+
+namespace reprise::capi {
+
+// Channels of a G-buffer, as a mask of what a call reads or writes.
+enum Channel : unsigned {
+    kColor = 1u << 0,
+    kDepth = 1u << 1,
+    kMotion = 1u << 2,
+    kNormal = 1u << 3,
+    kId = 1u << 4,
+    kUi = 1u << 5,
+};
+
+// Copies the channels in `read` that `given` has (colour always, required) into `frame`,
+// converted to its float layout; the others are cleared. `name` is the argument's name in
+// messages ("frame"). Reuses frame's buffers while the size stays the same.
+reprise_status read_gbuffer(const char* function, const char* name, const reprise_gbuffer* given,
+                            unsigned read, Frame& frame, bool& reset);
+
+// Checks `out` for a width x height result: colour required, the channels in `written` optional,
+// any other channel must be absent.
+reprise_status check_output(const char* function, const reprise_gbuffer* out, int width, int height,
+                            unsigned written);
+// Writes the channels `out` asks for (checked by check_output) and the camera and fps.
+// Channels `frame` lacks are an error, before anything is written.
+reprise_status write_gbuffer(const char* function, const Frame& frame, reprise_gbuffer* out);
+
+}  // namespace reprise::capi
+
+namespace reprise::capi {
+
+// A made frame pulled from a C++ object so that the caller can be told its size, kept until it
+// is received (converter, decoder).
+struct HeldFrame {
+    Frame frame;
+    bool held = false;
+};
+// REPRISE_OK with the held frame's size, or REPRISE_NEED_MORE when none is held.
+reprise_status held_size(const char* function, const HeldFrame& next, int32_t* width,
+                         int32_t* height);
+// Writes the held frame into `out` (check_output with `written`) and lets it go; NEED_MORE when
+// none is held; on an error it stays held.
+reprise_status receive_held(const char* function, HeldFrame& next, unsigned written,
+                            reprise_gbuffer* out);
+
+}  // namespace reprise::capi

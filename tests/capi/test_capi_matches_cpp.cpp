@@ -1,0 +1,173 @@
+// The C interface gives what the C++ classes give, bit for bit: the frame-rate converter's
+// outputs, the other eye, the encoder's packets and the decoder's frames, on the same synthetic
+// frames.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <vector>
+
+#include <glm/gtc/matrix_transform.hpp>
+
+#include "reprise.h"
+#include "reprise/codec/codec.hpp"
+#include "reprise/stereo/rig.hpp"
+#include "reprise/stereo/synthesize.hpp"
+#include "reprise/warp/fruc.hpp"
+#include "support/frames.hpp"
+
+namespace reprise {
+namespace {
+
+constexpr int kW = 64, kH = 48;
+
+// Three frames of random colour moving 3 px right per frame (wrapping around), seen by a
+// perspective camera.
+std::vector<Frame> frames() {
+    const Frame texture = test::flat_frame(kW, kH, 4.0f, {-3.0f, 0.0f}, 7);
+    std::vector<Frame> out;
+    for (int k = 0; k < 3; ++k) {
+        Frame f = texture;
+        for (int y = 0; y < kH; ++y)
+            for (int x = 0; x < kW; ++x) f.color(x, y) = texture.color((x - 3 * k + kW) % kW, y);
+        f.depth(5, 5) = test::kInf;  // a background pixel
+        f.camera.projection = glm::perspective(0.9f, float(kW) / kH, 0.1f, 100.0f);
+        f.camera.prev_projection = f.camera.projection;
+        f.camera.view = glm::translate(glm::mat4(1.0f), {-0.05f * k, 0.0f, 0.0f});
+        f.camera.prev_view = glm::translate(glm::mat4(1.0f), {-0.05f * (k - 1), 0.0f, 0.0f});
+        f.camera.near = 0.1f;
+        f.camera.far = 100.0f;
+        f.camera.time = k / 30.0;
+        f.fps = 30.0;
+        out.push_back(std::move(f));
+    }
+    return out;
+}
+
+template <class T>
+reprise_image image_of(const Image<T>& image, reprise_format format) {
+    return {const_cast<T*>(image.data()),       image.width(), image.height(),
+            int64_t(image.width() * sizeof(T)), format,        0};
+}
+
+void copy_matrix(const glm::mat4& m, float* a) { std::memcpy(a, &m[0][0], 16 * sizeof(float)); }
+
+reprise_gbuffer gbuffer_of(const Frame& f) {
+    reprise_gbuffer g;
+    EXPECT_EQ(reprise_gbuffer_init(&g, sizeof g), REPRISE_OK);
+    g.color = image_of(f.color, REPRISE_FORMAT_RGBA32_FLOAT);
+    g.depth = image_of(f.depth, REPRISE_FORMAT_R32_FLOAT);
+    g.motion = image_of(f.motion, REPRISE_FORMAT_RG32_FLOAT);
+    copy_matrix(f.camera.view, g.camera.view);
+    copy_matrix(f.camera.projection, g.camera.projection);
+    copy_matrix(f.camera.prev_view, g.camera.prev_view);
+    copy_matrix(f.camera.prev_projection, g.camera.prev_projection);
+    g.camera.near_plane = f.camera.near;
+    g.camera.far_plane = f.camera.far;
+    g.camera.time = f.camera.time;
+    g.camera.valid = 1;
+    g.fps = f.fps;
+    return g;
+}
+
+// An output G-buffer writing into `f`'s colour, depth and motion, sized kW x kH.
+reprise_gbuffer output_into(Frame& f) {
+    f.color.resize(kW, kH);
+    f.depth.resize(kW, kH);
+    f.motion.resize(kW, kH);
+    return gbuffer_of(f);
+}
+
+// Without and with a reported cut before the last frame (reset = start_new_shot).
+class CapiConverter : public testing::TestWithParam<bool> {};
+
+TEST_P(CapiConverter, OutputsAreTheFrameRateConverters) {
+    const bool cut = GetParam();
+    const std::vector<Frame> input = frames();
+    warp::FrameRateConverter cpp(2, warp::FrucOptions{});
+    reprise_converter* c = nullptr;
+    ASSERT_EQ(reprise_converter_create(REPRISE_ABI_VERSION, nullptr, &c), REPRISE_OK);
+    int compared = 0;
+    for (const Frame& f : input) {
+        const bool reset = cut && &f == &input.back();
+        if (reset) cpp.start_new_shot();
+        ASSERT_TRUE(cpp.send(f).ok());
+        reprise_gbuffer g = gbuffer_of(f);
+        g.reset = reset;
+        ASSERT_EQ(reprise_converter_send(c, &g), REPRISE_OK) << reprise_last_error();
+        Frame want, got;
+        while (cpp.receive(want)) {
+            reprise_gbuffer out = output_into(got);
+            ASSERT_EQ(reprise_converter_receive(c, &out), REPRISE_OK) << reprise_last_error();
+            EXPECT_TRUE(test::same_bits(want.color, got.color)) << "output " << compared;
+            EXPECT_TRUE(test::same_bits(want.depth, got.depth)) << "output " << compared;
+            EXPECT_TRUE(test::same_bits(want.motion, got.motion)) << "output " << compared;
+            EXPECT_EQ(want.camera.time, out.camera.time);
+            EXPECT_EQ(0, std::memcmp(&want.camera.view[0][0], out.camera.view, 64));
+            ++compared;
+        }
+        reprise_gbuffer out = output_into(got);
+        EXPECT_EQ(reprise_converter_receive(c, &out), REPRISE_NEED_MORE);
+    }
+    EXPECT_EQ(compared, 5);
+    // The frames move 3 px and their camera little: no cut is detected unless reported.
+    EXPECT_EQ(cpp.counters().cuts, cut ? 1u : 0u);
+    reprise_converter_destroy(c);
+}
+
+INSTANTIATE_TEST_SUITE_P(CapiMatchesCpp, CapiConverter, testing::Bool());
+
+TEST(CapiMatchesCpp, StereoEyeIsTheSynthesizers) {
+    const Frame left = frames()[1];
+    const stereo::EyeCameras eyes = stereo::eye_cameras(left.camera, {}, stereo::Anchor::Left);
+    Frame want, got;
+    stereo::StereoSynthesizer().synthesize(left, eyes.right, want, {});
+    reprise_stereo* s = nullptr;
+    ASSERT_EQ(reprise_stereo_create(REPRISE_ABI_VERSION, nullptr, &s), REPRISE_OK);
+    const reprise_gbuffer g = gbuffer_of(left);
+    reprise_gbuffer out = output_into(got);
+    out.motion = {};
+    ASSERT_EQ(reprise_stereo_synthesize(s, &g, &out), REPRISE_OK) << reprise_last_error();
+    EXPECT_TRUE(test::same_bits(want.color, got.color));
+    EXPECT_TRUE(test::same_bits(want.depth, got.depth));
+    EXPECT_EQ(0, std::memcmp(&eyes.right.view[0][0], out.camera.view, 64));
+    reprise_stereo_destroy(s);
+}
+
+TEST(CapiMatchesCpp, CodecPacketsAndDecodedFramesAreTheCodecs) {
+    const std::vector<Frame> input = frames();
+    codec::Encoder encoder;
+    codec::Decoder decoder;
+    reprise_encoder* ce = nullptr;
+    reprise_decoder* cd = nullptr;
+    ASSERT_EQ(reprise_encoder_create(REPRISE_ABI_VERSION, nullptr, &ce), REPRISE_OK);
+    ASSERT_EQ(reprise_decoder_create(REPRISE_ABI_VERSION, nullptr, &cd), REPRISE_OK);
+    for (std::size_t k = 0; k < input.size(); ++k) {
+        ASSERT_TRUE(encoder.send_frame(input[k]).ok());
+        codec::Packet packet;
+        ASSERT_EQ(encoder.receive_packet(packet), codec::Result::Ok);
+        const reprise_gbuffer g = gbuffer_of(input[k]);
+        ASSERT_EQ(reprise_encoder_send_frame(ce, &g), REPRISE_OK) << reprise_last_error();
+        std::vector<uint8_t> bytes(packet.data.size() + 16);
+        std::size_t size = 0;
+        ASSERT_EQ(reprise_encoder_receive_packet(ce, bytes.data(), bytes.size(), &size),
+                  REPRISE_OK);
+        bytes.resize(size);
+        EXPECT_EQ(bytes, packet.data) << "packet " << k;
+
+        ASSERT_TRUE(decoder.send_packet(packet.data).ok());
+        Frame want, got;
+        ASSERT_EQ(decoder.receive_frame(want), codec::Result::Ok);
+        ASSERT_EQ(reprise_decoder_send_packet(cd, bytes.data(), bytes.size()), REPRISE_OK);
+        reprise_gbuffer out = output_into(got);
+        ASSERT_EQ(reprise_decoder_receive_frame(cd, &out), REPRISE_OK) << reprise_last_error();
+        EXPECT_TRUE(test::same_bits(want.color, got.color)) << "frame " << k;
+        EXPECT_TRUE(test::same_bits(want.depth, got.depth)) << "frame " << k;
+        EXPECT_TRUE(test::same_bits(want.motion, got.motion)) << "frame " << k;
+        EXPECT_EQ(0, std::memcmp(&want.camera.projection[0][0], out.camera.projection, 64));
+    }
+    reprise_encoder_destroy(ce);
+    reprise_decoder_destroy(cd);
+}
+
+}  // namespace
+}  // namespace reprise
