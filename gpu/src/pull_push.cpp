@@ -169,8 +169,7 @@ void main() {
 )";
 
 // The image's holes (counted here: this pass runs also without levels) from filled level 1;
-// everything else (and an image without any valid pixel,
-// `top_level` empty) copied.
+// everything else, and every pixel of an image without a valid one (`top_level` empty), copied.
 constexpr const char* kFinal = R"(
 layout(binding = 0) uniform highp sampler2D color;
 layout(binding = 1) uniform highp usampler2D valid;
