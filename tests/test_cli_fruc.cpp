@@ -56,9 +56,8 @@ TEST(CliFruc, ColourOnlyInputIsInterpolatedWithOpticalFlow) {
     // Motion estimated per pair from scratch: ranges of pairs give the whole run's bytes too.
     const std::string parts = (dir / "parts").string();
     for (const std::string range : {"0:0", "1:1"})
-        ASSERT_EQ(test::run_reprise("fruc --in " + bare + " --factor 2 --range " + range +
-                                        " --out " + parts,
-                                    120)
+        ASSERT_EQ(test::run_reprise(
+                      "fruc --in " + bare + " --factor 2 --range " + range + " --out " + parts, 120)
                       .status,
                   0);
     EXPECT_EQ(test::differences(test::frames(parts), test::frames(made)), "");
@@ -80,10 +79,8 @@ std::string scratch(const std::string& name) {
 // 8 frames of the `cut` scene at 12 Hz: the camera cuts between inputs 5 and 6.
 std::string render_cut(const std::string& dir) {
     const std::string in = dir + "/in";
-    const test::Outcome r =
-        test::run_reprise("render --scene cut --frames 8 --fps 12 --size 32x24 --aa 1 --out " +
-                              q(in),
-                          60);
+    const test::Outcome r = test::run_reprise(
+        "render --scene cut --frames 8 --fps 12 --size 32x24 --aa 1 --out " + q(in), 60);
     EXPECT_EQ(r.status, 0) << r.output;
     return in;
 }
@@ -114,7 +111,8 @@ TEST(CliFruc, RangesThatMeetWriteTheWholeRunsBytes) {
                 ++written;
             }
         }
-        const std::size_t expected = options.find("extrapolate") != std::string::npos ? 8 * 2 : 7 * 3 + 1;
+        const std::size_t expected =
+            options.find("extrapolate") != std::string::npos ? 8 * 2 : 7 * 3 + 1;
         EXPECT_EQ(frames(whole_dir).size(), expected) << options;
         EXPECT_EQ(written, expected) << options << ": a frame written by two ranges, or none";
         EXPECT_EQ(differences(frames(parts), frames(whole_dir)), "") << options;
@@ -127,8 +125,8 @@ TEST(CliFruc, RangesThatMeetWriteTheWholeRunsBytes) {
 TEST(CliFruc, StereoRangesReadTheFrameBefore) {
     const std::string dir = scratch("stereo"), in = render_cut(dir);
     const std::string stereo = "stereo --temporal --ipd 0.3";
-    ASSERT_EQ(test::run_reprise(stereo + " --in " + q(in) + " --out " + q(dir + "/whole"), 60).status,
-              0);
+    ASSERT_EQ(
+        test::run_reprise(stereo + " --in " + q(in) + " --out " + q(dir + "/whole"), 60).status, 0);
     for (const std::string range : {"0:2", "3:7"}) {
         const test::Outcome r = test::run_reprise(
             stereo + " --in " + q(in) + " --range " + range + " --out " + q(dir + "/parts"), 60);
@@ -139,11 +137,10 @@ TEST(CliFruc, StereoRangesReadTheFrameBefore) {
     // The same frames 3..7 as a sequence of their own: frame 3 has no history.
     const std::string alone = dir + "/alone";
     fs::create_directories(alone);
-    for (int i = 3; i < 8; ++i)
-        fs::copy_file(frame_path(in, i), frame_path(alone, i));
-    ASSERT_EQ(test::run_reprise(stereo + " --in " + q(alone) + " --out " + q(dir + "/cold"), 60)
-                  .status,
-              0);
+    for (int i = 3; i < 8; ++i) fs::copy_file(frame_path(in, i), frame_path(alone, i));
+    ASSERT_EQ(
+        test::run_reprise(stereo + " --in " + q(alone) + " --out " + q(dir + "/cold"), 60).status,
+        0);
     const auto cold = frames(dir + "/cold"), whole = frames(dir + "/whole");
     EXPECT_NE(cold.at("right/frame_00000.exr"), whole.at("right/frame_00003.exr"));
     fs::remove_all(dir);
@@ -157,8 +154,8 @@ TEST(CliFruc, BadRangesAreRefusedNamingTheRange) {
         EXPECT_NE(r.status, 0) << range;
         EXPECT_NE(r.output.find("--range"), std::string::npos) << range << ": " << r.output;
     }
-    const test::Outcome r = test::run_reprise(
-        "stereo --in " + q(in) + " --range 0:8 --out " + q(dir + "/out"), 60);
+    const test::Outcome r =
+        test::run_reprise("stereo --in " + q(in) + " --range 0:8 --out " + q(dir + "/out"), 60);
     EXPECT_NE(r.output.find("the sequence has 8 frames"), std::string::npos) << r.output;
     const test::Outcome resumed = test::run_reprise(
         "fruc --in " + q(in) + " --range 0:1 --resume --out " + q(dir + "/out"), 60);

@@ -47,7 +47,8 @@ int command_batch(int argc, char** argv) {
     const std::string package = package_folder(executable);
     if (!package.empty()) {
         std::string joined = package;
-        if (const char* path = std::getenv("PYTHONPATH"); path && *path) joined.append(":").append(path);
+        if (const char* path = std::getenv("PYTHONPATH"); path && *path)
+            joined.append(":").append(path);
         ::setenv("PYTHONPATH", joined.c_str(), 1);
     }
     // The workers run this very executable (reprise.batch's --reprise).

@@ -28,7 +28,7 @@ struct FrucJob {
     double budget_db = 0.0;     // auto: the PSNR to reach (0: within slack of the best expected)
     bool resume = false, overwrite_inputs = false;
     std::string range;  // --range A:B: input pairs A..B only
-    std::string line;  // the options given, recorded for --resume
+    std::string line;   // the options given, recorded for --resume
 };
 
 // Resuming at output frame `on_disk` starts at the input whose pair makes it, two inputs early:
@@ -85,7 +85,8 @@ Status run_fruc(const FrucJob& job) {
     // inputs early, as a resumed run does: input A is the previous frame of the first pair and
     // the cut test between A-1 and A says whether A starts a shot.
     InputRange range;
-    REPRISE_TRY(parse_input_range(job.range, sequence.files.empty() ? 0 : sequence.files.size() - 1, "input pairs", range));
+    REPRISE_TRY(parse_input_range(job.range, sequence.files.empty() ? 0 : sequence.files.size() - 1,
+                                  "input pairs", range));
     if (!range.all && job.resume)
         return Status::error("--range and --resume cannot be combined (run the range again)");
     OutputFolder output;
@@ -95,7 +96,8 @@ Status run_fruc(const FrucJob& job) {
     OutputSpan wanted{0, outputs_of(n - 1, job.factor, options.mode).end};
     if (!range.all) {
         first = range.first == 0 ? 0 : range.first - 1;
-        wanted.begin = range.first == 0 ? 0 : outputs_of(range.first + 1, job.factor, options.mode).begin;
+        wanted.begin =
+            range.first == 0 ? 0 : outputs_of(range.first + 1, job.factor, options.mode).begin;
     }
 
     warp::FrameRateConverter converter(job.factor, options);

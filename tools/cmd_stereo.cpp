@@ -28,7 +28,7 @@ struct StereoJob {
     bool temporal = false;
     bool resume = false, overwrite_inputs = false;
     std::string range;  // --range A:B: frames A..B only
-    std::string line;  // the options given, recorded for --resume
+    std::string line;   // the options given, recorded for --resume
 };
 
 Status check(const StereoJob& j, stereo::StereoRig& rig, stereo::StereoOptions& options) {
@@ -138,10 +138,10 @@ Status run_stereo(const StereoJob& job, const stereo::StereoRig& rig,
     REPRISE_TRY(rendered.finish());
     REPRISE_TRY(made_eye.finish());
     const std::size_t made_count = end - begin;
-    std::fprintf(
-        stderr, "[stereo] %zu frames, %.2f ms per eye, %zu holes, %zu pixels from history -> %s\n",
-        made_count, made_count ? ms / double(made_count) : 0.0, holes, from_history,
-        job.out.c_str());
+    std::fprintf(stderr,
+                 "[stereo] %zu frames, %.2f ms per eye, %zu holes, %zu pixels from history -> %s\n",
+                 made_count, made_count ? ms / double(made_count) : 0.0, holes, from_history,
+                 job.out.c_str());
     if (nonfinite.total() > 0)
         std::fprintf(stderr, "[stereo] input: %s\n", describe_nonfinite(nonfinite).c_str());
     return {};

@@ -41,7 +41,8 @@ constexpr Command kCommands[] = {
 
 void print_usage(FILE* out) {
     std::fputs(
-        "usage: reprise COMMAND [options]   (reprise COMMAND --help for each; reprise --version)\n\n",
+        "usage: reprise COMMAND [options]   (reprise COMMAND --help for each; reprise "
+        "--version)\n\n",
         out);
     for (const Command& c : kCommands) std::fprintf(out, "  %-9s %s\n", c.name, c.summary);
     std::fputs(

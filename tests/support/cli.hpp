@@ -89,7 +89,7 @@ inline std::map<std::string, std::string> contents(const std::filesystem::path& 
 
 // The names of the files that differ between two listings, or are in one only.
 inline std::string differences(const std::map<std::string, std::string>& a,
-                        const std::map<std::string, std::string>& b) {
+                               const std::map<std::string, std::string>& b) {
     std::string names;
     for (const auto& [name, bytes] : a)
         if (!b.count(name) || b.at(name) != bytes) names += " " + name;
