@@ -4,7 +4,6 @@ import os
 import signal
 import stat
 import subprocess
-import threading
 
 import pytest
 
@@ -86,30 +85,27 @@ def test_chunks_give_the_whole_runs_bytes_and_resume_skips_complete_ones(sequenc
                   reprise=REPRISE)
 
 
-def test_a_killed_worker_costs_a_retry_not_a_frame(sequence, tmp_path):
+def test_a_killed_worker_costs_a_retry_not_a_frame(sequence, client, tmp_path):
+    """Last: the module's cluster loses a worker process (its nanny starts another)."""
     dir, whole = sequence
-    # Each chunk's run waits 1 s first, logged, so that a worker is surely mid-chunk when killed.
+    # Each chunk's run waits 0.5 s first, logged, so that a worker is surely mid-chunk when killed.
     log = tmp_path / "runs.log"
     slow = tmp_path / "slow-reprise"
-    slow.write_text(f'#!/bin/sh\necho "$*" >> {log}\nsleep 1\nexec {REPRISE} "$@"\n')
+    slow.write_text(f'#!/bin/sh\necho "$*" >> {log}\nsleep 0.5\nexec {REPRISE} "$@"\n')
     slow.chmod(slow.stat().st_mode | stat.S_IXUSR)
-    cluster = distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                       host="127.0.0.1", dashboard_address="127.0.0.1:0")
     killed = []
-    with distributed.Client(cluster) as client:
-        pids = client.run(os.getpid)
+    pids = client.run(os.getpid)
 
-        def kill_one_busy_worker(done, total, chunk, n):
-            if killed:
-                return
-            busy = [w for w, keys in client.processing().items() if keys]
-            if busy:
-                os.kill(pids[busy[0]], signal.SIGTERM)
-                killed.append(busy[0])
+    def kill_one_busy_worker(done, total, chunk, n):
+        if killed:
+            return
+        busy = [w for w, keys in client.processing().items() if keys]
+        if busy:
+            os.kill(pids[busy[0]], signal.SIGTERM)
+            killed.append(busy[0])
 
-        result = batch.run("fruc", dir / "in", tmp_path / "out", args=FRUC, client=client,
-                           chunk=2, reprise=str(slow), progress=kill_one_busy_worker)
-    cluster.close()
+    result = batch.run("fruc", dir / "in", tmp_path / "out", args=FRUC, client=client, chunk=2,
+                       reprise=str(slow), progress=kill_one_busy_worker)
     assert killed, "no worker was busy to be killed"
     assert (result.chunks, result.ran, result.frames) == (5, 5, 19)
     assert frames(tmp_path / "out") == whole  # every frame, once, identical
