@@ -104,7 +104,8 @@ Status run_fruc(const FrucJob& job) {
     FlowMotion flow;
     bool estimating = false;
     Frame in, out, ui_frame;
-    int made = int(first) * job.factor, written = 0;
+    int made = int(first) * job.factor;  // the index of the next output frame
+    int written = 0;                     // by this range
     double busy_ms = 0.0;
     if (output.frames_on_disk() > 0)
         std::fprintf(stderr, "[fruc] resuming: %d frames on disk, restarting at input %zu\n",
@@ -150,13 +151,15 @@ Status run_fruc(const FrucJob& job) {
                 REPRISE_TRY(output.write(made, out, write));
                 ++written;
             }
-        std::fprintf(stderr, "\r[fruc] %zu/%zu input frames, %d written", i + 1, n, written);
+        std::fprintf(stderr, "\r[fruc] %zu/%zu input frames, %d written", i + 1, n,
+                     range.all ? made : written);
     }
     REPRISE_TRY(output.finish());
     const warp::FrucCounters& c = converter.counters();
     std::fprintf(stderr, "\n");
     std::printf("fruc %s x%d, warp %s, fill %s: %zu inputs -> %d frames in %s\n", job.mode.c_str(),
-                job.factor, job.warp.c_str(), job.fill.c_str(), c.inputs, written, job.out.c_str());
+                job.factor, job.warp.c_str(), job.fill.c_str(), c.inputs,
+                range.all ? made : written, job.out.c_str());
     if (!range.all)
         std::printf("  range: input pairs %zu..%zu, frames %d..%d (read from input %zu on)\n",
                     range.first, range.last, wanted.begin, wanted.end - 1, first);

@@ -105,7 +105,8 @@ def run_chunk(reprise, command, source, output, args, chunk):
     work = os.path.join(state, f"{chunk.name}.{uuid.uuid4().hex}.partial")
     line = [reprise, command, "--in", source, "--out", work, "--range", f"{chunk.first}:{chunk.last}"]
     done = subprocess.run(line + list(args), stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
-                          text=True, preexec_fn=_die_with_parent)
+                          text=True,
+                          preexec_fn=_die_with_parent if sys.platform.startswith("linux") else None)
     if done.returncode != 0:
         shutil.rmtree(work, ignore_errors=True)
         raise BatchError(f"{chunk.name}: `{' '.join(line + list(args))}` failed "
