@@ -12,8 +12,12 @@
 #include "support/cli.hpp"
 
 namespace fs = std::filesystem;
+using reprise::test::contents;
+using reprise::test::differences;
+using reprise::test::frames;
 using reprise::test::fresh_directory;
 using reprise::test::Outcome;
+using reprise::test::q;
 using reprise::test::read_text;
 
 namespace {
@@ -22,42 +26,6 @@ Outcome run(const std::string& arguments) { return reprise::test::run_reprise(ar
 
 fs::path scratch(const std::string& name) {
     return fresh_directory(fs::temp_directory_path() / ("reprise-outputs-" + name));
-}
-
-// Quoted for the shell.
-std::string q(const fs::path& p) {
-    std::string quoted(1, '\'');
-    quoted += p.string();
-    quoted += '\'';
-    return quoted;
-}
-
-// Every regular file below `dir` (hidden ones too), by relative path, with its bytes.
-std::map<std::string, std::string> contents(const fs::path& dir) {
-    std::map<std::string, std::string> files;
-    for (const auto& entry : fs::recursive_directory_iterator(dir))
-        if (entry.is_regular_file())
-            files[fs::relative(entry.path(), dir).string()] = read_text(entry.path());
-    return files;
-}
-
-// The names of the files that differ between two listings, or are in one only.
-std::string differences(const std::map<std::string, std::string>& a,
-                        const std::map<std::string, std::string>& b) {
-    std::string names;
-    for (const auto& [name, bytes] : a)
-        if (!b.count(name) || b.at(name) != bytes) names += " " + name;
-    for (const auto& [name, bytes] : b)
-        if (!a.count(name)) names += " " + name;
-    return names;
-}
-
-// Frames only: frame_NNNNN.exr below `dir`.
-std::map<std::string, std::string> frames(const fs::path& dir) {
-    std::map<std::string, std::string> all = contents(dir), exr;
-    for (auto& [name, bytes] : all)
-        if (name.ends_with(".exr")) exr[name] = bytes;
-    return exr;
 }
 
 void expect_refused(const Outcome& r, const std::string& must_mention, const std::string& what) {

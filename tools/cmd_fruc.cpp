@@ -7,6 +7,7 @@
 #include "commands.hpp"
 #include "flow_motion.hpp"
 #include "fruc_options.hpp"
+#include "input_range.hpp"
 #include "outputs.hpp"
 #include "reprise/core/exr.hpp"
 #include "reprise/warp/fruc.hpp"
@@ -26,7 +27,8 @@ struct FrucJob {
     bool ui_composite = false;  // draw the UI into the output colour
     double budget_db = 0.0;     // auto: the PSNR to reach (0: within slack of the best expected)
     bool resume = false, overwrite_inputs = false;
-    std::string line;  // the options given, recorded for --resume
+    std::string range;  // --range A:B: input pairs A..B only
+    std::string line;   // the options given, recorded for --resume
 };
 
 // Resuming at output frame `on_disk` starts at the input whose pair makes it, two inputs early:
@@ -35,6 +37,17 @@ std::size_t resume_input(int on_disk, int factor, warp::FrucMode mode) {
     const int first =
         mode == warp::FrucMode::Interpolate ? (on_disk + factor - 1) / factor : on_disk / factor;
     return std::size_t(std::max(0, first - 2));
+}
+
+// The output frames input `i` makes when it is sent after input i - 1: interpolation gives the
+// frames between them and input i itself, extrapolation input i and the frames beyond it.
+struct OutputSpan {
+    int begin, end;
+};
+OutputSpan outputs_of(std::size_t i, int factor, warp::FrucMode mode) {
+    const int k = factor, j = int(i);
+    if (mode == warp::FrucMode::Extrapolate) return {j * k, (j + 1) * k};
+    return {j == 0 ? 0 : (j - 1) * k + 1, j * k + 1};
 }
 
 Status run_fruc(const FrucJob& job) {
@@ -67,17 +80,33 @@ Status run_fruc(const FrucJob& job) {
     REPRISE_TRY(check_one_size(sequence, "fruc"));
     OutputRules rules{.inputs = {job.in}, .overwrite_inputs = job.overwrite_inputs};
     if (!job.ui.empty()) rules.inputs.push_back(job.ui);
+    // A range of input pairs A..B writes the frames inputs A+1..B+1 make (and input 0's when A
+    // is 0), so that ranges that meet cover a whole run's frames once. Its converter starts two
+    // inputs early, as a resumed run does: input A is the previous frame of the first pair and
+    // the cut test between A-1 and A says whether A starts a shot.
+    InputRange range;
+    REPRISE_TRY(parse_input_range(job.range, sequence.files.empty() ? 0 : sequence.files.size() - 1,
+                                  "input pairs", range));
+    if (!range.all && job.resume)
+        return Status::error("--range and --resume cannot be combined (run the range again)");
     OutputFolder output;
-    REPRISE_TRY(output.open(job.out, rules, job.line, job.resume));
-    const std::size_t first = resume_input(output.frames_on_disk(), job.factor, options.mode);
+    REPRISE_TRY(output.open(job.out, rules, range.all ? job.line : std::string(), job.resume));
+    const std::size_t n = range.all ? sequence.files.size() : range.last + 2;
+    std::size_t first = resume_input(output.frames_on_disk(), job.factor, options.mode);
+    OutputSpan wanted{0, outputs_of(n - 1, job.factor, options.mode).end};
+    if (!range.all) {
+        first = range.first == 0 ? 0 : range.first - 1;
+        wanted.begin =
+            range.first == 0 ? 0 : outputs_of(range.first + 1, job.factor, options.mode).begin;
+    }
 
     warp::FrameRateConverter converter(job.factor, options);
     FlowMotion flow;
     bool estimating = false;
     Frame in, out, ui_frame;
-    int written = int(first) * job.factor;
+    int made = int(first) * job.factor;  // the index of the next output frame
+    int written = 0;                     // by this range
     double busy_ms = 0.0;
-    const std::size_t n = sequence.files.size();
     if (output.frames_on_disk() > 0)
         std::fprintf(stderr, "[fruc] resuming: %d frames on disk, restarting at input %zu\n",
                      output.frames_on_disk(), first);
@@ -117,14 +146,23 @@ Status run_fruc(const FrucJob& job) {
         busy_ms +=
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
                 .count();
-        while (converter.receive(out)) REPRISE_TRY(output.write(written++, out, write));
-        std::fprintf(stderr, "\r[fruc] %zu/%zu input frames, %d written", i + 1, n, written);
+        for (; converter.receive(out); ++made)
+            if (made >= wanted.begin && made < wanted.end) {
+                REPRISE_TRY(output.write(made, out, write));
+                ++written;
+            }
+        std::fprintf(stderr, "\r[fruc] %zu/%zu input frames, %d written", i + 1, n,
+                     range.all ? made : written);
     }
     REPRISE_TRY(output.finish());
     const warp::FrucCounters& c = converter.counters();
     std::fprintf(stderr, "\n");
     std::printf("fruc %s x%d, warp %s, fill %s: %zu inputs -> %d frames in %s\n", job.mode.c_str(),
-                job.factor, job.warp.c_str(), job.fill.c_str(), c.inputs, written, job.out.c_str());
+                job.factor, job.warp.c_str(), job.fill.c_str(), c.inputs,
+                range.all ? made : written, job.out.c_str());
+    if (!range.all)
+        std::printf("  range: input pairs %zu..%zu, frames %d..%d (read from input %zu on)\n",
+                    range.first, range.last, wanted.begin, wanted.end - 1, first);
     std::printf("  made %zu frames, %.2f ms each (without file I/O)\n", c.outputs,
                 c.outputs ? busy_ms / double(c.outputs) : 0.0);
     std::printf(
@@ -196,6 +234,10 @@ int command_fruc(int argc, char** argv) {
                 "warp;\nframes with ui.R ui.G ui.B ui.A channels need no flag");
     args.flag("--ui-composite", &job.ui_composite,
               "draw the UI into the output colour (default: keep it in ui.* channels)");
+    args.option("--range", &job.range,
+                "A:B: input pairs A..B only (pair i: inputs i and i+1), writing the frames "
+                "they make\n(and input 0 when A is 0); ranges that meet give a whole run's "
+                "bytes (a farm's chunks)");
     args.flag("--resume", &job.resume,
               "continue an interrupted run of the same arguments from the frames in --out");
     args.flag("--overwrite-inputs", &job.overwrite_inputs,

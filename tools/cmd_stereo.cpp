@@ -8,6 +8,7 @@
 
 #include "args.hpp"
 #include "commands.hpp"
+#include "input_range.hpp"
 #include "outputs.hpp"
 #include "reprise/core/exr.hpp"
 #include "reprise/core/memory_limit.hpp"
@@ -26,7 +27,8 @@ struct StereoJob {
     double fov = 0.0;  // degrees, for inputs without a camera
     bool temporal = false;
     bool resume = false, overwrite_inputs = false;
-    std::string line;  // the options given, recorded for --resume
+    std::string range;  // --range A:B: frames A..B only
+    std::string line;   // the options given, recorded for --resume
 };
 
 Status check(const StereoJob& j, stereo::StereoRig& rig, stereo::StereoOptions& options) {
@@ -63,15 +65,22 @@ Status run_stereo(const StereoJob& job, const stereo::StereoRig& rig,
     REPRISE_TRY(check_one_size(seq, "stereo"));
     const bool given_left = job.eye == "left";
     const OutputRules rules{.inputs = {job.in}, .overwrite_inputs = job.overwrite_inputs};
+    InputRange range;
+    REPRISE_TRY(parse_input_range(job.range, seq.files.size(), "frames", range));
+    if (!range.all && job.resume)
+        return Status::error("--range and --resume cannot be combined (run the range again)");
+    const std::string line = range.all ? job.line : std::string();  // chunks share a folder
     OutputFolder rendered, made_eye;
     REPRISE_TRY(check_output("--out", job.out, true, rules));
     REPRISE_TRY(
-        rendered.open(job.out + (given_left ? "/left" : "/right"), rules, job.line, job.resume));
+        rendered.open(job.out + (given_left ? "/left" : "/right"), rules, line, job.resume));
     REPRISE_TRY(
-        made_eye.open(job.out + (given_left ? "/right" : "/left"), rules, job.line, job.resume));
-    // Resumed: the temporal fill reads the frame before the first missing one.
+        made_eye.open(job.out + (given_left ? "/right" : "/left"), rules, line, job.resume));
+    // Resumed, or a range: the temporal fill reads the frame before the first one written.
     const int on_disk = std::min(rendered.frames_on_disk(), made_eye.frames_on_disk());
-    const std::size_t first = std::size_t(std::max(0, on_disk - (job.temporal ? 1 : 0)));
+    const std::size_t begin = range.all ? std::size_t(on_disk) : range.first;
+    const std::size_t end = range.all ? seq.files.size() : range.last + 1;
+    const std::size_t first = begin - (job.temporal && begin > 0 ? 1 : 0);
     if (on_disk > 0)
         std::fprintf(stderr, "[stereo] resuming: %d frames on disk, restarting at input %zu\n",
                      on_disk, first);
@@ -82,7 +91,7 @@ Status run_stereo(const StereoJob& job, const stereo::StereoRig& rig,
     std::size_t holes = 0, from_history = 0;
     NonfiniteRepair repair;  // the rendered eye is written too: repaired where it is read
     NonfiniteCounts nonfinite;
-    for (std::size_t i = first; i < seq.files.size(); ++i) {
+    for (std::size_t i = first; i < end; ++i) {
         const std::string& file = seq.files[i];
         REPRISE_TRY(read_frame(seq, i, frame));
         if (frame.depth.width() != frame.width() || frame.depth.height() != frame.height())
@@ -106,11 +115,16 @@ Status run_stereo(const StereoJob& job, const stereo::StereoRig& rig,
             frame.camera, rig, given_left ? stereo::Anchor::Left : stereo::Anchor::Right);
         // The file's camera is the rendered eye's as it was rendered; the rig only adds the other.
         const Camera& target = given_left ? eyes.right : eyes.left;
-        auto begin = std::chrono::steady_clock::now();
+        if (i < begin) {  // the history of the first frame written, not written itself
+            std::swap(previous, frame);
+            have_previous = true;
+            continue;
+        }
+        auto start = std::chrono::steady_clock::now();
         stereo::StereoStats stats = synthesizer.synthesize(
             frame, target, made, options, job.temporal && have_previous ? &previous : nullptr);
         made.fps = frame.fps;
-        ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - begin)
+        ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
                   .count();
         holes += stats.holes;
         from_history += stats.from_history;
@@ -123,9 +137,11 @@ Status run_stereo(const StereoJob& job, const stereo::StereoRig& rig,
     }
     REPRISE_TRY(rendered.finish());
     REPRISE_TRY(made_eye.finish());
-    std::fprintf(
-        stderr, "[stereo] %zu frames, %.2f ms per eye, %zu holes, %zu pixels from history -> %s\n",
-        seq.files.size(), ms / double(seq.files.size()), holes, from_history, job.out.c_str());
+    const std::size_t made_count = end - begin;
+    std::fprintf(stderr,
+                 "[stereo] %zu frames, %.2f ms per eye, %zu holes, %zu pixels from history -> %s\n",
+                 made_count, made_count ? ms / double(made_count) : 0.0, holes, from_history,
+                 job.out.c_str());
     if (nonfinite.total() > 0)
         std::fprintf(stderr, "[stereo] input: %s\n", describe_nonfinite(nonfinite).c_str());
     return {};
@@ -152,6 +168,9 @@ int command_stereo(int argc, char** argv) {
     args.option("--warp", &job.warp, "grid|splat (default grid)");
     args.option("--fill", &job.fill, "pullpush|andreev|none (default pullpush)");
     args.flag("--temporal", &job.temporal, "fill disocclusions from the previous frame first");
+    args.option("--range", &job.range,
+                "A:B: frames A..B only (--temporal reads frame A-1 first); ranges that meet "
+                "give a whole\nrun's bytes (a farm's chunks)");
     args.flag("--resume", &job.resume,
               "continue an interrupted run of the same arguments from the frames in --out");
     args.flag("--overwrite-inputs", &job.overwrite_inputs,

@@ -20,6 +20,7 @@ int command_decode(int argc, char** argv);
 int command_serve(int argc, char** argv);
 int command_connect(int argc, char** argv);
 int command_upsample(int argc, char** argv);
+int command_batch(int argc, char** argv);
 
 // `reprise info FILE.rps`: the stream's size, packets and bit rate.
 Status describe_stream(const std::string& path);

@@ -33,6 +33,9 @@ void FlowMotion::complete(Frame& frame) {
     if (frame.motion.empty()) {
         frame.motion.assign(w, h, glm::vec2(0.0f));
         if (st.previous_grey.size() == st.grey.size()) {
+            // Each pair from scratch (DIS would start from a flow field it is given): a run
+            // that starts mid-sequence (--resume, --range) then makes the same motion.
+            st.backward.release();
             st.flow->calc(st.grey, st.previous_grey, st.backward);  // now(p) ~ before(p + flow)
             for (int y = 0; y < h; ++y)
                 for (int x = 0; x < w; ++x) {

@@ -97,7 +97,7 @@ Status OutputFolder::open(const std::string& dir, const OutputRules& rules, cons
                 fs::remove(it->path(), ec);
         }
     }
-    std::ofstream(run_file, std::ios::trunc) << job;
+    if (!job.empty()) std::ofstream(run_file, std::ios::trunc) << job;
     return {};
 }
 

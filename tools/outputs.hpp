@@ -27,7 +27,8 @@ Status check_output(const std::string& option, const std::string& output, bool f
 class OutputFolder {
 public:
     // Checks `dir` against the rules and creates it. `job` describes the run (its arguments);
-    // it is kept in DIR/.reprise-run so that `resume` continues only the same run.
+    // it is kept in DIR/.reprise-run so that `resume` continues only the same run (empty: not
+    // recorded, as for a farm's chunks that share one folder).
     Status open(const std::string& dir, const OutputRules& rules, const std::string& job,
                 bool resume);
     // frame_00000.exr .. frame_{n-1}: complete frames a resumed run keeps.

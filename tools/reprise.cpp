@@ -34,11 +34,16 @@ constexpr Command kCommands[] = {
      "connect to a server, display its stream extrapolated to the display rate"},
     {"upsample", reprise::cli::command_upsample,
      "low-resolution jittered colour to full resolution (Herzog 2010)"},
+    {"batch", reprise::cli::command_batch,
+     "fruc or stereo of one sequence in chunks over a Dask cluster (python3-distributed)"},
     {"bench", reprise::cli::command_bench, "benchmarks (render, exr, reproject, grid, fill, fruc)"},
 };
 
 void print_usage(FILE* out) {
-    std::fputs("usage: reprise COMMAND [options]   (reprise COMMAND --help for each)\n\n", out);
+    std::fputs(
+        "usage: reprise COMMAND [options]   (reprise COMMAND --help for each; reprise "
+        "--version)\n\n",
+        out);
     for (const Command& c : kCommands) std::fprintf(out, "  %-9s %s\n", c.name, c.summary);
     std::fputs(
         "\nAny command takes --max-memory SIZE (8G, 512M, bytes; default 4G): what one call "
@@ -90,6 +95,10 @@ int main(int argc, char** argv) {
     std::string_view name = argv[1];
     if (name == "-h" || name == "--help" || name == "help") {
         print_usage(stdout);
+        return 0;
+    }
+    if (name == "--version" || name == "version") {
+        std::printf("reprise %s\n", REPRISE_VERSION);
         return 0;
     }
     for (const Command& c : kCommands)

@@ -1,11 +1,12 @@
-// The `reprise` Python module: numpy in, numpy out; a failed Status raises reprise.Error.
+// The native part of the `reprise` Python package (reprise._native, re-exported by
+// reprise/__init__.py): numpy in, numpy out; a failed Status raises reprise.Error.
 #include <cstdint>
 #include <string>
 
 #include "common.hpp"
 #include "reprise/core/memory_limit.hpp"
 
-PYBIND11_MODULE(reprise, m) {
+PYBIND11_MODULE(_native, m) {
     namespace rp = reprise::python;
     m.doc() =
         "reprise: frames nobody rendered (frame-rate upconversion, the other eye, a codec) from "
@@ -39,5 +40,5 @@ PYBIND11_MODULE(reprise, m) {
     m.def(
         "max_memory", [] { return reprise::memory_limit(); },
         "The memory limit in bytes (reprise.set_max_memory).");
-    m.attr("__version__") = "0.1.0";
+    m.attr("__version__") = REPRISE_VERSION;  // CMake's project version
 }

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -67,6 +68,42 @@ inline std::filesystem::path fresh_directory(const std::filesystem::path& dir) {
     std::filesystem::remove_all(dir);
     std::filesystem::create_directories(dir);
     return dir;
+}
+
+// Quoted for the shell.
+inline std::string q(const std::filesystem::path& p) {
+    std::string quoted(1, '\'');
+    quoted += p.string();
+    quoted += '\'';
+    return quoted;
+}
+
+// Every regular file below `dir` (hidden ones too), by relative path, with its bytes.
+inline std::map<std::string, std::string> contents(const std::filesystem::path& dir) {
+    std::map<std::string, std::string> files;
+    for (const auto& entry : std::filesystem::recursive_directory_iterator(dir))
+        if (entry.is_regular_file())
+            files[std::filesystem::relative(entry.path(), dir).string()] = read_text(entry.path());
+    return files;
+}
+
+// The names of the files that differ between two listings, or are in one only.
+inline std::string differences(const std::map<std::string, std::string>& a,
+                               const std::map<std::string, std::string>& b) {
+    std::string names;
+    for (const auto& [name, bytes] : a)
+        if (!b.count(name) || b.at(name) != bytes) names += " " + name;
+    for (const auto& [name, bytes] : b)
+        if (!a.count(name)) names += " " + name;
+    return names;
+}
+
+// Frames only: frame_NNNNN.exr below `dir`.
+inline std::map<std::string, std::string> frames(const std::filesystem::path& dir) {
+    std::map<std::string, std::string> all = contents(dir), exr;
+    for (auto& [name, bytes] : all)
+        if (name.ends_with(".exr")) exr[name] = bytes;
+    return exr;
 }
 
 }  // namespace reprise::test
