@@ -11,8 +11,10 @@
 #include "bench_report.hpp"
 #include "codec_peers.hpp"
 #include "depth_peers.hpp"
+#include "depth_video_peer.hpp"
 #include "reprise/core/metrics.hpp"
 #include "support/cli.hpp"
+#include "support/renderer.hpp"
 
 namespace reprise::cli {
 namespace {
@@ -226,6 +228,64 @@ TEST(CodecPeers, BadInputIsAStatus) {
     EXPECT_FALSE(encode_decode_peer({Image<Rgb8>(1, 1)}, {}, 30.0, out).ok());
     EXPECT_TRUE(encode_decode_peer({}, {}, 30.0, out).ok());
     EXPECT_TRUE(out.empty());
+}
+
+// A 10-bit ramp with a step, as the depth peer sends 1/z.
+std::vector<std::vector<uint16_t>> grey_ramps(int w, int h, int count) {
+    std::vector<std::vector<uint16_t>> planes(count, std::vector<uint16_t>(std::size_t(w) * h));
+    for (int i = 0; i < count; ++i)
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x)
+                planes[i][std::size_t(y) * w + x] =
+                    uint16_t(x < w / 2 ? 64 + 7 * x + 3 * y + i : 900 - 2 * y);
+    return planes;
+}
+
+TEST(CodecPeers, GreyTenBitLosslessIsExactAndLossyStaysClose) {
+    if (!peer_available(PeerKind::X265)) GTEST_SKIP() << "no x265 in this libavcodec";
+    const int w = 67, h = 41;  // odd: padded and cropped back
+    const auto planes = grey_ramps(w, h, 3);
+    std::vector<GreyFrame> out;
+    const PeerConfig lossless{.kind = PeerKind::X265, .preset = "ultrafast", .lossless = true};
+    ASSERT_TRUE(encode_decode_grey_peer(planes, w, h, 10, lossless, 30.0, out).ok());
+    ASSERT_EQ(out.size(), planes.size());
+    for (std::size_t i = 0; i < out.size(); ++i) {
+        EXPECT_EQ(out[i].decoded, planes[i]) << i;
+        EXPECT_GT(out[i].bytes, 0u);
+    }
+    const PeerConfig lossy{.kind = PeerKind::X265, .preset = "ultrafast", .crf = 20};
+    ASSERT_TRUE(encode_decode_grey_peer(planes, w, h, 10, lossy, 30.0, out).ok());
+    double sum = 0.0;
+    for (std::size_t p = 0; p < planes[0].size(); ++p)
+        sum += std::abs(int(out[0].decoded[p]) - int(planes[0][p]));
+    EXPECT_LT(sum / double(planes[0].size()), 4.0);  // of 1023 levels
+    if (peer_available(PeerKind::X264)) {            // High 10, 4:0:0
+        const PeerConfig x264{.kind = PeerKind::X264, .preset = "ultrafast", .lossless = true};
+        const Status s = encode_decode_grey_peer(planes, w, h, 10, x264, 30.0, out);
+        ASSERT_TRUE(s.ok()) << s.message();
+        EXPECT_EQ(out[1].decoded, planes[1]);
+    }
+    EXPECT_FALSE(encode_decode_grey_peer(planes, w, h, 8, lossless, 30.0, out).ok());
+    EXPECT_FALSE(encode_decode_grey_peer(planes, w + 1, h, 10, lossless, 30.0, out).ok());
+}
+
+// The immersive-video depth peer on rendered frames: lossless 10-bit 1/z over the scene's depth
+// range moves no pixel of `crossing` by more than 0.05 px for a 16.4 cm camera step, and keeps
+// the background; a coarse rate moves some pixels beyond 0.25 px.
+TEST(DepthVideoPeer, LosslessTenBitIsWithinAQuantisationStepAndCoarseRatesAreNot) {
+    if (!peer_available(PeerKind::X265)) GTEST_SKIP() << "no x265 in this libavcodec";
+    const std::vector<Frame> frames = test::render_scene("crossing", 2, 96, 64);
+    DepthVideoRun run;
+    const PeerConfig lossless{.kind = PeerKind::X265, .preset = "ultrafast", .lossless = true};
+    ASSERT_TRUE(run_depth_video_peer(frames, 30.0, lossless, 10, 0.164f, 0.25f, run).ok());
+    EXPECT_LT(run.max_error_px, 0.05);
+    EXPECT_EQ(run.share_over_bound, 0.0);
+    EXPECT_EQ(run.background_mismatches, 0u);
+    EXPECT_GT(run.bytes, 8.0);
+    const PeerConfig coarse{.kind = PeerKind::X265, .preset = "ultrafast", .crf = 45};
+    ASSERT_TRUE(run_depth_video_peer(frames, 30.0, coarse, 10, 0.164f, 0.25f, run).ok());
+    EXPECT_GT(run.max_error_px, 0.25);
+    EXPECT_GT(run.share_over_bound, 0.0);
 }
 
 // End to end on a tiny scene: every peer's rows, finite figures, the depth coders and the page.

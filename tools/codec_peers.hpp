@@ -3,6 +3,7 @@
 // same 8-bit sRGB display frames (yuv420p, limited range, BT.601 conversion by swscale), and
 // libavcodec decodes them again (h264, hevc, libdav1d), timed per frame.
 #include <cstddef>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -19,6 +20,7 @@ struct PeerConfig {
     int crf = 23;                     // the rate point: CRF (x264/x265 0..51, SVT-AV1 1..63)
     int threads = 2;                  // encoder and decoder threads
     int keyint = 0;                   // key frame interval; 0 = only the first frame
+    bool lossless = false;            // x264 qp 0, x265 lossless=1 (crf unused)
 };
 
 // "x264", "x265", "svt-av1".
@@ -44,6 +46,18 @@ struct PeerFrame {
 [[nodiscard]] Status encode_decode_peer(const std::vector<Image<Rgb8>>& frames,
                                         const PeerConfig& config, double fps,
                                         std::vector<PeerFrame>& out);
+
+// Grey video, as immersive-video systems send depth: each plane's w x h samples (0..2^bits - 1,
+// row-major) as gray10le / gray12le luma through x264 (High 10, 4:0:0) or x265 (4:0:0, 12 bits
+// too), decoded again; `out` gets the decoded planes, bytes and times.
+struct GreyFrame {
+    std::size_t bytes = 0;
+    double encode_ms = 0.0, decode_ms = 0.0, encode_convert_ms = 0.0, decode_convert_ms = 0.0;
+    std::vector<uint16_t> decoded;
+};
+[[nodiscard]] Status encode_decode_grey_peer(const std::vector<std::vector<uint16_t>>& planes,
+                                             int w, int h, int bits, const PeerConfig& config,
+                                             double fps, std::vector<GreyFrame>& out);
 
 // The streaming configurations of issue 8 §6, each at four rate points: x264 ultrafast,
 // veryfast, medium; x265 ultrafast; SVT-AV1 preset 10 (all low delay, zerolatency).

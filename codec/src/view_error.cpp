@@ -7,7 +7,8 @@
 namespace reprise::codec {
 
 ViewDepthError measure_view_depth_error(const Camera& camera, ImageView<const float> truth,
-                                        ImageView<const float> decoded, float displacement) {
+                                        ImageView<const float> decoded, float displacement,
+                                        float bound_px) {
     const glm::mat4& p = camera.projection;
     const double sx = p[0][0], sy = p[1][1], ox = p[2][0], oy = p[2][1];
     const int w = truth.width, h = truth.height;
@@ -33,16 +34,18 @@ ViewDepthError measure_view_depth_error(const Camera& camera, ImageView<const fl
             const glm::dvec3 worst = r > 0.0
                                          ? b * glm::dvec3(-u / r, -v / r, r) / std::sqrt(1 + r * r)
                                          : glm::dvec3(b, 0.0, 0.0);
+            double largest = 0.0;
             auto shift = [&](const glm::dvec3& t) {
                 const double dt = 1.0 - t.z * wt, dd = 1.0 - t.z * wd;
                 if (dt <= 0.0 || dd <= 0.0) return;  // at or behind the moved camera
                 const double ex = fx * (t.z * u - t.x), ey = fy * (t.z * v - t.y);
-                const double px = std::hypot(ex, ey) * std::abs(wt - wd) / (dt * dd);
-                result.max_px = std::max(result.max_px, px);
+                largest = std::max(largest, std::hypot(ex, ey) * std::abs(wt - wd) / (dt * dd));
             };
             for (const glm::dvec3& t : cube) shift(t);
             shift(worst);
             shift(-worst);
+            result.max_px = std::max(result.max_px, largest);
+            if (largest > bound_px) ++result.pixels_over_bound;
         }
     return result;
 }

@@ -2,6 +2,7 @@
 // Scene-aware predictive codec: each frame is predicted by reprojecting a reference the decoder
 // holds with the renderer's depth, cameras and motion; only what prediction gets wrong is coded.
 // Bitstream: docs/bitstream.md. Encoder and decoder are push/pull state machines (as dav1d).
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <functional>
@@ -163,9 +164,11 @@ struct ViewDepthError {
     double max_px = 0.0;                    // largest distance between the two reprojections
     std::size_t background_mismatches = 0;  // +inf in one and not the other
     std::size_t pixels = 0;                 // pixels with finite depth in both
+    std::size_t pixels_over_bound = 0;      // of those, moved by more than `bound_px`
 };
 ViewDepthError measure_view_depth_error(const Camera& camera, ImageView<const float> truth,
-                                        ImageView<const float> decoded, float displacement);
+                                        ImageView<const float> decoded, float displacement,
+                                        float bound_px = INFINITY);
 // The 1/z step DepthMode::View uses for frames of this size seen through `projection`.
 float view_depth_step(const glm::mat4& projection, int width, int height, float error_px,
                       float displacement);
