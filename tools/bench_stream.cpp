@@ -4,8 +4,9 @@
 // was displayed against the scene rendered at the displayed poses and instants, longest freeze.
 // Peers from the same run: frame repetition (the newest decoded frame shown as it is) and the
 // video-only model (x264 zerolatency of the same full-resolution frames at crf 23 and 15, newest
-// decoded shown), and that video turned to the display pose by rotation alone (the pose-only
-// timewarp of ALVR and Oculus Link).
+// decoded shown), that video turned to the display pose by rotation alone (the pose-only
+// timewarp of ALVR and Oculus Link), and that video plus its depth as 10-bit grey video
+// extrapolated to the display pose by reprise's client warp (as immersive-video systems send it).
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -18,8 +19,10 @@
 #include "bench.hpp"
 #include "bench_report.hpp"
 #include "codec_peers.hpp"
+#include "depth_video_peer.hpp"
 #include "reprise/client/stream_client.hpp"
 #include "reprise/server/stream_server.hpp"
+#include "reprise/warp/extrapolate.hpp"
 
 namespace reprise::cli {
 
@@ -124,6 +127,29 @@ void timewarp(const Image<Rgb8>& source, const glm::mat4& source_view, const glm
         }
 }
 
+// What a client of the colour + depth video peer holds: the decoded colour (back to linear
+// light), the decoded depth and the frame's camera; no object motion is sent, so every surface
+// counts as static (motion zero against a previous camera equal to its own).
+void receive_peer_frame(const Image<Rgb8>& colour, const Image<float>& depth, const Camera& camera,
+                        Frame& out) {
+    const int w = colour.width(), h = colour.height();
+    out.color.resize(w, h);
+    out.depth.resize(w, h);
+    out.motion.assign(w, h, glm::vec2(0.0f));
+    out.camera = camera;
+    out.camera.prev_view = camera.view;
+    out.camera.prev_projection = camera.projection;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const Rgb8 c = colour(x, y);
+            const float z = depth(x, y);
+            out.depth(x, y) = z;
+            out.color(x, y) =
+                glm::vec4(srgb_to_linear(c.r / 255.0f), srgb_to_linear(c.g / 255.0f),
+                          srgb_to_linear(c.b / 255.0f), std::isfinite(z) ? 1.0f : 0.0f);
+        }
+}
+
 struct StreamBench {
     const BenchOptions& options;
     int width = 256, height = 144;
@@ -205,8 +231,9 @@ struct StreamBench {
                            sst.bytes_sent * 8.0 / seconds / 1000.0};
         MethodSummary repeat{c.name, "repetition", ours.kbps};
         MethodSummary video{c.name, "x264-crf23"}, video_fine{c.name, "x264-crf15"};
-        MethodSummary warped{c.name, "x264-crf23+tw"};
-        const std::array<MethodSummary*, 5> all = {&ours, &repeat, &video, &video_fine, &warped};
+        MethodSummary warped{c.name, "x264-crf23+tw"}, with_depth{c.name, "x264+depth10"};
+        const std::array<MethodSummary*, 6> all = {&ours,       &repeat, &video,
+                                                   &video_fine, &warped, &with_depth};
         for (MethodSummary* m : all) {
             m->frames_lost = cst.frames_lost;
             m->fec_recovered = cst.fec_recovered;
@@ -232,7 +259,7 @@ struct StreamBench {
         longest = std::max(longest, ticks.back().t - freeze_start);
         for (MethodSummary* m : all) m->longest_freeze_ms = longest * 1000.0;
         video.latency_ms = video_fine.latency_ms = repeat.latency_ms;
-        warped.latency_ms = ours.latency_ms;  // turned to each display frame's pose
+        warped.latency_ms = with_depth.latency_ms = ours.latency_ms;  // at each display pose
 
         // The video-only peer: the same source frames (rendered at their poses) through x264.
         const int method_count = lowres ? 1 : int(all.size());
@@ -245,10 +272,14 @@ struct StreamBench {
                            source_times.end());
         Frame truth;
         std::vector<Image<Rgb8>> sources;
+        std::vector<Image<float>> source_depth;
+        std::vector<Camera> source_camera;
         for (double t : lowres ? std::vector<double>{} : source_times) {
             REPRISE_TRY(render_at(t, server::camera_view(scene.path, scene.scene, t), truth));
             sources.emplace_back(width, height);
             visualize_color(truth.color.view(), sources.back().view());
+            source_depth.push_back(truth.depth);  // a copy: truth is rendered into again
+            source_camera.push_back(truth.camera);
         }
         // Two rate points: x264's usual crf 23 and a finer one near reprise's bitrate.
         std::vector<PeerFrame> x264, x264_fine;
@@ -267,11 +298,26 @@ struct StreamBench {
         };
         video.kbps = warped.kbps = kbps(x264);
         video_fine.kbps = kbps(x264_fine);
+        // Depth beside the video: 1/z as 10-bit grey through x265 (crf 8 keeps every pixel of
+        // bench codec's scenes within 0.25 px of reprojection for 16.4 cm of camera motion).
+        DepthVideo depth_video;
+        if (!lowres && peer_available(PeerKind::X265)) {
+            std::vector<ImageView<const float>> depths;
+            for (const Image<float>& d : source_depth) depths.push_back(d.view());
+            REPRISE_TRY(code_depth_video(depths, fps,
+                                         {.kind = PeerKind::X265, .preset = "veryfast", .crf = 8},
+                                         10, depth_video));
+            double bytes = double(depth_video.range_bytes);
+            for (std::size_t b : depth_video.bytes) bytes += double(b);
+            with_depth.kbps = video.kbps + bytes * 8.0 / (double(depths.size()) / fps) / 1000.0;
+        }
+        warp::PoseExtrapolator extrapolator;
+        Frame received, extrapolated;
         const glm::mat4 projection =
             server::instant_on_path(scene.path, scene.scene, 0.0, width, height).projection;
 
         Image<glm::vec3> reference, shown;
-        Image<Rgb8> truth_rgb(width, height), turned;
+        Image<Rgb8> truth_rgb(width, height), turned, warped_depth(width, height);
         int index = 0;
         for (const Tick& k : ticks) {
             if (!k.evaluated) continue;
@@ -286,10 +332,21 @@ struct StreamBench {
                 timewarp(*video_frame,
                          server::camera_view(scene.path, scene.scene, source_times[si]), k.view,
                          projection, turned);
-            const std::array<const Image<Rgb8>*, 5> candidates = {
-                &k.ours, &k.repeated, video_frame,
+            const bool have_depth = video_frame && si < depth_video.decoded.size();
+            if (have_depth) {
+                receive_peer_frame(*video_frame, depth_video.decoded[si], source_camera[si],
+                                   received);
+                const float periods = float(std::clamp((k.t - source_times[si]) * fps, 0.0, 8.0));
+                extrapolator.extrapolate(received, k.view, projection, periods, extrapolated);
+                visualize_color(extrapolated.color.view(), warped_depth.view());
+            }
+            const std::array<const Image<Rgb8>*, 6> candidates = {
+                &k.ours,
+                &k.repeated,
+                video_frame,
                 si < x264_fine.size() ? &x264_fine[si].decoded : nullptr,
-                video_frame ? &turned : nullptr};
+                video_frame ? &turned : nullptr,
+                have_depth ? &warped_depth : nullptr};
             for (int m = 0; m < method_count; ++m) {
                 if (!candidates[m]) continue;
                 from_rgb8(candidates[m]->view(), shown);
@@ -297,7 +354,7 @@ struct StreamBench {
                 all[m]->errors.push_back(e);
                 csv.row({c.name, all[m]->method, std::to_string(index), strf("%.4f", e.psnr),
                          strf("%.6f", e.ssim), strf("%.6f", e.flip),
-                         strf("%.3f", all[m] == &ours || all[m] == &warped
+                         strf("%.3f", all[m] == &ours || all[m] == &warped || all[m] == &with_depth
                                           ? (k.displayed_us - k.pose_us) / 1000.0
                                           : (k.displayed_us - k.source_pose_us) / 1000.0)});
             }
@@ -388,7 +445,10 @@ Status bench_stream(const BenchOptions& options) {
         "times and losses; x264's "
         "error propagation after a loss is not modelled, which favours it). x264-crf23+tw: the "
         "crf 23 video turned to each display frame's pose by rotation alone (the pose-only "
-        "timewarp of ALVR and Oculus Link: no depth, no translation).",
+        "timewarp of ALVR and Oculus Link: no depth, no translation). x264+depth10: the crf 23 "
+        "video plus its depth as 10-bit grey video (1/z over the sequence's depth range, x265 "
+        "veryfast crf 8, as immersive-video systems send it; bits of both counted), extrapolated "
+        "to each display pose by reprise's client warp; no object motion is sent.",
         "Latency: pose sampled -> displayed, for reprise the pose each display frame was warped "
         "to, for the peers "
         "the pose of the frame the first time it is shown. Truth: the scene rendered at each "

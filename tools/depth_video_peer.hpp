@@ -20,6 +20,20 @@ struct DepthVideoRun {
     std::size_t background_mismatches = 0;
 };
 
+// "x265 10-bit veryfast crf 8", "x265 10-bit veryfast lossless".
+std::string depth_video_setting(const PeerConfig& config, int bits);
+
+// The depth video itself: `decoded` depth (background +inf) and bytes per frame, plus the depth
+// range sent once.
+struct DepthVideo {
+    std::vector<Image<float>> decoded;
+    std::vector<std::size_t> bytes;
+    std::vector<double> encode_ms, decode_ms;
+    std::size_t range_bytes = 0;
+};
+[[nodiscard]] Status code_depth_video(const std::vector<ImageView<const float>>& depths, double fps,
+                                      const PeerConfig& config, int bits, DepthVideo& out);
+
 // Codes the depth of `frames` (with cameras) as grey video and measures, per frame, the
 // reprojection error its decoded depth causes for a camera displaced by up to `displacement`
 // (codec::measure_view_depth_error), counting pixels beyond `bound_px`.
