@@ -102,7 +102,7 @@ ImageError mean_error(const std::vector<ImageError>& e) {
 void timewarp(const Image<Rgb8>& source, const glm::mat4& source_view, const glm::mat4& shown_view,
               const glm::mat4& projection, Image<Rgb8>& out) {
     const int w = source.width(), h = source.height();
-    out = Image<Rgb8>(w, h);
+    out.resize(w, h);
     const glm::mat4 unproject = glm::inverse(projection);
     const glm::mat3 turn = glm::mat3(source_view) * glm::transpose(glm::mat3(shown_view));
     for (int y = 0; y < h; ++y)
@@ -329,9 +329,7 @@ struct StreamBench {
                 source_times.begin();
             const Image<Rgb8>* video_frame = si < x264.size() ? &x264[si].decoded : nullptr;
             if (video_frame)
-                timewarp(*video_frame,
-                         server::camera_view(scene.path, scene.scene, source_times[si]), k.view,
-                         projection, turned);
+                timewarp(*video_frame, source_camera[si].view, k.view, projection, turned);
             const bool have_depth = video_frame && si < depth_video.decoded.size();
             if (have_depth) {
                 receive_peer_frame(*video_frame, depth_video.decoded[si], source_camera[si],
