@@ -55,17 +55,7 @@ using test::encode_all;
     return ::testing::AssertionSuccess();
 }
 
-std::vector<Frame> decode_all(const std::vector<Packet>& packets) {
-    Decoder decoder;
-    std::vector<Frame> out;
-    for (const Packet& p : packets) {
-        Status s = decoder.send_packet(p.data);
-        EXPECT_TRUE(s.ok()) << s.message();
-        Frame f;
-        while (decoder.receive_frame(f) == Result::Ok) out.push_back(std::move(f));
-    }
-    return out;
-}
+using test::decode_all;
 
 void fix_crc(std::vector<uint8_t>& packet) {
     if (packet.size() < 32) return;
@@ -486,7 +476,7 @@ TEST(Codec, ASilhouetteOnePixelOffCostsAFlag) {
 TEST(Codec, StreamsOfAnOlderVersionAreRefused) {
     const auto frames = render("crossing", 1, 64, 48);
     Coded coded = encode_all(frames, {.depth = DepthMode::View});
-    for (uint8_t version : {1, 2}) {  // before view depth; before bounded motion
+    for (uint8_t version : {1, 2, 3}) {  // before view depth, bounded motion, rigid objects
         std::vector<uint8_t> packet = coded.packets[0].data;
         packet[4] = version;
         Decoder decoder;

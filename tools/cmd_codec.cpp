@@ -89,10 +89,12 @@ void print_stats(const codec::StreamStats& s, double fps) {
     std::printf(
         "  left out: %zu of %zu colour blocks skipped (%.1f %%), %zu depth blocks predicted "
         "exactly, "
-        "motion beyond the cameras' on %zu pixels (%zu models, %zu pixels alone)\n",
+        "motion beyond the cameras' on %zu pixels (%zu rigid objects, %zu models, %zu pixels "
+        "alone)\n",
         s.blocks_skipped, s.blocks,
         100.0 * double(s.blocks_skipped) / double(std::max<std::size_t>(1, s.blocks)),
-        s.depth_zero_blocks, s.motion_residual_pixels, s.motion_models, s.motion_own_pixels);
+        s.depth_zero_blocks, s.motion_residual_pixels, s.motion_objects, s.motion_models,
+        s.motion_own_pixels);
     std::printf(
         "  %zu frames: %zu key, %zu predicted from an older reference, %zu intra macroblocks\n",
         s.frames, s.key_frames, s.older_reference, s.intra_blocks);

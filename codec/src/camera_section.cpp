@@ -10,8 +10,14 @@ namespace reprise::codec {
 
 namespace {
 
-enum : uint8_t { kSameView = 1, kPrevIsReference = 2, kSameLens = 4, kSameProjection = 8 };
-constexpr uint8_t kAllFlags = kSameView | kPrevIsReference | kSameLens | kSameProjection;
+enum : uint8_t {
+    kSameView = 1,
+    kPrevIsReference = 2,
+    kSameLens = 4,
+    kSameProjection = 8,
+    kObjects = 16
+};
+constexpr uint8_t kAllFlags = kSameView | kPrevIsReference | kSameLens | kSameProjection | kObjects;
 
 // `base`: the reference's matrix (xor-varint coding) or null (raw f32).
 void write_mat(ByteWriter& w, const glm::mat4& m, const glm::mat4* base) {
@@ -43,7 +49,8 @@ bool same_lens(const Camera& a, const Camera& b) {
 
 }  // namespace
 
-void encode_camera(const Camera& c, double time, const Picture* ref, std::vector<uint8_t>& out) {
+std::size_t encode_camera(const Camera& c, double time, const Picture* ref,
+                          std::span<const ObjectMotion> objects, std::vector<uint8_t>& out) {
     ByteWriter w(out);
     uint8_t flags = 0;
     const glm::mat4 *view = nullptr, *projection = nullptr;
@@ -55,6 +62,7 @@ void encode_camera(const Camera& c, double time, const Picture* ref, std::vector
         if (c.prev_view == rc.view && c.prev_projection == rc.projection) flags |= kPrevIsReference;
         if (same_lens(c, rc)) flags |= kSameLens;
     }
+    if (!objects.empty()) flags |= kObjects;
     w.u8(flags);
     if (!(flags & kSameView)) write_mat(w, c.view, view);
     if (!(flags & kSameProjection)) write_mat(w, c.projection, projection);
@@ -69,14 +77,19 @@ void encode_camera(const Camera& c, double time, const Picture* ref, std::vector
         w.f32(c.jitter.y);
     }
     w.f64(time);
+    const std::size_t before = out.size();
+    if (!objects.empty()) write_objects(objects, ref ? &ref->objects : nullptr, w);
+    return out.size() - before;
 }
 
-Status decode_camera(std::span<const uint8_t> in, const Picture* ref, Camera& c, double& time) {
+Status decode_camera(std::span<const uint8_t> in, const Picture* ref, Camera& c, double& time,
+                     int width, int height, std::vector<ObjectMotion>& objects,
+                     std::size_t& object_bytes) {
     ByteReader r(in, "camera section");
     const uint8_t flags = r.u8();
     if (flags & ~kAllFlags)
         return Status::error("camera section: unknown flags " + std::to_string(flags));
-    if (flags && !ref)
+    if ((flags & ~kObjects) && !ref)
         return Status::error("camera section: refers to the reference camera of a key frame");
     const glm::mat4* view = ref ? &ref->camera.view : nullptr;
     const glm::mat4* projection = ref ? &ref->camera.projection : nullptr;
@@ -101,6 +114,11 @@ Status decode_camera(std::span<const uint8_t> in, const Picture* ref, Camera& c,
     time = r.f64();
     c.time = time;
     if (!r.ok()) return Status::error(r.error());
+    objects.clear();
+    const std::size_t before = r.position();
+    if (flags & kObjects)
+        REPRISE_TRY(read_objects(r, width, height, ref ? &ref->objects : nullptr, objects));
+    object_bytes = r.position() - before;
     if (r.remaining())
         return Status::error("camera section: " + std::to_string(r.remaining()) +
                              " bytes left over");

@@ -67,14 +67,22 @@ Status Decoder::send_packet(std::span<const uint8_t> packet) {
     StreamStats fs;
     Camera camera;
     double time = 0.0;
-    REPRISE_TRY(decode_camera(sections[0], ref, camera, time));
+    std::vector<ObjectMotion> objects;
+    std::size_t object_bytes = 0;
+    REPRISE_TRY(
+        decode_camera(sections[0], ref, camera, time, sp.width, sp.height, objects, object_bytes));
+    fc.objects = objects;
+    pic.objects = objects;
+    fs.motion_bits += 8 * object_bytes;
+    fs.motion_objects = objects.size();
     REPRISE_TRY(decode_depth(fc, camera, sections[1], pic.depth, fs));
-    REPRISE_TRY(decode_motion(fc, camera, pic.depth.view(), sections[2], pic.motion, fs));
+    REPRISE_TRY(
+        decode_motion(fc, camera, pic.depth.view(), sections[2], pic.motion, pic.owner, fs));
     const ImageView<const glm::vec2> motion =
         motion_to_reference(sp, camera, pic.depth, pic.motion, ref, h.frame, s.work);
     fs.older_reference = ref && ref->frame + 1 != h.frame;
     REPRISE_TRY(decode_color(fc, motion, sections[3], pic.planes, fs));
-    fs.camera_bits += 8 * sections[0].size();
+    fs.camera_bits += 8 * (sections[0].size() - object_bytes);
     fs.frames = 1;
     fs.key_frames = key;
     fs.header_bits =

@@ -319,7 +319,12 @@ void temporal_codes(const FrameContext& fc, const Camera& camera, const Mapping&
     const int w = fc.sp->width, h = fc.sp->height;
     Image<float>& projected = fc.work->projected_depth;
     ensure_size(projected, w, h);
-    reproject_depth(fc.reference->camera, fc.reference->depth.view(), camera, projected.view());
+    // Objects move the reference's pixels only when it is the frame their motion starts from.
+    const Camera& rc = fc.reference->camera;
+    const bool previous = camera.prev_view == rc.view && camera.prev_projection == rc.projection;
+    reproject_depth(rc, fc.reference->depth.view(), camera, projected.view(),
+                    previous ? fc.reference->owner.view() : ImageView<const uint32_t>{},
+                    previous ? fc.objects : std::span<const ObjectMotion>{});
     ensure_size(out, w, h);
     parallel_for(0, h, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y)

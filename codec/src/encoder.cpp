@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <deque>
 #include <set>
 
@@ -21,16 +22,46 @@ namespace {
 
 constexpr std::size_t kMaxQueuedPackets = 16;
 
-// The view step of a new sequence: the client's, finer when the camera travels further than B
-// between frames, so that the camera motion both sides derive from decoded depth stays within the
-// motion bound (docs/bitstream.md, section 6). The travel is the key frame's; a camera that later
-// moves faster costs motion residuals.
-float sequence_view_step(const Camera& camera, int w, int h, float client, float motion_error) {
+// The rigid motions of a frame's objects, fitted to its rendered depth and motion (the camera
+// motion of the rendered depth decides which objects move on their own).
+std::vector<ObjectMotion> frame_objects(const EncoderOptions& options, const SequenceParams& sp,
+                                        const Frame& frame, const Camera& camera,
+                                        const Picture* ref, Image<glm::vec2>& scratch) {
+    if (!options.rigid_objects || sp.motion_error <= 0.0f || sp.depth == DepthMode::None ||
+        frame.id.empty() || frame.depth.empty() || frame.motion.empty())
+        return {};
+    ensure_size(scratch, sp.width, sp.height);
+    camera_motion(camera, frame.depth.view(), camera.prev_view, camera.prev_projection,
+                  scratch.view());
+    return fit_object_motions(
+        camera, frame.depth.view(), frame.id.view(), frame.motion.view(), scratch.view(),
+        sp.motion_error,
+        ref ? std::span<const ObjectMotion>(ref->objects) : std::span<const ObjectMotion>());
+}
+
+// The view step of a new sequence: the client's, finer when the camera, or an object relative to
+// it, travels further than B between frames, so that the motion both sides derive from decoded
+// depth stays within the motion bound (docs/bitstream.md, section 6). An object counts up to
+// kObjectTravel times the larger of B and the camera's travel: beyond, the depth it would need
+// costs more than its motion. The travels are the key frame's; what later moves faster costs
+// motion residuals.
+constexpr float kObjectTravel = 3.0f;
+float sequence_view_step(const Camera& camera, std::span<const ObjectMotion> objects, int w, int h,
+                         float client, float displacement, float motion_error) {
     if (motion_error <= 0.0f) return client;
     const glm::vec3 here = glm::vec3(glm::inverse(camera.view)[3]);
     const glm::vec3 before = glm::vec3(glm::inverse(camera.prev_view)[3]);
-    const float travel = glm::length(here - before);
-    if (!(travel > 0.0f && travel < 1e6f)) return client;
+    float travel = glm::length(here - before);
+    if (!(travel < 1e6f)) travel = 0.0f;
+    const float limit = kObjectTravel * std::max(displacement, travel);
+    float object_travel = 0.0f;
+    for (const ObjectMotion& o : objects) {
+        const float t =
+            glm::length(glm::vec3(o.translation[0], o.translation[1], o.translation[2]));
+        if (t <= limit) object_travel = std::max(object_travel, t);
+    }
+    travel = std::max(travel, object_travel);
+    if (!(travel > 0.0f)) return client;
     return std::min(client, view_depth_step(camera.projection, w, h, motion_error, travel));
 }
 
@@ -134,6 +165,10 @@ struct Encoder::State {
         return c;
     }
 
+    std::vector<ObjectMotion> fit_objects(const Frame& frame, const Camera& camera,
+                                          const Picture* ref) {
+        return frame_objects(options, sp, frame, camera, ref, work.base_motion);
+    }
     Status encode(const Frame& frame, const Camera& camera, int ref_slot, int qp_now, Picture& pic,
                   std::vector<uint8_t>& payload, StreamStats& fs, ColorEncodeResult& colour) {
         const bool key = ref_slot < 0;
@@ -142,18 +177,22 @@ struct Encoder::State {
         payload.clear();
         if (key) write_params(sp, payload);
 
+        std::vector<uint8_t> depth_section, motion_section;
+        std::vector<ObjectMotion> objects = fit_objects(frame, camera, ref);
+        fc.objects = objects;
+        encode_depth(fc, camera, frame.depth.view(), pic.depth, depth_section, fs);
+        encode_motion(fc, camera, pic.depth.view(), frame.motion.view(), frame.id.view(),
+                      pic.motion, pic.owner, motion_section, fs);
+        pic.objects = objects;
+
         std::vector<uint8_t> section;
-        encode_camera(camera, camera.time, ref, section);
-        fs.camera_bits += 8 * section.size();
+        const std::size_t object_bytes = encode_camera(camera, camera.time, ref, objects, section);
+        fs.camera_bits += 8 * (section.size() - object_bytes);
+        fs.motion_bits += 8 * object_bytes;
+        fs.motion_objects = objects.size();
         append_section(payload, section);
-
-        section.clear();
-        encode_depth(fc, camera, frame.depth.view(), pic.depth, section, fs);
-        append_section(payload, section);
-
-        section.clear();
-        encode_motion(fc, camera, pic.depth.view(), frame.motion.view(), pic.motion, section, fs);
-        append_section(payload, section);
+        append_section(payload, depth_section);
+        append_section(payload, motion_section);
 
         const ImageView<const glm::vec2> motion =
             motion_to_reference(sp, camera, pic.depth, pic.motion, ref, next_frame, work);
@@ -229,9 +268,13 @@ Status Encoder::send_frame(const Frame& given) {
         sp.view_displacement = s.options.view_displacement;
         const float client =
             view_depth_step(camera.projection, w, h, sp.view_error, sp.view_displacement);
-        sp.view_step = s.started && client == s.client_step
-                           ? s.sp.view_step
-                           : sequence_view_step(camera, w, h, client, sp.motion_error);
+        sp.view_step =
+            s.started && client == s.client_step
+                ? s.sp.view_step
+                : sequence_view_step(
+                      camera,
+                      frame_objects(s.options, sp, frame, camera, nullptr, s.work.base_motion), w,
+                      h, client, sp.view_displacement, sp.motion_error);
         s.client_step = client;
     }
     sp.slices = default_slices(h);

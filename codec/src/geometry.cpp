@@ -132,11 +132,51 @@ void camera_motion(const Camera& from, ImageView<const float> depth, const glm::
     });
 }
 
+bool unproject_pixel(const Camera& camera, int width, int height, int x, int y, float z,
+                     glm::vec4& out) {
+    return unprojector(camera, width, height).point(x, y, z, out);
+}
+
+glm::mat4 rigid_to_clip(const Camera& camera, const glm::dmat4& moved) {
+    return glm::mat4(glm::dmat4(camera.prev_projection) *
+                     glm::dmat4(between(camera.view, camera.prev_view)) * moved);
+}
+
+void rigid_motion(const Camera& from, ImageView<const float> depth, const glm::mat4& to_clip,
+                  int x0, int y0, ImageView<glm::vec2> out) {
+    const Unprojector un = unprojector(from, depth.width, depth.height);
+    parallel_for(0, out.height, [&](int r0, int r1) {
+        for (int r = r0; r < r1; ++r)
+            for (int c = 0; c < out.width; ++c) {
+                const int x = x0 + c, y = y0 + r;
+                glm::vec4 point;
+                glm::vec2 m{kNan, kNan};
+                if (un.point(x, y, depth(x, y), point)) {
+                    const glm::vec4 clip = to_clip * point;
+                    if (clip.w > 0.0f)
+                        m = {(clip.x / clip.w + 1.0f) * 0.5f * un.width - (float(x) + 0.5f),
+                             (1.0f - clip.y / clip.w) * 0.5f * un.height - (float(y) + 0.5f)};
+                }
+                out(c, r) = m;
+            }
+    });
+}
+
 void reproject_depth(const Camera& from, ImageView<const float> depth, const Camera& to,
-                     ImageView<float> out) {
+                     ImageView<float> out, ImageView<const uint32_t> owner,
+                     std::span<const ObjectMotion> objects) {
     const int w = depth.width, h = depth.height;
     REPRISE_ASSERT(out.width == w && out.height == h);
-    if (from.view == to.view && from.projection == to.projection) {
+    if (owner.empty()) objects = {};
+    // The object a pixel moves with, or -1.
+    auto object_of = [&](int x, int y) {
+        const uint32_t id = owner(x, y);
+        if (id != 0)
+            for (std::size_t k = 0; k < objects.size(); ++k)
+                if (objects[k].id == id) return int(k);
+        return -1;
+    };
+    if (from.view == to.view && from.projection == to.projection && objects.empty()) {
         for (int y = 0; y < h; ++y) std::copy(depth.row(y), depth.row(y) + w, out.row(y));
         return;
     }
@@ -149,13 +189,36 @@ void reproject_depth(const Camera& from, ImageView<const float> depth, const Cam
     // projected in parallel and a landing takes its slot by compare-and-swap.
     float* slots = out.data;
     REPRISE_ASSERT(out.stride == w);
+    auto land = [&](int32_t slot, float z) {
+        std::atomic_ref<float> target(slots[slot]);
+        float held = target.load(std::memory_order_relaxed);
+        while (!(z >= held) && !target.compare_exchange_weak(held, z, std::memory_order_relaxed)) {
+        }
+    };
+    // Pixels that moved with an object land where its inverse motion takes them.
+    std::vector<glm::mat4> object_clip, object_camera;
+    for (const ObjectMotion& o : objects) {
+        const glm::dmat4 moved = glm::inverse(o.matrix()) * glm::dmat4(to_camera);
+        object_camera.push_back(glm::mat4(moved));
+        object_clip.push_back(glm::mat4(glm::dmat4(to.projection) * moved));
+    }
     parallel_for(0, h, [&](int y0, int y1) {
         constexpr int kChunk = 256;
         int32_t slot[kChunk];
-        float tz[kChunk];
+        float tz[kChunk], held[kChunk];
         for (int y = y0; y < y1; ++y)
             for (int x0 = 0; x0 < w; x0 += kChunk) {
                 const int n = std::min(kChunk, w - x0);
+                const float* row = depth.row(y) + x0;
+                bool moved = false;
+                if (!objects.empty()) {
+                    for (int i = 0; i < n; ++i) {
+                        const bool own = object_of(x0 + i, y) >= 0;
+                        held[i] = own ? kNan : row[i];
+                        moved = moved || own;
+                    }
+                    if (moved) row = held;
+                }
                 forward_row({.projection = from.projection,
                              .to_clip = to_clip,
                              .to_camera = to_camera,
@@ -164,16 +227,28 @@ void reproject_depth(const Camera& from, ImageView<const float> depth, const Cam
                              .count = n,
                              .width = w,
                              .height = h,
-                             .depth = depth.row(y) + x0,
+                             .depth = row,
                              .slot = slot,
                              .z = tz});
+                for (int i = 0; i < n; ++i)
+                    if (slot[i] >= 0) land(slot[i], tz[i]);
+                if (!moved) continue;
                 for (int i = 0; i < n; ++i) {
-                    if (slot[i] < 0) continue;
-                    std::atomic_ref<float> target(slots[slot[i]]);
-                    float held = target.load(std::memory_order_relaxed);
-                    while (!(tz[i] >= held) &&
-                           !target.compare_exchange_weak(held, tz[i], std::memory_order_relaxed)) {
-                    }
+                    const int k = object_of(x0 + i, y);
+                    if (k < 0) continue;
+                    forward_row_reference({.projection = from.projection,
+                                           .to_clip = object_clip[std::size_t(k)],
+                                           .to_camera = object_camera[std::size_t(k)],
+                                           .x0 = x0 + i,
+                                           .y = y,
+                                           .count = 1,
+                                           .width = w,
+                                           .height = h,
+                                           .depth = depth.row(y) + x0 + i,
+                                           .slot = slot,
+                                           .z = tz},
+                                          0, 1);
+                    if (slot[0] >= 0) land(slot[0], tz[0]);
                 }
             }
     });

@@ -13,7 +13,7 @@ namespace reprise::codec {
 
 inline constexpr uint32_t kPacketMagic = 0x544B5052;  // "RPKT"
 inline constexpr uint32_t kFileMagic = 0x53525052;    // "RPRS"
-inline constexpr uint8_t kVersion = 3;
+inline constexpr uint8_t kVersion = 4;
 inline constexpr std::size_t kPacketHeaderSize = 32;
 inline constexpr std::size_t kMaxPayload = 256u << 20;
 inline constexpr int kMaxSide = 16384;
@@ -64,6 +64,8 @@ struct Picture {
     Planes planes;
     Image<float> depth;       // decoded depth (empty when the stream has none)
     Image<glm::vec2> motion;  // decoded backward motion to the previous frame
+    Image<uint32_t> owner;    // per pixel: the id of the object whose motion it took, else 0
+    std::vector<ObjectMotion> objects;  // the rigid object motions its packet sent
     Camera camera;
     double time = 0.0;
 };
@@ -104,10 +106,23 @@ void linear_from_planes(const Planes& planes, const SequenceParams& sp,
 // is behind `to` or depth is NaN/negative; 0 everywhere when the cameras are identical.
 void camera_motion(const Camera& from, ImageView<const float> depth, const glm::mat4& to_view,
                    const glm::mat4& to_projection, ImageView<glm::vec2> out);
+// Pixel (x, y) of a width x height picture at depth z in the camera space of `camera`
+// (homogeneous, w = 0 for a background direction); false for NaN or negative depth.
+bool unproject_pixel(const Camera& camera, int width, int height, int x, int y, float z,
+                     glm::vec4& out);
+// The clip transform of a point that moved rigidly: `moved` takes its position in the camera
+// space of `camera` to where it was one frame earlier (same space); then the previous camera.
+glm::mat4 rigid_to_clip(const Camera& camera, const glm::dmat4& moved);
+// The motion camera_motion gives, for the pixels of `out` (placed at x0, y0 in the picture) and
+// a point transform of rigid_to_clip, pixel by pixel (no row form).
+void rigid_motion(const Camera& from, ImageView<const float> depth, const glm::mat4& to_clip,
+                  int x0, int y0, ImageView<glm::vec2> out);
 // The reference depth forward-projected into camera `to` (z-buffered, nearest pixel);
 // NaN where nothing landed. A copy when the cameras are identical.
+// Pixels whose `owner` id is one of `objects` (this frame's) move with that object's motion.
 void reproject_depth(const Camera& from, ImageView<const float> depth, const Camera& to,
-                     ImageView<float> out);
+                     ImageView<float> out, ImageView<const uint32_t> owner = {},
+                     std::span<const ObjectMotion> objects = {});
 // What drives colour prediction: the decoded motion when the reference is the previous frame,
 // else the camera motion from this frame to the reference's camera (0 without depth).
 ImageView<const glm::vec2> motion_to_reference(const SequenceParams& sp, const Camera& camera,
@@ -133,6 +148,7 @@ struct Workspace {
     Image<glm::vec2> base_motion, to_reference;
     std::vector<MotionResidual> motion_residuals;
     MotionModelScratch motion_models;
+    std::vector<ObjectField> object_fields;
     Planes predicted;
     std::vector<uint8_t> coded_blocks[3];  // per 8x8 block of each plane: intra or with a residual
     std::vector<std::vector<uint8_t>> slice_bytes;
@@ -153,12 +169,15 @@ struct FrameContext {
     const Picture* reference = nullptr;  // null on key frames
     bool key = false;
     Workspace* work = nullptr;
+    std::span<const ObjectMotion> objects;  // this frame's, from the camera section
 };
 
-void encode_camera(const Camera& camera, double time, const Picture* reference,
-                   std::vector<uint8_t>& out);
+// The camera and the objects' rigid motions (their bytes returned; counted as motion).
+std::size_t encode_camera(const Camera& camera, double time, const Picture* reference,
+                          std::span<const ObjectMotion> objects, std::vector<uint8_t>& out);
 Status decode_camera(std::span<const uint8_t> in, const Picture* reference, Camera& camera,
-                     double& time);
+                     double& time, int width, int height, std::vector<ObjectMotion>& objects,
+                     std::size_t& object_bytes);
 
 // Depth: `source` is the input depth (any floats), reconstruction goes to `out`.
 void encode_depth(const FrameContext& fc, const Camera& camera, ImageView<const float> source,
@@ -169,10 +188,12 @@ Status decode_depth(const FrameContext& fc, const Camera& camera, std::span<cons
 // Motion: decoded motion = camera motion + residual (models within sp.motion_error, or per
 // pixel in eighths of a pixel when it is 0).
 void encode_motion(const FrameContext& fc, const Camera& camera, ImageView<const float> depth,
-                   ImageView<const glm::vec2> source, Image<glm::vec2>& out,
-                   std::vector<uint8_t>& bytes, StreamStats& stats);
+                   ImageView<const glm::vec2> source, ImageView<const uint32_t> ids,
+                   Image<glm::vec2>& out, Image<uint32_t>& owner, std::vector<uint8_t>& bytes,
+                   StreamStats& stats);
 Status decode_motion(const FrameContext& fc, const Camera& camera, ImageView<const float> depth,
-                     std::span<const uint8_t> in, Image<glm::vec2>& out, StreamStats& stats);
+                     std::span<const uint8_t> in, Image<glm::vec2>& out, Image<uint32_t>& owner,
+                     StreamStats& stats);
 
 // Colour. `motion` (to the reference) drives the inter prediction.
 struct ColorEncodeResult {

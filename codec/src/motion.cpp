@@ -182,8 +182,9 @@ std::vector<SliceJob> slice_jobs(const SequenceParams& sp, const Image<glm::vec2
 }  // namespace
 
 void encode_motion(const FrameContext& fc, const Camera& camera, ImageView<const float> depth,
-                   ImageView<const glm::vec2> source, Image<glm::vec2>& out,
-                   std::vector<uint8_t>& bytes, StreamStats& stats) {
+                   ImageView<const glm::vec2> source, ImageView<const uint32_t> ids,
+                   Image<glm::vec2>& out, Image<uint32_t>& owner, std::vector<uint8_t>& bytes,
+                   StreamStats& stats) {
     const SequenceParams& sp = *fc.sp;
     const int w = sp.width, h = sp.height;
     Image<glm::vec2>& base = fc.work->base_motion;
@@ -203,10 +204,15 @@ void encode_motion(const FrameContext& fc, const Camera& camera, ImageView<const
         });
     ByteWriter wr(bytes);
     wr.u8(any ? 0 : kNoResidual);
+    owner = {};
     if (!any) {
         std::swap(out, base);  // the camera motion is the motion (base is remade every frame)
     } else if (models) {
-        encode_motion_models(sp, base.view(), source, out.view(), fc.work->motion_models,
+        const bool objects = !fc.objects.empty();
+        if (objects) ensure_size(owner, w, h);
+        object_fields(camera, depth, fc.objects, fc.work->object_fields);
+        encode_motion_models(sp, base.view(), source, ids, fc.work->object_fields, out.view(),
+                             objects ? owner.view() : ImageView<uint32_t>{}, fc.work->motion_models,
                              fc.work->slice_bytes, bytes, stats);
     } else {
         std::vector<Residual>& residuals = fc.work->motion_residuals;
@@ -223,7 +229,8 @@ void encode_motion(const FrameContext& fc, const Camera& camera, ImageView<const
 }
 
 Status decode_motion(const FrameContext& fc, const Camera& camera, ImageView<const float> depth,
-                     std::span<const uint8_t> in, Image<glm::vec2>& out, StreamStats& stats) {
+                     std::span<const uint8_t> in, Image<glm::vec2>& out, Image<uint32_t>& owner,
+                     StreamStats& stats) {
     const SequenceParams& sp = *fc.sp;
     const int w = sp.width, h = sp.height;
     Image<glm::vec2>& base = fc.work->base_motion;
@@ -232,6 +239,7 @@ Status decode_motion(const FrameContext& fc, const Camera& camera, ImageView<con
     ByteReader r(in, "motion section");
     const uint8_t flags = r.u8();
     if (!r.ok()) return Status::error(r.error());
+    owner = {};
     if (flags & ~kNoResidual)
         return Status::error("motion section: unknown flags " + std::to_string(flags));
     if (flags & kNoResidual) {
@@ -241,8 +249,12 @@ Status decode_motion(const FrameContext& fc, const Camera& camera, ImageView<con
         std::vector<std::span<const uint8_t>> slices;
         if (!read_slices(r, sp.slices, slices)) return Status::error(r.error());
         if (sp.motion_error > 0.0f) {
-            REPRISE_TRY(decode_motion_models(sp, base.view(), slices, out.view(),
-                                             fc.work->motion_models, stats));
+            const bool objects = !fc.objects.empty();
+            if (objects) ensure_size(owner, w, h);
+            object_fields(camera, depth, fc.objects, fc.work->object_fields);
+            REPRISE_TRY(decode_motion_models(
+                sp, base.view(), fc.work->object_fields, slices, out.view(),
+                objects ? owner.view() : ImageView<uint32_t>{}, fc.work->motion_models, stats));
             stats.motion_bits += 8 * in.size();
             return {};
         }

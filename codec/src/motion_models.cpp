@@ -1,12 +1,13 @@
 // Motion within a bound: per 16x16 macroblock a quadtree down to 4x4 cells. A leaf says "the
-// cameras explain it" (zero), "the neighbour's affine model goes on here" (merge), "a new affine
-// model", or, for a 4x4 cell only, what each pixel is. Every decoded pixel lies within
-// motion_error px of the renderer's motion (docs/bitstream.md), so a rigid or smoothly deformed
-// object costs a few models instead of a residual per pixel.
+// cameras explain it" (zero), "the neighbour's model goes on here" (merge), "a rigid object's
+// motion", "a new affine model", or, for a 4x4 cell only, what each pixel is. Every decoded pixel
+// lies within motion_error px of the renderer's motion (docs/bitstream.md), so a rigid or smoothly
+// deformed object costs a few models instead of a residual per pixel.
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <type_traits>
 
 #include "internal.hpp"
 #include "motion_models.hpp"
@@ -53,6 +54,7 @@ struct Models {
     BitModel split[kLevels - 1];
     BitModel own_cell;
     BitModel pixel_zero[3], pixel_model[3], pixel_which[2], invalid;
+    BitModel object[kLevels], leaf_object, object_index[2 * kMaxObjects];
     IntModel<20> offset[2], gradient[4], pixel[2];
 };
 
@@ -62,9 +64,12 @@ struct Job {
     float bound;
     int64_t step;                             // of a pixel's own value
     ImageView<const glm::vec2> base, source;  // source: encoder only
+    ImageView<const uint32_t> ids;            // encoder only
+    std::span<const ObjectField> fields;
     ImageView<glm::vec2> out;
+    ImageView<uint32_t> owner;  // may be empty
     MotionModelScratch* scratch;
-    std::size_t pixels = 0, models = 0, own_pixels = 0;
+    std::size_t pixels = 0, models = 0, own_pixels = 0, object_nodes = 0;
 
     int width() const { return sp->width; }
     MotionCell* cell(int x, int y) const {
@@ -78,6 +83,24 @@ struct Job {
         const MotionCell* c = cell(x, y);
         return c && c->has_model ? &c->model : nullptr;
     }
+    // What model m decodes pixel (x, y) to, and the value (1/512 px over the camera motion)
+    // neighbours predict from.
+    glm::vec2 output(const MotionModel& m, int x, int y) const;
+    glm::ivec2 model_value(const MotionModel& m, int x, int y) const;
+    // m as an affine model at (x, y), what a new model is predicted from: an object's value there,
+    // no gradient.
+    MotionModel prediction(const MotionModel& m, int x, int y) const;
+    // The object of the pixel's id (encoder), or -1.
+    int object_of(int x, int y) const {
+        const uint32_t id = ids(x, y);
+        for (std::size_t k = 0; k < fields.size(); ++k)
+            if (fields[k].id == id) return int(k);
+        return -1;
+    }
+    void set_owner(int x, int y, const MotionModel* m) const {
+        if (!owner.empty())
+            owner(x, y) = m && m->object >= 0 ? fields[std::size_t(m->object)].id : 0;
+    }
 };
 
 // A decoded value as neighbours predict from it (clamped: prediction needs no more).
@@ -87,11 +110,31 @@ inline glm::ivec2 kept(int64_t vx, int64_t vy) {
 
 // A pixel's own value is a multiple of this step (1/512 px) from its prediction: at most half a
 // step per component, so within the bound.
+glm::vec2 Job::output(const MotionModel& m, int x, int y) const {
+    if (m.object >= 0) return fields[std::size_t(m.object)].at(x, y);
+    return model_output(base(x, y), m.value_x(x, y), m.value_y(x, y));
+}
+
+glm::ivec2 Job::model_value(const MotionModel& m, int x, int y) const {
+    if (m.object < 0) return kept(m.value_x(x, y), m.value_y(x, y));
+    const glm::vec2 v = (output(m, x, y) - usable_base(base(x, y))) * float(kUnit);
+    if (!finite(v)) return {0, 0};
+    return kept(clamped_round(v.x, kMaxValue), clamped_round(v.y, kMaxValue));
+}
+
+MotionModel Job::prediction(const MotionModel& m, int x, int y) const {
+    if (m.object < 0) return m;
+    const glm::ivec2 v = model_value(m, x, y);
+    MotionModel p;
+    p.ax = v.x, p.ay = v.y, p.x0 = x, p.y0 = y;
+    return p;
+}
+
 inline int64_t own_step(float bound) { return int64_t(std::floor(double(bound) * 512.0 * 1.38)); }
 
 inline bool same(const MotionModel& a, const MotionModel& b) {
-    return a.ax == b.ax && a.ay == b.ay && a.gxx == b.gxx && a.gxy == b.gxy && a.gyx == b.gyx &&
-           a.gyy == b.gyy && a.x0 == b.x0 && a.y0 == b.y0;
+    return a.object == b.object && a.ax == b.ax && a.ay == b.ay && a.gxx == b.gxx &&
+           a.gxy == b.gxy && a.gyx == b.gyx && a.gyy == b.gyy && a.x0 == b.x0 && a.y0 == b.y0;
 }
 
 struct Node {
@@ -133,9 +176,7 @@ bool fit_model(const Job& j, const Node& n, const MotionModel& pred, MotionModel
 bool model_fits(const Job& j, const Node& n, const MotionModel& m) {
     for (int y = n.y; y < n.y + n.h; ++y)
         for (int x = n.x; x < n.x + n.w; ++x)
-            if (!within(j.source(x, y),
-                        model_output(j.base(x, y), m.value_x(x, y), m.value_y(x, y)), j.bound))
-                return false;
+            if (!within(j.source(x, y), j.output(m, x, y), j.bound)) return false;
     return true;
 }
 
@@ -160,6 +201,7 @@ void apply_zero(Job& j, const Node& n) {
     for (int y = n.y; y < n.y + n.h; ++y)
         for (int x = n.x; x < n.x + n.w; ++x) {
             j.out(x, y) = j.base(x, y);
+            j.set_owner(x, y, nullptr);
             j.kind(x, y) = kZeroPixel;
             j.value(x, y) = {0, 0};
         }
@@ -169,10 +211,10 @@ void apply_zero(Job& j, const Node& n) {
 void apply_model(Job& j, const Node& n, const MotionModel& m) {
     for (int y = n.y; y < n.y + n.h; ++y)
         for (int x = n.x; x < n.x + n.w; ++x) {
-            const int64_t vx = m.value_x(x, y), vy = m.value_y(x, y);
-            j.out(x, y) = model_output(j.base(x, y), vx, vy);
+            j.out(x, y) = j.output(m, x, y);
+            j.set_owner(x, y, &m);
             j.kind(x, y) = kModelPixel;
-            j.value(x, y) = kept(vx, vy);
+            j.value(x, y) = j.model_value(m, x, y);
         }
     j.pixels += std::size_t(n.w) * n.h;
     set_cells(j, n, &m, false);
@@ -189,13 +231,10 @@ inline int pixel_context(const Job& j, int x, int y) {
 template <bool Encode, class Coder>
 bool code_pixels(Job& j, Models& m, const Node& n, const MotionModel* const (&cands)[2],
                  Coder& rc) {
-    const MotionModel none;
-    const MotionModel& c = cands[0] ? *cands[0] : none;
     for (int y = n.y; y < n.y + n.h; ++y)
         for (int x = n.x; x < n.x + n.w; ++x) {
             const int ctx = pixel_context(j, x, y);
             const glm::vec2 base = j.base(x, y);
-            int64_t cx = c.value_x(x, y), cy = c.value_y(x, y);
             PixelKind kind = kOwnPixel;
             int which = 0;
             const int which_ctx = x > n.x && j.kind(x - 1, y) == kModelPixel && j.which(x - 1, y);
@@ -205,10 +244,7 @@ bool code_pixels(Job& j, Models& m, const Node& n, const MotionModel* const (&ca
                     kind = kZeroPixel;
                 } else {
                     for (int k = 0; k < 2 && kind == kOwnPixel; ++k)
-                        if (cands[k] && within(s,
-                                               model_output(base, cands[k]->value_x(x, y),
-                                                            cands[k]->value_y(x, y)),
-                                               j.bound))
+                        if (cands[k] && within(s, j.output(*cands[k], x, y), j.bound))
                             kind = kModelPixel, which = k;
                 }
                 rc.bit(m.pixel_zero[ctx], kind == kZeroPixel);
@@ -224,15 +260,15 @@ bool code_pixels(Job& j, Models& m, const Node& n, const MotionModel* const (&ca
                     which = cands[1] ? rc.bit(m.pixel_which[which_ctx]) : 0;
                 }
             }
-            if (which) cx = cands[1]->value_x(x, y), cy = cands[1]->value_y(x, y);
             j.which(x, y) = uint8_t(which);
             glm::vec2 out = base;
-            if (kind == kModelPixel) out = model_output(base, cx, cy);
-            glm::ivec2 value = kind == kModelPixel ? kept(cx, cy) : glm::ivec2(0);
+            if (kind == kModelPixel) out = j.output(*cands[which], x, y);
+            glm::ivec2 value =
+                kind == kModelPixel ? j.model_value(*cands[which], x, y) : glm::ivec2(0);
             if (kind == kOwnPixel) {
                 // Predicted like a smooth field: the left pixel's value, else the above one's
                 // (when they are not the camera's), else the candidate's.
-                glm::ivec2 pred = kept(cx, cy);
+                glm::ivec2 pred = cands[0] ? j.model_value(*cands[0], x, y) : glm::ivec2(0);
                 if (x > 0 && j.kind(x - 1, y) != kZeroPixel)
                     pred = j.value(x - 1, y);
                 else if (y > j.y0 && j.kind(x, y - 1) != kZeroPixel)
@@ -264,12 +300,79 @@ bool code_pixels(Job& j, Models& m, const Node& n, const MotionModel* const (&ca
                 ++j.own_pixels;
             }
             j.out(x, y) = out;
+            j.set_owner(x, y, kind == kModelPixel ? cands[which] : nullptr);
             j.kind(x, y) = kind;
             j.value(x, y) = value;
             j.pixels += kind != kZeroPixel;
         }
     set_cells(j, n, cands[0], false);
     return true;
+}
+
+// An object index below `count`, bit by bit from the top through a tree of models; false when
+// the decoded index is not below count.
+template <class Coder>
+bool code_object_index(Models& m, int count, int& index, Coder& rc) {
+    int bits = 0;
+    while ((1 << bits) < count) ++bits;
+    int node = 1, value = 0;
+    for (int b = bits - 1; b >= 0; --b) {
+        int bit = 0;
+        if constexpr (std::is_same_v<Coder, RangeEncoder>) {
+            bit = (index >> b) & 1;
+            rc.bit(m.object_index[node], bit);
+        } else {
+            bit = rc.bit(m.object_index[node]);
+        }
+        value = value * 2 + bit;
+        node = node * 2 + bit;
+    }
+    index = value;
+    return value < count;
+}
+
+// The object that fits the whole node (encoder): the objects of the node's ids in turn.
+int fitting_object(const Job& j, const Node& n) {
+    int tried[2] = {-1, -1};
+    for (int y = n.y; y < n.y + n.h; ++y)
+        for (int x = n.x; x < n.x + n.w; ++x) {
+            const int k = j.object_of(x, y);
+            if (k < 0 || k == tried[0] || k == tried[1]) continue;
+            MotionModel object;
+            object.object = k;
+            if (model_fits(j, n, object)) return k;
+            if (tried[0] >= 0 && tried[1] >= 0) return -1;
+            tried[tried[0] >= 0] = k;
+        }
+    return -1;
+}
+
+// The object worth adding to a 4x4 cell's candidates (encoder): the one that gives the most of
+// its pixels that neither the cameras nor the candidates give, if any.
+int leaf_object(const Job& j, const Node& n, const MotionModel* const (&cands)[2]) {
+    int best = -1, best_count = 0;
+    for (int y = n.y; y < n.y + n.h; ++y)
+        for (int x = n.x; x < n.x + n.w; ++x) {
+            const int k = j.object_of(x, y);
+            if (k < 0 || k == best) continue;
+            bool offered = false;
+            for (const MotionModel* c : cands) offered = offered || (c && c->object == k);
+            if (offered) continue;
+            MotionModel object;
+            object.object = k;
+            int count = 0;
+            for (int yy = n.y; yy < n.y + n.h; ++yy)
+                for (int xx = n.x; xx < n.x + n.w; ++xx) {
+                    const glm::vec2 s = j.source(xx, yy);
+                    if (within(s, j.base(xx, yy), j.bound)) continue;
+                    bool given = false;
+                    for (const MotionModel* c : cands)
+                        given = given || (c && within(s, j.output(*c, xx, yy), j.bound));
+                    count += !given && within(s, j.output(object, xx, yy), j.bound);
+                }
+            if (count > best_count) best = k, best_count = count;
+        }
+    return best;
 }
 
 template <bool Encode, class Coder>
@@ -337,8 +440,24 @@ bool code_node(Job& j, Models& m, Node n, int level, Coder& rc) {
             return true;
         }
     }
+    if (!j.fields.empty()) {
+        MotionModel object;
+        if constexpr (Encode) {
+            object.object = fitting_object(j, n);
+            rc.bit(m.object[level], object.object >= 0);
+            if (object.object >= 0) code_object_index(m, int(j.fields.size()), object.object, rc);
+        } else if (rc.bit(m.object[level]) &&
+                   !code_object_index(m, int(j.fields.size()), object.object, rc)) {
+            return false;
+        }
+        if (object.object >= 0) {
+            apply_model(j, n, object);
+            ++j.object_nodes;
+            return true;
+        }
+    }
     const MotionModel none;
-    const MotionModel& pred = cands[0] ? *cands[0] : none;
+    const MotionModel pred = cands[0] ? j.prediction(*cands[0], n.x, n.y) : none;
     MotionModel model;
     bool fits = false;
     if constexpr (Encode) fits = fit_model(j, n, pred, model) && model_fits(j, n, model);
@@ -361,7 +480,23 @@ bool code_node(Job& j, Models& m, Node n, int level, Coder& rc) {
             rc.bit(m.own_cell, !fits);
         else
             fits = !rc.bit(m.own_cell);
-        if (!fits) return code_pixels<Encode>(j, m, n, cands, rc);
+        if (!fits) {
+            // An object the neighbours do not offer may join the candidates.
+            MotionModel object;
+            if (!j.fields.empty()) {
+                if constexpr (Encode) {
+                    object.object = leaf_object(j, n, cands);
+                    rc.bit(m.leaf_object, object.object >= 0);
+                    if (object.object >= 0)
+                        code_object_index(m, int(j.fields.size()), object.object, rc);
+                } else if (rc.bit(m.leaf_object) &&
+                           !code_object_index(m, int(j.fields.size()), object.object, rc)) {
+                    return false;
+                }
+                if (object.object >= 0) cands[cands[0] ? 1 : 0] = &object;
+            }
+            return code_pixels<Encode>(j, m, n, cands, rc);
+        }
     }
     if (!code_new_model<Encode>(j, m, n, pred, model, rc)) return false;
     apply_model(j, n, model);
@@ -382,8 +517,9 @@ bool code_slice(Job& j, Coder& rc) {
 }
 
 std::vector<Job> slice_jobs(const SequenceParams& sp, ImageView<const glm::vec2> base,
-                            ImageView<const glm::vec2> source, ImageView<glm::vec2> out,
-                            MotionModelScratch& scratch) {
+                            ImageView<const glm::vec2> source, ImageView<const uint32_t> ids,
+                            std::span<const ObjectField> fields, ImageView<glm::vec2> out,
+                            ImageView<uint32_t> owner, MotionModelScratch& scratch) {
     scratch.cell_columns = (sp.width + 3) / 4;
     scratch.cells.assign(std::size_t(scratch.cell_columns) * ((sp.height + 3) / 4), {});
     scratch.kinds.resize(std::size_t(sp.width) * sp.height);
@@ -393,8 +529,8 @@ std::vector<Job> slice_jobs(const SequenceParams& sp, ImageView<const glm::vec2>
     for (int s = 0; s < sp.slices; ++s) {
         const int y0 = std::min(sp.height, sp.slice_begin(s) * kMb);
         const int y1 = std::min(sp.height, sp.slice_begin(s + 1) * kMb);
-        jobs.push_back(
-            {&sp, y0, y1, sp.motion_error, own_step(sp.motion_error), base, source, out, &scratch});
+        jobs.push_back({&sp, y0, y1, sp.motion_error, own_step(sp.motion_error), base, source, ids,
+                        fields, out, owner, &scratch});
     }
     return jobs;
 }
@@ -417,11 +553,12 @@ bool motion_within_bound(ImageView<const glm::vec2> source, ImageView<const glm:
 }
 
 void encode_motion_models(const SequenceParams& sp, ImageView<const glm::vec2> base,
-                          ImageView<const glm::vec2> source, ImageView<glm::vec2> out,
-                          MotionModelScratch& scratch,
+                          ImageView<const glm::vec2> source, ImageView<const uint32_t> ids,
+                          std::span<const ObjectField> fields, ImageView<glm::vec2> out,
+                          ImageView<uint32_t> owner, MotionModelScratch& scratch,
                           std::vector<std::vector<uint8_t>>& slice_bytes,
                           std::vector<uint8_t>& bytes, StreamStats& stats) {
-    std::vector<Job> jobs = slice_jobs(sp, base, source, out, scratch);
+    std::vector<Job> jobs = slice_jobs(sp, base, source, ids, fields, out, owner, scratch);
     encode_slices(sp.slices, slice_bytes, bytes, [&](int s, std::vector<uint8_t>& b) {
         RangeEncoder rc(b);
         code_slice<true>(jobs[s], rc);
@@ -431,10 +568,11 @@ void encode_motion_models(const SequenceParams& sp, ImageView<const glm::vec2> b
 }
 
 Status decode_motion_models(const SequenceParams& sp, ImageView<const glm::vec2> base,
+                            std::span<const ObjectField> fields,
                             const std::vector<std::span<const uint8_t>>& slices,
-                            ImageView<glm::vec2> out, MotionModelScratch& scratch,
-                            StreamStats& stats) {
-    std::vector<Job> jobs = slice_jobs(sp, base, {}, out, scratch);
+                            ImageView<glm::vec2> out, ImageView<uint32_t> owner,
+                            MotionModelScratch& scratch, StreamStats& stats) {
+    std::vector<Job> jobs = slice_jobs(sp, base, {}, {}, fields, out, owner, scratch);
     REPRISE_TRY(decode_slices(slices, "motion section", [&](int s, std::span<const uint8_t> b) {
         RangeDecoder rc(b);
         return code_slice<false>(jobs[s], rc);

@@ -5,6 +5,7 @@
 #include <span>
 #include <vector>
 
+#include "object_motion.hpp"
 #include "reprise/core/image.hpp"
 #include "reprise/core/status.hpp"
 
@@ -14,8 +15,9 @@ struct SequenceParams;
 struct StreamStats;
 
 // Residual motion over the camera motion, in 1/512 px: value at the origin pixel plus a change
-// per pixel in x and in y.
+// per pixel in x and in y; or (object >= 0) the motion of that rigid object.
 struct MotionModel {
+    int object = -1;
     int64_t ax = 0, ay = 0;
     int64_t gxx = 0, gxy = 0, gyx = 0, gyy = 0;
     int x0 = 0, y0 = 0;
@@ -41,14 +43,19 @@ struct MotionModelScratch {
 bool motion_within_bound(ImageView<const glm::vec2> source, ImageView<const glm::vec2> base, int y,
                          float bound);
 
+// The objects' `fields` (object_motion.hpp) are what object models refer to; `ids` (the
+// encoder's object ids) chooses which one to try. `owner` (when not empty) gets each pixel's
+// object id where an object model gave its motion, else 0.
 void encode_motion_models(const SequenceParams& sp, ImageView<const glm::vec2> base,
-                          ImageView<const glm::vec2> source, ImageView<glm::vec2> out,
-                          MotionModelScratch& scratch,
+                          ImageView<const glm::vec2> source, ImageView<const uint32_t> ids,
+                          std::span<const ObjectField> fields, ImageView<glm::vec2> out,
+                          ImageView<uint32_t> owner, MotionModelScratch& scratch,
                           std::vector<std::vector<uint8_t>>& slice_bytes,
                           std::vector<uint8_t>& bytes, StreamStats& stats);
 Status decode_motion_models(const SequenceParams& sp, ImageView<const glm::vec2> base,
+                            std::span<const ObjectField> fields,
                             const std::vector<std::span<const uint8_t>>& slices,
-                            ImageView<glm::vec2> out, MotionModelScratch& scratch,
-                            StreamStats& stats);
+                            ImageView<glm::vec2> out, ImageView<uint32_t> owner,
+                            MotionModelScratch& scratch, StreamStats& stats);
 
 }  // namespace reprise::codec

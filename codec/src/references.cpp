@@ -19,6 +19,7 @@ void add_stats(StreamStats& total, const StreamStats& f) {
     total.motion_residual_pixels += f.motion_residual_pixels;
     total.motion_models += f.motion_models;
     total.motion_own_pixels += f.motion_own_pixels;
+    total.motion_objects += f.motion_objects;
     total.depth_zero_blocks += f.depth_zero_blocks;
     total.cameras_fitted += f.cameras_fitted;
 }

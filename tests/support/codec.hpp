@@ -1,4 +1,4 @@
-// Test support: a sequence through one encoder, packets and reconstructions kept.
+// Test support: a sequence through one encoder, packets and reconstructions kept; and back.
 #pragma once
 
 #include <gtest/gtest.h>
@@ -28,6 +28,18 @@ inline Coded encode_all(const std::vector<Frame>& frames, const codec::EncoderOp
     }
     c.stats = encoder.stats();
     return c;
+}
+
+inline std::vector<Frame> decode_all(const std::vector<codec::Packet>& packets) {
+    codec::Decoder decoder;
+    std::vector<Frame> out;
+    for (const codec::Packet& p : packets) {
+        Status s = decoder.send_packet(p.data);
+        EXPECT_TRUE(s.ok()) << s.message();
+        Frame f;
+        while (decoder.receive_frame(f) == codec::Result::Ok) out.push_back(std::move(f));
+    }
+    return out;
 }
 
 }  // namespace reprise::test

@@ -50,6 +50,10 @@ struct EncoderOptions {
     // Frames without a camera (identity matrices) and with depth and motion are coded with a
     // camera fitted to them, so that only motion it does not explain is sent (docs/bitstream.md).
     bool fit_cameras = true;
+    // With motion models (motion_error_px > 0) and depth: each object id that moves on its own
+    // gets a rigid motion fitted to its pixels, from which both sides derive its pixels' motion
+    // and predict its depth (docs/bitstream.md).
+    bool rigid_objects = true;
 };
 
 enum class PacketType : uint8_t { Key = 0, Inter = 1 };
@@ -73,6 +77,7 @@ struct StreamStats {
     std::size_t motion_residual_pixels = 0;  // pixels whose motion the cameras do not explain
     std::size_t motion_models = 0;           // affine motion models sent
     std::size_t motion_own_pixels = 0;       // pixels whose motion no model gives, sent alone
+    std::size_t motion_objects = 0;          // rigid object motions sent
     std::size_t depth_zero_blocks = 0;       // depth blocks predicted exactly
     std::size_t cameras_fitted = 0;  // encoder: frames without a camera coded with a fitted one
     // Encoder input: NaN/Inf repaired before coding (colour: holes; depth NaN/-inf and motion:
