@@ -73,9 +73,10 @@ TEST_F(CliBenchFruc, CsvHasFiniteRowsForOursAndTheDisPeer) {
                      ms = std::strtod(f[7].c_str(), nullptr);
         const double ssim = std::strtod(f[5].c_str(), nullptr),
                      flip = std::strtod(f[6].c_str(), nullptr);
+        // Measured: 43.1-45.0 dB with a fill, 33.0 without (splat+none), DIS 43.8-44.0.
         if (f[1] == "interpolate" || f[1] == "opencv-dis") {
-            EXPECT_TRUE(std::isfinite(psnr)) << line;
-            EXPECT_GT(psnr, 10.0) << line;  // a plausible frame, not noise or black
+            const bool unfilled = f[2].ends_with("+none");
+            EXPECT_GT(psnr, unfilled ? 31.0 : 41.0) << line;
         }
         EXPECT_TRUE(ssim >= -1.0 && ssim <= 1.0) << line;
         EXPECT_TRUE(flip >= 0.0 && flip <= 1.0) << line;

@@ -19,9 +19,11 @@ struct RestoreTarget {
     ~RestoreTarget() { simd::force_target(0); }
 };
 
+// Highway compiles a vector level and its portable fallback at least; on x86-64 the build has
+// SSE2 through AVX-512 and a machine runs two or more of them.
 TEST(Kernels, SeveralSimdLevelsAreAvailable) {
     const std::vector<simd::Target> targets = simd::available_targets();
-    ASSERT_FALSE(targets.empty());
+    ASSERT_GE(targets.size(), 2u);
     for (const simd::Target& t : targets) EXPECT_NE(t.bits, 0);
     RestoreTarget restore;
     simd::force_target(targets.back().bits);

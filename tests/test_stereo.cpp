@@ -299,8 +299,9 @@ TEST(StereoTemporal, PreviousOtherEyeFillsDisocclusions) {
                  b = display_psnr(now.right.color, temporal.color);
     std::printf("[stereo] temporal: %.2f dB (without: %.2f dB), %zu of %zu holes from history\n", b,
                 a, stats.from_history, stats.holes);
-    EXPECT_GT(stats.from_history, 0u);
-    EXPECT_GT(b, a - 0.5);
+    // Measured: 38.86 dB against 35.32, 651 of 809 holes.
+    EXPECT_GE(double(stats.from_history), 0.7 * double(stats.holes));
+    EXPECT_GT(b, a + 2.5);
 }
 
 TEST(StereoCompose, LayoutsPlaceTheEyesAndAnaglyphUsesDubois) {
