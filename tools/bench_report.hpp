@@ -76,7 +76,7 @@ public:
     CsvFile& operator=(const CsvFile&) = delete;
 
     // Creates the file and writes the header line (e.g. kErrorTimeColumns).
-    [[nodiscard]] Status open(const std::string& path, const std::string& header);
+    Status open(const std::string& path, const std::string& header);
     // One line of the standard error-against-time columns (psnr %.4f, ssim/flip %.6f, ms %.4f)
     // followed by `extra` cells (already formatted, joined with commas) when given.
     void error_row(const std::string& scene, const std::string& method, const std::string& setting,

@@ -107,7 +107,7 @@ struct EncodeJob {
     std::string in, out, chroma = "420", depth = "view";
     int qp = 28, quality = 0, bitrate = 0, keyint = 0, skip = 2;
     double motion_error = 0.25;
-    bool quality_given = false, overwrite_inputs = false, resume = false;
+    bool quality_given = false, overwrite_inputs = false, resume = false, no_objects = false;
     std::string line;  // the options given, recorded for --resume
 };
 
@@ -132,6 +132,7 @@ Status encoder_options(const EncodeJob& job, codec::EncoderOptions& o) {
         return Status::error(
             "encode: --motion-error must be 0 (per pixel, 1/8 px) or in 0.1..8 px");
     o.motion_error_px = float(job.motion_error);
+    o.rigid_objects = !job.no_objects;
     if (job.chroma == "420")
         o.chroma = codec::Chroma::C420;
     else if (job.chroma == "444")
@@ -345,6 +346,9 @@ int command_encode(int argc, char** argv) {
     args.option("--motion-error", &job.motion_error,
                 "largest error of the decoded motion in px: affine models per block where they "
                 "hold (default 0.25; 0: every pixel to 1/8 px)");
+    args.flag("--no-objects", &job.no_objects,
+              "no rigid object motions (default: each object id that moves on its own gets one, "
+              "with motion models and depth)");
     args.option("--skip", &job.skip,
                 "blocks within this many 8-bit levels of their prediction are skipped (default 2)");
     args.flag("--overwrite-inputs", &job.overwrite_inputs,

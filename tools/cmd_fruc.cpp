@@ -51,7 +51,8 @@ OutputSpan outputs_of(std::size_t i, int factor, warp::FrucMode mode) {
 }
 
 Status run_fruc(const FrucJob& job) {
-    if (job.factor < 1 || job.factor > 16) return Status::error("--factor must be in 1..16");
+    if (Status s = warp::check_fruc_factor(job.factor); !s.ok())
+        return Status::error("--" + s.message());
     if (job.out.empty()) return Status::error("--out DIR is required");
     warp::FrucOptions options;
     REPRISE_TRY(parse_fruc_options(job.mode, job.warp, job.fill, options));

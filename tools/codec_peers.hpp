@@ -43,7 +43,7 @@ struct PeerFrame {
 // it; `out` gets one entry per input frame. Sizes the encoder cannot take (odd sides, SVT-AV1
 // below 64 or not a multiple of 8) are padded by repeating the last row/column and the decoded
 // frames cropped back. Errors name the codec and the libavcodec call.
-[[nodiscard]] Status encode_decode_peer(const std::vector<Image<Rgb8>>& frames,
+Status encode_decode_peer(const std::vector<Image<Rgb8>>& frames,
                                         const PeerConfig& config, double fps,
                                         std::vector<PeerFrame>& out);
 
@@ -55,7 +55,7 @@ struct GreyFrame {
     double encode_ms = 0.0, decode_ms = 0.0, encode_convert_ms = 0.0, decode_convert_ms = 0.0;
     std::vector<uint16_t> decoded;
 };
-[[nodiscard]] Status encode_decode_grey_peer(const std::vector<std::vector<uint16_t>>& planes,
+Status encode_decode_grey_peer(const std::vector<std::vector<uint16_t>>& planes,
                                              int w, int h, int bits, const PeerConfig& config,
                                              double fps, std::vector<GreyFrame>& out);
 

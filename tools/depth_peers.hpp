@@ -14,7 +14,7 @@ namespace reprise::cli {
 
 // zstd at `level` (3 = `zstd -3`) of the floats' bytes as they are in memory.
 void zstd_compress_depth(std::span<const float> depth, int level, std::vector<uint8_t>& out);
-[[nodiscard]] Status zstd_decompress_depth(std::span<const uint8_t> in, std::size_t count,
+Status zstd_decompress_depth(std::span<const uint8_t> in, std::size_t count,
                                            std::vector<float>& out);
 
 enum class RvlMode : uint8_t {
@@ -34,7 +34,7 @@ struct RvlOptions {
 
 void rvl_encode(std::span<const float> depth, const RvlOptions& options, std::vector<uint8_t>& out);
 // `count` values; an input that ends early, runs past `count` or leaves bytes over is an error.
-[[nodiscard]] Status rvl_decode(std::span<const uint8_t> in, std::size_t count,
+Status rvl_decode(std::span<const uint8_t> in, std::size_t count,
                                 const RvlOptions& options, std::vector<float>& out);
 
 }  // namespace reprise::cli

@@ -11,32 +11,8 @@ warp::FrucOptions fruc_options(const std::string& mode, const std::string& warp_
                                const std::string& fill, bool refine) {
     warp::FrucOptions o;
     o.refine.enabled = refine;
-    if (mode == "interpolate")
-        o.mode = warp::FrucMode::Interpolate;
-    else if (mode == "extrapolate")
-        o.mode = warp::FrucMode::Extrapolate;
-    else
-        value_error("mode must be 'interpolate' or 'extrapolate', got '" + mode + "'");
-    if (warp_method == "grid")
-        o.warp = warp::WarpMethod::Grid;
-    else if (warp_method == "reverse")
-        o.warp = warp::WarpMethod::Reverse;
-    else if (warp_method == "splat")
-        o.warp = warp::WarpMethod::Splat;
-    else if (warp_method == "auto")
-        o.warp = warp::WarpMethod::Auto;
-    else
-        value_error("warp must be 'grid', 'reverse', 'splat' or 'auto', got '" + warp_method + "'");
-    if (fill == "pullpush")
-        o.fill = warp::FillMethod::PullPush;
-    else if (fill == "andreev")
-        o.fill = warp::FillMethod::Andreev;
-    else if (fill == "none")
-        o.fill = warp::FillMethod::None;
-    else if (fill == "auto")
-        o.fill = warp::FillMethod::Auto;
-    else
-        value_error("fill must be 'pullpush', 'andreev', 'none' or 'auto', got '" + fill + "'");
+    const Status parsed = warp::fruc_options_from_names(mode, warp_method, fill, o);
+    if (!parsed.ok()) value_error(parsed.message());
     return o;
 }
 
@@ -46,7 +22,7 @@ struct Converter {
         : converter(checked(factor), fruc_options(mode, warp_method, fill, refine)) {}
 
     static int checked(int factor) {
-        if (factor < 1 || factor > 16) value_error("factor must be in 1..16");
+        if (const Status s = warp::check_fruc_factor(factor); !s.ok()) value_error(s.message());
         return factor;
     }
 

@@ -35,8 +35,14 @@ def test_extrapolation_and_receive(pan_60):
 def test_bad_arguments_raise(pan_60):
     with pytest.raises(ValueError):
         reprise.FrameRateConverter(0)
+    with pytest.raises(ValueError, match="factor 17: expected 1..16"):
+        reprise.FrameRateConverter(17)
     with pytest.raises(ValueError, match="mode"):
         reprise.FrameRateConverter(2, mode="sideways")
+    with pytest.raises(ValueError, match="warp 'mesh': expected reverse, splat, grid, grid-bicubic"):
+        reprise.FrameRateConverter(2, warp="mesh")
+    # The names the command line takes: the bilinear grid too.
+    reprise.FrameRateConverter(2, warp="grid-bilinear")
     converter = reprise.FrameRateConverter(2)
     frame = reprise.Frame(np.zeros((8, 8, 4)), depth=np.ones((8, 8)))
     converter.send(frame)

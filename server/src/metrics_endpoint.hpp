@@ -11,7 +11,7 @@ class MetricsEndpoint {
 public:
     MetricsEndpoint();
     ~MetricsEndpoint();
-    [[nodiscard]] Status open(int port);  // 0: any free port
+    Status open(int port);  // 0: any free port
     int port() const;
     bool is_open() const;
     // Answers every connection waiting to be accepted with `body` (text/plain; version=0.0.4).

@@ -14,16 +14,6 @@ bool same_camera(const Camera& a, const Camera& b) {
     return a.view == b.view && a.projection == b.projection;
 }
 
-bool all_still(const GBufferView& f) {
-    if (f.motion.empty()) return false;
-    for (int y = 0; y < f.motion.height; ++y) {
-        const glm::vec2* m = f.motion.row(y);
-        for (int x = 0; x < f.motion.width; ++x)
-            if (m[x].x != 0.0f || m[x].y != 0.0f) return false;
-    }
-    return true;
-}
-
 float distance_between(const Camera& a, const Camera& b) {
     return glm::length(glm::vec3(glm::inverse(a.view)[3]) - glm::vec3(glm::inverse(b.view)[3]));
 }
@@ -92,7 +82,7 @@ StereoStats StereoSynthesizer::synthesize(const GBufferView& given, const Camera
     // The same viewpoint: nothing to warp.
     const GBufferView* exact =
         same_camera(rendered.camera, target)                                            ? &rendered
-        : history_usable && same_camera(history->camera, target) && all_still(rendered) ? history
+        : history_usable && same_camera(history->camera, target) && rendered.motion_is_zero() ? history
                                                                                         : nullptr;
     if (exact) {
         copy_into(out.color, exact->color);

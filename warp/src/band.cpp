@@ -13,6 +13,16 @@
 
 namespace reprise::warp {
 
+void check_warp_inputs(const GBufferView& source, const WarpTarget& t) {
+    REPRISE_ASSERT(source.depth.width == source.width() && source.depth.height == source.height());
+    REPRISE_ASSERT(source.motion.width == source.width() &&
+                   source.motion.height == source.height());
+    REPRISE_ASSERT(t.depth.width == t.color.width && t.depth.height == t.color.height);
+    REPRISE_ASSERT(t.covered.width == t.color.width && t.covered.height == t.color.height);
+    REPRISE_ASSERT(t.motion.empty() ||
+                   (t.motion.width == t.color.width && t.motion.height == t.color.height));
+}
+
 namespace {
 constexpr float kInf = std::numeric_limits<float>::infinity();
 

@@ -15,6 +15,10 @@ struct Band {
     int y0;
 };
 
+// What every forward warp asserts of its inputs: the source's depth and motion the size of its
+// colour, the target's channels the size of its colour (motion may be empty).
+void check_warp_inputs(const GBufferView& source, const WarpTarget& target);
+
 // Scratch rows with room for vector kernels to read a few pixels past the last.
 template <class T>
 ImageView<T> scratch_rows(std::vector<T>& pixels, int width, int rows) {

@@ -18,16 +18,6 @@ namespace {
 constexpr float kInf = std::numeric_limits<float>::infinity();
 constexpr int kBandRows = 8;  // a band's scratch stays in a core's cache
 
-void check_target(const GBufferView& source, const WarpTarget& t) {
-    REPRISE_ASSERT(source.depth.width == source.width() && source.depth.height == source.height());
-    REPRISE_ASSERT(source.motion.width == source.width() &&
-                   source.motion.height == source.height());
-    REPRISE_ASSERT(t.depth.width == t.color.width && t.depth.height == t.color.height);
-    REPRISE_ASSERT(t.covered.width == t.color.width && t.covered.height == t.color.height);
-    REPRISE_ASSERT(t.motion.empty() ||
-                   (t.motion.width == t.color.width && t.motion.height == t.color.height));
-}
-
 bool valid_source(float z, glm::vec2 m) {
     return z >= 0.0f && std::isfinite(m.x) && std::isfinite(m.y);  // z = +inf: background
 }
@@ -135,7 +125,7 @@ namespace {
 
 SplatScatter make_scatter(const GBufferView& source, float factor, const WarpTarget& target,
                           const SplatOptions& options) {
-    check_target(source, target);
+    check_warp_inputs(source, target);
     REPRISE_ASSERT(options.footprint == 1 || options.footprint == 2);
     REPRISE_ASSERT(std::isfinite(factor));
     const float tol = std::clamp(options.depth_tolerance, 0.0f, 0.5f);

@@ -382,7 +382,7 @@ Status FrameRateConverter::send_frame(const Frame& given, Frame* owned) {
             // A still pair is copied unless refinement finds its pictures differ (a moving
             // light, say): then it is interpolated like any other.
             bool still = false, still_refined = false;
-            if (!cut && warpable && motion_is_zero(frame)) {
+            if (!cut && warpable && frame.view().motion_is_zero()) {
                 still = true;
                 if (st.options.refine.enabled && a_warpable) {
                     const auto start = std::chrono::steady_clock::now();
@@ -430,7 +430,7 @@ Status FrameRateConverter::send_frame(const Frame& given, Frame* owned) {
             float s = float(k) / float(k_max);
             if (cut || !warpable) {
                 st.emit_copy(frame, before, frame.camera, fps, 1.0f + s);
-            } else if (motion_is_zero(frame)) {
+            } else if (frame.view().motion_is_zero()) {
                 ++st.counters.copied_still;
                 st.emit_copy(frame, before, frame.camera, fps, 1.0f + s);
             } else {

@@ -124,7 +124,4 @@ void extrapolate_to_camera(const GBufferView& f, const glm::mat4& future_view,
                            const FrucOptions& options, FrucScratch& scratch, Frame& out,
                            FrucCounters& counters);
 
-// True when every motion vector is exactly zero (and finite).
-bool motion_is_zero(const GBufferView& f);
-
 }  // namespace reprise::warp

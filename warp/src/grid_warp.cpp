@@ -17,13 +17,7 @@ namespace {
 constexpr int kBandRows = 8;  // a band's scratch (29 bytes a pixel) stays in a core's cache
 
 void check(const GBufferView& source, const WarpTarget& t) {
-    REPRISE_ASSERT(source.depth.width == source.width() && source.depth.height == source.height());
-    REPRISE_ASSERT(source.motion.width == source.width() &&
-                   source.motion.height == source.height());
-    REPRISE_ASSERT(t.depth.width == t.color.width && t.depth.height == t.color.height);
-    REPRISE_ASSERT(t.covered.width == t.color.width && t.covered.height == t.color.height);
-    REPRISE_ASSERT(t.motion.empty() ||
-                   (t.motion.width == t.color.width && t.motion.height == t.color.height));
+    check_warp_inputs(source, t);
     // The vector raster keeps source offsets (in pixels) in 32-bit lanes.
     REPRISE_ASSERT(source.color.empty() || double(source.width()) * source.height() <
                                                double(std::numeric_limits<int>::max()));

@@ -20,16 +20,6 @@ void WarpBuffers::resize(int w, int h) {
     covered.resize(w, h);
 }
 
-bool motion_is_zero(const GBufferView& f) {
-    if (f.motion.empty()) return false;
-    for (int y = 0; y < f.motion.height; ++y) {
-        const glm::vec2* m = f.motion.row(y);
-        for (int x = 0; x < f.motion.width; ++x)
-            if (m[x].x != 0.0f || m[x].y != 0.0f) return false;
-    }
-    return true;
-}
-
 // Reverse warp: the splat placed, at each covered pixel q, the source pixel p that lands there;
 // refine p = q - factor * motion(p) with the source's own (bilinear) motion and fetch colour
 // bicubically there. Taps are not depth-tested: across silhouettes the blend measured closer to

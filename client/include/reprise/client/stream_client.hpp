@@ -59,7 +59,7 @@ public:
 
     // Network work due at `now_us`: handshake, retransmissions, receiving, decoding, feedback,
     // reconnecting. Returns an error only when the server keeps refusing (wrong PIN, bad scene).
-    [[nodiscard]] Status poll(int64_t now_us);
+    Status poll(int64_t now_us);
     // Waits until a datagram may be readable, at most `timeout_us`.
     void wait(int64_t timeout_us);
     // Sends the current pose (scene time in seconds, world -> camera).
@@ -90,7 +90,7 @@ private:
 using PoseFunction = std::function<glm::mat4(double t)>;
 using ShowFunction =
     std::function<bool(const Frame& frame, const DisplayInfo& info, int64_t displayed_us)>;
-[[nodiscard]] Status run_client(StreamClient& client, double duration_s, double display_rate,
+Status run_client(StreamClient& client, double duration_s, double display_rate,
                                 const PoseFunction& pose, const ShowFunction& show);
 
 }  // namespace reprise::client

@@ -99,7 +99,7 @@ public:
 
     // Encodes one frame (colour required; depth, motion and the camera enable prediction).
     // The packet then comes out of receive_packet().
-    [[nodiscard]] Status send_frame(const Frame& frame);
+    Status send_frame(const Frame& frame);
     // Ok with the next packet, or NeedMoreData.
     Result receive_packet(Packet& packet);
     void flush();  // no delayed frames: kept for the state-machine shape
@@ -112,7 +112,7 @@ public:
     // them into the references and rate-control state this encoder would hold after them, so
     // that the next send_frame writes what one encoder over the whole sequence would have.
     // Only on an encoder that has encoded nothing; every packet must decode, frames 0, 1, ...
-    [[nodiscard]] Status resume(std::span<const std::span<const uint8_t>> packets);
+    Status resume(std::span<const std::span<const uint8_t>> packets);
     // Changes the rate-control target from the next frame on (0 = constant quality at qp); no
     // key frame is forced.
     void set_bitrate(int kbps);
@@ -147,7 +147,7 @@ public:
 
     // Takes one whole packet (header + payload). A bad packet is an error Status naming the
     // field; the decoder stays usable and resumes at the next decodable frame.
-    [[nodiscard]] Status send_packet(std::span<const uint8_t> packet);
+    Status send_packet(std::span<const uint8_t> packet);
     // Ok with the next decoded frame, or NeedMoreData.
     Result receive_frame(Frame& frame);
     void flush();
@@ -179,11 +179,11 @@ float view_depth_step(const glm::mat4& projection, int width, int height, float 
                       float displacement);
 
 // Checks one packet (length, version, CRC) and reads its header into `info` (data left empty).
-[[nodiscard]] Status inspect_packet(std::span<const uint8_t> packet, Packet& info,
+Status inspect_packet(std::span<const uint8_t> packet, Packet& info,
                                     int64_t& timestamp_us);
 
 // A .rps file: a file header followed by packets (docs/bitstream.md).
-[[nodiscard]] Status write_stream_header(std::vector<uint8_t>& out, int width, int height,
+Status write_stream_header(std::vector<uint8_t>& out, int width, int height,
                                          double fps);
 struct StreamInfo {
     int width = 0, height = 0;
@@ -199,12 +199,12 @@ struct StreamDamage {
 // Splits a whole .rps file into its packets, each checked as send_packet checks its header
 // (fields, length, CRC). After damage it resynchronises on the next byte where a whole valid
 // packet starts; every skipped stretch goes to `damage`. An error only for a bad file header.
-[[nodiscard]] Status split_stream(std::span<const uint8_t> file, StreamInfo& info,
+Status split_stream(std::span<const uint8_t> file, StreamInfo& info,
                                   std::vector<std::span<const uint8_t>>& packets,
                                   std::vector<StreamDamage>& damage);
 // The same, stopping at the first damage: an error naming it, with `packets` holding the whole
 // packets before it (a torn tail, say).
-[[nodiscard]] Status split_stream(std::span<const uint8_t> file, StreamInfo& info,
+Status split_stream(std::span<const uint8_t> file, StreamInfo& info,
                                   std::vector<std::span<const uint8_t>>& packets);
 
 // Frames first..last (or first and every later one when `open`) that a damaged file lost.
@@ -228,7 +228,7 @@ struct StreamReport {
 // until the next key frame or a frame whose reference is held. An error for a bad file header
 // or from the sink; the losses are in `report`.
 using FrameSink = std::function<Status(uint32_t frame, Frame& decoded)>;
-[[nodiscard]] Status decode_stream(std::span<const uint8_t> file, Decoder& decoder,
+Status decode_stream(std::span<const uint8_t> file, Decoder& decoder,
                                    StreamInfo& info, StreamReport& report, const FrameSink& sink);
 
 }  // namespace reprise::codec

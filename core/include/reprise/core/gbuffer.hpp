@@ -21,6 +21,17 @@ struct GBufferView {
     // The size of the colour, as Frame has it.
     int width() const { return color.width; }
     int height() const { return color.height; }
+
+    // Motion present and zero at every pixel: nothing moved (a still frame is copied, not warped).
+    bool motion_is_zero() const {
+        if (motion.empty()) return false;
+        for (int y = 0; y < motion.height; ++y) {
+            const glm::vec2* m = motion.row(y);
+            for (int x = 0; x < motion.width; ++x)
+                if (m[x].x != 0.0f || m[x].y != 0.0f) return false;
+        }
+        return true;
+    }
 };
 
 }  // namespace reprise

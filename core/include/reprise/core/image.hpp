@@ -7,6 +7,7 @@
 #include <string>
 #include <string_view>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include <glm/vec2.hpp>
@@ -39,6 +40,24 @@ class Image {
 public:
     Image() = default;
     Image(int width, int height, T value = T{}) { assign(width, height, value); }
+    Image(const Image&) = default;
+    Image& operator=(const Image&) = default;
+    // A moved-from image is 0 x 0, so that resizing it to its old size allocates again.
+    Image(Image&& other) noexcept
+        : pixels_(std::move(other.pixels_)),
+          width_(std::exchange(other.width_, 0)),
+          height_(std::exchange(other.height_, 0)) {
+        other.pixels_.clear();
+    }
+    Image& operator=(Image&& other) noexcept {
+        if (this != &other) {
+            pixels_ = std::move(other.pixels_);
+            other.pixels_.clear();
+            width_ = std::exchange(other.width_, 0);
+            height_ = std::exchange(other.height_, 0);
+        }
+        return *this;
+    }
 
     // A new size gives zero pixels (T{}); the current size keeps them as they are: no
     // reallocation and no clearing, so per-frame code can size its buffers every frame.

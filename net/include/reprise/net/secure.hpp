@@ -24,7 +24,7 @@ constexpr std::size_t kServerHelloSize = kHeaderSize + 32 + 32 + 32;  // 108
 constexpr std::size_t kClientFinishSize = kHeaderSize + 32;           // 44
 
 // libsodium must be initialised once before any of this; safe to call many times.
-[[nodiscard]] Status init_crypto();
+Status init_crypto();
 uint64_t random_u64();
 void random_bytes(std::span<uint8_t> out);
 
@@ -44,7 +44,7 @@ struct ResumptionTicket {
 
 // What a ClientHello's padding says: PIN (no ticket) or the ticket id it names. Refuses a hello
 // of another size or with padding that is not zero.
-[[nodiscard]] Status client_hello_ticket(std::span<const uint8_t> client_hello, bool& has_ticket,
+Status client_hello_ticket(std::span<const uint8_t> client_hello, bool& has_ticket,
                                          std::array<uint8_t, kTicketIdSize>& id);
 
 // Client side of the handshake.
@@ -55,7 +55,7 @@ public:
     void start(const std::string& secret, std::vector<uint8_t>& hello,
                const ResumptionTicket* ticket = nullptr);
     // Checks the ServerHello's key confirmation; on success writes the ClientFinish and the keys.
-    [[nodiscard]] Status finish(std::span<const uint8_t> server_hello,
+    Status finish(std::span<const uint8_t> server_hello,
                                 std::vector<uint8_t>& client_finish, SessionKeys& keys);
     uint64_t connection() const { return connection_; }
     ~ClientHandshake();
@@ -71,12 +71,12 @@ struct PendingHandshake {
     Key client_confirm{};  // the tag the client must send
     SessionKeys keys;
 };
-[[nodiscard]] Status answer_client_hello(const std::string& secret,
+Status answer_client_hello(const std::string& secret,
                                          std::span<const uint8_t> client_hello,
                                          std::vector<uint8_t>& server_hello,
                                          PendingHandshake& pending);
 // True when `client_finish` carries the expected confirmation (constant-time compare).
-[[nodiscard]] Status check_client_finish(const PendingHandshake& pending,
+Status check_client_finish(const PendingHandshake& pending,
                                          std::span<const uint8_t> client_finish);
 
 // Sliding window over the newest 256 sequence numbers.
@@ -105,7 +105,7 @@ public:
     void seal(std::span<const uint8_t> plaintext, std::vector<uint8_t>& datagram);
     // Opens a sealed datagram: header, connection, replay window, then AEAD; only then is the
     // sequence number marked seen. `plaintext` is resized to what it holds.
-    [[nodiscard]] Status open(std::span<const uint8_t> datagram, std::vector<uint8_t>& plaintext);
+    Status open(std::span<const uint8_t> datagram, std::vector<uint8_t>& plaintext);
 
     uint64_t connection() const { return connection_; }
     uint64_t sent() const { return next_send_ - 1; }

@@ -19,7 +19,7 @@ struct Endpoint {
 };
 
 // "A.B.C.D:PORT" or "localhost:PORT" (PORT 0 lets the system choose when binding).
-[[nodiscard]] Status parse_endpoint(const std::string& text, Endpoint& endpoint);
+Status parse_endpoint(const std::string& text, Endpoint& endpoint);
 
 // Wakes a thread waiting in UdpSocket::wait_readable from another thread (an eventfd).
 class Waker {
@@ -44,7 +44,7 @@ public:
     UdpSocket& operator=(UdpSocket&&) noexcept;
 
     // Binds to `local` (port 0: any free port).
-    [[nodiscard]] Status bind(const Endpoint& local);
+    Status bind(const Endpoint& local);
     Endpoint local() const;
     void close();
     bool is_open() const;

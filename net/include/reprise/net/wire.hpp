@@ -118,10 +118,10 @@ using Writer = FixedByteWriter;
 using Reader = ByteReader;
 
 void write_header(Writer& w, const DatagramHeader& header);
-[[nodiscard]] Status parse_header(std::span<const uint8_t> datagram, DatagramHeader& header);
+Status parse_header(std::span<const uint8_t> datagram, DatagramHeader& header);
 
 std::size_t encode(const RefusedDatagram& d, std::span<uint8_t> out);
-[[nodiscard]] Status parse(std::span<const uint8_t> datagram, RefusedDatagram& d);
+Status parse(std::span<const uint8_t> datagram, RefusedDatagram& d);
 
 // Scene names: 1..32 of [a-z0-9_-] (never a path).
 bool valid_scene_name(const std::string& name);
@@ -139,15 +139,15 @@ std::size_t encode_empty(MessageType type, std::span<uint8_t> out);  // KeyFrame
 std::size_t encode_error(const std::string& text, std::span<uint8_t> out);
 
 // Parsers take the whole plaintext (type byte included) and check every field.
-[[nodiscard]] Status message_type(std::span<const uint8_t> plaintext, MessageType& type);
-[[nodiscard]] Status parse(std::span<const uint8_t> plaintext, StartMessage& m);
-[[nodiscard]] Status parse(std::span<const uint8_t> plaintext, StreamInfoMessage& m);
-[[nodiscard]] Status parse(std::span<const uint8_t> plaintext, PoseMessage& m);
-[[nodiscard]] Status parse(std::span<const uint8_t> plaintext, AckMessage& m);
-[[nodiscard]] Status parse(std::span<const uint8_t> plaintext, LossReportMessage& m);
-[[nodiscard]] Status parse(std::span<const uint8_t> plaintext, ReceiverReportMessage& m);
-[[nodiscard]] Status parse(std::span<const uint8_t> plaintext, FragmentMessage& m);
-[[nodiscard]] Status parse(std::span<const uint8_t> plaintext, TicketMessage& m);
-[[nodiscard]] Status parse_error(std::span<const uint8_t> plaintext, std::string& text);
+Status message_type(std::span<const uint8_t> plaintext, MessageType& type);
+Status parse(std::span<const uint8_t> plaintext, StartMessage& m);
+Status parse(std::span<const uint8_t> plaintext, StreamInfoMessage& m);
+Status parse(std::span<const uint8_t> plaintext, PoseMessage& m);
+Status parse(std::span<const uint8_t> plaintext, AckMessage& m);
+Status parse(std::span<const uint8_t> plaintext, LossReportMessage& m);
+Status parse(std::span<const uint8_t> plaintext, ReceiverReportMessage& m);
+Status parse(std::span<const uint8_t> plaintext, FragmentMessage& m);
+Status parse(std::span<const uint8_t> plaintext, TicketMessage& m);
+Status parse_error(std::span<const uint8_t> plaintext, std::string& text);
 
 }  // namespace reprise::net

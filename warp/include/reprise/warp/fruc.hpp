@@ -4,6 +4,7 @@
 #include <array>
 #include <cstddef>
 #include <memory>
+#include <string>
 
 #include "reprise/core/nonfinite.hpp"
 #include "reprise/warp/fill.hpp"
@@ -142,6 +143,15 @@ struct FrucCounters {
     std::array<std::size_t, kAutoCandidates> auto_chosen{};
     std::array<std::size_t, kAutoCandidates> auto_left_out{};
 };
+
+// Settings by name, as `reprise fruc` and Python take them: mode interpolate | extrapolate;
+// warp reverse | splat | grid | grid-bicubic | grid-bilinear | auto; fill pullpush | andreev |
+// none | auto. An unknown name: an error naming the setting, the name and the choices.
+Status fruc_options_from_names(const std::string& mode, const std::string& warp,
+                               const std::string& fill, FrucOptions& options);
+// Output frames per input frame a FrameRateConverter makes: 1..kMaxFrucFactor.
+inline constexpr int kMaxFrucFactor = 16;
+Status check_fruc_factor(int factor);
 
 // The camera between or beyond two instants: view matrices blended as rigid motions (rotation
 // slerp, translation lerp, s may exceed 1), the projection taken from `b`.
