@@ -81,9 +81,10 @@ StereoStats StereoSynthesizer::synthesize(const GBufferView& given, const Camera
                                 history->depth.width == w && history->depth.height == h;
     // The same viewpoint: nothing to warp.
     const GBufferView* exact =
-        same_camera(rendered.camera, target)                                            ? &rendered
-        : history_usable && same_camera(history->camera, target) && rendered.motion_is_zero() ? history
-                                                                                        : nullptr;
+        same_camera(rendered.camera, target) ? &rendered
+        : history_usable && same_camera(history->camera, target) && rendered.motion_is_zero()
+            ? history
+            : nullptr;
     if (exact) {
         copy_into(out.color, exact->color);
         copy_into(out.depth, exact->depth);
