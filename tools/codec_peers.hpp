@@ -43,9 +43,8 @@ struct PeerFrame {
 // it; `out` gets one entry per input frame. Sizes the encoder cannot take (odd sides, SVT-AV1
 // below 64 or not a multiple of 8) are padded by repeating the last row/column and the decoded
 // frames cropped back. Errors name the codec and the libavcodec call.
-Status encode_decode_peer(const std::vector<Image<Rgb8>>& frames,
-                                        const PeerConfig& config, double fps,
-                                        std::vector<PeerFrame>& out);
+Status encode_decode_peer(const std::vector<Image<Rgb8>>& frames, const PeerConfig& config,
+                          double fps, std::vector<PeerFrame>& out);
 
 // Grey video, as immersive-video systems send depth: each plane's w x h samples (0..2^bits - 1,
 // row-major) as gray10le / gray12le luma through x264 (High 10, 4:0:0) or x265 (4:0:0, 12 bits
@@ -55,9 +54,9 @@ struct GreyFrame {
     double encode_ms = 0.0, decode_ms = 0.0, encode_convert_ms = 0.0, decode_convert_ms = 0.0;
     std::vector<uint16_t> decoded;
 };
-Status encode_decode_grey_peer(const std::vector<std::vector<uint16_t>>& planes,
-                                             int w, int h, int bits, const PeerConfig& config,
-                                             double fps, std::vector<GreyFrame>& out);
+Status encode_decode_grey_peer(const std::vector<std::vector<uint16_t>>& planes, int w, int h,
+                               int bits, const PeerConfig& config, double fps,
+                               std::vector<GreyFrame>& out);
 
 // The streaming configurations of issue 8 §6, each at four rate points: x264 ultrafast,
 // veryfast, medium; x265 ultrafast; SVT-AV1 preset 10 (all low delay, zerolatency).

@@ -15,7 +15,7 @@ namespace reprise::cli {
 // zstd at `level` (3 = `zstd -3`) of the floats' bytes as they are in memory.
 void zstd_compress_depth(std::span<const float> depth, int level, std::vector<uint8_t>& out);
 Status zstd_decompress_depth(std::span<const uint8_t> in, std::size_t count,
-                                           std::vector<float>& out);
+                             std::vector<float>& out);
 
 enum class RvlMode : uint8_t {
     // Lossless on every bit pattern: the float bits shifted so that +inf (background) is 0; a
@@ -34,7 +34,7 @@ struct RvlOptions {
 
 void rvl_encode(std::span<const float> depth, const RvlOptions& options, std::vector<uint8_t>& out);
 // `count` values; an input that ends early, runs past `count` or leaves bytes over is an error.
-Status rvl_decode(std::span<const uint8_t> in, std::size_t count,
-                                const RvlOptions& options, std::vector<float>& out);
+Status rvl_decode(std::span<const uint8_t> in, std::size_t count, const RvlOptions& options,
+                  std::vector<float>& out);
 
 }  // namespace reprise::cli

@@ -32,13 +32,12 @@ struct DepthVideo {
     std::size_t range_bytes = 0;
 };
 Status code_depth_video(const std::vector<ImageView<const float>>& depths, double fps,
-                                      const PeerConfig& config, int bits, DepthVideo& out);
+                        const PeerConfig& config, int bits, DepthVideo& out);
 
 // Codes the depth of `frames` (with cameras) as grey video and measures, per frame, the
 // reprojection error its decoded depth causes for a camera displaced by up to `displacement`
 // (codec::measure_view_depth_error), counting pixels beyond `bound_px`.
-Status run_depth_video_peer(const std::vector<Frame>& frames, double fps,
-                                          const PeerConfig& config, int bits, float displacement,
-                                          float bound_px, DepthVideoRun& run);
+Status run_depth_video_peer(const std::vector<Frame>& frames, double fps, const PeerConfig& config,
+                            int bits, float displacement, float bound_px, DepthVideoRun& run);
 
 }  // namespace reprise::cli

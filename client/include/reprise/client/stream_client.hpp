@@ -91,6 +91,6 @@ using PoseFunction = std::function<glm::mat4(double t)>;
 using ShowFunction =
     std::function<bool(const Frame& frame, const DisplayInfo& info, int64_t displayed_us)>;
 Status run_client(StreamClient& client, double duration_s, double display_rate,
-                                const PoseFunction& pose, const ShowFunction& show);
+                  const PoseFunction& pose, const ShowFunction& show);
 
 }  // namespace reprise::client

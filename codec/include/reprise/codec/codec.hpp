@@ -179,12 +179,10 @@ float view_depth_step(const glm::mat4& projection, int width, int height, float 
                       float displacement);
 
 // Checks one packet (length, version, CRC) and reads its header into `info` (data left empty).
-Status inspect_packet(std::span<const uint8_t> packet, Packet& info,
-                                    int64_t& timestamp_us);
+Status inspect_packet(std::span<const uint8_t> packet, Packet& info, int64_t& timestamp_us);
 
 // A .rps file: a file header followed by packets (docs/bitstream.md).
-Status write_stream_header(std::vector<uint8_t>& out, int width, int height,
-                                         double fps);
+Status write_stream_header(std::vector<uint8_t>& out, int width, int height, double fps);
 struct StreamInfo {
     int width = 0, height = 0;
     double fps = 0.0;
@@ -200,12 +198,12 @@ struct StreamDamage {
 // (fields, length, CRC). After damage it resynchronises on the next byte where a whole valid
 // packet starts; every skipped stretch goes to `damage`. An error only for a bad file header.
 Status split_stream(std::span<const uint8_t> file, StreamInfo& info,
-                                  std::vector<std::span<const uint8_t>>& packets,
-                                  std::vector<StreamDamage>& damage);
+                    std::vector<std::span<const uint8_t>>& packets,
+                    std::vector<StreamDamage>& damage);
 // The same, stopping at the first damage: an error naming it, with `packets` holding the whole
 // packets before it (a torn tail, say).
 Status split_stream(std::span<const uint8_t> file, StreamInfo& info,
-                                  std::vector<std::span<const uint8_t>>& packets);
+                    std::vector<std::span<const uint8_t>>& packets);
 
 // Frames first..last (or first and every later one when `open`) that a damaged file lost.
 struct LostFrames {
@@ -228,7 +226,7 @@ struct StreamReport {
 // until the next key frame or a frame whose reference is held. An error for a bad file header
 // or from the sink; the losses are in `report`.
 using FrameSink = std::function<Status(uint32_t frame, Frame& decoded)>;
-Status decode_stream(std::span<const uint8_t> file, Decoder& decoder,
-                                   StreamInfo& info, StreamReport& report, const FrameSink& sink);
+Status decode_stream(std::span<const uint8_t> file, Decoder& decoder, StreamInfo& info,
+                     StreamReport& report, const FrameSink& sink);
 
 }  // namespace reprise::codec

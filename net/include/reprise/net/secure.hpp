@@ -45,7 +45,7 @@ struct ResumptionTicket {
 // What a ClientHello's padding says: PIN (no ticket) or the ticket id it names. Refuses a hello
 // of another size or with padding that is not zero.
 Status client_hello_ticket(std::span<const uint8_t> client_hello, bool& has_ticket,
-                                         std::array<uint8_t, kTicketIdSize>& id);
+                           std::array<uint8_t, kTicketIdSize>& id);
 
 // Client side of the handshake.
 class ClientHandshake {
@@ -55,8 +55,8 @@ public:
     void start(const std::string& secret, std::vector<uint8_t>& hello,
                const ResumptionTicket* ticket = nullptr);
     // Checks the ServerHello's key confirmation; on success writes the ClientFinish and the keys.
-    Status finish(std::span<const uint8_t> server_hello,
-                                std::vector<uint8_t>& client_finish, SessionKeys& keys);
+    Status finish(std::span<const uint8_t> server_hello, std::vector<uint8_t>& client_finish,
+                  SessionKeys& keys);
     uint64_t connection() const { return connection_; }
     ~ClientHandshake();
 
@@ -71,13 +71,10 @@ struct PendingHandshake {
     Key client_confirm{};  // the tag the client must send
     SessionKeys keys;
 };
-Status answer_client_hello(const std::string& secret,
-                                         std::span<const uint8_t> client_hello,
-                                         std::vector<uint8_t>& server_hello,
-                                         PendingHandshake& pending);
+Status answer_client_hello(const std::string& secret, std::span<const uint8_t> client_hello,
+                           std::vector<uint8_t>& server_hello, PendingHandshake& pending);
 // True when `client_finish` carries the expected confirmation (constant-time compare).
-Status check_client_finish(const PendingHandshake& pending,
-                                         std::span<const uint8_t> client_finish);
+Status check_client_finish(const PendingHandshake& pending, std::span<const uint8_t> client_finish);
 
 // Sliding window over the newest 256 sequence numbers.
 class ReplayWindow {
