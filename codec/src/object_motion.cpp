@@ -8,18 +8,20 @@
 #include <bit>
 #include <cmath>
 #include <map>
+#include <mutex>
 
 #include <glm/gtc/quaternion.hpp>
 
 #include "internal.hpp"
 #include "least_squares.hpp"
+#include "reprise/core/parallel.hpp"
 
 namespace reprise::codec {
 
 namespace {
 
 constexpr int kMinPixels = 16;    // pixels the cameras do not explain
-constexpr int kMaxSamples = 600;  // per object
+constexpr int kMaxSamples = 300;  // per object
 constexpr int kRounds = 4;
 constexpr double kFloorPx = 0.05;          // the smallest trimming threshold
 constexpr double kMaxArea = 4.0;           // all objects' pixels, in pictures
@@ -109,7 +111,14 @@ bool fit_one(const Camera& camera, Candidate& c, float bound, int width, int hei
         model.residuals(q, s, r);
         for (std::size_t i = 0; i < s.size(); ++i) norms[i] = std::hypot(r[2 * i], r[2 * i + 1]);
         const double threshold = std::max(3.0 * 1.4826 * fit::median(norms), kFloorPx);
-        for (std::size_t i = 0; i < s.size(); ++i) inlier[i] = norms[i] <= threshold;
+        bool same = true;
+        for (std::size_t i = 0; i < s.size(); ++i) {
+            const uint8_t in = norms[i] <= threshold;
+            same = same && in == inlier[i];
+            inlier[i] = in;
+        }
+        // Settled on an exact fit: another round would refit the same samples to the same end.
+        if (same && threshold <= kFloorPx) break;
     }
     for (double v : q)
         if (!std::isfinite(v)) return false;
@@ -175,19 +184,36 @@ std::vector<ObjectMotion> fit_object_motions(const Camera& camera, ImageView<con
         const float z = depth(x, y);
         return z > 0.0f && std::isfinite(z) && finite(motion(x, y));
     };
-    for (int y = 0; y < h; ++y)
-        for (int x = 0; x < w; ++x) {
-            const uint32_t id = ids(x, y);
-            if (id == 0) continue;
+    // Counted per band of rows in parallel, merged under a lock (sums and extents: any order).
+    std::mutex merging;
+    parallel_for(0, h, [&](int r0, int r1) {
+        std::map<uint32_t, Candidate> band;
+        Candidate* last = nullptr;  // ids come in runs: one map lookup per run
+        for (int y = r0; y < r1; ++y)
+            for (int x = 0; x < w; ++x) {
+                const uint32_t id = ids(x, y);
+                if (id == 0) continue;
+                if (!last || last->id != id) {
+                    last = &band[id];
+                    last->id = id;
+                }
+                Candidate& c = *last;
+                ++c.pixels;
+                c.x0 = std::min(c.x0, x), c.y0 = std::min(c.y0, y);
+                c.x1 = std::max(c.x1, x + 1), c.y1 = std::max(c.y1, y + 1);
+                if (!usable(x, y)) continue;
+                ++c.usable;
+                c.unexplained += !explains(motion(x, y), base(x, y), bound);
+            }
+        const std::lock_guard lock(merging);
+        for (const auto& [id, b] : band) {
             Candidate& c = found[id];
             c.id = id;
-            ++c.pixels;
-            c.x0 = std::min(c.x0, x), c.y0 = std::min(c.y0, y);
-            c.x1 = std::max(c.x1, x + 1), c.y1 = std::max(c.y1, y + 1);
-            if (!usable(x, y)) continue;
-            ++c.usable;
-            c.unexplained += !explains(motion(x, y), base(x, y), bound);
+            c.pixels += b.pixels, c.usable += b.usable, c.unexplained += b.unexplained;
+            c.x0 = std::min(c.x0, b.x0), c.y0 = std::min(c.y0, b.y0);
+            c.x1 = std::max(c.x1, b.x1), c.y1 = std::max(c.y1, b.y1);
         }
+    });
     std::vector<Candidate*> chosen;
     for (auto& [id, c] : found)
         if (c.unexplained >= kMinPixels) chosen.push_back(&c);
@@ -198,11 +224,19 @@ std::vector<ObjectMotion> fit_object_motions(const Camera& camera, ImageView<con
     if (chosen.empty()) return objects;
     std::map<uint32_t, Candidate*> by_id;
     for (Candidate* c : chosen) by_id[c->id] = c;
+    uint32_t last_id = 0;
+    Candidate* chosen_of_last = nullptr;
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
-            auto it = by_id.find(ids(x, y));
-            if (it == by_id.end() || !usable(x, y)) continue;
-            Candidate& c = *it->second;
+            const uint32_t id = ids(x, y);
+            if (id == 0) continue;
+            if (id != last_id) {
+                const auto it = by_id.find(id);
+                last_id = id;
+                chosen_of_last = it == by_id.end() ? nullptr : it->second;
+            }
+            if (!chosen_of_last || !usable(x, y)) continue;
+            Candidate& c = *chosen_of_last;
             // Evenly over the usable pixels: the k-th sample at the k * usable / kMaxSamples-th.
             const int k = int(int64_t(c.seen++) * std::min(c.usable, kMaxSamples) / c.usable);
             if (k < int(c.samples.size())) continue;
