@@ -476,6 +476,27 @@ TEST(Codec, ASilhouetteOnePixelOffCostsAFlag) {
     }
 }
 
+// A zoom changes the view step the client's warps need; each frame then sends its own step in
+// the depth section instead of starting a new sequence with a key frame.
+TEST(Codec, AZoomKeepsOneKeyFrame) {
+    auto frames = render("pan", 6, 160, 96);
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+        const float now = 1.0f + 0.3f * float(i), before = 1.0f + 0.3f * float(i ? i - 1 : 0);
+        Camera& c = frames[i].camera;
+        c.projection[0][0] *= now, c.projection[1][1] *= now;
+        c.prev_projection[0][0] *= before, c.prev_projection[1][1] *= before;
+    }
+    const float first = view_depth_step(frames[0].camera.projection, 160, 96, 0.25f, 0.164f);
+    const float last = view_depth_step(frames.back().camera.projection, 160, 96, 0.25f, 0.164f);
+    ASSERT_GE(std::abs(std::log2(last / first)), 0.25f);  // two or more of its 2^(1/8) rungs
+    const Coded coded = encode_all(frames, {.depth = DepthMode::View});
+    EXPECT_EQ(coded.stats.key_frames, 1u);
+    const auto decoded = decode_all(coded.packets);
+    ASSERT_EQ(decoded.size(), frames.size());
+    for (std::size_t i = 0; i < frames.size(); ++i)
+        EXPECT_TRUE(same_frame(decoded[i], coded.reconstructions[i])) << "frame " << i;
+}
+
 TEST(Codec, StreamsOfAnOlderVersionAreRefused) {
     const auto frames = render("crossing", 1, 64, 48);
     Coded coded = encode_all(frames, {.depth = DepthMode::View});

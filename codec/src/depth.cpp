@@ -20,6 +20,8 @@ constexpr uint32_t kInvalidCode = (1u << 30) + 2;
 constexpr int kBlock = 8;
 constexpr uint32_t kNoPrediction = 0xFFFFFFFFu;  // no code maps here in either mode
 constexpr uint8_t kAllPredicted = 1;
+constexpr uint8_t kOwnStep = 2;  // view depth: this frame's 1/z step follows (f32)
+constexpr float kMinViewStep = 1e-12f, kMaxViewStep = 1e6f;
 
 // View-mode codes are k = round(1/z / step) in 0..2^30 (k = 0 decodes as half a step).
 constexpr uint32_t kMaxViewCode = 1u << 30;
@@ -75,9 +77,9 @@ struct Mapping {
     }
 };
 
-Mapping mapping_of(const SequenceParams& sp) {
+Mapping mapping_of(const SequenceParams& sp, float view_step) {
     const bool view = sp.depth == DepthMode::View;
-    return {sp.depth == DepthMode::Lossless, view, view ? double(sp.view_step) : sp.depth_step(),
+    return {sp.depth == DepthMode::Lossless, view, view ? double(view_step) : sp.depth_step(),
             double(sp.view_displacement)};
 }
 
@@ -411,7 +413,9 @@ void encode_depth(const FrameContext& fc, const Camera& camera, ImageView<const 
         out.clear();
         return;
     }
-    const Mapping map = mapping_of(sp);
+    const bool own_step =
+        sp.depth == DepthMode::View && fc.view_step > 0.0f && fc.view_step != sp.view_step;
+    const Mapping map = mapping_of(sp, own_step ? fc.view_step : sp.view_step);
     const int w = sp.width, h = sp.height;
     Image<uint32_t>& codes = fc.work->depth_codes;
     Image<uint32_t>& temporal = fc.work->temporal_codes;
@@ -436,7 +440,8 @@ void encode_depth(const FrameContext& fc, const Camera& camera, ImageView<const 
     for (std::size_t i = 0; all_predicted && i < codes.pixel_count(); ++i)
         all_predicted = codes.data()[i] == temporal.data()[i];
     ByteWriter wr(bytes);
-    wr.u8(all_predicted ? kAllPredicted : 0);
+    wr.u8(uint8_t((all_predicted ? kAllPredicted : 0) | (own_step ? kOwnStep : 0)));
+    if (own_step) wr.f32(fc.view_step);
     if (all_predicted) {
         stats.depth_zero_blocks +=
             std::size_t((w + kBlock - 1) / kBlock) * ((h + kBlock - 1) / kBlock);
@@ -462,7 +467,21 @@ Status decode_depth(const FrameContext& fc, const Camera& camera, std::span<cons
         out.clear();
         return {};
     }
-    const Mapping map = mapping_of(sp);
+    ByteReader r(in, "depth section");
+    const uint8_t flags = r.u8();
+    if (!r.ok()) return Status::error(r.error());
+    if ((flags & ~(kAllPredicted | kOwnStep)) ||
+        ((flags & kOwnStep) && sp.depth != DepthMode::View))
+        return Status::error("depth section: unknown flags " + std::to_string(flags));
+    float step = sp.view_step;
+    if (flags & kOwnStep) {
+        step = r.f32();
+        if (!r.ok()) return Status::error(r.error());
+        if (!(step >= kMinViewStep && step <= kMaxViewStep))
+            return Status::error("depth section: 1/z step " + std::to_string(step) +
+                                 " outside 1e-12..1e6");
+    }
+    const Mapping map = mapping_of(sp, step);
     const int w = sp.width, h = sp.height;
     Image<uint32_t>& codes = fc.work->depth_codes;
     Image<uint32_t>& temporal = fc.work->temporal_codes;
@@ -470,11 +489,6 @@ Status decode_depth(const FrameContext& fc, const Camera& camera, std::span<cons
     ensure_size(codes, w, h);
     ensure_size(residuals, w, h);
     temporal_codes(fc, camera, map, temporal);
-    ByteReader r(in, "depth section");
-    const uint8_t flags = r.u8();
-    if (!r.ok()) return Status::error(r.error());
-    if (flags & ~kAllPredicted)
-        return Status::error("depth section: unknown flags " + std::to_string(flags));
     if (flags & kAllPredicted) {
         if (temporal.empty())
             return Status::error("depth section: predicted from a reference on a key frame");

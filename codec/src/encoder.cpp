@@ -39,15 +39,18 @@ std::vector<ObjectMotion> frame_objects(const EncoderOptions& options, const Seq
         ref ? std::span<const ObjectMotion>(ref->objects) : std::span<const ObjectMotion>());
 }
 
-// The view step of a new sequence: the client's, finer when the camera, or an object relative to
-// it, travels further than B between frames, so that the motion both sides derive from decoded
-// depth stays within the motion bound (docs/bitstream.md, section 6). An object counts up to
-// kObjectTravel times the larger of B and the camera's travel: beyond, the depth it would need
-// costs more than its motion. The travels are the key frame's; what later moves faster costs
-// motion residuals.
+// A frame's view step: the client's (E and B with this projection), finer when the camera, or an
+// object relative to it, travels further than B since the previous frame, so that the motion both
+// sides derive from decoded depth stays within the motion bound (docs/bitstream.md, section 6).
+// An object counts up to kObjectTravel times the larger of B and the camera's travel: beyond,
+// the depth it would need costs more than its motion saves.
 constexpr float kObjectTravel = 3.0f;
-float sequence_view_step(const Camera& camera, std::span<const ObjectMotion> objects, int w, int h,
-                         float client, float displacement, float motion_error) {
+float frame_view_step(const SequenceParams& sp, const Camera& camera,
+                      std::span<const ObjectMotion> objects) {
+    const int w = sp.width, h = sp.height;
+    const float displacement = sp.view_displacement, motion_error = sp.motion_error;
+    const float client =
+        view_depth_step(camera.projection, w, h, sp.view_error, sp.view_displacement);
     if (motion_error <= 0.0f) return client;
     const glm::vec3 here = glm::vec3(glm::inverse(camera.view)[3]);
     const glm::vec3 before = glm::vec3(glm::inverse(camera.prev_view)[3]);
@@ -102,8 +105,6 @@ struct Encoder::State {
     Planes source_planes;
     Picture scratch;
     Workspace work;
-
-    float client_step = 0.0f;  // the view step the client's warps need (E and B)
 
     // Frames without a camera get a fitted one: poses chained from the first such frame's camera
     // space (the previous frame's view), a lens assumed until rotation lets the fit measure it.
@@ -180,6 +181,7 @@ struct Encoder::State {
         std::vector<uint8_t> depth_section, motion_section;
         std::vector<ObjectMotion> objects = fit_objects(frame, camera, ref);
         fc.objects = objects;
+        if (sp.depth == DepthMode::View) fc.view_step = frame_view_step(sp, camera, objects);
         encode_depth(fc, camera, frame.depth.view(), pic.depth, depth_section, fs);
         encode_motion(fc, camera, pic.depth.view(), frame.motion.view(), frame.id.view(),
                       pic.motion, pic.owner, motion_section, fs);
@@ -266,16 +268,12 @@ Status Encoder::send_frame(const Frame& given) {
     if (sp.depth == DepthMode::View) {
         sp.view_error = s.options.view_error_px;
         sp.view_displacement = s.options.view_displacement;
-        const float client =
-            view_depth_step(camera.projection, w, h, sp.view_error, sp.view_displacement);
-        sp.view_step =
-            s.started && client == s.client_step
-                ? s.sp.view_step
-                : sequence_view_step(
-                      camera,
-                      frame_objects(s.options, sp, frame, camera, nullptr, s.work.base_motion), w,
-                      h, client, sp.view_displacement, sp.motion_error);
-        s.client_step = client;
+        // The key frame's step; later frames send their own when it differs (a zoom, a faster
+        // camera or object), so that no step change needs a key frame.
+        sp.view_step = s.started ? s.sp.view_step
+                                 : frame_view_step(sp, camera,
+                                                   frame_objects(s.options, sp, frame, camera,
+                                                                 nullptr, s.work.base_motion));
     }
     sp.slices = default_slices(h);
     sp.fps = frame.fps > 0.0 ? frame.fps : s.options.fps;
@@ -398,9 +396,6 @@ Status Encoder::resume(std::span<const std::span<const uint8_t>> packets) {
     s.next_frame = uint32_t(packets.size());
     s.newest = s.slot_of(s.next_frame - 1);
     s.started = d.started;
-    if (s.sp.depth == DepthMode::View && s.newest >= 0)
-        s.client_step = view_depth_step(s.refs[s.newest].camera.projection, s.sp.width, s.sp.height,
-                                        s.sp.view_error, s.sp.view_displacement);
     if (s.newest >= 0 && has_projection(s.refs[s.newest].camera)) {
         const Camera& c = s.refs[s.newest].camera;
         s.chain.pose = glm::dmat4(c.view);

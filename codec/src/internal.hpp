@@ -170,6 +170,7 @@ struct FrameContext {
     bool key = false;
     Workspace* work = nullptr;
     std::span<const ObjectMotion> objects;  // this frame's, from the camera section
+    float view_step = 0.0f;  // encoder, view depth: this frame's step (0: the sequence's)
 };
 
 // The camera and the objects' rigid motions (their bytes returned; counted as motion).
