@@ -76,6 +76,12 @@ py::dict stats_dict(const codec::StreamStats& s) {
     d["blocks"] = s.blocks;
     d["blocks_skipped"] = s.blocks_skipped;
     d["intra_blocks"] = s.intra_blocks;
+    d["depth_zero_blocks"] = s.depth_zero_blocks;
+    d["motion_residual_pixels"] = s.motion_residual_pixels;
+    d["motion_objects"] = s.motion_objects;
+    d["motion_models"] = s.motion_models;
+    d["motion_own_pixels"] = s.motion_own_pixels;
+    d["cameras_fitted"] = s.cameras_fitted;
     return d;
 }
 
