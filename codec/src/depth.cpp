@@ -1,7 +1,9 @@
-// Depth: each pixel as a 32-bit code (the float's bits in an order-preserving map, or the
-// quantised log2 depth), predicted per 8x8 block either from the reference depth
-// forward-projected into this camera or spatially (median edge detector), residuals
-// context-coded. Blocks predicted exactly cost two flags.
+// Depth: each pixel as a 32-bit code (the float's bits in an order-preserving map, the
+// quantised log2 depth, or 1/z in eighths of the view step), predicted per 8x8 block either
+// from the reference depth forward-projected into this camera or spatially (median edge
+// detector), residuals context-coded. Blocks predicted exactly cost two flags. View mode sends
+// the prediction itself wherever it is within the bound and quantises residuals, so decoded
+// depth keeps its error from frame to frame instead of being rounded again each time.
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -23,14 +25,18 @@ constexpr uint8_t kAllPredicted = 1;
 constexpr uint8_t kOwnStep = 2;  // view depth: this frame's 1/z step follows (f32)
 constexpr float kMinViewStep = 1e-12f, kMaxViewStep = 1e6f;
 
-// View-mode codes are k = round(1/z / step) in 0..2^30 (k = 0 decodes as half a step).
+// View-mode codes are k = round(1/z / (q / 8)) in 0..2^30 (k = 0 decodes as half a code), for
+// the view step q; residuals count steps of 9 codes, so the nearest choice errs by at most q / 2.
 constexpr uint32_t kMaxViewCode = 1u << 30;
+constexpr int kViewCodesPerStep = 8;
+constexpr int kViewResidualStep = kViewCodesPerStep + 1;
 
 struct Mapping {
     bool lossless;
-    bool view;                  // uniform in 1/z
-    double step;                // log2 step (bounded) or 1/z step (view)
-    double displacement = 0.0;  // view: the declared largest camera displacement (encoder only)
+    bool view;                   // uniform in 1/z
+    double step;                 // log2 step (bounded) or 1/z per code (view: q / 8)
+    double displacement = 0.0;   // view: the declared largest camera displacement (encoder only)
+    uint32_t residual_step = 1;  // codes per residual unit
 
     uint32_t code(float z) const {
         if (lossless) {
@@ -79,8 +85,9 @@ struct Mapping {
 
 Mapping mapping_of(const SequenceParams& sp, float view_step) {
     const bool view = sp.depth == DepthMode::View;
-    return {sp.depth == DepthMode::Lossless, view, view ? double(view_step) : sp.depth_step(),
-            double(sp.view_displacement)};
+    return {sp.depth == DepthMode::Lossless, view,
+            view ? double(view_step) / kViewCodesPerStep : sp.depth_step(),
+            double(sp.view_displacement), view ? uint32_t(kViewResidualStep) : 1u};
 }
 
 inline uint32_t median_edge(int64_t a, int64_t b, int64_t c) {
@@ -106,10 +113,11 @@ struct Models {
 struct SliceJob {
     const Mapping* map;
     int width, y0, y1;
-    ImageView<uint32_t> codes;           // decoder fills, encoder has them
+    ImageView<uint32_t> codes;  // decoder fills; encoder has them, or chooses them in view mode
     ImageView<const uint32_t> temporal;  // kNoPrediction where nothing landed; empty on key frames
     ImageView<uint32_t> residuals;
     ImageView<uint32_t> predictions;  // encoder: the block's prediction of each pixel
+    ImageView<const float> source;    // encoder, view mode: the depth to code
     std::size_t zero_blocks = 0;
 };
 
@@ -159,8 +167,10 @@ inline uint32_t surface_prediction(const SliceJob& j, int x, int y, uint32_t p) 
     const bool left = x > 0, top = y > j.y0;
     if (left && j.map->surface(j.codes(x - 1, y))) return j.codes(x - 1, y);
     if (top && j.map->surface(j.codes(x, y - 1))) return j.codes(x, y - 1);
-    if (top && x + 1 < j.width && j.map->surface(j.codes(x + 1, y - 1)))
-        return j.codes(x + 1, y - 1);
+    // Above right only where the encoder, which decides block by block, knows it already.
+    const bool above_right =
+        top && x + 1 < j.width && ((x + 1) % kBlock != 0 || (y - j.y0) % kBlock == 0);
+    if (above_right && j.map->surface(j.codes(x + 1, y - 1))) return j.codes(x + 1, y - 1);
     if (left && top && j.map->surface(j.codes(x - 1, y - 1))) return j.codes(x - 1, y - 1);
     return p;
 }
@@ -186,53 +196,81 @@ inline uint64_t pixel_cost(const SliceJob& j, int x, int y, uint32_t p) {
     const uint32_t c = j.codes(x, y);
     if (c == p) return 0;
     if (c == j.map->empty()) return 1;
-    return 1 + residual_cost(int32_t(c - surface_prediction(j, x, y, p)));
+    return 1 + residual_cost(int32_t(c - surface_prediction(j, x, y, p)) /
+                             int32_t(j.map->residual_step));
 }
 
-// The encoder knows every code up front (coding is lossless), so it decides each block before
-// coding any: temporal prediction first, and the spatial one (the costly inverse-depth median)
-// only where the temporal one is not exact. Residuals of the whole block row are stored before
-// they are coded; the contexts read the same values the decoder has at that point.
+// View mode: the code sent for the source depth at (x, y) predicted by p. Any code whose inverse
+// depth is close enough to the truth keeps the reprojection error within the bound: p itself
+// when it is such a code, else the surface prediction plus the smallest number of residual steps
+// that is, else the nearest to the truth. The allowance shrinks by (1 - B/z)^2 for points near
+// the camera (docs/bitstream.md).
+uint32_t choose_view_code(const SliceJob& j, int x, int y, uint32_t p) {
+    const Mapping& map = *j.map;
+    const float z = j.source.empty() ? INFINITY : j.source(x, y);
+    const uint32_t k = map.code(z);
+    if (k > kMaxViewCode && k != kInvalidCode) return k;  // background: a flag
+    const double w = 1.0 / double(z);
+    auto within = [&](int64_t c) {
+        if (c < 0 || c > kMaxViewCode) return false;
+        const double wc = map.inverse_depth(uint32_t(c));
+        const double near = std::max(0.0, 1.0 - map.displacement * std::max(w, wc));
+        return std::abs(wc - w) <= kViewCodesPerStep * map.step * near * near;
+    };
+    if (k != kInvalidCode && within(p)) return p;
+    const int64_t base = surface_prediction(j, x, y, p), s = kViewResidualStep;
+    if (k == kInvalidCode)  // NaN: any code above 2^30 + 1
+        return uint32_t(base + std::max<int64_t>(0, (kInvalidCode - base + s - 1) / s) * s);
+    const int64_t r = (int64_t(k) - base + (k >= base ? s / 2 : -(s / 2))) / s;
+    for (int64_t d : {0, -1, 1})
+        if (within(base + (r + d) * s)) return uint32_t(base + (r + d) * s);
+    return uint32_t(base + r * s);
+}
+
+// The estimated cost of a block predicted temporally or spatially; in view mode, its codes are
+// chosen for that prediction on the way.
+uint64_t block_cost(SliceJob& j, int bx, int by, int bw, int bh, bool temporal) {
+    uint64_t cost = 0;
+    for (int y = by; y < by + bh; ++y)
+        for (int x = bx; x < bx + bw; ++x) {
+            const uint32_t p = predict(j, x, y, temporal);
+            if (j.map->view) j.codes(x, y) = choose_view_code(j, x, y, p);
+            cost += pixel_cost(j, x, y, p);
+        }
+    return cost;
+}
+
+// The encoder decides each block before coding any: temporal prediction first, and the spatial
+// one (the costly inverse-depth median) only where the temporal one is not exact. Residuals of
+// the whole block row are stored before they are coded; the contexts read the same values the
+// decoder has at that point.
 void encode_slice(SliceJob& j, std::vector<uint8_t>& bytes, std::vector<uint8_t>& block_flags) {
     RangeEncoder rc(bytes);
     Models m;
     const bool inter = !j.temporal.empty();
     const int blocks = (j.width + kBlock - 1) / kBlock;
     block_flags.resize(std::size_t(blocks));  // bit 0: temporal, bit 1: zero
-    uint32_t spatial_codes[kBlock * kBlock];
     for (int by = j.y0; by < j.y1; by += kBlock) {
         const int bh = std::min(kBlock, j.y1 - by);
         for (int b = 0; b < blocks; ++b) {
             const int bx = b * kBlock, bw = std::min(kBlock, j.width - bx);
-            bool use_temporal = false;
+            bool use_temporal = inter;
             uint64_t cost = 0;
-            bool spatial_known = false;
             if (inter) {
                 // Most blocks of a moving camera's depth are predicted exactly (no code equals
-                // kNoPrediction): a plain comparison finds them.
-                bool exact = true;
+                // kNoPrediction): with the codes known, a plain comparison finds them.
+                bool exact = !j.map->view;
                 for (int y = by; y < by + bh && exact; ++y)
                     exact = std::equal(&j.codes(bx, y), &j.codes(bx, y) + bw, &j.temporal(bx, y));
-                for (int y = by; y < by + bh && !exact; ++y)
-                    for (int x = bx; x < bx + bw; ++x) {
-                        uint32_t p = j.temporal(x, y);
-                        if (p == kNoPrediction) p = spatial(j, x, y);
-                        cost += pixel_cost(j, x, y, p);
-                    }
-                use_temporal = true;
+                if (!exact) cost = block_cost(j, bx, by, bw, bh, true);
             }
             if (!inter || cost > 0) {
-                uint64_t spatial_cost = 0;
-                for (int y = by; y < by + bh; ++y)
-                    for (int x = bx; x < bx + bw; ++x) {
-                        const uint32_t p = spatial(j, x, y);
-                        spatial_codes[(y - by) * kBlock + (x - bx)] = p;
-                        spatial_cost += pixel_cost(j, x, y, p);
-                    }
-                spatial_known = true;
+                const uint64_t spatial_cost = block_cost(j, bx, by, bw, bh, false);
                 if (!inter || spatial_cost < cost) {
                     use_temporal = false;
                     cost = spatial_cost;
+                } else if (j.map->view) {
+                    block_cost(j, bx, by, bw, bh, true);  // the temporal choice's codes again
                 }
             }
             if (inter) rc.bit(m.temporal, use_temporal);
@@ -245,13 +283,8 @@ void encode_slice(SliceJob& j, std::vector<uint8_t>& bytes, std::vector<uint8_t>
                 continue;
             }
             for (int y = by; y < by + bh; ++y)
-                for (int x = bx; x < bx + bw; ++x) {
-                    uint32_t p = use_temporal ? j.temporal(x, y) : kNoPrediction;
-                    if (p == kNoPrediction)
-                        p = spatial_known ? spatial_codes[(y - by) * kBlock + (x - bx)]
-                                          : spatial(j, x, y);
-                    j.predictions(x, y) = p;
-                }
+                for (int x = bx; x < bx + bw; ++x)
+                    j.predictions(x, y) = predict(j, x, y, use_temporal);
         }
         for (int y = by; y < by + bh; ++y)
             for (int b = 0; b < blocks; ++b) {
@@ -261,7 +294,10 @@ void encode_slice(SliceJob& j, std::vector<uint8_t>& bytes, std::vector<uint8_t>
                     const uint32_t p = j.predictions(x, y), c = j.codes(x, y);
                     const bool background = c == j.map->empty();
                     rc.bit(m.background[background_context(j, x, y, p)], background);
-                    j.residuals(x, y) = background ? 0 : c - surface_prediction(j, x, y, p);
+                    j.residuals(x, y) = background
+                                            ? 0
+                                            : uint32_t(int32_t(c - surface_prediction(j, x, y, p)) /
+                                                       int32_t(j.map->residual_step));
                     if (!background)
                         encode_int(rc, m.residual[flags & 1][residual_context(j, x, y)],
                                    int64_t(int32_t(j.residuals(x, y))));
@@ -304,7 +340,7 @@ bool decode_slice(SliceJob& j, std::span<const uint8_t> bytes) {
                 if (!decode_int(rc, m.residual[block_temporal[b]][residual_context(j, x, y)], r))
                     return false;
                 j.residuals(x, y) = uint32_t(r);
-                j.codes(x, y) = surface_prediction(j, x, y, p) + uint32_t(r);
+                j.codes(x, y) = surface_prediction(j, x, y, p) + uint32_t(r) * j.map->residual_step;
             }
         if (rc.overrun() > 8) return false;
     }
@@ -369,35 +405,6 @@ void depth_from_codes(const Mapping& map, const Image<uint32_t>& codes, Image<fl
     });
 }
 
-// View mode leaves the encoder a choice: any code whose inverse depth is close enough to the
-// truth keeps the reprojection error within the bound. Where the temporal or else the spatial
-// prediction is such a code, it is taken, so a block predicted within the bound has no residual.
-// The allowance shrinks by (1 - B/z)^2 for points near the camera (docs/bitstream.md).
-void choose_view_codes(SliceJob& j, ImageView<const float> source) {
-    const Mapping& map = *j.map;
-    const bool inter = !j.temporal.empty();
-    auto within = [&](uint32_t c, double w) {
-        if (c > kMaxViewCode) return false;
-        const double wc = map.inverse_depth(c);
-        const double near = std::max(0.0, 1.0 - map.displacement * std::max(w, wc));
-        return std::abs(wc - w) <= map.step * near * near;
-    };
-    for (int y = j.y0; y < j.y1; ++y)
-        for (int x = 0; x < j.width; ++x) {
-            const float z = source.empty() ? INFINITY : source(x, y);
-            uint32_t c = map.code(z);
-            if (c <= kMaxViewCode) {
-                const double w = 1.0 / double(z);
-                const uint32_t t = inter ? j.temporal(x, y) : kNoPrediction;
-                if (t != kNoPrediction && within(t, w))
-                    c = t;
-                else if (const uint32_t p = spatial(j, x, y); within(p, w))
-                    c = p;
-            }
-            j.codes(x, y) = c;
-        }
-}
-
 }  // namespace
 
 // Codes are log2(z) / step rounded: the decoded z is within 2^(step / 2) - 1 of the truth; a
@@ -423,36 +430,35 @@ void encode_depth(const FrameContext& fc, const Camera& camera, ImageView<const 
     ensure_size(codes, w, h);
     ensure_size(residuals, w, h);
     temporal_codes(fc, camera, map, temporal);
-    if (map.view) {
-        std::vector<SliceJob> jobs = slice_jobs(sp, map, codes, temporal, residuals);
-        parallel_for(0, sp.slices, [&](int s0, int s1) {
-            for (int s = s0; s < s1; ++s) choose_view_codes(jobs[s], source);
-        });
-    } else {
+    if (!map.view)
         parallel_for(0, h, [&](int y0, int y1) {
             for (int y = y0; y < y1; ++y)
                 for (int x = 0; x < w; ++x)
                     codes(x, y) = map.code(source.empty() ? INFINITY : source(x, y));
         });
-    }
     const std::size_t start = bytes.size();
+    ByteWriter wr(bytes);
+    wr.u8(uint8_t(own_step ? kOwnStep : 0));
+    if (own_step) wr.f32(fc.view_step);
+    const std::size_t slices_start = bytes.size();
+    Image<uint32_t>& predictions = fc.work->depth_predictions;
+    ensure_size(predictions, w, h);
+    std::vector<SliceJob> jobs = slice_jobs(sp, map, codes, temporal, residuals, &predictions);
+    for (SliceJob& j : jobs) j.source = source;
+    std::vector<std::vector<uint8_t>>& flags = fc.work->slice_flags;
+    flags.resize(std::size_t(sp.slices));
+    encode_slices(sp.slices, fc.work->slice_bytes, bytes,
+                  [&](int s, std::vector<uint8_t>& b) { encode_slice(jobs[s], b, flags[s]); });
+    // A frame whose every code is its temporal prediction needs only the flag.
     bool all_predicted = !temporal.empty();
     for (std::size_t i = 0; all_predicted && i < codes.pixel_count(); ++i)
         all_predicted = codes.data()[i] == temporal.data()[i];
-    ByteWriter wr(bytes);
-    wr.u8(uint8_t((all_predicted ? kAllPredicted : 0) | (own_step ? kOwnStep : 0)));
-    if (own_step) wr.f32(fc.view_step);
     if (all_predicted) {
+        bytes.resize(slices_start);
+        bytes[start] |= kAllPredicted;
         stats.depth_zero_blocks +=
             std::size_t((w + kBlock - 1) / kBlock) * ((h + kBlock - 1) / kBlock);
     } else {
-        Image<uint32_t>& predictions = fc.work->depth_predictions;
-        ensure_size(predictions, w, h);
-        std::vector<SliceJob> jobs = slice_jobs(sp, map, codes, temporal, residuals, &predictions);
-        std::vector<std::vector<uint8_t>>& flags = fc.work->slice_flags;
-        flags.resize(std::size_t(sp.slices));
-        encode_slices(sp.slices, fc.work->slice_bytes, bytes,
-                      [&](int s, std::vector<uint8_t>& b) { encode_slice(jobs[s], b, flags[s]); });
         for (const SliceJob& j : jobs) stats.depth_zero_blocks += j.zero_blocks;
     }
     stats.depth_bits += 8 * (bytes.size() - start);
