@@ -102,9 +102,12 @@ inline int magnitude_class(uint32_t left, uint32_t top) {
     return s == 0 ? 0 : s <= 8 ? 1 : s <= 256 ? 2 : 3;
 }
 
+// Block flags: bit 0 temporal, bit 1 zero (no residuals).
+constexpr uint8_t kTemporalBlock = 1, kZeroBlock = 2;
+
 struct Models {
-    BitModel temporal;
-    BitModel zero_block[2];
+    BitModel temporal[3];
+    BitModel zero_block[2][3];
     BitModel background[4];
     IntModel<24> residual[2][4];
 };
@@ -185,6 +188,17 @@ inline int residual_context(const SliceJob& j, int x, int y) {
     return magnitude_class(x > 0 ? j.residuals(x - 1, y) : 0, y > j.y0 ? j.residuals(x, y - 1) : 0);
 }
 
+// A block's flags are coded in the context of its left and above neighbours in the slice: how
+// many of them are temporal, and how many have residuals (silhouettes run across blocks).
+inline int temporal_context(const std::vector<uint8_t>& row, const std::vector<uint8_t>& above,
+                            int b) {
+    return (b > 0 && (row[b - 1] & kTemporalBlock)) +
+           (!above.empty() && (above[b] & kTemporalBlock));
+}
+inline int zero_context(const std::vector<uint8_t>& row, const std::vector<uint8_t>& above, int b) {
+    return (b > 0 && !(row[b - 1] & kZeroBlock)) + (!above.empty() && !(above[b] & kZeroBlock));
+}
+
 // Cost estimate of coding a block's residuals.
 inline uint64_t residual_cost(int32_t r) {
     return r == 0 ? 0 : 2 + 2 * uint64_t(std::bit_width(uint32_t(std::abs(int64_t(r)))));
@@ -249,8 +263,10 @@ void encode_slice(SliceJob& j, std::vector<uint8_t>& bytes, std::vector<uint8_t>
     Models m;
     const bool inter = !j.temporal.empty();
     const int blocks = (j.width + kBlock - 1) / kBlock;
-    block_flags.resize(std::size_t(blocks));  // bit 0: temporal, bit 1: zero
+    block_flags.assign(std::size_t(blocks), 0);
+    std::vector<uint8_t> above;
     for (int by = j.y0; by < j.y1; by += kBlock) {
+        if (by > j.y0) above = block_flags;
         const int bh = std::min(kBlock, j.y1 - by);
         for (int b = 0; b < blocks; ++b) {
             const int bx = b * kBlock, bw = std::min(kBlock, j.width - bx);
@@ -273,10 +289,10 @@ void encode_slice(SliceJob& j, std::vector<uint8_t>& bytes, std::vector<uint8_t>
                     block_cost(j, bx, by, bw, bh, true);  // the temporal choice's codes again
                 }
             }
-            if (inter) rc.bit(m.temporal, use_temporal);
-            rc.bit(m.zero_block[use_temporal], cost == 0);
+            if (inter) rc.bit(m.temporal[temporal_context(block_flags, above, b)], use_temporal);
+            rc.bit(m.zero_block[use_temporal][zero_context(block_flags, above, b)], cost == 0);
             j.zero_blocks += cost == 0;
-            block_flags[b] = uint8_t(use_temporal) | uint8_t(cost == 0) << 1;
+            block_flags[b] = (use_temporal ? kTemporalBlock : 0) | (cost == 0 ? kZeroBlock : 0);
             if (cost == 0) {
                 for (int y = by; y < by + bh; ++y)
                     std::fill(&j.residuals(bx, y), &j.residuals(bx, y) + bw, 0u);
@@ -289,7 +305,7 @@ void encode_slice(SliceJob& j, std::vector<uint8_t>& bytes, std::vector<uint8_t>
         for (int y = by; y < by + bh; ++y)
             for (int b = 0; b < blocks; ++b) {
                 const uint8_t flags = block_flags[b];
-                if (flags & 2) continue;
+                if (flags & kZeroBlock) continue;
                 for (int x = b * kBlock; x < std::min(j.width, (b + 1) * kBlock); ++x) {
                     const uint32_t p = j.predictions(x, y), c = j.codes(x, y);
                     const bool background = c == j.map->empty();
@@ -311,22 +327,23 @@ bool decode_slice(SliceJob& j, std::span<const uint8_t> bytes) {
     RangeDecoder rc(bytes);
     Models m;
     const bool inter = !j.temporal.empty();
-    std::vector<uint8_t> block_temporal, block_zero;
+    const int blocks = (j.width + kBlock - 1) / kBlock;
+    std::vector<uint8_t> flags(std::size_t(blocks), 0), above;
     for (int by = j.y0; by < j.y1; by += kBlock) {
         const int bh = std::min(kBlock, j.y1 - by);
-        const int blocks = (j.width + kBlock - 1) / kBlock;
-        block_temporal.assign(blocks, 0);
-        block_zero.assign(blocks, 0);
+        if (by > j.y0) above = flags;
         for (int b = 0; b < blocks; ++b) {
-            block_temporal[b] = inter ? uint8_t(rc.bit(m.temporal)) : 0;
-            block_zero[b] = uint8_t(rc.bit(m.zero_block[block_temporal[b]]));
-            j.zero_blocks += block_zero[b];
+            const bool temporal = inter && rc.bit(m.temporal[temporal_context(flags, above, b)]);
+            const bool zero = rc.bit(m.zero_block[temporal][zero_context(flags, above, b)]);
+            flags[b] = (temporal ? kTemporalBlock : 0) | (zero ? kZeroBlock : 0);
+            j.zero_blocks += zero;
         }
         for (int y = by; y < by + bh; ++y)
             for (int x = 0; x < j.width; ++x) {
                 const int b = x / kBlock;
-                const uint32_t p = predict(j, x, y, block_temporal[b]);
-                if (block_zero[b]) {
+                const bool temporal = flags[b] & kTemporalBlock;
+                const uint32_t p = predict(j, x, y, temporal);
+                if (flags[b] & kZeroBlock) {
                     j.residuals(x, y) = 0;
                     j.codes(x, y) = p;
                     continue;
@@ -337,7 +354,7 @@ bool decode_slice(SliceJob& j, std::span<const uint8_t> bytes) {
                     continue;
                 }
                 int64_t r = 0;
-                if (!decode_int(rc, m.residual[block_temporal[b]][residual_context(j, x, y)], r))
+                if (!decode_int(rc, m.residual[temporal][residual_context(j, x, y)], r))
                     return false;
                 j.residuals(x, y) = uint32_t(r);
                 j.codes(x, y) = surface_prediction(j, x, y, p) + uint32_t(r) * j.map->residual_step;
