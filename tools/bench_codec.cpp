@@ -1,6 +1,7 @@
 // reprise bench codec — error against bits against run time: reprise's scene-aware codec beside
 // x264, x265 and SVT-AV1 (through libavcodec) on the same 8-bit display frames, Bjøntegaard
-// delta rates, the depth coders (reprise lossless, zstd -3, RVL) and the speed ratios at 1080p.
+// delta rates, the depth coders (reprise lossless, zstd -3, RVL), the views a client makes from
+// the decoded depth (synthesized_views.hpp) and the speed ratios at 1080p.
 //
 // OUT/codec.csv: scene,codec,setting,frame,bits,psnr,ssim,flip,encode_ms,decode_ms (display
 // values against the original colour; codec "reprise" counts all its bits, "reprise-color" the
@@ -32,6 +33,7 @@
 #include "reprise/core/parallel.hpp"
 #include "reprise/server/builtin_scenes.hpp"
 #include "reprise/server/renderer.hpp"
+#include "synthesized_views.hpp"
 
 namespace reprise::cli {
 
@@ -48,6 +50,7 @@ constexpr double kStreamBdTarget = 0.0;        // all bits of the default stream
 constexpr double kGeometryShareTarget = 20.0;  // % of the default stream for depth + motion
 constexpr double kDecodeOverEncodeTarget = 2.0;
 constexpr double kDepthRatioTarget = 2.0;  // zstd -3 bytes / reprise lossless depth bytes
+constexpr double kViewLossTarget = 0.2;    // dB, views from decoded depth against rendered depth
 
 // One encoded frame, scored.
 struct Sample {
@@ -80,6 +83,9 @@ struct Sequence {
     std::vector<Frame> frames;            // the G-buffers (colour, depth, motion, camera)
     std::vector<Image<Rgb8>> shown;       // 8-bit display values: what every codec gets
     std::vector<Image<glm::vec3>> truth;  // display values of the original colour
+    // Built-in scenes and glTF files: what rendered them, for views at other instants and eyes.
+    std::shared_ptr<server::Scene> scene;
+    server::CameraPath path;
 };
 
 struct DepthResult {
@@ -106,9 +112,10 @@ void add_frame(Sequence& seq, Frame&& frame) {
 
 Status render_sequence(server::Renderer& renderer, const std::string& scene_name, int frames, int w,
                        int h, Sequence& seq) {
-    server::Scene scene;
-    server::CameraPath path;
-    REPRISE_TRY(server::load_scene(scene_name, scene, path));
+    seq.scene = std::make_shared<server::Scene>();
+    const server::Scene& scene = *seq.scene;
+    const server::CameraPath& path = seq.path;
+    REPRISE_TRY(server::load_scene(scene_name, *seq.scene, seq.path));
     seq.name = fs::path(scene_name).stem().string();
     seq.fps = 30.0;
     for (const server::SceneInfo& info : server::builtin_scenes())
@@ -231,7 +238,8 @@ struct ViewDepthRun {
     std::size_t background_mismatches = 0, finite_pixels = 0, pixels_over_bound = 0;
     float step = 0.0f;
     std::vector<DepthVideoRun>
-        video_peers;  // 1/z as grey video, as immersive-video systems send it
+        video_peers;         // 1/z as grey video, as immersive-video systems send it
+    SynthesizedViews views;  // rendered sequences only
 };
 
 // reprise's depth at the view bound beside the grey-video depth peer, per scene, and the target:
@@ -275,7 +283,30 @@ std::string depth_video_text(const std::vector<ViewDepthRun>& rows,
     return text;
 }
 
-Status run_view_depth(const Sequence& seq, int qp, ViewDepthRun& run) {
+// The client's views from decoded depth against the same views from rendered depth, per scene.
+std::string synthesized_views_text(const std::vector<ViewDepthRun>& rows) {
+    std::string text = strf(
+        "\nviews the client makes from the default stream's decoded colour, warped with its "
+        "decoded "
+        "depth and motion (dec) and with the rendered ones (ren): extrapolated 1, 2 and 3 display "
+        "periods ahead at 4x the frame rate and the other eye %.0f mm to the right, PSNR against "
+        "the scene rendered there, mean over frames; target: dec within %.1f dB of ren\n%-10s",
+        64.0, kViewLossTarget, "scene");
+    for (int k = 0; k < SynthesizedViews::kViews; ++k)
+        text += strf(" %23s", SynthesizedViews::name(k));
+    text += "\n";
+    for (const ViewDepthRun& v : rows) {
+        if (v.views.frames == 0) continue;
+        text += strf("%-10s", v.scene.c_str());
+        for (int k = 0; k < SynthesizedViews::kViews; ++k)
+            text += strf("  %6.2f/%6.2f %+6.2f dB", v.views.decoded_psnr[k] / v.views.frames,
+                         v.views.rendered_psnr[k] / v.views.frames, v.views.loss_db(k));
+        text += "\n";
+    }
+    return text;
+}
+
+Status run_view_depth(server::Renderer& renderer, const Sequence& seq, int qp, ViewDepthRun& run) {
     const codec::EncoderOptions options{.qp = qp, .fps = seq.fps, .depth = codec::DepthMode::View};
     codec::Encoder encoder(options);
     codec::Decoder decoder;
@@ -283,6 +314,9 @@ Status run_view_depth(const Sequence& seq, int qp, ViewDepthRun& run) {
     Frame decoded;
     run.scene = seq.name;
     run.frames = seq.frames.size();
+    std::unique_ptr<SynthesizedViewScorer> views;
+    if (seq.scene)
+        views = std::make_unique<SynthesizedViewScorer>(renderer, *seq.scene, seq.path, seq.fps);
     for (std::size_t i = 0; i < seq.frames.size(); ++i) {
         const Frame& frame = seq.frames[i];
         REPRISE_TRY(encoder.send_frame(frame));
@@ -294,6 +328,11 @@ Status run_view_depth(const Sequence& seq, int qp, ViewDepthRun& run) {
         const codec::ViewDepthError e =
             codec::measure_view_depth_error(frame.camera, frame.depth.view(), decoded.depth.view(),
                                             options.view_displacement, options.view_error_px);
+        if (views) {
+            REPRISE_TRY(views->add(int(i), frame, decoded, run.views));
+            std::fprintf(stderr, "\r[codec] %s: views from decoded depth %zu/%zu   ",
+                         seq.name.c_str(), i + 1, seq.frames.size());
+        }
         run.max_error_px = std::max(run.max_error_px, e.max_px);
         run.background_mismatches += e.background_mismatches;
         run.finite_pixels += e.pixels;
@@ -608,7 +647,7 @@ Status bench_codec(const BenchOptions& job) {
         }
         depth_rows.push_back(ds);
         ViewDepthRun view;
-        REPRISE_TRY(run_view_depth(seq, qps[qps.size() / 2], view));
+        REPRISE_TRY(run_view_depth(*renderer, seq, qps[qps.size() / 2], view));
         view.lossless_depth_bytes = ds.ours;
         view_rows.push_back(view);
         depth_csv.flush();
@@ -778,6 +817,7 @@ Status bench_codec(const BenchOptions& job) {
                      : "OUTSIDE the bound");
     depth_text += depth_video_text(view_rows, view_defaults);
     depth_text += motion_text;
+    depth_text += synthesized_views_text(view_rows);
 
     // Speed at 1080p.
     SpeedResult speed;
@@ -831,6 +871,15 @@ Status bench_codec(const BenchOptions& job) {
                 sum += r.psnr_stream, ++n;
         if (n) bd_stream = sum / n;
     }
+    std::string views_over;
+    bool views_known = false;
+    for (const ViewDepthRun& v : view_rows)
+        for (int k = 0; k < SynthesizedViews::kViews && v.views.frames > 0; ++k) {
+            views_known = true;
+            if (v.views.loss_db(k) < -kViewLossTarget)
+                views_over += strf(" %s %s %+.2f dB", v.scene.c_str(), SynthesizedViews::name(k),
+                                   v.views.loss_db(k));
+        }
     std::string geometry_over;
     for (const ViewDepthRun& v : view_rows) {
         const double share = 100.0 * (v.depth_bytes + v.motion_bytes) / v.total_bytes;
@@ -856,6 +905,11 @@ Status bench_codec(const BenchOptions& job) {
              kGeometryShareTarget, qps[qps.size() / 2],
              verdict(!view_rows.empty(), geometry_over.empty()).c_str(),
              geometry_over.empty() ? "" : (" (over:" + geometry_over + ")").c_str());
+    targets += strf(
+        "  views from decoded depth within %.1f dB of the same views from rendered depth, every "
+        "scene and view: %s%s\n",
+        kViewLossTarget, verdict(views_known, views_over.empty()).c_str(),
+        views_over.empty() ? "" : (" (" + views_over.substr(1) + ")").c_str());
     targets += strf(
         "  encode at least as fast as x264 veryfast at 1920x1080, %d threads: %.2fx: %s%s\n",
         job.threads, enc_ratio, verdict(!std::isnan(enc_ratio), enc_ratio >= 1.0).c_str(),
