@@ -699,6 +699,39 @@ TEST(Codec, ExtremeInputs) {
     }
 }
 
+// View depth over an extreme range: a surface at 1e7 (1/z far below one code) beside one at 0.5
+// decodes finite and positive everywhere, within the bound of section 6, never as a code outside
+// 0..2^30 (which would decode as NaN).
+TEST(Codec, ViewDepthKeepsExtremeRangesFinite) {
+    const int w = 48, h = 32;
+    std::vector<Frame> frames;
+    for (int i = 0; i < 3; ++i) {
+        Frame f = test::flat_frame(w, h, 1e7f, {0.0f, 0.0f}, uint32_t(i + 1));
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x)
+                if ((x / 5 + y / 3) % 2) f.depth(x, y) = 0.5f + 0.01f * float(x);
+        f.camera = camera_at(w, h, 0.1f * i);
+        f.camera.prev_view = camera_at(w, h, 0.1f * (i - 1)).view;
+        frames.push_back(f);
+    }
+    const EncoderOptions options{.depth = DepthMode::View};
+    const Coded coded = encode_all(frames, options);
+    const auto decoded = decode_all(coded.packets);
+    ASSERT_EQ(decoded.size(), frames.size());
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+        EXPECT_TRUE(same_frame(decoded[i], coded.reconstructions[i]));
+        for (std::size_t p = 0; p < decoded[i].depth.pixel_count(); ++p) {
+            const float z = decoded[i].depth.data()[p];
+            ASSERT_TRUE(z > 0.0f && std::isfinite(z))
+                << "frame " << i << " pixel " << p << ": " << z;
+        }
+        const ViewDepthError e =
+            measure_view_depth_error(frames[i].camera, frames[i].depth.view(),
+                                     decoded[i].depth.view(), options.view_displacement);
+        EXPECT_LE(e.max_px, options.view_error_px) << "frame " << i;
+    }
+}
+
 TEST(Codec, EightKFrame) {
     const int w = 8192, h = 4320;
     Frame f = test::constant_frame(w, h, 5.0f, {0.0f, 0.0f});

@@ -26,8 +26,7 @@ const char* SynthesizedViews::name(int view) {
     return names[view];
 }
 
-SynthesizedViewScorer::SynthesizedViewScorer(server::Renderer& renderer,
-                                             const server::Scene& scene,
+SynthesizedViewScorer::SynthesizedViewScorer(server::Renderer& renderer, const server::Scene& scene,
                                              const server::CameraPath& path, double fps)
     : renderer_(renderer), scene_(scene), path_(path), fps_(fps) {}
 
@@ -46,7 +45,8 @@ Status SynthesizedViewScorer::add(int index, const Frame& rendered, const Frame&
         const float periods = eye ? 0.0f : float(v + 1) / kDisplayPerFrame;
         const double time = (index + double(periods)) / fps_;
         server::Instant at = server::instant_on_path(path_, scene_, time, w, h);
-        const server::Instant before = server::instant_on_path(path_, scene_, time - 1.0 / fps_, w, h);
+        const server::Instant before =
+            server::instant_on_path(path_, scene_, time - 1.0 / fps_, w, h);
         if (eye) {
             const stereo::EyeCameras eyes =
                 stereo::eye_cameras(rendered.camera, {.ipd = kIpd}, stereo::Anchor::Left);

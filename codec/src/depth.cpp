@@ -216,9 +216,9 @@ inline uint64_t pixel_cost(const SliceJob& j, int x, int y, uint32_t p) {
 
 // View mode: the code sent for the source depth at (x, y) predicted by p. Any code whose inverse
 // depth is close enough to the truth keeps the reprojection error within the bound: p itself
-// when it is such a code, else the surface prediction plus the smallest number of residual steps
-// that is, else the nearest to the truth. The allowance shrinks by (1 - B/z)^2 for points near
-// the camera (docs/bitstream.md).
+// when it is such a code, else the surface prediction plus the residual steps that come nearest
+// the truth (within q / 2). The allowance shrinks by (1 - B/z)^2 for points near the camera
+// (docs/bitstream.md).
 uint32_t choose_view_code(const SliceJob& j, int x, int y, uint32_t p) {
     const Mapping& map = *j.map;
     const float z = j.source.empty() ? INFINITY : j.source(x, y);
@@ -235,10 +235,10 @@ uint32_t choose_view_code(const SliceJob& j, int x, int y, uint32_t p) {
     const int64_t base = surface_prediction(j, x, y, p), s = kViewResidualStep;
     if (k == kInvalidCode)  // NaN: any code above 2^30 + 1
         return uint32_t(base + std::max<int64_t>(0, (kInvalidCode - base + s - 1) / s) * s);
-    const int64_t r = (int64_t(k) - base + (k >= base ? s / 2 : -(s / 2))) / s;
-    for (int64_t d : {0, -1, 1})
-        if (within(base + (r + d) * s)) return uint32_t(base + (r + d) * s);
-    return uint32_t(base + r * s);
+    int64_t c = base + (int64_t(k) - base + (k >= base ? s / 2 : -(s / 2))) / s * s;
+    if (c < 0) c += s;  // the nearest code of 0..2^30 instead
+    if (c > kMaxViewCode) c -= s;
+    return uint32_t(c);
 }
 
 // The estimated cost of a block predicted temporally or spatially; in view mode, its codes are
