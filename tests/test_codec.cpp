@@ -519,8 +519,9 @@ TEST(Codec, AZoomKeepsOneKeyFrame) {
 TEST(Codec, StreamsOfAnOlderVersionAreRefused) {
     const auto frames = render("crossing", 1, 64, 48);
     Coded coded = encode_all(frames, {.depth = DepthMode::View});
-    // Before view depth, bounded motion, rigid objects, view depth in eighths of its step.
-    for (uint8_t version : {1, 2, 3, 4}) {
+    // Before view depth, bounded motion, rigid objects, view depth in eighths of its step, the
+    // temporal depth's plane fit.
+    for (uint8_t version : {1, 2, 3, 4, 5}) {
         std::vector<uint8_t> packet = coded.packets[0].data;
         packet[4] = version;
         Decoder decoder;

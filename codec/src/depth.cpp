@@ -379,7 +379,7 @@ void temporal_codes(const FrameContext& fc, const Camera& camera, const Mapping&
     const bool previous = camera.prev_view == rc.view && camera.prev_projection == rc.projection;
     reproject_depth(rc, fc.reference->depth.view(), camera, projected.view(),
                     previous ? fc.reference->owner.view() : ImageView<const uint32_t>{},
-                    previous ? fc.objects : std::span<const ObjectMotion>{});
+                    previous ? fc.objects : std::span<const ObjectMotion>{}, map.view);
     ensure_size(out, w, h);
     parallel_for(0, h, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y)

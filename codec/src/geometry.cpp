@@ -162,9 +162,61 @@ void rigid_motion(const Camera& from, ImageView<const float> depth, const glm::m
     });
 }
 
+namespace {
+
+// Where each reference pixel lands in the target (reproject_depth).
+struct Landings {
+    Image<int32_t> slot;
+    Image<float> z, px, py, held;
+    Image<int> object;  // index into the objects, -1: none
+    void resize(int w, int h) {
+        for (Image<float>* i : {&z, &px, &py, &held}) ensure_size(*i, w, h);
+        ensure_size(slot, w, h);
+        ensure_size(object, w, h);
+    }
+    // The landing of reference pixel (x, y) on the same surface as (nx, ny): landed, moved the
+    // same way, inverse depth within 1/8 of its own.
+    bool beside(int x, int y, int nx, int ny) const {
+        if (nx < 0 || ny < 0 || nx >= slot.width() || ny >= slot.height() || slot(nx, ny) < 0 ||
+            object(nx, ny) != object(x, y))
+            return false;
+        const float v = 1.0f / z(x, y), vn = 1.0f / z(nx, ny);
+        return std::abs(vn - v) <= 0.125f * v;
+    }
+    // The depth at the centre of target pixel (tx, ty) on the plane in (px, py, 1/z) through the
+    // landing of (x, y) and those of a horizontal and a vertical neighbour on its surface, taken
+    // kPlaneSpan pixels away (a decoded surface is a staircase of kept values: a wider span
+    // averages its steps out), else adjacent; its own depth where neither span has both, the
+    // plane is degenerate or it would move the value beyond its neighbours'.
+    static constexpr int kPlaneSpan = 6;
+    float at_centre(int x, int y, int tx, int ty) const {
+        const float own = z(x, y);
+        for (int k : {kPlaneSpan, 1}) {
+            const int dx = beside(x, y, x + k, y) ? k : beside(x, y, x - k, y) ? -k : 0;
+            const int dy = beside(x, y, x, y + k) ? k : beside(x, y, x, y - k) ? -k : 0;
+            if (dx == 0 || dy == 0) continue;
+            const float v = 1.0f / own;
+            const float ax = px(x + dx, y) - px(x, y), ay = py(x + dx, y) - py(x, y);
+            const float bx = px(x, y + dy) - px(x, y), by = py(x, y + dy) - py(x, y);
+            const float av = 1.0f / z(x + dx, y) - v, bv = 1.0f / z(x, y + dy) - v;
+            const float det = ax * by - ay * bx;
+            if (!(std::abs(det) >= 0.25f * float(k * k))) continue;
+            const float gx = (av * by - bv * ay) / det, gy = (ax * bv - bx * av) / det;
+            const float change =
+                gx * (float(tx) + 0.5f - px(x, y)) + gy * (float(ty) + 0.5f - py(x, y));
+            if (!(std::abs(change) <= std::max(std::abs(av), std::abs(bv))) || !(v + change > 0.0f))
+                continue;
+            return 1.0f / (v + change);
+        }
+        return own;
+    }
+};
+
+}  // namespace
+
 void reproject_depth(const Camera& from, ImageView<const float> depth, const Camera& to,
                      ImageView<float> out, ImageView<const uint32_t> owner,
-                     std::span<const ObjectMotion> objects) {
+                     std::span<const ObjectMotion> objects, bool plane_fit) {
     const int w = depth.width, h = depth.height;
     REPRISE_ASSERT(out.width == w && out.height == h);
     if (owner.empty()) objects = {};
@@ -202,55 +254,54 @@ void reproject_depth(const Camera& from, ImageView<const float> depth, const Cam
         object_camera.push_back(glm::mat4(moved));
         object_clip.push_back(glm::mat4(glm::dmat4(to.projection) * moved));
     }
+    // First where every pixel lands (objects' pixels with their object's motion), then each
+    // landing's value at the centre of the pixel it lands in.
+    thread_local Landings scratch;  // the workers below use this thread's, by reference
+    Landings& landings = scratch;
+    landings.resize(w, h);
     parallel_for(0, h, [&](int y0, int y1) {
-        constexpr int kChunk = 256;
-        int32_t slot[kChunk];
-        float tz[kChunk], held[kChunk];
-        for (int y = y0; y < y1; ++y)
-            for (int x0 = 0; x0 < w; x0 += kChunk) {
-                const int n = std::min(kChunk, w - x0);
-                const float* row = depth.row(y) + x0;
-                bool moved = false;
-                if (!objects.empty()) {
-                    for (int i = 0; i < n; ++i) {
-                        const bool own = object_of(x0 + i, y) >= 0;
-                        held[i] = own ? kNan : row[i];
-                        moved = moved || own;
-                    }
-                    if (moved) row = held;
-                }
-                forward_row({.projection = from.projection,
-                             .to_clip = to_clip,
-                             .to_camera = to_camera,
-                             .x0 = x0,
-                             .y = y,
-                             .count = n,
-                             .width = w,
-                             .height = h,
-                             .depth = row,
-                             .slot = slot,
-                             .z = tz});
-                for (int i = 0; i < n; ++i)
-                    if (slot[i] >= 0) land(slot[i], tz[i]);
-                if (!moved) continue;
-                for (int i = 0; i < n; ++i) {
-                    const int k = object_of(x0 + i, y);
-                    if (k < 0) continue;
-                    forward_row_reference({.projection = from.projection,
-                                           .to_clip = object_clip[std::size_t(k)],
-                                           .to_camera = object_camera[std::size_t(k)],
-                                           .x0 = x0 + i,
-                                           .y = y,
-                                           .count = 1,
-                                           .width = w,
-                                           .height = h,
-                                           .depth = depth.row(y) + x0 + i,
-                                           .slot = slot,
-                                           .z = tz},
-                                          0, 1);
-                    if (slot[0] >= 0) land(slot[0], tz[0]);
-                }
+        for (int y = y0; y < y1; ++y) {
+            ForwardRow row{.projection = from.projection,
+                           .to_clip = to_clip,
+                           .to_camera = to_camera,
+                           .x0 = 0,
+                           .y = y,
+                           .count = w,
+                           .width = w,
+                           .height = h,
+                           .depth = depth.row(y),
+                           .slot = &landings.slot(0, y),
+                           .z = &landings.z(0, y),
+                           .px = &landings.px(0, y),
+                           .py = &landings.py(0, y)};
+            int* object = &landings.object(0, y);
+            bool moved = false;
+            for (int x = 0; x < w; ++x)
+                moved |= (object[x] = objects.empty() ? -1 : object_of(x, y)) >= 0;
+            if (!moved) {
+                forward_row(row);
+                continue;
             }
+            float* held = &landings.held(0, y);
+            for (int x = 0; x < w; ++x) held[x] = object[x] >= 0 ? kNan : depth(x, y);
+            row.depth = held;
+            forward_row(row);
+            for (int x = 0; x < w; ++x) {
+                if (object[x] < 0) continue;
+                ForwardRow one = row;
+                one.to_clip = object_clip[std::size_t(object[x])];
+                one.to_camera = object_camera[std::size_t(object[x])];
+                one.depth = depth.row(y);
+                forward_row_reference(one, x, x + 1);
+            }
+        }
+    });
+    parallel_for(0, h, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y)
+            for (int x = 0; x < w; ++x)
+                if (const int32_t slot = landings.slot(x, y); slot >= 0)
+                    land(slot, plane_fit ? landings.at_centre(x, y, slot % w, slot / w)
+                                         : landings.z(x, y));
     });
 }
 
@@ -273,6 +324,8 @@ void forward_row_reference(const ForwardRow& r, int i_begin, int i_end) {
         if (!(tz > 0.0f)) continue;
         r.slot[i] = int32_t(py) * w + int32_t(px);
         r.z[i] = tz;
+        r.px[i] = px;
+        r.py[i] = py;
     }
 }
 

@@ -320,6 +320,10 @@ public:
             if (reference_.slot[i] >= 0 &&
                 std::memcmp(&optimized_.z[i], &reference_.z[i], sizeof(float)) != 0)
                 return "pixel " + std::to_string(i) + ": depth differs";
+            if (reference_.slot[i] >= 0 &&
+                (std::memcmp(&optimized_.px[i], &reference_.px[i], sizeof(float)) != 0 ||
+                 std::memcmp(&optimized_.py[i], &reference_.py[i], sizeof(float)) != 0))
+                return "pixel " + std::to_string(i) + ": landing point differs";
         }
         return {};
     }
@@ -327,12 +331,14 @@ public:
 private:
     struct Output {
         std::vector<int32_t> slot;
-        std::vector<float> z;
+        std::vector<float> z, px, py;
     };
     template <class Kernel>
     void run_into(Output& out, Kernel kernel) {
         out.slot.assign(depth_.size(), 0);
         out.z.assign(depth_.size(), 0.0f);
+        out.px.assign(depth_.size(), 0.0f);
+        out.py.assign(depth_.size(), 0.0f);
         parallel_for(0, height_, [&](int y0, int y1) {
             for (int y = y0; y < y1; ++y) {
                 const std::size_t o = std::size_t(y) * width_;
@@ -346,7 +352,9 @@ private:
                         .height = height_,
                         .depth = depth_.data() + o,
                         .slot = out.slot.data() + o,
-                        .z = out.z.data() + o});
+                        .z = out.z.data() + o,
+                        .px = out.px.data() + o,
+                        .py = out.py.data() + o});
             }
         });
     }

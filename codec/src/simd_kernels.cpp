@@ -283,6 +283,8 @@ void ForwardRowSimd(const ForwardRow& r) {
         const auto slot = hn::ConvertTo(di, py) * width_i + hn::ConvertTo(di, px);
         hn::StoreU(hn::IfThenElse(hn::RebindMask(di, lands), slot, none), di, r.slot + i);
         hn::StoreU(tz, df, r.z + i);
+        hn::StoreU(px, df, r.px + i);
+        hn::StoreU(py, df, r.py + i);
     }
     forward_row_reference(r, i, r.count);
 }
