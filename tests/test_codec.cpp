@@ -520,8 +520,8 @@ TEST(Codec, StreamsOfAnOlderVersionAreRefused) {
     const auto frames = render("crossing", 1, 64, 48);
     Coded coded = encode_all(frames, {.depth = DepthMode::View});
     // Before view depth, bounded motion, rigid objects, view depth in eighths of its step, the
-    // temporal depth's plane fit.
-    for (uint8_t version : {1, 2, 3, 4, 5}) {
+    // temporal depth's plane fit, its span by the picture's height.
+    for (uint8_t version : {1, 2, 3, 4, 5, 6}) {
         std::vector<uint8_t> packet = coded.packets[0].data;
         packet[4] = version;
         Decoder decoder;

@@ -169,7 +169,9 @@ struct Landings {
     Image<int32_t> slot;
     Image<float> z, px, py, held;
     Image<int> object;  // index into the objects, -1: none
+    // The span, 6 pixels at a height of 360 (measured best among 3-18 there and 12 at 720).
     void resize(int w, int h) {
+        span = std::max(2, int(std::lround(double(h) / 60.0)));
         for (Image<float>* i : {&z, &px, &py, &held}) ensure_size(*i, w, h);
         ensure_size(slot, w, h);
         ensure_size(object, w, h);
@@ -185,13 +187,13 @@ struct Landings {
     }
     // The depth at the centre of target pixel (tx, ty) on the plane in (px, py, 1/z) through the
     // landing of (x, y) and those of a horizontal and a vertical neighbour on its surface, taken
-    // kPlaneSpan pixels away (a decoded surface is a staircase of kept values: a wider span
-    // averages its steps out), else adjacent; its own depth where neither span has both, the
-    // plane is degenerate or it would move the value beyond its neighbours'.
-    static constexpr int kPlaneSpan = 6;
+    // `span` pixels away (a decoded surface is a staircase of kept values: a wider span averages
+    // its steps out), else adjacent; its own depth where neither span has both, the plane is
+    // degenerate or it would move the value beyond its neighbours'.
+    int span = 1;
     float at_centre(int x, int y, int tx, int ty) const {
         const float own = z(x, y);
-        for (int k : {kPlaneSpan, 1}) {
+        for (int k : {span, 1}) {
             const int dx = beside(x, y, x + k, y) ? k : beside(x, y, x - k, y) ? -k : 0;
             const int dy = beside(x, y, x, y + k) ? k : beside(x, y, x, y - k) ? -k : 0;
             if (dx == 0 || dy == 0) continue;
