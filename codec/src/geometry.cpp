@@ -169,7 +169,9 @@ struct Landings {
     Image<int32_t> slot;
     Image<float> z, px, py, held;
     Image<int> object;  // index into the objects, -1: none
-    // The span, 6 pixels at a height of 360 (measured best among 3-18 there and 12 at 720).
+    // The plane's span in pixels (at_centre): 6 at a height of 360, the best of 3 to 18 there, as
+    // 12 was at 720.
+    int span = 1;
     void resize(int w, int h) {
         span = std::max(2, int(std::lround(double(h) / 60.0)));
         for (Image<float>* i : {&z, &px, &py, &held}) ensure_size(*i, w, h);
@@ -190,7 +192,6 @@ struct Landings {
     // `span` pixels away (a decoded surface is a staircase of kept values: a wider span averages
     // its steps out), else adjacent; its own depth where neither span has both, the plane is
     // degenerate or it would move the value beyond its neighbours'.
-    int span = 1;
     float at_centre(int x, int y, int tx, int ty) const {
         const float own = z(x, y);
         for (int k : {span, 1}) {
