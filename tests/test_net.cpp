@@ -165,13 +165,15 @@ TEST(NetWire, HeadersOfEveryKindOfGarbageAreRefused) {
     DatagramHeader h;
     std::vector<uint8_t> d(kMaxDatagram + 1, 0);
     EXPECT_FALSE(parse_header(d, h).ok());  // oversized
-    d.assign({'R', 'P', 1, 4});
+    d.assign({'R', 'P', kProtocolVersion, 4});
     EXPECT_FALSE(parse_header(d, h).ok());  // truncated
     d.assign(20, 0);
     EXPECT_FALSE(parse_header(d, h).ok());  // bad magic
-    d[0] = 'R', d[1] = 'P', d[2] = 2, d[3] = 4;
-    EXPECT_FALSE(parse_header(d, h).ok());  // version
-    d[2] = 1, d[3] = 9;
+    d[0] = 'R', d[1] = 'P', d[2] = 1, d[3] = 4;
+    EXPECT_FALSE(parse_header(d, h).ok());  // version 1 (full-length parity)
+    d[2] = 3;
+    EXPECT_FALSE(parse_header(d, h).ok());
+    d[2] = 2, d[3] = 9;
     EXPECT_FALSE(parse_header(d, h).ok());  // type
     d[3] = 4;
     EXPECT_TRUE(parse_header(d, h).ok());
@@ -188,6 +190,12 @@ TEST(NetFragment, EveryPacketSizeReassemblesAndOneLossPerGroupIsRecovered) {
         const std::size_t data = (size + 1099) / 1100;
         ASSERT_EQ(n, data + (data + 3) / 4);
         for (std::size_t i = 0; i < n; ++i) ASSERT_LE(messages[i].size(), kMaxPlaintext);
+        // Parity is as long as its group's first fragment: a 100-byte packet costs 100 more.
+        for (std::size_t j = 0; data + j < n; ++j) {
+            FragmentMessage f;
+            ASSERT_TRUE(parse(messages[data + j], f).ok());
+            EXPECT_EQ(f.payload.size(), std::min<std::size_t>(1100, size - j * 4 * 1100)) << size;
+        }
         for (int drop_mode = 0; drop_mode < 3; ++drop_mode) {
             Reassembler r;
             std::vector<uint32_t> abandoned;

@@ -29,11 +29,14 @@ std::size_t fragment_packet(std::span<const uint8_t> packet, uint32_t frame, int
         messages[i].resize(encode(m, messages[i]));
     }
     for (std::size_t g = 0; g < groups; ++g) {
+        // As long as the group's first (longest) fragment: a one-fragment packet's parity is
+        // no longer than the packet.
         std::vector<uint8_t>& out = messages[count + g];
-        out.resize(kFragmentHeaderSize + size);
+        out.resize(kFragmentHeaderSize + std::min(size, packet.size() - g * group * size));
         std::fill(out.begin() + kFragmentHeaderSize, out.end(), 0);
         for (std::size_t i = g * group; i < std::min(count, (g + 1) * group); ++i) {
-            const std::size_t n = std::min(size, packet.size() - i * size);
+            const std::size_t n =
+                std::min(out.size() - kFragmentHeaderSize, packet.size() - i * size);
             const uint8_t* src = packet.data() + i * size;
             for (std::size_t b = 0; b < n; ++b) out[kFragmentHeaderSize + b] ^= src[b];
         }

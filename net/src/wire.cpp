@@ -269,19 +269,22 @@ Status parse(std::span<const uint8_t> plaintext, FragmentMessage& m) {
     if (uint64_t(m.data_count - 1) * m.fragment_size >= m.total_size ||
         uint64_t(m.data_count) * m.fragment_size < m.total_size)
         return Status::error("fragment: count and fragment size disagree with the packet size");
-    const bool last = m.kind == FragmentKind::Data && m.index + 1u == m.data_count;
-    const std::size_t expected =
-        last ? m.total_size - std::size_t(m.data_count - 1) * m.fragment_size : m.fragment_size;
-    if (m.payload.size() != expected)
-        return Status::error("fragment: payload size disagrees with the header");
     if (m.kind == FragmentKind::Data && m.index >= m.data_count)
         return Status::error("fragment: index " + std::to_string(m.index) + " beyond count " +
                              std::to_string(m.data_count));
+    // Data fragment i holds bytes [i P, min((i + 1) P, total)); parity group j is as long as its
+    // first data fragment, j g.
+    std::size_t first = m.index;
     if (m.kind == FragmentKind::Parity) {
         if (m.group_size == 0) return Status::error("fragment: parity without a group size");
         const unsigned groups = (m.data_count + m.group_size - 1u) / m.group_size;
         if (m.index >= groups) return Status::error("fragment: parity group beyond the packet");
+        first = std::size_t(m.index) * m.group_size;
     }
+    const std::size_t expected =
+        std::min<std::size_t>(m.fragment_size, m.total_size - first * m.fragment_size);
+    if (m.payload.size() != expected)
+        return Status::error("fragment: payload size disagrees with the header");
     return {};
 }
 Status parse(std::span<const uint8_t> plaintext, TicketMessage& m) {

@@ -16,7 +16,7 @@
 namespace reprise::net {
 
 constexpr uint8_t kMagic0 = 'R', kMagic1 = 'P';
-constexpr uint8_t kProtocolVersion = 1;
+constexpr uint8_t kProtocolVersion = 2;
 constexpr std::size_t kMaxDatagram = 1200;
 constexpr std::size_t kHeaderSize = 12;        // magic, version, type, connection id
 constexpr std::size_t kSealedHeaderSize = 20;  // + u64 sequence number
