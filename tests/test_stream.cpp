@@ -165,6 +165,11 @@ TEST(Stream, EndToEndDisplayedFramesMatchTheTruth) {
     EXPECT_EQ(c->stats().frames_lost, 0u);
     EXPECT_GE(s.kept.size(), 10u);
     EXPECT_GE(p, 28.0);
+    // No loss: parity only in the first second (up to 30 frames), then none.
+    const auto st = srv.server->stats();
+    EXPECT_GT(st.frames_without_parity, 0u);
+    EXPECT_GE(st.frames_without_parity + 35, st.frames_encoded);
+    EXPECT_NE(metrics.find("reprise_frames_without_parity_total"), std::string::npos);
 }
 
 TEST(Stream, LowResolutionColourIsUpsampledToTheTruth) {
@@ -201,6 +206,9 @@ TEST(Stream, FivePercentLossAndReorderingKeepTheStreamGoing) {
     EXPECT_GE(st.frames_decoded, 60u);
     EXPECT_GT(st.fec_recovered, 0u);
     EXPECT_GE(p, 24.0);
+    // Loss keeps parity on (a frame or two may go without it before the first loss is heard).
+    const auto sst = srv.server->stats();
+    EXPECT_LE(sst.frames_without_parity * 10, sst.frames_encoded);
 }
 
 TEST(Stream, HeavyLossLowersTheBitrateTarget) {
@@ -334,9 +342,9 @@ TEST(Stream, BadDatagramsAreDroppedWhileAnotherClientIsServed) {
     for (std::size_t i = 0; i < garbage.size(); ++i) garbage[i] = uint8_t(i * 7);
     attacker.socket.send_to(garbage, srv.at());  // garbage
     std::vector<uint8_t> oversized(1400, 0);
-    oversized[0] = 'R', oversized[1] = 'P', oversized[2] = 1, oversized[3] = 4;
+    oversized[0] = 'R', oversized[1] = 'P', oversized[2] = net::kProtocolVersion, oversized[3] = 4;
     attacker.socket.send_to(oversized, srv.at());  // oversized
-    std::vector<uint8_t> truncated = {'R', 'P', 1, 1, 0, 0};
+    std::vector<uint8_t> truncated = {'R', 'P', net::kProtocolVersion, 1, 0, 0};
     attacker.socket.send_to(truncated, srv.at());  // truncated
     // Wrong PIN: the server answers the hello, the attacker cannot confirm; a forged finish fails.
     EXPECT_FALSE(attacker.handshake("111111"));

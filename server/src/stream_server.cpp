@@ -331,6 +331,7 @@ struct StreamServer::State {
         }
         s.net.scene_name = m.scene.empty() ? std::string("default") : m.scene;
         s.net.started = true;
+        s.net.parity_until_us = now + detail::kParityAtStartUs;
         {
             std::lock_guard lock(s.mutex);
             s.box.started = true;
@@ -408,7 +409,9 @@ struct StreamServer::State {
                 net::LossReportMessage m;
                 parsed = net::parse(plaintext, m).ok();
                 if (parsed) {
+                    s->net.parity_until_us = now + detail::kParityAfterLossUs;
                     std::lock_guard lock(s->mutex);
+                    s->box.parity = true;
                     for (int i = 0; i < m.count; ++i)
                         if (int64_t(m.frames[i]) <= s->net.newest_sent) {
                             feedback_dropped += s->box.lost.size() >= detail::kMaxFeedback;
@@ -431,7 +434,7 @@ struct StreamServer::State {
             case net::MessageType::ReceiverReport: {
                 net::ReceiverReportMessage m;
                 parsed = net::parse(plaintext, m).ok();
-                if (parsed) adapt(*s, m);
+                if (parsed) adapt(*s, m, now);
                 break;
             }
             case net::MessageType::Bye:
@@ -445,13 +448,20 @@ struct StreamServer::State {
     }
 
     // Loss over the interval since the previous report moves the rate-control target.
-    void adapt(Session& session, const net::ReceiverReportMessage& m) {
+    // Parity protects frames while loss was seen recently: on a clean link it would cost up to a
+    // copy of every frame of one fragment.
+    void adapt(Session& session, const net::ReceiverReportMessage& m, int64_t now) {
         Session::Net& s = session.net;
         const uint32_t received = m.received - s.report_received,
                        missing = m.missing - s.report_missing;
         if (m.received < s.report_received || m.missing < s.report_missing) return;  // stale report
         s.report_received = m.received;
         s.report_missing = m.missing;
+        if (missing > 0) s.parity_until_us = now + detail::kParityAfterLossUs;
+        {
+            std::lock_guard lock(session.mutex);
+            session.box.parity = now < s.parity_until_us;
+        }
         if (received + missing == 0) return;
         const double loss = double(missing) / double(received + missing);
         if (m.rtt_us > 0)
@@ -517,6 +527,9 @@ struct StreamServer::State {
         metric("frames_dropped_total", "counter",
                "Frames encoded and dropped from a full hand-over or send queue.",
                double(st.frames_dropped));
+        metric("frames_without_parity_total", "counter",
+               "Frames sent without FEC parity (no loss reported for 10 s).",
+               double(st.frames_without_parity));
         metric("feedback_dropped_total", "counter",
                "Acks or loss reports dropped from a full session mailbox.",
                double(st.feedback_dropped));

@@ -25,6 +25,8 @@ struct LoadedScene {
 
 constexpr std::size_t kMaxFeedback = 64;  // acks or losses waiting for the worker
 constexpr std::size_t kMaxHandover = 2;   // encoded frames waiting for the network thread
+// FEC parity for the first second of a session, and for 10 s after any loss reported.
+constexpr int64_t kParityAtStartUs = 1'000'000, kParityAfterLossUs = 10'000'000;
 
 // An encoded frame as plaintext Fragment messages, waiting to be sealed and sent.
 struct EncodedFrame {
@@ -43,6 +45,7 @@ struct Mailbox {
     std::vector<uint32_t> acked, lost;  // each at most kMaxFeedback (the oldest dropped)
     bool key_frame = false;
     int bitrate_kbps = 0;
+    bool parity = true;  // FEC parity with the frames (kParityAfterLossUs after a reported loss)
     int64_t newest_acked = -1, last_progress_us = 0;
     std::size_t queue_bytes = 0;  // sealed bytes waiting for the socket
     // worker -> network
@@ -70,7 +73,8 @@ struct Session {
         uint32_t report_received = 0, report_missing = 0;
         int bitrate_kbps = 0;
         int64_t min_rtt_us = 0;
-        net::TicketMessage ticket;  // for the client's next handshake, sent with every StreamInfo
+        int64_t parity_until_us = 0;  // FEC parity is sent until then
+        net::TicketMessage ticket;    // for the client's next handshake, sent with every StreamInfo
     } net;
     struct Media {                                 // render worker only
         std::shared_ptr<const LoadedScene> scene;  // shared by the sessions that show it

@@ -22,6 +22,17 @@ double ms_since(std::chrono::steady_clock::time_point t) {
 // The low-resolution colour as a frame of its own: depth and motion taken from the full G-buffer
 // at each low pixel's sample position (motion in low pixels), the camera's jitter in low pixels,
 // so the colour stream predicts by reprojection like any other.
+void add_sections(const codec::StreamStats& frame, codec::StreamStats& sum) {
+    sum.frames += frame.frames;
+    sum.key_frames += frame.key_frames;
+    sum.older_reference += frame.older_reference;
+    sum.header_bits += frame.header_bits;
+    sum.camera_bits += frame.camera_bits;
+    sum.depth_bits += frame.depth_bits;
+    sum.motion_bits += frame.motion_bits;
+    sum.color_bits += frame.color_bits;
+}
+
 void make_colour_frame(Session::Media& m, glm::vec2 jitter) {
     const int lw = m.low_color.width(), lh = m.low_color.height();
     const int w = m.frame.width(), h = m.frame.height();
@@ -276,6 +287,9 @@ double RenderWorker::produce(Session& s, int64_t now) {
         ++link_.stats.frames_encoded;
         link_.stats.render_ms_total += render_ms;
         link_.stats.encode_ms_total += encode_ms;
+        add_sections(m.encoder.last_frame_stats(), link_.stats.coded);
+        if (link_.options.mode == net::StreamMode::LowRes)
+            add_sections(m.colour_encoder.last_frame_stats(), link_.stats.coded);
     }
     return std::max(render_ms + encode_ms, 1e-3);
 }
@@ -343,15 +357,17 @@ Status RenderWorker::render_encode(Session& s, const net::PoseMessage& pose, dou
 
 void RenderWorker::hand_over(Session& s, std::span<const uint8_t> payload, int64_t pose_time_us) {
     EncodedFrame f;
+    net::FecOptions fec = link_.options.fec;
     {
         std::lock_guard lock(s.mutex);
+        if (!s.box.parity) fec.group = 0;
         if (!s.box.spare.empty()) {
             f = std::move(s.box.spare.back());
             s.box.spare.pop_back();
         }
     }
     f.frame = s.media.packet.frame;
-    f.count = net::fragment_packet(payload, f.frame, pose_time_us, link_.options.fec, f.messages);
+    f.count = net::fragment_packet(payload, f.frame, pose_time_us, fec, f.messages);
     f.bytes = 0;
     for (std::size_t i = 0; i < f.count; ++i) f.bytes += f.messages[i].size();
     bool dropped = false;
@@ -368,9 +384,10 @@ void RenderWorker::hand_over(Session& s, std::span<const uint8_t> payload, int64
         s.box.frames.push_back(std::move(f));
     }
     link_.waker.wake();
-    if (dropped) {
+    if (dropped || fec.group != link_.options.fec.group) {
         std::lock_guard lock(link_.stats_mutex);
-        ++link_.stats.frames_dropped;
+        link_.stats.frames_dropped += dropped;
+        link_.stats.frames_without_parity += fec.group != link_.options.fec.group;
     }
 }
 

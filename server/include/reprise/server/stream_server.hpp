@@ -62,13 +62,17 @@ struct StreamServerStats {
     std::size_t dropped_datagrams = 0;   // garbage, truncated, oversized, unauthenticated, replayed
     std::size_t frames_sent = 0, frames_skipped = 0;
     std::size_t frames_encoded = 0;
-    std::size_t frames_dropped = 0;    // encoded, dropped from a full hand-over or send queue
-    std::size_t feedback_dropped = 0;  // acks or losses dropped from a full mailbox
-    std::size_t refused_full = 0;      // handshakes answered "server full" (--max-sessions)
+    std::size_t frames_dropped = 0;         // encoded, dropped from a full hand-over or send queue
+    std::size_t frames_without_parity = 0;  // sent without FEC: no loss reported for 10 s
+    std::size_t feedback_dropped = 0;       // acks or losses dropped from a full mailbox
+    std::size_t refused_full = 0;           // handshakes answered "server full" (--max-sessions)
     std::size_t datagrams_sent = 0, bytes_sent = 0;
     std::size_t loss_reports = 0, key_frame_requests = 0, acks = 0;
     std::size_t max_queue_bytes = 0;  // largest send queue of any session
     double encode_ms_total = 0.0, render_ms_total = 0.0;
+    // What the encoders wrote, summed over every frame encoded (both encoders in lowres mode):
+    // frames, key frames, older references and bits per section.
+    codec::StreamStats coded;
     double loss = 0.0;     // newest reported media loss fraction (any session)
     int bitrate_kbps = 0;  // newest target of the last session adapted
     // Rate adaptation (RateLadder): the current level (0 = as configured) and what it renders.
