@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <charconv>
 #include <cmath>
 #include <filesystem>
 #include <map>
@@ -154,6 +155,7 @@ struct StreamBench {
     const BenchOptions& options;
     int width = 256, height = 144;
     double duration = 4.0, display_rate = 120.0, fps = 30.0;
+    int qp = 28;  // the server's encoder
     int eval_every = 4;
     BenchScene scene;
     CsvFile csv;
@@ -168,6 +170,7 @@ struct StreamBench {
                                        .width = width,
                                        .height = height,
                                        .loopback_only = true};
+        so.encoder.qp = qp;
         if (lowres) {
             so.mode = net::StreamMode::LowRes;
             so.lowres_factor = 4;
@@ -223,6 +226,15 @@ struct StreamBench {
                      "%zu decode errors, %zu key requests\n",
                      c.name.c_str(), sst.frames_sent, sst.frames_skipped, cst.frames_decoded,
                      cst.decode_errors, cst.key_frame_requests);
+        const codec::StreamStats& coded = sst.coded;
+        std::fprintf(stderr,
+                     "[bench stream] %s: coded %zu frames (%zu key, %zu from an older reference), "
+                     "kbit: header %.1f, camera %.1f, depth %.1f, motion %.1f, colour %.1f; "
+                     "sent %.1f kbit in %zu datagrams, %zu frames without parity\n",
+                     c.name.c_str(), coded.frames, coded.key_frames, coded.older_reference,
+                     coded.header_bits / 1e3, coded.camera_bits / 1e3, coded.depth_bits / 1e3,
+                     coded.motion_bits / 1e3, coded.color_bits / 1e3, sst.bytes_sent * 8 / 1e3,
+                     sst.datagrams_sent, sst.frames_without_parity);
         if (ticks.empty())
             return Status::error("bench stream: " + c.name + ": nothing was displayed");
         const double seconds = duration;
@@ -291,10 +303,12 @@ struct StreamBench {
                 x264_fine));
         }
         // The peer sends one frame per server period while the stream runs.
+        // Over the same seconds as reprise's stream: when the server adapts below `fps`, the
+        // peer sends the same fewer frames.
         auto kbps = [&](const std::vector<PeerFrame>& frames) {
             std::size_t bytes = 0;
             for (const PeerFrame& p : frames) bytes += p.bytes;
-            return frames.empty() ? 0.0 : bytes * 8.0 / (double(frames.size()) / fps) / 1000.0;
+            return bytes * 8.0 / seconds / 1000.0;
         };
         video.kbps = warped.kbps = kbps(x264);
         video_fine.kbps = kbps(x264_fine);
@@ -309,7 +323,7 @@ struct StreamBench {
                                          10, depth_video));
             double bytes = double(depth_video.range_bytes);
             for (std::size_t b : depth_video.bytes) bytes += double(b);
-            with_depth.kbps = video.kbps + bytes * 8.0 / (double(depths.size()) / fps) / 1000.0;
+            with_depth.kbps = video.kbps + bytes * 8.0 / seconds / 1000.0;
         }
         warp::PoseExtrapolator extrapolator;
         Frame received, extrapolated;
@@ -391,6 +405,10 @@ Status bench_stream(const BenchOptions& options) {
     b.display_rate = options.display_rate;
     if (!(b.duration > 0.5 && b.duration <= 600))
         return Status::error("--duration must be in (0.5, 600]");
+    const char* const qps_end = options.qps.data() + options.qps.size();
+    if (auto [end, ec] = std::from_chars(options.qps.data(), qps_end, b.qp);
+        ec != std::errc() || end != qps_end || b.qp < 0 || b.qp > 51)
+        return Status::error("--qps: stream takes one qp in 0..51, not '" + options.qps + "'");
     const std::string out = options.out.empty() ? "out/bench-stream" : options.out;
     std::error_code ec;
     std::filesystem::create_directories(out, ec);
@@ -399,8 +417,9 @@ Status bench_stream(const BenchOptions& options) {
     REPRISE_TRY(
         b.csv.open(out + "/stream.csv", "condition,method,frame,psnr,ssim,flip,latency_ms"));
     std::printf(
-        "[bench stream] %s %dx%d, server %g Hz, display %g Hz, %g s per condition, renderer %s\n",
-        options.scene.c_str(), b.width, b.height, b.fps, b.display_rate, b.duration,
+        "[bench stream] %s %dx%d, server %g Hz at qp %d, display %g Hz, %g s per condition, "
+        "renderer %s\n",
+        options.scene.c_str(), b.width, b.height, b.fps, b.qp, b.display_rate, b.duration,
         b.scene.renderer->device().c_str());
     std::printf("%-16s %-16s %9s %7s %7s %8s %8s %8s %9s %6s %6s\n", "condition", "method", "kbps",
                 "PSNR", "FLIP", "lat.mean", "lat.p95", "lat.max", "freeze.ms", "lost", "fec");

@@ -193,7 +193,9 @@ int command_bench(int argc, char** argv) {
                 "folders of them (scripts/blender-scenes), held out; alone unless --scenes is "
                 "given too");
     args.option("--threads", &job.threads, "codec: threads per codec (default 2)");
-    args.option("--qps", &job.qps, "codec: reprise's qp rate points (default 22,28,34,40)");
+    args.option("--qps", &job.qps,
+                "codec: reprise's qp rate points (default 22,28,34,40); stream: the server's qp "
+                "(one, default 28)");
     args.option("--speed-size", &job.speed_size,
                 "codec: size of the speed run (default 1920x1080)");
     args.option("--speed-scene", &job.speed_scene, "codec: scene of the speed run (default pan)");
@@ -215,6 +217,7 @@ int command_bench(int argc, char** argv) {
     if (job.what == "reuse" && !args.given("--frames")) job.frames = 24;
     if (job.what == "reuse" && !args.given("--size")) job.size = "256x144";
     if (job.what == "stream" && !args.given("--size")) job.size = "256x144";
+    if (job.what == "stream" && !args.given("--qps")) job.qps = "28";
     if (job.what == "upsample" && !args.given("--frames")) job.frames = 12;
     if (job.what == "upsample" && !args.given("--factor")) job.factor = 0;  // both 4 and 2
     if (job.what == "upsample" && !args.given("--speed-frames")) job.speed_frames = 6;
