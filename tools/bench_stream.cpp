@@ -22,6 +22,7 @@
 #include "codec_peers.hpp"
 #include "depth_video_peer.hpp"
 #include "reprise/client/stream_client.hpp"
+#include "reprise/server/renderer.hpp"
 #include "reprise/server/stream_server.hpp"
 #include "reprise/warp/extrapolate.hpp"
 
@@ -156,6 +157,7 @@ struct StreamBench {
     int width = 256, height = 144;
     double duration = 4.0, display_rate = 120.0, fps = 30.0;
     int qp = 28;  // the server's encoder
+    int aa = 1;   // the server's anti-aliasing, and the peers' source frames' (the truth has 4)
     int eval_every = 4;
     BenchScene scene;
     CsvFile csv;
@@ -171,6 +173,7 @@ struct StreamBench {
                                        .height = height,
                                        .loopback_only = true};
         so.encoder.qp = qp;
+        so.aa_samples = aa;
         if (lowres) {
             so.mode = net::StreamMode::LowRes;
             so.lowres_factor = 4;
@@ -287,7 +290,7 @@ struct StreamBench {
         std::vector<Image<float>> source_depth;
         std::vector<Camera> source_camera;
         for (double t : lowres ? std::vector<double>{} : source_times) {
-            REPRISE_TRY(render_at(t, server::camera_view(scene.path, scene.scene, t), truth));
+            REPRISE_TRY(render_at(t, server::camera_view(scene.path, scene.scene, t), aa, truth));
             sources.emplace_back(width, height);
             visualize_color(truth.color.view(), sources.back().view());
             source_depth.push_back(truth.depth);  // a copy: truth is rendered into again
@@ -335,7 +338,7 @@ struct StreamBench {
         int index = 0;
         for (const Tick& k : ticks) {
             if (!k.evaluated) continue;
-            REPRISE_TRY(render_at(k.t, k.view, truth));
+            REPRISE_TRY(render_at(k.t, k.view, 4, truth));
             visualize_color(truth.color.view(), truth_rgb.view());
             from_rgb8(truth_rgb.view(), reference);
             const std::size_t si =
@@ -386,12 +389,13 @@ struct StreamBench {
         return {};
     }
 
-    Status render_at(double t, const glm::mat4& view, Frame& out) {
+    Status render_at(double t, const glm::mat4& view, int samples, Frame& out) {
         server::Instant now = server::instant_on_path(scene.path, scene.scene, t, width, height);
         now.view = view;
         server::Instant before = now;
         before.time -= 1.0 / fps;
-        return scene.renderer->render(scene.scene, now, before, {.width = width, .height = height},
+        return scene.renderer->render(scene.scene, now, before,
+                                      {.width = width, .height = height, .aa_samples = samples},
                                       out);
     }
 };
@@ -405,6 +409,8 @@ Status bench_stream(const BenchOptions& options) {
     b.display_rate = options.display_rate;
     if (!(b.duration > 0.5 && b.duration <= 600))
         return Status::error("--duration must be in (0.5, 600]");
+    b.aa = options.aa;
+    if (!server::aa_samples_valid(b.aa)) return Status::error("--aa must be 1, 2, 4, 8 or 16");
     const char* const qps_end = options.qps.data() + options.qps.size();
     if (auto [end, ec] = std::from_chars(options.qps.data(), qps_end, b.qp);
         ec != std::errc() || end != qps_end || b.qp < 0 || b.qp > 51)
@@ -417,9 +423,9 @@ Status bench_stream(const BenchOptions& options) {
     REPRISE_TRY(
         b.csv.open(out + "/stream.csv", "condition,method,frame,psnr,ssim,flip,latency_ms"));
     std::printf(
-        "[bench stream] %s %dx%d, server %g Hz at qp %d, display %g Hz, %g s per condition, "
-        "renderer %s\n",
-        options.scene.c_str(), b.width, b.height, b.fps, b.qp, b.display_rate, b.duration,
+        "[bench stream] %s %dx%d, server %g Hz at qp %d and aa %d, display %g Hz, %g s per "
+        "condition, renderer %s\n",
+        options.scene.c_str(), b.width, b.height, b.fps, b.qp, b.aa, b.display_rate, b.duration,
         b.scene.renderer->device().c_str());
     std::printf("%-16s %-16s %9s %7s %7s %8s %8s %8s %9s %6s %6s\n", "condition", "method", "kbps",
                 "PSNR", "FLIP", "lat.mean", "lat.p95", "lat.max", "freeze.ms", "lost", "fec");
@@ -469,8 +475,10 @@ Status bench_stream(const BenchOptions& options) {
         "Latency: pose sampled -> displayed, for reprise the pose each display frame was warped "
         "to, for the peers "
         "the pose of the frame the first time it is shown. Truth: the scene rendered at each "
-        "displayed pose and "
-        "instant."};
+        "displayed pose and instant with 4 anti-aliasing samples; the server renders with " +
+            strf("%d", b.aa) +
+            " (--aa) and the video peers' source frames are rendered with as many, at the "
+            "instants the stream showed."};
     std::string table = strf("%-16s %-16s %9s %7s %7s %8s %8s %9s\n", "condition", "method", "kbps",
                              "PSNR", "FLIP", "lat.mean", "lat.p95", "freeze.ms");
     std::map<std::string, PlotSeries> by_method;
