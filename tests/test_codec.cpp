@@ -602,6 +602,27 @@ TEST(Codec, KeyFramesOnRequestIntervalAndCut) {
     EXPECT_EQ(keys, 3);  // frames 0, 3, 6
 }
 
+// A server stepping its rate down (30 -> 20 -> 10 Hz) keeps predicting: no key frame, the
+// decoder keeps the key frame's rate, and every frame decodes as the encoder holds it.
+TEST(Codec, AChangeOfFrameRateNeedsNoKeyFrame) {
+    auto frames = render("pan", 6, 128, 72, 30);
+    Encoder encoder;
+    Decoder decoder;
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+        frames[i].fps = i < 2 ? 30.0 : i < 4 ? 20.0 : 10.0;
+        ASSERT_TRUE(encoder.send_frame(frames[i]).ok());
+        Packet p;
+        ASSERT_EQ(encoder.receive_packet(p), Result::Ok);
+        EXPECT_EQ(p.type, i == 0 ? PacketType::Key : PacketType::Inter) << "frame " << i;
+        ASSERT_TRUE(decoder.send_packet(p.data).ok()) << "frame " << i;
+        Frame out;
+        ASSERT_EQ(decoder.receive_frame(out), Result::Ok);
+        EXPECT_TRUE(same_frame(out, encoder.reconstruction())) << "frame " << i;
+        EXPECT_EQ(out.fps, 30.0);
+    }
+    EXPECT_EQ(encoder.stats().key_frames, 1u);
+}
+
 TEST(Codec, BadPacketsGiveAStatusAndTheDecoderResumes) {
     const auto frames = render("crossing", 4, 96, 64);
     const Coded coded = encode_all(frames, {});

@@ -276,15 +276,21 @@ Status Encoder::send_frame(const Frame& given) {
                                                                  nullptr, s.work.base_motion));
     }
     sp.slices = default_slices(h);
-    sp.fps = frame.fps > 0.0 ? frame.fps : s.options.fps;
-    if (s.started && !(sp == s.sp)) s.started = false;  // new parameters: a key frame
+    // A new frame rate (a server stepping down) needs no key frame: the sequence keeps its key
+    // frame's fps, rate control takes the frame's own.
+    const double fps = frame.fps > 0.0 ? frame.fps : s.options.fps;
+    sp.fps = s.started ? s.sp.fps : fps;
+    if (s.started && !(sp == s.sp)) {
+        s.started = false;  // new parameters: a key frame
+        sp.fps = fps;
+    }
     s.sp = sp;
 
     planes_from_linear(frame.color.view(), sp, s.source_planes);
     int ref = s.choose_reference();
     // Rate control: bounded frame sizes, re-encoding with a coarser quantiser when one is too big.
     const double target_bits =
-        s.options.bitrate_kbps > 0 ? s.options.bitrate_kbps * 1000.0 / std::max(1.0, sp.fps) : 0.0;
+        s.options.bitrate_kbps > 0 ? s.options.bitrate_kbps * 1000.0 / std::max(1.0, fps) : 0.0;
     int qp = s.qp;
     Picture& pic = s.scratch;
     std::vector<uint8_t> payload;
