@@ -40,10 +40,11 @@ TEST(CliBenchStream, PeersBesideTheStreamAtOneHundredMillisecondsRoundTrip) {
     const fs::path dir =
         fs::temp_directory_path() / ("reprise-cli-bench-stream-" + std::to_string(getpid()));
     fs::remove_all(dir);
-    const Outcome r = run_reprise("bench stream --size 128x72 --conditions rtt100ms --duration 1.5 "
-                                  "--qps 34 --out " +
-                                      dir.string(),
-                                  240);
+    const Outcome r = run_reprise(
+        "bench stream --size 128x72 --conditions rtt100ms --duration 1.5 "
+        "--qps 34 --out " +
+            dir.string(),
+        240);
     ASSERT_EQ(r.status, 0) << r.output;
     EXPECT_NE(r.output.find("at qp 34"), std::string::npos) << r.output;
     EXPECT_NE(r.output.find("rtt100ms: coded "), std::string::npos) << r.output;
