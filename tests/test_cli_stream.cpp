@@ -173,9 +173,9 @@ TEST(CliStream, ASecondClientOverMaxSessionsIsToldTheServerIsFull) {
 }
 
 // Both cores kept busy by other threads and 2000 garbage datagrams at the port: a correct client
-// shows its first frame within 3 s and from then on at least 90 % of its display frames (the
-// single-threaded server showed none: issue 23). The first session frame costs about 1 s on
-// llvmpipe even after the server's warm-up render (seen: 1.1 s against 15-50 ms later).
+// shows its first frame within 1 s and from then on at least 90 % of its display frames (the
+// single-threaded server showed none: issue 23). Measured 0.07-0.1 s in release and under ASan;
+// with llvmpipe's anisotropic filtering the first session frame took about 1.1 s.
 TEST(CliStream, AClientIsServedWhileBothCoresAreBusy) {
     const fs::path out =
         reprise::test::fresh_directory(fs::temp_directory_path() / "reprise-cli-stream-busy");
@@ -224,7 +224,7 @@ TEST(CliStream, AClientIsServedWhileBothCoresAreBusy) {
         ++shown;
     }
     EXPECT_GE(first, 0.0) << connected.output;
-    EXPECT_LE(first, 3.0) << "first frame shown at " << first << " s\n"
+    EXPECT_LE(first, 1.0) << "first frame shown at " << first << " s\n"
                           << connected.output << served.output;
     EXPECT_GE(shown, int(0.9 * (4.0 - first) * 30)) << connected.output << served.output;
 }
