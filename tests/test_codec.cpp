@@ -520,8 +520,8 @@ TEST(Codec, StreamsOfAnOlderVersionAreRefused) {
     const auto frames = render("crossing", 1, 64, 48);
     Coded coded = encode_all(frames, {.depth = DepthMode::View});
     // Before view depth, bounded motion, rigid objects, view depth in eighths of its step, the
-    // temporal depth's plane fit, its span by the picture's height.
-    for (uint8_t version : {1, 2, 3, 4, 5, 6}) {
+    // temporal depth's plane fit, its span by the picture's height, the kept picture.
+    for (uint8_t version : {1, 2, 3, 4, 5, 6, 7}) {
         std::vector<uint8_t> packet = coded.packets[0].data;
         packet[4] = version;
         Decoder decoder;
@@ -539,6 +539,56 @@ TEST(Codec, StreamsOfAnOlderVersionAreRefused) {
     const Status split = split_stream(file, info, packets);
     ASSERT_FALSE(split.ok());
     EXPECT_NE(split.message().find("version 1"), std::string::npos) << split.message();
+}
+
+// More frames in flight than reference pictures (100 ms round trip at 30 Hz): only frames 0 and 1
+// were acknowledged when frame 8 is reported lost. Frame 1 stayed held, so frame 10 predicts from
+// it; version 7 had replaced it by then and sent a key frame.
+TEST(Codec, TheNewestAcknowledgedPictureOutlivesTheFramesInFlight) {
+    const auto frames = render("pan", 11, 96, 64);
+    Encoder encoder;
+    Decoder decoder;
+    Frame out;
+    for (uint32_t i = 0; i < frames.size(); ++i) {
+        if (i == 10) encoder.report_loss(8);
+        ASSERT_TRUE(encoder.send_frame(frames[i]).ok());
+        Packet p;
+        ASSERT_EQ(encoder.receive_packet(p), Result::Ok);
+        if (i <= 1) encoder.acknowledge(i);
+        if (i == 8) continue;  // lost
+        const Status s = decoder.send_packet(p.data);
+        if (i == 9) {
+            EXPECT_FALSE(s.ok()) << "its reference was lost";
+            continue;
+        }
+        ASSERT_TRUE(s.ok()) << "frame " << i << ": " << s.message();
+        ASSERT_EQ(decoder.receive_frame(out), Result::Ok);
+        EXPECT_TRUE(same_frame(out, encoder.reconstruction())) << "frame " << i;
+        if (i == 10) {
+            EXPECT_EQ(p.type, PacketType::Inter);
+            EXPECT_EQ(p.reference, 1u);
+        }
+    }
+    EXPECT_EQ(encoder.stats().key_frames, 1u);
+}
+
+// A loss reported after a key frame for a frame before it (a round trip late): the key frame is
+// still the reference; version 7 took the report as a broken chain and sent key after key.
+TEST(Codec, ALossBeforeTheNewestKeyFrameNeedsNoOtherKeyFrame) {
+    const auto frames = render("pan", 6, 96, 64);
+    Encoder encoder;
+    std::vector<Packet> packets;
+    for (uint32_t i = 0; i < frames.size(); ++i) {
+        if (i == 3) encoder.request_key_frame();
+        if (i == 4) encoder.report_loss(2);
+        ASSERT_TRUE(encoder.send_frame(frames[i]).ok());
+        packets.emplace_back();
+        ASSERT_EQ(encoder.receive_packet(packets.back()), Result::Ok);
+    }
+    EXPECT_EQ(packets[3].type, PacketType::Key);
+    EXPECT_EQ(packets[4].type, PacketType::Inter);
+    EXPECT_EQ(packets[4].reference, 3u);
+    EXPECT_EQ(encoder.stats().key_frames, 2u);
 }
 
 TEST(Codec, RecoversFromALostPacketWithoutAKeyFrame) {

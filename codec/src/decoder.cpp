@@ -98,7 +98,7 @@ Status Decoder::send_packet(std::span<const uint8_t> packet) {
         s.sp = sp;
         s.started = true;
     }
-    const int slot = replacement_slot(s.refs);
+    const int slot = replacement_slot(s.refs, h.kept ? int64_t(h.frame) - h.kept : -1);
     std::swap(s.refs[slot], pic);
     s.have_newest = true;
     s.newest = h.frame;

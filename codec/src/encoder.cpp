@@ -124,6 +124,11 @@ struct Encoder::State {
             const int s = slot_of(n - 1);
             if (s >= 0 && !tainted[s]) return s;
         }
+        return newest_acknowledged();
+    }
+
+    // The slot of the newest held, acknowledged picture that depends on no lost frame, or -1.
+    int newest_acknowledged() const {
         int best = -1;
         for (int i = 0; i < kReferences; ++i)
             if (refs[i].held && !tainted[i] && acknowledged.count(refs[i].frame) &&
@@ -325,6 +330,11 @@ Status Encoder::send_frame(const Frame& given) {
     PacketHeader header{key ? PacketType::Key : PacketType::Inter, s.next_frame,
                         key ? s.next_frame : s.refs[ref].frame,
                         int64_t(std::llround(camera.time * 1e6))};
+    // The newest picture the receiver acknowledged stays held: after a loss the next frame
+    // predicts from it even when more frames than pictures were in flight.
+    const int kept = key ? -1 : s.newest_acknowledged();
+    if (kept >= 0 && s.next_frame - s.refs[kept].frame <= 0xffff)
+        header.kept = uint16_t(s.next_frame - s.refs[kept].frame);
     Packet packet;
     write_packet(header, payload, packet.data);
     packet.frame = header.frame;
@@ -332,8 +342,9 @@ Status Encoder::send_frame(const Frame& given) {
     packet.type = header.type;
     s.queue.push_back(std::move(packet));
 
-    // The new picture replaces the oldest (or a free) slot.
-    const int slot = replacement_slot(s.refs);
+    // The new picture replaces the oldest (or a free) slot, never the one kept.
+    const int slot =
+        replacement_slot(s.refs, header.kept ? int64_t(s.next_frame) - header.kept : -1);
     if (key) {
         for (auto& r : s.refs) r.held = false;
         s.last_key = s.next_frame;
@@ -431,6 +442,7 @@ void Encoder::acknowledge(uint32_t frame) {
 
 void Encoder::report_loss(uint32_t frame) {
     State& s = *state_;
+    if (s.started && frame < s.last_key) return;  // nothing after the newest key depends on it
     s.after_loss = true;
     // A lost frame and every held frame predicted from it (in frame order) are unusable.
     for (int pass = 0; pass < kReferences; ++pass)

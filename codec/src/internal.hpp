@@ -13,7 +13,7 @@ namespace reprise::codec {
 
 inline constexpr uint32_t kPacketMagic = 0x544B5052;  // "RPKT"
 inline constexpr uint32_t kFileMagic = 0x53525052;    // "RPRS"
-inline constexpr uint8_t kVersion = 7;
+inline constexpr uint8_t kVersion = 8;
 inline constexpr std::size_t kPacketHeaderSize = 32;
 inline constexpr std::size_t kMaxPayload = 256u << 20;
 inline constexpr int kMaxSide = 16384;
@@ -75,6 +75,7 @@ struct PacketHeader {
     PacketType type = PacketType::Key;
     uint32_t frame = 0, reference = 0;
     int64_t timestamp_us = 0;
+    uint16_t kept = 0;  // this picture replaces none with frame number frame - kept (0: none)
 };
 void write_packet(const PacketHeader& header, std::span<const uint8_t> payload,
                   std::vector<uint8_t>& out);
@@ -89,7 +90,8 @@ struct Workspace;
 // Adds one frame's counts to a running total.
 void add_stats(StreamStats& total, const StreamStats& frame);
 // The slot a new picture goes to: a free one, else the one with the smallest frame number.
-int replacement_slot(const Picture (&refs)[kReferences]);
+// A free slot, else the picture with the smallest frame number other than `kept`.
+int replacement_slot(const Picture (&refs)[kReferences], int64_t kept = -1);
 // The slot holding frame `frame`, or -1.
 int held_slot(const Picture (&refs)[kReferences], uint32_t frame);
 

@@ -19,7 +19,7 @@ void write_packet(const PacketHeader& h, std::span<const uint8_t> payload,
     w.u32(kPacketMagic);
     w.u8(kVersion);
     w.u8(uint8_t(h.type));
-    w.u16(0);
+    w.u16(h.kept);
     w.u32(h.frame);
     w.u32(h.reference);
     w.u64(uint64_t(h.timestamp_us));
@@ -38,7 +38,7 @@ Status parse_packet(std::span<const uint8_t> packet, PacketHeader& h,
     const uint32_t magic = r.u32();
     const uint8_t version = r.u8();
     const uint8_t type = r.u8();
-    const uint16_t flags = r.u16();
+    h.kept = r.u16();
     h.frame = r.u32();
     h.reference = r.u32();
     h.timestamp_us = int64_t(r.u64());
@@ -53,7 +53,6 @@ Status parse_packet(std::span<const uint8_t> packet, PacketHeader& h,
                              "; re-encode the stream)");
     if (type > uint8_t(PacketType::Inter))
         return Status::error("packet header: unknown type " + std::to_string(type));
-    if (flags) return Status::error("packet header: reserved flags set");
     if (length > kMaxPayload)
         return Status::error("packet header: payload length " + std::to_string(length) +
                              " above the maximum");
@@ -67,6 +66,10 @@ Status parse_packet(std::span<const uint8_t> packet, PacketHeader& h,
     if (h.type == PacketType::Key && h.reference != h.frame)
         return Status::error("packet header: key frame " + std::to_string(h.frame) +
                              " names a reference");
+    if (h.kept > 0 && (h.type == PacketType::Key || h.kept > h.frame))
+        return Status::error("packet header: frame " + std::to_string(h.frame) + " keeps frame " +
+                             std::to_string(int64_t(h.frame) - h.kept) +
+                             (h.type == PacketType::Key ? " (a key frame keeps none)" : ""));
     payload = r.bytes(length);
     return {};
 }

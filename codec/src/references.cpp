@@ -24,11 +24,12 @@ void add_stats(StreamStats& total, const StreamStats& f) {
     total.cameras_fitted += f.cameras_fitted;
 }
 
-int replacement_slot(const Picture (&refs)[kReferences]) {
-    int slot = 0;
+int replacement_slot(const Picture (&refs)[kReferences], int64_t kept) {
+    int slot = -1;
     for (int i = 0; i < kReferences; ++i) {
         if (!refs[i].held) return i;
-        if (refs[i].frame < refs[slot].frame) slot = i;
+        if (int64_t(refs[i].frame) != kept && (slot < 0 || refs[i].frame < refs[slot].frame))
+            slot = i;
     }
     return slot;
 }
