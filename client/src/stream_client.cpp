@@ -17,6 +17,10 @@ constexpr int64_t kHelloRetryUs = 250'000;
 constexpr int64_t kHandshakeGiveUpUs = 3'000'000;
 constexpr int64_t kReportIntervalUs = 100'000;
 constexpr int64_t kKeyRequestIntervalUs = 300'000;
+// After a reported loss the frames already on their way still fail to decode, until the server
+// predicts from a frame this client holds: a key frame is asked for only when failures last
+// longer than two round trips and this.
+constexpr int64_t kDecodeErrorGraceUs = 100'000;
 
 enum class Phase { Idle, HelloSent, Finished, Streaming };
 
@@ -42,6 +46,7 @@ struct StreamClient::State {
     warp::SpatioTemporalUpsampler upsampler;
     int64_t newest_completed = -1;
     int consecutive_decode_errors = 0;
+    int64_t first_decode_error_us = 0;  // of the current run of failures
     uint64_t received_sealed = 0;
     Frame decoded, scratch_decoded, displayed;
     bool have_decoded = false;
@@ -143,7 +148,10 @@ struct StreamClient::State {
             ++stats.decode_errors;
             abandoned.assign(1, packet.frame);
             report_lost(abandoned, now);
-            if (++consecutive_decode_errors >= 2) request_key(now);
+            if (consecutive_decode_errors++ == 0) first_decode_error_us = now;
+            if (consecutive_decode_errors >= 2 &&
+                now - first_decode_error_us > 2 * stats.last_rtt_us + kDecodeErrorGraceUs)
+                request_key(now);
             return;
         }
         if (lowres) {
