@@ -305,9 +305,8 @@ struct StreamBench {
                 sources, {.kind = PeerKind::X264, .preset = "veryfast", .crf = 15}, fps,
                 x264_fine));
         }
-        // The peer sends one frame per server period while the stream runs.
-        // Over the same seconds as reprise's stream: when the server adapts below `fps`, the
-        // peer sends the same fewer frames.
+        // The peer sends the frames the stream showed, over the same seconds as reprise's stream
+        // (when the server adapts below `fps`, the same fewer frames).
         auto kbps = [&](const std::vector<PeerFrame>& frames) {
             std::size_t bytes = 0;
             for (const PeerFrame& p : frames) bytes += p.bytes;

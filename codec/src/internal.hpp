@@ -87,10 +87,8 @@ int default_slices(int height);
 
 struct Workspace;
 
-// Adds one frame's counts to a running total.
-void add_stats(StreamStats& total, const StreamStats& frame);
-// The slot a new picture goes to: a free one, else the one with the smallest frame number.
-// A free slot, else the picture with the smallest frame number other than `kept`.
+// The slot a new picture goes to: a free one, else the picture with the smallest frame number
+// other than `kept`.
 int replacement_slot(const Picture (&refs)[kReferences], int64_t kept = -1);
 // The slot holding frame `frame`, or -1.
 int held_slot(const Picture (&refs)[kReferences], uint32_t frame);

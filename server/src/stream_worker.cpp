@@ -22,17 +22,6 @@ double ms_since(std::chrono::steady_clock::time_point t) {
 // The low-resolution colour as a frame of its own: depth and motion taken from the full G-buffer
 // at each low pixel's sample position (motion in low pixels), the camera's jitter in low pixels,
 // so the colour stream predicts by reprojection like any other.
-void add_sections(const codec::StreamStats& frame, codec::StreamStats& sum) {
-    sum.frames += frame.frames;
-    sum.key_frames += frame.key_frames;
-    sum.older_reference += frame.older_reference;
-    sum.header_bits += frame.header_bits;
-    sum.camera_bits += frame.camera_bits;
-    sum.depth_bits += frame.depth_bits;
-    sum.motion_bits += frame.motion_bits;
-    sum.color_bits += frame.color_bits;
-}
-
 void make_colour_frame(Session::Media& m, glm::vec2 jitter) {
     const int lw = m.low_color.width(), lh = m.low_color.height();
     const int w = m.frame.width(), h = m.frame.height();
@@ -287,9 +276,9 @@ double RenderWorker::produce(Session& s, int64_t now) {
         ++link_.stats.frames_encoded;
         link_.stats.render_ms_total += render_ms;
         link_.stats.encode_ms_total += encode_ms;
-        add_sections(m.encoder.last_frame_stats(), link_.stats.coded);
+        codec::add_stats(link_.stats.coded, m.encoder.last_frame_stats());
         if (link_.options.mode == net::StreamMode::LowRes)
-            add_sections(m.colour_encoder.last_frame_stats(), link_.stats.coded);
+            codec::add_stats(link_.stats.coded, m.colour_encoder.last_frame_stats());
     }
     return std::max(render_ms + encode_ms, 1e-3);
 }

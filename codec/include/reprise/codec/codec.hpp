@@ -88,6 +88,9 @@ struct StreamStats {
     }
 };
 
+// Adds one frame's (or stream's) counts to a running total.
+void add_stats(StreamStats& total, const StreamStats& frame);
+
 enum class Result { Ok, NeedMoreData, Error };
 
 class Encoder {

@@ -70,8 +70,7 @@ struct StreamServerStats {
     std::size_t loss_reports = 0, key_frame_requests = 0, acks = 0;
     std::size_t max_queue_bytes = 0;  // largest send queue of any session
     double encode_ms_total = 0.0, render_ms_total = 0.0;
-    // What the encoders wrote, summed over every frame encoded (both encoders in lowres mode):
-    // frames, key frames, older references and bits per section.
+    // What the encoders wrote, summed over every frame encoded (both encoders in lowres mode).
     codec::StreamStats coded;
     double loss = 0.0;     // newest reported media loss fraction (any session)
     int bitrate_kbps = 0;  // newest target of the last session adapted
