@@ -82,6 +82,23 @@ TEST_F(CamerasJson, FramesWithoutCamerasGetThemByFileName) {
     }
 }
 
+TEST_F(CamerasJson, TheCutFlagIsReadAndUnknownWhenAbsent) {
+    const std::string a = entry("0001.exr", camera_at(0.0f)),
+                      b = entry("0002.exr", camera_at(0.5f));
+    for (const auto& [cut, want] : {std::pair<std::string, Cut>{",\"cut\":true}", Cut::Yes},
+                                    {",\"cut\":false}", Cut::No},
+                                    {"}", Cut::Unknown}}) {
+        write_json("{\"frames\":[" + a + "," + b.substr(0, b.size() - 1) + cut + "]}");
+        Sequence seq;
+        ASSERT_TRUE(open(seq).ok());
+        Frame f;
+        ASSERT_TRUE(read_frame(seq, 1, f).ok());
+        EXPECT_EQ(f.camera.cut, want) << cut;
+        ASSERT_TRUE(read_frame(seq, 0, f).ok());
+        EXPECT_EQ(f.camera.cut, Cut::Unknown);
+    }
+}
+
 TEST_F(CamerasJson, AFrameCarryingItsCameraKeepsIt) {
     Frame own = test::flat_frame(8, 4, 3.0f, {});
     own.camera = camera_at(2.0f);
@@ -111,6 +128,8 @@ TEST_F(CamerasJson, BadFilesAreRefusedNamingWhatAndWhere) {
         {"{\"frames\":[" + good.substr(0, good.size() - 1) + ",\"near\":\"x\"}]}",
          "\"near\" is not a finite number"},
         {"{\"frames\":[" + good.substr(0, good.size() - 1) + ",\"near\":60}]}", "near < far"},
+        {"{\"frames\":[" + good.substr(0, good.size() - 1) + ",\"cut\":1}]}",
+         "frames[0]: \"cut\" must be true or false"},
         {"{\"frames\":[" + good.substr(0, good.size() - 1) + ",\"time\":1e999}]}",
          "not valid JSON"},
     };

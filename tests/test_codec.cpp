@@ -623,6 +623,32 @@ TEST(Codec, RecoversFromALostPacketWithoutAKeyFrame) {
     EXPECT_GT(display_psnr(frames[9].color, out.color), 30.0);
 }
 
+TEST(Codec, TheCameraSaysWhereCutsAreAndOnlyUnknownFramesAreTested) {
+    // Frames 12..17 of `cut`: the renderer marks frame 15 (index 3) Cut::Yes, the others No.
+    const auto rendered = render("cut", 6, 96, 54, 12);
+    ASSERT_EQ(rendered[3].camera.cut, Cut::Yes);
+    auto key_frames = [&](auto&& mark) {
+        Encoder encoder;
+        std::vector<int> keys;
+        for (std::size_t i = 0; i < rendered.size(); ++i) {
+            Frame f = rendered[i];
+            mark(i, f.camera.cut);
+            EXPECT_TRUE(encoder.send_frame(f).ok());
+            Packet p;
+            EXPECT_EQ(encoder.receive_packet(p), Result::Ok);
+            if (p.type == PacketType::Key) keys.push_back(int(i));
+        }
+        return keys;
+    };
+    EXPECT_EQ(key_frames([](std::size_t, Cut&) {}), (std::vector<int>{0, 3}));
+    EXPECT_EQ(key_frames([](std::size_t, Cut& c) { c = Cut::Unknown; }), (std::vector<int>{0, 3}))
+        << "detected from the prediction";
+    EXPECT_EQ(key_frames([](std::size_t, Cut& c) { c = Cut::No; }), (std::vector<int>{0}))
+        << "a cut the camera denies is coded as an inter frame";
+    EXPECT_EQ(key_frames([](std::size_t i, Cut& c) { c = i == 1 ? Cut::Yes : c; }),
+              (std::vector<int>{0, 1, 3}));
+}
+
 TEST(Codec, KeyFramesOnRequestIntervalAndCut) {
     auto frames = render("cut", 8, 128, 72, 12);  // the cut scene changes shot at 0.5 s: frame 15
     Encoder encoder({.keyint = 100});

@@ -118,6 +118,17 @@ TEST_F(ExrTest, RoundTripIsBitExact) {
     EXPECT_EQ(read.fps, written.fps);
 }
 
+TEST_F(ExrTest, TheCutFlagRoundTripsAndIsUnknownWhenAbsent) {
+    for (const Cut cut : {Cut::Yes, Cut::No, Cut::Unknown}) {
+        Frame written = full_frame(9, 5, 1);
+        written.camera.cut = cut;
+        ASSERT_TRUE(write_frame(path("cut.exr"), written).ok());
+        Frame read;
+        ASSERT_TRUE(read_frame(path("cut.exr"), read).ok());
+        EXPECT_EQ(read.camera.cut, cut) << int(cut);
+    }
+}
+
 TEST_F(ExrTest, LargerThanOneStripRoundTrips) {
     Frame written = full_frame(130, 150, 2);
     ASSERT_TRUE(write_frame(path("big.exr"), written).ok());

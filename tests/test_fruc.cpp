@@ -142,6 +142,30 @@ TEST(Fruc, CameraCutResetsHistoryWithoutGhosts) {
     }
 }
 
+TEST(Fruc, TheCameraSaysWhereCutsAreAndOnlyUnknownFramesAreTested) {
+    // Rendered frames 13..16 of `cut`; the renderer marks frame 15 (index 2) Cut::Yes, the others
+    // No.
+    const std::vector<Frame> rendered = render("cut", 30.0, 13, 4, 96, 54);
+    ASSERT_EQ(rendered[2].camera.cut, Cut::Yes);
+    ASSERT_EQ(rendered[3].camera.cut, Cut::No);
+    auto run = [&](auto&& mark) {
+        std::vector<Frame> input = rendered;
+        for (std::size_t i = 0; i < input.size(); ++i) mark(i, input[i].camera.cut);
+        FrucCounters counters;
+        convert(input, 2, {}, &counters);
+        return counters;
+    };
+    const FrucCounters as_rendered = run([](std::size_t, Cut&) {});
+    EXPECT_EQ(as_rendered.cuts, 1u);
+    EXPECT_EQ(as_rendered.cut_tests_skipped, 3u) << "every frame after the first said";
+    const FrucCounters unknown = run([](std::size_t, Cut& c) { c = Cut::Unknown; });
+    EXPECT_EQ(unknown.cuts, 1u) << "detected on the pixels";
+    EXPECT_EQ(unknown.cut_tests_skipped, 0u);
+    // The camera is believed: a cut it denies is not looked for, one it reports is taken.
+    EXPECT_EQ(run([](std::size_t, Cut& c) { c = Cut::No; }).cuts, 0u);
+    EXPECT_EQ(run([](std::size_t i, Cut& c) { c = i == 1 ? Cut::Yes : c; }).cuts, 2u);
+}
+
 template <class T>
 bool same_bits(const Image<T>& a, const Image<T>& b) {
     return a.width() == b.width() && a.height() == b.height() &&

@@ -169,8 +169,8 @@ Status run_fruc(const FrucJob& job) {
     std::printf(
         "  skipped: %zu still frames copied, %zu fills (no holes), %zu dynamic layers (nothing "
         "moving), "
-        "%zu true-motion passes (linear motion)\n",
-        c.copied_still, c.fills_skipped, c.dynamic_skipped, c.linear_motion);
+        "%zu true-motion passes (linear motion), %zu cut tests (the camera said)\n",
+        c.copied_still, c.fills_skipped, c.dynamic_skipped, c.linear_motion, c.cut_tests_skipped);
     std::printf(
         "  done: %zu fills (%zu hole pixels), %zu dynamic layers, %zu grid cells, %zu cuts, "
         "%zu true-motion frames\n",

@@ -121,8 +121,10 @@ Status run_stereo(const StereoJob& job, const stereo::StereoRig& rig,
             continue;
         }
         auto start = std::chrono::steady_clock::now();
-        stereo::StereoStats stats = synthesizer.synthesize(
-            frame, target, made, options, job.temporal && have_previous ? &previous : nullptr);
+        // Nothing of another shot fills this one's holes.
+        const bool history = job.temporal && have_previous && frame.camera.cut != Cut::Yes;
+        stereo::StereoStats stats =
+            synthesizer.synthesize(frame, target, made, options, history ? &previous : nullptr);
         made.fps = frame.fps;
         ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
                   .count();

@@ -40,7 +40,7 @@ extern "C" {
  * create takes the caller's REPRISE_ABI_VERSION: the major must equal the library's and the
  * minor be at most the library's. libreprise.so's SONAME carries the major. */
 #define REPRISE_ABI_VERSION_MAJOR 1
-#define REPRISE_ABI_VERSION_MINOR 0
+#define REPRISE_ABI_VERSION_MINOR 1
 #define REPRISE_ABI_VERSION \
     ((uint32_t)((REPRISE_ABI_VERSION_MAJOR << 16) | REPRISE_ABI_VERSION_MINOR))
 
@@ -109,12 +109,18 @@ typedef struct reprise_camera {
     int32_t reserved;            /* 0 */
 } reprise_camera;
 
+/* Whether a cut (a jump of the camera) lies between the previous frame and this one. A renderer
+ * knows: YES drops everything before the frame (history, prediction), NO spares the test of the
+ * pixels, UNKNOWN (0, what reprise_gbuffer_init sets) has the library test them. NO: ABI 1.1. */
+typedef int32_t reprise_reset;
+enum { REPRISE_RESET_UNKNOWN = 0, REPRISE_RESET_YES = 1, REPRISE_RESET_NO = 2 };
+
 /* A rendered instant (input) or a made one (output): which channels each call reads or writes
  * is in its comment. Fill it with reprise_gbuffer_init (all absent, no camera), then set
  * channels. */
 typedef struct reprise_gbuffer {
     uint32_t struct_size; /* sizeof(reprise_gbuffer) */
-    int32_t reset;        /* 1: a cut; nothing before this frame is used (history dropped) */
+    int32_t reset;        /* REPRISE_RESET_*: whether a cut came before this frame */
     reprise_image color;  /* linear-light RGB(A), 32/16 float; A = coverage, 1 if absent */
     reprise_image depth;  /* linear view depth, scene units, background +inf: R32/R16 float */
     reprise_image motion; /* backward motion, pixels: RG32/RG16 float */

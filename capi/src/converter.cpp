@@ -98,9 +98,7 @@ void reprise_converter_destroy(reprise_converter* converter) { delete converter;
 reprise_status reprise_converter_send(reprise_converter* converter, const reprise_gbuffer* frame) {
     const char* function = "reprise_converter_send";
     return with_handle(function, converter, "converter", [&](reprise_converter& c) {
-        bool reset = false;
-        REPRISE_CAPI_TRY(read_gbuffer(function, "frame", frame, kConverterReads, c.input, reset));
-        if (reset) c.fruc->start_new_shot();
+        REPRISE_CAPI_TRY(read_gbuffer(function, "frame", frame, kConverterReads, c.input));
         const Status status = c.fruc->send(std::move(c.input));
         if (!status) return fail(REPRISE_ERROR_INVALID_ARGUMENT, function, status.message());
         return reprise_status(REPRISE_OK);

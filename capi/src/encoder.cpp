@@ -96,10 +96,8 @@ void reprise_encoder_destroy(reprise_encoder* encoder) { delete encoder; }
 reprise_status reprise_encoder_send_frame(reprise_encoder* encoder, const reprise_gbuffer* frame) {
     const char* function = "reprise_encoder_send_frame";
     return with_handle(function, encoder, "encoder", [&](reprise_encoder& e) {
-        bool reset = false;
         REPRISE_CAPI_TRY(
-            read_gbuffer(function, "frame", frame, kColor | kDepth | kMotion, e.input, reset));
-        if (reset) e.encoder->request_key_frame();
+            read_gbuffer(function, "frame", frame, kColor | kDepth | kMotion, e.input));
         const Status status = e.encoder->send_frame(e.input);
         if (!status) return fail(REPRISE_ERROR_INVALID_ARGUMENT, function, status.message());
         return reprise_status(REPRISE_OK);

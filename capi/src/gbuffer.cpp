@@ -307,11 +307,13 @@ reprise_status check_gbuffer_struct(const char* function, const char* name,
 }  // namespace
 
 reprise_status read_gbuffer(const char* function, const char* name, const reprise_gbuffer* given,
-                            unsigned read, Frame& frame, bool& reset) {
+                            unsigned read, Frame& frame) {
     REPRISE_CAPI_TRY(check_gbuffer_struct(function, name, given));
     const std::string prefix = std::string(name) + "->";
-    REPRISE_CAPI_TRY(check_flag(function, (prefix + "reset").c_str(), given->reset));
-    reset = given->reset != 0;
+    if (given->reset < REPRISE_RESET_UNKNOWN || given->reset > REPRISE_RESET_NO)
+        return fail(REPRISE_ERROR_INVALID_ARGUMENT, function,
+                    prefix + "reset " + std::to_string(given->reset) +
+                        " is not REPRISE_RESET_UNKNOWN (0), _YES (1) or _NO (2)");
     if (!given->color.data)
         return fail(REPRISE_ERROR_INVALID_ARGUMENT, function,
                     prefix + "color.data is NULL: colour is required");
@@ -328,6 +330,9 @@ reprise_status read_gbuffer(const char* function, const char* name, const repris
     REPRISE_CAPI_TRY(read_channel(function, n, kIdSpec, given->id, read & kId, w, h, frame.id));
     REPRISE_CAPI_TRY(read_channel(function, n, kUiSpec, given->ui, read & kUi, w, h, frame.ui));
     REPRISE_CAPI_TRY(read_camera(function, n, given->camera, frame.camera));
+    frame.camera.cut = given->reset == REPRISE_RESET_YES  ? Cut::Yes
+                       : given->reset == REPRISE_RESET_NO ? Cut::No
+                                                          : Cut::Unknown;
     if (!std::isfinite(given->fps) || given->fps < 0.0)
         return fail(REPRISE_ERROR_INVALID_ARGUMENT, function,
                     prefix + "fps " + std::to_string(given->fps) + " is not 0 or positive");
@@ -369,7 +374,9 @@ reprise_status write_gbuffer(const char* function, const Frame& frame, reprise_g
     if (out->ui.data) write_pixels(frame.ui, out->ui);
     write_camera(frame.camera, out->camera);
     out->fps = frame.fps;
-    out->reset = 0;
+    out->reset = frame.camera.cut == Cut::Yes  ? REPRISE_RESET_YES
+                 : frame.camera.cut == Cut::No ? REPRISE_RESET_NO
+                                               : REPRISE_RESET_UNKNOWN;
     return REPRISE_OK;
 }
 

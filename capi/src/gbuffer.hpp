@@ -20,9 +20,10 @@ enum Channel : unsigned {
 
 // Copies the channels in `read` that `given` has (colour always, required) into `frame`,
 // converted to its float layout; the others are cleared. `name` is the argument's name in
-// messages ("frame"). Reuses frame's buffers while the size stays the same.
+// messages ("frame"). Reuses frame's buffers while the size stays the same. `reset` becomes
+// frame.camera.cut.
 reprise_status read_gbuffer(const char* function, const char* name, const reprise_gbuffer* given,
-                            unsigned read, Frame& frame, bool& reset);
+                            unsigned read, Frame& frame);
 
 // Checks `out` for a width x height result: colour required, the channels in `written` optional,
 // any other channel must be absent.

@@ -80,10 +80,9 @@ reprise_status reprise_stereo_synthesize(reprise_stereo* stereo, const reprise_g
                                          reprise_gbuffer* eye) {
     const char* function = "reprise_stereo_synthesize";
     return with_handle(function, stereo, "stereo", [&](reprise_stereo& s) {
-        bool reset = false;
         Frame& input = s.input;
         REPRISE_CAPI_TRY(
-            read_gbuffer(function, "rendered", rendered, kColor | kDepth | kMotion, input, reset));
+            read_gbuffer(function, "rendered", rendered, kColor | kDepth | kMotion, input));
         if (input.depth.empty())
             return fail(REPRISE_ERROR_INVALID_ARGUMENT, function,
                         "rendered->depth.data is NULL: the other eye needs depth");
@@ -92,7 +91,7 @@ reprise_status reprise_stereo_synthesize(reprise_stereo* stereo, const reprise_g
                         "rendered->camera is not valid: disparity needs the projection");
         REPRISE_CAPI_TRY(
             check_output(function, eye, input.width(), input.height(), kColor | kDepth));
-        if (reset) s.has_previous = false;
+        if (input.camera.cut == Cut::Yes) s.has_previous = false;
         const stereo::EyeCameras eyes = stereo::eye_cameras(
             input.camera, s.rig,
             s.rendered == stereo::Eye::Left ? stereo::Anchor::Left : stereo::Anchor::Right);

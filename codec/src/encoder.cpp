@@ -292,7 +292,9 @@ Status Encoder::send_frame(const Frame& given) {
     s.sp = sp;
 
     planes_from_linear(frame.color.view(), sp, s.source_planes);
-    int ref = s.choose_reference();
+    // A cut the frame's camera reports starts a key frame; one it does not say is detected below.
+    int ref = frame.camera.cut == Cut::Yes ? -1 : s.choose_reference();
+    const bool detect_cut = s.options.detect_cuts && frame.camera.cut == Cut::Unknown;
     // Rate control: bounded frame sizes, re-encoding with a coarser quantiser when one is too big.
     const double target_bits =
         s.options.bitrate_kbps > 0 ? s.options.bitrate_kbps * 1000.0 / std::max(1.0, fps) : 0.0;
@@ -305,8 +307,7 @@ Status Encoder::send_frame(const Frame& given) {
         ColorEncodeResult colour;
         const int qp_now = std::clamp(ref < 0 ? qp - 3 : qp, 0, 51);
         REPRISE_TRY(s.encode(frame, camera, ref, qp_now, pic, payload, fs, colour));
-        if (ref >= 0 && s.options.detect_cuts &&
-            colour.intra_macroblocks * 10 > colour.macroblocks * 6) {
+        if (ref >= 0 && detect_cut && colour.intra_macroblocks * 10 > colour.macroblocks * 6) {
             ref = -1;  // a cut: most of the frame is new
             --attempt;
             continue;

@@ -90,6 +90,11 @@ Status parse_cameras_json(std::string_view text, const std::string& path,
         if (glm::determinant(camera.view) == 0.0f || glm::determinant(camera.prev_view) == 0.0f)
             return Status::error(where + ": a view matrix is singular");
         camera.near = float(near), camera.far = float(far), camera.time = time;
+        if (entry.contains("cut")) {
+            if (!entry["cut"].is_boolean())
+                return Status::error(where + ": \"cut\" must be true or false");
+            camera.cut = entry["cut"].get<bool>() ? Cut::Yes : Cut::No;
+        }
         if (file != by_name.end()) cameras[file->second] = camera;  // others: not in this folder
     }
     return {};

@@ -398,6 +398,9 @@ void read_camera(const ImageSpec& spec, Camera& camera, bool& has_camera) {
     spec.getattribute("reprise:far", OIIO::TypeFloat, &camera.far);
     spec.getattribute("reprise:jitter", OIIO::TypeVector2, glm::value_ptr(camera.jitter));
     spec.getattribute("reprise:time", TypeDesc::DOUBLE, &camera.time);
+    int cut = 0;
+    if (spec.getattribute("reprise:cut", TypeDesc::INT, &cut))
+        camera.cut = cut ? Cut::Yes : Cut::No;
 }
 
 double read_fps(const ImageSpec& spec) {

@@ -192,6 +192,7 @@ Status write_frame(const std::string& path, const Frame& frame, const WriteOptio
     spec.attribute("reprise:jitter", OIIO::TypeVector2, glm::value_ptr(camera.jitter));
     spec.attribute("reprise:time", OIIO::TypeDesc::DOUBLE, &camera.time);
     spec.attribute("reprise:fps", OIIO::TypeDesc::DOUBLE, &frame.fps);
+    if (camera.cut != Cut::Unknown) spec.attribute("reprise:cut", int(camera.cut == Cut::Yes));
 
     const std::string temp = temporary_path(path);
     auto out = OIIO::ImageOutput::create("openexr");

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <limits>
+#include <optional>
 
 #include "common.hpp"
 #include "reprise/core/exr.hpp"
@@ -89,9 +90,17 @@ void assign_image(Image<T>& image, const py::handle& value, const char* what, in
             to[p * L::components + c] = c < components ? S(from[p * components + c]) : S(1);
 }
 
+// Camera::cut as Python sees it: None (unknown: tested on the pixels), True or False.
+Cut cut_of(std::optional<bool> cut) { return !cut ? Cut::Unknown : *cut ? Cut::Yes : Cut::No; }
+std::optional<bool> cut_value(Cut cut) {
+    if (cut == Cut::Unknown) return std::nullopt;
+    return cut == Cut::Yes;
+}
+
 Camera make_camera(const py::object& view, const py::object& projection,
                    const py::object& prev_view, const py::object& prev_projection, float near,
-                   float far, std::pair<float, float> jitter, double time) {
+                   float far, std::pair<float, float> jitter, double time,
+                   std::optional<bool> cut) {
     Camera c;
     if (!view.is_none()) c.view = matrix_from(view, "view");
     if (!projection.is_none()) c.projection = matrix_from(projection, "projection");
@@ -105,6 +114,7 @@ Camera make_camera(const py::object& view, const py::object& projection,
         value_error("camera: jitter must be finite");
     c.jitter = {jitter.first, jitter.second};
     c.time = time;
+    c.cut = cut_of(cut);
     return c;
 }
 
@@ -195,7 +205,7 @@ void bind_frame(py::module_& m) {
              py::arg("projection") = py::none(), py::arg("prev_view") = py::none(),
              py::arg("prev_projection") = py::none(), py::arg("near") = 0.1f,
              py::arg("far") = 1000.0f, py::arg("jitter") = std::pair<float, float>(0.0f, 0.0f),
-             py::arg("time") = 0.0)
+             py::arg("time") = 0.0, py::arg("cut") = py::none())
         .def_property(
             "view", [](const Camera& c) { return matrix_array(c.view); },
             [](Camera& c, const py::object& v) { c.view = matrix_from(v, "view"); })
@@ -218,6 +228,11 @@ void bind_frame(py::module_& m) {
                 c.jitter = {j.first, j.second};
             })
         .def_readwrite("time", &Camera::time)
+        .def_property(
+            "cut", [](const Camera& c) { return cut_value(c.cut); },
+            [](Camera& c, std::optional<bool> cut) { c.cut = cut_of(cut); },
+            "Whether a cut lies between the previous frame and this one: True, False, or None "
+            "(unknown: the converter and the encoder test the pixels).")
         .def("__repr__", [](const Camera& c) {
             return "<reprise.Camera near=" + std::to_string(c.near) +
                    " far=" + std::to_string(c.far) + " time=" + std::to_string(c.time) + ">";

@@ -60,6 +60,7 @@ struct Converter {
         d["dynamic_layers"] = c.dynamic_layers;
         d["dynamic_skipped"] = c.dynamic_skipped;
         d["cuts"] = c.cuts;
+        d["cut_tests_skipped"] = c.cut_tests_skipped;
         d["grid_cells"] = c.grid_cells;
         d["true_motion"] = c.true_motion;
         d["linear_motion"] = c.linear_motion;

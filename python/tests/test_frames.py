@@ -30,13 +30,14 @@ def test_rgb_colour_gets_alpha_one():
 
 def test_round_trip_reprise_layout(tmp_path, small_frame):
     small_frame.camera = reprise.Camera(view=np.diag([1.0, 1.0, 1.0, 1.0]), near=0.5, far=50.0,
-                                        time=1.25)
+                                        time=1.25, cut=True)
     path = str(tmp_path / "a.exr")
     reprise.write_frame(path, small_frame)
     back = reprise.read_frame(path)
     for name in ("color", "depth", "motion", "normal", "id"):
         assert np.array_equal(getattr(back, name), getattr(small_frame, name)), name
     assert back.camera.near == 0.5 and back.camera.time == 1.25 and back.fps == 24.0
+    assert back.camera.cut is True and reprise.Camera().cut is None
     header = reprise.read_header(path)
     assert "motion.x" in header["channels"] and not header["blender"]
 

@@ -20,6 +20,12 @@ def test_builtin_scene_frames(pan_60):
     moving = np.abs(frame.motion[..., 0]) > 0.1
     assert moving.mean() > 0.5
     assert frame.camera.time == pytest.approx(1 / 60)
+    assert frame.camera.cut is False  # a path knows no cut came
+
+
+def test_the_renderer_marks_the_cut(renderer):
+    frames = renderer.render_sequence(reprise.Scene("cut"), 3, start=14, width=32, height=18)
+    assert [f.camera.cut for f in frames] == [False, True, False]  # the shot changes at 0.5 s
 
 
 @pytest.mark.skipif(not os.path.exists(BOX), reason="assimp-testmodels not installed")

@@ -549,6 +549,11 @@ glm::vec3 light_direction_at(const Light& light, double time) {
     return glm::angleAxis(angle, glm::vec3(0, 1, 0)) * light.direction;
 }
 
+bool cut_between(const CameraPath& path, const Instant& before, const Instant& now) {
+    return path.motion == CameraMotion::Cut && before.time < path.cut_time &&
+           now.time >= path.cut_time;
+}
+
 Instant instant_on_path(const CameraPath& path, const Scene& scene, double time, int width,
                         int height) {
     return {.time = time,
@@ -968,6 +973,8 @@ Status Renderer::render(const Scene& scene, const Instant& current, const Instan
     c.far = current.far;
     c.jitter = current.jitter;
     c.time = current.time;
+    // Only a path knows that no cut came (render_frame); a caller's instants may jump.
+    c.cut = current.cut ? Cut::Yes : Cut::Unknown;
     if (scene.hud)
         draw_hud(current.time, w, h, frame.ui);
     else
@@ -980,10 +987,10 @@ Status Renderer::render_frame(const Scene& scene, const CameraPath& path, int in
     REPRISE_ASSERT(fps > 0);
     const int w = settings.width, h = settings.height;
     Instant now = instant_on_path(path, scene, index / fps, w, h);
-    Instant before = instant_on_path(path, scene, (index - 1) / fps, w, h);
-    now.cut = path.motion == CameraMotion::Cut && before.time < path.cut_time &&
-              now.time >= path.cut_time;
+    const Instant before = instant_on_path(path, scene, (index - 1) / fps, w, h);
+    now.cut = cut_between(path, before, now);
     REPRISE_TRY(render(scene, now, before, settings, frame));
+    frame.camera.cut = now.cut ? Cut::Yes : Cut::No;
     frame.fps = fps;
     return {};
 }
@@ -993,11 +1000,13 @@ Status Renderer::render_frame_lowres(const Scene& scene, const CameraPath& path,
                                      Frame& frame, Image<glm::vec4>& low_color, glm::vec2& jitter) {
     REPRISE_ASSERT(fps > 0);
     REPRISE_TRY(check_image_size(settings.width, settings.height, "renderer"));
-    const Instant now = instant_on_path(path, scene, index / fps, settings.width, settings.height);
+    Instant now = instant_on_path(path, scene, index / fps, settings.width, settings.height);
     const Instant before =
         instant_on_path(path, scene, (index - 1) / fps, settings.width, settings.height);
+    now.cut = cut_between(path, before, now);
     REPRISE_TRY(
         render_lowres(scene, now, before, settings, factor, index, frame, low_color, jitter));
+    frame.camera.cut = now.cut ? Cut::Yes : Cut::No;
     frame.fps = fps;
     return {};
 }

@@ -206,13 +206,16 @@ static double in_between_after(int reset) {
 }
 
 static void test_converter_reset(void) {
-    const double blended = in_between_after(0), continued = in_between_after(1);
+    const double blended = in_between_after(REPRISE_RESET_UNKNOWN),
+                 continued = in_between_after(REPRISE_RESET_YES),
+                 said_none = in_between_after(REPRISE_RESET_NO);
     printf(
         "converter: frame between against the first frame moved 2 px: %.2f dB blended, "
-        "%.2f dB after a reset\n",
-        blended, continued);
+        "%.2f dB after a reset, %.2f dB when told none came\n",
+        blended, continued, said_none);
     CHECK(continued > 60.0, "after a reset: %.2f dB", continued);
     CHECK(blended < 40.0, "without: %.2f dB", blended);
+    CHECK(said_none == blended, "told no cut: %.2f dB, untold %.2f dB", said_none, blended);
 }
 
 /* A plane at depth 4 seen by the left eye; the right eye, ipd 0.5 and focal length 32 px, sees
@@ -336,8 +339,9 @@ static void test_abi_mismatch(void) {
     EXPECT_STATUS(reprise_converter_create(REPRISE_ABI_VERSION + (1u << 16), NULL, &converter),
                   REPRISE_ERROR_ABI_MISMATCH);
     CHECK(converter == NULL, "no handle on a mismatch");
-    CHECK(strstr(reprise_last_error(), "abi_version 2.0") != NULL, "message: %s",
-          reprise_last_error());
+    char newer[32];
+    snprintf(newer, sizeof newer, "abi_version 2.%d", REPRISE_ABI_VERSION_MINOR);
+    CHECK(strstr(reprise_last_error(), newer) != NULL, "message: %s", reprise_last_error());
     reprise_decoder* decoder = NULL;
     EXPECT_STATUS(reprise_decoder_create(REPRISE_ABI_VERSION + 1, NULL, &decoder),
                   REPRISE_ERROR_ABI_MISMATCH);
@@ -406,8 +410,15 @@ static void test_bad_arguments(void) {
         CHECK(strstr(reprise_last_error(), cases[i].field) != NULL, "%s: message '%s' lacks '%s'",
               cases[i].what, reprise_last_error(), cases[i].field);
     }
-    /* A G-buffer from another reprise.h. */
+    /* A reset that is none of REPRISE_RESET_*. */
     reprise_gbuffer frame;
+    reprise_gbuffer_init(&frame, sizeof frame);
+    frame.color = image(rgba, W * 16, REPRISE_FORMAT_RGBA32_FLOAT);
+    frame.reset = 3;
+    EXPECT_STATUS(reprise_converter_send(converter, &frame), REPRISE_ERROR_INVALID_ARGUMENT);
+    CHECK(strstr(reprise_last_error(), "frame->reset 3") != NULL, "message: %s",
+          reprise_last_error());
+    /* A G-buffer from another reprise.h. */
     reprise_gbuffer_init(&frame, sizeof frame);
     frame.struct_size = 12;
     EXPECT_STATUS(reprise_converter_send(converter, &frame), REPRISE_ERROR_ABI_MISMATCH);

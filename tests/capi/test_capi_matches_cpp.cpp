@@ -77,7 +77,7 @@ reprise_gbuffer output_into(Frame& f) {
     return gbuffer_of(f);
 }
 
-// Without and with a reported cut before the last frame (reset = start_new_shot).
+// Without and with a reported cut before the last frame (reset = Camera::cut).
 class CapiConverter : public testing::TestWithParam<bool> {};
 
 TEST_P(CapiConverter, OutputsAreTheFrameRateConverters) {
@@ -89,10 +89,11 @@ TEST_P(CapiConverter, OutputsAreTheFrameRateConverters) {
     int compared = 0;
     for (const Frame& f : input) {
         const bool reset = cut && &f == &input.back();
-        if (reset) cpp.start_new_shot();
-        ASSERT_TRUE(cpp.send(f).ok());
+        Frame sent = f;
+        if (reset) sent.camera.cut = Cut::Yes;
+        ASSERT_TRUE(cpp.send(sent).ok());
         reprise_gbuffer g = gbuffer_of(f);
-        g.reset = reset;
+        g.reset = reset ? REPRISE_RESET_YES : REPRISE_RESET_UNKNOWN;
         ASSERT_EQ(reprise_converter_send(c, &g), REPRISE_OK) << reprise_last_error();
         Frame want, got;
         while (cpp.receive(want)) {

@@ -141,7 +141,6 @@ struct FrameRateConverter::State {
     Frame previous;  // colour, depth, motion and ids of the last input (no normals)
     bool has_previous = false;
     bool previous_starts_shot = false;  // its motion reaches back into another shot: unusable
-    bool shot_reported = false;         // start_new_shot(): the next frame is a cut
     FrameQueue ready;
     FrucOptions chosen;  // `options` with an auto warp or fill resolved for one frame
     NonfiniteRepair nonfinite;
@@ -170,11 +169,21 @@ struct FrameRateConverter::State {
         return chosen;
     }
 
-    // A shot change between `previous` and `frame`: most of the new frame has no counterpart in
-    // the old one, or what does differs in colour. Surveyed on every 4th pixel of every 4th row.
+    // A shot change between `previous` and `frame`: the frame's camera says so, or its size
+    // changed, or, when its camera does not say, its pixels show it (is_cut).
+    bool starts_shot(const Frame& frame) {
+        if (previous.width() != frame.width() || previous.height() != frame.height()) return true;
+        if (frame.camera.cut != Cut::Unknown) {
+            ++counters.cut_tests_skipped;
+            return frame.camera.cut == Cut::Yes;
+        }
+        return is_cut(frame);
+    }
+
+    // Most of the new frame has no counterpart in the old one, or what does differs in colour.
+    // Surveyed on every 4th pixel of every 4th row.
     bool is_cut(const Frame& frame) {
         const int w = frame.width(), h = frame.height();
-        if (previous.width() != w || previous.height() != h) return true;
         if (frame.depth.empty() || frame.motion.empty() || previous.depth.empty()) return false;
         scratch.reprojected.resize(w, h);
         scratch.valid.resize(w, h);
@@ -340,8 +349,6 @@ bool FrameRateConverter::receive(Frame& out) {
 
 Status FrameRateConverter::send(const Frame& frame) { return send_frame(frame, nullptr); }
 
-void FrameRateConverter::start_new_shot() { state_->shot_reported = true; }
-
 Status FrameRateConverter::send(Frame&& frame) { return send_frame(frame, &frame); }
 
 Status FrameRateConverter::send_frame(const Frame& given, Frame* owned) {
@@ -364,8 +371,7 @@ Status FrameRateConverter::send_frame(const Frame& given, Frame* owned) {
     ++st.counters.inputs;
     st.scratch.refiner.forget_region();
     const bool warpable = !frame.depth.empty() && !frame.motion.empty();
-    const bool cut = st.has_previous && (st.shot_reported || st.is_cut(frame));
-    st.shot_reported = false;
+    const bool cut = st.has_previous && st.starts_shot(frame);
     st.counters.cuts += cut;
     const int k_max = st.factor;
 

@@ -113,21 +113,23 @@ def upconvert(scene, frames):
 
 
 _written = []
-_cameras = {}  # frame path -> (view, projection, near, far, time), column-major lists
+_cameras = {}  # frame path -> (view, projection, near, far, time, camera name), column-major
 
 
 def write_cameras(scene, frames, folder):
     """cameras.json for reprise (Blender's files carry no camera): each frame after the first
     gets its camera and the previous frame's, which the Vector pass spans when every frame is
-    rendered (frame step 1). Without them reprise warps by the Vector pass alone."""
+    rendered (frame step 1), and whether the active camera changed since (a cut: markers bound
+    to cameras). Without them reprise warps by the Vector pass alone."""
     if scene.frame_step != 1 or any(path not in _cameras for path in frames):
         return
     entries = []
     for previous, path in zip(frames, frames[1:]):
-        view, projection, near, far, time = _cameras[path]
+        view, projection, near, far, time, name = _cameras[path]
         entries.append({"file": os.path.basename(path), "time": time, "view": view,
                         "projection": projection, "prev_view": _cameras[previous][0],
-                        "prev_projection": _cameras[previous][1], "near": near, "far": far})
+                        "prev_projection": _cameras[previous][1], "near": near, "far": far,
+                        "cut": name != _cameras[previous][5]})
     with open(os.path.join(folder, "cameras.json"), "w") as f:
         json.dump({"frames": entries}, f)
 
@@ -157,7 +159,8 @@ def record_camera(scene, path):
         return  # no cameras.json then
     render = scene.render
     time = (scene.frame_current - scene.frame_start) * render.fps_base / render.fps
-    _cameras[path] = matrices + (scene.camera.data.clip_start, scene.camera.data.clip_end, time)
+    _cameras[path] = matrices + (scene.camera.data.clip_start, scene.camera.data.clip_end, time,
+                                 scene.camera.name)
 
 
 @persistent

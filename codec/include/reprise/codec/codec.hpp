@@ -46,7 +46,9 @@ struct EncoderOptions {
     // channel is skipped (Mueller et al. 2021: T = 8/255 stays under one JND). 0 = skip only
     // what quantises to nothing.
     int skip_threshold = 2;
-    bool detect_cuts = true;  // key frame when the prediction misses most pixels
+    // A frame whose camera says Cut::Yes is a key frame. One whose camera does not say
+    // (Cut::Unknown) is a key frame when the prediction misses most pixels, if detect_cuts.
+    bool detect_cuts = true;
     // Frames without a camera (identity matrices) and with depth and motion are coded with a
     // camera fitted to them, so that only motion it does not explain is sent (docs/bitstream.md).
     bool fit_cameras = true;

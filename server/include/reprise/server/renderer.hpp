@@ -129,6 +129,8 @@ glm::vec2 lowres_jitter(int width, int height, int factor, int64_t index);
 
 Instant instant_on_path(const CameraPath& path, const Scene& scene, double time, int width,
                         int height);
+// Whether the path cuts between the two instants (Instant::cut).
+bool cut_between(const CameraPath& path, const Instant& before, const Instant& now);
 
 class Renderer {
 public:

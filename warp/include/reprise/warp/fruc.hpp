@@ -92,9 +92,10 @@ struct FrucOptions {
     // bilinear fetch (docs/benchmarks.md). The stereo eye keeps GridOptions' bilinear default.
     GridOptions grid{.bicubic = true};
     SplatOptions splat;
-    // A new frame whose reverse reprojection into the previous one misses on more than this
-    // fraction of pixels, or whose hits differ in mean display colour by more than cut_color,
-    // starts a new shot: the history is dropped, nothing is blended across it.
+    // A new frame whose camera does not say whether a cut came before it (Camera::cut Unknown) and
+    // whose reverse reprojection into the previous one misses on more than this fraction of pixels,
+    // or whose hits differ in mean display colour by more than cut_color, starts a new shot: the
+    // history is dropped, nothing is blended across it.
     float cut_misses = 0.6f;
     float cut_color = 0.12f;
     // A pixel is static when its motion differs from the camera-only motion by less than this
@@ -123,14 +124,15 @@ struct FrucCounters {
     std::size_t hole_pixels = 0;
     std::size_t dynamic_layers =
         0;  // extrapolation: frames with pixels the camera does not explain
-    std::size_t dynamic_skipped = 0;  // ... without: every pixel follows the camera
-    std::size_t cuts = 0;             // shot changes detected
-    std::size_t grid_cells = 0;       // adaptive-grid cells drawn
-    std::size_t true_motion = 0;      // in-between frames whose sides followed the true motion
-    std::size_t linear_motion = 0;    // ... that did not need it: a sparse survey found it linear
-    std::size_t refined_frames = 0;   // in-between frames whose sides disagreed: flow estimated
-    std::size_t refine_skipped = 0;   // ... whose sides agreed everywhere: nothing estimated
-    std::size_t refine_tiles = 0;     // tiles whose sides disagreed
+    std::size_t dynamic_skipped = 0;    // ... without: every pixel follows the camera
+    std::size_t cuts = 0;               // shot changes (the camera's Cut::Yes, or detected)
+    std::size_t cut_tests_skipped = 0;  // frames whose camera said whether a cut came: no test
+    std::size_t grid_cells = 0;         // adaptive-grid cells drawn
+    std::size_t true_motion = 0;        // in-between frames whose sides followed the true motion
+    std::size_t linear_motion = 0;      // ... that did not need it: a sparse survey found it linear
+    std::size_t refined_frames = 0;     // in-between frames whose sides disagreed: flow estimated
+    std::size_t refine_skipped = 0;     // ... whose sides agreed everywhere: nothing estimated
+    std::size_t refine_tiles = 0;       // tiles whose sides disagreed
     std::size_t refine_tiles_left_out = 0;  // ... not refined: past RefineOptions::max_flow_share
     std::size_t flow_pixels = 0;     // pixels the flow was estimated on (boxes around the tiles)
     std::size_t refined_pixels = 0;  // pixels that took the flow's colour
@@ -166,19 +168,17 @@ public:
     // interpolation gives, for every frame after the first, the K-1 frames between it and its
     // predecessor followed by the frame itself; extrapolation gives the frame itself followed by
     // K-1 frames beyond it. Frames must have colour; depth, motion and cameras enable warping
-    // (without them the output holds the last frame). Every output frame carries colour, depth,
-    // motion (per output period), the camera and the UI layer; normals and ids are not passed on.
-    // NaN and infinities are counted (counters().nonfinite) and repaired first: colour as holes,
-    // depth NaN/-inf and motion as unknown; no output value is NaN or infinite but background
-    // depth (+inf).
+    // (without them the output holds the last frame). A frame whose camera says Cut::Yes starts a
+    // new shot: nothing is blended across it (Cut::Unknown: detected). Every output frame carries
+    // colour, depth, motion (per output period), the camera and the UI layer; normals and ids are
+    // not passed on. NaN and infinities are counted (counters().nonfinite) and repaired first:
+    // colour as holes, depth NaN/-inf and motion as unknown; no output value is NaN or infinite but
+    // background depth (+inf).
     Status send(const Frame& frame);
     // The same without copying the frame to keep it: its buffers become the converter's, and
     // `frame` gets back buffers of an earlier one (contents unspecified) for the caller to refill.
     // Non-finite values are repaired in place.
     Status send(Frame&& frame);
-    // The next frame sent starts a new shot (a cut the renderer reports): it is handled as a
-    // detected cut (FrucCounters::cuts), nothing is blended across it.
-    void start_new_shot();
     // Takes the next output frame; false when the converter needs the next input.
     bool receive(Frame& out);
 
