@@ -9,7 +9,10 @@
 #include "reprise/codec/codec.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
-    reprise::codec::Decoder decoder({.max_pixels = 512 * 512});
+    reprise::codec::Decoder decoder;
+    REPRISE_ASSERT(reprise::codec::Decoder::create(
+                       reprise::codec::DecoderOptions{.max_pixels = 512 * 512}, decoder)
+                       .ok());
     std::size_t at = 0;
     std::vector<uint8_t> packet;
     reprise::Frame frame;
@@ -27,7 +30,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
             std::memcpy(packet.data() + 28, &crc, 4);
         }
         (void)decoder.send_packet(packet);
-        while (decoder.receive_frame(frame) == reprise::codec::Result::Ok) {
+        while (decoder.receive_frame(frame) == reprise::Result::Ok) {
         }
     }
     return 0;

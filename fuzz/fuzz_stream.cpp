@@ -10,7 +10,10 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     file.clear();
     if (!reprise::codec::write_stream_header(file, 64, 48, 30.0).ok()) __builtin_trap();
     file.insert(file.end(), data, data + size);
-    reprise::codec::Decoder decoder({.max_pixels = 512 * 512});
+    reprise::codec::Decoder decoder;
+    REPRISE_ASSERT(reprise::codec::Decoder::create(
+                       reprise::codec::DecoderOptions{.max_pixels = 512 * 512}, decoder)
+                       .ok());
     reprise::codec::StreamInfo info;
     reprise::codec::StreamReport report;
     std::size_t frames = 0;

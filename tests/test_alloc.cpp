@@ -136,7 +136,8 @@ void run_converter(warp::FrucMode mode, bool refine = false,
     for (int i = 0; i < 12; ++i) inputs.push_back(make_frame(i, refine));
     warp::FrucOptions options{.mode = mode, .warp = method};
     options.refine.enabled = refine;
-    warp::FrameRateConverter converter(2, options);
+    warp::FrameRateConverter converter;
+    EXPECT_TRUE(warp::FrameRateConverter::create(2, options, converter).ok());
     Frame in, out;
     bool ok = true;
     int made = 0;

@@ -254,7 +254,8 @@ TEST(Codec, StillSceneCostsAtMost64BytesPerFrame) {
 
 TEST(Codec, MovingCameraOverStillWorldSendsNoMotion) {
     const auto frames = render("pan", 4, 160, 96);
-    Encoder encoder(EncoderOptions{});
+    Encoder encoder;
+    EXPECT_TRUE(Encoder::create(EncoderOptions{}, encoder).ok());
     for (const Frame& f : frames) {
         ASSERT_TRUE(encoder.send_frame(f).ok());
         Packet p;
@@ -324,7 +325,8 @@ TEST(Codec, ViewDepthCostsAFractionOfLosslessDepth) {
         const auto frames = render(scene, 6, 160, 96);
         std::size_t depth_bits[2] = {0, 0};
         for (DepthMode mode : {DepthMode::Lossless, DepthMode::View}) {
-            Encoder encoder({.depth = mode});
+            Encoder encoder;
+            EXPECT_TRUE(Encoder::create(EncoderOptions{.depth = mode}, encoder).ok());
             for (const Frame& f : frames) {
                 ASSERT_TRUE(encoder.send_frame(f).ok());
                 Packet p;
@@ -343,7 +345,8 @@ TEST(Codec, ViewDepthCostsAFractionOfLosslessDepth) {
 // (1.39x when each frame re-rounded its temporal prediction, version 4).
 TEST(Codec, ViewDepthDoesNotDriftOnAnOrbit) {
     const auto frames = render("stroll", 12, 320, 180);
-    Encoder encoder({.depth = DepthMode::View});
+    Encoder encoder;
+    EXPECT_TRUE(Encoder::create(EncoderOptions{.depth = DepthMode::View}, encoder).ok());
     std::vector<std::size_t> bits;
     for (const Frame& f : frames) {
         ASSERT_TRUE(encoder.send_frame(f).ok());
@@ -392,7 +395,11 @@ TEST(Codec, BoundedMotionCostsAFractionOfPerPixelMotion) {
         const auto frames = render(scene, 5, 160, 96);
         std::size_t bits[2] = {0, 0};
         for (float bound : {0.0f, 0.25f}) {
-            Encoder encoder({.depth = DepthMode::View, .motion_error_px = bound});
+            Encoder encoder;
+            EXPECT_TRUE(
+                Encoder::create(EncoderOptions{.depth = DepthMode::View, .motion_error_px = bound},
+                                encoder)
+                    .ok());
             for (const Frame& f : frames) {
                 ASSERT_TRUE(encoder.send_frame(f).ok());
                 Packet p;
@@ -419,7 +426,10 @@ TEST(Codec, AffineMotionCostsOneModel) {
                                   -1.5f + 7.0f / 512 * (y - 16)};
         frames.push_back(f);
     }
-    Encoder encoder({.depth = DepthMode::View, .motion_error_px = 0.25f});
+    Encoder encoder;
+    EXPECT_TRUE(
+        Encoder::create(EncoderOptions{.depth = DepthMode::View, .motion_error_px = 0.25f}, encoder)
+            .ok());
     for (const Frame& f : frames) {
         ASSERT_TRUE(encoder.send_frame(f).ok());
         Packet p;
@@ -475,7 +485,8 @@ TEST(Codec, ASilhouetteOnePixelOffCostsAFlag) {
         frames.push_back(f);
     }
     for (DepthMode mode : {DepthMode::View, DepthMode::Lossless}) {
-        Encoder encoder({.depth = mode});
+        Encoder encoder;
+        EXPECT_TRUE(Encoder::create(EncoderOptions{.depth = mode}, encoder).ok());
         for (std::size_t i = 0; i < frames.size(); ++i) {
             ASSERT_TRUE(encoder.send_frame(frames[i]).ok());
             Packet p;
@@ -593,7 +604,8 @@ TEST(Codec, ALossBeforeTheNewestKeyFrameNeedsNoOtherKeyFrame) {
 
 TEST(Codec, RecoversFromALostPacketWithoutAKeyFrame) {
     const auto frames = render("crossing", 10, 128, 72);
-    Encoder encoder(EncoderOptions{});
+    Encoder encoder;
+    EXPECT_TRUE(Encoder::create(EncoderOptions{}, encoder).ok());
     Decoder decoder;
     std::vector<Packet> packets;
     Frame out;
@@ -621,6 +633,34 @@ TEST(Codec, RecoversFromALostPacketWithoutAKeyFrame) {
     EXPECT_EQ(encoder.stats().key_frames, 1u);
     EXPECT_GE(encoder.stats().older_reference, 1u);
     EXPECT_GT(display_psnr(frames[9].color, out.color), 30.0);
+}
+
+TEST(Codec, CreateRefusesBadOptionsNamingThem) {
+    const std::pair<EncoderOptions, const char*> bad[] = {
+        {{.qp = 52}, "qp 52"},
+        {{.bitrate_kbps = -1}, "bitrate_kbps -1"},
+        {{.fps = 0.0}, "fps 0"},
+        {{.keyint = -2}, "keyint -2"},
+        {{.depth = DepthMode::Bounded, .depth_error = 0.5f}, "depth_error"},
+        {{.depth = DepthMode::View, .view_displacement = 0.0f}, "view_displacement"},
+        {{.motion_error_px = 0.05f}, "motion_error_px"},
+        {{.skip_threshold = 256}, "skip_threshold 256"},
+    };
+    Encoder encoder;
+    for (const auto& [options, named] : bad) {
+        const Status s = Encoder::create(options, encoder);
+        ASSERT_FALSE(s.ok()) << named;
+        EXPECT_NE(s.message().find(named), std::string::npos) << s.message();
+    }
+    Decoder decoder;
+    const Status s = Decoder::create({.max_pixels = 0}, decoder);
+    ASSERT_FALSE(s.ok());
+    EXPECT_NE(s.message().find("max_pixels 0"), std::string::npos) << s.message();
+    // The encoder left as it was (default options) codes a frame.
+    ASSERT_TRUE(encoder.send_frame(render("pan", 1, 32, 18)[0]).ok());
+    Packet p;
+    EXPECT_EQ(encoder.receive_packet(p), Result::Ok);
+    EXPECT_EQ(encoder.receive_packet(p), Result::NeedMoreData);
 }
 
 TEST(Codec, TheCameraSaysWhereCutsAreAndOnlyUnknownFramesAreTested) {
@@ -651,7 +691,8 @@ TEST(Codec, TheCameraSaysWhereCutsAreAndOnlyUnknownFramesAreTested) {
 
 TEST(Codec, KeyFramesOnRequestIntervalAndCut) {
     auto frames = render("cut", 8, 128, 72, 12);  // the cut scene changes shot at 0.5 s: frame 15
-    Encoder encoder({.keyint = 100});
+    Encoder encoder;
+    EXPECT_TRUE(Encoder::create(EncoderOptions{.keyint = 100}, encoder).ok());
     std::vector<PacketType> types;
     for (std::size_t i = 0; i < frames.size(); ++i) {
         if (i == 5) encoder.request_key_frame();
@@ -667,7 +708,8 @@ TEST(Codec, KeyFramesOnRequestIntervalAndCut) {
     EXPECT_EQ(types[4], PacketType::Inter);
     EXPECT_EQ(types[5], PacketType::Key) << "requested";
     EXPECT_EQ(std::count(types.begin(), types.end(), PacketType::Key), 3);
-    Encoder periodic({.keyint = 3});
+    Encoder periodic;
+    EXPECT_TRUE(Encoder::create(EncoderOptions{.keyint = 3}, periodic).ok());
     int keys = 0;
     for (int i = 0; i < 7; ++i) {
         ASSERT_TRUE(periodic.send_frame(frames[0]).ok());
@@ -837,7 +879,8 @@ TEST(Codec, EightKFrame) {
         for (int x = 0; x < w; ++x)
             f.color(x, y) = {float(x % 256) / 255.0f, float(y % 256) / 255.0f, 0.5f, 1.0f};
     f.camera = camera_at(w, h);
-    Encoder encoder(EncoderOptions{});
+    Encoder encoder;
+    EXPECT_TRUE(Encoder::create(EncoderOptions{}, encoder).ok());
     Decoder decoder;
     // Scored on a 256 x 256 window at the far corner (the edges are where padding could go wrong).
     auto corner = [](const Image<glm::vec4>& image) {
@@ -868,7 +911,8 @@ TEST(Codec, EightKFrame) {
 // reconstruction, and the error against the source does not grow.
 TEST(Codec, TenThousandFramesWithoutDrift) {
     const int w = 24, h = 16;
-    Encoder encoder({.qp = 30, .keyint = 0});
+    Encoder encoder;
+    EXPECT_TRUE(Encoder::create(EncoderOptions{.qp = 30, .keyint = 0}, encoder).ok());
     Decoder decoder;
     double first_psnr = 0.0, last_psnr = 0.0;
     for (int i = 0; i < 10000; ++i) {
@@ -904,8 +948,13 @@ TEST(Codec, TenThousandFramesWithoutDrift) {
 TEST(Codec, BitrateTargetWithBoundedFrameSizes) {
     const auto frames = render("crossing", 24, 192, 108);  // bounded depth is part of the budget
     for (int kbps : {150, 600}) {
-        Encoder encoder(
-            {.bitrate_kbps = kbps, .fps = 30.0, .depth = DepthMode::Bounded, .depth_error = 1e-2f});
+        Encoder encoder;
+        EXPECT_TRUE(Encoder::create({.bitrate_kbps = kbps,
+                                     .fps = 30.0,
+                                     .depth = DepthMode::Bounded,
+                                     .depth_error = 1e-2f},
+                                    encoder)
+                        .ok());
         std::size_t total = 0;
         const double budget = kbps * 1000.0 / 30.0;
         for (std::size_t i = 0; i < frames.size(); ++i) {

@@ -25,7 +25,9 @@ struct Stream {
 Stream make_stream() {
     Stream s;
     EXPECT_TRUE(write_stream_header(s.file, 64, 48, 30.0).ok());
-    Encoder encoder({.qp = 30, .keyint = 5, .detect_cuts = false});
+    Encoder encoder;
+    EXPECT_TRUE(
+        Encoder::create(EncoderOptions{.qp = 30, .keyint = 5, .detect_cuts = false}, encoder).ok());
     for (int i = 0; i < kFrames; ++i) {
         Frame f = test::flat_frame(64, 48, 5.0f, {0.0f, 0.0f}, uint32_t(i + 1));
         f.camera.time = i / 30.0;

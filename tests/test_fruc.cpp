@@ -33,7 +33,8 @@ double psnr_of(const Frame& truth, const Frame& test) {
 
 std::vector<Frame> convert(const std::vector<Frame>& inputs, int factor, const FrucOptions& options,
                            FrucCounters* counters = nullptr) {
-    FrameRateConverter converter(factor, options);
+    FrameRateConverter converter;
+    EXPECT_TRUE(FrameRateConverter::create(factor, options, converter).ok());
     std::vector<Frame> outputs;
     for (const Frame& f : inputs) {
         EXPECT_TRUE(converter.send(f).ok());
@@ -142,6 +143,32 @@ TEST(Fruc, CameraCutResetsHistoryWithoutGhosts) {
     }
 }
 
+TEST(Fruc, CreateRefusesBadSettingsNamingThemAndKeepsTheConverter) {
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    FrameRateConverter converter;
+    ASSERT_TRUE(FrameRateConverter::create(3, {.mode = FrucMode::Extrapolate}, converter).ok());
+    const std::pair<int, FrucOptions> bad[] = {{0, {}},
+                                               {17, {}},
+                                               {2, {.cut_misses = 1.5f}},
+                                               {2, {.static_tolerance = nan}},
+                                               {2, {.splat = {.footprint = 3}}},
+                                               {2, {.refine = {.tile = 0}}},
+                                               {2, {.warp = WarpMethod(7)}}};
+    const char* named[] = {"factor 0",        "factor 17",   "cut_misses", "static_tolerance",
+                           "splat.footprint", "refine.tile", "warp 7"};
+    for (std::size_t i = 0; i < std::size(bad); ++i) {
+        const Status s = FrameRateConverter::create(bad[i].first, bad[i].second, converter);
+        ASSERT_FALSE(s.ok()) << named[i];
+        EXPECT_NE(s.message().find(named[i]), std::string::npos) << s.message();
+    }
+    // Still the extrapolating converter at factor 3: one frame in, three out.
+    ASSERT_TRUE(converter.send(render("pan", 30.0, 0, 1, 32, 18)[0]).ok());
+    Frame out;
+    int outputs = 0;
+    while (converter.receive(out) == Result::Ok) ++outputs;
+    EXPECT_EQ(outputs, 3);
+}
+
 TEST(Fruc, TheCameraSaysWhereCutsAreAndOnlyUnknownFramesAreTested) {
     // Rendered frames 13..16 of `cut`; the renderer marks frame 15 (index 2) Cut::Yes, the others
     // No.
@@ -179,7 +206,8 @@ TEST(Fruc, SendingOwnedFramesGivesTheSameFrames) {
     for (FrucMode mode : {FrucMode::Interpolate, FrucMode::Extrapolate}) {
         FrucCounters by_copy, by_move;
         const std::vector<Frame> expected = convert(input, 3, {.mode = mode}, &by_copy);
-        FrameRateConverter converter(3, {.mode = mode});
+        FrameRateConverter converter;
+        EXPECT_TRUE(FrameRateConverter::create(3, {.mode = mode}, converter).ok());
         Frame in, out;
         std::size_t k = 0;
         for (const Frame& f : input) {

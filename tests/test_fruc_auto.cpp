@@ -56,10 +56,14 @@ std::vector<Frame> holes_sequence() {
 // the made frames.
 std::vector<int> run_auto(const std::vector<Frame>& input, FrucMode mode, std::vector<Frame>& made,
                           float budget_db = 0.0f) {
-    FrameRateConverter converter(2, {.mode = mode,
-                                     .warp = WarpMethod::Auto,
-                                     .fill = FillMethod::Auto,
-                                     .auto_choice = {.budget_db = budget_db}});
+    FrameRateConverter converter;
+    EXPECT_TRUE(FrameRateConverter::create(2,
+                                           {.mode = mode,
+                                            .warp = WarpMethod::Auto,
+                                            .fill = FillMethod::Auto,
+                                            .auto_choice = {.budget_db = budget_db}},
+                                           converter)
+                    .ok());
     std::vector<int> chosen;
     Frame out;
     int index = 0;
@@ -77,9 +81,13 @@ std::vector<int> run_auto(const std::vector<Frame>& input, FrucMode mode, std::v
 // The made frame of a fixed converter on the pair (or the single frame when extrapolating).
 Frame fixed_output(const std::vector<Frame>& input, std::size_t made_index, FrucMode mode,
                    int candidate) {
-    FrameRateConverter converter(2, {.mode = mode,
-                                     .warp = auto_candidate_warp(candidate),
-                                     .fill = auto_candidate_fill(candidate)});
+    FrameRateConverter converter;
+    EXPECT_TRUE(FrameRateConverter::create(2,
+                                           {.mode = mode,
+                                            .warp = auto_candidate_warp(candidate),
+                                            .fill = auto_candidate_fill(candidate)},
+                                           converter)
+                    .ok());
     Frame out, result;
     int index = 0;
     for (const Frame& f : input) {

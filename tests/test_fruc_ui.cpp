@@ -34,7 +34,8 @@ std::vector<Frame> render_hud(double fps, int count) {
 
 std::vector<Frame> convert(const std::vector<Frame>& inputs, int factor, const FrucOptions& options,
                            FrucCounters* counters = nullptr) {
-    FrameRateConverter converter(factor, options);
+    FrameRateConverter converter;
+    EXPECT_TRUE(FrameRateConverter::create(factor, options, converter).ok());
     std::vector<Frame> outputs;
     Frame out;
     for (const Frame& f : inputs) {

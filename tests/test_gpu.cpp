@@ -45,15 +45,15 @@ const std::vector<Frame>& scene_frames(const std::string& name) {
 }
 
 // One run of a path: its output colour, its hit mask and counts.
-struct Result {
+struct Reprojected {
     Image<glm::vec4> out;
     Image<uint8_t> hit;
     warp::ReprojectCounts counts;
 };
 
-Result cpu_reproject(const Frame& current, const Frame& previous,
-                     const warp::ReprojectOptions& options = {}) {
-    Result r;
+Reprojected cpu_reproject(const Frame& current, const Frame& previous,
+                          const warp::ReprojectOptions& options = {}) {
+    Reprojected r;
     r.out.assign(current.width(), current.height(), glm::vec4(0.0f));
     r.hit.assign(current.width(), current.height(), 7);
     r.counts = warp::reproject(current, previous, warp::payload_of(previous.color.view()),
@@ -61,9 +61,9 @@ Result cpu_reproject(const Frame& current, const Frame& previous,
     return r;
 }
 
-Result gpu_reproject(const Frame& current, const Frame& previous,
-                     const warp::ReprojectOptions& options = {}) {
-    Result r;
+Reprojected gpu_reproject(const Frame& current, const Frame& previous,
+                          const warp::ReprojectOptions& options = {}) {
+    Reprojected r;
     r.out.assign(current.width(), current.height(), glm::vec4(0.0f));
     r.hit.assign(current.width(), current.height(), 7);
     const Status status =
@@ -81,7 +81,8 @@ std::size_t mask_differences(const Image<uint8_t>& a, const Image<uint8_t>& b) {
 
 // The tolerance: >= 50 dB on display values, holes within 0.1 % of the pixels, each
 // outcome's count too.
-void expect_equal_within_tolerance(const Result& cpu, const Result& gpu, const char* what) {
+void expect_equal_within_tolerance(const Reprojected& cpu, const Reprojected& gpu,
+                                   const char* what) {
     const std::size_t pixels = cpu.hit.pixel_count();
     const std::size_t allowed = pixels / 1000;
     EXPECT_LE(mask_differences(cpu.hit, gpu.hit), allowed) << what;
@@ -101,8 +102,8 @@ TEST(Gpu, ReprojectionMatchesTheCpuOnEveryBuiltInScene) {
         SCOPED_TRACE(info.name);
         const std::vector<Frame> frames =
             test::render_scene(info.name, 2, kWidth, kHeight, 30.0, 3);
-        const Result cpu = cpu_reproject(frames[1], frames[0]);
-        const Result gpu = gpu_reproject(frames[1], frames[0]);
+        const Reprojected cpu = cpu_reproject(frames[1], frames[0]);
+        const Reprojected gpu = gpu_reproject(frames[1], frames[0]);
         // Not vacuous: most of a frame 1/30 s on is found in the one before.
         EXPECT_GT(cpu.counts.hits, cpu.hit.pixel_count() / 2);
         expect_equal_within_tolerance(cpu, gpu, info.name);
@@ -118,8 +119,8 @@ TEST(Gpu, ReprojectionWithoutIdsAndWithTheSurveyStep) {
     expect_equal_within_tolerance(cpu_reproject(frames[1], frames[0]),
                                   gpu_reproject(frames[1], frames[0]), "no ids");
     const warp::ReprojectOptions survey{.step = 8};
-    const Result cpu = cpu_reproject(frames[1], frames[0], survey);
-    const Result gpu = gpu_reproject(frames[1], frames[0], survey);
+    const Reprojected cpu = cpu_reproject(frames[1], frames[0], survey);
+    const Reprojected gpu = gpu_reproject(frames[1], frames[0], survey);
     EXPECT_EQ(cpu.counts.hits + cpu.counts.misses(), std::size_t(12 * 8));
     expect_equal_within_tolerance(cpu, gpu, "step 8");
     // Pixels off the survey grid keep what they had (7).
@@ -129,8 +130,8 @@ TEST(Gpu, ReprojectionWithoutIdsAndWithTheSurveyStep) {
 TEST(Gpu, NonFiniteInputIsCountedAsOnTheCpu) {
     NonfiniteCounts expected;
     const std::vector<Frame> frames = test::spoiled_sequence(2, expected);
-    const Result cpu = cpu_reproject(frames[1], frames[0]);
-    const Result gpu = gpu_reproject(frames[1], frames[0]);
+    const Reprojected cpu = cpu_reproject(frames[1], frames[0]);
+    const Reprojected gpu = gpu_reproject(frames[1], frames[0]);
     EXPECT_GT(cpu.counts.invalid, 0u);
     EXPECT_EQ(gpu.counts.invalid, cpu.counts.invalid);
     expect_equal_within_tolerance(cpu, gpu, "NaN/Inf");
@@ -161,8 +162,8 @@ TEST(Gpu, ReprojectionOnExtremeValues) {
     Frame turned = frames[1];
     turned.camera.prev_view = glm::rotate(turned.camera.view, 2.5f, glm::vec3(0, 1, 0));
     for (const Frame* current : {&frames[1], &turned}) {
-        const Result cpu = cpu_reproject(*current, frames[0]);
-        const Result gpu = gpu_reproject(*current, frames[0]);
+        const Reprojected cpu = cpu_reproject(*current, frames[0]);
+        const Reprojected gpu = gpu_reproject(*current, frames[0]);
         EXPECT_GT(cpu.counts.invalid + cpu.counts.offscreen, 0u);
         expect_equal_within_tolerance(cpu, gpu, "extreme values");
     }
@@ -196,7 +197,7 @@ struct Textures {
 
 TEST(Gpu, TextureEntryPointWritesTheCallersTextures) {
     const std::vector<Frame>& frames = scene_frames("pan");
-    const Result cpu = cpu_reproject(frames[1], frames[0]);
+    const Reprojected cpu = cpu_reproject(frames[1], frames[0]);
     gpu::Context& context = shared_gpu();
     context.make_current();
     Textures t;
@@ -206,7 +207,7 @@ TEST(Gpu, TextureEntryPointWritesTheCallersTextures) {
     const Image<glm::vec4> zeros(kWidth, kHeight, glm::vec4(0.0f));
     const GLuint out = t.make(GL_RGBA32F, kWidth, kHeight, GL_RGBA, GL_FLOAT, zeros.data());
     const GLuint hit = t.make(GL_R32UI, kWidth, kHeight, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
-    Result gpu;
+    Reprojected gpu;
     const Status status = context.reproject(current, previous, payload, out, hit, {}, gpu.counts);
     ASSERT_TRUE(status.ok()) << status.message();
     EXPECT_EQ(context.timings().upload_ms, 0.0);
@@ -317,7 +318,7 @@ TEST(Gpu, PullPushMatchesTheCpuOnReprojectionHolesOfEveryBuiltInScene) {
         // The misses of reprojection are the holes to fill.
         const std::vector<Frame>& frames = scene_frames(info.name);
         const Frame& current = frames[1];
-        Result r = cpu_reproject(current, frames[0]);
+        Reprojected r = cpu_reproject(current, frames[0]);
         expect_same_fill(r.out, r.hit, &current.depth, info.name);
         expect_same_fill(r.out, r.hit, nullptr, info.name);
     }
@@ -355,7 +356,7 @@ TEST(Gpu, PullPushTreatsNonFiniteColourAsHoles) {
 
 TEST(Gpu, PullPushOnTexturesWritesTheOutputTexture) {
     const std::vector<Frame>& frames = scene_frames("fence");
-    const Result r = cpu_reproject(frames[1], frames[0]);
+    const Reprojected r = cpu_reproject(frames[1], frames[0]);
     Image<glm::vec4> cpu = r.out;
     warp::PullPush pull_push;
     const warp::FillStats expected =

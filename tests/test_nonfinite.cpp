@@ -81,7 +81,10 @@ TEST(Nonfinite, FrucEveryWarpFillAndModeEmitsFiniteAndCounts) {
                                              (moved ? " send(&&)" : " send(const&)");
                     NonfiniteCounts want;
                     std::vector<Frame> in = spoiled_sequence(3, want);
-                    FrameRateConverter converter(2, {.mode = mode, .warp = warp, .fill = fill});
+                    FrameRateConverter converter;
+                    ASSERT_TRUE(FrameRateConverter::create(
+                                    2, {.mode = mode, .warp = warp, .fill = fill}, converter)
+                                    .ok());
                     Frame out;
                     std::size_t outputs = 0, bad = 0;
                     for (Frame& f : in) {
@@ -155,10 +158,10 @@ TEST(Nonfinite, EncodeDecodeEmitsFiniteAndCounts) {
         ASSERT_TRUE(encoder.send_frame(f).ok());
         EXPECT_EQ(nonfinite_in(encoder.reconstruction()), 0u);
         codec::Packet p;
-        while (encoder.receive_packet(p) == codec::Result::Ok) {
+        while (encoder.receive_packet(p) == Result::Ok) {
             ASSERT_TRUE(decoder.send_packet(p.data).ok());
             Frame out;
-            while (decoder.receive_frame(out) == codec::Result::Ok) {
+            while (decoder.receive_frame(out) == Result::Ok) {
                 EXPECT_EQ(nonfinite_in(out), 0u);
                 ++decoded;
             }

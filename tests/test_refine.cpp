@@ -46,7 +46,8 @@ struct Made {
 Made between(const Frame& a, const Frame& b, const RefineOptions& refine) {
     FrucOptions options;
     options.refine = refine;
-    FrameRateConverter converter(2, options);
+    FrameRateConverter converter;
+    EXPECT_TRUE(FrameRateConverter::create(2, options, converter).ok());
     Made made;
     EXPECT_TRUE(converter.send(a).ok());
     Frame out;

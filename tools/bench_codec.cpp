@@ -193,7 +193,8 @@ Status run_ours(const Sequence& seq, int qp, bool default_stream, RunResult& tot
     color = {kOursColor, setting, kOursColor, {}};
     codec::EncoderOptions options{.qp = qp, .fps = seq.fps, .depth = codec::DepthMode::View};
     if (!default_stream) options.depth = codec::DepthMode::Lossless, options.motion_error_px = 0;
-    codec::Encoder encoder(options);
+    codec::Encoder encoder;
+    REPRISE_TRY(codec::Encoder::create(options, encoder));
     codec::Decoder decoder;
     codec::Packet packet;
     Frame decoded;
@@ -201,12 +202,12 @@ Status run_ours(const Sequence& seq, int qp, bool default_stream, RunResult& tot
     for (std::size_t i = 0; i < seq.frames.size(); ++i) {
         auto start = BenchClock::now();
         REPRISE_TRY(encoder.send_frame(seq.frames[i]));
-        if (encoder.receive_packet(packet) != codec::Result::Ok)
+        if (encoder.receive_packet(packet) != Result::Ok)
             return Status::error("reprise codec: no packet for frame " + std::to_string(i));
         const double encode_ms = ms_since(start);
         start = BenchClock::now();
         REPRISE_TRY(decoder.send_packet(packet.data));
-        if (decoder.receive_frame(decoded) != codec::Result::Ok)
+        if (decoder.receive_frame(decoded) != Result::Ok)
             return Status::error("reprise codec: no decoded frame for frame " + std::to_string(i));
         const double decode_ms = ms_since(start);
         const codec::StreamStats& stats = encoder.last_frame_stats();
@@ -308,7 +309,8 @@ std::string synthesized_views_text(const std::vector<ViewDepthRun>& rows) {
 
 Status run_view_depth(server::Renderer& renderer, const Sequence& seq, int qp, ViewDepthRun& run) {
     const codec::EncoderOptions options{.qp = qp, .fps = seq.fps, .depth = codec::DepthMode::View};
-    codec::Encoder encoder(options);
+    codec::Encoder encoder;
+    REPRISE_TRY(codec::Encoder::create(options, encoder));
     codec::Decoder decoder;
     codec::Packet packet;
     Frame decoded;
@@ -320,10 +322,10 @@ Status run_view_depth(server::Renderer& renderer, const Sequence& seq, int qp, V
     for (std::size_t i = 0; i < seq.frames.size(); ++i) {
         const Frame& frame = seq.frames[i];
         REPRISE_TRY(encoder.send_frame(frame));
-        if (encoder.receive_packet(packet) != codec::Result::Ok)
+        if (encoder.receive_packet(packet) != Result::Ok)
             return Status::error("reprise codec: no packet for frame " + std::to_string(i));
         REPRISE_TRY(decoder.send_packet(packet.data));
-        if (decoder.receive_frame(decoded) != codec::Result::Ok)
+        if (decoder.receive_frame(decoded) != Result::Ok)
             return Status::error("reprise codec: no decoded frame for frame " + std::to_string(i));
         const codec::ViewDepthError e =
             codec::measure_view_depth_error(frame.camera, frame.depth.view(), decoded.depth.view(),
@@ -358,10 +360,11 @@ Status run_view_depth(server::Renderer& renderer, const Sequence& seq, int qp, V
     // The same stream with every pixel's motion to 1/8 px, for what the models save.
     codec::EncoderOptions per_pixel = options;
     per_pixel.motion_error_px = 0.0f;
-    codec::Encoder reference(per_pixel);
+    codec::Encoder reference;
+    REPRISE_TRY(codec::Encoder::create(per_pixel, reference));
     for (const Frame& frame : seq.frames) {
         REPRISE_TRY(reference.send_frame(frame));
-        if (reference.receive_packet(packet) != codec::Result::Ok)
+        if (reference.receive_packet(packet) != Result::Ok)
             return Status::error("reprise codec: no packet");
     }
     run.per_pixel_motion_bytes = reference.stats().motion_bits / 8.0;

@@ -318,7 +318,8 @@ Status run_ours(SceneFrames& scene, const Setting& setting, int repeat, Run& run
     for (int rep = 0; rep < repeat; ++rep) {
         warp::FrucOptions options = setting.options;
         options.composite_ui = true;  // scored as shown
-        warp::FrameRateConverter converter(scene.factor, options);
+        warp::FrameRateConverter converter;
+        REPRISE_TRY(warp::FrameRateConverter::create(scene.factor, options, converter));
         int index = 0;
         for (const Frame& input : scene.input) {
             auto start = BenchClock::now();

@@ -22,6 +22,7 @@ namespace {
 
 struct Converter {
     const char* name;
+    warp::FrucOptions options;
     warp::FrameRateConverter converter;
     Frame in, out;
     Timing times;
@@ -44,14 +45,16 @@ Status bench_paths_size(const BenchScene& bench, int w, int h, int timed,
     const warp::RefineOptions off{.enabled = false};
     const warp::GridOptions bilinear{.bicubic = false};
     Converter converters[] = {
-        {"interpolate grid+pullpush", {2, {}}},
-        {"interpolate grid, refine off", {2, {.refine = off}}},
-        {"interpolate grid-bilinear, refine off", {2, {.grid = bilinear, .refine = off}}},
-        {"interpolate reverse+pullpush", {2, {.warp = WarpMethod::Reverse}}},
-        {"interpolate reverse, refine off", {2, {.warp = WarpMethod::Reverse, .refine = off}}},
-        {"extrapolate grid+pullpush", {2, {.mode = FrucMode::Extrapolate}}},
-        {"extrapolate grid-bilinear", {2, {.mode = FrucMode::Extrapolate, .grid = bilinear}}},
+        {"interpolate grid+pullpush", {}},
+        {"interpolate grid, refine off", {.refine = off}},
+        {"interpolate grid-bilinear, refine off", {.grid = bilinear, .refine = off}},
+        {"interpolate reverse+pullpush", {.warp = WarpMethod::Reverse}},
+        {"interpolate reverse, refine off", {.warp = WarpMethod::Reverse, .refine = off}},
+        {"extrapolate grid+pullpush", {.mode = FrucMode::Extrapolate}},
+        {"extrapolate grid-bilinear", {.mode = FrucMode::Extrapolate, .grid = bilinear}},
     };
+    for (Converter& c : converters)
+        REPRISE_TRY(warp::FrameRateConverter::create(2, c.options, c.converter));
     stereo::StereoSynthesizer synthesizer;
     Frame eye;
     Timing stereo_times, remap_times, copy_times;

@@ -178,7 +178,8 @@ Status run_encode(const EncodeJob& job, const codec::EncoderOptions& o) {
     Sequence sequence;
     REPRISE_TRY(open_sequence(job.in, sequence));
     REPRISE_TRY(check_one_size(sequence, "encode"));
-    codec::Encoder encoder(o);
+    codec::Encoder encoder;
+    REPRISE_TRY(codec::Encoder::create(o, encoder));
     const std::string partial = partial_path(job.out);
     std::vector<uint8_t> prefix;
     codec::StreamInfo resumed;
@@ -211,7 +212,7 @@ Status run_encode(const EncodeJob& job, const codec::EncoderOptions& o) {
         busy_ms += ms_since(start);
         if (!sent.ok()) return Status::error(sequence.files[i] + ": " + sent.message());
         codec::Packet packet;
-        while (encoder.receive_packet(packet) == codec::Result::Ok)
+        while (encoder.receive_packet(packet) == Result::Ok)
             out.insert(out.end(), packet.data.begin(), packet.data.end());
         if (!stream.write(reinterpret_cast<const char*>(out.data()), std::streamsize(out.size()))
                  .flush())

@@ -101,7 +101,8 @@ Status run_fruc(const FrucJob& job) {
             range.first == 0 ? 0 : outputs_of(range.first + 1, job.factor, options.mode).begin;
     }
 
-    warp::FrameRateConverter converter(job.factor, options);
+    warp::FrameRateConverter converter;
+    REPRISE_TRY(warp::FrameRateConverter::create(job.factor, options, converter));
     FlowMotion flow;
     bool estimating = false;
     Frame in, out, ui_frame;

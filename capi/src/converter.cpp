@@ -26,7 +26,7 @@ struct reprise_converter {
             flushed.pop_front();
             next.held = true;
         } else {
-            next.held = fruc->receive(next.frame);
+            next.held = fruc->receive(next.frame).ok();
         }
         return next.held;
     }
@@ -60,6 +60,13 @@ reprise_status to_fruc_options(const char* function, const reprise_converter_opt
     return REPRISE_OK;
 }
 
+// A new converter with c's factor and options (checked again by the library: its message).
+reprise_status make_converter(const char* function, reprise_converter& c) {
+    const Status made = warp::FrameRateConverter::create(c.factor, c.options, *c.fruc);
+    if (!made) return fail(REPRISE_ERROR_INVALID_ARGUMENT, function, made.message());
+    return REPRISE_OK;
+}
+
 reprise_converter_options default_options() {
     reprise_converter_options o{};
     o.factor = 2;
@@ -87,9 +94,8 @@ reprise_status reprise_converter_create(uint32_t abi_version,
                          [&](const reprise_converter_options& o, reprise_converter& made) {
                              REPRISE_CAPI_TRY(to_fruc_options(function, o, made.options));
                              made.factor = o.factor;
-                             made.fruc = std::make_unique<warp::FrameRateConverter>(made.factor,
-                                                                                    made.options);
-                             return reprise_status(REPRISE_OK);
+                             made.fruc = std::make_unique<warp::FrameRateConverter>();
+                             return make_converter(function, made);
                          });
 }
 
@@ -106,13 +112,13 @@ reprise_status reprise_converter_send(reprise_converter* converter, const repris
 }
 
 reprise_status reprise_converter_flush(reprise_converter* converter) {
-    return with_handle("reprise_converter_flush", converter, "converter",
-                       [&](reprise_converter& c) {
-                           Frame out;
-                           while (c.fruc->receive(out)) c.flushed.push_back(std::move(out));
-                           c.fruc = std::make_unique<warp::FrameRateConverter>(c.factor, c.options);
-                           return REPRISE_OK;
-                       });
+    const char* function = "reprise_converter_flush";
+    return with_handle(function, converter, "converter", [&](reprise_converter& c) {
+        Frame out;
+        while (c.fruc->receive(out)) c.flushed.push_back(std::move(out));
+        c.fruc = std::make_unique<warp::FrameRateConverter>();
+        return make_converter(function, c);
+    });
 }
 
 reprise_status reprise_converter_output_size(reprise_converter* converter, int32_t* width,

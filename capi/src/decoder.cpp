@@ -14,7 +14,7 @@ struct reprise_decoder {
     HeldFrame next;
 
     void pull() {
-        if (!next.held) next.held = decoder->receive_frame(next.frame) == codec::Result::Ok;
+        if (!next.held) next.held = decoder->receive_frame(next.frame) == Result::Ok;
     }
 };
 
@@ -42,7 +42,10 @@ reprise_status reprise_decoder_create(uint32_t abi_version, const reprise_decode
         [&](const reprise_decoder_options& o, reprise_decoder& made) {
             REPRISE_CAPI_TRY(check_range(function, "options->max_pixels", double(o.max_pixels), 1.0,
                                          double(kMaxImageSide) * kMaxImageSide));
-            made.decoder = std::make_unique<codec::Decoder>(codec::DecoderOptions{o.max_pixels});
+            made.decoder = std::make_unique<codec::Decoder>();
+            const Status status =
+                codec::Decoder::create({.max_pixels = o.max_pixels}, *made.decoder);
+            if (!status) return fail(REPRISE_ERROR_INVALID_ARGUMENT, function, status.message());
             return reprise_status(REPRISE_OK);
         });
 }

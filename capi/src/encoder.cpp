@@ -86,7 +86,11 @@ reprise_status reprise_encoder_create(uint32_t abi_version, const reprise_encode
                          [&](const reprise_encoder_options& o, reprise_encoder& made) {
                              codec::EncoderOptions options;
                              REPRISE_CAPI_TRY(to_encoder_options(function, o, options));
-                             made.encoder = std::make_unique<codec::Encoder>(options);
+                             made.encoder = std::make_unique<codec::Encoder>();
+                             const Status status = codec::Encoder::create(options, *made.encoder);
+                             if (!status)
+                                 return fail(REPRISE_ERROR_INVALID_ARGUMENT, function,
+                                             status.message());
                              return reprise_status(REPRISE_OK);
                          });
 }
@@ -111,10 +115,7 @@ reprise_status reprise_encoder_receive_packet(reprise_encoder* encoder, uint8_t*
         REPRISE_CAPI_TRY(check_pointer(function, size, "size"));
         *size = 0;
         if (!e.held) {
-            const codec::Result result = e.encoder->receive_packet(e.packet);
-            if (result == codec::Result::NeedMoreData) return reprise_status(REPRISE_NEED_MORE);
-            if (result == codec::Result::Error)
-                return fail(REPRISE_ERROR_INTERNAL, function, "the encoder gave no packet");
+            if (!e.encoder->receive_packet(e.packet)) return reprise_status(REPRISE_NEED_MORE);
             e.held = true;
         }
         const std::vector<uint8_t>& bytes = e.packet.data;

@@ -140,10 +140,10 @@ struct StreamClient::State {
         std::span<const uint8_t> geometry = packet.data, colour;
         bool ok = !lowres || split_bundle(packet.data, geometry, colour);
         ok = ok && decoder->send_packet(geometry).ok() &&
-             decoder->receive_frame(scratch_decoded) == codec::Result::Ok;
+             decoder->receive_frame(scratch_decoded) == Result::Ok;
         if (ok && lowres)
             ok = colour_decoder->send_packet(colour).ok() &&
-                 colour_decoder->receive_frame(low_decoded) == codec::Result::Ok;
+                 colour_decoder->receive_frame(low_decoded) == Result::Ok;
         if (!ok) {
             ++stats.decode_errors;
             abandoned.assign(1, packet.frame);

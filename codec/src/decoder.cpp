@@ -15,8 +15,16 @@ constexpr std::size_t kMaxQueuedFrames = 16;
 
 }  // namespace
 
-Decoder::Decoder(const DecoderOptions& options) : state_(std::make_unique<State>()) {
-    state_->options = options;
+Decoder::Decoder() : state_(std::make_unique<State>()) {}
+
+Status Decoder::create(const DecoderOptions& options, Decoder& decoder) {
+    if (options.max_pixels < 1)
+        return Status::error("decoder option max_pixels " + std::to_string(options.max_pixels) +
+                             ": expected at least 1");
+    Decoder made;
+    made.state_->options = options;
+    decoder = std::move(made);
+    return {};
 }
 Decoder::~Decoder() = default;
 Decoder::Decoder(Decoder&&) noexcept = default;

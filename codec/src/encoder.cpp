@@ -218,10 +218,42 @@ struct Encoder::State {
     }
 };
 
-Encoder::Encoder(const EncoderOptions& options) : state_(std::make_unique<State>()) {
-    state_->options = options;
-    state_->qp = std::clamp(options.qp, 0, 51);
+Status check_encoder_options(const EncoderOptions& o) {
+    auto bad = [](const std::string& what) { return Status::error("encoder option " + what); };
+    if (o.qp < 0 || o.qp > 51) return bad("qp " + std::to_string(o.qp) + ": expected 0..51");
+    if (o.bitrate_kbps < 0)
+        return bad("bitrate_kbps " + std::to_string(o.bitrate_kbps) + ": expected 0 or more");
+    if (!(o.fps > 0.0 && o.fps <= 1000.0))
+        return bad("fps " + std::to_string(o.fps) + ": expected more than 0, at most 1000");
+    if (o.keyint < 0) return bad("keyint " + std::to_string(o.keyint) + ": expected 0 or more");
+    if (o.chroma != Chroma::C420 && o.chroma != Chroma::C444) return bad("chroma: unknown");
+    if (int(o.depth) > int(DepthMode::View)) return bad("depth: unknown mode");
+    if (o.depth == DepthMode::Bounded && !(o.depth_error >= 1e-7f && o.depth_error <= 0.1f))
+        return bad("depth_error: a bound in 1e-7..0.1");
+    if (o.depth == DepthMode::View && !(o.view_error_px >= 1e-3f && o.view_error_px <= 100.0f &&
+                                        o.view_displacement > 0.0f && o.view_displacement <= 1e6f))
+        return bad("view_error_px / view_displacement: 0.001..100 px and (0, 1e6]");
+    if (!(o.motion_error_px == 0.0f ||
+          (o.motion_error_px >= kMinMotionError && o.motion_error_px <= 8.0f)))
+        return bad("motion_error_px: 0 or 0.1..8 px");
+    if (o.skip_threshold < 0 || o.skip_threshold > 255)
+        return bad("skip_threshold " + std::to_string(o.skip_threshold) + ": expected 0..255");
+    return {};
+}
+
+Encoder::Encoder() : state_(std::make_unique<State>()) {
+    state_->qp = state_->options.qp;
     state_->qp_state = state_->qp;
+}
+
+Status Encoder::create(const EncoderOptions& options, Encoder& encoder) {
+    REPRISE_TRY(check_encoder_options(options));
+    Encoder made;
+    made.state_->options = options;
+    made.state_->qp = options.qp;
+    made.state_->qp_state = options.qp;
+    encoder = std::move(made);
+    return {};
 }
 Encoder::~Encoder() = default;
 void Encoder::set_bitrate(int kbps) { state_->options.bitrate_kbps = std::max(0, kbps); }
@@ -245,17 +277,6 @@ Status Encoder::send_frame(const Frame& given) {
     if (s.queue.size() >= kMaxQueuedPackets)
         return Status::error("encoder: " + std::to_string(s.queue.size()) +
                              " packets not taken by receive_packet");
-    if (s.options.depth == DepthMode::Bounded &&
-        !(s.options.depth_error >= 1e-7f && s.options.depth_error <= 0.1f))
-        return Status::error("encoder: depth error bound must lie in 1e-7..0.1");
-    if (s.options.depth == DepthMode::View &&
-        !(s.options.view_error_px >= 1e-3f && s.options.view_error_px <= 100.0f &&
-          s.options.view_displacement > 0.0f && s.options.view_displacement <= 1e6f))
-        return Status::error(
-            "encoder: view depth needs an error in 0.001..100 px and a displacement in (0, 1e6]");
-    if (!(s.options.motion_error_px == 0.0f ||
-          (s.options.motion_error_px >= kMinMotionError && s.options.motion_error_px <= 8.0f)))
-        return Status::error("encoder: motion error bound must be 0 or lie in 0.1..8 px");
 
     NonfiniteCounts nonfinite;
     const Frame& frame = s.repair.clean(given, nonfinite);

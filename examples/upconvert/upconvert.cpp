@@ -17,8 +17,11 @@ reprise::Status upconvert(const std::string& in_dir, const std::string& out_dir,
     std::filesystem::create_directories(out_dir, error);
     if (error) return reprise::Status::error(out_dir + ": " + error.message());
 
-    reprise::warp::FrameRateConverter converter(2, {.mode = reprise::warp::FrucMode::Interpolate,
-                                                    .fill = reprise::warp::FillMethod::PullPush});
+    reprise::warp::FrameRateConverter converter;
+    REPRISE_TRY(reprise::warp::FrameRateConverter::create(
+        2,
+        {.mode = reprise::warp::FrucMode::Interpolate, .fill = reprise::warp::FillMethod::PullPush},
+        converter));
     reprise::Frame in, out;
     for (const std::string& file : sequence.files) {
         REPRISE_TRY(reprise::read_frame(file, in));

@@ -22,11 +22,6 @@ codec::EncoderOptions encoder_options(int qp, int bitrate_kbps, double fps, int 
                                       float depth_error, float view_error_px,
                                       float view_displacement, float motion_error_px,
                                       int skip_threshold, bool detect_cuts) {
-    if (qp < 0 || qp > 51) value_error("qp must be in 0..51");
-    if (bitrate_kbps < 0) value_error("bitrate_kbps must be >= 0");
-    if (!(fps > 0.0 && fps <= 10000.0)) value_error("fps must be in (0, 10000]");
-    if (keyint < 0) value_error("keyint must be >= 0");
-    if (skip_threshold < 0 || skip_threshold > 255) value_error("skip_threshold must be in 0..255");
     codec::EncoderOptions o{.qp = qp,
                             .bitrate_kbps = bitrate_kbps,
                             .fps = fps,
@@ -43,12 +38,6 @@ codec::EncoderOptions encoder_options(int qp, int bitrate_kbps, double fps, int 
         o.chroma = codec::Chroma::C444;
     else
         value_error("chroma must be '420' or '444'");
-    if (!(view_error_px >= 0.01f && view_error_px <= 16.0f))
-        value_error("view_error_px must be in [0.01, 16]");
-    if (!(view_displacement > 0.0f && view_displacement <= 1e6f))
-        value_error("view_displacement must be in (0, 1e6]");
-    if (!(motion_error_px == 0.0f || (motion_error_px >= 0.1f && motion_error_px <= 8.0f)))
-        value_error("motion_error_px must be 0 (every pixel to 1/8 px) or in [0.1, 8]");
     if (depth == "view")
         o.depth = codec::DepthMode::View;
     else if (depth == "lossless")
@@ -86,7 +75,10 @@ py::dict stats_dict(const codec::StreamStats& s) {
 }
 
 struct PyEncoder {
-    explicit PyEncoder(const codec::EncoderOptions& options) : encoder(options) {}
+    explicit PyEncoder(const codec::EncoderOptions& options) {
+        if (const Status made = codec::Encoder::create(options, encoder); !made)
+            value_error(made.message());
+    }
 
     py::bytes encode(const Frame& frame) {
         Status status;
@@ -94,7 +86,7 @@ struct PyEncoder {
         {
             py::gil_scoped_release release;
             status = encoder.send_frame(frame);
-            if (status.ok() && encoder.receive_packet(packet) != codec::Result::Ok)
+            if (status.ok() && encoder.receive_packet(packet) != Result::Ok)
                 status = Status::error("encoder: no packet for the frame");
         }
         check(status);
@@ -104,7 +96,10 @@ struct PyEncoder {
 };
 
 struct PyDecoder {
-    explicit PyDecoder(int64_t max_pixels) : decoder({.max_pixels = max_pixels}) {}
+    explicit PyDecoder(int64_t max_pixels) {
+        if (const Status made = codec::Decoder::create({.max_pixels = max_pixels}, decoder); !made)
+            value_error(made.message());
+    }
 
     std::optional<Frame> decode(const py::buffer& packet) {
         py::buffer_info info;
@@ -115,7 +110,7 @@ struct PyDecoder {
         {
             py::gil_scoped_release release;
             status = decoder.send_packet(bytes);
-            if (status.ok()) made = decoder.receive_frame(frame) == codec::Result::Ok;
+            if (status.ok()) made = decoder.receive_frame(frame) == Result::Ok;
         }
         check(status);
         if (!made) return std::nullopt;

@@ -18,12 +18,10 @@ warp::FrucOptions fruc_options(const std::string& mode, const std::string& warp_
 
 struct Converter {
     Converter(int factor, const std::string& mode, const std::string& warp_method,
-              const std::string& fill, bool refine)
-        : converter(checked(factor), fruc_options(mode, warp_method, fill, refine)) {}
-
-    static int checked(int factor) {
-        if (const Status s = warp::check_fruc_factor(factor); !s.ok()) value_error(s.message());
-        return factor;
+              const std::string& fill, bool refine) {
+        const Status made = warp::FrameRateConverter::create(
+            factor, fruc_options(mode, warp_method, fill, refine), converter);
+        if (!made) value_error(made.message());
     }
 
     void send(const Frame& frame) {

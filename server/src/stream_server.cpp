@@ -577,6 +577,7 @@ Status StreamServer::create(const StreamServerOptions& options,
         return Status::error("--lowres must be 2 or 4");
     if (options.mode == net::StreamMode::LowRes && options.lowres_factor == 1)
         return Status::error("--lowres must be 2 or 4");
+    REPRISE_TRY(codec::check_encoder_options(options.encoder));
     std::unique_ptr<StreamServer> s(new StreamServer());
     s->state_ = std::make_unique<State>(options);
     REPRISE_TRY(s->state_->socket.bind(options.listen));

@@ -87,8 +87,11 @@ struct Session {
         std::vector<uint8_t> bundle;
         int64_t frames_rendered = 0, newest_encoded = -1;
         int bitrate_kbps = 0;
-        std::vector<uint32_t> acked, lost;  // swapped out of the mailbox
-        explicit Media(const codec::EncoderOptions& eo) : encoder(eo), colour_encoder(eo) {}
+        std::vector<uint32_t> acked, lost;                 // swapped out of the mailbox
+        explicit Media(const codec::EncoderOptions& eo) {  // checked by StreamServer::create
+            REPRISE_ASSERT(codec::Encoder::create(eo, encoder).ok() &&
+                           codec::Encoder::create(eo, colour_encoder).ok());
+        }
     } media;
     std::mutex mutex;
     Mailbox box;

@@ -188,9 +188,10 @@ void RenderWorker::warm_up() {
                                              frame);
     const double render_ms = ms_since(t0);
     const auto t1 = std::chrono::steady_clock::now();
-    codec::Encoder encoder(o.encoder);
+    codec::Encoder encoder;
+    const Status made = codec::Encoder::create(o.encoder, encoder);  // checked by create
     codec::Packet packet;
-    if (s.ok() && encoder.send_frame(frame).ok()) encoder.receive_packet(packet);
+    if (s.ok() && made.ok() && encoder.send_frame(frame).ok()) encoder.receive_packet(packet);
     std::fprintf(stderr, "[serve] warmed up: render %.0f ms, encode %.0f ms\n", render_ms,
                  ms_since(t1));
 }
@@ -320,12 +321,12 @@ Status RenderWorker::render_encode(Session& s, const net::PoseMessage& pose, dou
                   glm::vec4(0.0f));
     }
     REPRISE_TRY(m.encoder.send_frame(m.frame));
-    if (m.encoder.receive_packet(m.packet) != codec::Result::Ok)
+    if (m.encoder.receive_packet(m.packet) != Result::Ok)
         return Status::error("encoder gave no packet");
     std::span<const uint8_t> payload = m.packet.data;
     if (lowres) {
         REPRISE_TRY(m.colour_encoder.send_frame(m.low));
-        if (m.colour_encoder.receive_packet(m.colour_packet) != codec::Result::Ok)
+        if (m.colour_encoder.receive_packet(m.colour_packet) != Result::Ok)
             return Status::error("colour encoder gave no packet");
         REPRISE_ASSERT(m.colour_packet.frame == m.packet.frame);
         bundle_packets(m.packet.data, m.colour_packet.data, m.bundle);

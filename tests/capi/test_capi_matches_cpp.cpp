@@ -83,7 +83,8 @@ class CapiConverter : public testing::TestWithParam<bool> {};
 TEST_P(CapiConverter, OutputsAreTheFrameRateConverters) {
     const bool cut = GetParam();
     const std::vector<Frame> input = frames();
-    warp::FrameRateConverter cpp(2, warp::FrucOptions{});
+    warp::FrameRateConverter cpp;
+    ASSERT_TRUE(warp::FrameRateConverter::create(2, warp::FrucOptions{}, cpp).ok());
     reprise_converter* c = nullptr;
     ASSERT_EQ(reprise_converter_create(REPRISE_ABI_VERSION, nullptr, &c), REPRISE_OK);
     int compared = 0;
@@ -145,7 +146,7 @@ TEST(CapiMatchesCpp, CodecPacketsAndDecodedFramesAreTheCodecs) {
     for (std::size_t k = 0; k < input.size(); ++k) {
         ASSERT_TRUE(encoder.send_frame(input[k]).ok());
         codec::Packet packet;
-        ASSERT_EQ(encoder.receive_packet(packet), codec::Result::Ok);
+        ASSERT_EQ(encoder.receive_packet(packet), Result::Ok);
         const reprise_gbuffer g = gbuffer_of(input[k]);
         ASSERT_EQ(reprise_encoder_send_frame(ce, &g), REPRISE_OK) << reprise_last_error();
         std::vector<uint8_t> bytes(packet.data.size() + 16);
@@ -157,7 +158,7 @@ TEST(CapiMatchesCpp, CodecPacketsAndDecodedFramesAreTheCodecs) {
 
         ASSERT_TRUE(decoder.send_packet(packet.data).ok());
         Frame want, got;
-        ASSERT_EQ(decoder.receive_frame(want), codec::Result::Ok);
+        ASSERT_EQ(decoder.receive_frame(want), Result::Ok);
         ASSERT_EQ(reprise_decoder_send_packet(cd, bytes.data(), bytes.size()), REPRISE_OK);
         reprise_gbuffer out = output_into(got);
         ASSERT_EQ(reprise_decoder_receive_frame(cd, &out), REPRISE_OK) << reprise_last_error();

@@ -17,12 +17,13 @@ struct Coded {
 
 inline Coded encode_all(const std::vector<Frame>& frames, const codec::EncoderOptions& options) {
     Coded c;
-    codec::Encoder encoder(options);
+    codec::Encoder encoder;
+    EXPECT_TRUE(codec::Encoder::create(options, encoder).ok());
     for (const Frame& f : frames) {
         Status s = encoder.send_frame(f);
         EXPECT_TRUE(s.ok()) << s.message();
         codec::Packet p;
-        EXPECT_EQ(encoder.receive_packet(p), codec::Result::Ok);
+        EXPECT_EQ(encoder.receive_packet(p), Result::Ok);
         c.packets.push_back(std::move(p));
         c.reconstructions.push_back(encoder.reconstruction());
     }
@@ -37,7 +38,7 @@ inline std::vector<Frame> decode_all(const std::vector<codec::Packet>& packets) 
         Status s = decoder.send_packet(p.data);
         EXPECT_TRUE(s.ok()) << s.message();
         Frame f;
-        while (decoder.receive_frame(f) == codec::Result::Ok) out.push_back(std::move(f));
+        while (decoder.receive_frame(f) == Result::Ok) out.push_back(std::move(f));
     }
     return out;
 }

@@ -325,14 +325,22 @@ struct FrameRateConverter::State {
     }
 };
 
-FrameRateConverter::FrameRateConverter(int factor, const FrucOptions& options)
-    : state_(std::make_unique<State>()) {
-    REPRISE_ASSERT(factor >= 1);
-    state_->factor = factor;
-    state_->options = options;
+FrameRateConverter::FrameRateConverter() : state_(std::make_unique<State>()) { state_->factor = 2; }
+
+Status FrameRateConverter::create(int factor, const FrucOptions& options,
+                                  FrameRateConverter& converter) {
+    REPRISE_TRY(check_fruc_factor(factor));
+    REPRISE_TRY(check_fruc_options(options));
+    FrameRateConverter made;
+    made.state_->factor = factor;
+    made.state_->options = options;
+    converter = std::move(made);
+    return {};
 }
 
 FrameRateConverter::~FrameRateConverter() = default;
+FrameRateConverter::FrameRateConverter(FrameRateConverter&&) noexcept = default;
+FrameRateConverter& FrameRateConverter::operator=(FrameRateConverter&&) noexcept = default;
 
 const FrucCounters& FrameRateConverter::counters() const { return state_->counters; }
 
@@ -340,11 +348,11 @@ void FrameRateConverter::refine_region(Image<uint8_t>& mask) const {
     state_->scratch.refiner.region(mask, state_->previous.width(), state_->previous.height());
 }
 
-bool FrameRateConverter::receive(Frame& out) {
+Result FrameRateConverter::receive(Frame& out) {
     State& st = *state_;
-    if (st.ready.empty()) return false;
+    if (st.ready.empty()) return Result::NeedMoreData;
     st.ready.pop_into(out);
-    return true;
+    return Result::Ok;
 }
 
 Status FrameRateConverter::send(const Frame& frame) { return send_frame(frame, nullptr); }

@@ -1,7 +1,7 @@
 #pragma once
 // Scene-aware predictive codec: each frame is predicted by reprojecting a reference the decoder
 // holds with the renderer's depth, cameras and motion; only what prediction gets wrong is coded.
-// Bitstream: docs/bitstream.md. Encoder and decoder are push/pull state machines (as dav1d).
+// Bitstream: docs/bitstream.md. Encoder and decoder are push/pull stages (reprise/core/status.hpp).
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -93,19 +93,24 @@ struct StreamStats {
 // Adds one frame's (or stream's) counts to a running total.
 void add_stats(StreamStats& total, const StreamStats& frame);
 
-enum class Result { Ok, NeedMoreData, Error };
+// The options' values in their ranges: an error naming the first that is not.
+Status check_encoder_options(const EncoderOptions& options);
 
 class Encoder {
 public:
-    explicit Encoder(const EncoderOptions& options = {});
+    Encoder();  // default options
+    // Checks the options (check_encoder_options), then makes `encoder` a new encoder with them;
+    // on an error it is left as it was.
+    static Status create(const EncoderOptions& options, Encoder& encoder);
     ~Encoder();
     Encoder(Encoder&&) noexcept;
     Encoder& operator=(Encoder&&) noexcept;
 
-    // Encodes one frame (colour required; depth, motion and the camera enable prediction).
-    // The packet then comes out of receive_packet().
+    // Encodes one frame (colour required; depth, motion and the camera enable prediction). The
+    // packet then comes out of receive_packet(). An error for a frame it cannot code (sizes,
+    // memory, more than 16 packets not taken); the encoder stays usable.
     Status send_frame(const Frame& frame);
-    // Ok with the next packet, or NeedMoreData.
+    // Ok with the next packet in `packet`, or NeedMoreData: send the next frame first.
     Result receive_packet(Packet& packet);
     void flush();  // no delayed frames: kept for the state-machine shape
 
@@ -145,7 +150,10 @@ struct DecoderOptions {
 
 class Decoder {
 public:
-    explicit Decoder(const DecoderOptions& options = {});
+    Decoder();  // default options
+    // Checks the options (max_pixels >= 1), then makes `decoder` a new decoder with them; on an
+    // error it is left as it was.
+    static Status create(const DecoderOptions& options, Decoder& decoder);
     ~Decoder();
     Decoder(Decoder&&) noexcept;
     Decoder& operator=(Decoder&&) noexcept;
@@ -153,7 +161,8 @@ public:
     // Takes one whole packet (header + payload). A bad packet is an error Status naming the
     // field; the decoder stays usable and resumes at the next decodable frame.
     Status send_packet(std::span<const uint8_t> packet);
-    // Ok with the next decoded frame, or NeedMoreData.
+    // Ok with the next decoded frame in `frame` (its buffers reused), or NeedMoreData: send the
+    // next packet first.
     Result receive_frame(Frame& frame);
     void flush();
 

@@ -26,6 +26,25 @@ private:
 
 inline Status ok() { return {}; }
 
+// The push/pull contract of the stages that take inputs and give outputs at their own pace
+// (FrameRateConverter, Encoder, Decoder), as dav1d's send_data/get_picture: a push call (send_*)
+// does the work and returns a Status, an error naming what was wrong (the stage stays usable);
+// a pull call (receive_*) only hands over what is ready: Ok, the output is written, or
+// NeedMoreData, nothing is ready (send the next input first).
+class [[nodiscard]] Result {
+public:
+    enum Kind { Ok, NeedMoreData };
+    Result(Kind kind) : kind_(kind) {}  // NOLINT: `return Result::Ok;`
+
+    Kind kind() const { return kind_; }
+    bool ok() const { return kind_ == Ok; }
+    explicit operator bool() const { return ok(); }
+    bool operator==(Kind kind) const { return kind_ == kind; }
+
+private:
+    Kind kind_;
+};
+
 }  // namespace reprise
 
 #define REPRISE_ASSERT(expr)                                                                  \

@@ -159,10 +159,18 @@ Status check_fruc_factor(int factor);
 // slerp, translation lerp, s may exceed 1), the projection taken from `b`.
 Camera camera_between(const Camera& a, const Camera& b, float s);
 
+// The options' values in their ranges: an error naming the first that is not.
+Status check_fruc_options(const FrucOptions& options);
+
 class FrameRateConverter {
 public:
-    FrameRateConverter(int factor, const FrucOptions& options);
+    FrameRateConverter();  // factor 2, default options
+    // Checks the factor (check_fruc_factor) and the options (check_fruc_options), then makes
+    // `converter` a new converter with them; on an error it is left as it was.
+    static Status create(int factor, const FrucOptions& options, FrameRateConverter& converter);
     ~FrameRateConverter();
+    FrameRateConverter(FrameRateConverter&&) noexcept;
+    FrameRateConverter& operator=(FrameRateConverter&&) noexcept;
 
     // Feeds the next rendered frame. Output frames then come out of receive() in order:
     // interpolation gives, for every frame after the first, the K-1 frames between it and its
@@ -179,8 +187,9 @@ public:
     // `frame` gets back buffers of an earlier one (contents unspecified) for the caller to refill.
     // Non-finite values are repaired in place.
     Status send(Frame&& frame);
-    // Takes the next output frame; false when the converter needs the next input.
-    bool receive(Frame& out);
+    // Ok with the next output frame in `out` (its buffers reused), or NeedMoreData: send the next
+    // input first.
+    Result receive(Frame& out);
 
     const FrucCounters& counters() const;
     // The region refinement surveyed as disagreeing for the last in-between frame made (1 on the
