@@ -635,6 +635,36 @@ TEST(Codec, RecoversFromALostPacketWithoutAKeyFrame) {
     EXPECT_GT(display_psnr(frames[9].color, out.color), 30.0);
 }
 
+TEST(Codec, TheEncoderReadsTheCallersBuffersThroughTheDescriptor) {
+    // Colour, depth and motion in buffers of the caller's (no Frame): the same packets as the
+    // Frame's, fps included (rate control).
+    const auto frames = render("crossing", 3, 64, 36);
+    Encoder from_frames, from_views;
+    const EncoderOptions options{.bitrate_kbps = 200, .depth = DepthMode::View};
+    ASSERT_TRUE(Encoder::create(options, from_frames).ok());
+    ASSERT_TRUE(Encoder::create(options, from_views).ok());
+    for (const Frame& f : frames) {
+        const Image<glm::vec4> color = f.color;
+        const Image<float> depth = f.depth;
+        const Image<glm::vec2> motion = f.motion;
+        const Image<uint32_t> id = f.id;
+        const GBufferView view{.color = color.view(),
+                               .depth = depth.view(),
+                               .motion = motion.view(),
+                               .id = id.view(),
+                               .camera = f.camera,
+                               .fps = 24.0};
+        Frame at_24 = f;
+        at_24.fps = 24.0;
+        ASSERT_TRUE(from_frames.send_frame(at_24).ok());
+        ASSERT_TRUE(from_views.send_frame(view).ok());
+        Packet a, b;
+        ASSERT_EQ(from_frames.receive_packet(a), Result::Ok);
+        ASSERT_EQ(from_views.receive_packet(b), Result::Ok);
+        EXPECT_EQ(a.data, b.data);
+    }
+}
+
 TEST(Codec, CreateRefusesBadOptionsNamingThem) {
     const std::pair<EncoderOptions, const char*> bad[] = {
         {{.qp = 52}, "qp 52"},

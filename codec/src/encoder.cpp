@@ -25,17 +25,15 @@ constexpr std::size_t kMaxQueuedPackets = 16;
 // The rigid motions of a frame's objects, fitted to its rendered depth and motion (the camera
 // motion of the rendered depth decides which objects move on their own).
 std::vector<ObjectMotion> frame_objects(const EncoderOptions& options, const SequenceParams& sp,
-                                        const Frame& frame, const Camera& camera,
+                                        const GBufferView& frame, const Camera& camera,
                                         const Picture* ref, Image<glm::vec2>& scratch) {
     if (!options.rigid_objects || sp.motion_error <= 0.0f || sp.depth == DepthMode::None ||
         frame.id.empty() || frame.depth.empty() || frame.motion.empty())
         return {};
     ensure_size(scratch, sp.width, sp.height);
-    camera_motion(camera, frame.depth.view(), camera.prev_view, camera.prev_projection,
-                  scratch.view());
+    camera_motion(camera, frame.depth, camera.prev_view, camera.prev_projection, scratch.view());
     return fit_object_motions(
-        camera, frame.depth.view(), frame.id.view(), frame.motion.view(), scratch.view(),
-        sp.motion_error,
+        camera, frame.depth, frame.id, frame.motion, scratch.view(), sp.motion_error,
         ref ? std::span<const ObjectMotion>(ref->objects) : std::span<const ObjectMotion>());
 }
 
@@ -138,7 +136,7 @@ struct Encoder::State {
     }
 
     // The camera to code `frame` with; `next` what the next fitted frame continues from.
-    Camera camera_for(const Frame& frame, Chain& next, StreamStats& fs) const {
+    Camera camera_for(const GBufferView& frame, Chain& next, StreamStats& fs) const {
         next = chain;
         if (!options.fit_cameras || !carries_no_camera(frame.camera) || frame.depth.empty() ||
             frame.motion.empty() || options.depth == DepthMode::None)
@@ -148,8 +146,7 @@ struct Encoder::State {
         if (chain.lens[2][3] == 0.0f) {
             // The focal length shows in how rotation bends the motion: kept once a fit rotates
             // the image centre by a pixel or more.
-            fit =
-                fit_camera(frame.depth.view(), frame.motion.view(), assumed_projection(w, h), true);
+            fit = fit_camera(frame.depth, frame.motion, assumed_projection(w, h), true);
             const double angle = std::acos(std::clamp(
                 (fit.relative[0][0] + fit.relative[1][1] + fit.relative[2][2] - 1.0) / 2.0, -1.0,
                 1.0));
@@ -157,10 +154,9 @@ struct Encoder::State {
                 angle * fit.projection[1][1] * h / 2.0 >= 1.0)
                 next.lens = fit.projection;
             else
-                fit = fit_camera(frame.depth.view(), frame.motion.view(), assumed_projection(w, h),
-                                 false);
+                fit = fit_camera(frame.depth, frame.motion, assumed_projection(w, h), false);
         } else {
-            fit = fit_camera(frame.depth.view(), frame.motion.view(), chain.lens, false);
+            fit = fit_camera(frame.depth, frame.motion, chain.lens, false);
         }
         Camera c = frame.camera;
         c.projection = c.prev_projection = fit.projection;
@@ -171,12 +167,13 @@ struct Encoder::State {
         return c;
     }
 
-    std::vector<ObjectMotion> fit_objects(const Frame& frame, const Camera& camera,
+    std::vector<ObjectMotion> fit_objects(const GBufferView& frame, const Camera& camera,
                                           const Picture* ref) {
         return frame_objects(options, sp, frame, camera, ref, work.base_motion);
     }
-    Status encode(const Frame& frame, const Camera& camera, int ref_slot, int qp_now, Picture& pic,
-                  std::vector<uint8_t>& payload, StreamStats& fs, ColorEncodeResult& colour) {
+    Status encode(const GBufferView& frame, const Camera& camera, int ref_slot, int qp_now,
+                  Picture& pic, std::vector<uint8_t>& payload, StreamStats& fs,
+                  ColorEncodeResult& colour) {
         const bool key = ref_slot < 0;
         const Picture* ref = key ? nullptr : &refs[ref_slot];
         FrameContext fc{&sp, ref, key, &work};
@@ -187,9 +184,9 @@ struct Encoder::State {
         std::vector<ObjectMotion> objects = fit_objects(frame, camera, ref);
         fc.objects = objects;
         if (sp.depth == DepthMode::View) fc.view_step = frame_view_step(sp, camera, objects);
-        encode_depth(fc, camera, frame.depth.view(), pic.depth, depth_section, fs);
-        encode_motion(fc, camera, pic.depth.view(), frame.motion.view(), frame.id.view(),
-                      pic.motion, pic.owner, motion_section, fs);
+        encode_depth(fc, camera, frame.depth, pic.depth, depth_section, fs);
+        encode_motion(fc, camera, pic.depth.view(), frame.motion, frame.id, pic.motion, pic.owner,
+                      motion_section, fs);
         pic.objects = objects;
 
         std::vector<uint8_t> section;
@@ -261,17 +258,17 @@ int Encoder::bitrate() const { return state_->options.bitrate_kbps; }
 Encoder::Encoder(Encoder&&) noexcept = default;
 Encoder& Encoder::operator=(Encoder&&) noexcept = default;
 
-Status Encoder::send_frame(const Frame& given) {
+Status Encoder::send_frame(const GBufferView& given) {
     State& s = *state_;
-    const int w = given.color.width(), h = given.color.height();
+    const int w = given.color.width, h = given.color.height;
     REPRISE_TRY(check_image_size(w, h, "encoder input frame " + std::to_string(s.next_frame)));
     // References, predictions and residuals: `reprise encode` peaked at 120 bytes a pixel (RSS at
     // 1920x1080 minus 960x540), 44 of them the caller's input frame.
     REPRISE_TRY(check_image_memory(w, h, 80, "encode"));
-    if (!given.depth.empty() && (given.depth.width() != w || given.depth.height() != h))
+    if (!given.depth.empty() && (given.depth.width != w || given.depth.height != h))
         return Status::error("encoder input frame " + std::to_string(s.next_frame) +
                              ": depth size differs from colour");
-    if (!given.motion.empty() && (given.motion.width() != w || given.motion.height() != h))
+    if (!given.motion.empty() && (given.motion.width != w || given.motion.height != h))
         return Status::error("encoder input frame " + std::to_string(s.next_frame) +
                              ": motion size differs from colour");
     if (s.queue.size() >= kMaxQueuedPackets)
@@ -279,7 +276,7 @@ Status Encoder::send_frame(const Frame& given) {
                              " packets not taken by receive_packet");
 
     NonfiniteCounts nonfinite;
-    const Frame& frame = s.repair.clean(given, nonfinite);
+    const GBufferView frame = s.repair.clean(given, nonfinite);
     State::Chain next_chain;
     StreamStats fitted;
     const Camera camera = s.camera_for(frame, next_chain, fitted);
@@ -312,7 +309,7 @@ Status Encoder::send_frame(const Frame& given) {
     }
     s.sp = sp;
 
-    planes_from_linear(frame.color.view(), sp, s.source_planes);
+    planes_from_linear(frame.color, sp, s.source_planes);
     // A cut the frame's camera reports starts a key frame; one it does not say is detected below.
     int ref = frame.camera.cut == Cut::Yes ? -1 : s.choose_reference();
     const bool detect_cut = s.options.detect_cuts && frame.camera.cut == Cut::Unknown;

@@ -250,6 +250,7 @@ GBufferView NonfiniteRepair::clean(const GBufferView& frame, NonfiniteCounts& co
     copy_into(frame.id, copy_.id);
     copy_.ui.clear();
     copy_.camera = frame.camera;
+    copy_.fps = frame.fps;
     repair(copy_);
     return copy_.view();
 }

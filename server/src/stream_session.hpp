@@ -81,7 +81,7 @@ struct Session {
         bool rendered_before = false;
         Instant previous;
         codec::Encoder encoder, colour_encoder;  // lowres: the low-resolution colour stream
-        Frame frame, low;
+        Frame frame, low;  // low: lowres depth and motion at the colour samples (no colour)
         Image<glm::vec4> low_color;
         codec::Packet packet, colour_packet;
         std::vector<uint8_t> bundle;

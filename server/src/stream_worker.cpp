@@ -21,16 +21,13 @@ double ms_since(std::chrono::steady_clock::time_point t) {
 
 // The low-resolution colour as a frame of its own: depth and motion taken from the full G-buffer
 // at each low pixel's sample position (motion in low pixels), the camera's jitter in low pixels,
-// so the colour stream predicts by reprojection like any other.
-void make_colour_frame(Session::Media& m, glm::vec2 jitter) {
+// so the colour stream predicts by reprojection like any other. The colour is m.low_color's.
+GBufferView make_colour_frame(Session::Media& m, glm::vec2 jitter) {
     const int lw = m.low_color.width(), lh = m.low_color.height();
     const int w = m.frame.width(), h = m.frame.height();
     const glm::vec2 footprint(float(w) / float(lw), float(h) / float(lh));
-    m.low.color.resize(lw, lh);
     m.low.depth.resize(lw, lh);
     m.low.motion.resize(lw, lh);
-    std::copy(m.low_color.data(), m.low_color.data() + m.low_color.pixel_count(),
-              m.low.color.data());
     for (int v = 0; v < lh; ++v)
         for (int u = 0; u < lw; ++u) {
             const int x =
@@ -40,9 +37,12 @@ void make_colour_frame(Session::Media& m, glm::vec2 jitter) {
             m.low.depth(u, v) = m.frame.depth(x, y);
             m.low.motion(u, v) = m.frame.motion(x, y) / footprint;
         }
-    m.low.camera = m.frame.camera;
-    m.low.camera.jitter = jitter / footprint;
-    m.low.fps = m.frame.fps;
+    GBufferView low = m.low.view();
+    low.color = m.low_color.view();
+    low.camera = m.frame.camera;
+    low.camera.jitter = jitter / footprint;
+    low.fps = m.frame.fps;
+    return low;
 }
 
 // lowres: both codec packets of one frame in one unit (docs/protocol.md, "Low-resolution mode").
@@ -314,8 +314,9 @@ Status RenderWorker::render_encode(Session& s, const net::PoseMessage& pose, dou
     m.previous = current;
     m.rendered_before = true;
     t0 = std::chrono::steady_clock::now();
+    GBufferView low;
     if (lowres) {
-        make_colour_frame(m, jitter);
+        low = make_colour_frame(m, jitter);
         // The geometry stream carries no colour: a constant that every prediction matches.
         std::fill(m.frame.color.data(), m.frame.color.data() + m.frame.color.pixel_count(),
                   glm::vec4(0.0f));
@@ -325,7 +326,7 @@ Status RenderWorker::render_encode(Session& s, const net::PoseMessage& pose, dou
         return Status::error("encoder gave no packet");
     std::span<const uint8_t> payload = m.packet.data;
     if (lowres) {
-        REPRISE_TRY(m.colour_encoder.send_frame(m.low));
+        REPRISE_TRY(m.colour_encoder.send_frame(low));
         if (m.colour_encoder.receive_packet(m.colour_packet) != Result::Ok)
             return Status::error("colour encoder gave no packet");
         REPRISE_ASSERT(m.colour_packet.frame == m.packet.frame);

@@ -106,10 +106,11 @@ public:
     Encoder(Encoder&&) noexcept;
     Encoder& operator=(Encoder&&) noexcept;
 
-    // Encodes one frame (colour required; depth, motion and the camera enable prediction). The
-    // packet then comes out of receive_packet(). An error for a frame it cannot code (sizes,
-    // memory, more than 16 packets not taken); the encoder stays usable.
-    Status send_frame(const Frame& frame);
+    // Encodes one frame, read through the G-buffer descriptor and not kept (colour required and
+    // setting the size; depth, motion, id and the camera enable prediction, fps rate control).
+    // A Frame converts to it. The packet then comes out of receive_packet(). An error for a frame
+    // it cannot code (sizes, memory, more than 16 packets not taken); the encoder stays usable.
+    Status send_frame(const GBufferView& frame);
     // Ok with the next packet in `packet`, or NeedMoreData: send the next frame first.
     Result receive_packet(Packet& packet);
     void flush();  // no delayed frames: kept for the state-machine shape

@@ -22,7 +22,7 @@ struct Frame {
     int height() const { return color.height(); }
 
     GBufferView view() const {
-        return {color.view(), depth.view(), motion.view(), normal.view(), id.view(), camera};
+        return {color.view(), depth.view(), motion.view(), normal.view(), id.view(), camera, fps};
     }
     operator GBufferView() const { return view(); }  // NOLINT: a Frame is a G-buffer
 };

@@ -17,6 +17,7 @@ struct GBufferView {
     ImageView<const glm::vec3> normal;  // world-space unit normal (0 on background)
     ImageView<const uint32_t> id;       // object id, 0 = background
     Camera camera;                      // view/projection of this instant and the previous one
+    double fps = 0.0;  // frame rate of the sequence this frame belongs to (0 = unknown)
 
     // The size of the colour, as Frame has it.
     int width() const { return color.width; }
