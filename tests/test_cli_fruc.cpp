@@ -13,7 +13,7 @@
 using namespace reprise;
 namespace fs = std::filesystem;
 
-TEST(CliFruc, ColourOnlyInputIsInterpolatedWithOpticalFlow) {
+TEST(CliFruc, ColorOnlyInputIsInterpolatedWithOpticalFlow) {
     const fs::path dir =
         fs::temp_directory_path() / ("reprise_cli_fruc_" + std::to_string(::getpid()));
     fs::remove_all(dir);
@@ -30,10 +30,10 @@ TEST(CliFruc, ColourOnlyInputIsInterpolatedWithOpticalFlow) {
     std::vector<Frame> input(3);
     for (int i = 0; i < 3; ++i) {
         ASSERT_TRUE(read_frame(frame_path(rendered, i), input[i]).ok());
-        Frame colour_only;
-        colour_only.color = input[i].color;
-        colour_only.fps = input[i].fps;
-        ASSERT_TRUE(write_frame(frame_path(bare, i), colour_only).ok());
+        Frame color_only;
+        color_only.color = input[i].color;
+        color_only.fps = input[i].fps;
+        ASSERT_TRUE(write_frame(frame_path(bare, i), color_only).ok());
     }
     const test::Outcome r =
         test::run_reprise("fruc --in " + bare + " --factor 2 --out " + made, 120);

@@ -480,7 +480,7 @@ TEST_F(ExrTest, OversizedHeaderIsRejectedBeforeAllocating) {
     EXPECT_TRUE(f.color.empty());
 }
 
-TEST_F(ExrTest, MissingColourChannelIsAnError) {
+TEST_F(ExrTest, MissingColorChannelIsAnError) {
     write_exr(path("gb.exr"), 1, 1, {"G", "B", "Z"}, {1.0f, 2.0f, 3.0f});
     Frame f;
     const Status s = read_frame(path("gb.exr"), f);

@@ -252,7 +252,7 @@ TEST(PullPush, AllHolesLeavesImageUnchanged) {
     }
 }
 
-TEST(PullPush, NonFiniteColourIsAHoleAndDoesNotSpread) {
+TEST(PullPush, NonFiniteColorIsAHoleAndDoesNotSpread) {
     Image<vec4> img(32, 20, vec4(0.25f, 0.5f, 0.75f, 1.0f));
     const Image<uint8_t> mask(32, 20, 1);
     img(3, 4) = vec4(kNaN, 0.5f, 0.75f, 1.0f);
@@ -537,7 +537,7 @@ TEST(Andreev, AllHolesLeavesImageUnchanged) {
     EXPECT_TRUE(same_bits(img, input));
 }
 
-TEST(Andreev, NonFiniteColourIsAHoleAndDoesNotSpread) {
+TEST(Andreev, NonFiniteColorIsAHoleAndDoesNotSpread) {
     Image<vec4> img(32, 20, vec4(0.25f, 0.5f, 0.75f, 1.0f));
     const Image<uint8_t> mask(32, 20, 1);
     img(3, 4) = vec4(kNaN, 0.5f, 0.75f, 1.0f);

@@ -347,7 +347,7 @@ TEST(Gpu, PullPushOnSparseOddAndEmptyImages) {
     }
 }
 
-TEST(Gpu, PullPushTreatsNonFiniteColourAsHoles) {
+TEST(Gpu, PullPushTreatsNonFiniteColorAsHoles) {
     NonfiniteCounts expected;
     const std::vector<Frame> frames = test::spoiled_sequence(1, expected);
     Image<uint8_t> valid(frames[0].width(), frames[0].height(), 1);

@@ -271,7 +271,7 @@ TEST(Flip, MaskedMeanIsTheMeanOfTheMapUnderTheMask) {
     EXPECT_TRUE(std::isnan(flip(a.view(), b.view(), none.view())));
 }
 
-TEST(Flip, ErrorIsSymmetricInColourForFlatImages) {
+TEST(Flip, ErrorIsSymmetricInColorForFlatImages) {
     auto a = flat(16, 16, 0.2f), b = flat(16, 16, 0.7f);
     EXPECT_DOUBLE_EQ(flip(a.view(), b.view()), flip(b.view(), a.view()));
 }

@@ -170,7 +170,7 @@ INSTANTIATE_TEST_SUITE_P(Samples, EdgeAntiAliasing,
                                            AaCase{4, AntiAliasing::Msaa},
                                            AaCase{16, AntiAliasing::Auto}));
 
-TEST(AntiAliasing, OffGivesSingleSampleColourAndOnAgreesAwayFromEdges) {
+TEST(AntiAliasing, OffGivesSingleSampleColorAndOnAgreesAwayFromEdges) {
     const Frame single = render_edge(1), aa = render_edge(4);
     for (int y = 0; y < kH; ++y)
         for (int x = 0; x < kW; ++x) {

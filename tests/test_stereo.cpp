@@ -199,7 +199,7 @@ TEST(StereoSynthesis, BackgroundAtInfinityDoesNotMoveInAParallelRig) {
         ASSERT_NEAR(right.color.data()[i].x, left.color.data()[i].x, 1e-4f);
 }
 
-TEST(StereoSynthesis, NonFiniteDepthAndColourNeverSpread) {
+TEST(StereoSynthesis, NonFiniteDepthAndColorNeverSpread) {
     const int w = 64, h = 48;
     const Camera c = camera_at(w, h);
     Frame left = plane(w, h, 3.0f, c);

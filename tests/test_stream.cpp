@@ -172,7 +172,7 @@ TEST(Stream, EndToEndDisplayedFramesMatchTheTruth) {
     EXPECT_NE(metrics.find("reprise_frames_without_parity_total"), std::string::npos);
 }
 
-TEST(Stream, LowResolutionColourIsUpsampledToTheTruth) {
+TEST(Stream, LowResolutionColorIsUpsampledToTheTruth) {
     server::StreamServerOptions so = server_options();
     so.mode = net::StreamMode::LowRes;
     so.lowres_factor = 4;

@@ -250,7 +250,7 @@ TEST(Upsample, HistoryFollowsMotion) {
     EXPECT_LT(error[1], 0.25 * error[0]);
 }
 
-TEST(Upsample, ConstantColourStaysExact) {
+TEST(Upsample, ConstantColorStaysExact) {
     const int w = 21, h = 13;
     Frame f = test::flat_frame(w, h, 3.0f, glm::vec2(0.7f, -0.3f));
     f.id.assign(w, h, 1u);
@@ -274,7 +274,7 @@ TEST(Upsample, ConstantColourStaysExact) {
     }
 }
 
-TEST(Upsample, NonFiniteColourOrDepthDoesNotSpread) {
+TEST(Upsample, NonFiniteColorOrDepthDoesNotSpread) {
     const int w = 40, h = 24;
     Frame f = test::flat_frame(w, h, 4.0f, glm::vec2(0.0f));
     f.id.assign(w, h, 1u);

@@ -132,9 +132,9 @@ void timewarp(const Image<Rgb8>& source, const glm::mat4& source_view, const glm
 // What a client of the colour + depth video peer holds: the decoded colour (back to linear
 // light), the decoded depth and the frame's camera; no object motion is sent, so every surface
 // counts as static (motion zero against a previous camera equal to its own).
-void receive_peer_frame(const Image<Rgb8>& colour, const Image<float>& depth, const Camera& camera,
+void receive_peer_frame(const Image<Rgb8>& color, const Image<float>& depth, const Camera& camera,
                         Frame& out) {
-    const int w = colour.width(), h = colour.height();
+    const int w = color.width(), h = color.height();
     out.color.resize(w, h);
     out.depth.resize(w, h);
     out.motion.assign(w, h, glm::vec2(0.0f));
@@ -143,7 +143,7 @@ void receive_peer_frame(const Image<Rgb8>& colour, const Image<float>& depth, co
     out.camera.prev_projection = camera.projection;
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
-            const Rgb8 c = colour(x, y);
+            const Rgb8 c = color(x, y);
             const float z = depth(x, y);
             out.depth(x, y) = z;
             out.color(x, y) =

@@ -40,7 +40,7 @@ struct StreamClient::State {
     bool have_info = false;
     std::unique_ptr<net::Reassembler> reassembler;
     std::unique_ptr<codec::Decoder> decoder;
-    std::unique_ptr<codec::Decoder> colour_decoder;  // lowres: the low-resolution colour stream
+    std::unique_ptr<codec::Decoder> color_decoder;  // lowres: the low-resolution colour stream
     Frame low_decoded;
     Image<glm::vec4> upsampled;
     warp::SpatioTemporalUpsampler upsampler;
@@ -93,7 +93,7 @@ struct StreamClient::State {
     void reset_stream() {
         reassembler = std::make_unique<net::Reassembler>();
         decoder = std::make_unique<codec::Decoder>();
-        colour_decoder = std::make_unique<codec::Decoder>();
+        color_decoder = std::make_unique<codec::Decoder>();
         upsampler.reset();
         newest_completed = -1;
         consecutive_decode_errors = 0;
@@ -137,13 +137,13 @@ struct StreamClient::State {
         if (!abandoned.empty()) report_lost(abandoned, now);
         newest_completed = packet.frame;
         const bool lowres = have_info && info.mode == net::StreamMode::LowRes;
-        std::span<const uint8_t> geometry = packet.data, colour;
-        bool ok = !lowres || split_bundle(packet.data, geometry, colour);
+        std::span<const uint8_t> geometry = packet.data, color;
+        bool ok = !lowres || split_bundle(packet.data, geometry, color);
         ok = ok && decoder->send_packet(geometry).ok() &&
              decoder->receive_frame(scratch_decoded) == Result::Ok;
         if (ok && lowres)
-            ok = colour_decoder->send_packet(colour).ok() &&
-                 colour_decoder->receive_frame(low_decoded) == Result::Ok;
+            ok = color_decoder->send_packet(color).ok() &&
+                 color_decoder->receive_frame(low_decoded) == Result::Ok;
         if (!ok) {
             ++stats.decode_errors;
             abandoned.assign(1, packet.frame);
@@ -182,12 +182,12 @@ struct StreamClient::State {
 
     // lowres bundle: u8 version 1, u32 n, n bytes geometry packet, u32 m, m bytes colour packet.
     static bool split_bundle(std::span<const uint8_t> bundle, std::span<const uint8_t>& geometry,
-                             std::span<const uint8_t>& colour) {
+                             std::span<const uint8_t>& color) {
         net::Reader r(bundle);
         if (r.u8() != 1) return false;
         geometry = r.bytes(r.u32());
-        colour = r.bytes(r.u32());
-        return r.ok() && r.remaining() == 0 && !geometry.empty() && !colour.empty();
+        color = r.bytes(r.u32());
+        return r.ok() && r.remaining() == 0 && !geometry.empty() && !color.empty();
     }
 
     void on_datagram(std::span<const uint8_t> d, int64_t now) {

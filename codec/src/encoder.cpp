@@ -173,7 +173,7 @@ struct Encoder::State {
     }
     Status encode(const GBufferView& frame, const Camera& camera, int ref_slot, int qp_now,
                   Picture& pic, std::vector<uint8_t>& payload, StreamStats& fs,
-                  ColorEncodeResult& colour) {
+                  ColorEncodeResult& color) {
         const bool key = ref_slot < 0;
         const Picture* ref = key ? nullptr : &refs[ref_slot];
         FrameContext fc{&sp, ref, key, &work};
@@ -201,8 +201,8 @@ struct Encoder::State {
         const ImageView<const glm::vec2> motion =
             motion_to_reference(sp, camera, pic.depth, pic.motion, ref, next_frame, work);
         section.clear();
-        colour = encode_color(fc, source_planes, motion, qp_now, options.skip_threshold, pic.planes,
-                              section, fs);
+        color = encode_color(fc, source_planes, motion, qp_now, options.skip_threshold, pic.planes,
+                             section, fs);
         append_section(payload, section);
         // The packet header, key frame parameters and section lengths.
         fs.header_bits = 8 * (kPacketHeaderSize + payload.size()) -
@@ -322,10 +322,10 @@ Status Encoder::send_frame(const GBufferView& given) {
     StreamStats fs;
     for (int attempt = 0;; ++attempt) {
         fs = {};
-        ColorEncodeResult colour;
+        ColorEncodeResult color;
         const int qp_now = std::clamp(ref < 0 ? qp - 3 : qp, 0, 51);
-        REPRISE_TRY(s.encode(frame, camera, ref, qp_now, pic, payload, fs, colour));
-        if (ref >= 0 && detect_cut && colour.intra_macroblocks * 10 > colour.macroblocks * 6) {
+        REPRISE_TRY(s.encode(frame, camera, ref, qp_now, pic, payload, fs, color));
+        if (ref >= 0 && detect_cut && color.intra_macroblocks * 10 > color.macroblocks * 6) {
             ref = -1;  // a cut: most of the frame is new
             --attempt;
             continue;

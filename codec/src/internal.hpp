@@ -93,7 +93,7 @@ int replacement_slot(const Picture (&refs)[kReferences], int64_t kept = -1);
 // The slot holding frame `frame`, or -1.
 int held_slot(const Picture (&refs)[kReferences], uint32_t frame);
 
-// --- colour.cpp
+// --- color.cpp
 // Linear colour -> 8-bit sRGB -> YCoCg-R, chroma averaged 2x2 for 4:2:0.
 void planes_from_linear(ImageView<const glm::vec4> color, const SequenceParams& sp, Planes& out);
 // YCoCg-R planes -> linear RGB (A = alpha_one ? 1 : coverage from depth).

@@ -51,7 +51,7 @@ struct CameraMotionRow {
 void camera_motion_row_reference(const CameraMotionRow& row, int x_begin, int x_end);
 void camera_motion_row(const CameraMotionRow& row);
 
-// Colour conversion of one row into YCoCg-R: linear RGB -> 8-bit sRGB codes (colour.cpp's
+// Colour conversion of one row into YCoCg-R: linear RGB -> 8-bit sRGB codes (color.cpp's
 // table and thresholds) -> y, co, cg.
 struct ToPlanesRow {
     const glm::vec4* color;

@@ -48,7 +48,7 @@ stereo::StereoOptions make_options(const std::string& warp_method, const std::st
 }
 
 // The synthesizer asserts colour and depth of one size; from Python that is a ValueError.
-void require_colour_and_depth(const Frame& f, const char* what) {
+void require_color_and_depth(const Frame& f, const char* what) {
     if (f.color.empty() || f.depth.empty())
         value_error(std::string(what) + ": needs colour and depth");
     if (f.depth.width() != f.width() || f.depth.height() != f.height())
@@ -70,8 +70,8 @@ py::dict stats_dict(const stereo::StereoStats& s) {
 struct Synthesizer {
     py::tuple synthesize(const Frame& rendered, const Camera& target, const std::string& warp,
                          const std::string& fill, const Frame* history) {
-        require_colour_and_depth(rendered, "rendered");
-        if (history) require_colour_and_depth(*history, "history");
+        require_color_and_depth(rendered, "rendered");
+        if (history) require_color_and_depth(*history, "history");
         const stereo::StereoOptions options = make_options(warp, fill);
         Frame out;
         out.fps = rendered.fps;

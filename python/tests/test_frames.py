@@ -22,7 +22,7 @@ def test_assignment_copies_into_the_same_buffer(small_frame):
     assert np.all(view == 3.0)
 
 
-def test_rgb_colour_gets_alpha_one():
+def test_rgb_color_gets_alpha_one():
     frame = reprise.Frame(np.zeros((2, 3, 3), np.float64))
     assert frame.color.shape == (2, 3, 4) and np.all(frame.color[..., 3] == 1.0)
     assert frame.depth is None and frame.motion is None

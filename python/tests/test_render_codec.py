@@ -90,7 +90,7 @@ def test_codec_streams_and_bad_packets(pan_60):
         reprise.Encoder(qp=99)
 
 
-def test_anti_aliasing_changes_colour_only(renderer):
+def test_anti_aliasing_changes_color_only(renderer):
     scene = reprise.Scene("fence", camera="pan")
     single = renderer.render(scene, frame=2, aa=1, **SIZE)
     four = renderer.render(scene, frame=2, aa=4, **SIZE)

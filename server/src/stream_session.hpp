@@ -80,17 +80,17 @@ struct Session {
         std::shared_ptr<const LoadedScene> scene;  // shared by the sessions that show it
         bool rendered_before = false;
         Instant previous;
-        codec::Encoder encoder, colour_encoder;  // lowres: the low-resolution colour stream
+        codec::Encoder encoder, color_encoder;  // lowres: the low-resolution colour stream
         Frame frame, low;  // low: lowres depth and motion at the colour samples (no colour)
         Image<glm::vec4> low_color;
-        codec::Packet packet, colour_packet;
+        codec::Packet packet, color_packet;
         std::vector<uint8_t> bundle;
         int64_t frames_rendered = 0, newest_encoded = -1;
         int bitrate_kbps = 0;
         std::vector<uint32_t> acked, lost;                 // swapped out of the mailbox
         explicit Media(const codec::EncoderOptions& eo) {  // checked by StreamServer::create
             REPRISE_ASSERT(codec::Encoder::create(eo, encoder).ok() &&
-                           codec::Encoder::create(eo, colour_encoder).ok());
+                           codec::Encoder::create(eo, color_encoder).ok());
         }
     } media;
     std::mutex mutex;

@@ -22,7 +22,7 @@ double ms_since(std::chrono::steady_clock::time_point t) {
 // The low-resolution colour as a frame of its own: depth and motion taken from the full G-buffer
 // at each low pixel's sample position (motion in low pixels), the camera's jitter in low pixels,
 // so the colour stream predicts by reprojection like any other. The colour is m.low_color's.
-GBufferView make_colour_frame(Session::Media& m, glm::vec2 jitter) {
+GBufferView make_color_frame(Session::Media& m, glm::vec2 jitter) {
     const int lw = m.low_color.width(), lh = m.low_color.height();
     const int w = m.frame.width(), h = m.frame.height();
     const glm::vec2 footprint(float(w) / float(lw), float(h) / float(lh));
@@ -46,15 +46,15 @@ GBufferView make_colour_frame(Session::Media& m, glm::vec2 jitter) {
 }
 
 // lowres: both codec packets of one frame in one unit (docs/protocol.md, "Low-resolution mode").
-void bundle_packets(std::span<const uint8_t> geometry, std::span<const uint8_t> colour,
+void bundle_packets(std::span<const uint8_t> geometry, std::span<const uint8_t> color,
                     std::vector<uint8_t>& out) {
-    out.resize(1 + 4 + geometry.size() + 4 + colour.size());
+    out.resize(1 + 4 + geometry.size() + 4 + color.size());
     net::Writer w(out);
     w.u8(1);
     w.u32(uint32_t(geometry.size()));
     w.bytes(geometry);
-    w.u32(uint32_t(colour.size()));
-    w.bytes(colour);
+    w.u32(uint32_t(color.size()));
+    w.bytes(color);
 }
 
 }  // namespace
@@ -223,24 +223,24 @@ double RenderWorker::produce(Session& s, int64_t now) {
     }
     for (uint32_t f : m.acked) {
         m.encoder.acknowledge(f);
-        m.colour_encoder.acknowledge(f);
+        m.color_encoder.acknowledge(f);
     }
     for (uint32_t f : m.lost) {
         m.encoder.report_loss(f);
-        m.colour_encoder.report_loss(f);
+        m.color_encoder.report_loss(f);
     }
     m.acked.clear();
     m.lost.clear();
     if (key_frame) {
         m.encoder.request_key_frame();
-        m.colour_encoder.request_key_frame();
+        m.color_encoder.request_key_frame();
     }
     if (bitrate > 0 && bitrate != m.bitrate_kbps) {
         m.bitrate_kbps = bitrate;
         if (link_.options.mode == net::StreamMode::LowRes) {
             // Geometry (depth + motion) and colour share the target by their usual weights.
             m.encoder.set_bitrate(std::max(1, bitrate * 2 / 3));
-            m.colour_encoder.set_bitrate(std::max(1, bitrate / 3));
+            m.color_encoder.set_bitrate(std::max(1, bitrate / 3));
         } else {
             m.encoder.set_bitrate(bitrate);
         }
@@ -279,7 +279,7 @@ double RenderWorker::produce(Session& s, int64_t now) {
         link_.stats.encode_ms_total += encode_ms;
         codec::add_stats(link_.stats.coded, m.encoder.last_frame_stats());
         if (link_.options.mode == net::StreamMode::LowRes)
-            codec::add_stats(link_.stats.coded, m.colour_encoder.last_frame_stats());
+            codec::add_stats(link_.stats.coded, m.color_encoder.last_frame_stats());
     }
     return std::max(render_ms + encode_ms, 1e-3);
 }
@@ -316,7 +316,7 @@ Status RenderWorker::render_encode(Session& s, const net::PoseMessage& pose, dou
     t0 = std::chrono::steady_clock::now();
     GBufferView low;
     if (lowres) {
-        low = make_colour_frame(m, jitter);
+        low = make_color_frame(m, jitter);
         // The geometry stream carries no colour: a constant that every prediction matches.
         std::fill(m.frame.color.data(), m.frame.color.data() + m.frame.color.pixel_count(),
                   glm::vec4(0.0f));
@@ -326,17 +326,17 @@ Status RenderWorker::render_encode(Session& s, const net::PoseMessage& pose, dou
         return Status::error("encoder gave no packet");
     std::span<const uint8_t> payload = m.packet.data;
     if (lowres) {
-        REPRISE_TRY(m.colour_encoder.send_frame(low));
-        if (m.colour_encoder.receive_packet(m.colour_packet) != Result::Ok)
+        REPRISE_TRY(m.color_encoder.send_frame(low));
+        if (m.color_encoder.receive_packet(m.color_packet) != Result::Ok)
             return Status::error("colour encoder gave no packet");
-        REPRISE_ASSERT(m.colour_packet.frame == m.packet.frame);
-        bundle_packets(m.packet.data, m.colour_packet.data, m.bundle);
+        REPRISE_ASSERT(m.color_packet.frame == m.packet.frame);
+        bundle_packets(m.packet.data, m.color_packet.data, m.bundle);
         payload = m.bundle;
     }
     m.newest_encoded = m.packet.frame;
     if (payload.size() > net::kMaxPacketBytes) {
         m.encoder.report_loss(m.packet.frame);
-        m.colour_encoder.report_loss(m.packet.frame);
+        m.color_encoder.report_loss(m.packet.frame);
         std::lock_guard lock(link_.stats_mutex);
         ++link_.stats.frames_dropped;
     } else {

@@ -305,7 +305,7 @@ struct MotionRefiner::State {
             const int t = decided[slot];
             if (label[t] != id) continue;
             uint8_t* pick = chosen.data() + slot * area;
-            glm::vec4* colour = chosen_color.data() + slot * area;
+            glm::vec4* flow_color = chosen_color.data() + slot * area;
             std::fill(pick, pick + area, uint8_t(0));
             const int tx0 = (t % tiles_x) * tile, ty0 = (t / tiles_x) * tile;
             const int tx1 = std::min(box.x1, tx0 + tile), ty1 = std::min(box.y1, ty0 + tile);
@@ -328,7 +328,7 @@ struct MotionRefiner::State {
                     if (!(flowed / float(count) + kWinMargin < rendered / float(count))) continue;
                     const std::size_t k = std::size_t(y - ty0) * tile + std::size_t(x - tx0);
                     pick[k] = 1;
-                    colour[k] = color_flow[i];
+                    flow_color[k] = color_flow[i];
                     ++won;
                 }
         }
@@ -394,11 +394,11 @@ void MotionRefiner::apply(ImageView<glm::vec4> color) const {
         const int x1 = std::min(color.width, x0 + st.tile),
                   y1 = std::min(color.height, y0 + st.tile);
         const uint8_t* pick = st.chosen.data() + slot * area;
-        const glm::vec4* colour = st.chosen_color.data() + slot * area;
+        const glm::vec4* flow_color = st.chosen_color.data() + slot * area;
         for (int y = y0; y < y1; ++y)
             for (int x = x0; x < x1; ++x) {
                 const std::size_t k = std::size_t(y - y0) * st.tile + std::size_t(x - x0);
-                if (pick[k]) color(x, y) = colour[k];
+                if (pick[k]) color(x, y) = flow_color[k];
             }
     }
 }
