@@ -227,6 +227,23 @@ SpatioTemporalUpsampler::SpatioTemporalUpsampler(UpsampleOptions options) : opti
 
 void SpatioTemporalUpsampler::reset() { has_history_ = false; }
 
+// One frame's pass: what every stage reads, and what they count.
+struct SpatioTemporalUpsampler::Pass {
+    FrameContext f;
+    GBufferView full;  // the guides, repaired
+    bool temporal = false;      // the history is fetched
+    bool history_ids = false;   // ... and tested on ids
+    StaticReprojection camera;  // this frame's pixels into the previous view
+    glm::mat4 to_previous_view{1.0f};
+    Counters counters;
+
+    Pass(const GBufferView& guides, int width, int height)
+        : full(guides),
+          camera(guides.camera, guides.camera.prev_view, guides.camera.prev_projection, width,
+                 height),
+          to_previous_view(camera.to_view()) {}
+};
+
 void SpatioTemporalUpsampler::upsample(ImageView<const glm::vec4> low_color, glm::vec2 jitter_px,
                                        const GBufferView& given, ImageView<glm::vec4> out,
                                        UpsampleStats* stats) {
@@ -249,35 +266,20 @@ void SpatioTemporalUpsampler::upsample(ImageView<const glm::vec4> low_color, glm
                    (full.motion.width == width && full.motion.height == height));
     REPRISE_ASSERT(o.depth_sigma > 0.0f && o.normal_sigma > 0.0f && o.epsilon > 0.0f &&
                    o.epsilon < 1.0f);
+    resize(width, height);
 
-    if (history_.width() != width || history_.height() != height) {
-        history_.resize(width, height);
-        next_history_.resize(width, height);
-        deltas_.resize(width, height);
-        next_deltas_.resize(width, height);
-        history_depth_.resize(width, height);
-        history_id_.resize(width, height);
-        reprojected_.resize(width, height);
-        gradient_.resize(width, height);
-        gradient_tmp_.resize(width, height);
-        tap_geometric_.resize(width, height);
-        tap_base_.resize(width, height);
-        has_history_ = false;
-    }
+    Pass pass(full, width, height);
+    FrameContext& f = pass.f;
+    f.low = low_color;
+    f.full = &pass.full;
     // Offsets beyond any image are nonsense; bounding them keeps every index computation in range.
     auto bounded = [](glm::vec2 v) {
         const float limit = float(kMaxImageSide);
         if (!std::isfinite(v.x) || !std::isfinite(v.y)) return glm::vec2(0.0f);
         return glm::clamp(v, glm::vec2(-limit), glm::vec2(limit));
     };
-    jitter_px = bounded(jitter_px);
-    const glm::vec2 full_jitter = bounded(full.camera.jitter);
-
-    FrameContext f;
-    f.low = low_color;
-    f.full = &full;
-    f.jitter = jitter_px;
-    f.full_jitter = full_jitter;
+    f.jitter = bounded(jitter_px);
+    f.full_jitter = bounded(full.camera.jitter);
     f.scale =
         glm::vec2(float(width) / float(low_color.width), float(height) / float(low_color.height));
     f.diagonal = std::sqrt(f.scale.x * f.scale.x + f.scale.y * f.scale.y);
@@ -286,138 +288,171 @@ void SpatioTemporalUpsampler::upsample(ImageView<const glm::vec4> low_color, glm
     f.options = &o;
     f.floor3 = o.epsilon * o.epsilon * o.epsilon;
     f.ids = o.id_test && !full.id.empty();
+    pass.temporal = has_history_ && !full.motion.empty() && o.history_weight > 0.0f;
+    pass.history_ids = o.id_test && !full.id.empty() && history_has_ids_;
 
-    const bool temporal = has_history_ && !full.motion.empty() && o.history_weight > 0.0f;
-    const bool ids = o.id_test && !full.id.empty() && history_has_ids_;
-    const StaticReprojection camera(full.camera, full.camera.prev_view, full.camera.prev_projection,
-                                    width, height);
-    const glm::mat4 to_previous_view = camera.to_view();
-    Counters counters;
+    if (pass.temporal) fetch_history(pass);
+    if (pass.temporal && o.gradient_steering) smooth_gradient(pass);
+    filter(pass, out);
+    keep_history(pass);
 
-    // The spatial taps (kept for the final pass) and the relative temporal gradient of a pixel
-    // whose history has just been fetched; the differences rotate for the next frame.
-    auto temporal_gradient = [&](int x, int y) {
-        const glm::vec4 h = reprojected_(x, y);
-        glm::vec4& d = next_deltas_(x, y);
-        float current = 1.0f;
-        const Taps taps = compute_taps(f, x, y);
-        tap_geometric_(x, y) = taps.geometric;
-        tap_base_(x, y) = taps.base;
-        if (h.w > 0.0f) {
-            const SpatialResult s = combine(f, x, y, taps, o.gamma_unsteered);
-            const float a = luminance(s.color), b = luminance(h);
-            const float scale = std::max(std::abs(a), std::abs(b));
-            current =
-                s.weight > 0.0f && scale > 0.0f ? std::clamp((a - b) / scale, -1.0f, 1.0f) : 0.0f;
-            gradient_(x, y) =
-                std::min(1.0f, std::abs(0.4f * current + 0.3f * d.x + 0.2f * d.y + 0.1f * d.z));
-        } else {
-            gradient_(x, y) = 1.0f;
-        }
-        d = glm::vec4(current, d.x, d.y, 0.0f);
-    };
-
-    // (A) History at p + motion, disocclusion test, raw temporal gradient.
-    if (temporal) {
-        parallel_for(0, height, [&](int y0, int y1) {
-            int64_t rejected = 0;
-            for (int y = y0; y < y1; ++y) {
-                for (int x = 0; x < width; ++x) {
-                    const float z = full.depth(x, y);
-                    const DepthKind kind = depth_kind(z);
-                    const glm::vec2 m = full.motion(x, y);
-                    glm::vec4 color(0.0f), delta(0.0f);
-                    float accepted = 0.0f;
-                    const float limit = float(kMaxImageSide);
-                    if (kind != DepthKind::Invalid && std::abs(m.x) < limit &&
-                        std::abs(m.y) < limit) {
-                        float expected = INFINITY;
-                        if (kind == DepthKind::Surface) {
-                            const glm::vec4 point =
-                                camera.unprojector().point(float(x) + 0.5f + full_jitter.x,
-                                                           float(y) + 0.5f + full_jitter.y, z);
-                            expected = -(to_previous_view * point).z;
-                        }
-                        // p + jitter + motion in the previous unjittered image; its pixels saw
-                        // their centre + the previous jitter.
-                        const float fx = float(x) + m.x + full_jitter.x - history_jitter_.x;
-                        const float fy = float(y) + m.y + full_jitter.y - history_jitter_.y;
-                        const int x0 = int(std::floor(fx)), y0b = int(std::floor(fy));
-                        const float ax = fx - float(x0), ay = fy - float(y0b);
-                        const uint32_t id = ids ? full.id(x, y) : 0u;
-                        for (int ty = 0; ty < 2; ++ty) {
-                            for (int tx = 0; tx < 2; ++tx) {
-                                const float w = (tx ? ax : 1.0f - ax) * (ty ? ay : 1.0f - ay);
-                                const int px = x0 + tx, py = y0b + ty;
-                                if (w <= 0.0f || px < 0 || py < 0 || px >= width || py >= height)
-                                    continue;
-                                if (ids && history_id_(px, py) != id) continue;
-                                const float zp = history_depth_(px, py);
-                                if (kind == DepthKind::Background) {
-                                    if (zp != INFINITY) continue;
-                                } else {
-                                    const float tolerance =
-                                        o.history_depth_tolerance * (ids ? 4.0f : 1.0f);
-                                    if (!(std::abs(zp - expected) <= tolerance * expected))
-                                        continue;
-                                }
-                                const glm::vec4 h = history_(px, py);
-                                if (!(h.w > 0.0f)) continue;
-                                color += w * h;
-                                delta += w * deltas_(px, py);
-                                accepted += w;
-                            }
-                        }
-                    }
-                    if (accepted > 1e-3f) {
-                        reprojected_(x, y) = color / accepted;
-                        next_deltas_(x, y) =
-                            delta / accepted;  // rotated below, after the spatial estimate
-                    } else {
-                        reprojected_(x, y) = glm::vec4(0.0f);
-                        next_deltas_(x, y) = glm::vec4(1.0f);
-                        ++rejected;
-                    }
-                    if (o.gradient_steering) temporal_gradient(x, y);
-                }
-            }
-            counters.rejected += rejected;
-        });
+    if (stats) {
+        *stats = {.history_rejected = pass.counters.rejected,
+                  .history_used = pass.counters.used,
+                  .nonfinite_samples = pass.counters.nonfinite,
+                  .unresolved = pass.counters.unresolved,
+                  .nonfinite = input_nonfinite};
     }
+}
 
-    if (temporal && o.gradient_steering) {
-        // (B) Box low-pass, slightly wider than a low pixel.
-        const int radius = o.gradient_radius > 0
-                               ? o.gradient_radius
-                               : int(std::ceil(std::max(f.scale.x, f.scale.y))) + 1;
-        parallel_for(0, height, [&](int y0, int y1) {
-            for (int y = y0; y < y1; ++y) {
-                for (int x = 0; x < width; ++x) {
-                    const int a = std::max(0, x - radius), b = std::min(width - 1, x + radius);
-                    float sum = 0.0f;
-                    for (int i = a; i <= b; ++i) sum += gradient_(i, y);
-                    gradient_tmp_(x, y) = sum / float(b - a + 1);
-                }
-            }
-        });
-        parallel_for(0, height, [&](int y0, int y1) {
-            for (int y = y0; y < y1; ++y) {
-                const int a = std::max(0, y - radius), b = std::min(height - 1, y + radius);
-                for (int x = 0; x < width; ++x) {
-                    float sum = 0.0f;
-                    for (int i = a; i <= b; ++i) sum += gradient_tmp_(x, i);
-                    gradient_(x, y) = sum / float(b - a + 1);
-                }
-            }
-        });
+void SpatioTemporalUpsampler::resize(int width, int height) {
+    if (history_.width() == width && history_.height() == height) return;
+    history_.resize(width, height);
+    next_history_.resize(width, height);
+    deltas_.resize(width, height);
+    next_deltas_.resize(width, height);
+    history_depth_.resize(width, height);
+    history_id_.resize(width, height);
+    reprojected_.resize(width, height);
+    gradient_.resize(width, height);
+    gradient_tmp_.resize(width, height);
+    tap_geometric_.resize(width, height);
+    tap_base_.resize(width, height);
+    has_history_ = false;
+}
+
+// The spatial taps of a pixel whose history has just been fetched (kept for the final pass) and
+// its relative temporal gradient; the differences rotate for the next frame.
+void SpatioTemporalUpsampler::temporal_gradient(const Pass& pass, int x, int y) {
+    const FrameContext& f = pass.f;
+    const glm::vec4 h = reprojected_(x, y);
+    glm::vec4& d = next_deltas_(x, y);
+    float current = 1.0f;
+    const Taps taps = compute_taps(f, x, y);
+    tap_geometric_(x, y) = taps.geometric;
+    tap_base_(x, y) = taps.base;
+    if (h.w > 0.0f) {
+        const SpatialResult s = combine(f, x, y, taps, options_.gamma_unsteered);
+        const float a = luminance(s.color), b = luminance(h);
+        const float scale = std::max(std::abs(a), std::abs(b));
+        current =
+            s.weight > 0.0f && scale > 0.0f ? std::clamp((a - b) / scale, -1.0f, 1.0f) : 0.0f;
+        gradient_(x, y) =
+            std::min(1.0f, std::abs(0.4f * current + 0.3f * d.x + 0.2f * d.y + 0.1f * d.z));
+    } else {
+        gradient_(x, y) = 1.0f;
     }
+    d = glm::vec4(current, d.x, d.y, 0.0f);
+}
 
-    // (C) Steered spatial filter blended with the history (eq. 7).
-    const bool cached_taps = temporal && o.gradient_steering && !o.recompute_taps;
+// (A) History at p + motion, disocclusion test, raw temporal gradient.
+void SpatioTemporalUpsampler::fetch_history(Pass& pass) {
+    const UpsampleOptions& o = options_;
+    const GBufferView& full = pass.full;
+    const int width = pass.f.width, height = pass.f.height;
+    const glm::vec2 full_jitter = pass.f.full_jitter;
+    const bool ids = pass.history_ids;
     parallel_for(0, height, [&](int y0, int y1) {
-        int64_t used = 0, nonfinite = 0, unresolved = 0;
+        int64_t rejected = 0;
         for (int y = y0; y < y1; ++y) {
             for (int x = 0; x < width; ++x) {
+                const float z = full.depth(x, y);
+                const DepthKind kind = depth_kind(z);
+                const glm::vec2 m = full.motion(x, y);
+                glm::vec4 color(0.0f), delta(0.0f);
+                float accepted = 0.0f;
+                const float limit = float(kMaxImageSide);
+                if (kind != DepthKind::Invalid && std::abs(m.x) < limit && std::abs(m.y) < limit) {
+                    float expected = INFINITY;
+                    if (kind == DepthKind::Surface) {
+                        const glm::vec4 point =
+                            pass.camera.unprojector().point(float(x) + 0.5f + full_jitter.x,
+                                                            float(y) + 0.5f + full_jitter.y, z);
+                        expected = -(pass.to_previous_view * point).z;
+                    }
+                    // p + jitter + motion in the previous unjittered image; its pixels saw
+                    // their centre + the previous jitter.
+                    const float fx = float(x) + m.x + full_jitter.x - history_jitter_.x;
+                    const float fy = float(y) + m.y + full_jitter.y - history_jitter_.y;
+                    const int x0 = int(std::floor(fx)), y0b = int(std::floor(fy));
+                    const float ax = fx - float(x0), ay = fy - float(y0b);
+                    const uint32_t id = ids ? full.id(x, y) : 0u;
+                    for (int ty = 0; ty < 2; ++ty) {
+                        for (int tx = 0; tx < 2; ++tx) {
+                            const float w = (tx ? ax : 1.0f - ax) * (ty ? ay : 1.0f - ay);
+                            const int px = x0 + tx, py = y0b + ty;
+                            if (w <= 0.0f || px < 0 || py < 0 || px >= width || py >= height)
+                                continue;
+                            if (ids && history_id_(px, py) != id) continue;
+                            const float zp = history_depth_(px, py);
+                            if (kind == DepthKind::Background) {
+                                if (zp != INFINITY) continue;
+                            } else {
+                                const float tolerance =
+                                    o.history_depth_tolerance * (ids ? 4.0f : 1.0f);
+                                if (!(std::abs(zp - expected) <= tolerance * expected)) continue;
+                            }
+                            const glm::vec4 h = history_(px, py);
+                            if (!(h.w > 0.0f)) continue;
+                            color += w * h;
+                            delta += w * deltas_(px, py);
+                            accepted += w;
+                        }
+                    }
+                }
+                if (accepted > 1e-3f) {
+                    reprojected_(x, y) = color / accepted;
+                    next_deltas_(x, y) = delta / accepted;  // rotated below, after the spatial one
+                } else {
+                    reprojected_(x, y) = glm::vec4(0.0f);
+                    next_deltas_(x, y) = glm::vec4(1.0f);
+                    ++rejected;
+                }
+                if (o.gradient_steering) temporal_gradient(pass, x, y);
+            }
+        }
+        pass.counters.rejected += rejected;
+    });
+}
+
+// (B) Box low-pass of the temporal gradient, slightly wider than a low pixel.
+void SpatioTemporalUpsampler::smooth_gradient(const Pass& pass) {
+    const int width = pass.f.width, height = pass.f.height;
+    const int radius = options_.gradient_radius > 0
+                           ? options_.gradient_radius
+                           : int(std::ceil(std::max(pass.f.scale.x, pass.f.scale.y))) + 1;
+    parallel_for(0, height, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y) {
+            for (int x = 0; x < width; ++x) {
+                const int a = std::max(0, x - radius), b = std::min(width - 1, x + radius);
+                float sum = 0.0f;
+                for (int i = a; i <= b; ++i) sum += gradient_(i, y);
+                gradient_tmp_(x, y) = sum / float(b - a + 1);
+            }
+        }
+    });
+    parallel_for(0, height, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y) {
+            const int a = std::max(0, y - radius), b = std::min(height - 1, y + radius);
+            for (int x = 0; x < width; ++x) {
+                float sum = 0.0f;
+                for (int i = a; i <= b; ++i) sum += gradient_tmp_(x, i);
+                gradient_(x, y) = sum / float(b - a + 1);
+            }
+        }
+    });
+}
+
+// (C) Steered spatial filter blended with the history (eq. 7).
+void SpatioTemporalUpsampler::filter(Pass& pass, ImageView<glm::vec4> out) {
+    const UpsampleOptions& o = options_;
+    const FrameContext& f = pass.f;
+    const bool temporal = pass.temporal;
+    const bool cached_taps = temporal && o.gradient_steering && !o.recompute_taps;
+    parallel_for(0, f.height, [&](int y0, int y1) {
+        int64_t used = 0, nonfinite = 0, unresolved = 0;
+        for (int y = y0; y < y1; ++y) {
+            for (int x = 0; x < f.width; ++x) {
                 const glm::vec4 history_color = temporal ? reprojected_(x, y) : glm::vec4(0.0f);
                 const bool history = history_color.w > 0.0f;
                 float fade = 0.0f, gamma_k = o.gamma_unsteered;
@@ -456,35 +491,33 @@ void SpatioTemporalUpsampler::upsample(ImageView<const glm::vec4> low_color, glm
                 } else if (!(s.weight > 0.0f)) {
                     ++unresolved;
                 }
-                const bool covered = depth_kind(full.depth(x, y)) == DepthKind::Surface;
+                const bool covered = depth_kind(pass.full.depth(x, y)) == DepthKind::Surface;
                 out(x, y) = glm::vec4(result.x, result.y, result.z, covered ? 1.0f : 0.0f);
                 next_history_(x, y) = glm::vec4(result.x, result.y, result.z, weight);
                 if (!temporal || !o.gradient_steering) next_deltas_(x, y) = glm::vec4(0.0f);
             }
         }
-        counters.used += used;
-        counters.nonfinite += nonfinite;
-        counters.unresolved += unresolved;
+        pass.counters.used += used;
+        pass.counters.nonfinite += nonfinite;
+        pass.counters.unresolved += unresolved;
     });
+}
 
+// (D) This frame's result, depth and ids become the history of the next.
+void SpatioTemporalUpsampler::keep_history(const Pass& pass) {
+    const GBufferView& full = pass.full;
     std::swap(history_, next_history_);
     std::swap(deltas_, next_deltas_);
-    for (int y = 0; y < height; ++y) {
-        std::memcpy(&history_depth_(0, y), full.depth.row(y), sizeof(float) * std::size_t(width));
+    for (int y = 0; y < pass.f.height; ++y) {
+        std::memcpy(&history_depth_(0, y), full.depth.row(y),
+                    sizeof(float) * std::size_t(pass.f.width));
         if (!full.id.empty())
-            std::memcpy(&history_id_(0, y), full.id.row(y), sizeof(uint32_t) * std::size_t(width));
+            std::memcpy(&history_id_(0, y), full.id.row(y),
+                        sizeof(uint32_t) * std::size_t(pass.f.width));
     }
-    history_jitter_ = full_jitter;
+    history_jitter_ = pass.f.full_jitter;
     history_has_ids_ = !full.id.empty();
     has_history_ = true;
-
-    if (stats) {
-        *stats = {.history_rejected = counters.rejected,
-                  .history_used = counters.used,
-                  .nonfinite_samples = counters.nonfinite,
-                  .unresolved = counters.unresolved,
-                  .nonfinite = input_nonfinite};
-    }
 }
 
 }  // namespace reprise::warp

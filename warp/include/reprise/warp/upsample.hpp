@@ -98,6 +98,14 @@ public:
     const UpsampleOptions& options() const { return options_; }
 
 private:
+    struct Pass;  // one frame's context (upsample.cpp)
+    void resize(int width, int height);
+    void fetch_history(Pass& pass);            // (A)
+    void temporal_gradient(const Pass& pass, int x, int y);
+    void smooth_gradient(const Pass& pass);    // (B)
+    void filter(Pass& pass, ImageView<glm::vec4> out);  // (C)
+    void keep_history(const Pass& pass);       // (D)
+
     UpsampleOptions options_;
     // History, double-buffered (read at p + motion while the next one is written).
     Image<glm::vec4> history_, next_history_;  // h_r rgb, a = h_w
