@@ -230,7 +230,7 @@ void SpatioTemporalUpsampler::reset() { has_history_ = false; }
 // One frame's pass: what every stage reads, and what they count.
 struct SpatioTemporalUpsampler::Pass {
     FrameContext f;
-    GBufferView full;  // the guides, repaired
+    GBufferView full;           // the guides, repaired
     bool temporal = false;      // the history is fetched
     bool history_ids = false;   // ... and tested on ids
     StaticReprojection camera;  // this frame's pixels into the previous view
@@ -335,8 +335,7 @@ void SpatioTemporalUpsampler::temporal_gradient(const Pass& pass, int x, int y) 
         const SpatialResult s = combine(f, x, y, taps, options_.gamma_unsteered);
         const float a = luminance(s.color), b = luminance(h);
         const float scale = std::max(std::abs(a), std::abs(b));
-        current =
-            s.weight > 0.0f && scale > 0.0f ? std::clamp((a - b) / scale, -1.0f, 1.0f) : 0.0f;
+        current = s.weight > 0.0f && scale > 0.0f ? std::clamp((a - b) / scale, -1.0f, 1.0f) : 0.0f;
         gradient_(x, y) =
             std::min(1.0f, std::abs(0.4f * current + 0.3f * d.x + 0.2f * d.y + 0.1f * d.z));
     } else {
@@ -365,9 +364,8 @@ void SpatioTemporalUpsampler::fetch_history(Pass& pass) {
                 if (kind != DepthKind::Invalid && std::abs(m.x) < limit && std::abs(m.y) < limit) {
                     float expected = INFINITY;
                     if (kind == DepthKind::Surface) {
-                        const glm::vec4 point =
-                            pass.camera.unprojector().point(float(x) + 0.5f + full_jitter.x,
-                                                            float(y) + 0.5f + full_jitter.y, z);
+                        const glm::vec4 point = pass.camera.unprojector().point(
+                            float(x) + 0.5f + full_jitter.x, float(y) + 0.5f + full_jitter.y, z);
                         expected = -(pass.to_previous_view * point).z;
                     }
                     // p + jitter + motion in the previous unjittered image; its pixels saw

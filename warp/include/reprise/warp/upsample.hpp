@@ -100,11 +100,11 @@ public:
 private:
     struct Pass;  // one frame's context (upsample.cpp)
     void resize(int width, int height);
-    void fetch_history(Pass& pass);            // (A)
+    void fetch_history(Pass& pass);  // (A)
     void temporal_gradient(const Pass& pass, int x, int y);
-    void smooth_gradient(const Pass& pass);    // (B)
+    void smooth_gradient(const Pass& pass);             // (B)
     void filter(Pass& pass, ImageView<glm::vec4> out);  // (C)
-    void keep_history(const Pass& pass);       // (D)
+    void keep_history(const Pass& pass);                // (D)
 
     UpsampleOptions options_;
     // History, double-buffered (read at p + motion while the next one is written).
