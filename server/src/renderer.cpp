@@ -238,6 +238,27 @@ struct Renderer::Gpu {
 
     GLint uniform(const char* name) const { return glGetUniformLocation(active, name); }
 
+    // What one render's passes share: its size, matrices and switches (Renderer::render).
+    struct Pass {
+        const Scene& scene;
+        const Instant& current;
+        const RenderSettings& settings;
+        int w, h;
+        glm::mat4 unjittered, view_projection, previous_view_projection;
+        glm::vec3 eye, light_direction;
+        glm::mat4 light_matrix{1.0f};  // heavy: set by draw_shadow_map
+        bool heavy, msaa, reusing;
+        int aa;
+        bool cache_usable = false;
+    };
+    void upload_geometry();
+    void draw_shadow_map(Pass& p);
+    void clear_targets(const Pass& p);
+    void use(const Pass& p, GLuint shader);
+    void draw_all(const Scene& scene, bool materials);
+    Status shade(const Pass& p);
+    void read_back(const Pass& p, Frame& frame);
+
     // Programs, shadow map and cache of the heavy mode, made on first use.
     Status prepare_heavy() {
         if (heavy_program[0]) return {};
@@ -670,17 +691,23 @@ Status Renderer::render(const Scene& scene, const Instant& current, const Instan
     g.upload_textures(scene);
     g.gather(scene, current.time, previous.time);
 
+    const bool heavy = settings.shading == Shading::Heavy;
     // Pixel p samples the unjittered image at p + jitter: shift the image by -jitter.
     const glm::mat4 unjittered = current.projection * current.view;
-    const glm::mat4 view_projection = shifted(unjittered, current.jitter, w, h);
-    glm::mat4 previous_view_projection = previous.projection * previous.view;
-    glm::vec3 eye = glm::vec3(glm::inverse(current.view)[3]);
-
-    const bool heavy = settings.shading == Shading::Heavy;
-    const int aa = heavy ? 1 : settings.aa_samples;
-    const bool msaa = g.uses_msaa(settings);
-    const ReuseSettings& reuse = settings.reuse;
-    const bool reusing = heavy && reuse.mode != Reuse::Off;
+    Gpu::Pass pass{.scene = scene,
+                   .current = current,
+                   .settings = settings,
+                   .w = w,
+                   .h = h,
+                   .unjittered = unjittered,
+                   .view_projection = shifted(unjittered, current.jitter, w, h),
+                   .previous_view_projection = previous.projection * previous.view,
+                   .eye = glm::vec3(glm::inverse(current.view)[3]),
+                   .light_direction = light_direction_at(scene.light, current.time),
+                   .heavy = heavy,
+                   .msaa = g.uses_msaa(settings),
+                   .reusing = heavy && settings.reuse.mode != Reuse::Off,
+                   .aa = heavy ? 1 : settings.aa_samples};
     if (heavy) {
         REPRISE_TRY(check_heavy_settings(settings));
         REPRISE_TRY(g.prepare_heavy());
@@ -689,270 +716,17 @@ Status Renderer::render(const Scene& scene, const Instant& current, const Instan
             g.cache_width = w, g.cache_height = h;
         }
     }
-    const bool cache_usable = reusing && g.cache_valid && !current.cut &&
-                              g.cache_scene == scene.revision && previous.time == g.cache_time &&
-                              previous.view == g.cache_view;
+    pass.cache_usable = pass.reusing && g.cache_valid && !current.cut &&
+                        g.cache_scene == scene.revision && previous.time == g.cache_time &&
+                        previous.view == g.cache_view;
 
-    glBindVertexArray(g.vertex_array);
-    glBindBuffer(GL_ARRAY_BUFFER, g.vertex_buffer);
-    glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(g.vertices.size() * sizeof(Vertex)), g.vertices.data(),
-                 GL_STREAM_DRAW);
-    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, g.index_buffer);
-    glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(g.indices.size() * sizeof(uint32_t)),
-                 g.indices.data(), GL_STREAM_DRAW);
-
-    const glm::vec3 light_direction = light_direction_at(scene.light, current.time);
-    glm::mat4 light_matrix(1.0f);
-    if (heavy) {
-        light_matrix = shadow_light_matrix(g.vertices, light_direction);
-        glBindFramebuffer(GL_FRAMEBUFFER, g.shadow_framebuffer);
-        glViewport(0, 0, kShadowMapSize, kShadowMapSize);
-        glClearDepthf(1.0f);
-        glClear(GL_DEPTH_BUFFER_BIT);
-        glEnable(GL_DEPTH_TEST);
-        glDepthFunc(GL_LESS);
-        glDisable(GL_CULL_FACE);
-        glUseProgram(g.shadow_program);
-        glUniformMatrix4fv(glGetUniformLocation(g.shadow_program, "u_light_matrix"), 1, GL_FALSE,
-                           glm::value_ptr(light_matrix));
-        for (const Draw& d : g.draws)
-            glDrawElements(GL_TRIANGLES, d.index_count, GL_UNSIGNED_INT,
-                           (void*)(std::size_t(d.first_index) * sizeof(uint32_t)));
-    }
-
-    glBindFramebuffer(GL_FRAMEBUFFER, g.framebuffer);
-    glViewport(0, 0, w, h);
-    const int slot = g.cache_slot;
-    if (reusing) {
-        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT3, GL_TEXTURE_2D,
-                               g.cache_term[slot], 0);
-        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT4, GL_TEXTURE_2D,
-                               g.cache_meta[slot], 0);
-        const GLenum buffers[5] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2,
-                                   GL_COLOR_ATTACHMENT3, GL_COLOR_ATTACHMENT4};
-        glDrawBuffers(5, buffers);
-        const glm::vec4 empty_meta(-1.0f, 0.0f, 0.0f, 0.0f);
-        glClearBufferfv(GL_COLOR, 3, glm::value_ptr(glm::vec4(0.0f)));
-        glClearBufferfv(GL_COLOR, 4, glm::value_ptr(empty_meta));
-    } else {
-        const GLenum buffers[3] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1,
-                                   GL_COLOR_ATTACHMENT2};
-        glDrawBuffers(3, buffers);
-    }
-    const glm::vec4 sky(scene.background, 0.0f), zero(0.0f);
-    glClearBufferfv(GL_COLOR, 0, glm::value_ptr(sky));
-    glClearBufferfv(GL_COLOR, 1, glm::value_ptr(zero));
-    glClearBufferfv(GL_COLOR, 2, glm::value_ptr(zero));
-    glClearDepthf(1.0f);
-    glClearStencil(0);
-    glClear(GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
-    glEnable(GL_DEPTH_TEST);
-    glDepthFunc(GL_LESS);
-    glDisable(GL_BLEND);
-
-    // Everything a program of the main pass needs besides the per-draw material.
-    auto use = [&](GLuint program) {
-        g.active = program;
-        glUseProgram(program);
-        glUniformMatrix4fv(g.uniform("u_view_projection"), 1, GL_FALSE,
-                           glm::value_ptr(view_projection));
-        glUniformMatrix4fv(g.uniform("u_unjittered_view_projection"), 1, GL_FALSE,
-                           glm::value_ptr(unjittered));
-        glUniformMatrix4fv(g.uniform("u_view"), 1, GL_FALSE, glm::value_ptr(current.view));
-        glUniformMatrix4fv(g.uniform("u_previous_view_projection"), 1, GL_FALSE,
-                           glm::value_ptr(previous_view_projection));
-        glUniform2f(g.uniform("u_size"), float(w), float(h));
-        glUniform3fv(g.uniform("u_eye"), 1, glm::value_ptr(eye));
-        glUniform3fv(g.uniform("u_light_direction"), 1, glm::value_ptr(light_direction));
-        glUniform3fv(g.uniform("u_light_color"), 1, glm::value_ptr(scene.light.color));
-        glUniform3fv(g.uniform("u_ambient"), 1, glm::value_ptr(scene.light.ambient));
-        glUniform1i(g.uniform("u_lit"), settings.shading == Shading::Lit);
-        glUniform1i(g.uniform("u_texture"), 0);
-        glUniform1f(g.uniform("u_lod_bias"),
-                    std::isfinite(settings.texture_lod_bias) ? settings.texture_lod_bias : 0.0f);
-        if (heavy) g.set_heavy_uniforms(scene, current, settings, light_matrix, cache_usable);
-        glActiveTexture(GL_TEXTURE0);
-    };
-    const Material fallback;
-    auto draw_all = [&](bool materials) {
-        const GLint base_color = g.uniform("u_base_color"), textured = g.uniform("u_textured"),
-                    specular = g.uniform("u_specular"), shininess = g.uniform("u_shininess"),
-                    mirror = g.uniform("u_mirror"), id = g.uniform("u_id");
-        for (const Draw& d : g.draws) {
-            const Material& m = d.material >= 0 ? scene.materials[d.material] : fallback;
-            if (materials) {
-                glUniform4fv(base_color, 1, glm::value_ptr(m.base_color));
-                glUniform1i(textured, m.base_color_texture >= 0);
-                if (m.base_color_texture >= 0)
-                    glBindTexture(GL_TEXTURE_2D, g.textures[m.base_color_texture]);
-                glUniform1f(specular, m.specular);
-                glUniform1f(shininess, m.shininess);
-                glUniform1f(mirror, m.mirror);
-                glUniform1f(id, d.id);
-            }
-            if (m.double_sided)
-                glDisable(GL_CULL_FACE);
-            else
-                glEnable(GL_CULL_FACE);
-            glFrontFace(d.mirrored ? GL_CW : GL_CCW);
-            glDrawElements(GL_TRIANGLES, d.index_count, GL_UNSIGNED_INT,
-                           (void*)(std::size_t(d.first_index) * sizeof(uint32_t)));
-        }
-    };
-    const auto shading_start = std::chrono::steady_clock::now();
-    const double shading_cpu_start = process_cpu_ms();
-    if (!heavy) {
-        use(g.program);
-        draw_all(true);
-        if (msaa) {
-            // The same draws into the multisampled target, resolved into the colour target.
-            REPRISE_TRY(g.prepare_msaa(aa, w, h));
-            glBindFramebuffer(GL_FRAMEBUFFER, g.msaa_framebuffer);
-            glClearBufferfv(GL_COLOR, 0, glm::value_ptr(sky));
-            glClear(GL_DEPTH_BUFFER_BIT);
-            draw_all(true);
-            glBindFramebuffer(GL_DRAW_FRAMEBUFFER, g.framebuffer);
-            const GLenum color_only = GL_COLOR_ATTACHMENT0;
-            glDrawBuffers(1, &color_only);
-            glBlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
-            glBindFramebuffer(GL_FRAMEBUFFER, g.framebuffer);
-        } else if (aa > 1) {
-            // Supersampling: the mean of `aa` passes, each sampling around p + jitter + offset;
-            // sky where a pass drew nothing is added on read-back from the summed coverage.
-            // Each pass lays depth first, then adds the one fragment per pixel at that depth
-            // (the stencil admits a single one where coplanar surfaces tie).
-            const GLenum color_only = GL_COLOR_ATTACHMENT0;
-            glDrawBuffers(1, &color_only);
-            glClearBufferfv(GL_COLOR, 0, glm::value_ptr(zero));
-            glBlendFunc(GL_CONSTANT_ALPHA, GL_ONE);
-            glBlendColor(0.0f, 0.0f, 0.0f, 1.0f / float(aa));
-            glStencilFunc(GL_EQUAL, 0, 0xff);
-            glStencilOp(GL_KEEP, GL_KEEP, GL_INCR);
-            const GLint matrix = g.uniform("u_view_projection");
-            const glm::vec2* positions = supersample_positions(aa);
-            for (int i = 0; i < aa; ++i) {
-                const glm::mat4 sample =
-                    shifted(unjittered, current.jitter + positions[i] / 16.0f, w, h);
-                glUniformMatrix4fv(matrix, 1, GL_FALSE, glm::value_ptr(sample));
-                glDepthMask(GL_TRUE);  // glClear obeys the write mask
-                glClear(GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
-                glDepthFunc(GL_LESS);
-                glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
-                draw_all(false);
-                glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-                glDepthFunc(GL_EQUAL);
-                glDepthMask(GL_FALSE);
-                glEnable(GL_STENCIL_TEST);
-                glEnable(GL_BLEND);
-                draw_all(true);
-                glDisable(GL_BLEND);
-                glDisable(GL_STENCIL_TEST);
-            }
-            glDepthFunc(GL_LESS);
-            glDepthMask(GL_TRUE);
-        }
-    } else {
-        // Depth pre-pass: each pixel then runs the heavy shader once.
-        g.active = g.shadow_program;
-        glUseProgram(g.shadow_program);
-        glUniformMatrix4fv(g.uniform("u_light_matrix"), 1, GL_FALSE,
-                           glm::value_ptr(view_projection));
-        glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
-        draw_all(false);
-        glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
-        glDepthFunc(GL_LEQUAL);
-        glDepthMask(GL_FALSE);
-        if (!reusing) {
-            use(g.heavy_program[0]);
-            draw_all(true);
-        } else {
-            // Nehab's two-pass control flow with the stencil in place of a depth shift: the hit
-            // pass marks what it reused; the miss pass shades the rest and is culled early
-            // wherever the hit pass covered a whole block.
-            glEnable(GL_STENCIL_TEST);
-            glStencilMask(0xff);
-            glStencilFunc(GL_ALWAYS, 1, 0xff);
-            glStencilOp(GL_KEEP, GL_KEEP, GL_REPLACE);
-            use(g.heavy_program[1]);
-            draw_all(true);
-            glStencilFunc(GL_EQUAL, 0, 0xff);
-            glStencilOp(GL_KEEP, GL_KEEP, GL_KEEP);
-            use(g.heavy_program[2]);
-            draw_all(true);
-            glDisable(GL_STENCIL_TEST);
-        }
-    }
-    if (heavy) {
-        glDepthMask(GL_TRUE);
-        glDepthFunc(GL_LESS);
-        glFinish();
-        g.stats.shading_ms = std::chrono::duration<double, std::milli>(
-                                 std::chrono::steady_clock::now() - shading_start)
-                                 .count();
-        g.stats.shading_cpu_ms = process_cpu_ms() - shading_cpu_start;
-    }
-
-    // Read back, turning GL's bottom-up rows into top-down images.
-    if (frame.width() != w || frame.height() != h || frame.depth.empty() || frame.id.empty()) {
-        frame.color.resize(w, h);
-        frame.depth.resize(w, h);
-        frame.motion.resize(w, h);
-        frame.normal.resize(w, h);
-        frame.id.resize(w, h);
-    }
-    g.readback.resize(std::size_t(w) * h);
-    auto read = [&](int attachment, auto&& store) {
-        glReadBuffer(GL_COLOR_ATTACHMENT0 + attachment);
-        glReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, g.readback.data());
-        for (int y = 0; y < h; ++y) {
-            const glm::vec4* row = g.readback.data() + std::size_t(h - 1 - y) * w;
-            for (int x = 0; x < w; ++x) store(x, y, row[x]);
-        }
-    };
-    if (aa > 1 && !msaa)
-        read(0, [&](int x, int y, glm::vec4 v) {
-            frame.color(x, y) = glm::vec4(glm::vec3(v) + (1.0f - v.a) * scene.background, v.a);
-        });
-    else
-        read(0, [&](int x, int y, glm::vec4 v) { frame.color(x, y) = v; });
-    read(2, [&](int x, int y, glm::vec4 v) { frame.normal(x, y) = glm::vec3(v); });
-    // Background: depth +inf, motion of the point at infinity seen through this pixel, with
-    // both ends projected the same way (a still camera gives exactly 0).
-    // Orthographic cameras see the far plane instead (w = 1: a point, not a direction).
-    const double point = current.projection[3][3] == 1.0f ? 1.0 : 0.0;
-    const glm::dmat4 unproject = glm::inverse(glm::dmat4(view_projection));
-    auto to_pixels = [&](const glm::mat4& matrix, glm::dvec4 world, glm::dvec2& pixel) {
-        glm::dvec4 clip = glm::dmat4(matrix) * world;
-        pixel = {(clip.x / clip.w * 0.5 + 0.5) * w, (0.5 - 0.5 * clip.y / clip.w) * h};
-        return clip.w > 0.0;
-    };
-    const float nan = std::numeric_limits<float>::quiet_NaN();
-    read(1, [&](int x, int y, glm::vec4 v) {
-        if (v.w != 0.0f) {
-            frame.depth(x, y) = v.x;
-            bool behind = std::abs(v.y) >= kNoPrevious;
-            frame.motion(x, y) = behind ? glm::vec2(nan) : glm::vec2(v.y, v.z);
-            frame.id(x, y) = uint32_t(v.w);
-            return;
-        }
-        frame.depth(x, y) = std::numeric_limits<float>::infinity();
-        frame.id(x, y) = 0;
-        glm::dvec2 ndc(2.0 * (x + 0.5) / w - 1.0, 1.0 - 2.0 * (y + 0.5) / h);
-        glm::dvec4 a = unproject * glm::dvec4(ndc, -1.0, 1.0),
-                   b = unproject * glm::dvec4(ndc, point, 1.0);
-        glm::dvec4 world =
-            point == 1.0 ? b / b.w : glm::dvec4(glm::dvec3(b) / b.w - glm::dvec3(a) / a.w, 0.0);
-        glm::dvec2 here, there;
-        bool visible =
-            to_pixels(unjittered, world, here) && to_pixels(previous_view_projection, world, there);
-        frame.motion(x, y) = visible ? glm::vec2(there - here) : glm::vec2(nan);
-    });
-    // Coverage stays the pixel centre's, as without anti-aliasing.
-    if (aa > 1)
-        for (int y = 0; y < h; ++y)
-            for (int x = 0; x < w; ++x) frame.color(x, y).a = frame.id(x, y) != 0 ? 1.0f : 0.0f;
-    if (heavy) g.read_reuse(reusing, frame.id);
-    if (reusing) {
+    g.upload_geometry();
+    if (heavy) g.draw_shadow_map(pass);
+    g.clear_targets(pass);
+    REPRISE_TRY(g.shade(pass));
+    g.read_back(pass, frame);
+    if (heavy) g.read_reuse(pass.reusing, frame.id);
+    if (pass.reusing) {
         g.cache_valid = true;
         g.cache_time = current.time;
         g.cache_view = current.view;
@@ -980,6 +754,280 @@ Status Renderer::render(const Scene& scene, const Instant& current, const Instan
     else
         frame.ui.clear();
     return {};
+}
+
+void Renderer::Gpu::upload_geometry() {
+    glBindVertexArray(vertex_array);
+    glBindBuffer(GL_ARRAY_BUFFER, vertex_buffer);
+    glBufferData(GL_ARRAY_BUFFER, GLsizeiptr(vertices.size() * sizeof(Vertex)), vertices.data(),
+                 GL_STREAM_DRAW);
+    glBindBuffer(GL_ELEMENT_ARRAY_BUFFER, index_buffer);
+    glBufferData(GL_ELEMENT_ARRAY_BUFFER, GLsizeiptr(indices.size() * sizeof(uint32_t)),
+                 indices.data(), GL_STREAM_DRAW);
+}
+
+// Heavy shading: the key light's depth, seen from the light.
+void Renderer::Gpu::draw_shadow_map(Pass& p) {
+    p.light_matrix = shadow_light_matrix(vertices, p.light_direction);
+    glBindFramebuffer(GL_FRAMEBUFFER, shadow_framebuffer);
+    glViewport(0, 0, kShadowMapSize, kShadowMapSize);
+    glClearDepthf(1.0f);
+    glClear(GL_DEPTH_BUFFER_BIT);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDisable(GL_CULL_FACE);
+    glUseProgram(shadow_program);
+    glUniformMatrix4fv(glGetUniformLocation(shadow_program, "u_light_matrix"), 1, GL_FALSE,
+                       glm::value_ptr(p.light_matrix));
+    for (const Draw& d : draws)
+        glDrawElements(GL_TRIANGLES, d.index_count, GL_UNSIGNED_INT,
+                       (void*)(std::size_t(d.first_index) * sizeof(uint32_t)));
+}
+
+// The G-buffer targets (and the reuse cache's, when reusing) bound and cleared.
+void Renderer::Gpu::clear_targets(const Pass& p) {
+    glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
+    glViewport(0, 0, p.w, p.h);
+    const int slot = cache_slot;
+    if (p.reusing) {
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT3, GL_TEXTURE_2D,
+                               cache_term[slot], 0);
+        glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT4, GL_TEXTURE_2D,
+                               cache_meta[slot], 0);
+        const GLenum buffers[5] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1, GL_COLOR_ATTACHMENT2,
+                                   GL_COLOR_ATTACHMENT3, GL_COLOR_ATTACHMENT4};
+        glDrawBuffers(5, buffers);
+        const glm::vec4 empty_meta(-1.0f, 0.0f, 0.0f, 0.0f);
+        glClearBufferfv(GL_COLOR, 3, glm::value_ptr(glm::vec4(0.0f)));
+        glClearBufferfv(GL_COLOR, 4, glm::value_ptr(empty_meta));
+    } else {
+        const GLenum buffers[3] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1,
+                                   GL_COLOR_ATTACHMENT2};
+        glDrawBuffers(3, buffers);
+    }
+    const glm::vec4 sky(p.scene.background, 0.0f), zero(0.0f);
+    glClearBufferfv(GL_COLOR, 0, glm::value_ptr(sky));
+    glClearBufferfv(GL_COLOR, 1, glm::value_ptr(zero));
+    glClearBufferfv(GL_COLOR, 2, glm::value_ptr(zero));
+    glClearDepthf(1.0f);
+    glClearStencil(0);
+    glClear(GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
+    glEnable(GL_DEPTH_TEST);
+    glDepthFunc(GL_LESS);
+    glDisable(GL_BLEND);
+}
+
+// Everything a program of the main pass needs besides the per-draw material.
+void Renderer::Gpu::use(const Pass& p, GLuint shader) {
+    active = shader;
+    glUseProgram(shader);
+    glUniformMatrix4fv(uniform("u_view_projection"), 1, GL_FALSE,
+                       glm::value_ptr(p.view_projection));
+    glUniformMatrix4fv(uniform("u_unjittered_view_projection"), 1, GL_FALSE,
+                       glm::value_ptr(p.unjittered));
+    glUniformMatrix4fv(uniform("u_view"), 1, GL_FALSE, glm::value_ptr(p.current.view));
+    glUniformMatrix4fv(uniform("u_previous_view_projection"), 1, GL_FALSE,
+                       glm::value_ptr(p.previous_view_projection));
+    glUniform2f(uniform("u_size"), float(p.w), float(p.h));
+    glUniform3fv(uniform("u_eye"), 1, glm::value_ptr(p.eye));
+    glUniform3fv(uniform("u_light_direction"), 1, glm::value_ptr(p.light_direction));
+    glUniform3fv(uniform("u_light_color"), 1, glm::value_ptr(p.scene.light.color));
+    glUniform3fv(uniform("u_ambient"), 1, glm::value_ptr(p.scene.light.ambient));
+    glUniform1i(uniform("u_lit"), p.settings.shading == Shading::Lit);
+    glUniform1i(uniform("u_texture"), 0);
+    glUniform1f(uniform("u_lod_bias"),
+                std::isfinite(p.settings.texture_lod_bias) ? p.settings.texture_lod_bias : 0.0f);
+    if (p.heavy) set_heavy_uniforms(p.scene, p.current, p.settings, p.light_matrix, p.cache_usable);
+    glActiveTexture(GL_TEXTURE0);
+}
+
+void Renderer::Gpu::draw_all(const Scene& scene, bool materials) {
+    static const Material fallback;
+    const GLint base_color = uniform("u_base_color"), textured = uniform("u_textured"),
+                specular = uniform("u_specular"), shininess = uniform("u_shininess"),
+                mirror = uniform("u_mirror"), id = uniform("u_id");
+    for (const Draw& d : draws) {
+        const Material& m = d.material >= 0 ? scene.materials[d.material] : fallback;
+        if (materials) {
+            glUniform4fv(base_color, 1, glm::value_ptr(m.base_color));
+            glUniform1i(textured, m.base_color_texture >= 0);
+            if (m.base_color_texture >= 0)
+                glBindTexture(GL_TEXTURE_2D, textures[m.base_color_texture]);
+            glUniform1f(specular, m.specular);
+            glUniform1f(shininess, m.shininess);
+            glUniform1f(mirror, m.mirror);
+            glUniform1f(id, d.id);
+        }
+        if (m.double_sided)
+            glDisable(GL_CULL_FACE);
+        else
+            glEnable(GL_CULL_FACE);
+        glFrontFace(d.mirrored ? GL_CW : GL_CCW);
+        glDrawElements(GL_TRIANGLES, d.index_count, GL_UNSIGNED_INT,
+                       (void*)(std::size_t(d.first_index) * sizeof(uint32_t)));
+    }
+}
+
+// The main pass: lit (single sample, MSAA resolved, or supersampled) or heavy (a depth
+// pre-pass, then full shading or the reuse cache's hit and miss passes).
+Status Renderer::Gpu::shade(const Pass& p) {
+    const auto shading_start = std::chrono::steady_clock::now();
+    const double shading_cpu_start = process_cpu_ms();
+    const int w = p.w, h = p.h, aa = p.aa;
+    const glm::vec4 sky(p.scene.background, 0.0f), zero(0.0f);
+    if (!p.heavy) {
+        use(p, program);
+        draw_all(p.scene, true);
+        if (p.msaa) {
+            // The same draws into the multisampled target, resolved into the colour target.
+            REPRISE_TRY(prepare_msaa(aa, w, h));
+            glBindFramebuffer(GL_FRAMEBUFFER, msaa_framebuffer);
+            glClearBufferfv(GL_COLOR, 0, glm::value_ptr(sky));
+            glClear(GL_DEPTH_BUFFER_BIT);
+            draw_all(p.scene, true);
+            glBindFramebuffer(GL_DRAW_FRAMEBUFFER, framebuffer);
+            const GLenum color_only = GL_COLOR_ATTACHMENT0;
+            glDrawBuffers(1, &color_only);
+            glBlitFramebuffer(0, 0, w, h, 0, 0, w, h, GL_COLOR_BUFFER_BIT, GL_NEAREST);
+            glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
+        } else if (aa > 1) {
+            // Supersampling: the mean of `aa` passes, each sampling around p + jitter + offset;
+            // sky where a pass drew nothing is added on read-back from the summed coverage.
+            // Each pass lays depth first, then adds the one fragment per pixel at that depth
+            // (the stencil admits a single one where coplanar surfaces tie).
+            const GLenum color_only = GL_COLOR_ATTACHMENT0;
+            glDrawBuffers(1, &color_only);
+            glClearBufferfv(GL_COLOR, 0, glm::value_ptr(zero));
+            glBlendFunc(GL_CONSTANT_ALPHA, GL_ONE);
+            glBlendColor(0.0f, 0.0f, 0.0f, 1.0f / float(aa));
+            glStencilFunc(GL_EQUAL, 0, 0xff);
+            glStencilOp(GL_KEEP, GL_KEEP, GL_INCR);
+            const GLint matrix = uniform("u_view_projection");
+            const glm::vec2* offsets = supersample_positions(aa);
+            for (int i = 0; i < aa; ++i) {
+                const glm::mat4 sample =
+                    shifted(p.unjittered, p.current.jitter + offsets[i] / 16.0f, w, h);
+                glUniformMatrix4fv(matrix, 1, GL_FALSE, glm::value_ptr(sample));
+                glDepthMask(GL_TRUE);  // glClear obeys the write mask
+                glClear(GL_DEPTH_BUFFER_BIT | GL_STENCIL_BUFFER_BIT);
+                glDepthFunc(GL_LESS);
+                glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+                draw_all(p.scene, false);
+                glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+                glDepthFunc(GL_EQUAL);
+                glDepthMask(GL_FALSE);
+                glEnable(GL_STENCIL_TEST);
+                glEnable(GL_BLEND);
+                draw_all(p.scene, true);
+                glDisable(GL_BLEND);
+                glDisable(GL_STENCIL_TEST);
+            }
+            glDepthFunc(GL_LESS);
+            glDepthMask(GL_TRUE);
+        }
+        return {};
+    }
+    // Depth pre-pass: each pixel then runs the heavy shader once.
+    active = shadow_program;
+    glUseProgram(shadow_program);
+    glUniformMatrix4fv(uniform("u_light_matrix"), 1, GL_FALSE, glm::value_ptr(p.view_projection));
+    glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+    draw_all(p.scene, false);
+    glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+    glDepthFunc(GL_LEQUAL);
+    glDepthMask(GL_FALSE);
+    if (!p.reusing) {
+        use(p, heavy_program[0]);
+        draw_all(p.scene, true);
+    } else {
+        // Nehab's two-pass control flow with the stencil in place of a depth shift: the hit
+        // pass marks what it reused; the miss pass shades the rest and is culled early
+        // wherever the hit pass covered a whole block.
+        glEnable(GL_STENCIL_TEST);
+        glStencilMask(0xff);
+        glStencilFunc(GL_ALWAYS, 1, 0xff);
+        glStencilOp(GL_KEEP, GL_KEEP, GL_REPLACE);
+        use(p, heavy_program[1]);
+        draw_all(p.scene, true);
+        glStencilFunc(GL_EQUAL, 0, 0xff);
+        glStencilOp(GL_KEEP, GL_KEEP, GL_KEEP);
+        use(p, heavy_program[2]);
+        draw_all(p.scene, true);
+        glDisable(GL_STENCIL_TEST);
+    }
+    glDepthMask(GL_TRUE);
+    glDepthFunc(GL_LESS);
+    glFinish();
+    stats.shading_ms =
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - shading_start)
+            .count();
+    stats.shading_cpu_ms = process_cpu_ms() - shading_cpu_start;
+    return {};
+}
+
+// Read back, turning GL's bottom-up rows into top-down images; the background's depth and
+// motion are computed here.
+void Renderer::Gpu::read_back(const Pass& p, Frame& frame) {
+    const int w = p.w, h = p.h;
+    if (frame.width() != w || frame.height() != h || frame.depth.empty() || frame.id.empty()) {
+        frame.color.resize(w, h);
+        frame.depth.resize(w, h);
+        frame.motion.resize(w, h);
+        frame.normal.resize(w, h);
+        frame.id.resize(w, h);
+    }
+    readback.resize(std::size_t(w) * h);
+    auto read = [&](int attachment, auto&& store) {
+        glReadBuffer(GL_COLOR_ATTACHMENT0 + attachment);
+        glReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, readback.data());
+        for (int y = 0; y < h; ++y) {
+            const glm::vec4* row = readback.data() + std::size_t(h - 1 - y) * w;
+            for (int x = 0; x < w; ++x) store(x, y, row[x]);
+        }
+    };
+    const glm::vec3 background = p.scene.background;
+    if (p.aa > 1 && !p.msaa)
+        read(0, [&](int x, int y, glm::vec4 v) {
+            frame.color(x, y) = glm::vec4(glm::vec3(v) + (1.0f - v.a) * background, v.a);
+        });
+    else
+        read(0, [&](int x, int y, glm::vec4 v) { frame.color(x, y) = v; });
+    read(2, [&](int x, int y, glm::vec4 v) { frame.normal(x, y) = glm::vec3(v); });
+    // Background: depth +inf, motion of the point at infinity seen through this pixel, with
+    // both ends projected the same way (a still camera gives exactly 0).
+    // Orthographic cameras see the far plane instead (w = 1: a point, not a direction).
+    const double point = p.current.projection[3][3] == 1.0f ? 1.0 : 0.0;
+    const glm::dmat4 unproject = glm::inverse(glm::dmat4(p.view_projection));
+    auto to_pixels = [&](const glm::mat4& matrix, glm::dvec4 world, glm::dvec2& pixel) {
+        glm::dvec4 clip = glm::dmat4(matrix) * world;
+        pixel = {(clip.x / clip.w * 0.5 + 0.5) * w, (0.5 - 0.5 * clip.y / clip.w) * h};
+        return clip.w > 0.0;
+    };
+    const float nan = std::numeric_limits<float>::quiet_NaN();
+    read(1, [&](int x, int y, glm::vec4 v) {
+        if (v.w != 0.0f) {
+            frame.depth(x, y) = v.x;
+            bool behind = std::abs(v.y) >= kNoPrevious;
+            frame.motion(x, y) = behind ? glm::vec2(nan) : glm::vec2(v.y, v.z);
+            frame.id(x, y) = uint32_t(v.w);
+            return;
+        }
+        frame.depth(x, y) = std::numeric_limits<float>::infinity();
+        frame.id(x, y) = 0;
+        glm::dvec2 ndc(2.0 * (x + 0.5) / w - 1.0, 1.0 - 2.0 * (y + 0.5) / h);
+        glm::dvec4 a = unproject * glm::dvec4(ndc, -1.0, 1.0),
+                   b = unproject * glm::dvec4(ndc, point, 1.0);
+        glm::dvec4 world =
+            point == 1.0 ? b / b.w : glm::dvec4(glm::dvec3(b) / b.w - glm::dvec3(a) / a.w, 0.0);
+        glm::dvec2 here, there;
+        bool visible = to_pixels(p.unjittered, world, here) &&
+                       to_pixels(p.previous_view_projection, world, there);
+        frame.motion(x, y) = visible ? glm::vec2(there - here) : glm::vec2(nan);
+    });
+    // Coverage stays the pixel centre's, as without anti-aliasing.
+    if (p.aa > 1)
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) frame.color(x, y).a = frame.id(x, y) != 0 ? 1.0f : 0.0f;
 }
 
 Status Renderer::render_frame(const Scene& scene, const CameraPath& path, int index, double fps,
