@@ -616,6 +616,129 @@ std::string summary_table(const std::vector<SceneSummary>& rows) {
 
 }  // namespace
 
+// The report's opening: what was run and how it is timed.
+void describe(const BenchOptions& job, int w, int h, const std::string& device, Report& report) {
+    report.title = "reprise bench fruc: frame-rate upconversion, error against run time";
+    const int synthesized = (job.frames - 1) * (job.factor - 1);
+    char text[2048];
+    std::snprintf(
+        text, sizeof text,
+        "x%d upconversion of %d input frames at 30 Hz (%dx%d, anti-aliasing %d samples), "
+        "renderer %s. Each method's %d in-between frames are compared with frames rendered at "
+        "%d Hz (display values: PSNR, SSIM, LDR-FLIP); the input frames passed through are not "
+        "scored.",
+        job.factor, job.frames, w, h, job.aa, device.c_str(), synthesized, 30 * job.factor);
+    report.paragraphs.push_back(text);
+    std::snprintf(
+        text, sizeof text,
+        "ms = wall-clock milliseconds per synthesized frame on this machine (%d threads for "
+        "reprise's loops), the fastest of %d runs (machines are shared and noisy). Ours: "
+        "FrameRateConverter::send() alone, from G-buffers in memory. "
+        "opencv-dis: DIS flow (preset MEDIUM) both ways per input pair, shared by its in-between "
+        "frames, plus remap and blend of 8-bit frames. ffmpeg-minterpolate (mi_mode=mci): the "
+        "whole ffmpeg run divided by the frames it synthesized, including process start, raw "
+        "video I/O and RGB/YUV conversion. grid+telea: the grid warp without fill plus "
+        "cv::inpaint (Telea) of its holes. rendered-vectors: the plain use of the rendered motion "
+        "anyone could write (both frames splatted one pixel each along their vectors, nearest "
+        "wins, blended on the same surface, holes by Telea). Scenes marked (held) are glTF "
+        "sample models or sequence folders (--in) no default was tuned on.",
+        thread_count(), job.repeat);
+    report.paragraphs.push_back(text);
+}
+
+// Every method on one scene: our settings (with grid+telea beside those that ask for it), the
+// UI baked into the colour when the scene has one, and the peers.
+Status run_methods(SceneFrames& scene, const std::string& scene_dir,
+                   const std::vector<Setting>& settings, const BenchOptions& job, bool has_ffmpeg,
+                   std::map<std::string, warp::FrucCounters>& auto_counts, std::vector<Run>& runs) {
+    runs.reserve(settings.size() + 3);
+    for (const Setting& setting : settings) {
+        runs.push_back({setting.method, setting.setting});
+        Run telea{"interpolate", "grid+telea"};
+        warp::FrucCounters counters;
+        REPRISE_TRY(run_ours(scene, setting, job.repeat, runs.back(),
+                             setting.with_telea ? &telea : nullptr, counters));
+        progress(scene.name, runs.back());
+        if (setting.setting == "auto")
+            std::fprintf(stderr, "[fruc] %s: %s auto chose / left out:\n%s", scene.name.c_str(),
+                         setting.method.c_str(), auto_choice_summary(counters).c_str());
+        if (setting.setting == "auto") auto_counts[scene.name + " " + setting.method] = counters;
+        if (setting.with_telea) {
+            runs.push_back(std::move(telea));
+            progress(scene.name, runs.back());
+        }
+    }
+    if (!scene.input[0].ui.empty()) {
+        // The same frames with the UI baked into the colour: warped along with the scene.
+        SceneFrames baked = scene;
+        for (Frame& f : baked.input) {
+            composite_ui(f.color.view(), f.ui.view(), f.color.view());
+            f.ui.clear();
+        }
+        Setting plain{"interpolate", "grid+pullpush+ui-warped"};
+        const Status parsed = parse_fruc_options("interpolate", "grid", "pullpush", plain.options);
+        REPRISE_ASSERT(parsed.ok());
+        runs.push_back({plain.method, plain.setting});
+        warp::FrucCounters ignored;
+        REPRISE_TRY(run_ours(baked, plain, job.repeat, runs.back(), nullptr, ignored));
+        progress(scene.name, runs.back());
+    }
+    runs.push_back({kDis, "medium"});
+    run_dis(scene, job.repeat, runs.back());
+    progress(scene.name, runs.back());
+    runs.push_back({kVectors, "splat+telea"});
+    run_vectors(scene, job.repeat, runs.back());
+    progress(scene.name, runs.back());
+    if (has_ffmpeg) {
+        Run ffmpeg{kFfmpeg, "mci"};
+        Status ran = run_ffmpeg(scene, scene_dir, job.repeat, ffmpeg);
+        if (ran.ok()) {
+            runs.push_back(std::move(ffmpeg));
+            progress(scene.name, runs.back());
+        } else {
+            std::printf("note: %s: ffmpeg peer skipped: %s\n", scene.name.c_str(),
+                        ran.message().c_str());
+        }
+    }
+    return {};
+}
+
+// The scene's row of the summary tables; `interpolation` and `peer` get its best interpolation
+// setting and its best peer (null when none ran).
+SceneSummary summarize(const std::string& scene_name, const SceneFrames& scene,
+                       const std::vector<Run>& runs, int w, int h, std::vector<AutoSummary>& autos,
+                       const Run*& interpolation, const Run*& peer) {
+    SceneSummary row{scene.name + (is_held_out(scene_name) ? " (held)" : "")};
+    interpolation = best_of(runs, [](const Run& r) {
+        return r.method == "interpolate" && r.setting != "grid+telea" && r.setting != "auto" &&
+               r.setting != "grid+pullpush+ui-warped";
+    });
+    const Run* extrapolation = best_of(
+        runs, [](const Run& r) { return r.method == "extrapolate" && r.setting != "auto"; });
+    for (const char* mode : {"interpolate", "extrapolate"})
+        autos.push_back(auto_summary(row.scene, mode, runs));
+    peer = best_of(runs, [](const Run& r) { return !r.ours(); });
+    if (interpolation) row.interpolation = interpolation->mean();
+    if (extrapolation) row.extrapolation = extrapolation->mean();
+    for (const Run& r : runs) {
+        if (r.method == "interpolate" && r.setting == "grid+pullpush") {
+            row.refine_on = r.mean();
+            row.region_on = r.region_psnr();
+            row.refine_ms = r.refine_ms;
+            row.region_share = double(r.region_pixels) /
+                               (double(w) * h * std::max<std::size_t>(1, r.scores.size()));
+        }
+        if (r.setting == kRefineOff) {
+            row.refine_off = r.mean();
+            row.region_off = r.region_psnr();
+        }
+        if (r.method == kFfmpeg) row.ffmpeg = r.mean();
+        if (r.method == kDis) row.dis = r.mean();
+        if (r.method == kVectors) row.vectors = r.mean();
+    }
+    return row;
+}
+
 Status bench_fruc(const BenchOptions& job) {
     if (job.factor < 2 || job.factor > 16)
         return Status::error("bench fruc: --factor must be in 2..16");
@@ -652,33 +775,9 @@ Status bench_fruc(const BenchOptions& job) {
     std::vector<AutoSummary> autos;
 
     Report report;
-    report.title = "reprise bench fruc: frame-rate upconversion, error against run time";
+    describe(job, w, h, renderer->device(), report);
     const int synthesized = (job.frames - 1) * (job.factor - 1);
     char text[2048];
-    std::snprintf(
-        text, sizeof text,
-        "x%d upconversion of %d input frames at 30 Hz (%dx%d, anti-aliasing %d samples), "
-        "renderer %s. Each method's %d in-between frames are compared with frames rendered at "
-        "%d Hz (display values: PSNR, SSIM, LDR-FLIP); the input frames passed through are not "
-        "scored.",
-        job.factor, job.frames, w, h, job.aa, renderer->device().c_str(), synthesized,
-        30 * job.factor);
-    report.paragraphs.push_back(text);
-    std::snprintf(
-        text, sizeof text,
-        "ms = wall-clock milliseconds per synthesized frame on this machine (%d threads for "
-        "reprise's loops), the fastest of %d runs (machines are shared and noisy). Ours: "
-        "FrameRateConverter::send() alone, from G-buffers in memory. "
-        "opencv-dis: DIS flow (preset MEDIUM) both ways per input pair, shared by its in-between "
-        "frames, plus remap and blend of 8-bit frames. ffmpeg-minterpolate (mi_mode=mci): the "
-        "whole ffmpeg run divided by the frames it synthesized, including process start, raw "
-        "video I/O and RGB/YUV conversion. grid+telea: the grid warp without fill plus "
-        "cv::inpaint (Telea) of its holes. rendered-vectors: the plain use of the rendered motion "
-        "anyone could write (both frames splatted one pixel each along their vectors, nearest "
-        "wins, blended on the same surface, holes by Telea). Scenes marked (held) are glTF "
-        "sample models or sequence folders (--in) no default was tuned on.",
-        thread_count(), job.repeat);
-    report.paragraphs.push_back(text);
     std::vector<SceneSummary> summaries;
 
     Status failure;
@@ -698,60 +797,8 @@ Status bench_fruc(const BenchOptions& job) {
         write_predictors(predictors_csv.file(), scene);
 
         std::vector<Run> runs;
-        runs.reserve(settings.size() + 3);
-        for (const Setting& setting : settings) {
-            runs.push_back({setting.method, setting.setting});
-            Run telea{"interpolate", "grid+telea"};
-            warp::FrucCounters counters;
-            failure = run_ours(scene, setting, job.repeat, runs.back(),
-                               setting.with_telea ? &telea : nullptr, counters);
-            if (!failure.ok()) break;
-            progress(scene.name, runs.back());
-            if (setting.setting == "auto")
-                std::fprintf(stderr, "[fruc] %s: %s auto chose / left out:\n%s", scene.name.c_str(),
-                             setting.method.c_str(), auto_choice_summary(counters).c_str());
-            if (setting.setting == "auto")
-                auto_counts[scene.name + " " + setting.method] = counters;
-            if (setting.with_telea) {
-                runs.push_back(std::move(telea));
-                progress(scene.name, runs.back());
-            }
-        }
+        failure = run_methods(scene, scene_dir, settings, job, has_ffmpeg, auto_counts, runs);
         if (!failure.ok()) break;
-        if (!scene.input[0].ui.empty()) {
-            // The same frames with the UI baked into the colour: warped along with the scene.
-            SceneFrames baked = scene;
-            for (Frame& f : baked.input) {
-                composite_ui(f.color.view(), f.ui.view(), f.color.view());
-                f.ui.clear();
-            }
-            Setting plain{"interpolate", "grid+pullpush+ui-warped"};
-            const Status parsed =
-                parse_fruc_options("interpolate", "grid", "pullpush", plain.options);
-            REPRISE_ASSERT(parsed.ok());
-            runs.push_back({plain.method, plain.setting});
-            warp::FrucCounters ignored;
-            failure = run_ours(baked, plain, job.repeat, runs.back(), nullptr, ignored);
-            if (!failure.ok()) break;
-            progress(scene.name, runs.back());
-        }
-        runs.push_back({kDis, "medium"});
-        run_dis(scene, job.repeat, runs.back());
-        progress(scene.name, runs.back());
-        runs.push_back({kVectors, "splat+telea"});
-        run_vectors(scene, job.repeat, runs.back());
-        progress(scene.name, runs.back());
-        if (has_ffmpeg) {
-            Run ffmpeg{kFfmpeg, "mci"};
-            Status ran = run_ffmpeg(scene, scene_dir, job.repeat, ffmpeg);
-            if (ran.ok()) {
-                runs.push_back(std::move(ffmpeg));
-                progress(scene.name, runs.back());
-            } else {
-                std::printf("note: %s: ffmpeg peer skipped: %s\n", scene.name.c_str(),
-                            ran.message().c_str());
-            }
-        }
 
         ReportSection section{scene.name};
         for (const server::SceneInfo& info : server::builtin_scenes())
@@ -772,34 +819,9 @@ Status bench_fruc(const BenchOptions& job) {
             section.points.push_back(p);
         }
 
-        SceneSummary row{scene.name + (is_held_out(scene_name) ? " (held)" : "")};
-        const Run* interpolation = best_of(runs, [](const Run& r) {
-            return r.method == "interpolate" && r.setting != "grid+telea" && r.setting != "auto" &&
-                   r.setting != "grid+pullpush+ui-warped";
-        });
-        const Run* extrapolation = best_of(
-            runs, [](const Run& r) { return r.method == "extrapolate" && r.setting != "auto"; });
-        for (const char* mode : {"interpolate", "extrapolate"})
-            autos.push_back(auto_summary(row.scene, mode, runs));
-        const Run* peer = best_of(runs, [](const Run& r) { return !r.ours(); });
-        if (interpolation) row.interpolation = interpolation->mean();
-        if (extrapolation) row.extrapolation = extrapolation->mean();
-        for (const Run& r : runs) {
-            if (r.method == "interpolate" && r.setting == "grid+pullpush") {
-                row.refine_on = r.mean();
-                row.region_on = r.region_psnr();
-                row.refine_ms = r.refine_ms;
-                row.region_share = double(r.region_pixels) /
-                                   (double(w) * h * std::max<std::size_t>(1, r.scores.size()));
-            }
-            if (r.setting == kRefineOff) {
-                row.refine_off = r.mean();
-                row.region_off = r.region_psnr();
-            }
-            if (r.method == kFfmpeg) row.ffmpeg = r.mean();
-            if (r.method == kDis) row.dis = r.mean();
-            if (r.method == kVectors) row.vectors = r.mean();
-        }
+        const Run *interpolation = nullptr, *peer = nullptr;
+        const SceneSummary row =
+            summarize(scene_name, scene, runs, w, h, autos, interpolation, peer);
         summaries.push_back(row);
         if (interpolation) {
             const std::string picture = scene.name + "/worst_frame.png";
