@@ -614,8 +614,6 @@ std::string summary_table(const std::vector<SceneSummary>& rows) {
     return text;
 }
 
-}  // namespace
-
 // The report's opening: what was run and how it is timed.
 void describe(const BenchOptions& job, int w, int h, const std::string& device, Report& report) {
     report.title = "reprise bench fruc: frame-rate upconversion, error against run time";
@@ -738,6 +736,8 @@ SceneSummary summarize(const std::string& scene_name, const SceneFrames& scene,
     }
     return row;
 }
+
+}  // namespace
 
 Status bench_fruc(const BenchOptions& job) {
     if (job.factor < 2 || job.factor > 16)

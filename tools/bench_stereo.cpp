@@ -155,6 +155,92 @@ std::string summary_table(const std::vector<SceneSummary>& rows, bool full_hd) {
     return out;
 }
 
+// The report's opening: what was compared and how it is timed.
+void describe(const stereo::StereoRig& rig, int w, int h, int frames, int repeat,
+              const std::string& device, Report& report) {
+    report.title = "reprise bench stereo: the second eye, error against run time";
+    char text[2048];
+    std::snprintf(
+        text, sizeof text,
+        "The right eye synthesized from the rendered left eye (parallel rig, ipd %.3f) compared "
+        "with "
+        "the right eye rendered, %dx%d, %d frames per scene from t = 10/30 s, renderer %s. Display "
+        "values: PSNR, SSIM, LDR-FLIP. Each scene has two plots: all pixels, and only the "
+        "disoccluded pixels (those no left-eye pixel lands on under a nearest-pixel splat).",
+        rig.ipd, w, h, frames, device.c_str());
+    report.paragraphs.push_back(text);
+    std::snprintf(
+        text, sizeof text,
+        "ms = wall-clock milliseconds per synthesized eye on this machine (%d threads), the "
+        "fastest "
+        "of %d runs. ours: StereoSynthesizer::synthesize() from the left eye's colour + depth in "
+        "memory, per warp (adaptive grid, splat) and fill (none, pull-push, Andreev); "
+        "+history also warps the previous frame's rendered right eye (as when the rendered eye "
+        "alternates per frame). Peers: dibr-splat = forward splat of footprint 1 with a depth test "
+        "and no fill; cv-remap = cv::remap of the left eye by its own disparity (bilinear); "
+        "copy-left-eye = the left eye as it is (ms = the copy). render = the renderer's time for "
+        "the second eye (PSNR +inf by definition, drawn on the top edge).",
+        thread_count(), repeat);
+    report.paragraphs.push_back(text);
+}
+
+// One eye of the path's centre camera at time t, rendered; the fastest of `times` runs in `ms`.
+Status render_eye(server::Renderer& renderer, const server::Scene& scene,
+                  const server::CameraPath& path, const stereo::StereoRig& rig, int w, int h,
+                  double t, stereo::Eye e, int times, Frame& out, double& ms) {
+    const double fps = 30.0;
+    const server::Instant now = server::instant_on_path(path, scene, t, w, h);
+    const server::Instant before = server::instant_on_path(path, scene, t - 1.0 / fps, w, h);
+    Camera centre;
+    centre.view = now.view;
+    centre.projection = now.projection;
+    centre.prev_view = before.view;
+    centre.prev_projection = before.projection;
+    const stereo::EyeCameras eyes = stereo::eye_cameras(centre, rig);
+    server::Instant a = now, b = before;
+    a.view = eyes[e].view;
+    a.projection = eyes[e].projection;
+    b.view = eyes[e].prev_view;
+    b.projection = eyes[e].prev_projection;
+    ms = 1e30;
+    for (int r = 0; r < times; ++r) {
+        auto begin = BenchClock::now();
+        REPRISE_TRY(renderer.render(scene, a, b, {.width = w, .height = h}, out));
+        ms = std::min(ms, ms_since(begin));
+    }
+    return {};
+}
+
+// The scene's summary row: our best and fastest settings, the peers, the renders; `best` and
+// `peer` get our best run and the best peer's.
+SceneSummary summarize(const std::string& name, const std::vector<Run>& runs, double render_left,
+                       double render_right, double dis_fraction, const Run*& best,
+                       const Run*& peer) {
+    SceneSummary row{name};
+    best = nullptr;
+    const Run* fastest = nullptr;
+    peer = nullptr;
+    for (const Run& run : runs) {
+        if (run.ours() && (!best || run.mean().psnr > best->mean().psnr)) best = &run;
+        if (run.ours() && (!fastest || run.mean_ms() < fastest->mean_ms())) fastest = &run;
+        if (!run.ours() && run.method != kRender && (!peer || run.mean().psnr > peer->mean().psnr))
+            peer = &run;
+        if (run.method == kSplatPeer) row.splat = run.mean().psnr;
+        if (run.method == kRemapPeer) row.remap = run.mean().psnr;
+        if (run.method == kCopyPeer) row.copy = run.mean().psnr;
+    }
+    row.best = best->mean();
+    row.best.ms = best->mean_ms();
+    row.best_dis = best->mean(true);
+    row.fastest = fastest->mean();
+    row.fastest.ms = fastest->mean_ms();
+    row.fastest_dis = fastest->mean(true);
+    row.render_left_ms = render_left;
+    row.render_right_ms = render_right;
+    row.disoccluded_fraction = dis_fraction;
+    return row;
+}
+
 }  // namespace
 
 Status bench_stereo(const BenchOptions& options) {
@@ -199,31 +285,8 @@ Status bench_stereo(const BenchOptions& options) {
     settings.push_back({"grid+pullpush+history", {}, true});
 
     Report report;
-    report.title = "reprise bench stereo: the second eye, error against run time";
+    describe(rig, w, h, frames, repeat, renderer->device(), report);
     char text[2048];
-    std::snprintf(
-        text, sizeof text,
-        "The right eye synthesized from the rendered left eye (parallel rig, ipd %.3f) compared "
-        "with "
-        "the right eye rendered, %dx%d, %d frames per scene from t = 10/30 s, renderer %s. Display "
-        "values: PSNR, SSIM, LDR-FLIP. Each scene has two plots: all pixels, and only the "
-        "disoccluded pixels (those no left-eye pixel lands on under a nearest-pixel splat).",
-        rig.ipd, w, h, frames, renderer->device().c_str());
-    report.paragraphs.push_back(text);
-    std::snprintf(
-        text, sizeof text,
-        "ms = wall-clock milliseconds per synthesized eye on this machine (%d threads), the "
-        "fastest "
-        "of %d runs. ours: StereoSynthesizer::synthesize() from the left eye's colour + depth in "
-        "memory, per warp (adaptive grid, splat) and fill (none, pull-push, Andreev); "
-        "+history also warps the previous frame's rendered right eye (as when the rendered eye "
-        "alternates per frame). Peers: dibr-splat = forward splat of footprint 1 with a depth test "
-        "and no fill; cv-remap = cv::remap of the left eye by its own disparity (bilinear); "
-        "copy-left-eye = the left eye as it is (ms = the copy). render = the renderer's time for "
-        "the second eye (PSNR +inf by definition, drawn on the top edge).",
-        thread_count(), repeat);
-    report.paragraphs.push_back(text);
-
     stereo::StereoSynthesizer synthesizer, probe_synth;
     Frame left, right, made, probe, history;
     Image<glm::vec3> truth_d(w, h), test_d(w, h);
@@ -248,30 +311,8 @@ Status bench_stereo(const BenchOptions& options) {
         runs.push_back({kRender, "right eye"});
         double render_left = 0.0, render_right = 0.0, dis_fraction = 0.0;
 
-        // Renders one eye of the centre camera at time t; the fastest of `times` runs.
-        auto render_eye = [&](double t, stereo::Eye e, int times, Frame& out,
-                              double& ms) -> Status {
-            const server::Instant now = server::instant_on_path(path, scene, t, w, h);
-            const server::Instant before =
-                server::instant_on_path(path, scene, t - 1.0 / fps, w, h);
-            Camera centre;
-            centre.view = now.view;
-            centre.projection = now.projection;
-            centre.prev_view = before.view;
-            centre.prev_projection = before.projection;
-            const stereo::EyeCameras eyes = stereo::eye_cameras(centre, rig);
-            server::Instant a = now, b = before;
-            a.view = eyes[e].view;
-            a.projection = eyes[e].projection;
-            b.view = eyes[e].prev_view;
-            b.projection = eyes[e].prev_projection;
-            ms = 1e30;
-            for (int r = 0; r < times; ++r) {
-                auto begin = BenchClock::now();
-                REPRISE_TRY(renderer->render(scene, a, b, {.width = w, .height = h}, out));
-                ms = std::min(ms, ms_since(begin));
-            }
-            return {};
+        auto render_eye = [&](double t, stereo::Eye e, int times, Frame& out, double& ms) {
+            return cli::render_eye(*renderer, scene, path, rig, w, h, t, e, times, out, ms);
         };
 
         {  // warm-up (shader compilation, first upload of the scene): not timed
@@ -370,29 +411,9 @@ Status bench_stereo(const BenchOptions& options) {
         }
         csv.flush();
 
-        SceneSummary row{name};
-        const Run* best = nullptr;
-        const Run* fastest = nullptr;
-        const Run* peer = nullptr;
-        for (const Run& run : runs) {
-            if (run.ours() && (!best || run.mean().psnr > best->mean().psnr)) best = &run;
-            if (run.ours() && (!fastest || run.mean_ms() < fastest->mean_ms())) fastest = &run;
-            if (!run.ours() && run.method != kRender &&
-                (!peer || run.mean().psnr > peer->mean().psnr))
-                peer = &run;
-            if (run.method == kSplatPeer) row.splat = run.mean().psnr;
-            if (run.method == kRemapPeer) row.remap = run.mean().psnr;
-            if (run.method == kCopyPeer) row.copy = run.mean().psnr;
-        }
-        row.best = best->mean();
-        row.best.ms = best->mean_ms();
-        row.best_dis = best->mean(true);
-        row.fastest = fastest->mean();
-        row.fastest.ms = fastest->mean_ms();
-        row.fastest_dis = fastest->mean(true);
-        row.render_left_ms = render_left;
-        row.render_right_ms = render_right;
-        row.disoccluded_fraction = dis_fraction;
+        const Run *best = nullptr, *peer = nullptr;
+        const SceneSummary row =
+            summarize(name, runs, render_left, render_right, dis_fraction, best, peer);
         summaries.push_back(row);
         std::snprintf(
             text, sizeof text,
