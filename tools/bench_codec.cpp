@@ -505,6 +505,189 @@ Status measure_speed(server::Renderer& renderer, const BenchOptions& job, int th
     return {};
 }
 
+// Lossless depth coders' bytes over a sequence.
+struct DepthSummary {
+    std::string scene;
+    double raw = 0, zstd = 0, rvl = 0, rvl16 = 0, ours = NAN;
+};
+
+// reprise's BD-rates against each peer group of one sequence, as rows and in bd_rate.csv.
+void add_bd_rows(const Sequence& seq, const std::vector<RunResult>& runs,
+                 std::vector<BdRow>& bd_rows, CsvFile& bd_csv) {
+    const std::vector<std::string> groups = groups_of(runs);
+    for (const std::string& g : groups) {
+        if (g == kOurs || g == kOursColor || g == kOursStream) continue;
+        BdRow row{seq.name, g, seq.builtin};
+        row.psnr_color = bd_rate(rd_curve(runs, g, false), rd_curve(runs, kOursColor, false));
+        row.psnr_total = bd_rate(rd_curve(runs, g, false), rd_curve(runs, kOurs, false));
+        row.flip_color = bd_rate(rd_curve(runs, g, true), rd_curve(runs, kOursColor, true));
+        row.flip_total = bd_rate(rd_curve(runs, g, true), rd_curve(runs, kOurs, true));
+        row.psnr_stream = bd_rate(rd_curve(runs, g, false), rd_curve(runs, kOursStream, false));
+        row.flip_stream = bd_rate(rd_curve(runs, g, true), rd_curve(runs, kOursStream, true));
+        for (auto [metric, bits, v] : {std::tuple{"psnr", "color", row.psnr_color},
+                                       {"psnr", "total", row.psnr_total},
+                                       {"flip", "color", row.flip_color},
+                                       {"flip", "total", row.flip_total},
+                                       {"psnr", "total-stream", row.psnr_stream},
+                                       {"flip", "total-stream", row.flip_stream}})
+            bd_csv.row({seq.name, g, metric, bits, strf("%.3f", v)});
+        bd_rows.push_back(row);
+    }
+    bd_csv.flush();
+}
+
+// One sequence's table (printed) and report section: rate-distortion curves and time bars.
+void sequence_report(const Sequence& seq, const std::vector<RunResult>& runs, Report& report) {
+    const int sw = seq.frames[0].width(), sh = seq.frames[0].height();
+    const std::vector<std::string> groups = groups_of(runs);
+    std::string table = strf("%s (%dx%d, %zu frames)\n%-22s %-16s %12s %8s %8s %8s %9s %9s\n",
+                             seq.name.c_str(), sw, sh, seq.frames.size(), "codec", "setting",
+                             "bits/frame", "PSNR", "SSIM", "FLIP", "enc ms", "dec ms");
+    ReportSection section{seq.name, seq.note};
+    std::vector<PlotSeries> psnr_series, flip_series;
+    std::vector<BarRow> bars;
+    for (const std::string& g : groups) {
+        PlotSeries ps{g}, fs_{g};
+        ps.dashed = fs_.dashed = g == kOursColor;
+        double enc = 0.0, dec = 0.0;
+        int n = 0;
+        for (const RunResult& r : runs) {
+            if (r.group != g) continue;
+            const double bits = r.mean(&Sample::bits);
+            ps.x.push_back(bits), ps.y.push_back(r.mean_error(&ImageError::psnr));
+            fs_.x.push_back(bits), fs_.y.push_back(r.mean_error(&ImageError::flip));
+            enc += r.mean(&Sample::encode_ms), dec += r.mean(&Sample::decode_ms), ++n;
+            table += strf("%-22s %-16s %12.0f %8.2f %8.4f %8.4f %9.2f %9.2f\n", r.codec.c_str(),
+                          r.setting.c_str(), bits, r.mean_error(&ImageError::psnr),
+                          r.mean_error(&ImageError::ssim), r.mean_error(&ImageError::flip),
+                          r.mean(&Sample::encode_ms), r.mean(&Sample::decode_ms));
+            if (r.codec != kOursColor)
+                section.points.push_back(
+                    {r.codec == kOurs ? std::string(kOurs) : r.group, r.setting,
+                     r.mean_error(&ImageError::psnr), r.mean_error(&ImageError::ssim),
+                     r.mean_error(&ImageError::flip), r.mean(&Sample::encode_ms)});
+        }
+        psnr_series.push_back(std::move(ps));
+        flip_series.push_back(std::move(fs_));
+        if (g != kOursColor) bars.push_back({g, {enc / n, dec / n}});
+    }
+    section.html = "<p>PSNR against bits per frame</p>\n" +
+                   line_plot_svg(psnr_series, {"bits per frame", "PSNR, dB (higher is better)"}) +
+                   "<p>FLIP against bits per frame</p>\n" +
+                   line_plot_svg(flip_series, {"bits per frame", "LDR-FLIP (lower is better)"}) +
+                   "<p>Time per frame, mean over the rate points</p>\n" +
+                   bar_chart_svg(bars, {"encode", "decode"}, "ms per frame");
+    section.time_label = "encode ms per frame (log scale)";
+    report.sections.push_back(std::move(section));
+    std::printf("%s\n", table.c_str());
+    std::fflush(stdout);
+}
+
+// The BD-rate table with the mean over the built-in scenes (also in bd_rate.csv).
+std::string bd_rate_text(const std::vector<BdRow>& bd_rows, CsvFile& bd_csv) {
+    std::string bd_text = strf(
+        "BD-rate of reprise against each peer (negative = reprise needs fewer bits "
+        "for the same quality; total: all bits with lossless depth and per-pixel motion, and "
+        "all bits of the default stream: depth to the view bound, motion within 0.25 px)\n"
+        "%-10s %-20s %12s %12s %12s %12s %14s %14s\n",
+        "scene", "anchor", "PSNR colour", "PSNR total", "FLIP colour", "FLIP total", "PSNR stream",
+        "FLIP stream");
+    std::map<std::string, std::vector<const BdRow*>> by_peer;
+    for (const BdRow& r : bd_rows) {
+        bd_text +=
+            strf("%-10s %-20s %12s %12s %12s %12s %14s %14s\n", r.scene.c_str(), r.peer.c_str(),
+                 pct(r.psnr_color).c_str(), pct(r.psnr_total).c_str(), pct(r.flip_color).c_str(),
+                 pct(r.flip_total).c_str(), pct(r.psnr_stream).c_str(), pct(r.flip_stream).c_str());
+        if (r.builtin) by_peer[r.peer].push_back(&r);
+    }
+    for (const auto& [peer, rows] : by_peer) {
+        double sums[6] = {0, 0, 0, 0, 0, 0};
+        int counts[6] = {0, 0, 0, 0, 0, 0};
+        for (const BdRow* r : rows) {
+            const double v[6] = {r->psnr_color, r->psnr_total,  r->flip_color,
+                                 r->flip_total, r->psnr_stream, r->flip_stream};
+            for (int k = 0; k < 6; ++k)
+                if (!std::isnan(v[k])) sums[k] += v[k], ++counts[k];
+        }
+        double m[6];
+        for (int k = 0; k < 6; ++k) m[k] = counts[k] ? sums[k] / counts[k] : NAN;
+        bd_text += strf("%-10s %-20s %12s %12s %12s %12s %14s %14s\n", "mean", peer.c_str(),
+                        pct(m[0]).c_str(), pct(m[1]).c_str(), pct(m[2]).c_str(), pct(m[3]).c_str(),
+                        pct(m[4]).c_str(), pct(m[5]).c_str());
+        for (auto [metric, bits, v] : {std::tuple{"psnr", "color", m[0]},
+                                       {"psnr", "total", m[1]},
+                                       {"flip", "color", m[2]},
+                                       {"flip", "total", m[3]},
+                                       {"psnr", "total-stream", m[4]},
+                                       {"flip", "total-stream", m[5]}})
+            bd_csv.row({"mean-builtin", peer, metric, bits, strf("%.3f", v)});
+    }
+    return bd_text;
+}
+
+// The depth tables (lossless coders, the view bound, the depth-video peer), the bits by section
+// and the synthesized views; `depth_ratio` gets the mean of zstd -3's bytes over ours.
+std::string depth_text(const std::vector<DepthSummary>& depth_rows,
+                       const std::vector<ViewDepthRun>& view_rows, int qp, double& depth_ratio) {
+    std::string depth_text = strf(
+        "depth, bytes over all frames (raw float = 4 bytes/pixel)\n"
+        "%-10s %12s %12s %12s %12s %14s %12s\n",
+        "scene", "raw", "zstd -3", "rvl float", "rvl 16 lossy", "reprise lossl.", "zstd/reprise");
+    double depth_ratio_sum = 0.0;
+    int depth_ratio_n = 0;
+    for (const DepthSummary& d : depth_rows) {
+        const double ratio = d.zstd / d.ours;
+        depth_text +=
+            strf("%-10s %12.0f %12.0f %12.0f %12.0f %14s %12s\n", d.scene.c_str(), d.raw, d.zstd,
+                 d.rvl, d.rvl16, std::isnan(d.ours) ? "n/a" : strf("%.0f", d.ours).c_str(),
+                 std::isnan(ratio) ? "n/a" : strf("%.2fx", ratio).c_str());
+        if (!std::isnan(ratio)) depth_ratio_sum += ratio, ++depth_ratio_n;
+    }
+
+    const codec::EncoderOptions view_defaults;
+    depth_text += strf(
+        "\ndepth to the view bound (--depth view): 1/z step from the intrinsics so that a camera "
+        "displaced by up to B = %.3f scene units moves no reprojected pixel by more than E = %.2f "
+        "px; qp %d; measured: largest reprojection error of decoded against rendered depth over "
+        "28 displacements of length B\n"
+        "%-10s %12s %12s %12s %10s %12s %12s %10s\n",
+        view_defaults.view_displacement, view_defaults.view_error_px, qp, "scene", "1/z step",
+        "view bytes", "lossless", "ratio", "depth share", "max err px", "bg wrong");
+    std::string motion_text = strf(
+        "\nbits per frame by section at qp %d (depth to the view bound, motion within %.2f px: "
+        "rigid objects and affine models per block, pixels alone where none fits; per-pixel = "
+        "every pixel to 1/8 px)\n%-10s %9s %9s %9s %9s %9s %8s %8s %11s %8s %9s %9s %10s\n",
+        qp, view_defaults.motion_error_px, "scene", "total", "camera", "depth", "motion", "colour",
+        "depth%", "motion%", "per-pixel", "objects", "models", "alone px", "max err px");
+    for (const ViewDepthRun& v : view_rows) {
+        const double n = 8.0 / double(std::max<std::size_t>(1, v.frames));
+        motion_text += strf(
+            "%-10s %9.0f %9.0f %9.0f %9.0f %9.0f %7.1f%% %7.1f%% %11.0f %8.1f %9.1f %9.1f %10.4f  "
+            "%s\n",
+            v.scene.c_str(), v.total_bytes * n, v.camera_bytes * n, v.depth_bytes * n,
+            v.motion_bytes * n, v.color_bytes * n, 100.0 * v.depth_bytes / v.total_bytes,
+            100.0 * v.motion_bytes / v.total_bytes, v.per_pixel_motion_bytes * n,
+            double(v.motion_objects) * n / 8.0, double(v.motion_models) * n / 8.0,
+            double(v.motion_own_pixels) * n / 8.0, v.max_motion_error_px,
+            v.max_motion_error_px <= view_defaults.motion_error_px ? "within the bound"
+                                                                   : "OUTSIDE the bound");
+    }
+    for (const ViewDepthRun& v : view_rows)
+        depth_text +=
+            strf("%-10s %12.3g %12.0f %12.0f %9.3fx %11.1f%% %12.4f %10zu  %s\n", v.scene.c_str(),
+                 double(v.step), v.depth_bytes, v.lossless_depth_bytes,
+                 v.depth_bytes / v.lossless_depth_bytes, 100.0 * v.depth_bytes / v.total_bytes,
+                 v.max_error_px, v.background_mismatches,
+                 v.max_error_px <= view_defaults.view_error_px && v.background_mismatches == 0
+                     ? "within the bound"
+                     : "OUTSIDE the bound");
+    depth_text += depth_video_text(view_rows, view_defaults);
+    depth_text += motion_text;
+    depth_text += synthesized_views_text(view_rows);
+    depth_ratio = depth_ratio_n ? depth_ratio_sum / depth_ratio_n : NAN;
+    return depth_text;
+}
+
 }  // namespace
 
 Status bench_codec(const BenchOptions& job) {
@@ -570,10 +753,6 @@ Status bench_codec(const BenchOptions& job) {
         "colour bits alone and its total bits (camera, depth, motion, colour, headers).");
 
     std::vector<BdRow> bd_rows;
-    struct DepthSummary {
-        std::string scene;
-        double raw = 0, zstd = 0, rvl = 0, rvl16 = 0, ours = NAN;
-    };
     std::vector<DepthSummary> depth_rows;
     std::vector<ViewDepthRun> view_rows;
 
@@ -655,172 +834,15 @@ Status bench_codec(const BenchOptions& job) {
         view_rows.push_back(view);
         depth_csv.flush();
 
-        // BD-rates of reprise against each peer group.
-        const std::vector<std::string> groups = groups_of(runs);
-        for (const std::string& g : groups) {
-            if (g == kOurs || g == kOursColor || g == kOursStream) continue;
-            BdRow row{seq.name, g, seq.builtin};
-            row.psnr_color = bd_rate(rd_curve(runs, g, false), rd_curve(runs, kOursColor, false));
-            row.psnr_total = bd_rate(rd_curve(runs, g, false), rd_curve(runs, kOurs, false));
-            row.flip_color = bd_rate(rd_curve(runs, g, true), rd_curve(runs, kOursColor, true));
-            row.flip_total = bd_rate(rd_curve(runs, g, true), rd_curve(runs, kOurs, true));
-            row.psnr_stream = bd_rate(rd_curve(runs, g, false), rd_curve(runs, kOursStream, false));
-            row.flip_stream = bd_rate(rd_curve(runs, g, true), rd_curve(runs, kOursStream, true));
-            for (auto [metric, bits, v] : {std::tuple{"psnr", "color", row.psnr_color},
-                                           {"psnr", "total", row.psnr_total},
-                                           {"flip", "color", row.flip_color},
-                                           {"flip", "total", row.flip_total},
-                                           {"psnr", "total-stream", row.psnr_stream},
-                                           {"flip", "total-stream", row.flip_stream}})
-                bd_csv.row({seq.name, g, metric, bits, strf("%.3f", v)});
-            bd_rows.push_back(row);
-        }
-        bd_csv.flush();
-
-        // Per-sequence table and report section.
-        std::string table = strf("%s (%dx%d, %zu frames)\n%-22s %-16s %12s %8s %8s %8s %9s %9s\n",
-                                 seq.name.c_str(), sw, sh, seq.frames.size(), "codec", "setting",
-                                 "bits/frame", "PSNR", "SSIM", "FLIP", "enc ms", "dec ms");
-        ReportSection section{seq.name, seq.note};
-        std::vector<PlotSeries> psnr_series, flip_series;
-        std::vector<BarRow> bars;
-        for (const std::string& g : groups) {
-            PlotSeries ps{g}, fs_{g};
-            ps.dashed = fs_.dashed = g == kOursColor;
-            double enc = 0.0, dec = 0.0;
-            int n = 0;
-            for (const RunResult& r : runs) {
-                if (r.group != g) continue;
-                const double bits = r.mean(&Sample::bits);
-                ps.x.push_back(bits), ps.y.push_back(r.mean_error(&ImageError::psnr));
-                fs_.x.push_back(bits), fs_.y.push_back(r.mean_error(&ImageError::flip));
-                enc += r.mean(&Sample::encode_ms), dec += r.mean(&Sample::decode_ms), ++n;
-                table += strf("%-22s %-16s %12.0f %8.2f %8.4f %8.4f %9.2f %9.2f\n", r.codec.c_str(),
-                              r.setting.c_str(), bits, r.mean_error(&ImageError::psnr),
-                              r.mean_error(&ImageError::ssim), r.mean_error(&ImageError::flip),
-                              r.mean(&Sample::encode_ms), r.mean(&Sample::decode_ms));
-                if (r.codec != kOursColor)
-                    section.points.push_back(
-                        {r.codec == kOurs ? std::string(kOurs) : r.group, r.setting,
-                         r.mean_error(&ImageError::psnr), r.mean_error(&ImageError::ssim),
-                         r.mean_error(&ImageError::flip), r.mean(&Sample::encode_ms)});
-            }
-            psnr_series.push_back(std::move(ps));
-            flip_series.push_back(std::move(fs_));
-            if (g != kOursColor) bars.push_back({g, {enc / n, dec / n}});
-        }
-        section.html =
-            "<p>PSNR against bits per frame</p>\n" +
-            line_plot_svg(psnr_series, {"bits per frame", "PSNR, dB (higher is better)"}) +
-            "<p>FLIP against bits per frame</p>\n" +
-            line_plot_svg(flip_series, {"bits per frame", "LDR-FLIP (lower is better)"}) +
-            "<p>Time per frame, mean over the rate points</p>\n" +
-            bar_chart_svg(bars, {"encode", "decode"}, "ms per frame");
-        section.time_label = "encode ms per frame (log scale)";
-        report.sections.push_back(std::move(section));
-        std::printf("%s\n", table.c_str());
-        std::fflush(stdout);
+        add_bd_rows(seq, runs, bd_rows, bd_csv);
+        sequence_report(seq, runs, report);
     }
 
-    // BD-rate table, with the mean over the built-in scenes.
-    std::string bd_text;
-    {
-        bd_text = strf(
-            "BD-rate of reprise against each peer (negative = reprise needs fewer bits "
-            "for the same quality; total: all bits with lossless depth and per-pixel motion, and "
-            "all bits of the default stream: depth to the view bound, motion within 0.25 px)\n"
-            "%-10s %-20s %12s %12s %12s %12s %14s %14s\n",
-            "scene", "anchor", "PSNR colour", "PSNR total", "FLIP colour", "FLIP total",
-            "PSNR stream", "FLIP stream");
-        std::map<std::string, std::vector<const BdRow*>> by_peer;
-        for (const BdRow& r : bd_rows) {
-            bd_text += strf("%-10s %-20s %12s %12s %12s %12s %14s %14s\n", r.scene.c_str(),
-                            r.peer.c_str(), pct(r.psnr_color).c_str(), pct(r.psnr_total).c_str(),
-                            pct(r.flip_color).c_str(), pct(r.flip_total).c_str(),
-                            pct(r.psnr_stream).c_str(), pct(r.flip_stream).c_str());
-            if (r.builtin) by_peer[r.peer].push_back(&r);
-        }
-        for (const auto& [peer, rows] : by_peer) {
-            double sums[6] = {0, 0, 0, 0, 0, 0};
-            int counts[6] = {0, 0, 0, 0, 0, 0};
-            for (const BdRow* r : rows) {
-                const double v[6] = {r->psnr_color, r->psnr_total,  r->flip_color,
-                                     r->flip_total, r->psnr_stream, r->flip_stream};
-                for (int k = 0; k < 6; ++k)
-                    if (!std::isnan(v[k])) sums[k] += v[k], ++counts[k];
-            }
-            double m[6];
-            for (int k = 0; k < 6; ++k) m[k] = counts[k] ? sums[k] / counts[k] : NAN;
-            bd_text += strf("%-10s %-20s %12s %12s %12s %12s %14s %14s\n", "mean", peer.c_str(),
-                            pct(m[0]).c_str(), pct(m[1]).c_str(), pct(m[2]).c_str(),
-                            pct(m[3]).c_str(), pct(m[4]).c_str(), pct(m[5]).c_str());
-            for (auto [metric, bits, v] : {std::tuple{"psnr", "color", m[0]},
-                                           {"psnr", "total", m[1]},
-                                           {"flip", "color", m[2]},
-                                           {"flip", "total", m[3]},
-                                           {"psnr", "total-stream", m[4]},
-                                           {"flip", "total-stream", m[5]}})
-                bd_csv.row({"mean-builtin", peer, metric, bits, strf("%.3f", v)});
-        }
-    }
+    const std::string bd_text = bd_rate_text(bd_rows, bd_csv);
 
-    // Depth table.
-    std::string depth_text = strf(
-        "depth, bytes over all frames (raw float = 4 bytes/pixel)\n"
-        "%-10s %12s %12s %12s %12s %14s %12s\n",
-        "scene", "raw", "zstd -3", "rvl float", "rvl 16 lossy", "reprise lossl.", "zstd/reprise");
-    double depth_ratio_sum = 0.0;
-    int depth_ratio_n = 0;
-    for (const DepthSummary& d : depth_rows) {
-        const double ratio = d.zstd / d.ours;
-        depth_text +=
-            strf("%-10s %12.0f %12.0f %12.0f %12.0f %14s %12s\n", d.scene.c_str(), d.raw, d.zstd,
-                 d.rvl, d.rvl16, std::isnan(d.ours) ? "n/a" : strf("%.0f", d.ours).c_str(),
-                 std::isnan(ratio) ? "n/a" : strf("%.2fx", ratio).c_str());
-        if (!std::isnan(ratio)) depth_ratio_sum += ratio, ++depth_ratio_n;
-    }
-
-    const codec::EncoderOptions view_defaults;
-    depth_text += strf(
-        "\ndepth to the view bound (--depth view): 1/z step from the intrinsics so that a camera "
-        "displaced by up to B = %.3f scene units moves no reprojected pixel by more than E = %.2f "
-        "px; qp %d; measured: largest reprojection error of decoded against rendered depth over "
-        "28 displacements of length B\n"
-        "%-10s %12s %12s %12s %10s %12s %12s %10s\n",
-        view_defaults.view_displacement, view_defaults.view_error_px, qps[qps.size() / 2], "scene",
-        "1/z step", "view bytes", "lossless", "ratio", "depth share", "max err px", "bg wrong");
-    std::string motion_text = strf(
-        "\nbits per frame by section at qp %d (depth to the view bound, motion within %.2f px: "
-        "rigid objects and affine models per block, pixels alone where none fits; per-pixel = "
-        "every pixel to 1/8 px)\n%-10s %9s %9s %9s %9s %9s %8s %8s %11s %8s %9s %9s %10s\n",
-        qps[qps.size() / 2], view_defaults.motion_error_px, "scene", "total", "camera", "depth",
-        "motion", "colour", "depth%", "motion%", "per-pixel", "objects", "models", "alone px",
-        "max err px");
-    for (const ViewDepthRun& v : view_rows) {
-        const double n = 8.0 / double(std::max<std::size_t>(1, v.frames));
-        motion_text += strf(
-            "%-10s %9.0f %9.0f %9.0f %9.0f %9.0f %7.1f%% %7.1f%% %11.0f %8.1f %9.1f %9.1f %10.4f  "
-            "%s\n",
-            v.scene.c_str(), v.total_bytes * n, v.camera_bytes * n, v.depth_bytes * n,
-            v.motion_bytes * n, v.color_bytes * n, 100.0 * v.depth_bytes / v.total_bytes,
-            100.0 * v.motion_bytes / v.total_bytes, v.per_pixel_motion_bytes * n,
-            double(v.motion_objects) * n / 8.0, double(v.motion_models) * n / 8.0,
-            double(v.motion_own_pixels) * n / 8.0, v.max_motion_error_px,
-            v.max_motion_error_px <= view_defaults.motion_error_px ? "within the bound"
-                                                                   : "OUTSIDE the bound");
-    }
-    for (const ViewDepthRun& v : view_rows)
-        depth_text +=
-            strf("%-10s %12.3g %12.0f %12.0f %9.3fx %11.1f%% %12.4f %10zu  %s\n", v.scene.c_str(),
-                 double(v.step), v.depth_bytes, v.lossless_depth_bytes,
-                 v.depth_bytes / v.lossless_depth_bytes, 100.0 * v.depth_bytes / v.total_bytes,
-                 v.max_error_px, v.background_mismatches,
-                 v.max_error_px <= view_defaults.view_error_px && v.background_mismatches == 0
-                     ? "within the bound"
-                     : "OUTSIDE the bound");
-    depth_text += depth_video_text(view_rows, view_defaults);
-    depth_text += motion_text;
-    depth_text += synthesized_views_text(view_rows);
+    double depth_ratio = NAN;
+    const std::string depth_text =
+        cli::depth_text(depth_rows, view_rows, qps[qps.size() / 2], depth_ratio);
 
     // Speed at 1080p.
     SpeedResult speed;
@@ -891,7 +913,6 @@ Status bench_codec(const BenchOptions& job) {
     }
     const double enc_ratio = speed.x264_veryfast_encode / speed.ours_encode;
     const double dec_ratio = speed.ours_encode / speed.ours_decode;
-    const double depth_ratio = depth_ratio_n ? depth_ratio_sum / depth_ratio_n : NAN;
     const bool full_hd = speed.w == 1920 && speed.h == 1080;
     std::string targets = "targets (issue 8 §7, issue 18 §6)\n";
     targets += strf(
