@@ -163,8 +163,10 @@ struct StreamBench {
     CsvFile csv;
     std::vector<MethodSummary> summaries;
 
-    // lowres: reprise's lowres mode only (the peers come from the full-mode run).
-    Status run_condition(const Condition& c, bool lowres) {
+    // The stream under condition c (lowres: reprise's lowres mode) shown at the display rate:
+    // what each display tick showed, and what the server and the client counted.
+    Status stream_and_display(const Condition& c, bool lowres, std::vector<Tick>& ticks,
+                              server::StreamServerStats& sst, client::StreamClientStats& cst) {
         server::StreamServerOptions so{.scene = options.scene,
                                        .listen = {0x7f000001u, 0},
                                        .secret = "bench-stream",
@@ -191,7 +193,6 @@ struct StreamBench {
                                        .downlink = c.down};
         std::unique_ptr<client::StreamClient> client;
         Status s = client::StreamClient::create(co, client);
-        std::vector<Tick> ticks;
         ticks.reserve(std::size_t(duration * display_rate) + 8);
         Image<Rgb8> rgb(width, height);
         if (s.ok())
@@ -222,8 +223,8 @@ struct StreamBench {
         thread.join();
         REPRISE_TRY(s);
         REPRISE_TRY(served);
-        const server::StreamServerStats sst = srv->stats();
-        const client::StreamClientStats cst = client->stats();
+        sst = srv->stats();
+        cst = client->stats();
         std::fprintf(stderr,
                      "[bench stream] %s: server sent %zu frames, skipped %zu; client decoded %zu, "
                      "%zu decode errors, %zu key requests\n",
@@ -238,6 +239,50 @@ struct StreamBench {
                      coded.header_bits / 1e3, coded.camera_bits / 1e3, coded.depth_bits / 1e3,
                      coded.motion_bits / 1e3, coded.color_bits / 1e3, sst.bytes_sent * 8 / 1e3,
                      sst.datagrams_sent, sst.frames_without_parity);
+        return {};
+    }
+
+    // Latency: ours uses the newest pose for every display frame; the peers show a frame first
+    // when it arrives, so theirs is the age of its pose at that moment. Returns the longest time
+    // (s) no new frame was decoded.
+    static double latencies(const std::vector<Tick>& ticks, MethodSummary& ours,
+                            MethodSummary& repeat) {
+        std::map<int64_t, bool> first_shown;
+        double freeze_start = ticks.front().t, longest = 0.0;
+        std::size_t last_decoded = ticks.front().decoded;
+        for (const Tick& k : ticks) {
+            ours.latency_ms.push_back((k.displayed_us - k.pose_us) / 1000.0);
+            if (!first_shown[k.source_pose_us]) {
+                first_shown[k.source_pose_us] = true;
+                repeat.latency_ms.push_back((k.displayed_us - k.source_pose_us) / 1000.0);
+            }
+            if (k.decoded != last_decoded) {
+                longest = std::max(longest, k.t - freeze_start);
+                freeze_start = k.t;
+                last_decoded = k.decoded;
+            }
+        }
+        return std::max(longest, ticks.back().t - freeze_start);
+    }
+
+    // The instants the stream's shown frames were rendered for, each once, in order.
+    static std::vector<double> source_times_of(const std::vector<Tick>& ticks) {
+        std::vector<double> source_times;
+        for (const Tick& k : ticks)
+            if (source_times.empty() || source_times.back() != k.source_time)
+                source_times.push_back(k.source_time);
+        std::sort(source_times.begin(), source_times.end());
+        source_times.erase(std::unique(source_times.begin(), source_times.end()),
+                           source_times.end());
+        return source_times;
+    }
+
+    // lowres: reprise's lowres mode only (the peers come from the full-mode run).
+    Status run_condition(const Condition& c, bool lowres) {
+        std::vector<Tick> ticks;
+        server::StreamServerStats sst;
+        client::StreamClientStats cst;
+        REPRISE_TRY(stream_and_display(c, lowres, ticks, sst, cst));
         if (ticks.empty())
             return Status::error("bench stream: " + c.name + ": nothing was displayed");
         const double seconds = duration;
@@ -254,37 +299,14 @@ struct StreamBench {
             m->fec_recovered = cst.fec_recovered;
             m->decoded = cst.frames_decoded;
         }
-        // Latency: ours uses the newest pose for every display frame; the peers show a frame
-        // first when it arrives, so theirs is the age of its pose at that moment.
-        std::map<int64_t, bool> first_shown;
-        double freeze_start = ticks.front().t, longest = 0.0;
-        std::size_t last_decoded = ticks.front().decoded;
-        for (const Tick& k : ticks) {
-            ours.latency_ms.push_back((k.displayed_us - k.pose_us) / 1000.0);
-            if (!first_shown[k.source_pose_us]) {
-                first_shown[k.source_pose_us] = true;
-                repeat.latency_ms.push_back((k.displayed_us - k.source_pose_us) / 1000.0);
-            }
-            if (k.decoded != last_decoded) {
-                longest = std::max(longest, k.t - freeze_start);
-                freeze_start = k.t;
-                last_decoded = k.decoded;
-            }
-        }
-        longest = std::max(longest, ticks.back().t - freeze_start);
+        const double longest = latencies(ticks, ours, repeat);
         for (MethodSummary* m : all) m->longest_freeze_ms = longest * 1000.0;
         video.latency_ms = video_fine.latency_ms = repeat.latency_ms;
         warped.latency_ms = with_depth.latency_ms = ours.latency_ms;  // at each display pose
 
         // The video-only peer: the same source frames (rendered at their poses) through x264.
         const int method_count = lowres ? 1 : int(all.size());
-        std::vector<double> source_times;
-        for (const Tick& k : ticks)
-            if (source_times.empty() || source_times.back() != k.source_time)
-                source_times.push_back(k.source_time);
-        std::sort(source_times.begin(), source_times.end());
-        source_times.erase(std::unique(source_times.begin(), source_times.end()),
-                           source_times.end());
+        const std::vector<double> source_times = source_times_of(ticks);
         Frame truth;
         std::vector<Image<Rgb8>> sources;
         std::vector<Image<float>> source_depth;
