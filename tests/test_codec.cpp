@@ -665,6 +665,29 @@ TEST(Codec, TheEncoderReadsTheCallersBuffersThroughTheDescriptor) {
     }
 }
 
+TEST(Codec, AColorlessDecoderGivesTheSameGeometryWithoutColor) {
+    const auto frames = render("crossing", 3, 64, 36);
+    Encoder encoder;
+    ASSERT_TRUE(Encoder::create({.depth = DepthMode::View}, encoder).ok());
+    Decoder full, geometry;
+    ASSERT_TRUE(Decoder::create({.color = false}, geometry).ok());
+    Frame a, b;
+    for (const Frame& f : frames) {
+        ASSERT_TRUE(encoder.send_frame(f).ok());
+        Packet p;
+        ASSERT_EQ(encoder.receive_packet(p), Result::Ok);
+        ASSERT_TRUE(full.send_packet(p.data).ok());
+        ASSERT_TRUE(geometry.send_packet(p.data).ok());
+        ASSERT_EQ(full.receive_frame(a), Result::Ok);
+        ASSERT_EQ(geometry.receive_frame(b), Result::Ok);
+        EXPECT_TRUE(b.color.empty());
+        EXPECT_FALSE(a.color.empty());
+        EXPECT_EQ(a.depth, b.depth);
+        EXPECT_TRUE(std::memcmp(a.motion.data(), b.motion.data(),
+                                sizeof(glm::vec2) * a.motion.pixel_count()) == 0);
+    }
+}
+
 TEST(Codec, CreateRefusesBadOptionsNamingThem) {
     const std::pair<EncoderOptions, const char*> bad[] = {
         {{.qp = 52}, "qp 52"},

@@ -40,7 +40,9 @@ struct StreamClient::State {
     bool have_info = false;
     std::unique_ptr<net::Reassembler> reassembler;
     std::unique_ptr<codec::Decoder> decoder;
-    std::unique_ptr<codec::Decoder> color_decoder;  // lowres: the low-resolution colour stream
+    std::unique_ptr<codec::Decoder> color_decoder;
+    bool colorless_decoder =
+        false;  // `decoder` leaves colour out (lowres)  // lowres: the low-resolution colour stream
     Frame low_decoded;
     Image<glm::vec4> upsampled;
     warp::SpatioTemporalUpsampler upsampler;
@@ -93,6 +95,7 @@ struct StreamClient::State {
     void reset_stream() {
         reassembler = std::make_unique<net::Reassembler>();
         decoder = std::make_unique<codec::Decoder>();
+        colorless_decoder = false;
         color_decoder = std::make_unique<codec::Decoder>();
         upsampler.reset();
         newest_completed = -1;
@@ -139,6 +142,9 @@ struct StreamClient::State {
         const bool lowres = have_info && info.mode == net::StreamMode::LowRes;
         std::span<const uint8_t> geometry = packet.data, color;
         bool ok = !lowres || split_bundle(packet.data, geometry, color);
+        // lowres: the colour buffer of the frame handed back to the decoder (which makes none)
+        // stays here for the next upsampling.
+        if (lowres && upsampled.empty()) std::swap(upsampled, scratch_decoded.color);
         ok = ok && decoder->send_packet(geometry).ok() &&
              decoder->receive_frame(scratch_decoded) == Result::Ok;
         if (ok && lowres)
@@ -157,7 +163,7 @@ struct StreamClient::State {
         if (lowres) {
             // Herzog 2010: the low-resolution colour to full resolution, guided by the decoded
             // full-resolution depth and motion; the jitter comes with the colour stream's camera.
-            const int w = scratch_decoded.width(), h = scratch_decoded.height();
+            const int w = scratch_decoded.depth.width(), h = scratch_decoded.depth.height();
             const glm::vec2 footprint(float(w) / float(low_decoded.width()),
                                       float(h) / float(low_decoded.height()));
             const GBufferView guides{.depth = scratch_decoded.depth.view(),
@@ -248,6 +254,14 @@ struct StreamClient::State {
                 if (!net::parse(plaintext, m).ok()) return;
                 info = m;
                 have_info = true;
+                // lowres: the full-resolution stream's colour is never shown (the upsampled
+                // low-resolution colour is): its decoder leaves it out.
+                if (const bool lowres = m.mode == net::StreamMode::LowRes;
+                    lowres != colorless_decoder) {
+                    decoder = std::make_unique<codec::Decoder>();
+                    REPRISE_ASSERT(codec::Decoder::create({.color = !lowres}, *decoder).ok());
+                    colorless_decoder = lowres;
+                }
                 if (phase == Phase::Finished) {
                     phase = Phase::Streaming;
                     ++stats.connects;

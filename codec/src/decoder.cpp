@@ -120,7 +120,10 @@ Status Decoder::send_packet(std::span<const uint8_t> packet) {
         frame.normal.clear();
         frame.id.clear();
     }
-    linear_from_planes(out.planes, s.sp, out.depth.view(), frame.color);
+    if (s.options.color)
+        linear_from_planes(out.planes, s.sp, out.depth.view(), frame.color);
+    else
+        frame.color.clear();
     frame.depth = out.depth;
     frame.motion = out.motion;
     frame.camera = out.camera;
@@ -140,9 +143,11 @@ Result Decoder::receive_frame(Frame& frame) {
     Frame old = std::move(s.queue.front());
     s.queue.pop_front();
     // A frame the caller moved from keeps its size but not its pixels: not reused.
-    if (old.color.width() == s.sp.width && old.color.height() == s.sp.height &&
-        old.color.pixel_count() == std::size_t(s.sp.width) * std::size_t(s.sp.height) &&
-        s.spare.size() < 2)
+    auto whole = [&](const auto& image) {
+        return image.width() == s.sp.width && image.height() == s.sp.height &&
+               image.pixel_count() == std::size_t(s.sp.width) * std::size_t(s.sp.height);
+    };
+    if ((s.options.color ? whole(old.color) : whole(old.depth)) && s.spare.size() < 2)
         s.spare.push_back(std::move(old));
     return Result::Ok;
 }

@@ -191,7 +191,8 @@ void RenderWorker::warm_up() {
     codec::Encoder encoder;
     const Status made = codec::Encoder::create(o.encoder, encoder);  // checked by create
     codec::Packet packet;
-    if (s.ok() && made.ok() && encoder.send_frame(frame).ok()) encoder.receive_packet(packet);
+    if (s.ok() && made.ok() && encoder.send_frame(frame).ok())
+        (void)encoder.receive_packet(packet);  // warm-up: the packet is not sent
     std::fprintf(stderr, "[serve] warmed up: render %.0f ms, encode %.0f ms\n", render_ms,
                  ms_since(t1));
 }

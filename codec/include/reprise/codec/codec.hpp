@@ -147,6 +147,10 @@ struct DecoderOptions {
     // Key frames announcing more pixels are refused: what one stream can make the decoder
     // allocate is bounded (about 60 bytes per pixel for the references it keeps).
     int64_t max_pixels = int64_t(8192) * 4320;
+    // Off: decoded frames carry no colour (Frame::color empty; the size is depth's), for a
+    // geometry stream whose colour the caller does not use (lowres streaming). The colour planes
+    // are still decoded: the next frames predict from them.
+    bool color = true;
 };
 
 class Decoder {
