@@ -688,6 +688,78 @@ std::string depth_text(const std::vector<DepthSummary>& depth_rows,
     return depth_text;
 }
 
+// Every codec on one sequence: reprise at each qp (all bits with lossless depth, its colour
+// alone, the default stream) and each peer, into `runs` and codec.csv; `our_depth_bits` gets
+// reprise's lossless depth bits per frame.
+Status run_codecs(const Sequence& seq, const std::vector<int>& qps,
+                  const std::vector<PeerConfig>& peers, CsvFile& csv, std::vector<RunResult>& runs,
+                  std::vector<double>& our_depth_bits) {
+    for (int qp : qps) {
+        RunResult total, color;
+        REPRISE_TRY(run_ours(seq, qp, false, total, color,
+                             our_depth_bits.empty() ? &our_depth_bits : nullptr));
+        std::fprintf(stderr,
+                     "[codec] %s: reprise qp %2d: %9.0f bits/frame (colour %9.0f) %6.2f dB "
+                     "%8.2f ms enc %8.2f ms dec\n",
+                     seq.name.c_str(), qp, total.mean(&Sample::bits), color.mean(&Sample::bits),
+                     total.mean_error(&ImageError::psnr), total.mean(&Sample::encode_ms),
+                     total.mean(&Sample::decode_ms));
+        runs.push_back(std::move(total));
+        runs.push_back(std::move(color));
+        RunResult stream, unused;
+        REPRISE_TRY(run_ours(seq, qp, true, stream, unused, nullptr));
+        std::fprintf(stderr, "[codec] %s: reprise stream qp %2d: %9.0f bits/frame %6.2f dB\n",
+                     seq.name.c_str(), qp, stream.mean(&Sample::bits),
+                     stream.mean_error(&ImageError::psnr));
+        runs.push_back(std::move(stream));
+    }
+    for (const PeerConfig& config : peers) {
+        RunResult run;
+        REPRISE_TRY(run_peer(seq, config, run));
+        std::fprintf(stderr,
+                     "[codec] %s: %-8s %-18s %9.0f bits/frame %6.2f dB %8.2f ms enc %8.2f ms dec\n",
+                     seq.name.c_str(), run.codec.c_str(), run.setting.c_str(),
+                     run.mean(&Sample::bits), run.mean_error(&ImageError::psnr),
+                     run.mean(&Sample::encode_ms), run.mean(&Sample::decode_ms));
+        runs.push_back(std::move(run));
+    }
+    for (const RunResult& r : runs)
+        for (const Sample& s : r.samples)
+            csv.row({seq.name, r.codec, r.setting, std::to_string(s.frame), strf("%.0f", s.bits),
+                     strf("%.4f", s.error.psnr), strf("%.6f", s.error.ssim),
+                     strf("%.6f", s.error.flip), strf("%.4f", s.encode_ms),
+                     strf("%.4f", s.decode_ms)});
+    csv.flush();
+    return {};
+}
+
+// The lossless depth coders on one sequence (ours from `our_depth_bits`), into depth.csv.
+DepthSummary depth_coders(const Sequence& seq, const std::vector<double>& our_depth_bits,
+                          CsvFile& depth_csv) {
+    const int sw = seq.frames[0].width(), sh = seq.frames[0].height();
+    std::vector<DepthResult> depth;
+    run_depth_peers(seq, depth);
+    if (!our_depth_bits.empty()) {
+        DepthResult ours{"reprise-lossless"};
+        for (double b : our_depth_bits) ours.bytes.push_back(b / 8.0);
+        ours.encode_ms.assign(ours.bytes.size(), NAN);  // inside the codec's frame time
+        ours.decode_ms.assign(ours.bytes.size(), NAN);
+        depth.insert(depth.begin(), std::move(ours));
+    }
+    DepthSummary ds{seq.name};
+    ds.raw = 4.0 * double(sw) * sh * double(seq.frames.size());
+    for (const DepthResult& d : depth) {
+        for (std::size_t i = 0; i < d.bytes.size(); ++i)
+            depth_csv.row({seq.name, d.coder, std::to_string(i), strf("%.0f", d.bytes[i]),
+                           strf("%.4f", d.encode_ms[i]), strf("%.4f", d.decode_ms[i])});
+        if (d.coder == "zstd-3") ds.zstd = d.total_bytes();
+        if (d.coder == "rvl-float") ds.rvl = d.total_bytes();
+        if (d.coder == "rvl-16bit-inverse (lossy)") ds.rvl16 = d.total_bytes();
+        if (d.coder == "reprise-lossless") ds.ours = d.total_bytes();
+    }
+    return ds;
+}
+
 }  // namespace
 
 Status bench_codec(const BenchOptions& job) {
@@ -764,69 +836,12 @@ Status bench_codec(const BenchOptions& job) {
             REPRISE_TRY(read_sequence(input.substr(3), job.frames, seq));
         else
             REPRISE_TRY(render_sequence(*renderer, input, job.frames, w, h, seq));
-        const int sw = seq.frames[0].width(), sh = seq.frames[0].height();
 
         std::vector<RunResult> runs;
         std::vector<double> our_depth_bits;
-        for (int qp : qps) {
-            RunResult total, color;
-            REPRISE_TRY(run_ours(seq, qp, false, total, color,
-                                 our_depth_bits.empty() ? &our_depth_bits : nullptr));
-            std::fprintf(stderr,
-                         "[codec] %s: reprise qp %2d: %9.0f bits/frame (colour %9.0f) %6.2f dB "
-                         "%8.2f ms enc %8.2f ms dec\n",
-                         seq.name.c_str(), qp, total.mean(&Sample::bits), color.mean(&Sample::bits),
-                         total.mean_error(&ImageError::psnr), total.mean(&Sample::encode_ms),
-                         total.mean(&Sample::decode_ms));
-            runs.push_back(std::move(total));
-            runs.push_back(std::move(color));
-            RunResult stream, unused;
-            REPRISE_TRY(run_ours(seq, qp, true, stream, unused, nullptr));
-            std::fprintf(stderr, "[codec] %s: reprise stream qp %2d: %9.0f bits/frame %6.2f dB\n",
-                         seq.name.c_str(), qp, stream.mean(&Sample::bits),
-                         stream.mean_error(&ImageError::psnr));
-            runs.push_back(std::move(stream));
-        }
-        for (const PeerConfig& config : peers) {
-            RunResult run;
-            REPRISE_TRY(run_peer(seq, config, run));
-            std::fprintf(
-                stderr,
-                "[codec] %s: %-8s %-18s %9.0f bits/frame %6.2f dB %8.2f ms enc %8.2f ms dec\n",
-                seq.name.c_str(), run.codec.c_str(), run.setting.c_str(), run.mean(&Sample::bits),
-                run.mean_error(&ImageError::psnr), run.mean(&Sample::encode_ms),
-                run.mean(&Sample::decode_ms));
-            runs.push_back(std::move(run));
-        }
-        for (const RunResult& r : runs)
-            for (const Sample& s : r.samples)
-                csv.row({seq.name, r.codec, r.setting, std::to_string(s.frame),
-                         strf("%.0f", s.bits), strf("%.4f", s.error.psnr),
-                         strf("%.6f", s.error.ssim), strf("%.6f", s.error.flip),
-                         strf("%.4f", s.encode_ms), strf("%.4f", s.decode_ms)});
-        csv.flush();
+        REPRISE_TRY(run_codecs(seq, qps, peers, csv, runs, our_depth_bits));
 
-        // Depth coders.
-        std::vector<DepthResult> depth;
-        run_depth_peers(seq, depth);
-        if (!our_depth_bits.empty()) {
-            DepthResult ours{"reprise-lossless"};
-            for (double b : our_depth_bits) ours.bytes.push_back(b / 8.0);
-            ours.encode_ms.assign(ours.bytes.size(), NAN);  // inside the codec's frame time
-            ours.decode_ms.assign(ours.bytes.size(), NAN);
-            depth.insert(depth.begin(), std::move(ours));
-        }
-        DepthSummary ds{seq.name};
-        ds.raw = 4.0 * double(sw) * sh * double(seq.frames.size());
-        for (const DepthResult& d : depth) {
-            for (std::size_t i = 0; i < d.bytes.size(); ++i)
-                depth_csv.row({seq.name, d.coder, std::to_string(i), strf("%.0f", d.bytes[i]),
-                               strf("%.4f", d.encode_ms[i]), strf("%.4f", d.decode_ms[i])});
-            if (d.coder == "zstd-3") ds.zstd = d.total_bytes();
-            if (d.coder == "rvl-float") ds.rvl = d.total_bytes();
-            if (d.coder == "rvl-16bit-inverse (lossy)") ds.rvl16 = d.total_bytes();
-            if (d.coder == "reprise-lossless") ds.ours = d.total_bytes();
-        }
+        const DepthSummary ds = depth_coders(seq, our_depth_bits, depth_csv);
         depth_rows.push_back(ds);
         ViewDepthRun view;
         REPRISE_TRY(run_view_depth(*renderer, seq, qps[qps.size() / 2], view));
