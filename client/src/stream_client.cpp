@@ -40,9 +40,8 @@ struct StreamClient::State {
     bool have_info = false;
     std::unique_ptr<net::Reassembler> reassembler;
     std::unique_ptr<codec::Decoder> decoder;
-    std::unique_ptr<codec::Decoder> color_decoder;
-    bool colorless_decoder =
-        false;  // `decoder` leaves colour out (lowres)  // lowres: the low-resolution colour stream
+    std::unique_ptr<codec::Decoder> color_decoder;  // lowres: the low-resolution colour stream
+    bool colorless_decoder = false;                 // `decoder` leaves colour out (lowres)
     Frame low_decoded;
     Image<glm::vec4> upsampled;
     warp::SpatioTemporalUpsampler upsampler;
