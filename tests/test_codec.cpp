@@ -688,6 +688,32 @@ TEST(Codec, AColorlessDecoderGivesTheSameGeometryWithoutColor) {
     }
 }
 
+// A DecodedFrame reads the decoder's picture in place. Held across more frames than the decoder
+// keeps references, it still reads what it was given: the decoder decodes into a new picture
+// instead of the one a frame holds.
+TEST(Codec, ADecodedFrameHeldAcrossManyFramesKeepsItsPicture) {
+    const auto frames = render("crossing", 8, 64, 36);
+    const Coded coded = encode_all(frames, {.depth = DepthMode::View});
+    const std::vector<Frame> copies = decode_all(coded.packets);
+    Decoder decoder;
+    std::vector<DecodedFrame> held(frames.size());
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+        ASSERT_TRUE(decoder.send_packet(coded.packets[i].data).ok());
+        ASSERT_EQ(decoder.receive_frame(held[i]), Result::Ok);
+    }
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+        ASSERT_EQ(held[i].width(), 64);
+        Image<float> depth;
+        Image<glm::vec2> motion;
+        depth.assign(held[i].depth());
+        motion.assign(held[i].motion());
+        EXPECT_TRUE(same_bits(depth, copies[i].depth)) << "frame " << i;
+        EXPECT_TRUE(same_bits(motion, copies[i].motion)) << "frame " << i;
+        EXPECT_TRUE(same_bits(held[i].color, copies[i].color)) << "frame " << i;
+        EXPECT_EQ(held[i].camera.view, copies[i].camera.view) << "frame " << i;
+    }
+}
+
 TEST(Codec, CreateRefusesBadOptionsNamingThem) {
     const std::pair<EncoderOptions, const char*> bad[] = {
         {{.qp = 52}, "qp 52"},

@@ -5,11 +5,10 @@
 #include <utility>
 #include <vector>
 
-#include "reprise/codec/kernel_registry.hpp"
+#include "kernel_case.hpp"
 #include "reprise/core/simd.hpp"
-#include "reprise/warp/kernel_registry.hpp"
 
-namespace reprise::warp {
+namespace reprise::kernels {
 namespace {
 
 const std::vector<std::pair<int, int>> kSizes = {{1, 1},  {1, 7},  {3, 2},    {7, 5},  {17, 3},
@@ -35,11 +34,9 @@ TEST(Kernels, SeveralSimdLevelsAreAvailable) {
 TEST(Kernels, EveryLevelAgreesWithTheReference) {
     RestoreTarget restore;
     const std::vector<simd::Target> targets = simd::available_targets();
-    ASSERT_GE(kernel_registry().size(), 4u);
-    ASSERT_GE(codec::kernel_registry().size(), 2u);
-    std::vector<KernelEntry> entries(kernel_registry().begin(), kernel_registry().end());
-    entries.insert(entries.end(), codec::kernel_registry().begin(), codec::kernel_registry().end());
-    for (const KernelEntry& entry : entries) {
+    ASSERT_GE(warp_kernels().size(), 9u);
+    ASSERT_GE(codec_kernels().size(), 7u);
+    for (const KernelEntry& entry : every_kernel()) {
         std::unique_ptr<KernelCase> k = entry.make();
         uint32_t seed = 1;
         for (const KernelInputs inputs : {KernelInputs::Random, KernelInputs::WorstCase})
@@ -64,4 +61,4 @@ TEST(Kernels, EveryLevelAgreesWithTheReference) {
 }
 
 }  // namespace
-}  // namespace reprise::warp
+}  // namespace reprise::kernels

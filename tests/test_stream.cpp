@@ -77,11 +77,11 @@ Session run(client::StreamClient& c, std::size_t frames, double max_seconds = 30
     Session s;
     Status st = client::run_client(
         c, max_seconds, 60.0, [&](double t) { return server::camera_view(path, scene, t); },
-        [&](const Frame& f, const client::DisplayInfo& info, int64_t displayed_us) {
+        [&](const GBufferView& f, const client::DisplayInfo& info, int64_t displayed_us) {
             s.max_latency_ms = std::max(s.max_latency_ms, (displayed_us - info.pose_us) / 1000.0);
             if (info.scene_time >= warmup && s.shown++ % keep_every == 0) {
                 Shown k{info.scene_time, f.camera.view, {}};
-                k.color = f.color;
+                k.color.assign(f.color);
                 s.kept.push_back(std::move(k));
             }
             return c.stats().frames_decoded < frames;
@@ -227,7 +227,7 @@ TEST(Stream, HeavyLossLowersTheBitrateTarget) {
     // longer; a server too slow for its rate also lowers its target, before it has seen loss).
     ASSERT_TRUE(client::run_client(
                     *c, 20.0, 60.0, [&](double t) { return server::camera_view(path, scene, t); },
-                    [&](const Frame&, const client::DisplayInfo&, int64_t) {
+                    [&](const GBufferView&, const client::DisplayInfo&, int64_t) {
                         const auto st = srv.server->stats();
                         return !(st.loss > 0.1 && st.bitrate_kbps > 0 && st.bitrate_kbps < 1000);
                     })

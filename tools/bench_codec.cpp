@@ -197,7 +197,7 @@ Status run_ours(const Sequence& seq, int qp, bool default_stream, RunResult& tot
     REPRISE_TRY(codec::Encoder::create(options, encoder));
     codec::Decoder decoder;
     codec::Packet packet;
-    Frame decoded;
+    codec::DecodedFrame decoded;
     Image<glm::vec3> display;
     for (std::size_t i = 0; i < seq.frames.size(); ++i) {
         auto start = BenchClock::now();
@@ -216,7 +216,7 @@ Status run_ours(const Sequence& seq, int qp, bool default_stream, RunResult& tot
                          "[codec] note: reprise's stream stats count %zu bits, its packet "
                          "has %zu\n",
                          stats.total_bits(), 8 * packet.data.size());
-        display.resize(decoded.width(), decoded.height());
+        display.resize(decoded.color.width(), decoded.color.height());
         to_display(decoded.color.view(), display.view());
         Sample s{int(i), 8.0 * double(packet.data.size()),
                  image_error(seq.truth[i].view(), display.view()), encode_ms, decode_ms};
@@ -313,7 +313,7 @@ Status run_view_depth(server::Renderer& renderer, const Sequence& seq, int qp, V
     REPRISE_TRY(codec::Encoder::create(options, encoder));
     codec::Decoder decoder;
     codec::Packet packet;
-    Frame decoded;
+    codec::DecodedFrame decoded;
     run.scene = seq.name;
     run.frames = seq.frames.size();
     std::unique_ptr<SynthesizedViewScorer> views;
@@ -328,10 +328,10 @@ Status run_view_depth(server::Renderer& renderer, const Sequence& seq, int qp, V
         if (decoder.receive_frame(decoded) != Result::Ok)
             return Status::error("reprise codec: no decoded frame for frame " + std::to_string(i));
         const codec::ViewDepthError e =
-            codec::measure_view_depth_error(frame.camera, frame.depth.view(), decoded.depth.view(),
+            codec::measure_view_depth_error(frame.camera, frame.depth.view(), decoded.depth(),
                                             options.view_displacement, options.view_error_px);
         if (views) {
-            REPRISE_TRY(views->add(int(i), frame, decoded, run.views));
+            REPRISE_TRY(views->add(int(i), frame, decoded.view(), run.views));
             std::fprintf(stderr, "\r[codec] %s: views from decoded depth %zu/%zu   ",
                          seq.name.c_str(), i + 1, seq.frames.size());
         }
@@ -350,8 +350,9 @@ Status run_view_depth(server::Renderer& renderer, const Sequence& seq, int qp, V
         run.total_bytes += double(packet.data.size());
         Frame given = frame;  // the motion the encoder codes: NaN repaired at its door
         NonfiniteRepair().repair(given);
-        for (std::size_t p = 0; p < given.motion.pixel_count() && !decoded.motion.empty(); ++p) {
-            const glm::vec2 d = decoded.motion.data()[p] - given.motion.data()[p];
+        const ImageView<const glm::vec2> motion = decoded.motion();
+        for (std::size_t p = 0; p < given.motion.pixel_count() && !motion.empty(); ++p) {
+            const glm::vec2 d = motion.data[p] - given.motion.data()[p];
             const double err = std::sqrt(double(d.x) * d.x + double(d.y) * d.y);
             if (std::isfinite(err))
                 run.max_motion_error_px = std::max(run.max_motion_error_px, err);

@@ -1,4 +1,4 @@
-// reprise bench kernels — every (kernel, reference) pair of the warp kernel registry at every SIMD
+// reprise bench kernels — every (kernel, reference) pair of the kernel harness at every SIMD
 // level the CPU runs, against its scalar reference and cv::remap of a float RGBA image of the same
 // size, timed in the same run; each level's output is checked against the reference first.
 #include <cmath>
@@ -12,10 +12,9 @@
 #include "args.hpp"
 #include "bench.hpp"
 #include "bench_report.hpp"
-#include "reprise/codec/kernel_registry.hpp"
+#include "kernel_case.hpp"
 #include "reprise/core/parallel.hpp"
 #include "reprise/core/simd.hpp"
-#include "reprise/warp/kernel_registry.hpp"
 
 namespace reprise::cli {
 
@@ -58,12 +57,9 @@ Timing time_kernel(int runs, Reset&& reset, Run&& run) {
 Status bench_kernels_size(int w, int h, int runs, CsvFile& csv) {
     const std::vector<simd::Target> targets = simd::available_targets();
     Status status;
-    std::vector<warp::KernelEntry> entries;
-    for (const auto registry : {warp::kernel_registry(), codec::kernel_registry()})
-        for (const warp::KernelEntry& entry : registry) entries.push_back(entry);
-    for (const warp::KernelEntry& entry : entries) {
-        std::unique_ptr<warp::KernelCase> k = entry.make();
-        k->generate(w, h, warp::KernelInputs::Random, 7);
+    for (const kernels::KernelEntry& entry : kernels::every_kernel()) {
+        std::unique_ptr<kernels::KernelCase> k = entry.make();
+        k->generate(w, h, kernels::KernelInputs::Random, 7);
         // The peer in between each kernel's runs: the machine's load moves during a run.
         const Timing remap = time_remap(w, h, runs);
         const Timing reference = time_kernel(

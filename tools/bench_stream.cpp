@@ -199,7 +199,7 @@ struct StreamBench {
             s = client::run_client(
                 *client, duration, display_rate,
                 [&](double t) { return server::camera_view(scene.path, scene.scene, t); },
-                [&](const Frame& f, const client::DisplayInfo& info, int64_t displayed_us) {
+                [&](const GBufferView& f, const client::DisplayInfo& info, int64_t displayed_us) {
                     Tick k;
                     k.t = info.scene_time;
                     k.view = f.camera.view;
@@ -212,7 +212,7 @@ struct StreamBench {
                                   f.height() == height;
                     if (k.evaluated) {
                         k.ours = Image<Rgb8>(width, height);
-                        visualize_color(f.color.view(), k.ours.view());
+                        visualize_color(f.color, k.ours.view());
                         k.repeated = Image<Rgb8>(width, height);
                         visualize_color(client->newest_decoded()->color.view(), k.repeated.view());
                     }

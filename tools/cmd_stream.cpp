@@ -254,7 +254,7 @@ Status run_connect(const ConnectJob& job) {
     double latency_sum = 0.0;
     REPRISE_TRY(client::run_client(
         *c, job.duration, job.display_rate, pose,
-        [&](const Frame& f, const client::DisplayInfo& info, int64_t displayed_us) {
+        [&](const GBufferView& f, const client::DisplayInfo& info, int64_t displayed_us) {
             const double latency = (displayed_us - info.pose_us) / 1000.0;
             latency_sum += latency;
             if (writer) {

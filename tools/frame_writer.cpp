@@ -13,7 +13,7 @@ FrameWriter::FrameWriter(std::string folder, std::size_t slots, WriteFunction wr
 
 FrameWriter::~FrameWriter() { (void)finish(); }
 
-bool FrameWriter::submit(const Frame& frame, int index, double time, double fps) {
+bool FrameWriter::submit(const GBufferView& frame, int index, double time, double fps) {
     Job job;
     {
         std::lock_guard lock(mutex_);
@@ -25,7 +25,7 @@ bool FrameWriter::submit(const Frame& frame, int index, double time, double fps)
         job = std::move(free_.back());
         free_.pop_back();
     }
-    job.frame = frame;  // the copy outside the lock; the slot's buffers keep their capacity
+    job.frame.assign(frame);  // the copy outside the lock; the slot's buffers are reused
     job.frame.camera.time = time;
     job.frame.fps = fps;
     job.index = index;

@@ -25,7 +25,7 @@ public:
 
     // Written with its camera time and frame rate set to `time` and `fps` (a displayed frame's
     // instant). False when it was dropped (all slots waiting) or a write failed before.
-    bool submit(const Frame& frame, int index, double time, double fps);
+    bool submit(const GBufferView& frame, int index, double time, double fps);
     // Writes what waits, stops the thread; the first write error, if any.
     Status finish();
     std::size_t written() const;

@@ -89,7 +89,7 @@ bool StreamWindow::pump(double dt) {
 
 glm::mat4 StreamWindow::view() const { return glm::inverse(state_->camera_to_world()); }
 
-void StreamWindow::show(const Frame& frame) {
+void StreamWindow::show(const GBufferView& frame) {
     State& s = *state_;
     const int w = frame.width(), h = frame.height();
     if (!s.texture || s.tw != w || s.th != h) {
@@ -100,7 +100,7 @@ void StreamWindow::show(const Frame& frame) {
         s.pixels = Image<Rgb8>(w, h);
     }
     if (!s.texture) return;
-    visualize_color(frame.color.view(), s.pixels.view());
+    visualize_color(frame.color, s.pixels.view());
     SDL_UpdateTexture(s.texture, nullptr, s.pixels.data(),
                       int(s.pixels.view().stride * sizeof(Rgb8)));
     SDL_RenderClear(s.renderer);

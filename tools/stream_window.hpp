@@ -18,7 +18,7 @@ public:
     // Handles pending events and moves the camera by `dt` seconds; false once the window closed.
     bool pump(double dt);
     glm::mat4 view() const;  // world -> camera of the interactive camera
-    void show(const Frame& frame);
+    void show(const GBufferView& frame);
 
     struct State;
 

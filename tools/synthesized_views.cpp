@@ -30,12 +30,12 @@ SynthesizedViewScorer::SynthesizedViewScorer(server::Renderer& renderer, const s
                                              const server::CameraPath& path, double fps)
     : renderer_(renderer), scene_(scene), path_(path), fps_(fps) {}
 
-Status SynthesizedViewScorer::add(int index, const Frame& rendered, const Frame& decoded,
+Status SynthesizedViewScorer::add(int index, const Frame& rendered, const GBufferView& decoded,
                                   SynthesizedViews& views) {
     const int w = rendered.width(), h = rendered.height();
     const server::RenderSettings settings{.width = w, .height = h};
     // The same decoded colour with the renderer's own depth and motion.
-    lossless_ = decoded;
+    lossless_.assign(decoded);
     lossless_.depth = rendered.depth;
     lossless_.motion = rendered.motion;
     warp::PoseExtrapolator extrapolator;

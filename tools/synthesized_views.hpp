@@ -27,7 +27,8 @@ public:
                           const server::CameraPath& path, double fps);
     // Adds frame `index` of the sequence: `rendered` as the renderer made it, `decoded` as the
     // client got it.
-    Status add(int index, const Frame& rendered, const Frame& decoded, SynthesizedViews& views);
+    Status add(int index, const Frame& rendered, const GBufferView& decoded,
+               SynthesizedViews& views);
 
 private:
     server::Renderer& renderer_;

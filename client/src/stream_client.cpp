@@ -42,14 +42,17 @@ struct StreamClient::State {
     std::unique_ptr<codec::Decoder> decoder;
     std::unique_ptr<codec::Decoder> color_decoder;  // lowres: the low-resolution colour stream
     bool colorless_decoder = false;                 // `decoder` leaves colour out (lowres)
-    Frame low_decoded;
+    codec::DecodedFrame low_decoded;
     Image<glm::vec4> upsampled;
     warp::SpatioTemporalUpsampler upsampler;
     int64_t newest_completed = -1;
     int consecutive_decode_errors = 0;
     int64_t first_decode_error_us = 0;  // of the current run of failures
     uint64_t received_sealed = 0;
-    Frame decoded, scratch_decoded, displayed;
+    // Decoded frames read the decoder's pictures in place (no copy of depth and motion).
+    codec::DecodedFrame decoded, scratch_decoded;
+    Frame displayed;
+    GBufferView shown;
     bool have_decoded = false;
     int64_t decoded_pose_us = 0;
     uint32_t decoded_frame = 0;
@@ -162,11 +165,11 @@ struct StreamClient::State {
         if (lowres) {
             // Herzog 2010: the low-resolution colour to full resolution, guided by the decoded
             // full-resolution depth and motion; the jitter comes with the colour stream's camera.
-            const int w = scratch_decoded.depth.width(), h = scratch_decoded.depth.height();
-            const glm::vec2 footprint(float(w) / float(low_decoded.width()),
-                                      float(h) / float(low_decoded.height()));
-            const GBufferView guides{.depth = scratch_decoded.depth.view(),
-                                     .motion = scratch_decoded.motion.view(),
+            const int w = scratch_decoded.width(), h = scratch_decoded.height();
+            const glm::vec2 footprint(float(w) / float(low_decoded.color.width()),
+                                      float(h) / float(low_decoded.color.height()));
+            const GBufferView guides{.depth = scratch_decoded.depth(),
+                                     .motion = scratch_decoded.motion(),
                                      .camera = scratch_decoded.camera};
             upsampled.resize(w, h);
             upsampler.upsample(low_decoded.color.view(), low_decoded.camera.jitter * footprint,
@@ -408,24 +411,28 @@ void StreamClient::send_pose(const glm::mat4& view, double scene_time, int64_t n
     s.send_sealed(s.message, now_us);
 }
 
-const Frame* StreamClient::display(const glm::mat4& view, double scene_time, int64_t pose_us,
-                                   DisplayInfo& info) {
+const GBufferView* StreamClient::display(const glm::mat4& view, double scene_time, int64_t pose_us,
+                                         DisplayInfo& info) {
     State& s = *state_;
     if (!s.have_decoded) return nullptr;
-    const Frame& f = s.decoded;
+    const codec::DecodedFrame& f = s.decoded;
     info.scene_time = scene_time;
     info.pose_us = pose_us;
     info.source_pose_us = s.decoded_pose_us;
     info.source_scene_time = f.camera.time;
     info.source_frame = s.decoded_frame;
     info.extrapolated = s.options.extrapolate;
-    if (!s.options.extrapolate) return &f;
+    if (!s.options.extrapolate) {
+        s.shown = f.view();
+        return &s.shown;
+    }
     const double fps = s.have_info ? s.info.fps : (f.fps > 0 ? f.fps : 30.0);
     const float periods = float(std::clamp((scene_time - f.camera.time) * fps, 0.0, 8.0));
-    s.extrapolator.extrapolate(f, view, f.camera.projection, periods, s.displayed);
+    s.extrapolator.extrapolate(f.view(), view, f.camera.projection, periods, s.displayed);
     s.displayed.camera.time = scene_time;
     s.displayed.fps = f.fps;
-    return &s.displayed;
+    s.shown = s.displayed.view();
+    return &s.shown;
 }
 
 bool StreamClient::connected() const { return state_->phase == Phase::Streaming; }
@@ -434,7 +441,7 @@ const net::StreamInfoMessage* StreamClient::stream_info() const {
 }
 const StreamClientStats& StreamClient::stats() const { return state_->stats; }
 const net::ResumptionTicket& StreamClient::ticket() const { return state_->ticket; }
-const Frame* StreamClient::newest_decoded() const {
+const codec::DecodedFrame* StreamClient::newest_decoded() const {
     return state_->have_decoded ? &state_->decoded : nullptr;
 }
 
@@ -465,7 +472,7 @@ Status run_client(StreamClient& client, double duration_s, double display_rate,
         const glm::mat4 view = pose(t);
         const int64_t sampled = net::now_us();
         client.send_pose(view, t, sampled);
-        if (const Frame* f = client.display(view, t, sampled, info))
+        if (const GBufferView* f = client.display(view, t, sampled, info))
             if (!show(*f, info, net::now_us())) break;
     }
     return {};

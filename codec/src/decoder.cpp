@@ -61,7 +61,7 @@ Status Decoder::send_packet(std::span<const uint8_t> packet) {
         if (slot < 0)
             return Status::error(where + ": reference frame " + std::to_string(h.reference) +
                                  " is not held");
-        ref = &s.refs[slot];
+        ref = s.refs[slot].get();
     }
     std::span<const uint8_t> sections[4];
     for (auto& section : sections) section = r.bytes(r.varint());
@@ -71,7 +71,7 @@ Status Decoder::send_packet(std::span<const uint8_t> packet) {
                              " bytes after the last section");
 
     FrameContext fc{&sp, ref, key, &s.work};
-    Picture& pic = s.scratch;
+    Picture& pic = *s.scratch;
     StreamStats fs;
     Camera camera;
     double time = 0.0;
@@ -102,54 +102,92 @@ Status Decoder::send_packet(std::span<const uint8_t> packet) {
     pic.frame = h.frame;
     pic.held = true;
     if (key) {
-        for (auto& p : s.refs) p.held = false;
+        for (auto& p : s.refs) p->held = false;
         s.sp = sp;
         s.started = true;
     }
     const int slot = replacement_slot(s.refs, h.kept ? int64_t(h.frame) - h.kept : -1);
-    std::swap(s.refs[slot], pic);
+    std::swap(s.refs[slot], s.scratch);
+    // The picture replaced is the next one decoded into, unless a frame handed out still reads it.
+    if (s.scratch.use_count() > 1) s.scratch = std::make_shared<Picture>();
     s.have_newest = true;
     s.newest = h.frame;
     add_stats(s.stats, fs);
 
-    const Picture& out = s.refs[slot];
-    Frame frame;
+    State::Output out{.picture = s.refs[slot], .fps = s.sp.fps};
     if (!s.spare.empty()) {
-        frame = std::move(s.spare.back());
+        out.color = std::move(s.spare.back());
         s.spare.pop_back();
-        frame.normal.clear();
-        frame.id.clear();
     }
     if (s.options.color)
-        linear_from_planes(out.planes, s.sp, out.depth.view(), frame.color);
+        linear_from_planes(out.picture->planes, s.sp, out.picture->depth.view(), out.color);
     else
-        frame.color.clear();
-    frame.depth = out.depth;
-    frame.motion = out.motion;
-    frame.camera = out.camera;
-    frame.fps = s.sp.fps;
-    s.queue.push_back(std::move(frame));
+        out.color.clear();
+    s.queue.push_back(std::move(out));
     return {};
 }
 
-Result Decoder::receive_frame(Frame& frame) {
+GBufferView DecodedFrame::view() const {
+    return {
+        .color = color.view(), .depth = depth_, .motion = motion_, .camera = camera, .fps = fps};
+}
+
+void DecodedFrame::release() {
+    picture_.reset();
+    depth_ = {}, motion_ = {};
+}
+
+Result Decoder::receive_frame(DecodedFrame& frame) {
     State& s = *state_;
     if (s.queue.empty()) return Result::NeedMoreData;
-    std::swap(frame, s.queue.front());
-    // A stream can spell NaN (lossless depth keeps float bits): repaired on the way out only,
-    // so the references stay the encoder's.
-    s.stats.nonfinite += s.repair.repair(frame);
-    // The caller's previous buffers come back for the next output (no allocation per frame).
-    Frame old = std::move(s.queue.front());
+    State::Output& out = s.queue.front();
+    // The caller's colour buffer comes back for a later frame (no allocation per frame); one
+    // the caller moved from keeps its size but not its pixels, and is not reused.
+    std::swap(frame.color, out.color);
+    const Image<glm::vec4>& old = out.color;
+    if (old.width() == s.sp.width && old.height() == s.sp.height &&
+        old.pixel_count() == std::size_t(s.sp.width) * std::size_t(s.sp.height) &&
+        s.spare.size() < 2)
+        s.spare.push_back(std::move(out.color));
+    const Picture& pic = *out.picture;
+    frame.camera = pic.camera;
+    frame.fps = out.fps;
+    frame.depth_ = pic.depth.view();
+    frame.motion_ = pic.motion.view();
+    frame.picture_ = std::move(out.picture);
     s.queue.pop_front();
-    // A frame the caller moved from keeps its size but not its pixels: not reused.
-    auto whole = [&](const auto& image) {
-        return image.width() == s.sp.width && image.height() == s.sp.height &&
-               image.pixel_count() == std::size_t(s.sp.width) * std::size_t(s.sp.height);
-    };
-    if ((s.options.color ? whole(old.color) : whole(old.depth)) && s.spare.size() < 2)
-        s.spare.push_back(std::move(old));
+    // A stream can spell NaN (lossless depth keeps float bits): repaired in copies, so the
+    // references stay the encoder's.
+    NonfiniteCounts counts = count_nonfinite(frame.view());
+    if (counts.depth) {
+        frame.repaired_depth_.assign(frame.depth_);
+        s.repair.repair_depth(frame.repaired_depth_.view());
+        frame.depth_ = frame.repaired_depth_.view();
+    }
+    if (counts.motion) {
+        frame.repaired_motion_.assign(frame.motion_);
+        s.repair.repair_motion(frame.repaired_motion_.view());
+        frame.motion_ = frame.repaired_motion_.view();
+    }
+    if (counts.color) s.repair.repair_color(frame.color.view());
+    counts.frames = counts.total() > 0;
+    s.stats.nonfinite += counts;
     return Result::Ok;
+}
+
+Result Decoder::receive_frame(Frame& frame) {
+    DecodedFrame& d = state_->as_frame;
+    const Result result = receive_frame(d);
+    if (!result) return result;
+    std::swap(frame.color, d.color);
+    frame.depth.assign(d.depth());
+    frame.motion.assign(d.motion());
+    frame.normal.clear();
+    frame.id.clear();
+    frame.camera = d.camera;
+    frame.fps = d.fps;
+    d.release();
+    return result;
 }
 
 void Decoder::flush() {}

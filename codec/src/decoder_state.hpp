@@ -1,6 +1,7 @@
 #pragma once
 // What a decoder holds between packets; the encoder reads it to resume a stream.
 #include <deque>
+#include <memory>
 #include <vector>
 
 #include "internal.hpp"
@@ -12,15 +13,28 @@ struct Decoder::State {
     DecoderOptions options;
     SequenceParams sp;
     bool started = false;
-    Picture refs[kReferences];
+    // Shared with the DecodedFrames handed out; a picture one of them still holds is not
+    // decoded into again.
+    std::shared_ptr<Picture> refs[kReferences];
     bool have_newest = false;
     uint32_t newest = 0;
-    std::deque<Frame> queue;
-    std::vector<Frame> spare;  // frames handed back by receive_frame, reused for output
+    struct Output {
+        std::shared_ptr<const Picture> picture;
+        Image<glm::vec4> color;
+        double fps = 0.0;
+    };
+    std::deque<Output> queue;
+    std::vector<Image<glm::vec4>> spare;  // colour buffers handed back, reused for output
     StreamStats stats;
     NonfiniteRepair repair;
-    Picture scratch;
+    std::shared_ptr<Picture> scratch;
     Workspace work;
+    DecodedFrame as_frame;  // receive_frame(Frame&)'s, keeping its colour buffer
+
+    State() {
+        for (auto& p : refs) p = std::make_shared<Picture>();
+        scratch = std::make_shared<Picture>();
+    }
 
     int slot_of(uint32_t frame) const { return held_slot(refs, frame); }
 };

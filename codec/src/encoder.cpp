@@ -394,7 +394,7 @@ Status Encoder::resume(std::span<const std::span<const uint8_t>> packets) {
     if (s.started || s.next_frame != 0)
         return Status::error("resume: the encoder has already encoded frames");
     Decoder decoder;
-    Frame decoded;
+    DecodedFrame decoded;
     std::vector<uint32_t> reference_of(packets.size());
     for (uint32_t n = 0; n < packets.size(); ++n) {
         Packet info;
@@ -424,8 +424,9 @@ Status Encoder::resume(std::span<const std::span<const uint8_t>> packets) {
     if (packets.empty()) return {};
     Decoder::State& d = *decoder.state_;
     s.sp = d.sp;
+    decoded.release();
     for (int i = 0; i < kReferences; ++i) {
-        std::swap(s.refs[i], d.refs[i]);
+        s.refs[i] = std::move(*d.refs[i]);
         s.reference_of[i] = s.refs[i].held ? reference_of[s.refs[i].frame] : 0;
         s.tainted[i] = false;
     }

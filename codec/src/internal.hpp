@@ -87,11 +87,28 @@ int default_slices(int height);
 
 struct Workspace;
 
+// Held pictures: values in the encoder, shared with the frames handed out in the decoder.
+inline const Picture& held(const Picture& p) { return p; }
+inline const Picture& held(const std::shared_ptr<Picture>& p) { return *p; }
 // The slot a new picture goes to: a free one, else the picture with the smallest frame number
 // other than `kept`.
-int replacement_slot(const Picture (&refs)[kReferences], int64_t kept = -1);
+template <class Held>
+int replacement_slot(const Held (&refs)[kReferences], int64_t kept = -1) {
+    int slot = -1;
+    for (int i = 0; i < kReferences; ++i) {
+        const Picture& p = held(refs[i]);
+        if (!p.held) return i;
+        if (int64_t(p.frame) != kept && (slot < 0 || p.frame < held(refs[slot]).frame)) slot = i;
+    }
+    return slot;
+}
 // The slot holding frame `frame`, or -1.
-int held_slot(const Picture (&refs)[kReferences], uint32_t frame);
+template <class Held>
+int held_slot(const Held (&refs)[kReferences], uint32_t frame) {
+    for (int i = 0; i < kReferences; ++i)
+        if (held(refs[i]).held && held(refs[i]).frame == frame) return i;
+    return -1;
+}
 
 // --- color.cpp
 // Linear colour -> 8-bit sRGB -> YCoCg-R, chroma averaged 2x2 for 4:2:0.

@@ -160,17 +160,6 @@ std::size_t pull_push_fill(ImageView<T> image, IsBad is_bad, Combine combine,
     return n;
 }
 
-template <class T>
-void copy_into(ImageView<const T> from, Image<T>& to) {
-    if (from.empty()) {
-        to.clear();
-        return;
-    }
-    to.resize(from.width, from.height);
-    for (int y = 0; y < from.height; ++y)
-        std::copy(from.row(y), from.row(y) + from.width, &to(0, y));
-}
-
 const auto any_bad = [](const auto& v) { return bad(v); };
 
 }  // namespace
@@ -228,14 +217,8 @@ const Frame& NonfiniteRepair::clean(const Frame& frame, NonfiniteCounts& counts)
     counts.ui = count(frame.ui.view(), any_bad);
     counts.frames = counts.total() > 0;
     if (counts.total() == 0) return frame;
-    copy_into(frame.color.view(), copy_.color);
-    copy_into(frame.depth.view(), copy_.depth);
-    copy_into(frame.motion.view(), copy_.motion);
-    copy_into(frame.normal.view(), copy_.normal);
-    copy_into(frame.id.view(), copy_.id);
-    copy_into(frame.ui.view(), copy_.ui);
-    copy_.camera = frame.camera;
-    copy_.fps = frame.fps;
+    copy_.assign(frame);
+    copy_.ui.assign(frame.ui.view());
     repair(copy_);
     return copy_;
 }
@@ -243,14 +226,7 @@ const Frame& NonfiniteRepair::clean(const Frame& frame, NonfiniteCounts& counts)
 GBufferView NonfiniteRepair::clean(const GBufferView& frame, NonfiniteCounts& counts) {
     counts = count_nonfinite(frame);
     if (counts.total() == 0) return frame;
-    copy_into(frame.color, copy_.color);
-    copy_into(frame.depth, copy_.depth);
-    copy_into(frame.motion, copy_.motion);
-    copy_into(frame.normal, copy_.normal);
-    copy_into(frame.id, copy_.id);
-    copy_.ui.clear();
-    copy_.camera = frame.camera;
-    copy_.fps = frame.fps;
+    copy_.assign(frame);
     repair(copy_);
     return copy_.view();
 }
@@ -259,7 +235,7 @@ ImageView<const glm::vec4> NonfiniteRepair::clean(ImageView<const glm::vec4> col
                                                   std::size_t& n) {
     n = count(color, any_bad);
     if (n == 0) return color;
-    copy_into(color, color_copy_);
+    color_copy_.assign(color);
     repair_color(color_copy_.view());
     return color_copy_.view();
 }

@@ -18,17 +18,6 @@ float distance_between(const Camera& a, const Camera& b) {
     return glm::length(glm::vec3(glm::inverse(a.view)[3]) - glm::vec3(glm::inverse(b.view)[3]));
 }
 
-template <class T>
-void copy_into(Image<T>& to, ImageView<const T> from) {
-    to.resize(from.width, from.height);
-    parallel_for(
-        0, from.height,
-        [&](int y0, int y1) {
-            for (int y = y0; y < y1; ++y) std::copy_n(from.row(y), from.width, &to(0, y));
-        },
-        64);
-}
-
 }  // namespace
 
 std::size_t StereoSynthesizer::warp_into(const GBufferView& source, const Camera& target,
@@ -86,8 +75,8 @@ StereoStats StereoSynthesizer::synthesize(const GBufferView& given, const Camera
             ? history
             : nullptr;
     if (exact) {
-        copy_into(out.color, exact->color);
-        copy_into(out.depth, exact->depth);
+        out.color.assign(exact->color);
+        out.depth.assign(exact->depth);
         covered_.fill(uint8_t(exact == &rendered));
         stats.covered = exact == &rendered ? n : 0;
         stats.from_history = exact == &rendered ? 0 : n;

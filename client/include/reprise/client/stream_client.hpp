@@ -7,6 +7,7 @@
 #include <memory>
 #include <string>
 
+#include "reprise/codec/codec.hpp"
 #include "reprise/core/frame.hpp"
 #include "reprise/core/status.hpp"
 #include "reprise/net/fault_injector.hpp"
@@ -65,9 +66,10 @@ public:
     // Sends the current pose (scene time in seconds, world -> camera).
     void send_pose(const glm::mat4& view, double scene_time, int64_t now_us);
     // The display frame for this pose: the newest decoded frame extrapolated to it (or shown as
-    // it is without extrapolation). Null before the first frame was decoded.
-    const Frame* display(const glm::mat4& view, double scene_time, int64_t pose_us,
-                         DisplayInfo& info);
+    // it is without extrapolation), valid until the next call. Null before the first frame was
+    // decoded.
+    const GBufferView* display(const glm::mat4& view, double scene_time, int64_t pose_us,
+                               DisplayInfo& info);
 
     bool connected() const;
     const net::StreamInfoMessage* stream_info()
@@ -75,7 +77,7 @@ public:
     const StreamClientStats& stats() const;
     // The newest resumption ticket the server sent (valid once a session was admitted).
     const net::ResumptionTicket& ticket() const;
-    const Frame* newest_decoded() const;
+    const codec::DecodedFrame* newest_decoded() const;
 
     struct State;
 
@@ -89,7 +91,7 @@ private:
 // `pose` gives the world -> camera matrix at t; `show` may return false to stop early.
 using PoseFunction = std::function<glm::mat4(double t)>;
 using ShowFunction =
-    std::function<bool(const Frame& frame, const DisplayInfo& info, int64_t displayed_us)>;
+    std::function<bool(const GBufferView& frame, const DisplayInfo& info, int64_t displayed_us)>;
 Status run_client(StreamClient& client, double duration_s, double display_rate,
                   const PoseFunction& pose, const ShowFunction& show);
 

@@ -153,6 +153,33 @@ struct DecoderOptions {
     bool color = true;
 };
 
+// A decoded frame that shares the decoder's picture, as dav1d hands out its pictures: depth and
+// motion are read where the decoder keeps them to predict the next frames, with no copy, and
+// stay valid (unchanged) while this object holds the picture; colour is its own. Non-finite depth
+// or motion (a lossless stream can spell NaN) comes repaired, in a copy of the channel.
+class DecodedFrame {
+public:
+    Image<glm::vec4> color;  // linear light; empty with DecoderOptions::color = false
+    Camera camera;
+    double fps = 0.0;
+
+    ImageView<const float> depth() const { return depth_; }
+    ImageView<const glm::vec2> motion() const { return motion_; }
+    int width() const { return depth_.width; }  // depth sets the size (colour may be absent)
+    int height() const { return depth_.height; }
+    GBufferView view() const;
+    // Lets go of the picture: the decoder may reuse it (colour stays).
+    void release();
+
+private:
+    friend class Decoder;
+    std::shared_ptr<const void> picture_;
+    ImageView<const float> depth_;
+    ImageView<const glm::vec2> motion_;
+    Image<float> repaired_depth_;
+    Image<glm::vec2> repaired_motion_;
+};
+
 class Decoder {
 public:
     Decoder();  // default options
@@ -166,8 +193,11 @@ public:
     // Takes one whole packet (header + payload). A bad packet is an error Status naming the
     // field; the decoder stays usable and resumes at the next decodable frame.
     Status send_packet(std::span<const uint8_t> packet);
-    // Ok with the next decoded frame in `frame` (its buffers reused), or NeedMoreData: send the
-    // next packet first.
+    // Ok with the next decoded frame in `frame`, or NeedMoreData: send the next packet first.
+    // The frame's colour buffer goes back to the decoder for a later frame (no allocation per
+    // frame); its picture is let go.
+    Result receive_frame(DecodedFrame& frame);
+    // The same into a Frame that owns its channels: depth and motion are copied.
     Result receive_frame(Frame& frame);
     void flush();
 

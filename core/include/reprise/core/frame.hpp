@@ -25,6 +25,12 @@ struct Frame {
         return {color.view(), depth.view(), motion.view(), normal.view(), id.view(), camera, fps};
     }
     operator GBufferView() const { return view(); }  // NOLINT: a Frame is a G-buffer
+    // A copy of the view's channels and camera (no UI layer); buffers of the same size are reused.
+    void assign(const GBufferView& v) {
+        color.assign(v.color), depth.assign(v.depth), motion.assign(v.motion);
+        normal.assign(v.normal), id.assign(v.id), ui.clear();
+        camera = v.camera, fps = v.fps;
+    }
 };
 
 // The display value of linear light: clamp to [0, 1], then the sRGB transfer function.

@@ -73,6 +73,13 @@ public:
         resize(width, height);
         fill(value);
     }
+    // Sizes the image as the view and copies its pixels (any row stride); an empty view empties it.
+    void assign(ImageView<const T> from) {
+        if (from.empty()) return clear();
+        resize(from.width, from.height);
+        for (int y = 0; y < from.height; ++y)
+            std::copy_n(from.row(y), from.width, pixels_.data() + std::size_t(y) * width_);
+    }
     void fill(T value) { std::fill(pixels_.begin(), pixels_.end(), value); }
     void clear() { resize(0, 0); }
 

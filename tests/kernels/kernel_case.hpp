@@ -1,13 +1,16 @@
 #pragma once
-// Every warp kernel that has an optimized version beside its scalar reference, with generators of
-// random and worst-case inputs: `reprise bench kernels` times each at every SIMD level, and
-// tests/test_kernels.cpp checks that each level agrees with the reference (checkasm-style).
+// The checkasm-style kernel harness: every optimized kernel of the libraries (their row kernels,
+// declared beside their scalar references in warp/src/kernels.hpp and codec/src/kernels.hpp) as a
+// case that generates random and worst-case inputs, runs the reference and the kernel, and
+// compares. tests/test_kernels.cpp checks every SIMD level against the reference;
+// `reprise bench kernels` times them.
 #include <cstdint>
 #include <memory>
 #include <span>
 #include <string>
+#include <vector>
 
-namespace reprise::warp {
+namespace reprise::kernels {
 
 enum class KernelInputs {
     Random,     // a plausible frame
@@ -38,6 +41,13 @@ struct KernelEntry {
     std::unique_ptr<KernelCase> (*make)();
 };
 
-std::span<const KernelEntry> kernel_registry();
+std::span<const KernelEntry> warp_kernels();
+std::span<const KernelEntry> codec_kernels();
 
-}  // namespace reprise::warp
+inline std::vector<KernelEntry> every_kernel() {
+    std::vector<KernelEntry> entries(warp_kernels().begin(), warp_kernels().end());
+    entries.insert(entries.end(), codec_kernels().begin(), codec_kernels().end());
+    return entries;
+}
+
+}  // namespace reprise::kernels

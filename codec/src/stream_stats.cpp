@@ -1,4 +1,4 @@
-// What encoder and decoder keep alike: the held pictures' slots and the running counts.
+// The running counts encoder and decoder keep alike.
 #include "internal.hpp"
 
 namespace reprise::codec {
@@ -22,22 +22,6 @@ void add_stats(StreamStats& total, const StreamStats& f) {
     total.motion_objects += f.motion_objects;
     total.depth_zero_blocks += f.depth_zero_blocks;
     total.cameras_fitted += f.cameras_fitted;
-}
-
-int replacement_slot(const Picture (&refs)[kReferences], int64_t kept) {
-    int slot = -1;
-    for (int i = 0; i < kReferences; ++i) {
-        if (!refs[i].held) return i;
-        if (int64_t(refs[i].frame) != kept && (slot < 0 || refs[i].frame < refs[slot].frame))
-            slot = i;
-    }
-    return slot;
-}
-
-int held_slot(const Picture (&refs)[kReferences], uint32_t frame) {
-    for (int i = 0; i < kReferences; ++i)
-        if (refs[i].held && refs[i].frame == frame) return i;
-    return -1;
 }
 
 }  // namespace reprise::codec

@@ -1,46 +1,20 @@
-#include "reprise/codec/kernel_registry.hpp"
-
+// The codec's kernels' cases (codec/src/kernels.hpp): the encoder and decoder must agree, so
+// every case is bit-exact.
+#include <algorithm>
 #include <cmath>
-#include <cstring>
-#include <limits>
-#include <memory>
-#include <random>
-#include <string>
 #include <vector>
 
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "kernels.hpp"
+#include "codec/src/kernels.hpp"
+#include "generators.hpp"
 #include "reprise/core/parallel.hpp"
 
-namespace reprise::codec {
+namespace reprise::kernels {
 
 namespace {
 
-using warp::KernelCase;
-using warp::KernelEntry;
-using warp::KernelInputs;
-
-constexpr float kInf = std::numeric_limits<float>::infinity();
-constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
-
-float uniform(std::mt19937& rng, float a, float b) {
-    return a + (b - a) * float(rng() >> 8) * (1.0f / 16777216.0f);
-}
-
-float worst_value(std::mt19937& rng) {
-    constexpr float values[] = {kNaN,   kInf,   -kInf, 0.0f, -0.0f, 1e30f,
-                                -1e30f, 1e-30f, -1.0f, 0.5f, 3e5f,  -3e5f};
-    return values[rng() % std::size(values)];
-}
-
-template <class T>
-std::string compare_values(const char* what, const std::vector<T>& a, const std::vector<T>& b) {
-    for (std::size_t i = 0; i < a.size(); ++i)
-        if (std::memcmp(&a[i], &b[i], sizeof(T)) != 0)
-            return std::string(what) + ": element " + std::to_string(i) + " differs";
-    return {};
-}
+using namespace reprise::codec;
 
 // Catmull-Rom prediction of a plane (luma, or 4:2:0 chroma from luma motion). Random: a camera
 // pan's smooth motion with 1/64 steps and a depth edge; worst case: NaN/Inf and huge motion,
@@ -75,7 +49,7 @@ public:
     }
     void run() override { run_into(optimized_, predict_row); }
     std::string compare() const override {
-        return compare_values("prediction", optimized_, reference_);
+        return compare_elements("prediction", optimized_, reference_);
     }
 
 private:
@@ -120,10 +94,7 @@ public:
         width_ = w, height_ = h;
         const bool worst = inputs == KernelInputs::WorstCase;
         depth_.resize(std::size_t(w) * h);
-        for (float& z : depth_) {
-            z = rng() % 10 == 0 ? kInf : uniform(rng, 0.5f, 80.0f);
-            if (worst && rng() % 3 == 0) z = worst_value(rng);
-        }
+        for (float& z : depth_) z = random_depth(rng, 0.5f, 80.0f, worst);
         auto v4 = [&](float range) {
             return glm::vec4(uniform(rng, -range, range), uniform(rng, -range, range),
                              uniform(rng, -range, range), uniform(rng, -range, range));
@@ -154,7 +125,7 @@ public:
     }
     void run() override { run_into(optimized_, camera_motion_row); }
     std::string compare() const override {
-        return compare_values("motion", optimized_, reference_);
+        return compare_floats("motion", optimized_, reference_);
     }
 
 private:
@@ -204,7 +175,7 @@ public:
     }
     void run() override { run_into(optimized_, to_planes_row); }
     std::string compare() const override {
-        return compare_values("planes", optimized_, reference_);
+        return compare_elements("planes", optimized_, reference_);
     }
 
 private:
@@ -255,7 +226,7 @@ public:
     }
     void run() override { run_into(optimized_, from_planes_row); }
     std::string compare() const override {
-        return compare_values("colour", optimized_, reference_);
+        return compare_floats("colour", optimized_, reference_);
     }
 
 private:
@@ -292,14 +263,8 @@ public:
         width_ = w, height_ = h;
         const bool worst = inputs == KernelInputs::WorstCase;
         depth_.resize(std::size_t(w) * h);
-        for (float& z : depth_) {
-            z = rng() % 10 == 0 ? kInf : uniform(rng, 0.2f, 60.0f);
-            if (worst && rng() % 3 == 0) z = worst_value(rng);
-        }
-        const bool ortho = seed % 3 == 0;
-        projection_ =
-            ortho ? glm::ortho(-4.0f, 4.0f, -3.0f, 3.0f, 0.1f, 50.0f)
-                  : glm::perspective(uniform(rng, 0.5f, 1.5f), float(w) / float(h), 0.1f, 100.0f);
+        for (float& z : depth_) z = random_depth(rng, 0.2f, 60.0f, worst);
+        projection_ = random_projection(rng, w, h, seed % 3 == 0);
         const float forward = worst ? uniform(rng, 5.0f, 30.0f) : uniform(rng, -0.3f, 0.3f);
         to_camera_ = glm::rotate(
             glm::translate(glm::mat4(1.0f), glm::vec3(uniform(rng, -0.5f, 0.5f),
@@ -399,7 +364,7 @@ public:
     }
     void run() override { run_into(optimized_, motion_residual_row); }
     std::string compare() const override {
-        return compare_values("row needs a residual", optimized_, reference_);
+        return compare_elements("row needs a residual", optimized_, reference_);
     }
 
 private:
@@ -419,11 +384,6 @@ private:
     std::vector<uint8_t> reference_, optimized_;
 };
 
-template <class T, auto... Args>
-std::unique_ptr<KernelCase> make() {
-    return std::make_unique<T>(Args...);
-}
-
 constexpr KernelEntry kEntries[] = {
     {"codec prediction, luma", "bit-exact", true, make<PredictCase, false>},
     {"codec prediction, 4:2:0 chroma", "bit-exact", true, make<PredictCase, true>},
@@ -436,6 +396,6 @@ constexpr KernelEntry kEntries[] = {
 
 }  // namespace
 
-std::span<const KernelEntry> kernel_registry() { return kEntries; }
+std::span<const KernelEntry> codec_kernels() { return kEntries; }
 
-}  // namespace reprise::codec
+}  // namespace reprise::kernels

@@ -1,94 +1,27 @@
-#include "reprise/warp/kernel_registry.hpp"
-
+// The warp kernels' cases (warp/src/kernels.hpp and the public reprojection and splat entry
+// points): random frames and their worst cases.
 #include <algorithm>
 #include <atomic>
 #include <cmath>
-#include <cstring>
-#include <limits>
 #include <optional>
-#include <random>
 #include <utility>
 #include <vector>
 
 #include <glm/gtc/matrix_transform.hpp>
 
-#include "kernels.hpp"
+#include "generators.hpp"
 #include "reprise/core/camera_math.hpp"
 #include "reprise/core/frame.hpp"
 #include "reprise/core/parallel.hpp"
 #include "reprise/warp/reproject.hpp"
 #include "reprise/warp/splat.hpp"
+#include "warp/src/kernels.hpp"
 
-namespace reprise::warp {
+namespace reprise::kernels {
 
 namespace {
 
-constexpr float kInf = std::numeric_limits<float>::infinity();
-constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
-
-float uniform(std::mt19937& rng, float a, float b) {
-    return a + (b - a) * float(rng() >> 8) * (1.0f / 16777216.0f);
-}
-
-// The worst values a float input can hold, picked at random.
-float worst_value(std::mt19937& rng) {
-    constexpr float values[] = {
-        kNaN,  kInf,   -kInf,  0.0f,  -0.0f,
-        1e30f, -1e30f, 1e-30f, -1.0f, std::numeric_limits<float>::denorm_min()};
-    return values[rng() % std::size(values)];
-}
-
-// The worst cases of every depth + motion input: kind 0 a bad depth, 1 a bad motion component,
-// 2 motion (1e30, -1e30). False for other kinds (the caller's own).
-bool spoil_depth_or_motion(std::mt19937& rng, unsigned kind, float& z, glm::vec2& m) {
-    switch (kind) {
-        case 0:
-            z = worst_value(rng);
-            return true;
-        case 1:
-            m[int(rng() % 2)] = worst_value(rng);
-            return true;
-        case 2:
-            m = {1e30f, -1e30f};
-            return true;
-        default:
-            return false;
-    }
-}
-
-// Bitwise equality of two float arrays (NaN payloads included unless `any_nan`: then a NaN
-// matches any NaN); names the first difference.
-template <class T>
-std::string compare_bits(const char* what, const std::vector<T>& a, const std::vector<T>& b,
-                         bool any_nan = false) {
-    const std::size_t floats = a.size() * sizeof(T) / sizeof(float);
-    const auto* fa = reinterpret_cast<const uint32_t*>(a.data());
-    const auto* fb = reinterpret_cast<const uint32_t*>(b.data());
-    for (std::size_t i = 0; i < floats; ++i)
-        if (fa[i] != fb[i]) {
-            float va, vb;
-            std::memcpy(&va, fa + i, 4);
-            std::memcpy(&vb, fb + i, 4);
-            if (any_nan && std::isnan(va) && std::isnan(vb)) continue;
-            return std::string(what) + ": float " + std::to_string(i) + " is " +
-                   std::to_string(va) + ", reference " + std::to_string(vb);
-        }
-    return {};
-}
-
-// Two cameras a little apart (a translation and a turn), perspective or orthographic.
-Camera random_camera(std::mt19937& rng, int w, int h, bool ortho, float move) {
-    Camera c;
-    c.projection =
-        ortho ? glm::ortho(-4.0f, 4.0f, -3.0f, 3.0f, 0.1f, 50.0f)
-              : glm::perspective(uniform(rng, 0.5f, 1.5f), float(w) / float(h), 0.1f, 100.0f);
-    c.view =
-        glm::translate(glm::mat4(1.0f), glm::vec3(uniform(rng, -1, 1), 0, uniform(rng, -1, 1)));
-    c.prev_view = glm::rotate(glm::translate(c.view, move * glm::vec3(0.05f, -0.02f, 0.1f)),
-                              uniform(rng, -0.05f, 0.05f), glm::vec3(0, 1, 0));
-    c.prev_projection = c.projection;
-    return c;
-}
+using namespace reprise::warp;
 
 // ---------------------------------------------------------------------------------------------
 
@@ -158,9 +91,9 @@ public:
             return "holes " + std::to_string(optimized_.holes) + ", reference " +
                    std::to_string(reference_.holes);
         if (optimized_.valid != reference_.valid) return "valid differs";
-        std::string d = compare_bits("colour", optimized_.color, reference_.color);
-        if (d.empty()) d = compare_bits("depth", optimized_.depth, reference_.depth);
-        if (d.empty()) d = compare_bits("motion", optimized_.motion, reference_.motion);
+        std::string d = compare_floats("colour", optimized_.color, reference_.color);
+        if (d.empty()) d = compare_floats("depth", optimized_.depth, reference_.depth);
+        if (d.empty()) d = compare_floats("motion", optimized_.motion, reference_.motion);
         return d;
     }
 
@@ -256,8 +189,8 @@ public:
         if (optimized_.dynamic != reference_.dynamic)
             return "moving pixels " + std::to_string(optimized_.dynamic) + ", reference " +
                    std::to_string(reference_.dynamic);
-        std::string d = compare_bits("depth", optimized_.depth, reference_.depth);
-        if (d.empty()) d = compare_bits("motion", optimized_.motion, reference_.motion);
+        std::string d = compare_floats("depth", optimized_.depth, reference_.depth);
+        if (d.empty()) d = compare_floats("motion", optimized_.motion, reference_.motion);
         return d;
     }
 
@@ -336,8 +269,8 @@ public:
         if (optimized_.holes != reference_.holes || optimized_.empty != reference_.empty)
             return "counts differ";
         if (optimized_.bits != reference_.bits) return "hole bits differ";
-        std::string d = compare_bits("level 1", optimized_.color, reference_.color);
-        if (d.empty()) d = compare_bits("level 1 depth", optimized_.depth, reference_.depth);
+        std::string d = compare_floats("level 1", optimized_.color, reference_.color);
+        if (d.empty()) d = compare_floats("level 1 depth", optimized_.depth, reference_.depth);
         return d;
     }
 
@@ -424,8 +357,8 @@ public:
     void run() override { run_into(optimized_, pull_level_row); }
     std::string compare() const override {
         if (optimized_.empty != reference_.empty) return "empty counts differ";
-        std::string d = compare_bits("level", optimized_.color, reference_.color);
-        if (d.empty()) d = compare_bits("level depth", optimized_.depth, reference_.depth);
+        std::string d = compare_floats("level", optimized_.color, reference_.color);
+        if (d.empty()) d = compare_floats("level depth", optimized_.depth, reference_.depth);
         return d;
     }
 
@@ -532,7 +465,7 @@ public:
                                  optimized_out_.data() + optimized_out_.pixel_count());
         std::vector<glm::vec4> b(reference_out_.data(),
                                  reference_out_.data() + reference_out_.pixel_count());
-        return compare_bits("payload", a, b);
+        return compare_floats("payload", a, b);
     }
 
 private:
@@ -583,8 +516,8 @@ public:
     void run() override { run_into(optimized_, displacement_row); }
     std::string compare() const override {
         std::string d =
-            compare_bits("displacement", optimized_.displacement, reference_.displacement);
-        if (d.empty()) d = compare_bits("target depth", optimized_.depth, reference_.depth);
+            compare_floats("displacement", optimized_.displacement, reference_.displacement);
+        if (d.empty()) d = compare_floats("target depth", optimized_.depth, reference_.depth);
         return d;
     }
 
@@ -658,7 +591,7 @@ public:
                                        optimized_.data() + optimized_.pixel_count());
         const std::vector<glm::vec4> b(reference_.data(),
                                        reference_.data() + reference_.pixel_count());
-        return compare_bits("colour", a, b);
+        return compare_floats("colour", a, b);
     }
 
 private:
@@ -731,7 +664,7 @@ public:
                                        optimized_.data() + optimized_.pixel_count());
         const std::vector<glm::vec4> b(reference_.data(),
                                        reference_.data() + reference_.pixel_count());
-        return compare_bits("colour", a, b, /*any_nan=*/true);
+        return compare_floats("colour", a, b, /*any_nan=*/true);
     }
 
 private:
@@ -817,9 +750,9 @@ public:
                 return footprint + "covered " + std::to_string(a.count) + ", reference " +
                        std::to_string(b.count);
             if (!(a.covered == b.covered)) return footprint + "coverage differs";
-            std::string d = compare_bits("colour", pixels(a.color), pixels(b.color));
-            if (d.empty()) d = compare_bits("depth", pixels(a.depth), pixels(b.depth));
-            if (d.empty()) d = compare_bits("motion", pixels(a.motion), pixels(b.motion));
+            std::string d = compare_floats("colour", pixels(a.color), pixels(b.color));
+            if (d.empty()) d = compare_floats("depth", pixels(a.depth), pixels(b.depth));
+            if (d.empty()) d = compare_floats("motion", pixels(a.motion), pixels(b.motion));
             if (!d.empty()) return footprint + d;
         }
         return {};
@@ -856,11 +789,6 @@ private:
 
 // ---------------------------------------------------------------------------------------------
 
-template <class T>
-std::unique_ptr<KernelCase> make() {
-    return std::make_unique<T>();
-}
-
 constexpr KernelEntry kEntries[] = {
     {"interpolate blend", "bit-exact", true, make<BlendCase>},
     {"extrapolate static layer", "bit-exact", true, make<StaticLayerCase>},
@@ -875,6 +803,6 @@ constexpr KernelEntry kEntries[] = {
 
 }  // namespace
 
-std::span<const KernelEntry> kernel_registry() { return kEntries; }
+std::span<const KernelEntry> warp_kernels() { return kEntries; }
 
-}  // namespace reprise::warp
+}  // namespace reprise::kernels
