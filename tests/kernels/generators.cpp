@@ -9,8 +9,18 @@ float uniform(std::mt19937& rng, float a, float b) {
 }
 
 float worst_value(std::mt19937& rng) {
-    constexpr float values[] = {kNaN,   kInf,   -kInf, 0.0f,  -0.0f, 1e30f,
-                                -1e30f, 1e-30f, -1.0f, 0.5f,  3e5f,  -3e5f,
+    constexpr float values[] = {kNaN,
+                                kInf,
+                                -kInf,
+                                0.0f,
+                                -0.0f,
+                                1e30f,
+                                -1e30f,
+                                1e-30f,
+                                -1.0f,
+                                0.5f,
+                                3e5f,
+                                -3e5f,
                                 std::numeric_limits<float>::denorm_min()};
     return values[rng() % std::size(values)];
 }
