@@ -761,6 +761,131 @@ DepthSummary depth_coders(const Sequence& seq, const std::vector<double>& our_de
     return ds;
 }
 
+Report codec_report(const BenchOptions& job, int w, int h) {
+    Report report;
+    report.title = "reprise bench codec: error against bits against run time";
+    report.paragraphs.push_back(strf(
+        "Every codec gets the same 8-bit sRGB display frames (reprise's codec its G-buffers: "
+        "linear colour, depth, motion, cameras) and is scored on display values of its decoded "
+        "frames against the original colour (PSNR, SSIM, LDR-FLIP). %dx%d, %d frames per built-in "
+        "scene at 30 Hz; %d threads per codec. Peers through libavcodec, low delay as streaming "
+        "uses them: x264 (ultrafast, veryfast, medium; tune zerolatency, no B-frames), x265 "
+        "ultrafast zerolatency, SVT-AV1 preset 10 with its low-delay prediction structure "
+        "(which SVT-AV1 1.4 calls work in progress), CRF at four rate points each; yuv420p via "
+        "swscale (BT.601, limited range).",
+        w, h, job.frames, job.threads));
+    report.paragraphs.push_back(
+        "Times are wall-clock ms per frame on this machine: encode = RGB to YUV conversion + "
+        "send_frame + receive_packet (peers), send_frame + receive_packet (reprise); decode = "
+        "send_packet + receive_frame (+ YUV to RGB for peers). Bits include every header (x264's "
+        "SPS/PPS in band). BD-rate: Bjøntegaard delta rate of reprise against each peer over the "
+        "common quality interval (monotone cubic interpolation of log rate), counting reprise's "
+        "colour bits alone and its total bits (camera, depth, motion, colour, headers).");
+    return report;
+}
+
+// The speed run at 1080p (when --speed-frames > 0): its CSV rows and its text.
+Status speed_run(server::Renderer& renderer, const BenchOptions& job, int qp, CsvFile& speed_csv,
+                 SpeedResult& speed, std::string& speed_text) {
+    if (job.speed_frames > 0) {
+        REPRISE_TRY(measure_speed(renderer, job, job.threads, qp, speed));
+        speed_csv.row({strf("%dx%d", speed.w, speed.h), std::to_string(speed.frames), "x264",
+                       "veryfast crf 26", strf("%.3f", speed.x264_veryfast_encode),
+                       strf("%.3f", speed.x264_veryfast_decode)});
+        speed_csv.row({strf("%dx%d", speed.w, speed.h), std::to_string(speed.frames), "x264",
+                       "ultrafast crf 26", strf("%.3f", speed.x264_ultrafast_encode), ""});
+        speed_csv.row({strf("%dx%d", speed.w, speed.h), std::to_string(speed.frames), kOurs,
+                       strf("qp %d", qp), strf("%.3f", speed.ours_encode),
+                       strf("%.3f", speed.ours_decode)});
+    }
+    if (speed.measured) {
+        speed_text = strf(
+            "speed at %dx%d, %d frames, %d threads per codec (reprise: %d pool threads), mean ms "
+            "per frame\n  x264 veryfast zerolatency: encode %8.2f  decode %8.2f  (of which "
+            "swscale RGB->YUV %.2f, YUV->RGB %.2f)\n"
+            "  x264 ultrafast zerolatency: encode %7.2f\n",
+            speed.w, speed.h, speed.frames, job.threads, thread_count(), speed.x264_veryfast_encode,
+            speed.x264_veryfast_decode, speed.rgb_to_yuv, speed.yuv_to_rgb,
+            speed.x264_ultrafast_encode);
+        speed_text += strf(
+            "  reprise qp %d: encode %8.2f  decode %8.2f\n"
+            "  encode speed reprise / x264 veryfast = %.2fx (>= 1 wanted), / ultrafast = %.2fx\n"
+            "  reprise decode speed / its encode speed = %.2fx (>= 2 wanted)\n",
+            qp, speed.ours_encode, speed.ours_decode,
+            speed.x264_veryfast_encode / speed.ours_encode,
+            speed.x264_ultrafast_encode / speed.ours_encode, speed.ours_encode / speed.ours_decode);
+    }
+    return {};
+}
+
+// What bench codec prints against the targets of issue 8 §7 and issue 18 §6.
+std::string targets_text(const BenchOptions& job, int qp, const std::vector<BdRow>& bd_rows,
+                         const std::vector<ViewDepthRun>& view_rows, const SpeedResult& speed,
+                         double depth_ratio) {
+    // Mean BD-rate against x264 veryfast over the built-in scenes, of the colour (issue 8 §7) or
+    // of all bits of the default stream (issue 18 §6).
+    auto mean_vs_veryfast = [&](double BdRow::*metric) {
+        double sum = 0.0;
+        int n = 0;
+        for (const BdRow& r : bd_rows)
+            if (r.builtin && r.peer == "x264 veryfast" && !std::isnan(r.*metric))
+                sum += r.*metric, ++n;
+        return n ? sum / n : NAN;
+    };
+    const double bd_vf = mean_vs_veryfast(&BdRow::psnr_color);
+    const double bd_stream = mean_vs_veryfast(&BdRow::psnr_stream);
+    std::string views_over;
+    bool views_known = false;
+    for (const ViewDepthRun& v : view_rows)
+        for (int k = 0; k < SynthesizedViews::kViews && v.views.frames > 0; ++k) {
+            views_known = true;
+            if (v.views.loss_db(k) < -kViewLossTarget)
+                views_over += strf(" %s %s %+.2f dB", v.scene.c_str(), SynthesizedViews::name(k),
+                                   v.views.loss_db(k));
+        }
+    std::string geometry_over;
+    for (const ViewDepthRun& v : view_rows) {
+        const double share = 100.0 * (v.depth_bytes + v.motion_bytes) / v.total_bytes;
+        if (share > kGeometryShareTarget)
+            geometry_over += strf(" %s %.1f%%", v.scene.c_str(), share);
+    }
+    const double enc_ratio = speed.x264_veryfast_encode / speed.ours_encode;
+    const double dec_ratio = speed.ours_encode / speed.ours_decode;
+    const bool full_hd = speed.w == 1920 && speed.h == 1080;
+    std::string targets = "targets (issue 8 §7, issue 18 §6)\n";
+    targets += strf(
+        "  colour BD-rate (PSNR) vs x264 veryfast, mean over built-in scenes: %s (<= %.0f%%): %s\n",
+        pct(bd_vf).c_str(), kColorBdTarget,
+        verdict(!std::isnan(bd_vf), bd_vf <= kColorBdTarget).c_str());
+    targets += strf(
+        "  all bits of the default stream, BD-rate (PSNR) vs x264 veryfast, mean over built-in "
+        "scenes: %s (<= %.0f%%): %s\n",
+        pct(bd_stream).c_str(), kStreamBdTarget,
+        verdict(!std::isnan(bd_stream), bd_stream <= kStreamBdTarget).c_str());
+    targets +=
+        strf("  depth + motion <= %.0f%% of the default stream at qp %d, every scene: %s%s\n",
+             kGeometryShareTarget, qp, verdict(!view_rows.empty(), geometry_over.empty()).c_str(),
+             geometry_over.empty() ? "" : (" (over:" + geometry_over + ")").c_str());
+    targets += strf(
+        "  views from decoded depth within %.1f dB of the same views from rendered depth, every "
+        "scene and view: %s%s\n",
+        kViewLossTarget, verdict(views_known, views_over.empty()).c_str(),
+        views_over.empty() ? "" : (" (" + views_over.substr(1) + ")").c_str());
+    targets += strf(
+        "  encode at least as fast as x264 veryfast at 1920x1080, %d threads: %.2fx: %s%s\n",
+        job.threads, enc_ratio, verdict(!std::isnan(enc_ratio), enc_ratio >= 1.0).c_str(),
+        full_hd || !speed.measured ? "" : strf(" (measured at %dx%d)", speed.w, speed.h).c_str());
+    targets +=
+        strf("  decode >= %.0fx our encode speed: %.2fx: %s\n", kDecodeOverEncodeTarget, dec_ratio,
+             verdict(!std::isnan(dec_ratio), dec_ratio >= kDecodeOverEncodeTarget).c_str());
+    targets += strf(
+        "  lossless depth >= %.0fx smaller than zstd -3 (mean ratio over sequences): %.2fx: %s\n",
+        kDepthRatioTarget, depth_ratio,
+        verdict(!std::isnan(depth_ratio), depth_ratio >= kDepthRatioTarget).c_str());
+
+    return targets;
+}
+
 }  // namespace
 
 Status bench_codec(const BenchOptions& job) {
@@ -805,25 +930,7 @@ Status bench_codec(const BenchOptions& job) {
     std::unique_ptr<server::Renderer> renderer;
     REPRISE_TRY(server::Renderer::create(renderer));
 
-    Report report;
-    report.title = "reprise bench codec: error against bits against run time";
-    report.paragraphs.push_back(strf(
-        "Every codec gets the same 8-bit sRGB display frames (reprise's codec its G-buffers: "
-        "linear colour, depth, motion, cameras) and is scored on display values of its decoded "
-        "frames against the original colour (PSNR, SSIM, LDR-FLIP). %dx%d, %d frames per built-in "
-        "scene at 30 Hz; %d threads per codec. Peers through libavcodec, low delay as streaming "
-        "uses them: x264 (ultrafast, veryfast, medium; tune zerolatency, no B-frames), x265 "
-        "ultrafast zerolatency, SVT-AV1 preset 10 with its low-delay prediction structure "
-        "(which SVT-AV1 1.4 calls work in progress), CRF at four rate points each; yuv420p via "
-        "swscale (BT.601, limited range).",
-        w, h, job.frames, job.threads));
-    report.paragraphs.push_back(
-        "Times are wall-clock ms per frame on this machine: encode = RGB to YUV conversion + "
-        "send_frame + receive_packet (peers), send_frame + receive_packet (reprise); decode = "
-        "send_packet + receive_frame (+ YUV to RGB for peers). Bits include every header (x264's "
-        "SPS/PPS in band). BD-rate: Bjøntegaard delta rate of reprise against each peer over the "
-        "common quality interval (monotone cubic interpolation of log rate), counting reprise's "
-        "colour bits alone and its total bits (camera, depth, motion, colour, headers).");
+    Report report = codec_report(job, w, h);
 
     std::vector<BdRow> bd_rows;
     std::vector<DepthSummary> depth_rows;
@@ -860,108 +967,12 @@ Status bench_codec(const BenchOptions& job) {
     const std::string depth_text =
         cli::depth_text(depth_rows, view_rows, qps[qps.size() / 2], depth_ratio);
 
-    // Speed at 1080p.
     SpeedResult speed;
-    if (job.speed_frames > 0) {
-        REPRISE_TRY(measure_speed(*renderer, job, job.threads, qps[qps.size() / 2], speed));
-        speed_csv.row({strf("%dx%d", speed.w, speed.h), std::to_string(speed.frames), "x264",
-                       "veryfast crf 26", strf("%.3f", speed.x264_veryfast_encode),
-                       strf("%.3f", speed.x264_veryfast_decode)});
-        speed_csv.row({strf("%dx%d", speed.w, speed.h), std::to_string(speed.frames), "x264",
-                       "ultrafast crf 26", strf("%.3f", speed.x264_ultrafast_encode), ""});
-        speed_csv.row({strf("%dx%d", speed.w, speed.h), std::to_string(speed.frames), kOurs,
-                       strf("qp %d", qps[qps.size() / 2]), strf("%.3f", speed.ours_encode),
-                       strf("%.3f", speed.ours_decode)});
-    }
     std::string speed_text;
-    if (speed.measured) {
-        speed_text = strf(
-            "speed at %dx%d, %d frames, %d threads per codec (reprise: %d pool threads), mean ms "
-            "per frame\n  x264 veryfast zerolatency: encode %8.2f  decode %8.2f  (of which "
-            "swscale RGB->YUV %.2f, YUV->RGB %.2f)\n"
-            "  x264 ultrafast zerolatency: encode %7.2f\n",
-            speed.w, speed.h, speed.frames, job.threads, thread_count(), speed.x264_veryfast_encode,
-            speed.x264_veryfast_decode, speed.rgb_to_yuv, speed.yuv_to_rgb,
-            speed.x264_ultrafast_encode);
-        speed_text += strf(
-            "  reprise qp %d: encode %8.2f  decode %8.2f\n"
-            "  encode speed reprise / x264 veryfast = %.2fx (>= 1 wanted), / ultrafast = %.2fx\n"
-            "  reprise decode speed / its encode speed = %.2fx (>= 2 wanted)\n",
-            qps[qps.size() / 2], speed.ours_encode, speed.ours_decode,
-            speed.x264_veryfast_encode / speed.ours_encode,
-            speed.x264_ultrafast_encode / speed.ours_encode, speed.ours_encode / speed.ours_decode);
-    }
+    REPRISE_TRY(speed_run(*renderer, job, qps[qps.size() / 2], speed_csv, speed, speed_text));
 
-    // Targets of issue 8 §7.
-    double bd_vf = NAN;
-    {
-        double sum = 0.0;
-        int n = 0;
-        for (const BdRow& r : bd_rows)
-            if (r.builtin && r.peer == "x264 veryfast" && !std::isnan(r.psnr_color))
-                sum += r.psnr_color, ++n;
-        if (n) bd_vf = sum / n;
-    }
-    // Issue 18 §6: all bits of the default stream against x264 veryfast; depth + motion share.
-    double bd_stream = NAN;
-    {
-        double sum = 0.0;
-        int n = 0;
-        for (const BdRow& r : bd_rows)
-            if (r.builtin && r.peer == "x264 veryfast" && !std::isnan(r.psnr_stream))
-                sum += r.psnr_stream, ++n;
-        if (n) bd_stream = sum / n;
-    }
-    std::string views_over;
-    bool views_known = false;
-    for (const ViewDepthRun& v : view_rows)
-        for (int k = 0; k < SynthesizedViews::kViews && v.views.frames > 0; ++k) {
-            views_known = true;
-            if (v.views.loss_db(k) < -kViewLossTarget)
-                views_over += strf(" %s %s %+.2f dB", v.scene.c_str(), SynthesizedViews::name(k),
-                                   v.views.loss_db(k));
-        }
-    std::string geometry_over;
-    for (const ViewDepthRun& v : view_rows) {
-        const double share = 100.0 * (v.depth_bytes + v.motion_bytes) / v.total_bytes;
-        if (share > kGeometryShareTarget)
-            geometry_over += strf(" %s %.1f%%", v.scene.c_str(), share);
-    }
-    const double enc_ratio = speed.x264_veryfast_encode / speed.ours_encode;
-    const double dec_ratio = speed.ours_encode / speed.ours_decode;
-    const bool full_hd = speed.w == 1920 && speed.h == 1080;
-    std::string targets = "targets (issue 8 §7, issue 18 §6)\n";
-    targets += strf(
-        "  colour BD-rate (PSNR) vs x264 veryfast, mean over built-in scenes: %s (<= %.0f%%): %s\n",
-        pct(bd_vf).c_str(), kColorBdTarget,
-        verdict(!std::isnan(bd_vf), bd_vf <= kColorBdTarget).c_str());
-    targets += strf(
-        "  all bits of the default stream, BD-rate (PSNR) vs x264 veryfast, mean over built-in "
-        "scenes: %s (<= %.0f%%): %s\n",
-        pct(bd_stream).c_str(), kStreamBdTarget,
-        verdict(!std::isnan(bd_stream), bd_stream <= kStreamBdTarget).c_str());
-    targets +=
-        strf("  depth + motion <= %.0f%% of the default stream at qp %d, every scene: %s%s\n",
-             kGeometryShareTarget, qps[qps.size() / 2],
-             verdict(!view_rows.empty(), geometry_over.empty()).c_str(),
-             geometry_over.empty() ? "" : (" (over:" + geometry_over + ")").c_str());
-    targets += strf(
-        "  views from decoded depth within %.1f dB of the same views from rendered depth, every "
-        "scene and view: %s%s\n",
-        kViewLossTarget, verdict(views_known, views_over.empty()).c_str(),
-        views_over.empty() ? "" : (" (" + views_over.substr(1) + ")").c_str());
-    targets += strf(
-        "  encode at least as fast as x264 veryfast at 1920x1080, %d threads: %.2fx: %s%s\n",
-        job.threads, enc_ratio, verdict(!std::isnan(enc_ratio), enc_ratio >= 1.0).c_str(),
-        full_hd || !speed.measured ? "" : strf(" (measured at %dx%d)", speed.w, speed.h).c_str());
-    targets +=
-        strf("  decode >= %.0fx our encode speed: %.2fx: %s\n", kDecodeOverEncodeTarget, dec_ratio,
-             verdict(!std::isnan(dec_ratio), dec_ratio >= kDecodeOverEncodeTarget).c_str());
-    targets += strf(
-        "  lossless depth >= %.0fx smaller than zstd -3 (mean ratio over sequences): %.2fx: %s\n",
-        kDepthRatioTarget, depth_ratio,
-        verdict(!std::isnan(depth_ratio), depth_ratio >= kDepthRatioTarget).c_str());
-
+    const std::string targets =
+        targets_text(job, qps[qps.size() / 2], bd_rows, view_rows, speed, depth_ratio);
     const std::string text = bd_text + (bd_text.empty() ? "" : "\n") + depth_text + "\n" +
                              speed_text + (speed_text.empty() ? "" : "\n") + targets;
     std::printf("%s", text.c_str());

@@ -184,6 +184,37 @@ void describe(const stereo::StereoRig& rig, int w, int h, int frames, int repeat
     report.paragraphs.push_back(text);
 }
 
+// The fastest of `times` runs of `run`, in ms.
+template <class Run>
+double fastest_ms(int times, Run&& run) {
+    double ms = 1e30;
+    for (int r = 0; r < times; ++r) {
+        auto begin = BenchClock::now();
+        run();
+        ms = std::min(ms, ms_since(begin));
+    }
+    return ms;
+}
+
+struct OurSetting {
+    std::string setting;
+    stereo::StereoOptions options;
+    bool history = false;
+};
+// Every warp with every fill, and the default with history.
+std::vector<OurSetting> our_settings() {
+    std::vector<OurSetting> settings;
+    for (auto [warp_name, warp] : {std::pair{"grid", stereo::StereoWarp::Grid},
+                                   std::pair{"splat", stereo::StereoWarp::Splat}})
+        for (auto [fill_name, fill] : {std::pair{"none", stereo::StereoFill::None},
+                                       std::pair{"pullpush", stereo::StereoFill::PullPush},
+                                       std::pair{"andreev", stereo::StereoFill::Andreev}})
+            settings.push_back(
+                {std::string(warp_name) + "+" + fill_name, {.warp = warp, .fill = fill}});
+    settings.push_back({"grid+pullpush+history", {}, true});
+    return settings;
+}
+
 // One eye of the path's centre camera at time t, rendered; the fastest of `times` runs in `ms`.
 Status render_eye(server::Renderer& renderer, const server::Scene& scene,
                   const server::CameraPath& path, const stereo::StereoRig& rig, int w, int h,
@@ -202,13 +233,11 @@ Status render_eye(server::Renderer& renderer, const server::Scene& scene,
     a.projection = eyes[e].projection;
     b.view = eyes[e].prev_view;
     b.projection = eyes[e].prev_projection;
-    ms = 1e30;
-    for (int r = 0; r < times; ++r) {
-        auto begin = BenchClock::now();
-        REPRISE_TRY(renderer.render(scene, a, b, {.width = w, .height = h}, out));
-        ms = std::min(ms, ms_since(begin));
-    }
-    return {};
+    Status status;
+    ms = fastest_ms(times, [&] {
+        if (status.ok()) status = renderer.render(scene, a, b, {.width = w, .height = h}, out);
+    });
+    return status;
 }
 
 // The scene's summary row: our best and fastest settings, the peers, the renders; `best` and
@@ -241,6 +270,48 @@ SceneSummary summarize(const std::string& name, const std::vector<Run>& runs, do
     return row;
 }
 
+// The scene's CSV rows, summary row and report sections (all pixels, disoccluded ones).
+Status add_scene(const std::string& scene_name, const std::string& name,
+                 const std::vector<Run>& runs, std::size_t render_i, double render_left,
+                 double render_right, double dis_fraction, const std::string& out_dir, CsvFile& csv,
+                 std::vector<SceneSummary>& summaries, Report& report) {
+    char text[512];
+    ReportSection all{name}, dis_section{name + ", disoccluded pixels only"};
+    for (const server::SceneInfo& info : server::builtin_scenes())
+        if (scene_name == info.name) all.note = info.stresses;
+    for (const Run& run : runs) {
+        for (const Score& s : run.scores) {
+            csv.error_row(name, run.method, run.setting, s.frame, s.all, s.ms);
+            csv.error_row(name, run.method, run.setting + "+disoccluded", s.frame, s.disoccluded,
+                          s.ms);
+        }
+        all.points.push_back(run.mean());
+        dis_section.points.push_back(run.mean(true));
+    }
+    csv.flush();
+
+    const Run *best = nullptr, *peer = nullptr;
+    const SceneSummary row =
+        summarize(name, runs, render_left, render_right, dis_fraction, best, peer);
+    summaries.push_back(row);
+    std::snprintf(
+        text, sizeof text,
+        " Mean disoccluded fraction %.2f%%; renderer: left eye %.2f ms, right eye %.2f ms; "
+        "pair ratio (render + ours %s) / (two renders) = %.3f.",
+        100.0 * dis_fraction, render_left, render_right, best->setting.c_str(),
+        row.ratio(row.best));
+    all.note += text;
+    const std::string picture = name + "/worst_frame.png";
+    REPRISE_TRY(worst_picture(*best, runs[render_i], peer, out_dir + "/" + picture));
+    all.images.push_back({picture, "The lowest-PSNR frame of our best setting (" + best->setting +
+                                       ") beside the rendered right eye and the best peer (" +
+                                       (peer ? peer->method : std::string("-")) +
+                                       "); below, the window where ours differs most, enlarged."});
+    report.sections.push_back(std::move(all));
+    report.sections.push_back(std::move(dis_section));
+    return {};
+}
+
 }  // namespace
 
 Status bench_stereo(const BenchOptions& options) {
@@ -269,20 +340,7 @@ Status bench_stereo(const BenchOptions& options) {
     const double fps = 30.0;
     const bool full_hd = w == 1920 && h == 1080;
 
-    struct OurSetting {
-        std::string setting;
-        stereo::StereoOptions options;
-        bool history = false;
-    };
-    std::vector<OurSetting> settings;
-    for (auto [warp_name, warp] : {std::pair{"grid", stereo::StereoWarp::Grid},
-                                   std::pair{"splat", stereo::StereoWarp::Splat}})
-        for (auto [fill_name, fill] : {std::pair{"none", stereo::StereoFill::None},
-                                       std::pair{"pullpush", stereo::StereoFill::PullPush},
-                                       std::pair{"andreev", stereo::StereoFill::Andreev}})
-            settings.push_back(
-                {std::string(warp_name) + "+" + fill_name, {.warp = warp, .fill = fill}});
-    settings.push_back({"grid+pullpush+history", {}, true});
+    const std::vector<OurSetting> settings = our_settings();
 
     Report report;
     describe(rig, w, h, frames, repeat, renderer->device(), report);
@@ -350,45 +408,23 @@ Status bench_stereo(const BenchOptions& options) {
                 to_rgb8(test_d.view(), run.shown[i]);
             };
             for (std::size_t k = 0; k < settings.size(); ++k) {
-                double ms = 1e30;
-                for (int r = 0; r < repeat; ++r) {
-                    auto begin = BenchClock::now();
+                const double ms = fastest_ms(repeat, [&] {
                     synthesizer.synthesize(left, target, made, settings[k].options,
                                            settings[k].history ? &history : nullptr);
-                    ms = std::min(ms, ms_since(begin));
-                }
+                });
                 record(runs[k], made.color, ms);
             }
-            {
-                double ms = 1e30;
-                for (int r = 0; r < repeat; ++r) {
-                    auto begin = BenchClock::now();
-                    synthesizer.synthesize(left, target, made,
-                                           {.warp = stereo::StereoWarp::Splat,
-                                            .fill = stereo::StereoFill::None,
-                                            .splat = {.footprint = 1}});
-                    ms = std::min(ms, ms_since(begin));
-                }
-                record(runs[splat_i], made.color, ms);
-            }
-            {
-                double ms = 1e30;
-                for (int r = 0; r < repeat; ++r) {
-                    auto begin = BenchClock::now();
-                    remap_by_disparity(left, rig, remapped);
-                    ms = std::min(ms, ms_since(begin));
-                }
-                record(runs[splat_i + 1], remapped, ms);
-            }
-            {
-                double ms = 1e30;
-                for (int r = 0; r < repeat; ++r) {
-                    auto begin = BenchClock::now();
-                    copied = left.color;
-                    ms = std::min(ms, ms_since(begin));
-                }
-                record(runs[splat_i + 2], copied, ms);
-            }
+            double ms = fastest_ms(repeat, [&] {
+                synthesizer.synthesize(left, target, made,
+                                       {.warp = stereo::StereoWarp::Splat,
+                                        .fill = stereo::StereoFill::None,
+                                        .splat = {.footprint = 1}});
+            });
+            record(runs[splat_i], made.color, ms);
+            ms = fastest_ms(repeat, [&] { remap_by_disparity(left, rig, remapped); });
+            record(runs[splat_i + 1], remapped, ms);
+            ms = fastest_ms(repeat, [&] { copied = left.color; });
+            record(runs[splat_i + 2], copied, ms);
             record(runs[render_i], right.color, right_ms);
             std::printf("[stereo] %s frame %d: render L %.1f ms, R %.1f ms, %.2f%% disoccluded\n",
                         name.c_str(), i, left_ms, right_ms,
@@ -397,41 +433,9 @@ Status bench_stereo(const BenchOptions& options) {
         }
         if (!failure.ok()) break;
 
-        ReportSection all{name}, dis_section{name + ", disoccluded pixels only"};
-        for (const server::SceneInfo& info : server::builtin_scenes())
-            if (scene_name == info.name) all.note = info.stresses;
-        for (const Run& run : runs) {
-            for (const Score& s : run.scores) {
-                csv.error_row(name, run.method, run.setting, s.frame, s.all, s.ms);
-                csv.error_row(name, run.method, run.setting + "+disoccluded", s.frame,
-                              s.disoccluded, s.ms);
-            }
-            all.points.push_back(run.mean());
-            dis_section.points.push_back(run.mean(true));
-        }
-        csv.flush();
-
-        const Run *best = nullptr, *peer = nullptr;
-        const SceneSummary row =
-            summarize(name, runs, render_left, render_right, dis_fraction, best, peer);
-        summaries.push_back(row);
-        std::snprintf(
-            text, sizeof text,
-            " Mean disoccluded fraction %.2f%%; renderer: left eye %.2f ms, right eye %.2f ms; "
-            "pair ratio (render + ours %s) / (two renders) = %.3f.",
-            100.0 * dis_fraction, render_left, render_right, best->setting.c_str(),
-            row.ratio(row.best));
-        all.note += text;
-        const std::string picture = name + "/worst_frame.png";
-        failure = worst_picture(*best, runs[render_i], peer, out_dir + "/" + picture);
+        failure = add_scene(scene_name, name, runs, render_i, render_left, render_right,
+                            dis_fraction, out_dir, csv, summaries, report);
         if (!failure.ok()) break;
-        all.images.push_back(
-            {picture, "The lowest-PSNR frame of our best setting (" + best->setting +
-                          ") beside the rendered right eye and the best peer (" +
-                          (peer ? peer->method : std::string("-")) +
-                          "); below, the window where ours differs most, enlarged."});
-        report.sections.push_back(std::move(all));
-        report.sections.push_back(std::move(dis_section));
     }
     REPRISE_TRY(failure);
 
