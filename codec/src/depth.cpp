@@ -11,6 +11,7 @@
 #include <limits>
 
 #include "internal.hpp"
+#include "kernels.hpp"
 #include "slices.hpp"
 
 namespace reprise::codec {
@@ -20,7 +21,6 @@ namespace {
 constexpr uint32_t kInfCode = (1u << 30) + 1;
 constexpr uint32_t kInvalidCode = (1u << 30) + 2;
 constexpr int kBlock = 8;
-constexpr uint32_t kNoPrediction = 0xFFFFFFFFu;  // no code maps here in either mode
 constexpr uint8_t kAllPredicted = 1;
 constexpr uint8_t kOwnStep = 2;  // view depth: this frame's 1/z step follows (f32)
 constexpr float kMinViewStep = 1e-12f, kMaxViewStep = 1e6f;
@@ -82,6 +82,14 @@ struct Mapping {
                (!view || c <= kMaxViewCode);
     }
 };
+
+// View mode: code c (at most 2^30) decodes to an inverse depth within the bound of w (docs/
+// bitstream.md): the allowance shrinks by (1 - B max(w, w_c))^2 for points near the camera.
+inline bool view_code_within(double w, uint32_t c, double step, double displacement) {
+    const double wc = c == 0 ? 0.5 * step : double(c) * step;
+    const double near = std::max(0.0, 1.0 - displacement * std::max(w, wc));
+    return std::abs(wc - w) <= kViewCodesPerStep * step * near * near;
+}
 
 Mapping mapping_of(const SequenceParams& sp, float view_step) {
     const bool view = sp.depth == DepthMode::View;
@@ -214,6 +222,19 @@ inline uint64_t pixel_cost(const SliceJob& j, int x, int y, uint32_t p) {
                              int32_t(j.map->residual_step));
 }
 
+}  // namespace
+
+void view_keep_row_reference(const ViewKeepRow& r, int i_begin, int i_end) {
+    for (int i = i_begin; i < i_end; ++i) {
+        const float z = r.source[i];
+        const uint32_t t = r.temporal[i];
+        r.keep[i] = t <= kMaxViewCode && z > 0.0f && z < INFINITY &&
+                    view_code_within(1.0 / double(z), t, r.step, r.displacement);
+    }
+}
+
+namespace {
+
 // View mode: the code sent for the source depth at (x, y) predicted by p. Any code whose inverse
 // depth is close enough to the truth keeps the reprojection error within the bound: p itself
 // when it is such a code, else the surface prediction plus the residual steps that come nearest
@@ -224,14 +245,9 @@ uint32_t choose_view_code(const SliceJob& j, int x, int y, uint32_t p) {
     const float z = j.source.empty() ? INFINITY : j.source(x, y);
     const uint32_t k = map.code(z);
     if (k > kMaxViewCode && k != kInvalidCode) return k;  // background: a flag
-    const double w = 1.0 / double(z);
-    auto within = [&](int64_t c) {
-        if (c < 0 || c > kMaxViewCode) return false;
-        const double wc = map.inverse_depth(uint32_t(c));
-        const double near = std::max(0.0, 1.0 - map.displacement * std::max(w, wc));
-        return std::abs(wc - w) <= kViewCodesPerStep * map.step * near * near;
-    };
-    if (k != kInvalidCode && within(p)) return p;
+    if (k != kInvalidCode && p <= kMaxViewCode &&
+        view_code_within(1.0 / double(z), p, map.step, map.displacement))
+        return p;
     const int64_t base = surface_prediction(j, x, y, p), s = kViewResidualStep;
     if (k == kInvalidCode)  // NaN: any code above 2^30 + 1
         return uint32_t(base + std::max<int64_t>(0, (kInvalidCode - base + s - 1) / s) * s);
@@ -265,9 +281,20 @@ void encode_slice(SliceJob& j, std::vector<uint8_t>& bytes, std::vector<uint8_t>
     const int blocks = (j.width + kBlock - 1) / kBlock;
     block_flags.assign(std::size_t(blocks), 0);
     std::vector<uint8_t> above;
+    // View mode: which pixels of the block row keep their temporal prediction (most of them).
+    const bool keep_test = inter && j.map->view && !j.source.empty();
+    std::vector<uint8_t> keep(keep_test ? std::size_t(kBlock) * j.width : 0);
     for (int by = j.y0; by < j.y1; by += kBlock) {
         if (by > j.y0) above = block_flags;
         const int bh = std::min(kBlock, j.y1 - by);
+        if (keep_test)
+            for (int y = by; y < by + bh; ++y)
+                view_keep_row({.source = j.source.row(y),
+                               .temporal = j.temporal.row(y),
+                               .count = j.width,
+                               .step = j.map->step,
+                               .displacement = j.map->displacement,
+                               .keep = &keep[std::size_t(y - by) * j.width]});
         for (int b = 0; b < blocks; ++b) {
             const int bx = b * kBlock, bw = std::min(kBlock, j.width - bx);
             bool use_temporal = inter;
@@ -275,9 +302,17 @@ void encode_slice(SliceJob& j, std::vector<uint8_t>& bytes, std::vector<uint8_t>
             if (inter) {
                 // Most blocks of a moving camera's depth are predicted exactly (no code equals
                 // kNoPrediction): with the codes known, a plain comparison finds them.
-                bool exact = !j.map->view;
+                bool exact = true;
                 for (int y = by; y < by + bh && exact; ++y)
-                    exact = std::equal(&j.codes(bx, y), &j.codes(bx, y) + bw, &j.temporal(bx, y));
+                    exact = keep_test
+                                ? std::all_of(&keep[std::size_t(y - by) * j.width + bx],
+                                              &keep[std::size_t(y - by) * j.width + bx + bw],
+                                              [](uint8_t k) { return k != 0; })
+                                : !j.map->view && std::equal(&j.codes(bx, y), &j.codes(bx, y) + bw,
+                                                             &j.temporal(bx, y));
+                if (exact && j.map->view)  // the codes are the predictions
+                    for (int y = by; y < by + bh; ++y)
+                        std::copy_n(&j.temporal(bx, y), bw, &j.codes(bx, y));
                 if (!exact) cost = block_cost(j, bx, by, bw, bh, true);
             }
             if (!inter || cost > 0) {

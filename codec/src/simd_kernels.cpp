@@ -4,6 +4,7 @@
 // end of a row, a filter window over the plane's edge) go through the reference itself.
 #include <algorithm>
 #include <bit>
+#include <cmath>
 #include <limits>
 
 #include "kernels.hpp"
@@ -317,6 +318,37 @@ bool MotionResidualRowSimd(const MotionResidualRow& r) {
     return motion_residual_row_reference(r, x, r.width);
 }
 
+void ViewKeepRowSimd(const ViewKeepRow& r) {
+    const hn::ScalableTag<double> dd;
+    const hn::Rebind<float, decltype(dd)> df;
+    const hn::Rebind<int32_t, decltype(dd)> di32;
+    const hn::Rebind<int64_t, decltype(dd)> di64;
+    using VD = hn::Vec<decltype(dd)>;
+    const int n = int(hn::Lanes(dd));
+    const VD zero = hn::Zero(dd), one = hn::Set(dd, 1.0), inf = hn::Set(dd, HUGE_VAL);
+    const VD step = hn::Set(dd, r.step), half_step = hn::Set(dd, 0.5 * r.step);
+    const VD bound = hn::Set(dd, 8 * r.step), displacement = hn::Set(dd, r.displacement);
+    const VD max_code = hn::Set(dd, double(1u << 30));
+    int i = 0;
+    for (; i + n <= r.count; i += n) {
+        const VD z = hn::PromoteTo(dd, hn::LoadU(df, r.source + i));
+        // Codes above 2^31 (kNoPrediction) read as negative, those in (2^30, 2^31) above 2^30.
+        const VD c = hn::ConvertTo(
+            dd,
+            hn::PromoteTo(di64, hn::LoadU(di32, reinterpret_cast<const int32_t*>(r.temporal) + i)));
+        const VD wc = hn::IfThenElse(c == zero, half_step, c * step);
+        const VD w = one / z;
+        const VD near = hn::Max(zero, one - displacement * hn::Max(w, wc));
+        const auto keep =
+            hn::And(hn::And(c >= zero, c <= max_code),
+                    hn::And(hn::And(z > zero, z < inf), hn::Abs(wc - w) <= bound * near * near));
+        uint8_t bits[HWY_MAX_BYTES / 8 + 8] = {};
+        hn::StoreMaskBits(dd, keep, bits);
+        for (int k = 0; k < n; ++k) r.keep[i + k] = (bits[k / 8] >> (k % 8)) & 1;
+    }
+    view_keep_row_reference(r, i, r.count);
+}
+
 }  // namespace reprise::codec::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
 
@@ -330,6 +362,9 @@ HWY_EXPORT(ToPlanesRowSimd);
 HWY_EXPORT(FromPlanesRowSimd);
 HWY_EXPORT(ForwardRowSimd);
 HWY_EXPORT(MotionResidualRowSimd);
+HWY_EXPORT(ViewKeepRowSimd);
+
+void view_keep_row(const ViewKeepRow& row) { HWY_DYNAMIC_DISPATCH(ViewKeepRowSimd)(row); }
 
 bool motion_residual_row(const MotionResidualRow& row) {
     return HWY_DYNAMIC_DISPATCH(MotionResidualRowSimd)(row);

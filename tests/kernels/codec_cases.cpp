@@ -384,12 +384,74 @@ private:
     std::vector<uint8_t> reference_, optimized_;
 };
 
+// View-mode depth: which pixels keep their temporal prediction. Random: predictions within a few
+// codes of the depth's own (the bound's edge among them), missing ones, code 0; worst case: NaN,
+// Inf, negative and zero depth, codes around and above 2^30, a displacement of 0 or 10^6.
+class ViewKeepCase final : public KernelCase {
+public:
+    void generate(int w, int h, KernelInputs inputs, uint32_t seed) override {
+        std::mt19937 rng(seed);
+        width_ = w, height_ = h;
+        const bool worst = inputs == KernelInputs::WorstCase;
+        step_ = double(uniform(rng, 1e-5f, 1e-3f));
+        displacement_ = worst && seed % 3 == 0 ? (seed % 2 ? 0.0 : 1e6) : uniform(rng, 0.0f, 0.5f);
+        source_.resize(std::size_t(w) * h);
+        temporal_.resize(source_.size());
+        for (std::size_t i = 0; i < source_.size(); ++i) {
+            const float z = random_depth(rng, 0.2f, 60.0f, worst);
+            source_[i] = z;
+            const double own = z > 0.0f && z < kInf ? std::nearbyint(1.0 / double(z) / step_) : 0;
+            const int64_t near_own = int64_t(own) + int64_t(rng() % 25) - 12;
+            const uint32_t choices[] = {uint32_t(std::clamp<int64_t>(near_own, 0, 1 << 30)),
+                                        uint32_t(std::clamp<int64_t>(near_own, 0, 1 << 30)),
+                                        0xFFFFFFFFu, 0u};
+            temporal_[i] = choices[rng() % 4];
+            if (worst && rng() % 4 == 0) {
+                const uint32_t extremes[] = {1u << 30,    (1u << 30) + 1, (1u << 30) + 2,
+                                             0x7FFFFFFFu, 0x80000000u,    0xFFFFFFFEu};
+                temporal_[i] = extremes[rng() % std::size(extremes)];
+            }
+        }
+    }
+    void run_reference() override {
+        run_into(reference_, [](const ViewKeepRow& r) { view_keep_row_reference(r, 0, r.count); });
+    }
+    void run() override { run_into(optimized_, view_keep_row); }
+    std::string compare() const override {
+        return compare_elements("keeps its prediction", optimized_, reference_);
+    }
+
+private:
+    template <class Kernel>
+    void run_into(std::vector<uint8_t>& out, Kernel kernel) {
+        out.assign(source_.size(), 2);
+        parallel_for(0, height_, [&](int y0, int y1) {
+            for (int y = y0; y < y1; ++y) {
+                const std::size_t o = std::size_t(y) * width_;
+                kernel({.source = source_.data() + o,
+                        .temporal = temporal_.data() + o,
+                        .count = width_,
+                        .step = step_,
+                        .displacement = displacement_,
+                        .keep = out.data() + o});
+            }
+        });
+    }
+
+    int width_ = 0, height_ = 0;
+    double step_ = 1e-4, displacement_ = 0.164;
+    std::vector<float> source_;
+    std::vector<uint32_t> temporal_;
+    std::vector<uint8_t> reference_, optimized_;
+};
+
 constexpr KernelEntry kEntries[] = {
     {"codec prediction, luma", "bit-exact", true, make<PredictCase, false>},
     {"codec prediction, 4:2:0 chroma", "bit-exact", true, make<PredictCase, true>},
     {"codec camera motion", "bit-exact", true, make<CameraMotionCase>},
     {"codec depth forward projection", "bit-exact", true, make<ForwardCase>},
     {"codec motion residual test", "bit-exact", true, make<MotionResidualCase>},
+    {"codec view depth keeps its prediction", "bit-exact", true, make<ViewKeepCase>},
     {"codec colour to YCoCg-R", "bit-exact", true, make<ToPlanesCase>},
     {"codec YCoCg-R to colour", "bit-exact", true, make<FromPlanesCase>},
 };
