@@ -189,22 +189,32 @@ std::vector<ObjectMotion> fit_object_motions(const Camera& camera, ImageView<con
     parallel_for(0, h, [&](int r0, int r1) {
         std::map<uint32_t, Candidate> band;
         Candidate* last = nullptr;  // ids come in runs: one map lookup per run
-        for (int y = r0; y < r1; ++y)
-            for (int x = 0; x < w; ++x) {
-                const uint32_t id = ids(x, y);
+        for (int y = r0; y < r1; ++y) {
+            const uint32_t* id_row = ids.row(y);
+            const float* z_row = depth.row(y);
+            const glm::vec2 *m_row = motion.row(y), *base_row = base.row(y);
+            for (int x = 0, end = 0; x < w; x = end) {
+                const uint32_t id = id_row[x];
+                for (end = x + 1; end < w && id_row[end] == id;) ++end;
                 if (id == 0) continue;
                 if (!last || last->id != id) {
                     last = &band[id];
                     last->id = id;
                 }
                 Candidate& c = *last;
-                ++c.pixels;
+                c.pixels += end - x;
                 c.x0 = std::min(c.x0, x), c.y0 = std::min(c.y0, y);
-                c.x1 = std::max(c.x1, x + 1), c.y1 = std::max(c.y1, y + 1);
-                if (!usable(x, y)) continue;
-                ++c.usable;
-                c.unexplained += !explains(motion(x, y), base(x, y), bound);
+                c.x1 = std::max(c.x1, end), c.y1 = std::max(c.y1, y + 1);
+                int run_usable = 0, run_unexplained = 0;
+                for (int k = x; k < end; ++k) {
+                    const float z = z_row[k];
+                    const bool u = z > 0.0f && std::isfinite(z) && finite(m_row[k]);
+                    run_usable += u;
+                    run_unexplained += u && !explains(m_row[k], base_row[k], bound);
+                }
+                c.usable += run_usable, c.unexplained += run_unexplained;
             }
+        }
         const std::lock_guard lock(merging);
         for (const auto& [id, b] : band) {
             Candidate& c = found[id];
