@@ -275,8 +275,11 @@ Status Encoder::send_frame(const GBufferView& given) {
         return Status::error("encoder: " + std::to_string(s.queue.size()) +
                              " packets not taken by receive_packet");
 
+    // The codec codes no normals: they are neither scanned nor repaired.
+    GBufferView coded = given;
+    coded.normal = {};
     NonfiniteCounts nonfinite;
-    const GBufferView frame = s.repair.clean(given, nonfinite);
+    const GBufferView frame = s.repair.clean(coded, nonfinite);
     State::Chain next_chain;
     StreamStats fitted;
     const Camera camera = s.camera_for(frame, next_chain, fitted);
