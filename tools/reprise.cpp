@@ -4,6 +4,10 @@
 #include <string>
 #include <string_view>
 
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
+
 #include "commands.hpp"
 #include "reprise/core/memory_limit.hpp"
 
@@ -84,9 +88,22 @@ bool take_max_memory(int& argc, char** argv) {
     return true;
 }
 
+// Frame-sized working buffers come and go every frame. glibc's defaults hand large freed blocks
+// back to the system and map the next ones afresh, so every frame paid its page faults again
+// (bench codec's 1080p speed run: encode 111-123 -> 73-77 ms, decode 90-100 -> 66-70 ms on a
+// 2-core virtual machine): keep freed memory in the process for reuse.
+void keep_freed_memory() {
+#if defined(__GLIBC__)
+    mallopt(M_MMAP_THRESHOLD, 32 << 20);  // glibc's largest
+    mallopt(M_TRIM_THRESHOLD, 1 << 30);
+    mallopt(M_TOP_PAD, 64 << 20);
+#endif
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
+    keep_freed_memory();
     if (!take_max_memory(argc, argv)) return 2;
     if (argc < 2) {
         print_usage(stderr);
