@@ -154,11 +154,18 @@ void linear_from_planes(const Planes& planes, const SequenceParams& sp,
                         co_column[c - c_lo] = 3 * co_plane(c, cy) + co_plane(c, ny);
                         cg_column[c - c_lo] = 3 * cg_plane(c, cy) + cg_plane(c, ny);
                     }
-                    for (int i = 0; i < n; ++i) {
-                        int cx, nx;
-                        chroma_taps(x0 + i, cw, cx, nx);
-                        co[i] = int16_t((3 * co_column[cx - c_lo] + co_column[nx - c_lo] + 8) >> 4);
-                        cg[i] = int16_t((3 * cg_column[cx - c_lo] + cg_column[nx - c_lo] + 8) >> 4);
+                    // Pixels 2c and 2c + 1 share column c; their other taps are c - 1 and c + 1
+                    // (chroma_taps), clamped to the plane. x0 is even.
+                    for (int i = 0; i < n; i += 2) {
+                        const int c = (x0 + i) / 2, k = c - c_lo;
+                        const int left = std::max(c - 1, 0) - c_lo;
+                        const int right = std::min(c + 1, cw - 1) - c_lo;
+                        const int co3 = 3 * co_column[k] + 8, cg3 = 3 * cg_column[k] + 8;
+                        co[i] = int16_t((co3 + co_column[left]) >> 4);
+                        cg[i] = int16_t((cg3 + cg_column[left]) >> 4);
+                        if (i + 1 == n) break;
+                        co[i + 1] = int16_t((co3 + co_column[right]) >> 4);
+                        cg[i + 1] = int16_t((cg3 + cg_column[right]) >> 4);
                     }
                     pco = co, pcg = cg;
                 }
