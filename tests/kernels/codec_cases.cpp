@@ -400,7 +400,10 @@ public:
         for (std::size_t i = 0; i < source_.size(); ++i) {
             const float z = random_depth(rng, 0.2f, 60.0f, worst);
             source_[i] = z;
-            const double own = z > 0.0f && z < kInf ? std::nearbyint(1.0 / double(z) / step_) : 0;
+            // The depth's own code, at most 2^30 (a denormal depth's would overflow int64).
+            const double own = z > 0.0f && z < kInf
+                                   ? std::min(std::nearbyint(1.0 / double(z) / step_), 0x1p30)
+                                   : 0.0;
             const int64_t near_own = int64_t(own) + int64_t(rng() % 25) - 12;
             const uint32_t choices[] = {uint32_t(std::clamp<int64_t>(near_own, 0, 1 << 30)),
                                         uint32_t(std::clamp<int64_t>(near_own, 0, 1 << 30)),
