@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <random>
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -68,6 +70,50 @@ TEST(DepthReprojection, ThePlaneFitGivesAPlanesDepthAtPixelCentres) {
     const double plane = largest_inverse_depth_error(fitted, truth);
     EXPECT_GT(plain, 1e-2);
     EXPECT_LT(plane, 1e-5);
+}
+
+// Decoded depth errs by up to the view bound at every pixel, independently. A prediction from one
+// landing carries its error on; the mean over a landing and its neighbours on the surface damps
+// it, so that the errors of a surface transported frame after frame do not spread past the bound.
+// Measured: RMS error 0.51 of the source's (1.01 from one landing alone); holes where the camera
+// came closer (cracks between landings) 10 of 13,376 ground pixels (2,775 without the crack fill).
+TEST(DepthReprojection, ThePlaneFitDampsDecodedErrorsAndFillsCracks) {
+    const Camera from = camera_at({0.0f, 2.0f, 5.0f});
+    Camera to = camera_at({0.05f, 1.95f, 4.6f});
+    to.prev_view = from.view;
+    Image<float> source = ground_depth(from);
+    const Image<float> truth = ground_depth(to);
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> noise(-1e-3f, 1e-3f);
+    double source_error = 0.0;
+    std::size_t noisy = 0;
+    for (std::size_t i = 0; i < source.pixel_count(); ++i) {
+        float& z = source.data()[i];
+        if (!std::isfinite(z)) continue;
+        const float e = noise(rng);
+        z = 1.0f / (1.0f / z * (1.0f + e));
+        source_error += double(e) * e, ++noisy;
+    }
+    Image<float> fitted(kW, kH);
+    reproject_depth(from, source.view(), to, fitted.view(), {}, {}, true);
+    double error = 0.0;
+    std::size_t ground = 0, holes = 0, compared = 0;
+    for (int y = 4; y < kH - 4; ++y)
+        for (int x = 4; x < kW - 4; ++x) {
+            if (!std::isfinite(truth(x, y))) continue;
+            ++ground;
+            if (std::isnan(fitted(x, y))) {
+                ++holes;
+                continue;
+            }
+            const double e = double(truth(x, y)) / fitted(x, y) - 1.0;
+            error += e * e, ++compared;
+        }
+    const double ratio = std::sqrt(error / compared) / std::sqrt(source_error / noisy);
+    std::printf("RMS error %.3f of the source's; holes %zu of %zu ground pixels\n", ratio, holes,
+                ground);
+    EXPECT_LT(ratio, 0.6);
+    EXPECT_LT(holes, ground / 200);
 }
 
 }  // namespace

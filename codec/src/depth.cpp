@@ -1,5 +1,5 @@
 // Depth: each pixel as a 32-bit code (the float's bits in an order-preserving map, the
-// quantised log2 depth, or 1/z in eighths of the view step), predicted per 8x8 block either
+// quantised log2 depth, or 1/z in 32nds of the view step), predicted per 8x8 block either
 // from the reference depth forward-projected into this camera or spatially (median edge
 // detector), residuals context-coded. Blocks predicted exactly cost two flags. View mode sends
 // the prediction itself wherever it is within the bound and quantises residuals, so decoded
@@ -25,16 +25,15 @@ constexpr uint8_t kAllPredicted = 1;
 constexpr uint8_t kOwnStep = 2;  // view depth: this frame's 1/z step follows (f32)
 constexpr float kMinViewStep = 1e-12f, kMaxViewStep = 1e6f;
 
-// View-mode codes are k = round(1/z / (q / 8)) in 0..2^30 (k = 0 decodes as half a code), for
-// the view step q; residuals count steps of 9 codes, so the nearest choice errs by at most q / 2.
+// View-mode codes are k = round(1/z / (q / 32)) in 0..2^30 (k = 0 decodes as half a code), for
+// the view step q; residuals count steps of 33 codes, so the nearest choice errs by at most q / 2.
 constexpr uint32_t kMaxViewCode = 1u << 30;
-constexpr int kViewCodesPerStep = 8;
 constexpr int kViewResidualStep = kViewCodesPerStep + 1;
 
 struct Mapping {
     bool lossless;
     bool view;                   // uniform in 1/z
-    double step;                 // log2 step (bounded) or 1/z per code (view: q / 8)
+    double step;                 // log2 step (bounded) or 1/z per code (view: q / 32)
     double displacement = 0.0;   // view: the declared largest camera displacement (encoder only)
     uint32_t residual_step = 1;  // codes per residual unit
 
@@ -85,10 +84,12 @@ struct Mapping {
 
 // View mode: code c (at most 2^30) decodes to an inverse depth within the bound of w (docs/
 // bitstream.md): the allowance shrinks by (1 - B max(w, w_c))^2 for points near the camera.
-inline bool view_code_within(double w, uint32_t c, double step, double displacement) {
+// `share` < 1 asks for that share of the allowance.
+inline bool view_code_within(double w, uint32_t c, double step, double displacement,
+                             double share = 1.0) {
     const double wc = c == 0 ? 0.5 * step : double(c) * step;
     const double near = std::max(0.0, 1.0 - displacement * std::max(w, wc));
-    return std::abs(wc - w) <= kViewCodesPerStep * step * near * near;
+    return std::abs(wc - w) <= share * kViewCodesPerStep * step * near * near;
 }
 
 Mapping mapping_of(const SequenceParams& sp, float view_step) {
@@ -239,14 +240,17 @@ namespace {
 // depth is close enough to the truth keeps the reprojection error within the bound: p itself
 // when it is such a code, else the surface prediction plus the residual steps that come nearest
 // the truth (within q / 2). The allowance shrinks by (1 - B/z)^2 for points near the camera
-// (docs/bitstream.md).
+// (docs/bitstream.md). A key frame keeps p only within 4/5 of the allowance: every later frame
+// transports its depth, and values left at the edge of the bound would leave it at the first
+// noise of that transport, a residual each.
 uint32_t choose_view_code(const SliceJob& j, int x, int y, uint32_t p) {
     const Mapping& map = *j.map;
     const float z = j.source.empty() ? INFINITY : j.source(x, y);
     const uint32_t k = map.code(z);
     if (k > kMaxViewCode && k != kInvalidCode) return k;  // background: a flag
+    const double share = j.temporal.empty() ? 0.8 : 1.0;
     if (k != kInvalidCode && p <= kMaxViewCode &&
-        view_code_within(1.0 / double(z), p, map.step, map.displacement))
+        view_code_within(1.0 / double(z), p, map.step, map.displacement, share))
         return p;
     const int64_t base = surface_prediction(j, x, y, p), s = kViewResidualStep;
     if (k == kInvalidCode)  // NaN: any code above 2^30 + 1

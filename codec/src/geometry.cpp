@@ -190,11 +190,15 @@ struct Landings {
     // The depth at the centre of target pixel (tx, ty) on the plane in (px, py, 1/z) through the
     // landing of (x, y) and those of a horizontal and a vertical neighbour on its surface, taken
     // `span` pixels away (a decoded surface is a staircase of kept values: a wider span averages
-    // its steps out), else adjacent; its own depth where neither span has both, the plane is
-    // degenerate or it would move the value beyond its neighbours'.
+    // its steps out), else half as far, down to adjacent ones; its own depth where no span has
+    // both, the plane is degenerate or it would move the value beyond its neighbours'. The value
+    // is the mean of the plane's value at the centre through this landing and through each
+    // adjacent landing on the surface: decoded depth carries errors of up to the bound, and a
+    // prediction from one landing would carry its error on, frame after frame, until the errors
+    // of a surface spread past the bound (each such pixel a residual).
     float at_centre(int x, int y, int tx, int ty) const {
         const float own = z(x, y);
-        for (int k : {span, 1}) {
+        for (int k = span; k >= 1; k /= 2) {
             const int dx = beside(x, y, x + k, y) ? k : beside(x, y, x - k, y) ? -k : 0;
             const int dy = beside(x, y, x, y + k) ? k : beside(x, y, x, y - k) ? -k : 0;
             if (dx == 0 || dy == 0) continue;
@@ -205,15 +209,53 @@ struct Landings {
             const float det = ax * by - ay * bx;
             if (!(std::abs(det) >= 0.25f * float(k * k))) continue;
             const float gx = (av * by - bv * ay) / det, gy = (ax * bv - bx * av) / det;
-            const float change =
-                gx * (float(tx) + 0.5f - px(x, y)) + gy * (float(ty) + 0.5f - py(x, y));
+            const float cx = float(tx) + 0.5f, cy = float(ty) + 0.5f;
+            const float change = gx * (cx - px(x, y)) + gy * (cy - py(x, y));
             if (!(std::abs(change) <= std::max(std::abs(av), std::abs(bv))) || !(v + change > 0.0f))
                 continue;
-            return 1.0f / (v + change);
+            float sum = v + change;
+            int count = 1;
+            for (const auto [nx, ny] : {std::pair{x - 1, y}, {x + 1, y}, {x, y - 1}, {x, y + 1}}) {
+                if (!beside(x, y, nx, ny)) continue;
+                const float value =
+                    1.0f / z(nx, ny) + gx * (cx - px(nx, ny)) + gy * (cy - py(nx, ny));
+                if (value > 0.0f) sum += value, ++count;
+            }
+            return float(count) / sum;
         }
         return own;
     }
 };
+
+// A pixel no landing reached between two on one surface, across, down or diagonally (a crack
+// where the reference was stretched, or where two cracks cross), takes their mean inverse depth:
+// exact on a plane, as both are values at pixel centres.
+void fill_cracks(ImageView<float> depth, Image<float>& scratch) {
+    const int w = depth.width, h = depth.height;
+    auto mean = [](float a, float b) {
+        const float va = 1.0f / a, vb = 1.0f / b;
+        return a < kInf && b < kInf && std::abs(va - vb) <= 0.125f * std::max(va, vb)
+                   ? 2.0f / (va + vb)
+                   : kNan;
+    };
+    parallel_for(0, h, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y)
+            for (int x = 0; x < w; ++x) {
+                float v = kNan;
+                if (std::isnan(depth(x, y)) && x > 0 && y > 0 && x + 1 < w && y + 1 < h)
+                    for (const auto [dx, dy] : {std::pair{1, 0}, {0, 1}, {1, 1}, {1, -1}}) {
+                        v = mean(depth(x - dx, y - dy), depth(x + dx, y + dy));
+                        if (!std::isnan(v)) break;
+                    }
+                scratch(x, y) = v;
+            }
+    });
+    parallel_for(0, h, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y)
+            for (int x = 0; x < w; ++x)
+                if (!std::isnan(scratch(x, y))) depth(x, y) = scratch(x, y);
+    });
+}
 
 }  // namespace
 
@@ -306,6 +348,7 @@ void reproject_depth(const Camera& from, ImageView<const float> depth, const Cam
                     land(slot, plane_fit ? landings.at_centre(x, y, slot % w, slot / w)
                                          : landings.z(x, y));
     });
+    if (plane_fit) fill_cracks(out, landings.held);
 }
 
 void forward_row_reference(const ForwardRow& r, int i_begin, int i_end) {

@@ -115,7 +115,8 @@ bool motion_residual_row(const MotionResidualRow& row);
 // View-mode depth (depth.cpp, choose_view_code): whether each pixel keeps its temporal prediction,
 // that is, the prediction exists (not kNoPrediction), the depth to code is finite and positive,
 // and the prediction's inverse depth w_c (c step, or step / 2 for c = 0) is within the bound of
-// w = 1 / z: |w_c - w| <= 8 step near^2, near = max(0, 1 - displacement max(w, w_c)). In binary64.
+// w = 1 / z: |w_c - w| <= kViewCodesPerStep step near^2, near = max(0, 1 - displacement max(w,
+// w_c)). In binary64.
 struct ViewKeepRow {
     const float* source;       // the depth to code
     const uint32_t* temporal;  // the temporal prediction's codes
@@ -127,5 +128,6 @@ struct ViewKeepRow {
 void view_keep_row_reference(const ViewKeepRow& row, int i_begin, int i_end);
 void view_keep_row(const ViewKeepRow& row);
 inline constexpr uint32_t kNoPrediction = 0xFFFFFFFFu;  // no depth code maps here
+inline constexpr int kViewCodesPerStep = 32;            // view-mode codes per step q of 1/z
 
 }  // namespace reprise::codec

@@ -327,7 +327,8 @@ void ViewKeepRowSimd(const ViewKeepRow& r) {
     const int n = int(hn::Lanes(dd));
     const VD zero = hn::Zero(dd), one = hn::Set(dd, 1.0), inf = hn::Set(dd, HUGE_VAL);
     const VD step = hn::Set(dd, r.step), half_step = hn::Set(dd, 0.5 * r.step);
-    const VD bound = hn::Set(dd, 8 * r.step), displacement = hn::Set(dd, r.displacement);
+    const VD bound = hn::Set(dd, kViewCodesPerStep * r.step),
+             displacement = hn::Set(dd, r.displacement);
     const VD max_code = hn::Set(dd, double(1u << 30));
     int i = 0;
     for (; i + n <= r.count; i += n) {

@@ -384,9 +384,9 @@ private:
     std::vector<uint8_t> reference_, optimized_;
 };
 
-// View-mode depth: which pixels keep their temporal prediction. Random: predictions within a few
-// codes of the depth's own (the bound's edge among them), missing ones, code 0; worst case: NaN,
-// Inf, negative and zero depth, codes around and above 2^30, a displacement of 0 or 10^6.
+// View-mode depth: which pixels keep their temporal prediction. Random: predictions within two
+// steps of the depth's own code (the bound's edge among them), missing ones, code 0; worst case:
+// NaN, Inf, negative and zero depth, codes around and above 2^30, a displacement of 0 or 10^6.
 class ViewKeepCase final : public KernelCase {
 public:
     void generate(int w, int h, KernelInputs inputs, uint32_t seed) override {
@@ -404,7 +404,8 @@ public:
             const double own = z > 0.0f && z < kInf
                                    ? std::min(std::nearbyint(1.0 / double(z) / step_), 0x1p30)
                                    : 0.0;
-            const int64_t near_own = int64_t(own) + int64_t(rng() % 25) - 12;
+            const int64_t near_own =
+                int64_t(own) + int64_t(rng() % (4 * kViewCodesPerStep + 1)) - 2 * kViewCodesPerStep;
             const uint32_t choices[] = {uint32_t(std::clamp<int64_t>(near_own, 0, 1 << 30)),
                                         uint32_t(std::clamp<int64_t>(near_own, 0, 1 << 30)),
                                         0xFFFFFFFFu, 0u};
