@@ -387,6 +387,9 @@ private:
 // View-mode depth: which pixels keep their temporal prediction. Random: predictions within two
 // steps of the depth's own code (the bound's edge among them), missing ones, code 0; worst case:
 // NaN, Inf, negative and zero depth, codes around and above 2^30, a displacement of 0 or 10^6.
+// With a displacement of 0 the step is a power of two and a quarter of the depths too, their
+// predictions exactly one step from their own code or one code beyond: the bound itself, exact
+// in binary64.
 class ViewKeepCase final : public KernelCase {
 public:
     void generate(int w, int h, KernelInputs inputs, uint32_t seed) override {
@@ -395,6 +398,8 @@ public:
         const bool worst = inputs == KernelInputs::WorstCase;
         step_ = double(uniform(rng, 1e-5f, 1e-3f));
         displacement_ = worst && seed % 3 == 0 ? (seed % 2 ? 0.0 : 1e6) : uniform(rng, 0.0f, 0.5f);
+        const bool exact_edges = displacement_ == 0.0;
+        if (exact_edges) step_ = 0x1p-12;
         source_.resize(std::size_t(w) * h);
         temporal_.resize(source_.size());
         for (std::size_t i = 0; i < source_.size(); ++i) {
@@ -414,6 +419,12 @@ public:
                 const uint32_t extremes[] = {1u << 30,    (1u << 30) + 1, (1u << 30) + 2,
                                              0x7FFFFFFFu, 0x80000000u,    0xFFFFFFFEu};
                 temporal_[i] = extremes[rng() % std::size(extremes)];
+            }
+            if (exact_edges && rng() % 4 == 0) {
+                const int e = int(rng() % 11) - 4;  // depth 2^e: 1/z = 2^(12 - e) steps exactly
+                source_[i] = std::ldexp(1.0f, e);
+                const int64_t edge = kViewCodesPerStep + int64_t(rng() % 2);
+                temporal_[i] = uint32_t((int64_t(1) << (12 - e)) + (rng() % 2 ? edge : -edge));
             }
         }
     }
