@@ -168,13 +168,14 @@ namespace {
 struct Landings {
     Image<int32_t> slot;
     Image<float> z, px, py, held;
-    Image<int> object;  // index into the objects, -1: none
+    Image<float> inverse;  // 1 / z of each landing (plane fit only)
+    Image<int> object;     // index into the objects, -1: none
     // The plane's span in pixels (at_centre): 6 at a height of 360, the best of 3 to 18 there, as
     // 12 was at 720.
     int span = 1;
     void resize(int w, int h) {
         span = std::max(2, int(std::lround(double(h) / 60.0)));
-        for (Image<float>* i : {&z, &px, &py, &held}) ensure_size(*i, w, h);
+        for (Image<float>* i : {&z, &px, &py, &held, &inverse}) ensure_size(*i, w, h);
         ensure_size(slot, w, h);
         ensure_size(object, w, h);
     }
@@ -184,8 +185,8 @@ struct Landings {
         if (nx < 0 || ny < 0 || nx >= slot.width() || ny >= slot.height() || slot(nx, ny) < 0 ||
             object(nx, ny) != object(x, y))
             return false;
-        const float v = 1.0f / z(x, y), vn = 1.0f / z(nx, ny);
-        return std::abs(vn - v) <= 0.125f * v;
+        const float v = inverse(x, y);
+        return std::abs(inverse(nx, ny) - v) <= 0.125f * v;
     }
     // The depth at the centre of target pixel (tx, ty) on the plane in (px, py, 1/z) through the
     // landing of (x, y) and those of a horizontal and a vertical neighbour on its surface, taken
@@ -202,10 +203,10 @@ struct Landings {
             const int dx = beside(x, y, x + k, y) ? k : beside(x, y, x - k, y) ? -k : 0;
             const int dy = beside(x, y, x, y + k) ? k : beside(x, y, x, y - k) ? -k : 0;
             if (dx == 0 || dy == 0) continue;
-            const float v = 1.0f / own;
+            const float v = inverse(x, y);
             const float ax = px(x + dx, y) - px(x, y), ay = py(x + dx, y) - py(x, y);
             const float bx = px(x, y + dy) - px(x, y), by = py(x, y + dy) - py(x, y);
-            const float av = 1.0f / z(x + dx, y) - v, bv = 1.0f / z(x, y + dy) - v;
+            const float av = inverse(x + dx, y) - v, bv = inverse(x, y + dy) - v;
             const float det = ax * by - ay * bx;
             if (!(std::abs(det) >= 0.25f * float(k * k))) continue;
             const float gx = (av * by - bv * ay) / det, gy = (ax * bv - bx * av) / det;
@@ -218,7 +219,7 @@ struct Landings {
             for (const auto [nx, ny] : {std::pair{x - 1, y}, {x + 1, y}, {x, y - 1}, {x, y + 1}}) {
                 if (!beside(x, y, nx, ny)) continue;
                 const float value =
-                    1.0f / z(nx, ny) + gx * (cx - px(nx, ny)) + gy * (cy - py(nx, ny));
+                    inverse(nx, ny) + gx * (cx - px(nx, ny)) + gy * (cy - py(nx, ny));
                 if (value > 0.0f) sum += value, ++count;
             }
             return float(count) / sum;
@@ -325,20 +326,23 @@ void reproject_depth(const Camera& from, ImageView<const float> depth, const Cam
                 moved |= (object[x] = objects.empty() ? -1 : object_of(x, y)) >= 0;
             if (!moved) {
                 forward_row(row);
-                continue;
+            } else {
+                float* held = &landings.held(0, y);
+                for (int x = 0; x < w; ++x) held[x] = object[x] >= 0 ? kNan : depth(x, y);
+                row.depth = held;
+                forward_row(row);
+                for (int x = 0; x < w; ++x) {
+                    if (object[x] < 0) continue;
+                    ForwardRow one = row;
+                    one.to_clip = object_clip[std::size_t(object[x])];
+                    one.to_camera = object_camera[std::size_t(object[x])];
+                    one.depth = depth.row(y);
+                    forward_row_reference(one, x, x + 1);
+                }
             }
-            float* held = &landings.held(0, y);
-            for (int x = 0; x < w; ++x) held[x] = object[x] >= 0 ? kNan : depth(x, y);
-            row.depth = held;
-            forward_row(row);
-            for (int x = 0; x < w; ++x) {
-                if (object[x] < 0) continue;
-                ForwardRow one = row;
-                one.to_clip = object_clip[std::size_t(object[x])];
-                one.to_camera = object_camera[std::size_t(object[x])];
-                one.depth = depth.row(y);
-                forward_row_reference(one, x, x + 1);
-            }
+            if (plane_fit)
+                for (int x = 0; x < w; ++x)
+                    landings.inverse(x, y) = row.slot[x] >= 0 ? 1.0f / row.z[x] : 0.0f;
         }
     });
     parallel_for(0, h, [&](int y0, int y1) {
