@@ -258,6 +258,26 @@ void fill_cracks(ImageView<float> depth, Image<float>& scratch) {
     });
 }
 
+// A run of up to kWidestGap pixels across where nothing landed, between two landings, takes the
+// farther one's depth: where the camera or an object moved, what comes into view lies behind.
+constexpr int kWidestGap = 8;
+void fill_gaps(ImageView<float> depth) {
+    const int w = depth.width;
+    parallel_for(0, depth.height, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y) {
+            float* row = depth.row(y);
+            for (int x = 1; x < w; ++x) {
+                if (!std::isnan(row[x])) continue;
+                int end = x;
+                while (end < w && std::isnan(row[end])) ++end;
+                if (end < w && end - x <= kWidestGap && row[x - 1] < kInf && row[end] < kInf)
+                    std::fill(row + x, row + end, std::max(row[x - 1], row[end]));
+                x = end;
+            }
+        }
+    });
+}
+
 }  // namespace
 
 void reproject_depth(const Camera& from, ImageView<const float> depth, const Camera& to,
@@ -352,7 +372,10 @@ void reproject_depth(const Camera& from, ImageView<const float> depth, const Cam
                     land(slot, plane_fit ? landings.at_centre(x, y, slot % w, slot / w)
                                          : landings.z(x, y));
     });
-    if (plane_fit) fill_cracks(out, landings.held);
+    if (plane_fit) {
+        fill_cracks(out, landings.held);
+        fill_gaps(out);
+    }
 }
 
 void forward_row_reference(const ForwardRow& r, int i_begin, int i_end) {

@@ -138,7 +138,8 @@ void rigid_motion(const Camera& from, ImageView<const float> depth, const glm::m
 // NaN where nothing landed. A copy when the cameras are identical.
 // Pixels whose `owner` id is one of `objects` (this frame's) move with that object's motion.
 // `plane_fit`: each landing takes the value of its surface's plane at the centre of the pixel it
-// lands in, instead of the value where it landed (docs/bitstream.md, section 6).
+// lands in, instead of the value where it landed, and cracks and narrow gaps between landings are
+// filled (docs/bitstream.md, section 6).
 void reproject_depth(const Camera& from, ImageView<const float> depth, const Camera& to,
                      ImageView<float> out, ImageView<const uint32_t> owner = {},
                      std::span<const ObjectMotion> objects = {}, bool plane_fit = false);
