@@ -9,6 +9,7 @@
 #include <map>
 #include <memory>
 #include <random>
+#include <string>
 #include <vector>
 
 #include <GLES3/gl32.h>
@@ -80,21 +81,33 @@ std::size_t mask_differences(const Image<uint8_t>& a, const Image<uint8_t>& b) {
 }
 
 // The tolerance: >= 50 dB on display values, holes within 0.1 % of the pixels, each
-// outcome's count too.
-void expect_equal_within_tolerance(const Reprojected& cpu, const Reprojected& gpu,
-                                   const char* what) {
+// outcome's count too. Returns what is out of it ("" when nothing is).
+std::string out_of_tolerance(const Reprojected& cpu, const Reprojected& gpu) {
     const std::size_t pixels = cpu.hit.pixel_count();
     const std::size_t allowed = pixels / 1000;
-    EXPECT_LE(mask_differences(cpu.hit, gpu.hit), allowed) << what;
-    EXPECT_GE(test::display_psnr(cpu.out, gpu.out), 50.0) << what;
-    auto near = [&](std::size_t a, std::size_t b) { return (a > b ? a - b : b - a) <= allowed; };
-    EXPECT_TRUE(near(cpu.counts.hits, gpu.counts.hits)) << what;
-    EXPECT_TRUE(near(cpu.counts.offscreen, gpu.counts.offscreen)) << what;
-    EXPECT_TRUE(near(cpu.counts.behind, gpu.counts.behind)) << what;
-    EXPECT_TRUE(near(cpu.counts.occluded, gpu.counts.occluded)) << what;
-    EXPECT_TRUE(near(cpu.counts.other_id, gpu.counts.other_id)) << what;
-    EXPECT_TRUE(near(cpu.counts.invalid, gpu.counts.invalid)) << what;
-    EXPECT_EQ(gpu.counts.hits + gpu.counts.misses(), cpu.counts.hits + cpu.counts.misses()) << what;
+    std::string out;
+    auto check = [&](const char* what, std::size_t a, std::size_t b) {
+        if ((a > b ? a - b : b - a) > allowed)
+            out += std::string(what) + " cpu " + std::to_string(a) + " gpu " + std::to_string(b) +
+                   "; ";
+    };
+    check("hit mask differences", 0, mask_differences(cpu.hit, gpu.hit));
+    check("hits", cpu.counts.hits, gpu.counts.hits);
+    check("offscreen", cpu.counts.offscreen, gpu.counts.offscreen);
+    check("behind", cpu.counts.behind, gpu.counts.behind);
+    check("occluded", cpu.counts.occluded, gpu.counts.occluded);
+    check("other id", cpu.counts.other_id, gpu.counts.other_id);
+    check("invalid", cpu.counts.invalid, gpu.counts.invalid);
+    if (gpu.counts.hits + gpu.counts.misses() != cpu.counts.hits + cpu.counts.misses())
+        out += "looked-up pixels differ; ";
+    const double db = test::display_psnr(cpu.out, gpu.out);
+    if (!(db >= 50.0)) out += "colour " + std::to_string(db) + " dB; ";
+    return out;
+}
+
+void expect_equal_within_tolerance(const Reprojected& cpu, const Reprojected& gpu,
+                                   const char* what) {
+    EXPECT_EQ(out_of_tolerance(cpu, gpu), "") << what;
 }
 
 TEST(Gpu, ReprojectionMatchesTheCpuOnEveryBuiltInScene) {
@@ -161,11 +174,23 @@ TEST(Gpu, ReprojectionOnExtremeValues) {
     // The previous camera turned half round: much of the frame is behind it.
     Frame turned = frames[1];
     turned.camera.prev_view = glm::rotate(turned.camera.view, 2.5f, glm::vec3(0, 1, 0));
+    // GPUs may flush subnormal floats to zero (GLSL ES allows it; NVIDIA's driver does, llvmpipe
+    // does not): a depth of 1e-40 is then a depth of 0, which lands elsewhere. The GPU must match
+    // the CPU on the input as given or on the input with subnormals flushed.
+    auto flushed = [](Frame f) {
+        for (std::size_t i = 0; i < f.depth.pixel_count(); ++i)
+            if (std::fpclassify(f.depth.data()[i]) == FP_SUBNORMAL) f.depth.data()[i] = 0.0f;
+        return f;
+    };
     for (const Frame* current : {&frames[1], &turned}) {
         const Reprojected cpu = cpu_reproject(*current, frames[0]);
         const Reprojected gpu = gpu_reproject(*current, frames[0]);
         EXPECT_GT(cpu.counts.invalid + cpu.counts.offscreen, 0u);
-        expect_equal_within_tolerance(cpu, gpu, "extreme values");
+        const std::string as_given = out_of_tolerance(cpu, gpu);
+        const std::string as_flushed =
+            out_of_tolerance(cpu_reproject(flushed(*current), flushed(frames[0])), gpu);
+        EXPECT_TRUE(as_given.empty() || as_flushed.empty())
+            << "as given: " << as_given << "\nsubnormals flushed: " << as_flushed;
     }
     EXPECT_GT(cpu_reproject(turned, frames[0]).counts.behind, 0u);
 }

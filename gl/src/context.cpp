@@ -77,7 +77,9 @@ Status Context::create(std::unique_ptr<Context>& context) {
         return Status::error("REPRISE_EGL='" + mode + "': expected device or surfaceless");
     const char* client_extensions = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
     EGLDisplay display = EGL_NO_DISPLAY;
-    if (mode != "surfaceless" && has_extension(client_extensions, "EGL_EXT_device_enumeration"))
+    // libglvnd offers enumeration as part of EGL_EXT_device_base (NVIDIA's driver behind it).
+    if (mode != "surfaceless" && (has_extension(client_extensions, "EGL_EXT_device_enumeration") ||
+                                  has_extension(client_extensions, "EGL_EXT_device_base")))
         display = hardware_display();
     if (display == EGL_NO_DISPLAY && mode == "device")
         return Status::error("EGL: no hardware EGL device found (REPRISE_EGL=device)");

@@ -108,9 +108,8 @@ layout(binding = 1) uniform highp usampler2D valid;
 layout(binding = 2) uniform highp sampler2D fine_depth;
 layout(binding = 0, rgba32f) writeonly uniform highp image2D out_color;
 layout(binding = 1, r32f) writeonly uniform highp image2D out_depth;
-void main() {
-    ivec2 q = ivec2(gl_GlobalInvocationID.xy);
-    if (q.x >= coarse_size.x || q.y >= coarse_size.y) return;
+// Whether coarse pixel q stays empty.
+bool pull(ivec2 q) {
     highp vec3 p[4];
     highp float w[4], d[4];
     int n = 0;
@@ -136,7 +135,12 @@ void main() {
     pull_pixel(p, w, d, n, result, depth);
     imageStore(out_color, q, result);
     if (use_depth) imageStore(out_depth, q, vec4(depth));
-    if (result.a < 1.0) atomicAdd(counts[1 + level], 1u);
+    return result.a < 1.0;
+}
+void main() {
+    ivec2 q = ivec2(gl_GlobalInvocationID.xy);
+    bool inside = q.x < coarse_size.x && q.y < coarse_size.y;
+    COUNT_IN_GROUP(inside && pull(q), counts[1 + level])
 }
 )";
 
@@ -178,17 +182,21 @@ layout(binding = 3) uniform highp sampler2D coarse_depth;
 layout(binding = 4) uniform highp sampler2D top_level;
 layout(binding = 0, rgba32f) writeonly uniform highp image2D out_color;
 uniform bool has_levels;
-void main() {
-    ivec2 q = ivec2(gl_GlobalInvocationID.xy);
-    if (q.x >= fine_size.x || q.y >= fine_size.y) return;
+// Whether pixel q is a hole.
+bool fill_pixel(ivec2 q) {
     highp vec4 c = texelFetch(color, q, 0);
     bool hole = texelFetch(valid, q, 0).r == 0u || !finite3(c.rgb);
-    if (hole) atomicAdd(counts[0], 1u);
     if (hole && has_levels && texelFetch(top_level, ivec2(0), 0).a > 0.0) {
         highp float ud;
         c = vec4(upsample(coarse, coarse_depth, q, ud), c.a);
     }
     imageStore(out_color, q, c);
+    return hole;
+}
+void main() {
+    ivec2 q = ivec2(gl_GlobalInvocationID.xy);
+    bool inside = q.x < fine_size.x && q.y < fine_size.y;
+    COUNT_IN_GROUP(inside && fill_pixel(q), counts[0])
 }
 )";
 

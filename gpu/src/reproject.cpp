@@ -87,12 +87,27 @@ uint classify(ivec2 p) {
     return HIT;
 }
 
+// Each invocation's outcome goes to shared memory and eight invocations count them: one global
+// atomic per group and outcome. (Atomics on one address serialise: per pixel on the counters,
+// or per pixel on shared counters, the pass took 36-90 ms at 1920x1080 on an H200, against
+// 0.07 ms without counting.)
+shared uint group_outcomes[64];
+
 void main() {
+    uint i = gl_LocalInvocationIndex;
     ivec2 p = ivec2(gl_GlobalInvocationID.xy) * step;
-    if (p.x >= size.x || p.y >= size.y) return;
-    uint outcome = classify(p);
-    atomicAdd(counts[outcome], 1u);
-    if (write_hit) imageStore(hit_image, p, uvec4(outcome == HIT ? 1u : 0u));
+    uint outcome = 8u;  // outside the image: not counted
+    if (p.x < size.x && p.y < size.y) {
+        outcome = classify(p);
+        if (write_hit) imageStore(hit_image, p, uvec4(outcome == HIT ? 1u : 0u));
+    }
+    group_outcomes[i] = outcome;
+    barrier();
+    if (i < 8u) {
+        uint n = 0u;
+        for (int k = 0; k < 64; ++k) n += group_outcomes[k] == i ? 1u : 0u;
+        if (n != 0u) atomicAdd(counts[i], n);
+    }
 }
 )";
 

@@ -38,6 +38,21 @@ inline constexpr const char* kComputeHeader = R"(#version 310 es
 #define PRECISE
 #endif
 layout(local_size_x = 8, local_size_y = 8) in;
+// COUNT_IN_GROUP(condition, counter) as the whole body of main(): counts where `condition` holds
+// in the work group, then adds the group's count to `counter` once. Atomics on one address
+// serialise (per pixel, on the counter or on a shared one, they cost tens of ms at 1920x1080 on
+// an H200), so each invocation writes its flag to shared memory and the first one adds them up.
+// barrier() may not sit in control flow, so every invocation evaluates `condition`, whose side
+// effects are the pass.
+shared uint group_flags[64];
+#define COUNT_IN_GROUP(condition, counter) \
+    group_flags[gl_LocalInvocationIndex] = (condition) ? 1u : 0u; \
+    barrier(); \
+    if (gl_LocalInvocationIndex == 0u) { \
+        uint n = 0u; \
+        for (int k = 0; k < 64; ++k) n += group_flags[k]; \
+        if (n != 0u) atomicAdd(counter, n); \
+    }
 )";
 
 // glFinish, then the milliseconds since `since`, which moves to now.
