@@ -1,8 +1,10 @@
 // The GPU context: its GL context, the counters buffer, and the plumbing of uploads and downloads.
 #include <chrono>
 #include <cstdio>
+#include <cstring>
 #include <string>
 
+#include "reprise/core/parallel.hpp"
 #include "reprise/gpu/context.hpp"
 #include "state.hpp"
 
@@ -28,11 +30,74 @@ void Texture::ensure(GLenum new_format, int w, int h) {
     height = h;
 }
 
-void upload(const Texture& texture, const void* data, std::ptrdiff_t stride) {
+namespace {
+
+std::size_t texel_bytes(GLenum format) {
+    switch (format) {
+        case GL_RGBA32F:
+            return 16;
+        case GL_RG32F:
+            return 8;
+        case GL_R8UI:
+            return 1;
+        default:  // GL_R32F, GL_R32UI
+            return 4;
+    }
+}
+
+}  // namespace
+
+GLuint ContextState::make_counters(std::size_t bytes) {
+    GLuint buffer = 0;
+    glGenBuffers(1, &buffer);
+    glBindBuffer(GL_SHADER_STORAGE_BUFFER, buffer);
+    glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(bytes), nullptr, GL_DYNAMIC_COPY);
+    return buffer;
+}
+
+void ContextState::read_counters(GLuint buffer, void* out, std::size_t bytes) {
+    REPRISE_ASSERT(bytes <= 64 * sizeof(GLuint));  // the readback buffer's size
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+    glBindBuffer(GL_COPY_READ_BUFFER, buffer);
+    glBindBuffer(GL_COPY_WRITE_BUFFER, readback_buffer);
+    glCopyBufferSubData(GL_COPY_READ_BUFFER, GL_COPY_WRITE_BUFFER, 0, 0, GLsizeiptr(bytes));
+    std::memset(out, 0, bytes);
+    if (const void* mapped =
+            glMapBufferRange(GL_COPY_WRITE_BUFFER, 0, GLsizeiptr(bytes), GL_MAP_READ_BIT)) {
+        std::memcpy(out, mapped, bytes);
+        glUnmapBuffer(GL_COPY_WRITE_BUFFER);
+    }
+    glBindBuffer(GL_COPY_READ_BUFFER, 0);
+    glBindBuffer(GL_COPY_WRITE_BUFFER, 0);
+}
+
+void ContextState::upload(const Texture& texture, const void* data, std::ptrdiff_t stride) {
     GLenum format = 0, type = 0;
     gl::transfer_format(texture.format, format, type);
+    const std::size_t row = texel_bytes(texture.format) * std::size_t(texture.width);
+    const std::size_t bytes = row * std::size_t(texture.height);
+    const std::size_t source_row = texel_bytes(texture.format) * std::size_t(stride);
     glBindTexture(GL_TEXTURE_2D, texture.name);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glBindBuffer(GL_PIXEL_UNPACK_BUFFER, unpack_buffer);
+    glBufferData(GL_PIXEL_UNPACK_BUFFER, GLsizeiptr(bytes), nullptr, GL_STREAM_DRAW);
+    auto* mapped = static_cast<unsigned char*>(glMapBufferRange(
+        GL_PIXEL_UNPACK_BUFFER, 0, GLsizeiptr(bytes),
+        GL_MAP_WRITE_BIT | GL_MAP_INVALIDATE_BUFFER_BIT | GL_MAP_UNSYNCHRONIZED_BIT));
+    const auto* source = static_cast<const unsigned char*>(data);
+    if (mapped) {
+        parallel_for(0, texture.height, [&](int y0, int y1) {
+            for (int y = y0; y < y1; ++y)
+                std::memcpy(mapped + std::size_t(y) * row, source + std::size_t(y) * source_row,
+                            row);
+        });
+        glUnmapBuffer(GL_PIXEL_UNPACK_BUFFER);
+        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, texture.width, texture.height, format, type,
+                        nullptr);
+        glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+        return;
+    }
+    glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);  // the driver would not map: from client memory
     glPixelStorei(GL_UNPACK_ROW_LENGTH, GLint(stride));
     glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, texture.width, texture.height, format, type, data);
     glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
@@ -101,6 +166,8 @@ Context::~Context() {
     glDeleteBuffers(1, &state_->fill_counts);
     glDeleteSamplers(1, &state_->nearest_sampler);
     glDeleteBuffers(1, &state_->counts_buffer);
+    glDeleteBuffers(1, &state_->unpack_buffer);
+    glDeleteBuffers(1, &state_->readback_buffer);
     glDeleteFramebuffers(1, &state_->read_framebuffer);
     glDeleteProgram(state_->reproject_program);
 }
@@ -118,10 +185,12 @@ Status Context::create(std::unique_ptr<Context>& context) {
                              std::to_string(minor));
     REPRISE_TRY(create_programs(s));
     REPRISE_TRY(create_fill_programs(s));
-    glGenBuffers(1, &s.counts_buffer);
-    glBindBuffer(GL_SHADER_STORAGE_BUFFER, s.counts_buffer);
-    glBufferData(GL_SHADER_STORAGE_BUFFER, 8 * sizeof(GLuint), nullptr, GL_DYNAMIC_READ);
+    s.counts_buffer = s.make_counters(8 * sizeof(GLuint));
+    glGenBuffers(1, &s.readback_buffer);
+    glBindBuffer(GL_COPY_WRITE_BUFFER, s.readback_buffer);
+    glBufferData(GL_COPY_WRITE_BUFFER, 64 * sizeof(GLuint), nullptr, GL_STREAM_READ);
     glGenFramebuffers(1, &s.read_framebuffer);
+    glGenBuffers(1, &s.unpack_buffer);
     glGenSamplers(1, &s.nearest_sampler);
     glSamplerParameteri(s.nearest_sampler, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     glSamplerParameteri(s.nearest_sampler, GL_TEXTURE_MAG_FILTER, GL_NEAREST);

@@ -319,12 +319,7 @@ Status fill_passes(ContextState& s, GLuint color, GLuint valid, GLuint depth, in
     glUseProgram(0);
 
     GLuint n[kMaxLevels + 2] = {};
-    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
-    if (const void* mapped =
-            glMapBufferRange(GL_SHADER_STORAGE_BUFFER, 0, sizeof n, GL_MAP_READ_BIT)) {
-        std::memcpy(n, mapped, sizeof n);
-        glUnmapBuffer(GL_SHADER_STORAGE_BUFFER);
-    }
+    s.read_counters(s.fill_counts, n, sizeof n);
     REPRISE_TRY(gl::check_errors("gpu pull-push"));
     // The counts as the CPU reports them: levels pulled until one had no empty pixel.
     stats = {.holes = n[0]};
@@ -355,10 +350,7 @@ Status create_fill_programs(ContextState& s) {
         s.pull_level_program));
     REPRISE_TRY(gl::link_compute((prelude + kPush).c_str(), "push", s.push_program));
     REPRISE_TRY(gl::link_compute((prelude + kFinal).c_str(), "fill", s.final_program));
-    glGenBuffers(1, &s.fill_counts);
-    glBindBuffer(GL_SHADER_STORAGE_BUFFER, s.fill_counts);
-    glBufferData(GL_SHADER_STORAGE_BUFFER, (kMaxLevels + 2) * sizeof(GLuint), nullptr,
-                 GL_DYNAMIC_READ);
+    s.fill_counts = s.make_counters((kMaxLevels + 2) * sizeof(GLuint));
     return {};
 }
 
@@ -377,11 +369,11 @@ Status Context::fill(ImageView<glm::vec4> color, ImageView<const uint8_t> valid,
     s.color.ensure(GL_RGBA32F, w, h);
     s.valid.ensure(GL_R8UI, w, h);
     s.out.ensure(GL_RGBA32F, w, h);
-    upload(s.color, color.data, color.stride);
-    upload(s.valid, valid.data, valid.stride);
+    s.upload(s.color, color.data, color.stride);
+    s.upload(s.valid, valid.data, valid.stride);
     if (!depth.empty()) {
         s.depth.ensure(GL_R32F, w, h);
-        upload(s.depth, depth.data, depth.stride);
+        s.upload(s.depth, depth.data, depth.stride);
     }
     timings_.upload_ms = finish_ms(t);
     REPRISE_TRY(fill_passes(s, s.color.name, s.valid.name, depth.empty() ? 0u : s.depth.name, w, h,

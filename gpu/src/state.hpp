@@ -21,9 +21,6 @@ struct Texture {
     void ensure(GLenum new_format, int w, int h);
 };
 
-// Uploads `h` rows of `w` pixels, `stride` pixels apart, into `texture` (already sized).
-void upload(const Texture& texture, const void* data, std::ptrdiff_t stride);
-
 // An error naming `what` unless texture `name` is a 2D texture of `format` and w x h.
 Status check_texture(unsigned name, GLenum format, int w, int h, const char* what);
 
@@ -39,11 +36,9 @@ inline constexpr const char* kComputeHeader = R"(#version 310 es
 #endif
 layout(local_size_x = 8, local_size_y = 8) in;
 // COUNT_IN_GROUP(condition, counter) as the whole body of main(): counts where `condition` holds
-// in the work group, then adds the group's count to `counter` once. Atomics on one address
-// serialise (per pixel, on the counter or on a shared one, they cost tens of ms at 1920x1080 on
-// an H200), so each invocation writes its flag to shared memory and the first one adds them up.
-// barrier() may not sit in control flow, so every invocation evaluates `condition`, whose side
-// effects are the pass.
+// in the work group (each invocation's flag in shared memory, added up by the first), then adds
+// the group's count to `counter` with one atomic. barrier() may not sit in control flow, so every
+// invocation evaluates `condition`, whose side effects are the pass.
 shared uint group_flags[64];
 #define COUNT_IN_GROUP(condition, counter) \
     group_flags[gl_LocalInvocationIndex] = (condition) ? 1u : 0u; \
@@ -73,6 +68,18 @@ struct ContextState {
     std::vector<Texture> pulled, pulled_depth, filled, filled_depth;
     std::vector<glm::uvec4> hit_readback;  // integer downloads come as RGBA
 
+    // Counters live in GPU memory (a buffer hinted for reading may be placed in the host's, where
+    // every shader atomic crosses the bus: reprojection took 39-90 ms at 1920x1080 on an H200,
+    // 0.32 ms with them in GPU memory) and are copied into this one to be read.
+    GLuint readback_buffer = 0;
+    GLuint unpack_buffer = 0;  // uploads go through it: the GPU lays the texels out, not the CPU
+
+    // A counters buffer in GPU memory of `bytes`.
+    GLuint make_counters(std::size_t bytes);
+    // The first `bytes` of counters buffer `buffer` (the shaders that wrote it finished).
+    void read_counters(GLuint buffer, void* out, std::size_t bytes);
+    // Uploads the texture's rows, `stride` pixels apart, into `texture` (already sized).
+    void upload(const Texture& texture, const void* data, std::ptrdiff_t stride);
     // Reads `texture` (GL_RGBA32F into floats, GL_R32UI into hit_readback) through the
     // framebuffer; `stride` in pixels for float targets.
     void download(const Texture& texture, void* data, std::ptrdiff_t stride);
