@@ -15,8 +15,11 @@
 #include <GLES3/gl32.h>
 
 #include "reprise/gpu/context.hpp"
+#include "reprise/stereo/rig.hpp"
+#include "reprise/stereo/synthesize.hpp"
 #include "reprise/warp/fill.hpp"
 #include "reprise/warp/reproject.hpp"
+#include "reprise/warp/splat.hpp"
 #include "support/frames.hpp"
 #include "support/nonfinite.hpp"
 #include "support/renderer.hpp"
@@ -415,6 +418,166 @@ TEST(Gpu, PullPushOnTexturesWritesTheOutputTexture) {
         << status.message();
     status = context.fill(color, valid, 0, kWidth, kHeight, color, got);
     EXPECT_EQ(status.message(), "gpu pull-push: the output is the colour texture");
+}
+
+}  // namespace
+
+namespace {
+
+// --- The splat and the stereo eye (StereoWarp::Splat) against the CPU.
+
+struct Splatted {
+    Image<glm::vec4> color;
+    Image<float> depth;
+    Image<glm::vec2> motion;
+    Image<uint8_t> covered;
+    std::size_t count = 0;
+    explicit Splatted(int w, int h) : color(w, h), depth(w, h), motion(w, h), covered(w, h) {}
+    warp::WarpTarget target() {
+        return {color.view(), depth.view(), motion.view(), covered.view()};
+    }
+};
+
+// The colour of covered pixels (others 0), as a display-PSNR input.
+Image<glm::vec4> covered_color(const Splatted& s) {
+    Image<glm::vec4> c(s.color.width(), s.color.height(), glm::vec4(0.0f));
+    for (std::size_t i = 0; i < c.pixel_count(); ++i)
+        if (s.covered.data()[i]) c.data()[i] = s.color.data()[i];
+    return c;
+}
+
+TEST(Gpu, SplatMatchesTheCpuOnEveryBuiltInScene) {
+    const std::size_t allowed = std::size_t(kWidth) * kHeight / 1000;
+    for (const server::SceneInfo& info : server::builtin_scenes()) {
+        SCOPED_TRACE(info.name);
+        const Frame& f = scene_frames(info.name)[1];
+        for (int footprint : {1, 2})
+            for (float factor : {-0.5f, 1.0f}) {
+                Splatted cpu(kWidth, kHeight), gpu(kWidth, kHeight);
+                cpu.count = warp::splat(f, factor, cpu.target(), {.footprint = footprint});
+                const Status status = shared_gpu().splat(f, factor, gpu.target(),
+                                                         {.footprint = footprint}, gpu.count);
+
+                ASSERT_TRUE(status.ok()) << status.message();
+                EXPECT_GT(cpu.count, std::size_t(kWidth) * kHeight / 2);
+                EXPECT_LE(mask_differences(cpu.covered, gpu.covered), allowed);
+                const double db = test::display_psnr(covered_color(cpu), covered_color(gpu));
+                EXPECT_GE(db, 50.0) << "footprint " << footprint << " factor " << factor;
+                std::size_t motion_off = 0;
+                for (std::size_t i = 0; i < gpu.motion.pixel_count(); ++i)
+                    motion_off += gpu.covered.data()[i] && cpu.covered.data()[i] &&
+                                  gpu.motion.data()[i] != cpu.motion.data()[i];
+                EXPECT_LE(motion_off, allowed);
+                std::printf(
+                    "%-10s splat %d x%+.1f covered cpu %zu gpu %zu, masks differ at %zu, "
+                    "%.1f dB\n",
+                    info.name, footprint, factor, cpu.count, gpu.count,
+                    mask_differences(cpu.covered, gpu.covered), db);
+            }
+    }
+}
+
+const stereo::StereoOptions kSplatEye{.warp = stereo::StereoWarp::Splat};
+
+TEST(Gpu, StereoEyeMatchesTheCpuOnEveryBuiltInScene) {
+    std::size_t holes = 0;
+    for (const server::SceneInfo& info : server::builtin_scenes()) {
+        SCOPED_TRACE(info.name);
+        const Frame& f = scene_frames(info.name)[1];
+        const Camera right = stereo::eye_cameras(f.camera, {}, stereo::Anchor::Left).right;
+        Frame cpu, gpu;
+        const stereo::StereoStats expected = stereo::synthesize_eye(f, right, kSplatEye, cpu);
+        stereo::StereoStats stats;
+        const Status status = shared_gpu().stereo_eye(f, right, gpu, stats, kSplatEye);
+        ASSERT_TRUE(status.ok()) << status.message();
+        const std::size_t allowed = cpu.color.pixel_count() / 1000;
+        holes += expected.holes;
+        EXPECT_LE(std::max(stats.holes, expected.holes) - std::min(stats.holes, expected.holes),
+                  allowed);
+        EXPECT_EQ(stats.filled + stats.unfilled, stats.holes);
+        const double db = test::display_psnr(cpu.color, gpu.color);
+        EXPECT_GE(db, 50.0);
+        EXPECT_EQ(gpu.camera.view, right.view);
+        std::printf("%-10s eye holes cpu %zu gpu %zu, %.1f dB\n", info.name, expected.holes,
+                    stats.holes, db);
+    }
+    EXPECT_GT(holes, 50u);  // not vacuous: pull-push had holes to fill (84 at 96x64)
+}
+
+// Every source pixel onto one target pixel: more candidates than the shader sorts, taken by the
+// rule (nearest depth, closest landing, first in source order), which agrees with the CPU here.
+TEST(Gpu, SplatOfTheWholeImageOntoOnePixel) {
+    Frame f = scene_frames("crossing")[1];
+    for (int y = 0; y < kHeight; ++y)
+        for (int x = 0; x < kWidth; ++x) {
+            f.motion(x, y) = {float(40 - x), float(30 - y)};
+            if (std::isfinite(f.depth(x, y))) f.depth(x, y) = 5.0f;
+        }
+    Splatted cpu(kWidth, kHeight), gpu(kWidth, kHeight);
+    cpu.count = warp::splat(f, 1.0f, cpu.target());
+    ASSERT_TRUE(shared_gpu().splat(f, 1.0f, gpu.target(), {}, gpu.count).ok());
+    EXPECT_EQ(cpu.count, 1u);
+    EXPECT_EQ(gpu.count, 1u);
+    EXPECT_EQ(mask_differences(cpu.covered, gpu.covered), 0u);
+    EXPECT_EQ(gpu.color(40, 30), cpu.color(40, 30));
+    EXPECT_EQ(gpu.depth(40, 30), 5.0f);
+}
+
+TEST(Gpu, StereoEyeRepairsNonFiniteInputAsTheCpu) {
+    NonfiniteCounts spoiled;
+    const std::vector<Frame> frames = test::spoiled_sequence(1, spoiled);
+    const Frame& f = frames[0];
+    const Camera right = stereo::eye_cameras(f.camera, {}, stereo::Anchor::Left).right;
+    Frame cpu, gpu;
+    const stereo::StereoStats expected = stereo::synthesize_eye(f, right, kSplatEye, cpu);
+    stereo::StereoStats stats;
+    ASSERT_TRUE(shared_gpu().stereo_eye(f, right, gpu, stats, kSplatEye).ok());
+    EXPECT_GT(stats.nonfinite.total(), 0u);
+    EXPECT_EQ(stats.nonfinite.total(), expected.nonfinite.total());
+    for (std::size_t i = 0; i < gpu.color.pixel_count(); ++i)
+        ASSERT_TRUE(test::finite(gpu.color.data()[i])) << "pixel " << i;
+    EXPECT_GE(test::display_psnr(cpu.color, gpu.color), 50.0);
+}
+
+TEST(Gpu, StereoEyeOnTexturesAndOptionsTheGpuLacks) {
+    const Frame& f = scene_frames("fence")[1];
+    const Camera right = stereo::eye_cameras(f.camera, {}, stereo::Anchor::Left).right;
+    Frame from_images;
+    stereo::StereoStats image_stats, texture_stats;
+    gpu::Context& context = shared_gpu();
+    ASSERT_TRUE(context.stereo_eye(f, right, from_images, image_stats, kSplatEye).ok());
+    context.make_current();
+    Textures t;
+    const gpu::GBufferTextures rendered = t.gbuffer(f);
+    const GLuint color = t.make(GL_RGBA32F, kWidth, kHeight, GL_RGBA, GL_FLOAT, f.color.data());
+    const GLuint out = t.make(GL_RGBA32F, kWidth, kHeight, GL_RGBA, GL_FLOAT, nullptr);
+    const GLuint depth = t.make(GL_R32F, kWidth, kHeight, GL_RED, GL_FLOAT, nullptr);
+    const Status status =
+        context.stereo_eye(rendered, color, right, out, depth, texture_stats, kSplatEye);
+    ASSERT_TRUE(status.ok()) << status.message();
+    EXPECT_EQ(texture_stats.holes, image_stats.holes);
+    EXPECT_EQ(context.timings().upload_ms, 0.0);
+    GLuint framebuffer = 0;
+    glGenFramebuffers(1, &framebuffer);
+    glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, out, 0);
+    Image<glm::vec4> read(kWidth, kHeight);
+    glReadPixels(0, 0, kWidth, kHeight, GL_RGBA, GL_FLOAT, read.data());
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glDeleteFramebuffers(1, &framebuffer);
+    EXPECT_EQ(test::display_psnr(read, from_images.color), INFINITY);
+
+    Frame unused;
+    stereo::StereoStats s;
+    const Status grid = context.stereo_eye(f, right, unused, s, {});
+    EXPECT_NE(grid.message().find("grid warp is not on the GPU"), std::string::npos);
+    const Status andreev = context.stereo_eye(
+        f, right, unused, s,
+        {.warp = stereo::StereoWarp::Splat, .fill = stereo::StereoFill::Andreev});
+    EXPECT_NE(andreev.message().find("Andreev"), std::string::npos);
+    const Status same_texture =
+        context.stereo_eye(rendered, color, right, color, depth, s, kSplatEye);
+    EXPECT_NE(same_texture.message().find("the output is the rendered colour"), std::string::npos);
 }
 
 }  // namespace

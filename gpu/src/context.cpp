@@ -13,6 +13,8 @@ namespace reprise::gpu {
 // One per path, linked once.
 Status create_programs(ContextState& state);
 Status create_fill_programs(ContextState& state);
+Status create_splat_programs(ContextState& state);
+Status create_stereo_programs(ContextState& state);
 
 double finish_ms(std::chrono::steady_clock::time_point& since) {
     glFinish();
@@ -133,6 +135,8 @@ Status check_texture(unsigned name, GLenum format, int w, int h, const char* wha
 }
 
 void ContextState::download(const Texture& texture, void* data, std::ptrdiff_t stride) {
+    // Shader image stores become visible to reads through a framebuffer only after this.
+    glMemoryBarrier(GL_FRAMEBUFFER_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
     glBindFramebuffer(GL_FRAMEBUFFER, read_framebuffer);
     glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, texture.name, 0);
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
@@ -148,6 +152,19 @@ void ContextState::download(const Texture& texture, void* data, std::ptrdiff_t s
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
 }
 
+void ContextState::download_channels(const Texture& texture, float* data, int channels,
+                                     std::ptrdiff_t stride) {
+    const int w = texture.width, h = texture.height;
+    float_readback.resize(std::size_t(w) * std::size_t(h));
+    download(texture, float_readback.data(), w);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            for (int c = 0; c < channels; ++c)
+                data[(std::size_t(y) * std::size_t(stride) + std::size_t(x)) *
+                         std::size_t(channels) +
+                     std::size_t(c)] = float_readback[std::size_t(y) * w + x][c];
+}
+
 Context::Context() : state_(std::make_unique<ContextState>()) {}
 
 Context::~Context() {
@@ -155,14 +172,19 @@ Context::~Context() {
     state_->gl->make_current();
     for (Texture* t : {&state_->depth, &state_->motion, &state_->id, &state_->previous_depth,
                        &state_->previous_id, &state_->payload, &state_->out, &state_->hit,
-                       &state_->color, &state_->valid})
+                       &state_->color, &state_->valid, &state_->splat_motion, &state_->displacement,
+                       &state_->target_depth, &state_->eye_color})
         glDeleteTextures(1, &t->name);
     for (auto* chain :
          {&state_->pulled, &state_->pulled_depth, &state_->filled, &state_->filled_depth})
         for (Texture& t : *chain) glDeleteTextures(1, &t.name);
-    for (GLuint program : {state_->pull_image_program, state_->pull_level_program,
-                           state_->push_program, state_->final_program})
+    for (GLuint program :
+         {state_->pull_image_program, state_->pull_level_program, state_->push_program,
+          state_->final_program, state_->splat_scatter_program, state_->splat_clear_program,
+          state_->splat_gather_program, state_->displacement_program, state_->finish_program})
         glDeleteProgram(program);
+    glDeleteBuffers(1, &state_->splat_counts);
+    glDeleteBuffers(1, &state_->splat_lists);
     glDeleteBuffers(1, &state_->fill_counts);
     glDeleteSamplers(1, &state_->nearest_sampler);
     glDeleteBuffers(1, &state_->counts_buffer);
@@ -185,6 +207,8 @@ Status Context::create(std::unique_ptr<Context>& context) {
                              std::to_string(minor));
     REPRISE_TRY(create_programs(s));
     REPRISE_TRY(create_fill_programs(s));
+    REPRISE_TRY(create_splat_programs(s));
+    REPRISE_TRY(create_stereo_programs(s));
     s.counts_buffer = s.make_counters(8 * sizeof(GLuint));
     glGenBuffers(1, &s.readback_buffer);
     glBindBuffer(GL_COPY_WRITE_BUFFER, s.readback_buffer);

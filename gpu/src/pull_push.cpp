@@ -244,6 +244,8 @@ void common_uniforms(GLuint program, bool use_depth, int level) {
     glUniform1i(glGetUniformLocation(program, "level"), level);
 }
 
+}  // namespace
+
 // The passes over textures the caller or the CPU entry prepared; `out` gets the filled colour.
 Status fill_passes(ContextState& s, GLuint color, GLuint valid, GLuint depth, int w, int h,
                    GLuint out, warp::FillStats& stats) {
@@ -337,8 +339,6 @@ Status fill_passes(ContextState& s, GLuint color, GLuint valid, GLuint depth, in
         }
     return {};
 }
-
-}  // namespace
 
 Status create_fill_programs(ContextState& s) {
     const std::string prelude = std::string(kComputeHeader) + kPrelude;

@@ -6,6 +6,7 @@
 
 #include <glm/vec4.hpp>
 
+#include "reprise/core/nonfinite.hpp"
 #include "reprise/gl/context.hpp"
 #include "reprise/gl/program.hpp"
 #include "reprise/gpu/context.hpp"
@@ -50,6 +51,19 @@ shared uint group_flags[64];
     }
 )";
 
+// A splat's source on the GPU: colour GL_RGBA32F, depth GL_R32F, motion (RG of any float format).
+struct SplatTextures {
+    GLuint color = 0, depth = 0, motion = 0;
+    int width = 0, height = 0;
+};
+
+// The passes of each path over textures, shared by its CPU-image and texture entry points.
+Status fill_passes(ContextState& s, GLuint color, GLuint valid, GLuint depth, int w, int h,
+                   GLuint out, warp::FillStats& stats);
+Status splat_passes(ContextState& s, const SplatTextures& in, float factor,
+                    const warp::SplatOptions& options, int tw, int th, GLuint out_color,
+                    GLuint out_depth, GLuint out_covered, bool carry_motion, std::size_t& covered);
+
 // glFinish, then the milliseconds since `since`, which moves to now.
 double finish_ms(std::chrono::steady_clock::time_point& since);
 
@@ -66,7 +80,18 @@ struct ContextState {
     GLuint fill_counts = 0;  // holes, then the empty pixels of each level
     Texture color, valid;
     std::vector<Texture> pulled, pulled_depth, filled, filled_depth;
-    std::vector<glm::uvec4> hit_readback;  // integer downloads come as RGBA
+    std::vector<glm::uvec4> hit_readback;   // integer downloads come as RGBA
+    std::vector<glm::vec4> float_readback;  // so do float ones of fewer channels
+    // Splat: the lists of landings per target pixel, the motion carried, and how many pixels of
+    // the last splat had more candidates than the shader sorts (taken by the rule instead).
+    GLuint splat_scatter_program = 0, splat_clear_program = 0, splat_gather_program = 0;
+    GLuint splat_counts = 0, splat_lists = 0;
+    std::size_t splat_list_bytes = 0, splat_by_rule = 0;
+    Texture splat_motion;
+    // Stereo eye: displacement (RG) and the depth seen from the target.
+    GLuint displacement_program = 0, finish_program = 0;
+    NonfiniteRepair eye_repair;
+    Texture displacement, target_depth, eye_color;
 
     // Counters live in GPU memory (a buffer hinted for reading may be placed in the host's, where
     // every shader atomic crosses the bus: reprojection took 39-90 ms at 1920x1080 on an H200,
@@ -83,6 +108,9 @@ struct ContextState {
     // Reads `texture` (GL_RGBA32F into floats, GL_R32UI into hit_readback) through the
     // framebuffer; `stride` in pixels for float targets.
     void download(const Texture& texture, void* data, std::ptrdiff_t stride);
+    // The first `channels` of each pixel of a float texture into floats, `stride` pixels apart.
+    void download_channels(const Texture& texture, float* data, int channels,
+                           std::ptrdiff_t stride);
 };
 
 }  // namespace reprise::gpu

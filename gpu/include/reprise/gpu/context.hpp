@@ -10,8 +10,10 @@
 
 #include "reprise/core/gbuffer.hpp"
 #include "reprise/core/status.hpp"
+#include "reprise/stereo/synthesize.hpp"
 #include "reprise/warp/fill.hpp"
 #include "reprise/warp/reproject.hpp"
+#include "reprise/warp/splat.hpp"
 
 namespace reprise::gpu {
 
@@ -66,6 +68,26 @@ public:
     // width x height; the filled colour goes to `out` (GL_RGBA32F, not `color`).
     Status fill(unsigned color, unsigned valid, unsigned depth, int width, int height, unsigned out,
                 warp::FillStats& stats);
+
+    // warp::splat on the GPU. Among the candidates within the depth tolerance of a pixel's
+    // nearest one, the one landing nearest its centre wins, ties to the first in source order
+    // (the CPU z-tests in source order against the one stored: the same where candidates do not
+    // chain across the tolerance). `covered` gets the covered pixel count.
+    Status splat(const GBufferView& source, float factor, const warp::WarpTarget& target,
+                 const warp::SplatOptions& options, std::size_t& covered);
+
+    // stereo::StereoSynthesizer::synthesize without history, for StereoWarp::Splat and
+    // StereoFill::PullPush or None (others are an error): displacement through depth, the
+    // splat, pull-push, non-finite colour to 0. Cameras without jitter, projections without skew.
+    Status stereo_eye(const GBufferView& rendered, const Camera& target, Frame& out,
+                      stereo::StereoStats& stats, const stereo::StereoOptions& options = {});
+    // The same on textures: `rendered.depth` and `color` (GL_RGBA32F) in, `out_color`
+    // (GL_RGBA32F) and `out_depth` (GL_R32F) written, all of the rendered size. No repair of
+    // NaN/Inf input here (the CPU-image entry repairs as the CPU does): pixels with NaN depth are
+    // left out, colour with a non-finite channel comes out 0.
+    Status stereo_eye(const GBufferTextures& rendered, unsigned color, const Camera& target,
+                      unsigned out_color, unsigned out_depth, stereo::StereoStats& stats,
+                      const stereo::StereoOptions& options = {});
 
 private:
     Context();
