@@ -1,7 +1,7 @@
 // reprise bench paths --backend gles: the stages the GPU backend has (reverse reprojection,
-// pull-push), each beside its CPU reference on the same frames in the same run; the GPU's
-// upload, compute and download apart, the texture entry point on textures already on the GPU,
-// and how far the GPU's result is from the CPU's.
+// pull-push, the forward splat, the stereo eye by splat), each beside its CPU reference on the same
+// frames in the same run; the GPU's upload, compute and download apart, the texture entry point on
+// textures already on the GPU, and how far the GPU's result is from the CPU's.
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -12,8 +12,11 @@
 
 #include "reprise/core/metrics.hpp"
 #include "reprise/gpu/context.hpp"
+#include "reprise/stereo/rig.hpp"
+#include "reprise/stereo/synthesize.hpp"
 #include "reprise/warp/fill.hpp"
 #include "reprise/warp/reproject.hpp"
+#include "reprise/warp/splat.hpp"
 
 namespace reprise::cli {
 
@@ -61,8 +64,8 @@ struct Textures {
 // Both stages on textures already on the GPU (the last pair of frames), `runs` times each:
 // compute alone, as an application that keeps its frames on the GPU pays it.
 Status time_texture_path(gpu::Context& context, const Frame& current, const Frame& previous,
-                         const Image<uint8_t>& hit_mask, int runs, Timing& reproject,
-                         Timing& fill) {
+                         const Image<uint8_t>& hit_mask, int runs, Timing& reproject, Timing& fill,
+                         Timing& eye) {
     context.make_current();
     const int w = current.width(), h = current.height();
     Textures t;
@@ -72,13 +75,20 @@ Status time_texture_path(gpu::Context& context, const Frame& current, const Fram
     const GLuint hit = t.make(GL_R32UI, w, h, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
     const GLuint valid = t.make(GL_R8UI, w, h, GL_RED_INTEGER, GL_UNSIGNED_BYTE, hit_mask.data());
     const GLuint filled = t.make(GL_RGBA32F, w, h, GL_RGBA, GL_FLOAT, nullptr);
+    const GLuint color = t.make(GL_RGBA32F, w, h, GL_RGBA, GL_FLOAT, current.color.data());
+    const GLuint eye_depth = t.make(GL_R32F, w, h, GL_RED, GL_FLOAT, nullptr);
+    const Camera right = stereo::eye_cameras(current.camera, {}, stereo::Anchor::Left).right;
     warp::ReprojectCounts counts;
     warp::FillStats stats;
+    stereo::StereoStats eye_stats;
     for (int i = 0; i <= runs; ++i) {  // the first run untimed
         REPRISE_TRY(context.reproject(now, before, payload, out, hit, {}, counts));
         if (i) reproject.ms.push_back(context.timings().compute_ms);
         REPRISE_TRY(context.fill(out, valid, now.depth, w, h, filled, stats));
         if (i) fill.ms.push_back(context.timings().compute_ms);
+        REPRISE_TRY(context.stereo_eye(now, color, right, filled, eye_depth, eye_stats,
+                                       {.warp = stereo::StereoWarp::Splat}));
+        if (i) eye.ms.push_back(context.timings().compute_ms);
     }
     return {};
 }
@@ -99,7 +109,15 @@ Status bench_gles_stages(const std::vector<Frame>& frames, const std::string& si
     Image<glm::vec4> cpu_out(w, h), gpu_out(w, h), cpu_filled(w, h), gpu_filled(w, h);
     Image<uint8_t> cpu_hit(w, h), gpu_hit(w, h);
     warp::PullPush pull_push;
-    StageTimes stages[2] = {{"reproject RGBA"}, {"pull-push (depth)"}};
+    StageTimes stages[4] = {
+        {"reproject RGBA"}, {"pull-push (depth)"}, {"splat x-0.5"}, {"stereo-eye splat+pp"}};
+    warp::SplatOptions splat_options;
+    const stereo::StereoOptions eye_options{.warp = stereo::StereoWarp::Splat};
+    Image<glm::vec4> cpu_color(w, h), gpu_color(w, h);
+    Image<float> cpu_depth(w, h), gpu_depth(w, h);
+    Image<uint8_t> cpu_covered(w, h), gpu_covered(w, h);
+    stereo::StereoSynthesizer synthesizer;
+    Frame cpu_eye, gpu_eye;
     warp::ReprojectCounts counts;
     warp::FillStats stats;
     // Frame i reprojected into frame i - 1, then its misses filled; the first pair untimed (the
@@ -137,9 +155,41 @@ Status bench_gles_stages(const std::vector<Frame>& frames, const std::string& si
         REPRISE_TRY(status);
         if (timing) record(stages[1], context->timings(), fill_total.ms[0]);
         stages[1].worst_db = std::min(stages[1].worst_db, display_psnr(cpu_filled, gpu_filled));
+
+        // The current frame splatted halfway to the previous one (interpolation's half).
+        Timing& cpu_splat = timing ? stages[2].cpu : scratch;
+        const warp::WarpTarget cpu_target{
+            cpu_color.view(), cpu_depth.view(), {}, cpu_covered.view()};
+        const warp::WarpTarget gpu_target{
+            gpu_color.view(), gpu_depth.view(), {}, gpu_covered.view()};
+        time_once(cpu_splat, [&] { warp::splat(current, -0.5f, cpu_target, splat_options); });
+        Timing splat_total;
+        std::size_t covered = 0;
+        time_once(splat_total, [&] {
+            status = context->splat(current, -0.5f, gpu_target, splat_options, covered);
+        });
+        REPRISE_TRY(status);
+        if (timing) record(stages[2], context->timings(), splat_total.ms[0]);
+        stages[2].worst_db = std::min(stages[2].worst_db, display_psnr(cpu_color, gpu_color));
+
+        // The right eye from the current frame as the left (IPD 64 mm).
+        const Camera right = stereo::eye_cameras(current.camera, {}, stereo::Anchor::Left).right;
+        Timing& cpu_eye_time = timing ? stages[3].cpu : scratch;
+        time_once(cpu_eye_time,
+                  [&] { synthesizer.synthesize(current, right, cpu_eye, eye_options); });
+        Timing eye_total;
+        stereo::StereoStats eye_stats;
+        time_once(eye_total, [&] {
+            status = context->stereo_eye(current, right, gpu_eye, eye_stats, eye_options);
+        });
+        REPRISE_TRY(status);
+        if (timing) record(stages[3], context->timings(), eye_total.ms[0]);
+        stages[3].worst_db =
+            std::min(stages[3].worst_db, display_psnr(cpu_eye.color, gpu_eye.color));
     }
     REPRISE_TRY(time_texture_path(*context, frames.back(), frames[frames.size() - 2], cpu_hit,
-                                  int(frames.size()) - 2, stages[0].textures, stages[1].textures));
+                                  int(frames.size()) - 2, stages[0].textures, stages[1].textures,
+                                  stages[3].textures));
     std::printf(
         "gles: %s; GPU columns are medians; textures: the texture entry point on "
         "textures already on the GPU (compute alone)\n",
