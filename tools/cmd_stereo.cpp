@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 
 #include <glm/gtc/matrix_transform.hpp>
 
@@ -13,6 +14,7 @@
 #include "reprise/core/exr.hpp"
 #include "reprise/core/memory_limit.hpp"
 #include "reprise/core/nonfinite.hpp"
+#include "reprise/gpu/context.hpp"
 #include "reprise/stereo/rig.hpp"
 #include "reprise/stereo/synthesize.hpp"
 
@@ -22,6 +24,7 @@ namespace {
 
 struct StereoJob {
     std::string in, out, rig = "parallel", eye = "left", warp = "grid", fill = "pullpush";
+    std::string backend = "cpu";
     double ipd = 0.064;
     double convergence = 10.0;
     double fov = 0.0;  // degrees, for inputs without a camera
@@ -48,6 +51,13 @@ Status check(const StereoJob& j, stereo::StereoRig& rig, stereo::StereoOptions& 
         return Status::error("--warp: '" + j.warp + "' is not grid or splat");
     if (j.fill != "pullpush" && j.fill != "andreev" && j.fill != "none")
         return Status::error("--fill: '" + j.fill + "' is not pullpush, andreev or none");
+    if (j.backend != "cpu" && j.backend != "gles")
+        return Status::error("--backend: '" + j.backend + "' is not cpu or gles");
+    if (j.backend == "gles" && (j.warp != "splat" || j.fill == "andreev" || j.temporal))
+        return Status::error(
+            "--backend gles: the GPU makes the eye with --warp splat and --fill pullpush or "
+            "none, without --temporal (the grid warp, Andreev's fill and the history are not on "
+            "the GPU yet)");
     rig = {.ipd = float(j.ipd),
            .convergence = float(j.convergence),
            .rig = j.rig == "offaxis" ? stereo::Rig::OffAxis : stereo::Rig::Parallel};
@@ -85,6 +95,8 @@ Status run_stereo(const StereoJob& job, const stereo::StereoRig& rig,
         std::fprintf(stderr, "[stereo] resuming: %d frames on disk, restarting at input %zu\n",
                      on_disk, first);
     stereo::StereoSynthesizer synthesizer;
+    std::unique_ptr<gpu::Context> gpu;
+    if (job.backend == "gles") REPRISE_TRY(gpu::Context::create(gpu));
     Frame frame, previous, made;
     bool have_previous = false;
     double ms = 0.0;
@@ -123,8 +135,12 @@ Status run_stereo(const StereoJob& job, const stereo::StereoRig& rig,
         auto start = std::chrono::steady_clock::now();
         // Nothing of another shot fills this one's holes.
         const bool history = job.temporal && have_previous && frame.camera.cut != Cut::Yes;
-        stereo::StereoStats stats =
-            synthesizer.synthesize(frame, target, made, options, history ? &previous : nullptr);
+        stereo::StereoStats stats;
+        if (gpu)
+            REPRISE_TRY(gpu->stereo_eye(frame, target, made, stats, options));
+        else
+            stats =
+                synthesizer.synthesize(frame, target, made, options, history ? &previous : nullptr);
         made.fps = frame.fps;
         ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
                   .count();
@@ -169,6 +185,8 @@ int command_stereo(int argc, char** argv) {
     args.option("--eye", &job.eye, "which eye the input is: left|right (default left)");
     args.option("--warp", &job.warp, "grid|splat (default grid)");
     args.option("--fill", &job.fill, "pullpush|andreev|none (default pullpush)");
+    args.option("--backend", &job.backend,
+                "cpu|gles (default cpu); gles: OpenGL ES compute shaders, with --warp splat");
     args.flag("--temporal", &job.temporal, "fill disocclusions from the previous frame first");
     args.option("--range", &job.range,
                 "A:B: frames A..B only (--temporal reads frame A-1 first); ranges that meet "
