@@ -18,6 +18,7 @@
 #include "reprise/stereo/rig.hpp"
 #include "reprise/stereo/synthesize.hpp"
 #include "reprise/warp/fill.hpp"
+#include "reprise/warp/fruc.hpp"
 #include "reprise/warp/reproject.hpp"
 #include "reprise/warp/splat.hpp"
 #include "support/frames.hpp"
@@ -578,6 +579,89 @@ TEST(Gpu, StereoEyeOnTexturesAndOptionsTheGpuLacks) {
     const Status same_texture =
         context.stereo_eye(rendered, color, right, color, depth, s, kSplatEye);
     EXPECT_NE(same_texture.message().find("the output is the rendered colour"), std::string::npos);
+}
+
+}  // namespace
+
+namespace {
+
+// --- The in-between frame against the CPU converter with the same options.
+
+const warp::FrucOptions kSplatInterpolation{
+    .warp = warp::WarpMethod::Splat, .true_motion = false, .refine = {.enabled = false}};
+
+// The frame the CPU makes halfway between `a` and `b`.
+Frame cpu_between(const Frame& a, const Frame& b) {
+    warp::FrameRateConverter converter;
+    EXPECT_TRUE(warp::FrameRateConverter::create(2, kSplatInterpolation, converter).ok());
+    std::vector<Frame> outputs;
+    for (const Frame* f : {&a, &b}) {
+        EXPECT_TRUE(converter.send(Frame(*f)).ok());
+        Frame out;
+        while (converter.receive(out)) outputs.push_back(std::move(out));
+    }
+    EXPECT_EQ(converter.counters().outputs, 1u);
+    EXPECT_EQ(outputs.size(), 3u);  // a, the made frame, b
+    return outputs.size() == 3 ? outputs[1] : Frame{};
+}
+
+TEST(Gpu, InterpolationMatchesTheCpuOnEveryBuiltInScene) {
+    std::size_t holes = 0;
+    for (const server::SceneInfo& info : server::builtin_scenes()) {
+        SCOPED_TRACE(info.name);
+        const std::vector<Frame>& frames = scene_frames(info.name);
+        const Frame cpu = cpu_between(frames[0], frames[1]);
+        Frame gpu;
+        gpu::InterpolateStats stats;
+        const Status status = shared_gpu().interpolate(frames[0], frames[1], 0.5f, gpu, stats);
+        ASSERT_TRUE(status.ok()) << status.message();
+        const double db = test::display_psnr(cpu.color, gpu.color);
+        EXPECT_GE(db, 50.0);
+        holes += stats.holes;
+        std::printf("%-10s between: covered a %zu b %zu, holes %zu, %.1f dB\n", info.name,
+                    stats.covered_a, stats.covered_b, stats.holes, db);
+    }
+    EXPECT_GT(holes, 0u);  // not vacuous: some holes filled
+}
+
+TEST(Gpu, InterpolationOnTexturesAndBadArguments) {
+    const std::vector<Frame>& frames = scene_frames("crossing");
+    gpu::Context& context = shared_gpu();
+    Frame from_images;
+    gpu::InterpolateStats image_stats, texture_stats;
+    ASSERT_TRUE(context.interpolate(frames[0], frames[1], 0.25f, from_images, image_stats).ok());
+    context.make_current();
+    Textures t;
+    const gpu::GBufferTextures a = t.gbuffer(frames[0]), b = t.gbuffer(frames[1]);
+    const GLuint a_color =
+        t.make(GL_RGBA32F, kWidth, kHeight, GL_RGBA, GL_FLOAT, frames[0].color.data());
+    const GLuint b_color =
+        t.make(GL_RGBA32F, kWidth, kHeight, GL_RGBA, GL_FLOAT, frames[1].color.data());
+    const GLuint out = t.make(GL_RGBA32F, kWidth, kHeight, GL_RGBA, GL_FLOAT, nullptr);
+    const GLuint depth = t.make(GL_R32F, kWidth, kHeight, GL_RED, GL_FLOAT, nullptr);
+    const Status status =
+        context.interpolate(a, a_color, b, b_color, 0.25f, out, depth, texture_stats);
+    ASSERT_TRUE(status.ok()) << status.message();
+    EXPECT_EQ(texture_stats.holes, image_stats.holes);
+    GLuint framebuffer = 0;
+    glGenFramebuffers(1, &framebuffer);
+    glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, out, 0);
+    Image<glm::vec4> read(kWidth, kHeight);
+    glReadPixels(0, 0, kWidth, kHeight, GL_RGBA, GL_FLOAT, read.data());
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glDeleteFramebuffers(1, &framebuffer);
+    EXPECT_EQ(test::display_psnr(read, from_images.color), INFINITY);
+
+    EXPECT_NE(context.interpolate(a, a_color, b, b_color, 0.5f, a_color, depth, texture_stats)
+                  .message()
+                  .find("the output is an input colour"),
+              std::string::npos);
+    Frame unused;
+    EXPECT_NE(context.interpolate(frames[0], frames[1], 1.5f, unused, texture_stats)
+                  .message()
+                  .find("s must lie in [0, 1]"),
+              std::string::npos);
 }
 
 }  // namespace

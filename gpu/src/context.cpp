@@ -15,6 +15,7 @@ Status create_programs(ContextState& state);
 Status create_fill_programs(ContextState& state);
 Status create_splat_programs(ContextState& state);
 Status create_stereo_programs(ContextState& state);
+Status create_interpolate_programs(ContextState& state);
 
 double finish_ms(std::chrono::steady_clock::time_point& since) {
     glFinish();
@@ -209,6 +210,7 @@ Status Context::create(std::unique_ptr<Context>& context) {
     REPRISE_TRY(create_fill_programs(s));
     REPRISE_TRY(create_splat_programs(s));
     REPRISE_TRY(create_stereo_programs(s));
+    REPRISE_TRY(create_interpolate_programs(s));
     s.counts_buffer = s.make_counters(8 * sizeof(GLuint));
     glGenBuffers(1, &s.readback_buffer);
     glBindBuffer(GL_COPY_WRITE_BUFFER, s.readback_buffer);

@@ -60,12 +60,26 @@ struct SplatTextures {
 // The passes of each path over textures, shared by its CPU-image and texture entry points.
 Status fill_passes(ContextState& s, GLuint color, GLuint valid, GLuint depth, int w, int h,
                    GLuint out, warp::FillStats& stats);
+Status interpolate_passes(ContextState& s, const SplatTextures& a, const SplatTextures& b,
+                          float s_between, int w, int h, const warp::SplatOptions& options,
+                          GLuint out_color, GLuint out_depth, InterpolateStats& stats);
 Status splat_passes(ContextState& s, const SplatTextures& in, float factor,
                     const warp::SplatOptions& options, int tw, int th, GLuint out_color,
                     GLuint out_depth, GLuint out_covered, bool carry_motion, std::size_t& covered);
 
 // glFinish, then the milliseconds since `since`, which moves to now.
 double finish_ms(std::chrono::steady_clock::time_point& since);
+
+// The in-between frame's inputs (a, b) and intermediates.
+struct Interpolation {
+    Texture a_color, a_depth, a_motion, b_color, b_depth, b_motion;
+    Texture side_a_color, side_a_depth, side_a_covered, side_b_color, side_b_depth, side_b_covered,
+        blended, valid;
+    Texture* all[14] = {&a_color,        &a_depth,      &a_motion,     &b_color,
+                        &b_depth,        &b_motion,     &side_a_color, &side_a_depth,
+                        &side_a_covered, &side_b_color, &side_b_depth, &side_b_covered,
+                        &blended,        &valid};
+};
 
 struct ContextState {
     std::unique_ptr<gl::Context> gl;
@@ -91,6 +105,9 @@ struct ContextState {
     // Stereo eye: displacement (RG) and the depth seen from the target.
     GLuint displacement_program = 0, finish_program = 0;
     NonfiniteRepair eye_repair;
+    // Interpolation: the blend of the two splatted sides, a plain copy, and the hole count.
+    GLuint blend_program = 0, copy_program = 0, blend_counts = 0;
+    Interpolation interpolation;
     Texture displacement, target_depth, eye_color;
 
     // Counters live in GPU memory (a buffer hinted for reading may be placed in the host's, where

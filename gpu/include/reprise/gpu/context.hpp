@@ -34,6 +34,13 @@ struct GBufferTextures {
     Camera camera;
 };
 
+// What an in-between frame took: covered pixels of each side, pixels neither covered, and the
+// fill's stats (all zero when there were no holes: no fill).
+struct InterpolateStats {
+    std::size_t covered_a = 0, covered_b = 0, holes = 0;
+    warp::FillStats fill;
+};
+
 struct ContextState;  // GL objects and scratch (private)
 
 class Context {
@@ -88,6 +95,19 @@ public:
     Status stereo_eye(const GBufferTextures& rendered, unsigned color, const Camera& target,
                       unsigned out_color, unsigned out_depth, stereo::StereoStats& stats,
                       const stereo::StereoOptions& options = {});
+
+    // The frame at `s` in [0, 1] between a (0) and b (1) with b's backward motion: warp's
+    // interpolate_frame for FrucOptions{.warp = Splat, .true_motion = false, .refine off} and
+    // pull-push: b splatted by 1 - s, a by -s, blended by s where both land on one surface (depths
+    // within 2 %), the nearer or the only one elsewhere, pull-push over what neither covers.
+    // Colour and depth out (out.motion, normal and id cleared; out.camera is b's).
+    Status interpolate(const GBufferView& a, const GBufferView& b, float s, Frame& out,
+                       InterpolateStats& stats, const warp::SplatOptions& options = {});
+    // The same on textures: colour GL_RGBA32F, depth GL_R32F, motion GL_RG32F, all one size;
+    // `out_color` and `out_depth` written.
+    Status interpolate(const GBufferTextures& a, unsigned a_color, const GBufferTextures& b,
+                       unsigned b_color, float s, unsigned out_color, unsigned out_depth,
+                       InterpolateStats& stats, const warp::SplatOptions& options = {});
 
 private:
     Context();

@@ -1,0 +1,232 @@
+// The in-between frame on the GPU: warp's interpolate_frame for the splat without refinement and
+// without true motion (FrucOptions{.warp = Splat, .true_motion = false, .refine = off}): b
+// splatted by 1 - s, a by -s, the two blended where both see one surface, pull-push over what
+// neither covers.
+#include <chrono>
+#include <string>
+
+#include "state.hpp"
+
+namespace reprise::gpu {
+
+namespace {
+
+// warp::blend_row_reference per pixel.
+constexpr const char* kBlend = R"(
+layout(binding = 0) uniform highp sampler2D color_a;
+layout(binding = 1) uniform highp sampler2D depth_a;
+layout(binding = 2) uniform highp usampler2D covered_a;
+layout(binding = 3) uniform highp sampler2D color_b;
+layout(binding = 4) uniform highp sampler2D depth_b;
+layout(binding = 5) uniform highp usampler2D covered_b;
+layout(binding = 0, rgba32f) writeonly uniform highp image2D out_color;
+layout(binding = 1, r32f) writeonly uniform highp image2D out_depth;
+layout(binding = 2, r32ui) writeonly uniform highp uimage2D out_valid;
+layout(std430, binding = 0) buffer Counts { uint counts[]; };
+uniform ivec2 size;
+uniform highp float s;
+
+bool positive_inf(highp float v) { return floatBitsToUint(v) == 0x7f800000u; }
+
+// Whether pixel p is a hole.
+bool blend(ivec2 p) {
+    bool ca = texelFetch(covered_a, p, 0).r != 0u, cb = texelFetch(covered_b, p, 0).r != 0u;
+    highp float za = texelFetch(depth_a, p, 0).r, zb = texelFetch(depth_b, p, 0).r;
+    highp vec4 a = texelFetch(color_a, p, 0), c = texelFetch(color_b, p, 0);
+    highp float z = zb;
+    if (ca) {
+        PRECISE highp float gap = abs(za - zb), allowed = 0.02 * min(za, zb);
+        bool both_background = positive_inf(za) && positive_inf(zb);
+        if (cb && (both_background || (!positive_inf(za) && !positive_inf(zb) && gap <= allowed))) {
+            PRECISE highp vec4 mixed = (1.0 - s) * a + s * c;
+            c = mixed;
+            z = min(za, zb);
+        } else if (!cb || !(zb < za)) {
+            c = a;
+            z = za;
+        }
+    }
+    imageStore(out_color, p, c);
+    imageStore(out_depth, p, vec4(z));
+    imageStore(out_valid, p, uvec4(ca || cb ? 1u : 0u));
+    return !ca && !cb;
+}
+
+void main() {
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    bool inside = p.x < size.x && p.y < size.y;
+    COUNT_IN_GROUP(inside && blend(p), counts[0])
+}
+)";
+
+constexpr const char* kCopy = R"(
+layout(binding = 0) uniform highp sampler2D from;
+layout(binding = 0, rgba32f) writeonly uniform highp image2D to;
+uniform ivec2 size;
+void main() {
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    if (p.x < size.x && p.y < size.y) imageStore(to, p, texelFetch(from, p, 0));
+}
+)";
+
+Status copy_color(ContextState& s, GLuint from, GLuint to, int w, int h) {
+    glUseProgram(s.copy_program);
+    glBindTexture(GL_TEXTURE_2D, from);
+    glBindSampler(0, s.nearest_sampler);
+    glBindImageTexture(0, to, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glUniform2i(glGetUniformLocation(s.copy_program, "size"), w, h);
+    glDispatchCompute(GLuint((w + 7) / 8), GLuint((h + 7) / 8), 1);
+    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
+    glBindSampler(0, 0);
+    glUseProgram(0);
+    return {};
+}
+
+}  // namespace
+
+Status create_interpolate_programs(ContextState& s) {
+    REPRISE_TRY(
+        gl::link_compute((std::string(kComputeHeader) + kBlend).c_str(), "blend", s.blend_program));
+    REPRISE_TRY(
+        gl::link_compute((std::string(kComputeHeader) + kCopy).c_str(), "copy", s.copy_program));
+    s.blend_counts = s.make_counters(sizeof(GLuint));
+    return {};
+}
+
+// a and b (w x h, on the GPU) made into the frame at s: colour and depth into out_color /
+// out_depth.
+Status interpolate_passes(ContextState& s, const SplatTextures& a, const SplatTextures& b,
+                          float s_between, int w, int h, const warp::SplatOptions& options,
+                          GLuint out_color, GLuint out_depth, InterpolateStats& stats) {
+    Interpolation& k = s.interpolation;
+    k.side_a_color.ensure(GL_RGBA32F, w, h);
+    k.side_a_depth.ensure(GL_R32F, w, h);
+    k.side_a_covered.ensure(GL_R32UI, w, h);
+    k.side_b_color.ensure(GL_RGBA32F, w, h);
+    k.side_b_depth.ensure(GL_R32F, w, h);
+    k.side_b_covered.ensure(GL_R32UI, w, h);
+    k.blended.ensure(GL_RGBA32F, w, h);
+    k.valid.ensure(GL_R32UI, w, h);
+    REPRISE_TRY(splat_passes(s, b, 1.0f - s_between, options, w, h, k.side_b_color.name,
+                             k.side_b_depth.name, k.side_b_covered.name, false, stats.covered_b));
+    REPRISE_TRY(splat_passes(s, a, -s_between, options, w, h, k.side_a_color.name,
+                             k.side_a_depth.name, k.side_a_covered.name, false, stats.covered_a));
+
+    glUseProgram(s.blend_program);
+    const GLuint inputs[6] = {k.side_a_color.name, k.side_a_depth.name, k.side_a_covered.name,
+                              k.side_b_color.name, k.side_b_depth.name, k.side_b_covered.name};
+    for (GLuint unit = 0; unit < 6; ++unit) {
+        glActiveTexture(GL_TEXTURE0 + unit);
+        glBindTexture(GL_TEXTURE_2D, inputs[unit]);
+        glBindSampler(unit, s.nearest_sampler);
+    }
+    glActiveTexture(GL_TEXTURE0);
+    glBindImageTexture(0, k.blended.name, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glBindImageTexture(1, out_depth, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+    glBindImageTexture(2, k.valid.name, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32UI);
+    const GLuint zero = 0;
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, s.blend_counts);
+    glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, sizeof zero, &zero);
+    glUniform2i(glGetUniformLocation(s.blend_program, "size"), w, h);
+    glUniform1f(glGetUniformLocation(s.blend_program, "s"), s_between);
+    glDispatchCompute(GLuint((w + 7) / 8), GLuint((h + 7) / 8), 1);
+    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
+                    GL_SHADER_STORAGE_BARRIER_BIT);
+    for (GLuint unit = 0; unit < 6; ++unit) glBindSampler(unit, 0);
+    glUseProgram(0);
+    GLuint holes = 0;
+    s.read_counters(s.blend_counts, &holes, sizeof holes);
+    stats.holes = holes;
+    stats.fill = {};
+    // No holes, no fill: the blend as it is (the fill's last pass writes every pixel).
+    if (holes)
+        REPRISE_TRY(
+            fill_passes(s, k.blended.name, k.valid.name, out_depth, w, h, out_color, stats.fill));
+    else
+        REPRISE_TRY(copy_color(s, k.blended.name, out_color, w, h));
+    return gl::check_errors("gpu interpolate");
+}
+
+Status Context::interpolate(const GBufferView& a, const GBufferView& b, float s_between, Frame& out,
+                            InterpolateStats& stats, const warp::SplatOptions& options) {
+    timings_ = {};
+    stats = {};
+    const int w = b.width(), h = b.height();
+    if (a.width() != w || a.height() != h)
+        return Status::error("gpu interpolate: the frames are " + std::to_string(a.width()) + "x" +
+                             std::to_string(a.height()) + " and " + std::to_string(w) + "x" +
+                             std::to_string(h));
+    if (!(s_between >= 0.0f && s_between <= 1.0f))
+        return Status::error("gpu interpolate: s must lie in [0, 1]");
+    out.motion.clear();
+    out.normal.clear();
+    out.id.clear();
+    out.camera = b.camera;
+    if (w <= 0 || h <= 0) return {};
+    ContextState& s = *state_;
+    s.gl->make_current();
+    Interpolation& k = s.interpolation;
+    auto t = std::chrono::steady_clock::now();
+    Texture* textures[6] = {&k.a_color, &k.a_depth, &k.a_motion,
+                            &k.b_color, &k.b_depth, &k.b_motion};
+    const GBufferView* frames[2] = {&a, &b};
+    for (int f = 0; f < 2; ++f) {
+        textures[3 * f]->ensure(GL_RGBA32F, w, h);
+        textures[3 * f + 1]->ensure(GL_R32F, w, h);
+        textures[3 * f + 2]->ensure(GL_RG32F, w, h);
+    }
+    s.color.ensure(GL_RGBA32F, w, h);
+    s.depth.ensure(GL_R32F, w, h);
+    for (int f = 0; f < 2; ++f) {
+        s.upload(*textures[3 * f], frames[f]->color.data, frames[f]->color.stride);
+        s.upload(*textures[3 * f + 1], frames[f]->depth.data, frames[f]->depth.stride);
+        s.upload(*textures[3 * f + 2], frames[f]->motion.data, frames[f]->motion.stride);
+    }
+    timings_.upload_ms = finish_ms(t);
+    REPRISE_TRY(interpolate_passes(s, {k.a_color.name, k.a_depth.name, k.a_motion.name, w, h},
+                                   {k.b_color.name, k.b_depth.name, k.b_motion.name, w, h},
+                                   s_between, w, h, options, s.color.name, s.depth.name, stats));
+    timings_.compute_ms = finish_ms(t);
+    out.color.resize(w, h);
+    out.depth.resize(w, h);
+    s.download(s.color, out.color.data(), w);
+    s.download_channels(s.depth, out.depth.data(), 1, w);
+    REPRISE_TRY(gl::check_errors("gpu interpolate download"));
+    timings_.download_ms = finish_ms(t);
+    return {};
+}
+
+Status Context::interpolate(const GBufferTextures& a, unsigned a_color, const GBufferTextures& b,
+                            unsigned b_color, float s_between, unsigned out_color,
+                            unsigned out_depth, InterpolateStats& stats,
+                            const warp::SplatOptions& options) {
+    timings_ = {};
+    stats = {};
+    ContextState& s = *state_;
+    s.gl->make_current();
+    const int w = b.width, h = b.height;
+    if (w <= 0 || h <= 0 || a.width != w || a.height != h)
+        return Status::error("gpu interpolate: texture sizes " + std::to_string(a.width) + "x" +
+                             std::to_string(a.height) + " and " + std::to_string(w) + "x" +
+                             std::to_string(h) + " must be equal and positive");
+    if (!(s_between >= 0.0f && s_between <= 1.0f))
+        return Status::error("gpu interpolate: s must lie in [0, 1]");
+    REPRISE_TRY(check_texture(a.depth, GL_R32F, w, h, "a depth"));
+    REPRISE_TRY(check_texture(a.motion, GL_RG32F, w, h, "a motion"));
+    REPRISE_TRY(check_texture(a_color, GL_RGBA32F, w, h, "a colour"));
+    REPRISE_TRY(check_texture(b.depth, GL_R32F, w, h, "b depth"));
+    REPRISE_TRY(check_texture(b.motion, GL_RG32F, w, h, "b motion"));
+    REPRISE_TRY(check_texture(b_color, GL_RGBA32F, w, h, "b colour"));
+    REPRISE_TRY(check_texture(out_color, GL_RGBA32F, w, h, "output colour"));
+    REPRISE_TRY(check_texture(out_depth, GL_R32F, w, h, "output depth"));
+    if (out_color == a_color || out_color == b_color)
+        return Status::error("gpu interpolate: the output is an input colour");
+    auto t = std::chrono::steady_clock::now();
+    REPRISE_TRY(interpolate_passes(s, {a_color, a.depth, a.motion, w, h},
+                                   {b_color, b.depth, b.motion, w, h}, s_between, w, h, options,
+                                   out_color, out_depth, stats));
+    timings_.compute_ms = finish_ms(t);
+    return {};
+}
+
+}  // namespace reprise::gpu
