@@ -1,7 +1,8 @@
 // reprise bench paths --backend gles: the stages the GPU backend has (reverse reprojection,
-// pull-push, the forward splat, the stereo eye by splat), each beside its CPU reference on the same
-// frames in the same run; the GPU's upload, compute and download apart, the texture entry point on
-// textures already on the GPU, and how far the GPU's result is from the CPU's.
+// pull-push, the forward splat, the stereo eye and the in-between frame by splat), each beside its
+// CPU reference on the same frames in the same run; the GPU's upload, compute and download apart,
+// the texture entry point on textures already on the GPU, and how far the GPU's result is from the
+// CPU's.
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -15,6 +16,7 @@
 #include "reprise/stereo/rig.hpp"
 #include "reprise/stereo/synthesize.hpp"
 #include "reprise/warp/fill.hpp"
+#include "reprise/warp/fruc.hpp"
 #include "reprise/warp/reproject.hpp"
 #include "reprise/warp/splat.hpp"
 
@@ -65,7 +67,7 @@ struct Textures {
 // compute alone, as an application that keeps its frames on the GPU pays it.
 Status time_texture_path(gpu::Context& context, const Frame& current, const Frame& previous,
                          const Image<uint8_t>& hit_mask, int runs, Timing& reproject, Timing& fill,
-                         Timing& eye) {
+                         Timing& eye, Timing& between) {
     context.make_current();
     const int w = current.width(), h = current.height();
     Textures t;
@@ -77,6 +79,8 @@ Status time_texture_path(gpu::Context& context, const Frame& current, const Fram
     const GLuint filled = t.make(GL_RGBA32F, w, h, GL_RGBA, GL_FLOAT, nullptr);
     const GLuint color = t.make(GL_RGBA32F, w, h, GL_RGBA, GL_FLOAT, current.color.data());
     const GLuint eye_depth = t.make(GL_R32F, w, h, GL_RED, GL_FLOAT, nullptr);
+    const GLuint previous_color =
+        t.make(GL_RGBA32F, w, h, GL_RGBA, GL_FLOAT, previous.color.data());
     const Camera right = stereo::eye_cameras(current.camera, {}, stereo::Anchor::Left).right;
     warp::ReprojectCounts counts;
     warp::FillStats stats;
@@ -89,6 +93,10 @@ Status time_texture_path(gpu::Context& context, const Frame& current, const Fram
         REPRISE_TRY(context.stereo_eye(now, color, right, filled, eye_depth, eye_stats,
                                        {.warp = stereo::StereoWarp::Splat}));
         if (i) eye.ms.push_back(context.timings().compute_ms);
+        gpu::InterpolateStats between_stats;
+        REPRISE_TRY(context.interpolate(before, previous_color, now, color, 0.5f, filled, eye_depth,
+                                        between_stats));
+        if (i) between.ms.push_back(context.timings().compute_ms);
     }
     return {};
 }
@@ -109,8 +117,17 @@ Status bench_gles_stages(const std::vector<Frame>& frames, const std::string& si
     Image<glm::vec4> cpu_out(w, h), gpu_out(w, h), cpu_filled(w, h), gpu_filled(w, h);
     Image<uint8_t> cpu_hit(w, h), gpu_hit(w, h);
     warp::PullPush pull_push;
-    StageTimes stages[4] = {
-        {"reproject RGBA"}, {"pull-push (depth)"}, {"splat x-0.5"}, {"stereo-eye splat+pp"}};
+    StageTimes stages[5] = {{"reproject RGBA"},
+                            {"pull-push (depth)"},
+                            {"splat x-0.5"},
+                            {"stereo-eye splat+pp"},
+                            {"interpolate splat+pp"}};
+    // The CPU's in-between frame with the same method (both sides splatted, blended, pull-push).
+    const warp::FrucOptions between_options{
+        .warp = warp::WarpMethod::Splat, .true_motion = false, .refine = {.enabled = false}};
+    warp::FrameRateConverter converter;
+    REPRISE_TRY(warp::FrameRateConverter::create(2, between_options, converter));
+    Frame between_in, gpu_between;
     warp::SplatOptions splat_options;
     const stereo::StereoOptions eye_options{.warp = stereo::StereoWarp::Splat};
     Image<glm::vec4> cpu_color(w, h), gpu_color(w, h);
@@ -186,10 +203,32 @@ Status bench_gles_stages(const std::vector<Frame>& frames, const std::string& si
         if (timing) record(stages[3], context->timings(), eye_total.ms[0]);
         stages[3].worst_db =
             std::min(stages[3].worst_db, display_psnr(cpu_eye.color, gpu_eye.color));
+
+        // The frame halfway between the previous and the current one: the converter gets the
+        // current frame (it holds the previous) and gives the made frame, then the input.
+        Timing& cpu_between = timing ? stages[4].cpu : scratch;
+        between_in = current;
+        Frame received[2];
+        int count = 0;
+        time_once(cpu_between, [&] {
+            status = converter.send(std::move(between_in));
+            while (count < 2 && converter.receive(received[count])) ++count;
+        });
+        REPRISE_TRY(status);
+        Timing between_total;
+        gpu::InterpolateStats between_stats;
+        time_once(between_total, [&] {
+            status = context->interpolate(previous, current, 0.5f, gpu_between, between_stats);
+        });
+        REPRISE_TRY(status);
+        if (timing) record(stages[4], context->timings(), between_total.ms[0]);
+        if (count == 2)
+            stages[4].worst_db =
+                std::min(stages[4].worst_db, display_psnr(received[0].color, gpu_between.color));
     }
     REPRISE_TRY(time_texture_path(*context, frames.back(), frames[frames.size() - 2], cpu_hit,
                                   int(frames.size()) - 2, stages[0].textures, stages[1].textures,
-                                  stages[3].textures));
+                                  stages[3].textures, stages[4].textures));
     std::printf(
         "gles: %s; GPU columns are medians; textures: the texture entry point on "
         "textures already on the GPU (compute alone)\n",
