@@ -224,6 +224,19 @@ struct Textures {
     ~Textures() { glDeleteTextures(GLsizei(names.size()), names.data()); }
 };
 
+// A GL_RGBA32F texture read back as the application would (through a framebuffer).
+Image<glm::vec4> read_rgba(GLuint texture) {
+    Image<glm::vec4> pixels(kWidth, kHeight);
+    GLuint framebuffer = 0;
+    glGenFramebuffers(1, &framebuffer);
+    glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
+    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, texture, 0);
+    glReadPixels(0, 0, kWidth, kHeight, GL_RGBA, GL_FLOAT, pixels.data());
+    glBindFramebuffer(GL_FRAMEBUFFER, 0);
+    glDeleteFramebuffers(1, &framebuffer);
+    return pixels;
+}
+
 TEST(Gpu, TextureEntryPointWritesTheCallersTextures) {
     const std::vector<Frame>& frames = scene_frames("pan");
     const Reprojected cpu = cpu_reproject(frames[1], frames[0]);
@@ -404,15 +417,7 @@ TEST(Gpu, PullPushOnTexturesWritesTheOutputTexture) {
     ASSERT_TRUE(status.ok()) << status.message();
     EXPECT_EQ(got.holes, expected.holes);
     EXPECT_GT(got.holes, 0u);
-    Image<glm::vec4> gpu(kWidth, kHeight);
-    GLuint framebuffer = 0;
-    glGenFramebuffers(1, &framebuffer);
-    glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, out, 0);
-    glReadPixels(0, 0, kWidth, kHeight, GL_RGBA, GL_FLOAT, gpu.data());
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    glDeleteFramebuffers(1, &framebuffer);
-    EXPECT_GE(test::display_psnr(cpu, gpu), 50.0);
+    EXPECT_GE(test::display_psnr(cpu, read_rgba(out)), 50.0);
 
     status = context.fill(color, depth, 0, kWidth, kHeight, out, got);
     EXPECT_NE(status.message().find("(valid) has internal format"), std::string::npos)
@@ -558,14 +563,7 @@ TEST(Gpu, StereoEyeOnTexturesAndOptionsTheGpuLacks) {
     ASSERT_TRUE(status.ok()) << status.message();
     EXPECT_EQ(texture_stats.holes, image_stats.holes);
     EXPECT_EQ(context.timings().upload_ms, 0.0);
-    GLuint framebuffer = 0;
-    glGenFramebuffers(1, &framebuffer);
-    glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, out, 0);
-    Image<glm::vec4> read(kWidth, kHeight);
-    glReadPixels(0, 0, kWidth, kHeight, GL_RGBA, GL_FLOAT, read.data());
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    glDeleteFramebuffers(1, &framebuffer);
+    const Image<glm::vec4> read = read_rgba(out);
     EXPECT_EQ(test::display_psnr(read, from_images.color), INFINITY);
 
     Frame unused;
@@ -643,14 +641,7 @@ TEST(Gpu, InterpolationOnTexturesAndBadArguments) {
         context.interpolate(a, a_color, b, b_color, 0.25f, out, depth, texture_stats);
     ASSERT_TRUE(status.ok()) << status.message();
     EXPECT_EQ(texture_stats.holes, image_stats.holes);
-    GLuint framebuffer = 0;
-    glGenFramebuffers(1, &framebuffer);
-    glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
-    glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, out, 0);
-    Image<glm::vec4> read(kWidth, kHeight);
-    glReadPixels(0, 0, kWidth, kHeight, GL_RGBA, GL_FLOAT, read.data());
-    glBindFramebuffer(GL_FRAMEBUFFER, 0);
-    glDeleteFramebuffers(1, &framebuffer);
+    const Image<glm::vec4> read = read_rgba(out);
     EXPECT_EQ(test::display_psnr(read, from_images.color), INFINITY);
 
     EXPECT_NE(context.interpolate(a, a_color, b, b_color, 0.5f, a_color, depth, texture_stats)
