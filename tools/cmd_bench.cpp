@@ -131,11 +131,6 @@ Status bench_exr(const BenchJob& job) {
 
 }  // namespace
 
-Status open_bench_scene(const std::string& name, BenchScene& bench) {
-    REPRISE_TRY(server::load_scene(name, bench.scene, bench.path));
-    return server::Renderer::create(bench.renderer);
-}
-
 int command_bench(int argc, char** argv) {
     BenchJob job;
     Args args(

@@ -14,8 +14,7 @@ namespace {
 
 Status run(const std::string& scene, const std::string& sizes, int frames) {
     BenchScene bench;
-    REPRISE_TRY(server::load_scene(scene, bench.scene, bench.path));
-    REPRISE_TRY(server::Renderer::create(bench.renderer));
+    REPRISE_TRY(open_bench_scene(scene, bench));
     std::printf("scene %s from frame 10, %d timed frames\n", scene.c_str(), frames);
     for (const std::string& size : split_list(sizes)) {
         int w = 0, h = 0;

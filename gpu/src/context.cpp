@@ -50,6 +50,35 @@ std::size_t texel_bytes(GLenum format) {
 
 }  // namespace
 
+void ContextState::bind_inputs(std::initializer_list<GLuint> textures) const {
+    GLuint unit = 0;
+    for (GLuint t : textures) {
+        glActiveTexture(GL_TEXTURE0 + unit);
+        glBindTexture(GL_TEXTURE_2D, t);
+        glBindSampler(unit, nearest_sampler);
+        ++unit;
+    }
+    glActiveTexture(GL_TEXTURE0);
+}
+
+void ContextState::unbind_inputs() {
+    for (GLuint unit = 0; unit < 8; ++unit) glBindSampler(unit, 0);
+}
+
+void ContextState::reset_counters(GLuint buffer, std::size_t count) {
+    const GLuint zeros[64] = {};
+    REPRISE_ASSERT(count <= 64);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, buffer);
+    glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, GLsizeiptr(count * sizeof(GLuint)), zeros);
+}
+
+void dispatch(int w, int h) {
+    glDispatchCompute(GLuint((w + 7) / 8), GLuint((h + 7) / 8), 1);
+    // Read-backs put their own barriers (download, read_counters).
+    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
+                    GL_SHADER_STORAGE_BARRIER_BIT);
+}
+
 GLuint ContextState::make_counters(std::size_t bytes) {
     GLuint buffer = 0;
     glGenBuffers(1, &buffer);

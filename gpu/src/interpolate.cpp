@@ -71,13 +71,11 @@ void main() {
 
 Status copy_color(ContextState& s, GLuint from, GLuint to, int w, int h) {
     glUseProgram(s.copy_program);
-    glBindTexture(GL_TEXTURE_2D, from);
-    glBindSampler(0, s.nearest_sampler);
+    s.bind_inputs({from});
     glBindImageTexture(0, to, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     glUniform2i(glGetUniformLocation(s.copy_program, "size"), w, h);
-    glDispatchCompute(GLuint((w + 7) / 8), GLuint((h + 7) / 8), 1);
-    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
-    glBindSampler(0, 0);
+    dispatch(w, h);
+    ContextState::unbind_inputs();
     glUseProgram(0);
     return {};
 }
@@ -113,26 +111,16 @@ Status interpolate_passes(ContextState& s, const SplatTextures& a, const SplatTe
                              k.side_a_depth.name, k.side_a_covered.name, false, stats.covered_a));
 
     glUseProgram(s.blend_program);
-    const GLuint inputs[6] = {k.side_a_color.name, k.side_a_depth.name, k.side_a_covered.name,
-                              k.side_b_color.name, k.side_b_depth.name, k.side_b_covered.name};
-    for (GLuint unit = 0; unit < 6; ++unit) {
-        glActiveTexture(GL_TEXTURE0 + unit);
-        glBindTexture(GL_TEXTURE_2D, inputs[unit]);
-        glBindSampler(unit, s.nearest_sampler);
-    }
-    glActiveTexture(GL_TEXTURE0);
+    s.bind_inputs({k.side_a_color.name, k.side_a_depth.name, k.side_a_covered.name,
+                   k.side_b_color.name, k.side_b_depth.name, k.side_b_covered.name});
     glBindImageTexture(0, k.blended.name, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     glBindImageTexture(1, out_depth, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
     glBindImageTexture(2, k.valid.name, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32UI);
-    const GLuint zero = 0;
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, s.blend_counts);
-    glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, sizeof zero, &zero);
+    ContextState::reset_counters(s.blend_counts, 1);
     glUniform2i(glGetUniformLocation(s.blend_program, "size"), w, h);
     glUniform1f(glGetUniformLocation(s.blend_program, "s"), s_between);
-    glDispatchCompute(GLuint((w + 7) / 8), GLuint((h + 7) / 8), 1);
-    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
-                    GL_SHADER_STORAGE_BARRIER_BIT);
-    for (GLuint unit = 0; unit < 6; ++unit) glBindSampler(unit, 0);
+    dispatch(w, h);
+    ContextState::unbind_inputs();
     glUseProgram(0);
     GLuint holes = 0;
     s.read_counters(s.blend_counts, &holes, sizeof holes);

@@ -205,27 +205,6 @@ void set_sizes(GLuint program, int fw, int fh, int cw, int ch) {
     glUniform2i(glGetUniformLocation(program, "coarse_size"), cw, ch);
 }
 
-void bind_inputs(ContextState& s, std::initializer_list<GLuint> textures) {
-    GLuint unit = 0;
-    for (GLuint t : textures) {
-        glActiveTexture(GL_TEXTURE0 + unit);
-        glBindTexture(GL_TEXTURE_2D, t);
-        glBindSampler(unit, s.nearest_sampler);
-        ++unit;
-    }
-    glActiveTexture(GL_TEXTURE0);
-}
-
-void unbind_samplers() {
-    for (GLuint unit = 0; unit < 5; ++unit) glBindSampler(unit, 0);
-}
-
-void run(int w, int h) {
-    glDispatchCompute(GLuint((w + 7) / 8), GLuint((h + 7) / 8), 1);
-    glMemoryBarrier(GL_TEXTURE_FETCH_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
-                    GL_SHADER_STORAGE_BARRIER_BIT);
-}
-
 // The chain's sizes: level s has ceil(w / 2^(s+1)) x ceil(h / 2^(s+1)) pixels, down to 1x1.
 int level_count(int w, int h) {
     int n = 0;
@@ -266,9 +245,7 @@ Status fill_passes(ContextState& s, GLuint color, GLuint valid, GLuint depth, in
             s.filled_depth[l].ensure(GL_R32F, lw, lh);
         }
     }
-    const GLuint zeros[kMaxLevels + 2] = {};
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, s.fill_counts);
-    glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, sizeof zeros, zeros);
+    ContextState::reset_counters(s.fill_counts, kMaxLevels + 2);
     auto depth_of = [&](std::vector<Texture>& chain, int l) {
         return use_depth ? chain[std::size_t(l)].name : 0u;
     };
@@ -282,14 +259,14 @@ Status fill_passes(ContextState& s, GLuint color, GLuint valid, GLuint depth, in
         const int fh = l == 0 ? h : s.pulled[std::size_t(l) - 1].height;
         set_sizes(program, fw, fh, target.width, target.height);
         if (l == 0)
-            bind_inputs(s, {color, valid, depth});
+            s.bind_inputs({color, valid, depth});
         else
-            bind_inputs(s, {s.pulled[std::size_t(l) - 1].name, 0, depth_of(s.pulled_depth, l - 1)});
+            s.bind_inputs({s.pulled[std::size_t(l) - 1].name, 0, depth_of(s.pulled_depth, l - 1)});
         glBindImageTexture(0, target.name, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
         if (use_depth)
             glBindImageTexture(1, s.pulled_depth[std::size_t(l)].name, 0, GL_FALSE, 0,
                                GL_WRITE_ONLY, GL_R32F);
-        run(target.width, target.height);
+        dispatch(target.width, target.height);
     }
     // Push, from the top.
     for (int l = levels - 1; l >= 0; --l) {
@@ -299,25 +276,25 @@ Status fill_passes(ContextState& s, GLuint color, GLuint valid, GLuint depth, in
         glUniform1i(glGetUniformLocation(s.push_program, "top"), top);
         const Texture& coarse = s.filled[std::size_t(top ? l : l + 1)];
         set_sizes(s.push_program, target.width, target.height, coarse.width, coarse.height);
-        bind_inputs(s, {s.pulled[std::size_t(l)].name, top ? 0u : coarse.name,
-                        depth_of(s.pulled_depth, l), top ? 0u : depth_of(s.filled_depth, l + 1)});
+        s.bind_inputs({s.pulled[std::size_t(l)].name, top ? 0u : coarse.name,
+                       depth_of(s.pulled_depth, l), top ? 0u : depth_of(s.filled_depth, l + 1)});
         glBindImageTexture(0, target.name, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
         if (use_depth)
             glBindImageTexture(1, s.filled_depth[std::size_t(l)].name, 0, GL_FALSE, 0,
                                GL_WRITE_ONLY, GL_R32F);
-        run(target.width, target.height);
+        dispatch(target.width, target.height);
     }
     // The image's holes.
     common_uniforms(s.final_program, use_depth, 0);
     glUniform1i(glGetUniformLocation(s.final_program, "has_levels"), levels > 0);
     set_sizes(s.final_program, w, h, levels ? s.filled[0].width : 1,
               levels ? s.filled[0].height : 1);
-    bind_inputs(
-        s, {color, valid, levels ? s.filled[0].name : 0u, levels ? depth_of(s.filled_depth, 0) : 0u,
-            levels ? s.pulled[std::size_t(levels) - 1].name : 0u});
+    s.bind_inputs({color, valid, levels ? s.filled[0].name : 0u,
+                   levels ? depth_of(s.filled_depth, 0) : 0u,
+                   levels ? s.pulled[std::size_t(levels) - 1].name : 0u});
     glBindImageTexture(0, out, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-    run(w, h);
-    unbind_samplers();
+    dispatch(w, h);
+    ContextState::unbind_inputs();
     glUseProgram(0);
 
     GLuint n[kMaxLevels + 2] = {};

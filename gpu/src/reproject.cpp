@@ -112,19 +112,13 @@ void main() {
 using Clock = std::chrono::steady_clock;
 
 // Binds the inputs and runs the shader over `width` x `height`; returns the counts.
-Status dispatch(ContextState& s, GLuint depth, GLuint motion, GLuint id, GLuint previous_depth,
-                GLuint previous_id, GLuint payload, GLuint out, GLuint hit, int width, int height,
-                int previous_width, int previous_height, const warp::ReprojectSetup& k, int step,
-                warp::ReprojectCounts& counts) {
+Status reproject_pass(ContextState& s, GLuint depth, GLuint motion, GLuint id,
+                      GLuint previous_depth, GLuint previous_id, GLuint payload, GLuint out,
+                      GLuint hit, int width, int height, int previous_width, int previous_height,
+                      const warp::ReprojectSetup& k, int step, warp::ReprojectCounts& counts) {
     const GLuint program = s.reproject_program;
     glUseProgram(program);
-    const GLuint inputs[6] = {depth, motion, id, previous_depth, previous_id, payload};
-    for (int unit = 0; unit < 6; ++unit) {
-        glActiveTexture(GLenum(GL_TEXTURE0 + unit));
-        glBindTexture(GL_TEXTURE_2D, inputs[unit]);
-        glBindSampler(GLuint(unit), s.nearest_sampler);
-    }
-    glActiveTexture(GL_TEXTURE0);
+    s.bind_inputs({depth, motion, id, previous_depth, previous_id, payload});
     glBindImageTexture(0, out, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     if (hit) glBindImageTexture(1, hit, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32UI);
     auto set = [&](const char* name, float v) {
@@ -141,17 +135,11 @@ Status dispatch(ContextState& s, GLuint depth, GLuint motion, GLuint id, GLuint 
     glUniform2i(glGetUniformLocation(program, "previous_size"), previous_width, previous_height);
     glUniform1i(glGetUniformLocation(program, "step"), step);
 
-    const GLuint zeros[8] = {};
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, s.counts_buffer);
-    glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, sizeof zeros, zeros);
-    const int looked_up_x = (width + step - 1) / step, looked_up_y = (height + step - 1) / step;
-    glDispatchCompute(GLuint((looked_up_x + 7) / 8), GLuint((looked_up_y + 7) / 8), 1);
-    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT |
-                    GL_FRAMEBUFFER_BARRIER_BIT | GL_SHADER_IMAGE_ACCESS_BARRIER_BIT |
-                    GL_TEXTURE_FETCH_BARRIER_BIT);
+    ContextState::reset_counters(s.counts_buffer, 8);
+    dispatch((width + step - 1) / step, (height + step - 1) / step);  // the looked-up pixels
     GLuint n[8] = {};
     s.read_counters(s.counts_buffer, n, sizeof n);
-    for (int unit = 0; unit < 6; ++unit) glBindSampler(GLuint(unit), 0);
+    ContextState::unbind_inputs();
     glUseProgram(0);
     REPRISE_TRY(gl::check_errors("gpu reproject"));
     counts = {.hits = n[0],
@@ -217,9 +205,9 @@ Status Context::reproject(const GBufferView& current, const GBufferView& previou
     timings_.upload_ms = finish_ms(t);
 
     const int step = std::max(1, options.step);
-    REPRISE_TRY(dispatch(s, s.depth.name, s.motion.name, ids ? s.id.name : 0, s.previous_depth.name,
-                         ids ? s.previous_id.name : 0, s.payload.name, s.out.name, s.hit.name, w, h,
-                         pw, ph, k, step, counts));
+    REPRISE_TRY(reproject_pass(s, s.depth.name, s.motion.name, ids ? s.id.name : 0,
+                               s.previous_depth.name, ids ? s.previous_id.name : 0, s.payload.name,
+                               s.out.name, s.hit.name, w, h, pw, ph, k, step, counts));
     timings_.compute_ms = finish_ms(t);
 
     s.download(s.out, out.data, out.stride / 4);
@@ -260,9 +248,9 @@ Status Context::reproject(const GBufferTextures& current, const GBufferTextures&
         warp::reproject_setup(current.camera, previous.camera, w, h, ids, options);
     Clock::time_point t = Clock::now();
     timings_.upload_ms = 0.0;
-    REPRISE_TRY(dispatch(s, current.depth, current.motion, ids ? current.id : 0, previous.depth,
-                         ids ? previous.id : 0, payload, out, hit, w, h, pw, ph, k,
-                         std::max(1, options.step), counts));
+    REPRISE_TRY(reproject_pass(s, current.depth, current.motion, ids ? current.id : 0,
+                               previous.depth, ids ? previous.id : 0, payload, out, hit, w, h, pw,
+                               ph, k, std::max(1, options.step), counts));
     timings_.compute_ms = finish_ms(t);
     timings_.download_ms = 0.0;
     return {};

@@ -225,16 +225,8 @@ Status splat_passes(ContextState& s, const SplatTextures& in, float factor,
     glBindBuffer(GL_SHADER_STORAGE_BUFFER, s.splat_lists);
     glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, sizeof header, header);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, s.splat_lists);
-    const GLuint zeros[2] = {};
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, s.splat_counts);
-    glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, sizeof zeros, zeros);
-    const GLuint inputs[3] = {in.color, in.depth, in.motion};
-    for (GLuint unit = 0; unit < 3; ++unit) {
-        glActiveTexture(GL_TEXTURE0 + unit);
-        glBindTexture(GL_TEXTURE_2D, inputs[unit]);
-        glBindSampler(unit, s.nearest_sampler);
-    }
-    glActiveTexture(GL_TEXTURE0);
+    ContextState::reset_counters(s.splat_counts, 2);
+    s.bind_inputs({in.color, in.depth, in.motion});
     glBindImageTexture(3, out_color, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     glBindImageTexture(4, out_depth, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
     glBindImageTexture(5, out_covered, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32UI);
@@ -249,14 +241,12 @@ Status splat_passes(ContextState& s, const SplatTextures& in, float factor,
         glUniform1f(glGetUniformLocation(program, "tol_hi"), 1.0f + tol);
         glUniform1i(glGetUniformLocation(program, "footprint"), options.footprint);
         glUniform1i(glGetUniformLocation(program, "carry_motion"), carry_motion);
-        glDispatchCompute(GLuint((w + 7) / 8), GLuint((h + 7) / 8), 1);
-        glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
-                        GL_SHADER_STORAGE_BARRIER_BIT);
+        dispatch(w, h);
     };
     pass(s.splat_clear_program, tw, th);
     pass(s.splat_scatter_program, in.width, in.height);
     pass(s.splat_gather_program, tw, th);
-    for (GLuint unit = 0; unit < 3; ++unit) glBindSampler(unit, 0);
+    ContextState::unbind_inputs();
     glUseProgram(0);
     GLuint n[2] = {};
     s.read_counters(s.splat_counts, n, sizeof n);

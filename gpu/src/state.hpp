@@ -1,6 +1,7 @@
 #pragma once
 // What a gpu::Context owns: the GL context, programs, and textures sized once per frame size.
 #include <chrono>
+#include <initializer_list>
 #include <memory>
 #include <vector>
 
@@ -67,6 +68,9 @@ Status splat_passes(ContextState& s, const SplatTextures& in, float factor,
                     const warp::SplatOptions& options, int tw, int th, GLuint out_color,
                     GLuint out_depth, GLuint out_covered, bool carry_motion, std::size_t& covered);
 
+// The bound program over w x h in 8x8 groups, its writes visible to whatever comes next.
+void dispatch(int w, int h);
+
 // glFinish, then the milliseconds since `since`, which moves to now.
 double finish_ms(std::chrono::steady_clock::time_point& since);
 
@@ -116,6 +120,12 @@ struct ContextState {
     GLuint readback_buffer = 0;
     GLuint unpack_buffer = 0;  // uploads go through it: the GPU lays the texels out, not the CPU
 
+    // Binds `textures` to units 0, 1, ... for texelFetch through the nearest sampler (0: none).
+    void bind_inputs(std::initializer_list<GLuint> textures) const;
+    // Units 0..7 without a sampler again (the application's own filtering applies).
+    static void unbind_inputs();
+    // Zeroes the first `count` counters of `buffer` and binds it as storage buffer 0.
+    static void reset_counters(GLuint buffer, std::size_t count);
     // A counters buffer in GPU memory of `bytes`.
     GLuint make_counters(std::size_t bytes);
     // The first `bytes` of counters buffer `buffer` (the shaders that wrote it finished).

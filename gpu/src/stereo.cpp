@@ -71,15 +71,7 @@ void main() {
 
 void run(GLuint program, int w, int h) {
     glUniform2i(glGetUniformLocation(program, "size"), w, h);
-    glDispatchCompute(GLuint((w + 7) / 8), GLuint((h + 7) / 8), 1);
-    glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT);
-}
-
-void bind_input(ContextState& s, GLuint unit, GLuint texture) {
-    glActiveTexture(GL_TEXTURE0 + unit);
-    glBindTexture(GL_TEXTURE_2D, texture);
-    glBindSampler(unit, s.nearest_sampler);
-    glActiveTexture(GL_TEXTURE0);
+    dispatch(w, h);
 }
 
 Status check_options(const stereo::StereoOptions& o) {
@@ -117,7 +109,7 @@ Status eye_passes(ContextState& s, GLuint color, GLuint depth, int w, int h, con
 
     const GLuint program = s.displacement_program;
     glUseProgram(program);
-    bind_input(s, 0, depth);
+    s.bind_inputs({depth});
     glBindImageTexture(0, s.displacement.name, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     glBindImageTexture(1, s.target_depth.name, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
     glUniformMatrix4fv(glGetUniformLocation(program, "P"), 1, GL_FALSE,
@@ -147,10 +139,10 @@ Status eye_passes(ContextState& s, GLuint color, GLuint depth, int w, int h, con
     stats.unfilled = filled.unfilled;
 
     glUseProgram(s.finish_program);
-    bind_input(s, 0, stats.filled ? s.out.name : s.eye_color.name);
+    s.bind_inputs({stats.filled ? s.out.name : s.eye_color.name});
     glBindImageTexture(0, out_color, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     run(s.finish_program, w, h);
-    glBindSampler(0, 0);
+    ContextState::unbind_inputs();
     glUseProgram(0);
     return gl::check_errors("gpu stereo eye");
 }
