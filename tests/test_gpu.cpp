@@ -622,6 +622,20 @@ TEST(Gpu, InterpolationMatchesTheCpuOnEveryBuiltInScene) {
     EXPECT_GT(holes, 0u);  // not vacuous: some holes filled
 }
 
+TEST(Gpu, InterpolationRepairsNonFiniteInputAsTheCpu) {
+    NonfiniteCounts spoiled;
+    const std::vector<Frame> frames = test::spoiled_sequence(2, spoiled);
+    const Frame cpu = cpu_between(frames[0], frames[1]);
+    Frame gpu;
+    gpu::InterpolateStats stats;
+    ASSERT_TRUE(shared_gpu().interpolate(frames[0], frames[1], 0.5f, gpu, stats).ok());
+    EXPECT_GT(spoiled.total(), 0u);
+    EXPECT_EQ(stats.nonfinite.total(), spoiled.total());
+    for (std::size_t i = 0; i < gpu.color.pixel_count(); ++i)
+        ASSERT_TRUE(test::finite(gpu.color.data()[i])) << "pixel " << i;
+    EXPECT_GE(test::display_psnr(cpu.color, gpu.color), 50.0);
+}
+
 TEST(Gpu, InterpolationOnTexturesAndBadArguments) {
     const std::vector<Frame>& frames = scene_frames("crossing");
     gpu::Context& context = shared_gpu();

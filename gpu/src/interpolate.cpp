@@ -135,10 +135,18 @@ Status interpolate_passes(ContextState& s, const SplatTextures& a, const SplatTe
     return gl::check_errors("gpu interpolate");
 }
 
-Status Context::interpolate(const GBufferView& a, const GBufferView& b, float s_between, Frame& out,
-                            InterpolateStats& stats, const warp::SplatOptions& options) {
+Status Context::interpolate(const GBufferView& given_a, const GBufferView& given_b, float s_between,
+                            Frame& out, InterpolateStats& stats,
+                            const warp::SplatOptions& options) {
     timings_ = {};
     stats = {};
+    ContextState& s = *state_;
+    Interpolation& k = s.interpolation;
+    // NaN and infinities (but background depth) repaired first, as the CPU converter does.
+    const GBufferView a = k.repair_a.clean(given_a, stats.nonfinite);
+    NonfiniteCounts found_in_b;
+    const GBufferView b = k.repair_b.clean(given_b, found_in_b);
+    stats.nonfinite += found_in_b;
     const int w = b.width(), h = b.height();
     if (a.width() != w || a.height() != h)
         return Status::error("gpu interpolate: the frames are " + std::to_string(a.width()) + "x" +
@@ -151,9 +159,7 @@ Status Context::interpolate(const GBufferView& a, const GBufferView& b, float s_
     out.id.clear();
     out.camera = b.camera;
     if (w <= 0 || h <= 0) return {};
-    ContextState& s = *state_;
     s.gl->make_current();
-    Interpolation& k = s.interpolation;
     auto t = std::chrono::steady_clock::now();
     Texture* textures[6] = {&k.a_color, &k.a_depth, &k.a_motion,
                             &k.b_color, &k.b_depth, &k.b_motion};

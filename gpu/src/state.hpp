@@ -79,6 +79,7 @@ struct Interpolation {
     Texture a_color, a_depth, a_motion, b_color, b_depth, b_motion;
     Texture side_a_color, side_a_depth, side_a_covered, side_b_color, side_b_depth, side_b_covered,
         blended, valid;
+    NonfiniteRepair repair_a, repair_b;  // each keeps its repaired copy until the next call
     Texture* all[14] = {&a_color,        &a_depth,      &a_motion,     &b_color,
                         &b_depth,        &b_motion,     &side_a_color, &side_a_depth,
                         &side_a_covered, &side_b_color, &side_b_depth, &side_b_covered,

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "reprise/core/gbuffer.hpp"
+#include "reprise/core/nonfinite.hpp"
 #include "reprise/core/status.hpp"
 #include "reprise/stereo/synthesize.hpp"
 #include "reprise/warp/fill.hpp"
@@ -34,11 +35,13 @@ struct GBufferTextures {
     Camera camera;
 };
 
-// What an in-between frame took: covered pixels of each side, pixels neither covered, and the
-// fill's stats (all zero when there were no holes: no fill).
+// What an in-between frame took: covered pixels of each side, pixels neither covered, the
+// fill's stats (all zero when there were no holes: no fill), and the NaN/Inf the CPU-image entry
+// repaired in its inputs (as the CPU converter does).
 struct InterpolateStats {
     std::size_t covered_a = 0, covered_b = 0, holes = 0;
     warp::FillStats fill;
+    NonfiniteCounts nonfinite;
 };
 
 struct ContextState;  // GL objects and scratch (private)
@@ -100,7 +103,8 @@ public:
     // interpolate_frame for FrucOptions{.warp = Splat, .true_motion = false, .refine off} and
     // pull-push: b splatted by 1 - s, a by -s, blended by s where both land on one surface (depths
     // within 2 %), the nearer or the only one elsewhere, pull-push over what neither covers.
-    // Colour and depth out (out.motion, normal and id cleared; out.camera is b's).
+    // Colour and depth out (out.motion, normal and id cleared; out.camera is b's). NaN/Inf in a
+    // and b are repaired first, as the CPU converter does; the texture entry does not repair.
     Status interpolate(const GBufferView& a, const GBufferView& b, float s, Frame& out,
                        InterpolateStats& stats, const warp::SplatOptions& options = {});
     // The same on textures: colour GL_RGBA32F, depth GL_R32F, motion GL_RG32F, all one size;
