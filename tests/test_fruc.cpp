@@ -284,10 +284,12 @@ void expect_true_motion_beats_linear(bool cameras) {
             "[fruc] %s, orbit at 2 rad/s, 10 -> 20 Hz, %s cameras: true motion %.2f dB, linear "
             "%.2f dB\n",
             scene_name, cameras ? "with" : "without", psnr[1], psnr[0]);
-        // Measured with cameras 27.49 / 25.27 and 22.39 / 21.04, without 27.48 and 22.35.
+        // Measured with cameras 30.33 / 28.58 and 24.05 / 23.34, without 29.90 and 23.91 (before
+        // the blend took both sides within 15 % in depth and the side not stretched over a
+        // disocclusion: 27.49 / 25.27 and 22.39 / 21.04, without 27.48 and 22.35).
         const bool pan = std::string(scene_name) == "pan";
-        EXPECT_GT(psnr[1], pan ? 27.0 : 22.0) << scene_name;
-        EXPECT_GT(psnr[1], psnr[0] + (pan ? 1.5 : 1.0)) << scene_name;
+        EXPECT_GT(psnr[1], pan ? 29.5 : 23.5) << scene_name;
+        EXPECT_GT(psnr[1], psnr[0] + (pan ? 1.0 : 0.4)) << scene_name;
     }
 }
 
@@ -328,4 +330,30 @@ TEST(FrucWithoutCameras, ExtrapolationFollowsTheMotionAlone) {
         const bool pan = std::string(scene) == "pan";
         EXPECT_GT(sum_without, sum_repeat + 3.0 * (pan ? 6.0 : 3.0)) << scene;
     }
+}
+
+// A square slides 8 px right per frame over a still background. Halfway, each side's grid warp
+// stretches its edge triangles over the strip the square uncovers on its side, in front of the
+// background the other side saw: the in-between frame takes that other side there.
+TEST(FrucBlend, TheSideThatSawTheUncoveredStripIsTaken) {
+    const int w = 96, h = 48, step = 8;
+    const std::vector<Frame> input = {test::sliding_square_frame(w, h, 33, step),
+                                      test::sliding_square_frame(w, h, 33 + step, step)};
+    const Frame truth = test::sliding_square_frame(w, h, 33 + step / 2, step);
+    double psnr[2];
+    for (bool marked : {false, true}) {
+        FrucOptions options{.mode = FrucMode::Interpolate, .true_motion = false};
+        options.refine.enabled = false;
+        if (!marked) options.grid.stretched_area = std::numeric_limits<float>::infinity();
+        const std::vector<Frame> out = convert(input, 2, options);
+        ASSERT_EQ(out.size(), 3u);
+        psnr[marked] = psnr_of(truth, out[1]);
+    }
+    std::printf(
+        "[fruc] sliding square, in-between frame: %.2f dB (stretched sides not marked: "
+        "%.2f dB)\n",
+        psnr[1], psnr[0]);
+    // Measured 43.88 dB, 25.49 without the mark.
+    EXPECT_GT(psnr[1], 40.0);
+    EXPECT_GT(psnr[1], psnr[0] + 10.0) << "the mark, not the blend, takes the right side";
 }

@@ -139,6 +139,36 @@ TEST(GridWarp, IntegerTranslationShiftsExactly) {
         }
 }
 
+// A square that slid 8 px right, warped back to where it was: the edge triangles across its right
+// edge stretch over the 8 px it uncovers, whose pixels but the one at each end are marked.
+TEST(GridWarp, EdgeTrianglesStretchedOverADisocclusionAreMarked) {
+    const int w = 96, h = 48, x0 = 41, step = 8;  // a 2 px cell straddles each edge
+    const Frame f = sliding_square_frame(w, h, x0, step);
+    Output out(w, h);
+    (void)warp_both(f, 1.0f, out);
+    std::size_t stretched = 0;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            const bool uncovered = y >= 16 && y < 32 && x >= x0 + 16 - step && x < x0 + 16;
+            stretched += out.covered(x, y) == kCoveredStretched;
+            // The strip the square uncovered, away from its border rows and the square's new
+            // edge (the anti-aliasing zone of one pixel), is stretched.
+            if (uncovered && y >= 17 && y < 31 && x >= x0 + 16 - step + 1 && x < x0 + 15) {
+                ASSERT_EQ(out.covered(x, y), kCoveredStretched) << x << "," << y;
+            } else if (!(y >= 15 && y < 33 && x >= x0 - step - 1 && x < x0 + 17)) {
+                ASSERT_EQ(out.covered(x, y), 1) << x << "," << y;
+            }
+        }
+    EXPECT_LE(stretched, std::size_t(16 + 2) * (step + 2)) << "only the uncovered strip";
+    (void)warp_both(f, 1.0f, out, {.stretched_area = kInf});
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) ASSERT_EQ(out.covered(x, y), 1) << "none marked";
+    // A still frame: nothing stretches.
+    (void)warp_both(sliding_square_frame(w, h, x0, 0), 1.0f, out);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) ASSERT_EQ(out.covered(x, y), 1);
+}
+
 TEST(GridWarp, FactorScalesMotion) {
     const int w = 40, h = 36;
     Frame f = flat_frame(w, h, 4.0f, {0.0f, 4.0f});

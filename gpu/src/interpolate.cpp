@@ -28,14 +28,15 @@ uniform highp float s;
 
 bool positive_inf(highp float v) { return floatBitsToUint(v) == 0x7f800000u; }
 
-// Whether pixel p is a hole.
+// Whether pixel p is a hole. blend_row_reference's rule (kSameSurface 0.15); the splat marks no
+// pixel kCoveredStretched, so its rule for stretched sides never applies here.
 bool blend(ivec2 p) {
     bool ca = texelFetch(covered_a, p, 0).r != 0u, cb = texelFetch(covered_b, p, 0).r != 0u;
     highp float za = texelFetch(depth_a, p, 0).r, zb = texelFetch(depth_b, p, 0).r;
     highp vec4 a = texelFetch(color_a, p, 0), c = texelFetch(color_b, p, 0);
     highp float z = zb;
     if (ca) {
-        PRECISE highp float gap = abs(za - zb), allowed = 0.02 * min(za, zb);
+        PRECISE highp float gap = abs(za - zb), allowed = 0.15 * min(za, zb);
         bool both_background = positive_inf(za) && positive_inf(zb);
         if (cb && (both_background || (!positive_inf(za) && !positive_inf(zb) && gap <= allowed))) {
             PRECISE highp vec4 mixed = (1.0 - s) * a + s * c;

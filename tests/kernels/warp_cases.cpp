@@ -37,14 +37,15 @@ public:
         s_ = uniform(rng, 0.05f, 0.95f);
         scale_ = worst ? -1e30f : uniform(rng, 0.5f, 2.0f);
         for (std::size_t i = 0; i < n; ++i) {
-            covered_a_[i] = uint8_t(rng() % 8 ? (worst ? 1 + rng() % 255 : 1) : 0);
-            covered_b_[i] = uint8_t(rng() % 8 ? 1 : 0);
+            // 0, 1 or kCoveredStretched (a: any byte in the worst case)
+            covered_a_[i] = uint8_t(rng() % 8 ? (worst ? 1 + rng() % 255 : 1 + rng() % 2) : 0);
+            covered_b_[i] = uint8_t(rng() % 8 ? 1 + rng() % 2 : 0);
             const float z = uniform(rng, 0.5f, 50.0f);
             depth_a_[i] = z;
             switch (rng() % 4) {  // same surface, nearer, farther, background on both
                 case 0:
-                    depth_b_[i] = z * uniform(rng, 0.97f, 1.03f);
-                    break;  // about the 2 % line
+                    depth_b_[i] = z * uniform(rng, 0.8f, 1.2f);
+                    break;  // about the kSameSurface line
                 case 1:
                     depth_b_[i] = z * 0.5f;
                     break;

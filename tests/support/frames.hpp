@@ -1,6 +1,7 @@
 // Test support: synthetic frames, bit-exact image comparison and display PSNR.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <limits>
@@ -37,6 +38,19 @@ inline Frame flat_frame(int w, int h, float depth, glm::vec2 motion, uint32_t se
     std::uniform_real_distribution<float> u(0.0f, 1.0f);
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) f.color(x, y) = {u(rng), u(rng), u(rng), 1.0f};
+    return f;
+}
+
+// A still noise background (depth 10) behind a red square of `side` px (depth 2) whose top-left
+// corner is at (x0, 16) and which moved `step` px to the right since the previous frame.
+inline Frame sliding_square_frame(int w, int h, int x0, int step, int side = 16) {
+    Frame f = flat_frame(w, h, 10.0f, {0.0f, 0.0f}, 5);
+    for (int y = 16; y < std::min(h, 16 + side); ++y)
+        for (int x = std::max(x0, 0); x < std::min(w, x0 + side); ++x) {
+            f.color(x, y) = {1.0f, 0.2f, 0.2f, 1.0f};
+            f.depth(x, y) = 2.0f;
+            f.motion(x, y) = {-float(step), 0.0f};
+        }
     return f;
 }
 

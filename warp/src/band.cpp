@@ -39,7 +39,8 @@ void clear_band(const Band& band) {
     }
 }
 
-std::size_t finish_band(const Band& band, float background_from, std::size_t* nonfinite) {
+std::size_t finish_band(const Band& band, float background_from, std::size_t* nonfinite,
+                        bool keep_stretched) {
     const WarpTarget& v = band.view;
     std::size_t count = 0, bad = 0;
     for (int y = 0; y < v.color.height; ++y) {
@@ -51,7 +52,8 @@ std::size_t finish_band(const Band& band, float background_from, std::size_t* no
             if (covered[x]) {
                 ++count;
                 bad += !finite_color(color[x]);
-                covered[x] = 1;
+                covered[x] =
+                    keep_stretched && covered[x] == kCoveredStretched ? kCoveredStretched : 1;
                 if (depth[x] >= background_from) depth[x] = kInf;
             } else {
                 color[x] = glm::vec4(0.0f);
@@ -83,7 +85,7 @@ void put(float* p, __m128 v, bool aligned) {
 #endif
 
 std::size_t copy_band(const Band& scratch, const WarpTarget& target, float background_from,
-                      std::size_t* nonfinite) {
+                      std::size_t* nonfinite, bool keep_stretched) {
     const WarpTarget& s = scratch.view;
     const bool motion = !target.motion.empty();
     const int width = s.color.width;
@@ -114,8 +116,12 @@ std::size_t copy_band(const Band& scratch, const WarpTarget& target, float backg
             const __m128i wide =
                 _mm_unpacklo_epi16(_mm_unpacklo_epi8(_mm_cvtsi32_si128(bytes), zero), zero);
             const __m128i set = _mm_cmpgt_epi32(wide, zero);
-            const int ones = _mm_cvtsi128_si32(
-                _mm_packus_epi16(_mm_packs_epi32(_mm_srli_epi32(set, 31), zero), zero));
+            const __m128i level =
+                keep_stretched
+                    ? _mm_min_epi16(wide, _mm_set1_epi32(kCoveredStretched))  // 0, 1 or 2 here
+                    : _mm_srli_epi32(set, 31);
+            const int ones =
+                _mm_cvtsi128_si32(_mm_packus_epi16(_mm_packs_epi32(level, zero), zero));
             std::memcpy(tc + x, &ones, 4);
             const __m128 hit = _mm_castsi128_ps(set);
             constexpr uint8_t kBits[16] = {0, 1, 1, 2, 1, 2, 2, 3, 1, 2, 2, 3, 2, 3, 3, 4};
@@ -152,7 +158,7 @@ std::size_t copy_band(const Band& scratch, const WarpTarget& target, float backg
         for (; x < width; ++x) {
             const bool hit = sc[x] != 0;
             count += hit;
-            tc[x] = hit ? 1 : 0;
+            tc[x] = !hit ? 0 : keep_stretched && sc[x] == kCoveredStretched ? kCoveredStretched : 1;
             td[x] = sd[x] >= background_from ? kInf : sd[x];
             tcol[x] = hit ? scol[x] : glm::vec4(0.0f);
             bad += hit && !finite_color(scol[x]);

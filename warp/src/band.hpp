@@ -38,9 +38,10 @@ void clear_band(const Band& band);
 // In place: covered becomes 0/1, depths at or beyond `background_from` +inf, colour and motion
 // 0 where nothing landed. Returns the covered count; adds to `nonfinite`, when given, the covered
 // pixels whose colour has a NaN or infinite channel.
-std::size_t finish_band(const Band& band, float background_from, std::size_t* nonfinite = nullptr);
+std::size_t finish_band(const Band& band, float background_from, std::size_t* nonfinite = nullptr,
+                        bool keep_stretched = false);
 // The same, written from a scratch band to its rows of `target`.
 std::size_t copy_band(const Band& scratch, const WarpTarget& target, float background_from,
-                      std::size_t* nonfinite = nullptr);
+                      std::size_t* nonfinite = nullptr, bool keep_stretched = false);
 
 }  // namespace reprise::warp

@@ -337,12 +337,27 @@ private:
         return place(cx, cy, d < kBackgroundFrom ? d : kBackgroundDepth, m.x, m.y, v);
     }
 
+    // An edge triangle across a depth edge whose area grew by more than stretched_area from the
+    // source to the target spans what the source did not see.
+    uint8_t coverage(const Vertex& a, const Vertex& b, const Vertex& c) const {
+        const float z_lo = std::min({a.z, b.z, c.z}), z_hi = std::max({a.z, b.z, c.z});
+        if (!(z_hi > z_lo * p_.vertex_z_ratio)) return 1;
+        const double source =
+            std::fabs(double(b.sx - a.sx) * (c.sy - a.sy) - double(b.sy - a.sy) * (c.sx - a.sx));
+        const double target = std::fabs(double(int64_t(b.x) - a.x) * (int64_t(c.y) - a.y) -
+                                        double(int64_t(b.y) - a.y) * (int64_t(c.x) - a.x)) /
+                              (double(kSubpixel) * kSubpixel);
+        return (target - source) * 0.5 > p_.stretched_area ? kCoveredStretched : 1;
+    }
+
     void emit(int x, int y, int x1, int y1, bool smooth) {
         Cell c;
         c.perspective = smooth;
         if (!vertex(x, y, x, y, c.v[0]) || !vertex(x1, y, x1 - 1, y, c.v[1]) ||
             !vertex(x1, y1, x1 - 1, y1 - 1, c.v[2]) || !vertex(x, y1, x, y1 - 1, c.v[3]))
             return;
+        c.coverage[0] = smooth ? 1 : coverage(c.v[0], c.v[1], c.v[2]);
+        c.coverage[1] = smooth ? 1 : coverage(c.v[0], c.v[2], c.v[3]);
         int lo = c.v[0].y, hi = c.v[0].y;
         for (const Vertex& v : c.v) {
             lo = std::min(lo, v.y);
@@ -384,6 +399,7 @@ Params make_params(const GridOptions& o, float factor) {
     p.motion_limit = factor != 0.0f ? motion / std::fabs(factor) : kInf;
     p.vertex_z_ratio = 1.0f + 2.0f * p.depth_tolerance;
     p.vertex_motion = 2.0f * p.motion_limit;
+    p.stretched_area = o.stretched_area >= 0.0f ? o.stretched_area : 0.0f;  // NaN: 0
     p.factor = factor;
     return p;
 }

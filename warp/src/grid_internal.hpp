@@ -22,6 +22,9 @@ struct Cell {
     // Passed the smoothness test: depth is interpolated as 1/z (perspective-correct). Else (the
     // smallest cells across an edge) linearly, so that background never pulls geometry along.
     bool perspective;
+    // Per triangle (v0 v1 v2, v0 v2 v3), what `covered` becomes where it is drawn: 1, or
+    // kCoveredStretched for an edge triangle across a depth edge stretched over a disocclusion.
+    uint8_t coverage[2];
 };
 struct Row {  // the cells grown from one row of starting cells
     std::vector<Cell> cells;
@@ -70,6 +73,7 @@ struct Params {
     float motion_limit;     // motion_threshold / |factor|: allowed motion error, source pixels
     float vertex_z_ratio;   // 1 + 2 depth_tolerance: 2x2 pixels that share a vertex
     float vertex_motion;    // 2 motion_limit: their motion range
+    float stretched_area;   // stretched_area: px^2 an edge triangle grows by to be stretched
     int cell, min_cell;
     float factor;
 };

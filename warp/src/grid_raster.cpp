@@ -53,7 +53,7 @@ Edge edge(const Vertex& a, const Vertex& b, int64_t px, int64_t py) {
 #if defined(__SSE2__)
 // A triangle's gradients and bounds in every lane, for the vector kernel.
 struct VectorTriangle {
-    __m128 gz, z_lo, z_hi, depth_lo, depth_hi;
+    __m128 gz, z_lo, z_hi, depth_lo, depth_hi, stretch_scale, stretch_last;
     __m128 gsx, sx_lo, sx_hi, gsy, sy_lo, sy_hi;
     __m128 gmx, mx_lo, mx_hi, gmy, my_lo, my_hi;
     __m128i stride, last_column, last_row;
@@ -64,6 +64,12 @@ struct Triangle {
     Edge e[3];
     Plane z, sx, sy, mx, my;  // z: of 1/depth when `perspective`, else of depth
     bool perspective;
+    // A stretched triangle (kCoveredStretched) marks the pixels more than a pixel from both its
+    // nearest and its farthest vertices: (z - z_lo) * stretch_scale px from the nearest, of
+    // stretch_span px. Within a pixel of either end lies what the source saw (an anti-aliased
+    // edge); each of its pixels is marked 1 like every pixel of other triangles.
+    bool stretched;
+    float stretch_scale, stretch_span;
     float z_lo, z_hi;                  // the vertices' depth range (perspective)
     float ax, ay;                      // vertex a, pixels
     float sx_lo, sx_hi, sy_lo, sy_hi;  // source positions kept where taps need no clamping
@@ -82,12 +88,13 @@ public:
           bicubic_(bicubic) {}
 
     void cell(const Cell& c) const {
-        triangle(c.v[0], c.v[1], c.v[2], c.perspective);
-        triangle(c.v[0], c.v[2], c.v[3], c.perspective);
+        triangle(c.v[0], c.v[1], c.v[2], c.perspective, c.coverage[0]);
+        triangle(c.v[0], c.v[2], c.v[3], c.perspective, c.coverage[1]);
     }
 
 private:
-    void triangle(const Vertex& a, const Vertex& b_in, const Vertex& c_in, bool perspective) const {
+    void triangle(const Vertex& a, const Vertex& b_in, const Vertex& c_in, bool perspective,
+                  uint8_t coverage) const {
         const Vertex* b = &b_in;
         const Vertex* c = &c_in;
         int64_t area = (int64_t(b->x) - a.x) * (int64_t(c->y) - a.y) -
@@ -127,6 +134,15 @@ private:
                          std::max({va, vb, vc})};
         };
         t.perspective = perspective;
+        t.stretched = coverage == kCoveredStretched;
+        t.stretch_span = t.stretch_scale = 0.0f;
+        if (t.stretched) {
+            const float z_lo = std::min({a.z, b->z, c->z}), z_hi = std::max({a.z, b->z, c->z});
+            const float ab = std::hypot(e1x, e1y), ac = std::hypot(e2x, e2y);
+            const float bc = std::hypot(e2x - e1x, e2y - e1y);
+            t.stretch_span = std::max({ab, ac, bc});
+            t.stretch_scale = t.stretch_span / (z_hi - z_lo);
+        }
         if (perspective) {
             // 1/z is affine in screen space on a plane; depth 0 stands in as 1e-30.
             auto inverse = [](float z) { return 1.0f / std::max(z, 1e-30f); };
@@ -161,6 +177,8 @@ private:
             v.z_hi = _mm_set1_ps(t.z.hi);
             v.depth_lo = _mm_set1_ps(t.z_lo);
             v.depth_hi = _mm_set1_ps(t.z_hi);
+            v.stretch_scale = _mm_set1_ps(t.stretch_scale);
+            v.stretch_last = _mm_set1_ps(t.stretch_span - 1.0f);
             v.gsx = _mm_set1_ps(t.sx.gx);
             v.sx_lo = _mm_set1_ps(t.sx_lo);
             v.sx_hi = _mm_set1_ps(t.sx_hi);
@@ -225,6 +243,12 @@ private:
         return v < hi ? v : hi;
     }
 
+    static uint8_t coverage_at(const Triangle& t, float zc) {
+        if (!t.stretched) return 1;
+        const float from_near = (zc - t.z.lo) * t.stretch_scale;
+        return from_near >= 1.0f && from_near <= t.stretch_span - 1.0f ? kCoveredStretched : 1;
+    }
+
     struct SpanStart {
         float z, sx, sy, mx, my;
     };
@@ -251,7 +275,7 @@ private:
             if (t.perspective) zc = clamp_like_sse(1.0f / zc, t.z_lo, t.z_hi);
             if (!(zc < depth[x])) continue;
             depth[x] = zc;
-            covered[x] = 1;
+            covered[x] = coverage_at(t, zc);
             // Positions are >= 0.5 here, so truncation is floor.
             const float fx = clamp_like_sse(s.sx + t.sx.gx * k, t.sx_lo, t.sx_hi) - 0.5f;
             const float fy = clamp_like_sse(s.sy + t.sy.gx * k, t.sy_lo, t.sy_hi) - 0.5f;
@@ -307,12 +331,22 @@ private:
             int mask = _mm_movemask_ps(pass);
             if (!mask) continue;
             _mm_storeu_ps(depth + k, _mm_or_ps(_mm_and_ps(pass, zc), _mm_andnot_ps(pass, d)));
-            {  // coverage: any non-zero byte where a pixel passed
-                const __m128i p = _mm_castps_si128(pass);
-                const __m128i bytes = _mm_packs_epi16(_mm_packs_epi32(p, p), p);
-                int old, set = _mm_cvtsi128_si32(bytes);
+            {  // coverage (coverage_at) where a pixel passed
+                __m128i level = _mm_set1_epi32(1);
+                if (t.stretched) {
+                    const __m128 from_near = _mm_mul_ps(_mm_sub_ps(zc, v.z_lo), v.stretch_scale);
+                    const __m128 middle = _mm_and_ps(_mm_cmpge_ps(from_near, one),
+                                                     _mm_cmple_ps(from_near, v.stretch_last));
+                    level = _mm_sub_epi32(level, _mm_castps_si128(middle));  // 1 or 2
+                }
+                const __m128i p = _mm_and_si128(_mm_castps_si128(pass), level);
+                const __m128i bytes = _mm_packus_epi16(_mm_packs_epi32(p, p), p);
+                const __m128i keep = _mm_castps_si128(pass);
+                const int set =
+                    _mm_cvtsi128_si32(_mm_packs_epi16(_mm_packs_epi32(keep, keep), keep));
+                int old;
                 std::memcpy(&old, covered + k, 4);
-                old |= set;
+                old = (old & ~set) | _mm_cvtsi128_si32(bytes);
                 std::memcpy(covered + k, &old, 4);
             }
             if (motion) {

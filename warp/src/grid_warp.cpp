@@ -81,7 +81,7 @@ GridStats GridWarper::run(const GBufferView& source, float factor, const WarpTar
     if (!threaded) {
         const Band whole{target, 0};
         draw(whole, false);
-        stats.covered = finish_band(whole, grid::kBackgroundFrom, &stats.nonfinite);
+        stats.covered = finish_band(whole, grid::kBackgroundFrom, &stats.nonfinite, true);
         return stats;
     }
 
@@ -104,7 +104,7 @@ GridStats GridWarper::run(const GBufferView& source, float factor, const WarpTar
                          scratch_rows(scratch.covered, width, rows)},
                         y0};
                     draw(band, true);
-                    n += copy_band(band, target, grid::kBackgroundFrom, &bad);
+                    n += copy_band(band, target, grid::kBackgroundFrom, &bad, true);
                 }
                 covered += n;
                 nonfinite += bad;

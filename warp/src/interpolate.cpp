@@ -122,7 +122,12 @@ std::size_t blend_row_reference(const BlendRow& r) {
             r.motion[x] *= r.motion_scale;
             continue;
         }
-        if (cb && std::abs(za - zb) <= 0.02f * std::min(za, zb)) {
+        const bool stretched_a = r.covered_a[x] == kCoveredStretched,
+                   stretched_b = r.covered_b[x] == kCoveredStretched;
+        if (cb && stretched_a != stretched_b) {  // the side not stretched over a disocclusion
+            if (stretched_b)
+                r.color[x] = r.color_a[x], r.depth[x] = za, r.motion[x] = r.motion_a[x];
+        } else if (cb && std::abs(za - zb) <= kSameSurface * std::min(za, zb)) {
             r.color[x] = (1.0f - s) * r.color_a[x] + s * r.color[x];
             r.depth[x] = std::min(za, zb);
         } else if (cb && std::isinf(za) && std::isinf(zb)) {

@@ -9,6 +9,7 @@
 #include <glm/vec4.hpp>
 
 #include "reprise/core/image.hpp"
+#include "reprise/warp/splat.hpp"
 
 namespace reprise {
 class StaticReprojection;
@@ -17,9 +18,11 @@ class StaticReprojection;
 namespace reprise::warp {
 
 // Interpolation's blend of one row: warped frame a (inputs *_a) merged in place into warped
-// frame b (color, depth, motion): both covered and at the same depth (2 %) or both background:
-// (1 - s) a + s b; a alone or in front: a; otherwise b. Motion scaled by motion_scale;
-// valid = covered by either. Returns the number of pixels covered by neither.
+// frame b (color, depth, motion): covered by both but stretched over a disocclusion on one side
+// only (kCoveredStretched): the other side; else both at the same depth (kSameSurface) or both
+// background: (1 - s) a + s b; a alone or in front: a; otherwise b. Motion scaled by
+// motion_scale; valid = covered by either. Returns the number of pixels covered by neither.
+inline constexpr float kSameSurface = 0.15f;  // relative depth difference of one surface
 struct BlendRow {
     const uint8_t* covered_a;
     const uint8_t* covered_b;

@@ -39,7 +39,8 @@ float mean_difference(glm::vec4 a, glm::vec4 b) {
            (1.0f / 3.0f);
 }
 
-// The blend's test (interpolate.cpp): one surface, or background on both sides.
+// One surface (tighter than the blend's kSameSurface: surfaces whose depth changed between the
+// frames are not surveyed), or background on both sides.
 bool same_surface(float za, float zb) {
     if (std::isinf(za) && std::isinf(zb)) return true;
     return std::abs(za - zb) <= 0.02f * std::min(za, zb);

@@ -27,28 +27,36 @@ std::size_t BlendRowSimd(const BlendRow& r) {
     using VF = hn::Vec<decltype(df)>;
     const int n = int(hn::Lanes(df));
     const VF one_minus_s = hn::Set(df, 1.0f - r.s), s = hn::Set(df, r.s);
-    const VF scale = hn::Set(df, r.motion_scale), tolerance = hn::Set(df, 0.02f);
+    const VF scale = hn::Set(df, r.motion_scale), tolerance = hn::Set(df, kSameSurface);
     const VF inf = hn::Set(df, std::numeric_limits<float>::infinity());
     const auto zero_i = hn::Zero(di), one_i = hn::Set(di, 1);
+    const auto stretched = hn::Set(di, int32_t{kCoveredStretched});
     std::size_t holes = 0;
     int x = 0;
     for (; x + n <= r.width; x += n) {
-        const auto ca =
-            hn::RebindMask(df, hn::PromoteTo(di, hn::LoadU(du8, r.covered_a + x)) != zero_i);
-        const auto cb =
-            hn::RebindMask(df, hn::PromoteTo(di, hn::LoadU(du8, r.covered_b + x)) != zero_i);
+        const auto qa = hn::PromoteTo(di, hn::LoadU(du8, r.covered_a + x));
+        const auto qb = hn::PromoteTo(di, hn::LoadU(du8, r.covered_b + x));
+        const auto ca = hn::RebindMask(df, qa != zero_i), cb = hn::RebindMask(df, qb != zero_i);
         const auto covered = hn::Or(ca, cb);
         hn::StoreU(hn::DemoteTo(du8, hn::IfThenElseZero(hn::RebindMask(di, covered), one_i)), du8,
                    r.valid + x);
         holes += std::size_t(n) - hn::CountTrue(df, covered);
+        const auto sa = hn::RebindMask(df, qa == stretched),
+                   sb = hn::RebindMask(df, qb == stretched);
+        const auto one_stretched = hn::And(hn::And(ca, cb), hn::Xor(sa, sb));
 
         const VF za = hn::LoadU(df, r.depth_a + x), zb = hn::LoadU(df, r.depth + x);
         const auto both = hn::And(ca, cb);
         const VF nearer = hn::IfThenElse(zb < za, zb, za);  // std::min(za, zb), signed zeros too
-        const auto same = hn::And(both, hn::Abs(za - zb) <= tolerance * nearer);
-        const auto background = hn::And(both, hn::And(hn::Abs(za) == inf, hn::Abs(zb) == inf));
+        const auto unstretched = hn::AndNot(one_stretched, both);
+        const auto same = hn::And(unstretched, hn::Abs(za - zb) <= tolerance * nearer);
+        const auto background =
+            hn::And(unstretched, hn::And(hn::Abs(za) == inf, hn::Abs(zb) == inf));
         const auto blend = hn::Or(same, background);
-        const auto take_a = hn::AndNot(blend, hn::And(ca, hn::Or(hn::Not(cb), hn::Not(zb < za))));
+        const auto take_a = hn::Or(
+            hn::And(one_stretched, sb),
+            hn::AndNot(one_stretched,
+                       hn::AndNot(blend, hn::And(ca, hn::Or(hn::Not(cb), hn::Not(zb < za))))));
 
         float* color = &r.color[x].x;
         const float* color_a = &r.color_a[x].x;

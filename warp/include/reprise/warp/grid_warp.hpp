@@ -20,11 +20,17 @@ struct GridOptions {
     // Colour by a Catmull-Rom (bicubic) fetch at the interpolated source position instead of a
     // bilinear one: sharper, as the reverse warp's refetch.
     bool bicubic = false;
+    // An edge triangle (a smallest cell across a depth edge) whose area grows by more than this
+    // many px^2 from source to target is stretched over a disocclusion: its pixels are marked
+    // kCoveredStretched, and an in-between frame takes the other side there where that side
+    // saw the surface (+inf: none marked). Below ~3 px^2 it also marks silhouettes that only
+    // widen by a pixel or two, whose anti-aliased edge is better kept (docs/benchmarks.md).
+    float stretched_area = 3.0f;
 };
 
 struct GridStats {
     std::size_t cells = 0;      // cells drawn
-    std::size_t covered = 0;    // covered output pixels
+    std::size_t covered = 0;    // covered output pixels (stretched ones too)
     std::size_t nonfinite = 0;  // ... whose colour has a NaN or infinite channel
 };
 

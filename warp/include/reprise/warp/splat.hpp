@@ -14,8 +14,11 @@ struct WarpTarget {
     ImageView<glm::vec4> color;
     ImageView<float> depth;       // z-buffer: nearer wins; +inf where nothing landed
     ImageView<glm::vec2> motion;  // the source's motion carried along (may be empty)
-    ImageView<uint8_t> covered;   // 1 where something landed
+    // 1 where something landed; kCoveredStretched where only a shape stretched over a
+    // disocclusion did (the grid warp's edge triangles)
+    ImageView<uint8_t> covered;
 };
+inline constexpr uint8_t kCoveredStretched = 2;
 
 struct SplatOptions {
     // 1: the pixel that contains the landing point; 2: the pixels whose centres lie less than one
