@@ -284,7 +284,7 @@ void expect_true_motion_beats_linear(bool cameras) {
             "[fruc] %s, orbit at 2 rad/s, 10 -> 20 Hz, %s cameras: true motion %.2f dB, linear "
             "%.2f dB\n",
             scene_name, cameras ? "with" : "without", psnr[1], psnr[0]);
-        // Measured with cameras 30.33 / 28.58 and 24.05 / 23.34, without 29.90 and 23.91 (before
+        // Measured with cameras 30.34 / 28.58 and 24.04 / 23.36, without 29.90 and 23.90 (before
         // the blend took both sides within 15 % in depth and the side not stretched over a
         // disocclusion: 27.49 / 25.27 and 22.39 / 21.04, without 27.48 and 22.35).
         const bool pan = std::string(scene_name) == "pan";
