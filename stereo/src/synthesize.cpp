@@ -91,13 +91,21 @@ StereoStats StereoSynthesizer::synthesize(const GBufferView& given, const Camera
                   stats.cells, maybe_nonfinite);
     stats.holes = n - stats.covered;
 
+    // Pixels only a grid triangle stretched over a disocclusion covered come from the history
+    // where it saw them, and are otherwise left to pull-push (Andreev's fill measured worse than
+    // the stretched triangle there; docs/benchmarks.md).
+    const bool refill = o.fill == StereoFill::PullPush;
+    valid_.resize(w, h);
+    std::size_t stretched = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        const uint8_t c = covered_.data()[i];
+        stretched += c == warp::kCoveredStretched;
+        valid_.data()[i] = refill && c == warp::kCoveredStretched ? 0 : c;
+    }
+    stats.stretched = stretched;
+    ImageView<const uint8_t> valid = valid_.view();
     std::size_t history_holes_filled = 0;
-    // Without history the rendered eye's coverage is what the filler keeps.
-    ImageView<const uint8_t> valid = covered_.view();
     if (history_usable) {
-        valid_.resize(w, h);
-        std::copy(covered_.data(), covered_.data() + n, valid_.data());
-        valid = valid_.view();
         history_color_.resize(w, h);
         history_depth_.resize(w, h);
         history_covered_.resize(w, h);
@@ -109,11 +117,15 @@ StereoStats StereoSynthesizer::synthesize(const GBufferView& given, const Camera
         const float tol = o.history_depth_tolerance;
         std::size_t taken = 0, holes_taken = 0;
         for (std::size_t i = 0; i < n; ++i) {
-            if (!history_covered_.data()[i]) continue;
+            const uint8_t seen = history_covered_.data()[i];
+            if (!seen) continue;
             const float zh = history_depth_.data()[i], zc = out.depth.data()[i];
-            const bool hole = !valid_.data()[i];
+            // A stretched pixel takes only what the history saw unstretched.
+            const bool stretched_here = covered_.data()[i] == warp::kCoveredStretched;
+            const bool hole = !stretched_here && !valid_.data()[i];
+            const bool better = hole || (stretched_here && seen != warp::kCoveredStretched);
             const bool same = zh == zc || std::abs(zh - zc) <= tol * std::min(zh, zc);
-            if (hole || (closer && same)) {
+            if (better || (closer && same)) {
                 out.color.data()[i] = history_color_.data()[i];
                 out.depth.data()[i] = zh;
                 valid_.data()[i] = 1;

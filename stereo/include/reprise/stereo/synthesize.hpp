@@ -31,8 +31,11 @@ struct StereoOptions {
 };
 
 struct StereoStats {
-    std::size_t covered = 0;       // pixels the rendered eye's warp covered
-    std::size_t holes = 0;         // pixels it left empty
+    std::size_t covered = 0;  // pixels the rendered eye's warp covered
+    std::size_t holes = 0;    // pixels it left empty
+    // ... covered only by a grid triangle stretched over a disocclusion (warp::kCoveredStretched):
+    // taken from the history where it saw them, else left to pull-push (other fills keep them)
+    std::size_t stretched = 0;
     std::size_t from_history = 0;  // pixels taken from the history view
     std::size_t filled = 0;        // pixels invented by the hole filler
     std::size_t unfilled = 0;      // holes left (no fill, or nothing to fill from): colour 0
