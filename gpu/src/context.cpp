@@ -87,16 +87,16 @@ GLuint ContextState::make_counters(std::size_t bytes) {
     return buffer;
 }
 
-void ContextState::read_counters(GLuint buffer, void* out, std::size_t bytes) {
+void ContextState::read_counters(GLuint buffer, void* counts, std::size_t bytes) {
     REPRISE_ASSERT(bytes <= 64 * sizeof(GLuint));  // the readback buffer's size
     glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
     glBindBuffer(GL_COPY_READ_BUFFER, buffer);
     glBindBuffer(GL_COPY_WRITE_BUFFER, readback_buffer);
     glCopyBufferSubData(GL_COPY_READ_BUFFER, GL_COPY_WRITE_BUFFER, 0, 0, GLsizeiptr(bytes));
-    std::memset(out, 0, bytes);
+    std::memset(counts, 0, bytes);
     if (const void* mapped =
             glMapBufferRange(GL_COPY_WRITE_BUFFER, 0, GLsizeiptr(bytes), GL_MAP_READ_BIT)) {
-        std::memcpy(out, mapped, bytes);
+        std::memcpy(counts, mapped, bytes);
         glUnmapBuffer(GL_COPY_WRITE_BUFFER);
     }
     glBindBuffer(GL_COPY_READ_BUFFER, 0);

@@ -130,7 +130,7 @@ struct ContextState {
     // A counters buffer in GPU memory of `bytes`.
     GLuint make_counters(std::size_t bytes);
     // The first `bytes` of counters buffer `buffer` (the shaders that wrote it finished).
-    void read_counters(GLuint buffer, void* out, std::size_t bytes);
+    void read_counters(GLuint buffer, void* counts, std::size_t bytes);
     // Uploads the texture's rows, `stride` pixels apart, into `texture` (already sized).
     void upload(const Texture& texture, const void* data, std::ptrdiff_t stride);
     // Reads `texture` (GL_RGBA32F into floats, GL_R32UI into hit_readback) through the
