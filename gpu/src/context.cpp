@@ -195,6 +195,14 @@ void ContextState::download_channels(const Texture& texture, float* data, int ch
                      std::size_t(c)] = float_readback[std::size_t(y) * w + x][c];
 }
 
+void ContextState::download_made(Frame& made) {
+    const int w = color.width, h = color.height;
+    made.color.resize(w, h);
+    made.depth.resize(w, h);
+    download(color, made.color.data(), w);
+    download_channels(depth, made.depth.data(), 1, w);
+}
+
 Context::Context() : state_(std::make_unique<ContextState>()) {}
 
 Context::~Context() {

@@ -182,10 +182,7 @@ Status Context::interpolate(const GBufferView& given_a, const GBufferView& given
                                    {k.b_color.name, k.b_depth.name, k.b_motion.name, w, h},
                                    s_between, w, h, options, s.color.name, s.depth.name, stats));
     timings_.compute_ms = finish_ms(t);
-    out.color.resize(w, h);
-    out.depth.resize(w, h);
-    s.download(s.color, out.color.data(), w);
-    s.download_channels(s.depth, out.depth.data(), 1, w);
+    s.download_made(out);
     REPRISE_TRY(gl::check_errors("gpu interpolate download"));
     timings_.download_ms = finish_ms(t);
     return {};

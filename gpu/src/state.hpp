@@ -139,6 +139,8 @@ struct ContextState {
     // The first `channels` of each pixel of a float texture into floats, `stride` pixels apart.
     void download_channels(const Texture& texture, float* data, int channels,
                            std::ptrdiff_t stride);
+    // A made frame's colour and depth (the `color` and `depth` textures) into `made`, sized.
+    void download_made(Frame& made);
 };
 
 }  // namespace reprise::gpu

@@ -180,10 +180,7 @@ Status Context::stereo_eye(const GBufferView& given, const Camera& target, Frame
     REPRISE_TRY(eye_passes(s, s.payload.name, s.previous_depth.name, w, h, rendered.camera, target,
                            options, s.color.name, s.depth.name, stats));
     timings_.compute_ms = finish_ms(t);
-    out.color.resize(w, h);
-    out.depth.resize(w, h);
-    s.download(s.color, out.color.data(), w);
-    s.download_channels(s.depth, out.depth.data(), 1, w);
+    s.download_made(out);
     REPRISE_TRY(gl::check_errors("gpu stereo eye download"));
     timings_.download_ms = finish_ms(t);
     return {};
