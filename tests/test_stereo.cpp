@@ -12,6 +12,7 @@
 #include "reprise/core/metrics.hpp"
 #include "reprise/server/builtin_scenes.hpp"
 #include "reprise/server/renderer.hpp"
+#include "reprise/stereo/alternate.hpp"
 #include "reprise/stereo/compose.hpp"
 #include "reprise/stereo/rig.hpp"
 #include "reprise/stereo/synthesize.hpp"
@@ -308,6 +309,65 @@ TEST(StereoTemporal, PreviousOtherEyeFillsDisocclusions) {
     EXPECT_GT(stats.stretched, 0u);
     EXPECT_GT(b, 40.0);
     EXPECT_GT(b, a + 2.5);
+}
+
+TEST(StereoTemporal, MovingObjectsOfTheHistoryAreLeftOut) {
+    // crossing: objects move across a still background; the left eye made from the right one
+    // has its holes on the side the objects come from, where the history shows them.
+    const StereoRig rig{.ipd = 0.064f};
+    const double dt = 1.0 / 30.0, t = 12.0 / 30.0;
+    EyePair before = render_eyes("crossing", t - dt, dt, rig);
+    EyePair now = render_eyes("crossing", t, dt, rig);
+    StereoSynthesizer synthesizer;
+    Frame kept, stale;
+    StereoStats stats = synthesizer.synthesize(now.right, now.cameras.left, kept, {}, &before.left);
+    synthesizer.synthesize(now.right, now.cameras.left, stale, {.history_moving_tolerance = kInf},
+                           &before.left);
+    const double a = display_psnr(now.left.color, kept.color),
+                 b = display_psnr(now.left.color, stale.color);
+    std::printf("[stereo] moving history left out: %.2f dB (kept: %.2f dB), %zu pixels left out\n",
+                a, b, stats.history_moving);
+    // Measured: 43.45 dB against 41.94, 3597 pixels left out.
+    EXPECT_GT(stats.history_moving, 0u);
+    EXPECT_GT(a, b + 1.0);
+    // Without motion the history is kept whole.
+    GBufferView no_motion = before.left.view();
+    no_motion.motion = {};
+    stats = synthesizer.synthesize(now.right, now.cameras.left, stale, {}, &no_motion);
+    EXPECT_EQ(stats.history_moving, 0u);
+}
+
+TEST(StereoAlternation, EyesTakeTurnsAndTheMadeOneFillsFromItsOwnLastRender) {
+    const StereoRig rig{.ipd = 0.064f};
+    const double dt = 1.0 / 30.0;
+    EyeAlternation alternation;
+    Frame made, alone;
+    for (int i = 0; i < 4; ++i) {
+        EyePair pair = render_eyes("pan", 0.4 + i * dt, dt, rig);
+        const Eye eye = EyeAlternation::rendered_eye(i);
+        EXPECT_EQ(eye, i % 2 ? Eye::Right : Eye::Left);
+        const Frame& rendered = eye == Eye::Left ? pair.left : pair.right;
+        const Frame& truth = eye == Eye::Left ? pair.right : pair.left;
+        if (i == 3) pair.right.camera.cut = Cut::Yes;  // a new shot: no history
+        const StereoStats stats = alternation.next(rendered, eye, truth.camera, made);
+        synthesize_eye(rendered, truth.camera, {}, alone);
+        const double psnr = display_psnr(truth.color, made.color),
+                     without = display_psnr(truth.color, alone.color);
+        std::printf(
+            "[stereo] alternation frame %d (%s eye made): %.2f dB (without history "
+            "%.2f dB), %zu holes, %zu stretched, %zu from history\n",
+            i, eye == Eye::Left ? "right" : "left", psnr, without, stats.holes, stats.stretched,
+            stats.from_history);
+        EXPECT_EQ(made.camera.view, truth.camera.view);
+        // Frame 0 has no history yet, frame 3 starts a shot: the same as without.
+        if (i == 0 || i == 3) {
+            EXPECT_EQ(stats.from_history, 0u);
+            EXPECT_EQ(made.color, alone.color);
+        } else {  // measured: 42.00 against 40.99 dB, 41.70 against 41.37
+            EXPECT_GT(psnr, without + 0.2);
+        }
+        EXPECT_GT(psnr, 38.0);
+    }
 }
 
 TEST(StereoCompose, LayoutsPlaceTheEyesAndAnaglyphUsesDubois) {

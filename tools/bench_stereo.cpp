@@ -23,6 +23,7 @@
 #include "reprise/core/visualize.hpp"
 #include "reprise/server/builtin_scenes.hpp"
 #include "reprise/server/renderer.hpp"
+#include "reprise/stereo/alternate.hpp"
 #include "reprise/stereo/rig.hpp"
 #include "reprise/stereo/synthesize.hpp"
 
@@ -40,7 +41,8 @@ const char* const kOurs = "ours";
 const char* const kSplatPeer = "dibr-splat";  // forward splat, footprint 1, no fill
 const char* const kRemapPeer = "cv-remap";    // backward remap by the left eye's disparity
 const char* const kCopyPeer = "copy-left-eye";
-const char* const kRender = "render";  // the renderer's second eye (the truth)
+const char* const kRender = "render";        // the renderer's second eye (the truth)
+const char* const kAlternate = "alternate";  // one eye rendered per frame, the other made
 
 // Naive backward DIBR peer: right(x) = left(x + d(x)), d from the left eye's own depth at x.
 void remap_by_disparity(const Frame& left, const stereo::StereoRig& rig, Image<glm::vec4>& out) {
@@ -121,6 +123,13 @@ struct SceneSummary {
     double splat = NAN, remap = NAN, copy = NAN;  // peers' PSNR, all pixels
     double render_left_ms = NAN, render_right_ms = NAN;
     double disoccluded_fraction = NAN;
+    // Eye alternation: the made eye (right on even frames, left on odd) and its cost.
+    ReportPoint alternate;
+    double alternate_render_ms = NAN;         // the rendered eye, mean over frames
+    double fixed = NAN, fixed_history = NAN;  // grid+pullpush without / with the history
+    double alternate_ratio() const {
+        return (alternate_render_ms + alternate.ms) / (render_left_ms + render_right_ms);
+    }
     double ratio(const ReportPoint& ours) const {
         return (render_left_ms + ours.ms) / (render_left_ms + render_right_ms);
     }
@@ -155,6 +164,21 @@ std::string summary_table(const std::vector<SceneSummary>& rows, bool full_hd) {
     return out;
 }
 
+std::string alternation_table(const std::vector<SceneSummary>& rows) {
+    std::string out;
+    char line[512];
+    std::snprintf(line, sizeof line, "%-9s %9s %7s %9s %9s %8s %9s %6s\n", "scene", "alternate",
+                  "flip", "grid+pp", "+history", "ms", "render_ms", "ratio");
+    out += line;
+    for (const SceneSummary& r : rows) {
+        std::snprintf(line, sizeof line, "%-9s %9.2f %7.4f %9.2f %9.2f %8.2f %9.2f %6.3f\n",
+                      r.scene.c_str(), r.alternate.psnr, r.alternate.flip, r.fixed, r.fixed_history,
+                      r.alternate.ms, r.alternate_render_ms, r.alternate_ratio());
+        out += line;
+    }
+    return out;
+}
+
 // The report's opening: what was compared and how it is timed.
 void describe(const stereo::StereoRig& rig, int w, int h, int frames, int repeat,
               const std::string& device, Report& report) {
@@ -179,7 +203,10 @@ void describe(const stereo::StereoRig& rig, int w, int h, int frames, int repeat
         "alternates per frame). Peers: dibr-splat = forward splat of footprint 1 with a depth test "
         "and no fill; cv-remap = cv::remap of the left eye by its own disparity (bilinear); "
         "copy-left-eye = the left eye as it is (ms = the copy). render = the renderer's time for "
-        "the second eye (PSNR +inf by definition, drawn on the top edge).",
+        "the second eye (PSNR +inf by definition, drawn on the top edge). alternate = eye "
+        "alternation: each frame renders one eye (left on even frames) and makes the other with "
+        "EyeAlternation, the made eye scored against its rendered twin (ms: the synthesis with "
+        "the copy it keeps as history).",
         thread_count(), repeat);
     report.paragraphs.push_back(text);
 }
@@ -257,6 +284,9 @@ SceneSummary summarize(const std::string& name, const std::vector<Run>& runs, do
         if (run.method == kSplatPeer) row.splat = run.mean().psnr;
         if (run.method == kRemapPeer) row.remap = run.mean().psnr;
         if (run.method == kCopyPeer) row.copy = run.mean().psnr;
+        if (run.ours() && run.setting == "grid+pullpush") row.fixed = run.mean().psnr;
+        if (run.ours() && run.setting == "grid+pullpush+history")
+            row.fixed_history = run.mean().psnr;
     }
     row.best = best->mean();
     row.best.ms = best->mean_ms();
@@ -272,8 +302,9 @@ SceneSummary summarize(const std::string& name, const std::vector<Run>& runs, do
 
 // The scene's CSV rows, summary row and report sections (all pixels, disoccluded ones).
 Status add_scene(const std::string& scene_name, const std::string& name,
-                 const std::vector<Run>& runs, std::size_t render_i, double render_left,
-                 double render_right, double dis_fraction, const std::string& out_dir, CsvFile& csv,
+                 const std::vector<Run>& runs, std::size_t render_i, const Run& alternate,
+                 double render_left, double render_right, double alternate_render,
+                 double dis_fraction, const std::string& out_dir, CsvFile& csv,
                  std::vector<SceneSummary>& summaries, Report& report) {
     char text[512];
     ReportSection all{name}, dis_section{name + ", disoccluded pixels only"};
@@ -288,11 +319,16 @@ Status add_scene(const std::string& scene_name, const std::string& name,
         all.points.push_back(run.mean());
         dis_section.points.push_back(run.mean(true));
     }
+    for (const Score& s : alternate.scores)
+        csv.error_row(name, alternate.method, alternate.setting, s.frame, s.all, s.ms);
+    all.points.push_back(alternate.mean());
     csv.flush();
 
     const Run *best = nullptr, *peer = nullptr;
-    const SceneSummary row =
-        summarize(name, runs, render_left, render_right, dis_fraction, best, peer);
+    SceneSummary row = summarize(name, runs, render_left, render_right, dis_fraction, best, peer);
+    row.alternate = alternate.mean();
+    row.alternate.ms = alternate.mean_ms();
+    row.alternate_render_ms = alternate_render;
     summaries.push_back(row);
     std::snprintf(
         text, sizeof text,
@@ -368,6 +404,12 @@ Status bench_stereo(const BenchOptions& options) {
         const std::size_t render_i = runs.size();
         runs.push_back({kRender, "right eye"});
         double render_left = 0.0, render_right = 0.0, dis_fraction = 0.0;
+        // Eye alternation over the same frames: frame i renders EyeAlternation::rendered_eye(i)
+        // and makes the other; before frame 0 it keeps the right eye of the frame before.
+        stereo::EyeAlternation alternation;
+        Run alternate{kAlternate, "grid+pullpush"};
+        double alternate_render = 0.0;
+        Image<glm::vec3> other_truth_d(w, h);
 
         auto render_eye = [&](double t, stereo::Eye e, int times, Frame& out, double& ms) {
             return cli::render_eye(*renderer, scene, path, rig, w, h, t, e, times, out, ms);
@@ -426,6 +468,19 @@ Status bench_stereo(const BenchOptions& options) {
             ms = fastest_ms(repeat, [&] { copied = left.color; });
             record(runs[splat_i + 2], copied, ms);
             record(runs[render_i], right.color, right_ms);
+
+            if (i == 0) alternation.next(history, stereo::Eye::Right, history.camera, made);
+            const stereo::Eye eye = stereo::EyeAlternation::rendered_eye(i);
+            const Frame& shown = eye == stereo::Eye::Left ? left : right;
+            const Frame& other = eye == stereo::Eye::Left ? right : left;
+            ms = fastest_ms(repeat, [&] { alternation.next(shown, eye, other.camera, made); });
+            to_display(other.color.view(), other_truth_d.view());
+            to_display(made.color.view(), test_d.view());
+            alternate.scores.push_back({.frame = i,
+                                        .all = image_error(other_truth_d.view(), test_d.view()),
+                                        .disoccluded = {NAN, NAN, NAN},
+                                        .ms = ms});
+            alternate_render += (eye == stereo::Eye::Left ? left_ms : right_ms) / frames;
             std::printf("[stereo] %s frame %d: render L %.1f ms, R %.1f ms, %.2f%% disoccluded\n",
                         name.c_str(), i, left_ms, right_ms,
                         100.0 * double(dis) / disoccluded.pixel_count());
@@ -433,13 +488,21 @@ Status bench_stereo(const BenchOptions& options) {
         }
         if (!failure.ok()) break;
 
-        failure = add_scene(scene_name, name, runs, render_i, render_left, render_right,
-                            dis_fraction, out_dir, csv, summaries, report);
+        failure = add_scene(scene_name, name, runs, render_i, alternate, render_left, render_right,
+                            alternate_render, dis_fraction, out_dir, csv, summaries, report);
         if (!failure.ok()) break;
     }
     REPRISE_TRY(failure);
 
-    const std::string table = summary_table(summaries, full_hd);
+    const std::string table = summary_table(summaries, full_hd) +
+                              "\neye alternation (Didyk et al. 2010): each frame renders one eye, "
+                              "left on even frames, and makes the other with that eye's last "
+                              "rendered frame as history; PSNR of the made eye (both eyes "
+                              "taking turns) against the rendered one; grid+pp, +history: the "
+                              "right eye always made from the left, without and with the "
+                              "previous rendered right eye; ratio = (render of the one eye + "
+                              "ms) / (render L + render R)\n" +
+                              alternation_table(summaries);
     std::snprintf(text, sizeof text,
                   "stereo, %dx%d, %d frames per scene, ipd %.3f, fastest of %d runs, %d threads; "
                   "PSNR dB (psnr_d: disoccluded pixels only); ms per synthesized eye; splat/remap/"

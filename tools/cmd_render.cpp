@@ -9,7 +9,9 @@
 #include "reprise/core/exr.hpp"
 #include "reprise/server/builtin_scenes.hpp"
 #include "reprise/server/renderer.hpp"
+#include "reprise/stereo/alternate.hpp"
 #include "reprise/stereo/rig.hpp"
+#include "timing.hpp"
 
 namespace reprise::cli {
 
@@ -35,6 +37,7 @@ struct RenderJob {
     bool allow_outside_paths = false;
     double stereo = 0.0;       // IPD; > 0 renders both eyes into OUT/left and OUT/right
     double convergence = 0.0;  // > 0: off-axis rig converging there
+    bool alternate = false;    // with stereo: render one eye per frame, synthesize the other
     int lowres = 0;  // 2 or 4: also colour at 1/lowres of the pixels, jittered, in OUT/lowres
     int aa = 4;      // anti-aliasing samples per pixel, 1 = off
 };
@@ -43,6 +46,26 @@ struct ReuseTotals : server::ReuseStats {
     void add(const server::ReuseStats& s) {
         covered += s.covered, hits += s.hits, reused += s.reused, shaded += s.shaded;
         shading_ms += s.shading_ms, shading_cpu_ms += s.shading_cpu_ms;
+    }
+};
+
+// What eye alternation rendered, made and took from the history.
+struct AlternationTotals {
+    double render_ms = 0.0, synthesis_ms = 0.0;
+    std::size_t pixels = 0, from_history = 0, filled = 0, stretched = 0;
+    void add(const stereo::StereoStats& s, double ms) {
+        synthesis_ms += ms;
+        pixels += s.covered + s.holes;
+        from_history += s.from_history, filled += s.filled, stretched += s.stretched;
+    }
+    void print(int frames) const {
+        const double n = std::max(frames, 1), p = std::max<double>(double(pixels), 1.0);
+        std::printf(
+            "alternating eyes: one eye rendered per frame (%.2f ms), the other synthesized "
+            "(%.2f ms); of its pixels %.2f %% from the history, %.2f %% invented by the fill, "
+            "%.2f %% stretched\n",
+            render_ms / n, synthesis_ms / n, 100.0 * double(from_history) / p,
+            100.0 * double(filled) / p, 100.0 * double(stretched) / p);
     }
 };
 
@@ -106,6 +129,7 @@ Status run_render(const RenderJob& job) {
     if (job.lowres != 0 && job.lowres != 2 && job.lowres != 4)
         return Status::error("--lowres " + std::to_string(job.lowres) + " must be 2 or 4");
     if (job.lowres != 0 && stereo) return Status::error("--lowres and --stereo do not combine");
+    if (job.alternate && !stereo) return Status::error("--alternate needs --stereo IPD");
     const std::string lowres_dir = job.out + "/lowres";
     const stereo::StereoRig rig{
         .ipd = float(job.stereo),
@@ -147,7 +171,9 @@ Status run_render(const RenderJob& job) {
     std::fprintf(stderr, "[render] %s, %dx%d, %d frames at %g Hz, %s, on %s\n", job.scene.c_str(),
                  width, height, job.frames, job.fps, aa.c_str(), renderer->device().c_str());
     ReuseTotals totals;
-    Frame frame, low;
+    Frame frame, low, made;
+    stereo::EyeAlternation alternation;
+    AlternationTotals alternated;
     auto begin = std::chrono::steady_clock::now();
     for (int i = 0; i < job.frames; ++i) {
         if (job.lowres) {
@@ -180,16 +206,28 @@ Status run_render(const RenderJob& job) {
             centre.prev_view = before.view;
             centre.prev_projection = before.projection;
             const stereo::EyeCameras eyes = stereo::eye_cameras(centre, rig);
+            auto eye_path = [&](stereo::Eye e) {
+                return frame_path(e == stereo::Eye::Left ? left_dir : right_dir, i);
+            };
             for (stereo::Eye e : {stereo::Eye::Left, stereo::Eye::Right}) {
+                if (job.alternate && e != stereo::EyeAlternation::rendered_eye(i)) continue;
                 server::Instant a = now, b = before;
                 a.view = eyes[e].view;
                 a.projection = eyes[e].projection;
                 b.view = eyes[e].prev_view;
                 b.projection = eyes[e].prev_projection;
+                const auto started = BenchClock::now();
                 REPRISE_TRY(renderer->render(scene, a, b, settings, frame));
+                alternated.render_ms += ms_since(started);
                 frame.fps = job.fps;
-                REPRISE_TRY(write_frame(
-                    frame_path(e == stereo::Eye::Left ? left_dir : right_dir, i), frame));
+                REPRISE_TRY(write_frame(eye_path(e), frame));
+                if (!job.alternate) continue;
+                const auto synthesis = BenchClock::now();
+                const stereo::StereoStats stats =
+                    alternation.next(frame, e, eyes[stereo::other(e)], made);
+                alternated.add(stats, ms_since(synthesis));
+                made.fps = job.fps;
+                REPRISE_TRY(write_frame(eye_path(stereo::other(e)), made));
             }
         }
         std::fprintf(stderr, "\r[render] %d/%d", i + 1, job.frames);
@@ -198,6 +236,7 @@ Status run_render(const RenderJob& job) {
         std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
     std::fprintf(stderr, "\n[render] %.2f s (%.1f frames/s with EXR writing) -> %s\n", seconds,
                  job.frames / seconds, job.out.c_str());
+    if (job.alternate) alternated.print(job.frames);
     const double frames = std::max(job.frames - 1, 1);
     if (settings.shading == server::Shading::Heavy)
         std::printf(
@@ -253,6 +292,10 @@ int command_render(int argc, char** argv) {
         "IPD: render both eyes (the camera is the rig's centre) into OUT/left and OUT/right");
     args.option("--convergence", &job.convergence,
                 "with --stereo: off-axis rig converging at this distance");
+    args.flag("--alternate", &job.alternate,
+              "with --stereo: render one eye per frame (left on even frames, right on odd) and "
+              "synthesize\nthe other from it, holes filled from that eye's last rendered frame "
+              "(Didyk et al. 2010)");
     args.option(
         "--lowres", &job.lowres,
         "2|4: also colour at 1/2 (W/2 x H) or 1/4 (W/2 x H/2) of the pixels with a per-frame "

@@ -100,7 +100,7 @@ Status run_stereo(const StereoJob& job, const stereo::StereoRig& rig,
     Frame frame, previous, made;
     bool have_previous = false;
     double ms = 0.0;
-    std::size_t holes = 0, stretched = 0, from_history = 0;
+    std::size_t holes = 0, stretched = 0, from_history = 0, history_moving = 0;
     NonfiniteRepair repair;  // the rendered eye is written too: repaired where it is read
     NonfiniteCounts nonfinite;
     for (std::size_t i = first; i < end; ++i) {
@@ -147,6 +147,7 @@ Status run_stereo(const StereoJob& job, const stereo::StereoRig& rig,
         holes += stats.holes;
         stretched += stats.stretched;
         from_history += stats.from_history;
+        history_moving += stats.history_moving;
         REPRISE_TRY(rendered.write(int(i), frame));
         REPRISE_TRY(made_eye.write(int(i), made));
         if (job.temporal) {
@@ -159,9 +160,9 @@ Status run_stereo(const StereoJob& job, const stereo::StereoRig& rig,
     const std::size_t made_count = end - begin;
     std::fprintf(stderr,
                  "[stereo] %zu frames, %.2f ms per eye, %zu holes, %zu stretched, %zu pixels from "
-                 "history -> %s\n",
+                 "history (%zu of its pixels left out as moving) -> %s\n",
                  made_count, made_count ? ms / double(made_count) : 0.0, holes, stretched,
-                 from_history, job.out.c_str());
+                 from_history, history_moving, job.out.c_str());
     if (nonfinite.total() > 0)
         std::fprintf(stderr, "[stereo] input: %s\n", describe_nonfinite(nonfinite).c_str());
     return {};

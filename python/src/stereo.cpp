@@ -59,7 +59,9 @@ py::dict stats_dict(const stereo::StereoStats& s) {
     py::dict d;
     d["covered"] = s.covered;
     d["holes"] = s.holes;
+    d["stretched"] = s.stretched;
     d["from_history"] = s.from_history;
+    d["history_moving"] = s.history_moving;
     d["filled"] = s.filled;
     d["unfilled"] = s.unfilled;
     d["cells"] = s.cells;

@@ -1,14 +1,18 @@
 // The second eye: warp the rendered eye (and the history) to the target, merge, fill.
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <limits>
 
+#include "reprise/core/camera_math.hpp"
 #include "reprise/core/parallel.hpp"
 #include "reprise/stereo/synthesize.hpp"
 
 namespace reprise::stereo {
 
 namespace {
+
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 
 bool same_camera(const Camera& a, const Camera& b) {
     return a.view == b.view && a.projection == b.projection;
@@ -18,16 +22,53 @@ float distance_between(const Camera& a, const Camera& b) {
     return glm::length(glm::vec3(glm::inverse(a.view)[3]) - glm::vec3(glm::inverse(b.view)[3]));
 }
 
+// Leaves out of the warp (NaN displacement) the pixels of `source` whose motion its camera does
+// not explain within `tolerance` px; returns how many. Without motion, none.
+std::size_t drop_moving(const GBufferView& source, float tolerance,
+                        ImageView<glm::vec2> displacement) {
+    const int w = source.width(), h = source.height();
+    if (source.motion.width != w || source.motion.height != h ||
+        !(tolerance < std::numeric_limits<float>::infinity()))
+        return 0;
+    const StaticReprojection to_previous = camera_only_motion(source.camera, w, h);
+    const float tolerance2 = tolerance * tolerance;
+    std::atomic<std::size_t> dropped{0};
+    parallel_for(0, h, [&](int y0, int y1) {
+        std::size_t local = 0;
+        for (int y = y0; y < y1; ++y) {
+            const float* z = source.depth.row(y);
+            const glm::vec2* m = source.motion.row(y);
+            glm::vec2* d = displacement.row(y);
+            for (int x = 0; x < w; ++x) {
+                if (std::isnan(d[x].x)) continue;
+                const glm::vec2 p(float(x) + 0.5f, float(y) + 0.5f);
+                glm::vec2 before;
+                bool still = std::isfinite(m[x].x) && std::isfinite(m[x].y) &&
+                             to_previous.land(p.x, p.y, z[x], before);
+                if (still) {
+                    const glm::vec2 error = before - p - m[x];
+                    still = glm::dot(error, error) <= tolerance2;
+                }
+                if (!still) d[x] = glm::vec2(kNaN), ++local;
+            }
+        }
+        dropped += local;
+    });
+    return dropped.load();
+}
+
 }  // namespace
 
 std::size_t StereoSynthesizer::warp_into(const GBufferView& source, const Camera& target,
                                          const StereoOptions& o, const warp::WarpTarget& into,
-                                         std::size_t& cells, bool& maybe_nonfinite) {
+                                         std::size_t& cells, bool& maybe_nonfinite,
+                                         std::size_t* moving) {
     const int w = source.width(), h = source.height();
     displacement_.resize(w, h);
     target_depth_.resize(w, h);
     // The displacement reads the source's depth; the warp carries the target's depth along.
     stereo_displacement(source, target, displacement_.view(), target_depth_.view());
+    if (moving) *moving = drop_moving(source, o.history_moving_tolerance, displacement_.view());
     const GBufferView moved{.color = source.color,
                             .depth = target_depth_.view(),
                             .motion = displacement_.view(),
@@ -111,7 +152,7 @@ StereoStats StereoSynthesizer::synthesize(const GBufferView& given, const Camera
         history_covered_.resize(w, h);
         warp_into(*history, target, o,
                   {history_color_.view(), history_depth_.view(), {}, history_covered_.view()},
-                  stats.cells, maybe_nonfinite);
+                  stats.cells, maybe_nonfinite, &stats.history_moving);
         const bool closer = o.history_replaces && distance_between(history->camera, target) <
                                                       distance_between(rendered.camera, target);
         const float tol = o.history_depth_tolerance;

@@ -28,6 +28,11 @@ struct StereoOptions {
     // objects it puts their texture where they were (crossing: -14 dB). By default it fills holes.
     float history_depth_tolerance = 0.01f;
     bool history_replaces = false;
+    // History pixels whose motion (from the frame before it) its camera does not explain within
+    // this many pixels are left out: the history shows moving objects where they were, and would
+    // fill the holes beside them with their stale copy. +inf keeps them; a history without
+    // motion keeps them all.
+    float history_moving_tolerance = 0.5f;
 };
 
 struct StereoStats {
@@ -36,10 +41,11 @@ struct StereoStats {
     // ... covered only by a grid triangle stretched over a disocclusion (warp::kCoveredStretched):
     // taken from the history where it saw them, else left to pull-push (other fills keep them)
     std::size_t stretched = 0;
-    std::size_t from_history = 0;  // pixels taken from the history view
-    std::size_t filled = 0;        // pixels invented by the hole filler
-    std::size_t unfilled = 0;      // holes left (no fill, or nothing to fill from): colour 0
-    std::size_t cells = 0;         // grid cells drawn (both warps)
+    std::size_t from_history = 0;    // pixels taken from the history view
+    std::size_t history_moving = 0;  // history pixels left out as moving (history_moving_tolerance)
+    std::size_t filled = 0;          // pixels invented by the hole filler
+    std::size_t unfilled = 0;        // holes left (no fill, or nothing to fill from): colour 0
+    std::size_t cells = 0;           // grid cells drawn (both warps)
     // NaN/Inf in the rendered eye and the history, repaired before warping (colour: holes;
     // depth NaN/-inf and motion: unknown; see reprise/core/nonfinite.hpp).
     NonfiniteCounts nonfinite;
@@ -70,9 +76,11 @@ public:
 
 private:
     // Warps `source` to `target` into `into`; returns the covered pixel count (cells in `cells`;
-    // `maybe_nonfinite` set when covered colour may hold NaN or infinity).
+    // `maybe_nonfinite` set when covered colour may hold NaN or infinity). With `moving`, its
+    // moving pixels are left out and counted there.
     std::size_t warp_into(const GBufferView& source, const Camera& target, const StereoOptions& o,
-                          const warp::WarpTarget& into, std::size_t& cells, bool& maybe_nonfinite);
+                          const warp::WarpTarget& into, std::size_t& cells, bool& maybe_nonfinite,
+                          std::size_t* moving = nullptr);
 
     Image<glm::vec2> displacement_;  // the source's displacement to the target, as motion
     Image<float> target_depth_;      // and its depth seen from the target
