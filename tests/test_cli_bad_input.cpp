@@ -71,6 +71,8 @@ TEST(CliBadInput, ArgumentsGetOneMessageAndStatusTwo) {
         "--threshold", "NaN threshold");
     expect_clean_failure(run("render --scene courtyard --pcf 99 --out " + out.string()), "--pcf",
                          "huge PCF");
+    expect_clean_failure(run("render --alternate --out " + out.string()), "--stereo",
+                         "alternation without a pair");
     EXPECT_EQ(run("render --help").status, 0);
     EXPECT_EQ(run("--help").status, 0);
 }

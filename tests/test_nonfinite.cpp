@@ -72,9 +72,16 @@ TEST(Nonfinite, FrucEveryWarpFillAndModeEmitsFiniteAndCounts) {
     for (FrucMode mode : {FrucMode::Interpolate, FrucMode::Extrapolate})
         for (WarpMethod warp :
              {WarpMethod::Reverse, WarpMethod::Splat, WarpMethod::Grid, WarpMethod::Auto})
-            for (FillMethod fill :
-                 {FillMethod::None, FillMethod::PullPush, FillMethod::Andreev, FillMethod::Auto})
+            for (FillMethod fill : {FillMethod::None, FillMethod::PullPush, FillMethod::Andreev,
+                                    FillMethod::Auto, FillMethod::Patch})
                 for (bool moved : {false, true}) {
+                    if (warp == WarpMethod::Auto && fill == FillMethod::Patch) {
+                        FrameRateConverter refused;
+                        EXPECT_FALSE(FrameRateConverter::create(
+                                         2, {.mode = mode, .warp = warp, .fill = fill}, refused)
+                                         .ok());
+                        continue;
+                    }
                     const std::string what = "mode " + std::to_string(int(mode)) + " warp " +
                                              std::to_string(int(warp)) + " fill " +
                                              std::to_string(int(fill)) +

@@ -127,6 +127,7 @@ std::vector<Setting> fruc_settings(bool quick) {
         add("interpolate", warp::FrucOptions{}.grid.bicubic ? "grid-bilinear" : "grid-bicubic",
             "pullpush");
         add("interpolate", "reverse", "pullpush");
+        add("interpolate", "grid", "patch");
         add("interpolate", "splat", "none");
         add("extrapolate", "grid", "pullpush");
         add("interpolate", "auto", "auto");
@@ -142,6 +143,7 @@ std::vector<Setting> fruc_settings(bool quick) {
                 else
                     add(mode, warp_name, fill);
             }
+        add(mode, "grid", "patch");
         add(mode, "auto", "auto");
     }
     return settings;

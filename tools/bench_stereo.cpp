@@ -235,7 +235,8 @@ std::vector<OurSetting> our_settings() {
                                    std::pair{"splat", stereo::StereoWarp::Splat}})
         for (auto [fill_name, fill] : {std::pair{"none", stereo::StereoFill::None},
                                        std::pair{"pullpush", stereo::StereoFill::PullPush},
-                                       std::pair{"andreev", stereo::StereoFill::Andreev}})
+                                       std::pair{"andreev", stereo::StereoFill::Andreev},
+                                       std::pair{"patch", stereo::StereoFill::Patch}})
             settings.push_back(
                 {std::string(warp_name) + "+" + fill_name, {.warp = warp, .fill = fill}});
     settings.push_back({"grid+pullpush+history", {}, true});

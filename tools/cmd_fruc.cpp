@@ -223,7 +223,9 @@ int command_fruc(int argc, char** argv) {
     args.option("--warp", &job.warp,
                 "reverse | splat | grid | auto (default grid; grid-bicubic, grid-bilinear pick "
                 "its colour\nfetch; auto: chosen per frame)");
-    args.option("--fill", &job.fill, "pullpush | andreev | none | auto (default pullpush)");
+    args.option("--fill", &job.fill,
+                "pullpush | andreev | patch | none | auto (default pullpush); patch: "
+                "frequency-selective reconstruction, slow");
     args.option("--budget-db", &job.budget_db,
                 "auto: the PSNR (dB) a made frame should reach; the cheapest setting expected to "
                 "reach it\nis taken (default 0: the cheapest within 0.25 dB of the best expected)");

@@ -49,20 +49,23 @@ Status check(const StereoJob& j, stereo::StereoRig& rig, stereo::StereoOptions& 
         return Status::error("--eye: '" + j.eye + "' is not left or right");
     if (j.warp != "grid" && j.warp != "splat")
         return Status::error("--warp: '" + j.warp + "' is not grid or splat");
-    if (j.fill != "pullpush" && j.fill != "andreev" && j.fill != "none")
-        return Status::error("--fill: '" + j.fill + "' is not pullpush, andreev or none");
+    if (j.fill != "pullpush" && j.fill != "andreev" && j.fill != "patch" && j.fill != "none")
+        return Status::error("--fill: '" + j.fill + "' is not pullpush, andreev, patch or none");
     if (j.backend != "cpu" && j.backend != "gles")
         return Status::error("--backend: '" + j.backend + "' is not cpu or gles");
-    if (j.backend == "gles" && (j.warp != "splat" || j.fill == "andreev" || j.temporal))
+    if (j.backend == "gles" &&
+        (j.warp != "splat" || j.fill == "andreev" || j.fill == "patch" || j.temporal))
         return Status::error(
             "--backend gles: the GPU makes the eye with --warp splat and --fill pullpush or "
-            "none, without --temporal (the grid warp, Andreev's fill and the history are not on "
+            "none, without --temporal (the grid warp, Andreev's and the patch fill and the history "
+            "are not on "
             "the GPU yet)");
     rig = {.ipd = float(j.ipd),
            .convergence = float(j.convergence),
            .rig = j.rig == "offaxis" ? stereo::Rig::OffAxis : stereo::Rig::Parallel};
     options = {.warp = j.warp == "splat" ? stereo::StereoWarp::Splat : stereo::StereoWarp::Grid,
                .fill = j.fill == "andreev" ? stereo::StereoFill::Andreev
+                       : j.fill == "patch" ? stereo::StereoFill::Patch
                        : j.fill == "none"  ? stereo::StereoFill::None
                                            : stereo::StereoFill::PullPush};
     return {};
@@ -187,7 +190,9 @@ int command_stereo(int argc, char** argv) {
     args.option("--rig", &job.rig, "parallel|offaxis (default parallel)");
     args.option("--eye", &job.eye, "which eye the input is: left|right (default left)");
     args.option("--warp", &job.warp, "grid|splat (default grid)");
-    args.option("--fill", &job.fill, "pullpush|andreev|none (default pullpush)");
+    args.option("--fill", &job.fill,
+                "pullpush|andreev|patch|none (default pullpush; patch: frequency-selective "
+                "reconstruction, slow)");
     args.option("--backend", &job.backend,
                 "cpu|gles (default cpu); gles: OpenGL ES compute shaders, with --warp splat");
     args.flag("--temporal", &job.temporal, "fill disocclusions from the previous frame first");

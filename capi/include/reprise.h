@@ -150,7 +150,8 @@ enum {
     REPRISE_FILL_PULLPUSH = 0,
     REPRISE_FILL_NONE = 1,
     REPRISE_FILL_ANDREEV = 2,
-    REPRISE_FILL_AUTO = 3
+    REPRISE_FILL_AUTO = 3,
+    REPRISE_FILL_PATCH = 4 /* frequency-selective reconstruction; not with REPRISE_WARP_AUTO */
 };
 
 typedef struct reprise_converter_options {
@@ -203,7 +204,7 @@ typedef struct reprise_stereo_options {
     reprise_rig rig;          /* default parallel */
     reprise_eye rendered_eye; /* the eye the input is (default left): the other is made */
     reprise_warp warp;        /* grid (default) or splat */
-    reprise_fill fill;        /* pull-push (default), none or Andreev */
+    reprise_fill fill;        /* pull-push (default), none, Andreev or patch (not auto) */
     int32_t temporal;         /* 1: the previous rendered frame fills holes first (default 0) */
 } reprise_stereo_options;
 

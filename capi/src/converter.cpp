@@ -42,14 +42,15 @@ reprise_status to_fruc_options(const char* function, const reprise_converter_opt
     REPRISE_CAPI_TRY(check_range(function, "options->factor", o.factor, 1, 16));
     REPRISE_CAPI_TRY(check_range(function, "options->mode", o.mode, 0, 1));
     REPRISE_CAPI_TRY(check_range(function, "options->warp", o.warp, 0, 3));
-    REPRISE_CAPI_TRY(check_range(function, "options->fill", o.fill, 0, 3));
+    REPRISE_CAPI_TRY(check_range(function, "options->fill", o.fill, 0, 4));
     REPRISE_CAPI_TRY(check_flag(function, "options->refine", o.refine));
     REPRISE_CAPI_TRY(check_range(function, "options->budget_db", o.budget_db, 0.0, 100.0));
     REPRISE_CAPI_TRY(check_flag(function, "options->composite_ui", o.composite_ui));
     constexpr warp::WarpMethod warps[] = {warp::WarpMethod::Grid, warp::WarpMethod::Reverse,
                                           warp::WarpMethod::Splat, warp::WarpMethod::Auto};
     constexpr warp::FillMethod fills[] = {warp::FillMethod::PullPush, warp::FillMethod::None,
-                                          warp::FillMethod::Andreev, warp::FillMethod::Auto};
+                                          warp::FillMethod::Andreev, warp::FillMethod::Auto,
+                                          warp::FillMethod::Patch};
     fruc.mode = o.mode == REPRISE_FRUC_EXTRAPOLATE ? warp::FrucMode::Extrapolate
                                                    : warp::FrucMode::Interpolate;
     fruc.warp = warps[o.warp];

@@ -42,10 +42,14 @@ reprise_status configure(const char* function, const reprise_stereo_options& o, 
         return fail(REPRISE_ERROR_INVALID_ARGUMENT, function,
                     "options->warp " + std::to_string(o.warp) +
                         " is neither REPRISE_WARP_GRID nor REPRISE_WARP_SPLAT");
-    REPRISE_CAPI_TRY(check_range(function, "options->fill", o.fill, 0, 2));
+    REPRISE_CAPI_TRY(check_range(function, "options->fill", o.fill, 0, 4));
+    if (o.fill == REPRISE_FILL_AUTO)
+        return fail(REPRISE_ERROR_INVALID_ARGUMENT, function,
+                    "options->fill REPRISE_FILL_AUTO: the eye has no automatic fill");
     REPRISE_CAPI_TRY(check_flag(function, "options->temporal", o.temporal));
     constexpr stereo::StereoFill fills[] = {stereo::StereoFill::PullPush, stereo::StereoFill::None,
-                                            stereo::StereoFill::Andreev};
+                                            stereo::StereoFill::Andreev, stereo::StereoFill::None,
+                                            stereo::StereoFill::Patch};
     s.rig = {.ipd = o.ipd,
              .convergence = o.convergence,
              .rig = o.rig == REPRISE_RIG_OFF_AXIS ? stereo::Rig::OffAxis : stereo::Rig::Parallel};

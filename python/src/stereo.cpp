@@ -40,10 +40,12 @@ stereo::StereoOptions make_options(const std::string& warp_method, const std::st
         o.fill = stereo::StereoFill::PullPush;
     else if (fill == "andreev")
         o.fill = stereo::StereoFill::Andreev;
+    else if (fill == "patch")
+        o.fill = stereo::StereoFill::Patch;
     else if (fill == "none")
         o.fill = stereo::StereoFill::None;
     else
-        value_error("fill must be 'pullpush', 'andreev' or 'none', got '" + fill + "'");
+        value_error("fill must be 'pullpush', 'andreev', 'patch' or 'none', got '" + fill + "'");
     return o;
 }
 

@@ -133,9 +133,9 @@ StereoStats StereoSynthesizer::synthesize(const GBufferView& given, const Camera
     stats.holes = n - stats.covered;
 
     // Pixels only a grid triangle stretched over a disocclusion covered come from the history
-    // where it saw them, and are otherwise left to pull-push (Andreev's fill measured worse than
-    // the stretched triangle there; docs/benchmarks.md).
-    const bool refill = o.fill == StereoFill::PullPush;
+    // where it saw them, and are otherwise left to pull-push or the patch fill (Andreev's fill
+    // measured worse than the stretched triangle there; docs/benchmarks.md).
+    const bool refill = o.fill == StereoFill::PullPush || o.fill == StereoFill::Patch;
     valid_.resize(w, h);
     std::size_t stretched = 0;
     for (std::size_t i = 0; i < n; ++i) {
@@ -183,6 +183,8 @@ StereoStats StereoSynthesizer::synthesize(const GBufferView& given, const Camera
         filled = pull_push_.fill(out.color.view(), valid, out.depth.view());
     else if (o.fill == StereoFill::Andreev)
         filled = andreev_.fill(out.color.view(), valid, out.depth.view());
+    else if (o.fill == StereoFill::Patch)
+        filled = patch_.fill(out.color.view(), valid, out.depth.view());
     else {
         filled.holes = stats.holes - history_holes_filled;
         filled.unfilled = filled.holes;

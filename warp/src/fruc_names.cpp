@@ -35,8 +35,11 @@ Status fruc_options_from_names(const std::string& mode, const std::string& warp,
         options.fill = FillMethod::None;
     else if (fill == "auto")
         options.fill = FillMethod::Auto;
+    else if (fill == "patch")
+        options.fill = FillMethod::Patch;
     else
-        return Status::error("fill '" + fill + "': expected pullpush, andreev, none or auto");
+        return Status::error("fill '" + fill +
+                             "': expected pullpush, andreev, patch, none or auto");
     return {};
 }
 
@@ -56,8 +59,12 @@ Status check_fruc_options(const FrucOptions& o) {
         return Status::error("fruc option mode " + std::to_string(int(o.mode)) + ": unknown");
     if (int(o.warp) < 0 || int(o.warp) > int(WarpMethod::Auto))
         return Status::error("fruc option warp " + std::to_string(int(o.warp)) + ": unknown");
-    if (int(o.fill) < 0 || int(o.fill) > int(FillMethod::Auto))
+    if (int(o.fill) < 0 || int(o.fill) > int(FillMethod::Patch))
         return Status::error("fruc option fill " + std::to_string(int(o.fill)) + ": unknown");
+    if (o.warp == WarpMethod::Auto && o.fill == FillMethod::Patch)
+        return Status::error(
+            "fruc options warp auto and fill patch: the automatic choice has no model of the "
+            "patch fill (give a fixed warp, or fill auto)");
     const double huge = 1e6;
     for (const auto& [name, value, lo, hi] : {
              std::tuple<const char*, double, double, double>{"cut_misses", o.cut_misses, 0, 1},

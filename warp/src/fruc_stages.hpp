@@ -63,6 +63,7 @@ struct FrucScratch {
     GridWarper grid;
     PullPush pull_push;
     AndreevInpaint andreev;
+    PatchFill patch;
     MotionRefiner refiner;
 };
 

@@ -105,6 +105,8 @@ void fill_holes(ImageView<glm::vec4> color, ImageView<const uint8_t> valid,
     ++counters.fills;
     if (options.fill == FillMethod::PullPush)
         scratch.pull_push.fill(color, valid, depth);
+    else if (options.fill == FillMethod::Patch)
+        scratch.patch.fill(color, valid, depth);
     else
         scratch.andreev.fill(color, valid, depth);
 }

@@ -14,7 +14,7 @@
 namespace reprise::stereo {
 
 enum class StereoWarp { Grid, Splat };
-enum class StereoFill { None, PullPush, Andreev };
+enum class StereoFill { None, PullPush, Andreev, Patch };  // Patch: warp::PatchFill
 
 struct StereoOptions {
     StereoWarp warp = StereoWarp::Grid;
@@ -92,6 +92,7 @@ private:
     warp::GridWarper grid_;
     warp::PullPush pull_push_;
     warp::AndreevInpaint andreev_;
+    warp::PatchFill patch_;
     NonfiniteRepair rendered_repair_, history_repair_;
 };
 

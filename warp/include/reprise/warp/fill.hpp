@@ -1,6 +1,6 @@
 #pragma once
-// Hole filling for warped frames: pull-push (Marroquim et al. 2007), its depth-aware variant
-// and Andreev-style patch inpainting.
+// Hole filling for warped frames: pull-push (Marroquim et al. 2007), its depth-aware variant,
+// Andreev-style patch inpainting and frequency-selective reconstruction.
 //
 // Shared rules: a pixel is a hole where valid(p) == 0 or where its RGB is not finite (NaN/Inf
 // never spread). Only the RGB of holes is written; valid pixels and every alpha stay bit-exact.
@@ -63,6 +63,26 @@ private:
     Image<uint8_t> state_;       // 0 hole, 1 valid on entry, 2 filled by an earlier pass
     Image<uint16_t> up_, down_;  // holes: distance to the nearest valid pixel; valid: run length
     Image<float> filled_depth_;
+};
+
+// Frequency-selective reconstruction (Seiler et al. 2015; Genser et al. 2018: OpenCV contrib's
+// xphoto::inpaint, FSR_FAST): each block with holes is modelled as a sparse sum of DCT basis
+// functions fitted to its known pixels, which continues texture and edges into a hole that
+// pull-push blurs. It works on 8-bit display values (sRGB of colour clamped to [0, 1]): filled
+// pixels are at most 1 and quantised to display steps. With depth, a valid
+// pixel within 8 px of a hole that is nearer than the farthest valid pixel within 8 px by the
+// background ratio is not a known sample (it keeps its colour), so disocclusions continue the
+// background. Holes are filled whenever any pixel is valid; with none, unfilled == holes.
+// Single-threaded and far slower than the other fills (docs/benchmarks.md has its cost).
+class PatchFill {
+public:
+    FillStats fill(ImageView<glm::vec4> color, ImageView<const uint8_t> valid,
+                   ImageView<const float> depth = {});
+
+private:
+    Image<uint8_t> known_, away_;  // 255: a known sample; away: no hole within 8 px
+    Image<float> far_, farthest_;  // known depth (holes 0), its maximum within 8 px
+    Image<glm::u8vec3> source_;    // display values, BGR
 };
 
 // One-shot form of AndreevInpaint::fill (allocates its scratch per call).

@@ -21,7 +21,9 @@ enum class WarpMethod {
     Grid,     // adaptive-grid warp
     Auto,     // per frame, the cheapest expected to meet AutoOptions' budget (with the fill)
 };
-enum class FillMethod { None, PullPush, Andreev, Auto };
+// Patch: frequency-selective reconstruction (PatchFill); not a candidate of the automatic choice
+// (warp Auto with fill Patch is refused).
+enum class FillMethod { None, PullPush, Andreev, Auto, Patch };
 
 // The per-frame choice of `--warp auto --fill auto`: every fixed warp x fill is a candidate, its
 // error and cost predicted from a survey of the input (FramePredictors) by models fitted to
