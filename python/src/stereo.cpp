@@ -2,6 +2,7 @@
 #include <pybind11/stl.h>
 
 #include "common.hpp"
+#include "reprise/stereo/alternate.hpp"
 #include "reprise/stereo/rig.hpp"
 #include "reprise/stereo/synthesize.hpp"
 
@@ -89,6 +90,30 @@ struct Synthesizer {
     stereo::StereoSynthesizer synthesizer;
 };
 
+stereo::Eye make_eye(const std::string& eye) {
+    if (eye != "left" && eye != "right")
+        value_error("eye must be 'left' or 'right', got '" + eye + "'");
+    return eye == "left" ? stereo::Eye::Left : stereo::Eye::Right;
+}
+
+struct Alternation {
+    py::tuple next(const Frame& rendered, const std::string& eye, const Camera& target,
+                   const std::string& warp, const std::string& fill) {
+        require_color_and_depth(rendered, "rendered");
+        const stereo::StereoOptions options = make_options(warp, fill);
+        const stereo::Eye e = make_eye(eye);
+        Frame out;
+        out.fps = rendered.fps;
+        stereo::StereoStats stats;
+        {
+            py::gil_scoped_release release;
+            stats = alternation.next(rendered, e, target, out, options);
+        }
+        return py::make_tuple(std::move(out), stats_dict(stats));
+    }
+    stereo::EyeAlternation alternation;
+};
+
 }  // namespace
 
 void bind_stereo(py::module_& m) {
@@ -113,6 +138,26 @@ void bind_stereo(py::module_& m) {
              py::arg("warp") = "grid", py::arg("fill") = "pullpush", py::arg("history") = nullptr,
              "(frame, stats): the view of camera `target` from `rendered` (colour, depth, "
              "camera); `history` (e.g. the previous frame's other eye) fills holes first.");
+
+    py::class_<Alternation>(m, "EyeAlternation",
+                            "Temporal eye alternation (Didyk et al. 2010): each frame renders one "
+                            "eye, the two taking turns, and the other is made from it with that "
+                            "eye's last rendered frame as history.")
+        .def(py::init<>())
+        .def_static(
+            "rendered_eye",
+            [](long long index) {
+                return stereo::EyeAlternation::rendered_eye(index) == stereo::Eye::Left ? "left"
+                                                                                        : "right";
+            },
+            py::arg("index"), "The eye to render at frame `index`: 'left' on even frames.")
+        .def("next", &Alternation::next, py::arg("rendered"), py::arg("eye"), py::arg("target"),
+             py::arg("warp") = "grid", py::arg("fill") = "pullpush",
+             "(frame, stats): the other eye, seen from camera `target`, from `rendered` (eye "
+             "'left' or 'right' of this frame), with that other eye's last render as history "
+             "(none across a shot change); keeps `rendered` as its eye's history.")
+        .def(
+            "reset", [](Alternation& a) { a.alternation.reset(); }, "Forgets both histories.");
 
     m.def(
         "synthesize_eye",

@@ -32,3 +32,24 @@ def test_bad_stereo_input_raises(pan_60):
         reprise.synthesize_eye(pan_60[0], rig="crossed")
     with pytest.raises(ValueError, match="history"):
         reprise.StereoSynthesizer().synthesize(pan_60[0], pan_60[0].camera, history=no_depth)
+
+
+def test_eye_alternation_makes_each_eye_in_turn(renderer, pan_60):
+    scene = reprise.Scene("pan")
+    alternation = reprise.EyeAlternation()
+    for i in range(3):
+        left = pan_60[i]  # the left eye; the right one rendered beside it
+        _, right_camera = reprise.eye_cameras(left.camera, ipd=0.2, anchor="left")
+        right = renderer.render_camera(scene, right_camera, time=left.camera.time,
+                                       prev_time=left.camera.time - 1 / 60, **SIZE)
+        eye = reprise.EyeAlternation.rendered_eye(i)
+        assert eye == ("left" if i % 2 == 0 else "right")
+        rendered, truth = (left, right) if eye == "left" else (right, left)
+        made, stats = alternation.next(rendered, eye, truth.camera)
+        print(f"alternation frame {i}: {psnr(truth, made):.2f} dB, "
+              f"{stats['from_history']} pixels from history")
+        assert np.array_equal(made.camera.view, truth.camera.view)
+        assert (stats["from_history"] > 0) == (i > 0)
+        assert psnr(truth, made) > 28.0
+    with pytest.raises(ValueError, match="eye"):
+        alternation.next(pan_60[0], "middle", pan_60[0].camera)

@@ -61,9 +61,7 @@ FillStats PatchFill::fill(ImageView<glm::vec4> color, ImageView<const uint8_t> v
         for (int y = 0; y < h; ++y)
             for (int x = 0; x < w; ++x) {
                 const float d = depth(x, y);
-                far_(x, y) = !known_(x, y) ? 0.0f
-                                       : std::isnan(d)           ? INFINITY
-                                                                 : std::max(d, 0.0f);
+                far_(x, y) = !known_(x, y) ? 0.0f : std::isnan(d) ? INFINITY : std::max(d, 0.0f);
             }
         cv::Mat away = as_mat(away_, CV_8U), farthest = as_mat(farthest_, CV_32F);
         cv::erode(as_mat(known_, CV_8U), away, cv::Mat(), {-1, -1}, reach);
@@ -71,8 +69,7 @@ FillStats PatchFill::fill(ImageView<glm::vec4> color, ImageView<const uint8_t> v
         for (int y = 0; y < h; ++y)
             for (int x = 0; x < w; ++x) {
                 uint8_t& k = known_(x, y);
-                if (k && !away_(x, y) &&
-                    far_(x, y) * kBackgroundDepthRatio < farthest_(x, y))
+                if (k && !away_(x, y) && far_(x, y) * kBackgroundDepthRatio < farthest_(x, y))
                     k = 0;
             }
     }
@@ -80,8 +77,8 @@ FillStats PatchFill::fill(ImageView<glm::vec4> color, ImageView<const uint8_t> v
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
             const glm::vec4 c = color(x, y);
-            source_(x, y) = known_(x, y) ? glm::u8vec3(encode(c.b), encode(c.g), encode(c.r))
-                                         : glm::u8vec3(0);
+            source_(x, y) =
+                known_(x, y) ? glm::u8vec3(encode(c.b), encode(c.g), encode(c.r)) : glm::u8vec3(0);
         }
     cv::Mat filled;
     cv::xphoto::inpaint(as_mat(source_, CV_8UC3), as_mat(known_, CV_8U), filled,
