@@ -3,8 +3,11 @@
 `reprise bench fruc` run: fruc.csv (PSNR and ms per frame and setting) joined with
 fruc_predictors.csv (the survey of each frame). Prints the kModels table to paste.
 
-    build/tools/reprise bench fruc --scenes pan,fence,crossing,specular,fast --out OUT
+    build/tools/reprise bench fruc --scenes pan,fence,crossing,specular,fast,courtyard,stroll --out OUT
     scripts/fit_auto.py OUT WIDTH HEIGHT
+
+docs/results/auto-fit/ keeps the rows of the run the current table was fitted to (session 17):
+`scripts/fit_auto.py docs/results/auto-fit 640 360` prints that table again.
 
 Per mode, the reference setting (grid+pullpush) has the saturating error model of Sitthi-amorn
 et al. 2008: MSE of display values = floor + alpha (1 - exp(-lambda v)) + beta sigma + kappa d
