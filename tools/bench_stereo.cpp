@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <map>
 #include <sstream>
@@ -18,6 +19,8 @@
 #include "args.hpp"
 #include "bench.hpp"
 #include "bench_report.hpp"
+#include "peers.hpp"
+#include "reprise/core/exr.hpp"
 #include "reprise/core/metrics.hpp"
 #include "reprise/core/parallel.hpp"
 #include "reprise/core/visualize.hpp"
@@ -26,6 +29,7 @@
 #include "reprise/stereo/alternate.hpp"
 #include "reprise/stereo/rig.hpp"
 #include "reprise/stereo/synthesize.hpp"
+#include "timing.hpp"
 
 namespace reprise::cli {
 
@@ -118,9 +122,9 @@ Status worst_picture(const Run& ours, const Run& truth, const Run* peer, const s
 
 struct SceneSummary {
     std::string scene;
-    ReportPoint best, best_dis;                   // our best setting (by PSNR on all pixels)
-    ReportPoint fastest, fastest_dis;             // our fastest setting (mean ms)
-    double splat = NAN, remap = NAN, copy = NAN;  // peers' PSNR, all pixels
+    ReportPoint best, best_dis;        // our best setting (by PSNR on all pixels)
+    ReportPoint fastest, fastest_dis;  // our fastest setting (mean ms)
+    double splat = NAN, telea = NAN, remap = NAN, copy = NAN;  // peers' PSNR, all pixels
     double render_left_ms = NAN, render_right_ms = NAN;
     double disoccluded_fraction = NAN;
     // Eye alternation: the made eye (right on even frames, left on odd) and its cost.
@@ -138,8 +142,8 @@ struct SceneSummary {
 std::string summary_table(const std::vector<SceneSummary>& rows, bool full_hd) {
     std::string out;
     char line[512];
-    std::snprintf(line, sizeof line, "%-9s %-22s %7s %7s %8s | %7s %7s %7s | %9s %6s %6s %s\n",
-                  "scene", "ours best", "psnr", "psnr_d", "ms", "splat", "remap", "copyL",
+    std::snprintf(line, sizeof line, "%-9s %-22s %7s %7s %8s | %7s %7s %7s %7s | %9s %6s %6s %s\n",
+                  "scene", "ours best", "psnr", "psnr_d", "ms", "splat", "telea", "remap", "copyL",
                   "render_ms", "dis%", "ratio", "targets (ratio<=0.6, ms<=8 @1080p)");
     out += line;
     for (const SceneSummary& r : rows)
@@ -148,16 +152,18 @@ std::string summary_table(const std::vector<SceneSummary>& rows, bool full_hd) {
             const ReportPoint& d = fastest ? r.fastest_dis : r.best_dis;
             const double ratio = r.ratio(p);
             std::string verdict =
-                std::string("ratio ") + (ratio <= kPairRatioTarget ? "met" : "NOT met");
+                std::isnan(ratio)
+                    ? "ratio n/a (read, not rendered)"
+                    : std::string("ratio ") + (ratio <= kPairRatioTarget ? "met" : "NOT met");
             verdict += full_hd
                            ? std::string(", ms ") + (p.ms <= kSynthesisTargetMs ? "met" : "NOT met")
                            : std::string(", ms n/a (not 1920x1080)");
             const std::string label = (fastest ? "  fastest: " : "") + p.setting;
             std::snprintf(
                 line, sizeof line,
-                "%-9s %-22s %7.2f %7.2f %8.2f | %7.2f %7.2f %7.2f | %9.2f %6.2f %6.3f %s\n",
+                "%-9s %-22s %7.2f %7.2f %8.2f | %7.2f %7.2f %7.2f %7.2f | %9.2f %6.2f %6.3f %s\n",
                 fastest ? "" : r.scene.c_str(), label.c_str(), p.psnr, d.psnr, p.ms, r.splat,
-                r.remap, r.copy, r.render_right_ms, 100.0 * r.disoccluded_fraction, ratio,
+                r.telea, r.remap, r.copy, r.render_right_ms, 100.0 * r.disoccluded_fraction, ratio,
                 verdict.c_str());
             out += line;
         }
@@ -201,12 +207,17 @@ void describe(const stereo::StereoRig& rig, int w, int h, int frames, int repeat
         "memory, per warp (adaptive grid, splat) and fill (none, pull-push, Andreev); "
         "+history also warps the previous frame's rendered right eye (as when the rendered eye "
         "alternates per frame). Peers: dibr-splat = forward splat of footprint 1 with a depth test "
-        "and no fill; cv-remap = cv::remap of the left eye by its own disparity (bilinear); "
+        "and no fill, and the same with its holes filled by cv::inpaint Telea on display values "
+        "(dibr-splat telea; ms both); cv-remap = cv::remap of the left eye by its own disparity "
+        "(bilinear); "
         "copy-left-eye = the left eye as it is (ms = the copy). render = the renderer's time for "
         "the second eye (PSNR +inf by definition, drawn on the top edge). alternate = eye "
         "alternation: each frame renders one eye (left on even frames) and makes the other with "
         "EyeAlternation, the made eye scored against its rendered twin (ms: the synthesis with "
-        "the copy it keeps as history).",
+        "the copy it keeps as history). Sequence folders (--in: input/ the left eye, right/ the "
+        "right one, scripts/blender-scenes --stereo) are read, not rendered: no render times, "
+        "the history is the right eye of the frame before, and the eyes stand as far apart as "
+        "their cameras.",
         thread_count(), repeat);
     report.paragraphs.push_back(text);
 }
@@ -282,7 +293,8 @@ SceneSummary summarize(const std::string& name, const std::vector<Run>& runs, do
         if (run.ours() && (!fastest || run.mean_ms() < fastest->mean_ms())) fastest = &run;
         if (!run.ours() && run.method != kRender && (!peer || run.mean().psnr > peer->mean().psnr))
             peer = &run;
-        if (run.method == kSplatPeer) row.splat = run.mean().psnr;
+        if (run.method == kSplatPeer && run.setting == "nofill") row.splat = run.mean().psnr;
+        if (run.method == kSplatPeer && run.setting == "telea") row.telea = run.mean().psnr;
         if (run.method == kRemapPeer) row.remap = run.mean().psnr;
         if (run.method == kCopyPeer) row.copy = run.mean().psnr;
         if (run.ours() && run.setting == "grid+pullpush") row.fixed = run.mean().psnr;
@@ -349,18 +361,53 @@ Status add_scene(const std::string& scene_name, const std::string& name,
     return {};
 }
 
+// Sequence folders given by --in: the left eye in DIR/input (scripts/blender-scenes --stereo) or
+// DIR/left (reprise render --stereo), the right eye in DIR/right.
+const char* const kSequencePrefix = "in:";
+
+bool holds_exr(const fs::path& dir) {
+    std::error_code ec;
+    for (const fs::directory_entry& e : fs::directory_iterator(dir, ec))
+        if (e.path().extension() == ".exr") return true;
+    return false;
+}
+fs::path left_eye_dir(const fs::path& dir) {
+    return holds_exr(dir / "input") ? dir / "input" : dir / "left";
+}
+bool holds_eyes(const fs::path& dir) {
+    return holds_exr(left_eye_dir(dir)) && holds_exr(dir / "right");
+}
+
+// Each --in folder holds the two eyes or folders that do.
+std::vector<std::string> eye_sequences(const std::string& spec) {
+    std::vector<std::string> sequences;
+    for (const std::string& dir : split_list(spec)) {
+        std::error_code ec;
+        std::vector<std::string> inner;
+        if (!holds_eyes(dir))
+            for (const fs::directory_entry& e : fs::directory_iterator(dir, ec))
+                if (e.is_directory() && holds_eyes(e.path())) inner.push_back(e.path().string());
+        std::sort(inner.begin(), inner.end(), natural_less);
+        if (inner.empty()) inner.push_back(dir);  // opening it names what is missing
+        sequences.insert(sequences.end(), inner.begin(), inner.end());
+    }
+    return sequences;
+}
+
+float eye_distance(const Camera& a, const Camera& b) {
+    return glm::length(glm::vec3(glm::inverse(a.view)[3]) - glm::vec3(glm::inverse(b.view)[3]));
+}
+
 }  // namespace
 
 Status bench_stereo(const BenchOptions& options) {
     int w = 0, h = 0;
     REPRISE_TRY(parse_size(options.size, w, h));
-    std::vector<std::string> scenes;
-    if (options.scenes.empty()) {
+    std::vector<std::string> scenes = split_list(options.scenes);
+    if (scenes.empty() && options.in.empty())
         for (const server::SceneInfo& s : server::builtin_scenes()) scenes.push_back(s.name);
-    } else {
-        std::stringstream list(options.scenes);
-        for (std::string s; std::getline(list, s, ',');) scenes.push_back(s);
-    }
+    for (const std::string& dir : eye_sequences(options.in))
+        scenes.push_back(kSequencePrefix + dir);
     const std::string out_dir = options.out.empty() ? "out/bench-stereo" : options.out;
     std::error_code ec;
     fs::create_directories(out_dir, ec);
@@ -385,21 +432,41 @@ Status bench_stereo(const BenchOptions& options) {
     stereo::StereoSynthesizer synthesizer, probe_synth;
     Frame left, right, made, probe, history;
     Image<glm::vec3> truth_d(w, h), test_d(w, h);
-    Image<uint8_t> disoccluded(w, h);
+    Image<uint8_t> disoccluded(w, h), holes(w, h);
     Image<glm::vec4> remapped, copied;
     std::vector<SceneSummary> summaries;
     Status failure;
     for (const std::string& scene_name : scenes) {
         server::Scene scene;
         server::CameraPath path;
-        failure = server::load_scene(scene_name, scene, path);
-        if (!failure.ok()) break;
-        const std::string name = fs::path(scene_name).stem().string();
+        const bool sequence = scene_name.rfind(kSequencePrefix, 0) == 0;
+        const std::string dir = sequence ? scene_name.substr(std::strlen(kSequencePrefix)) : "";
+        Sequence lefts, rights;
+        int scene_frames = frames;
+        if (sequence) {
+            failure = open_sequence(left_eye_dir(dir).string(), lefts);
+            if (failure.ok()) failure = open_sequence(dir + "/right", rights);
+            if (!failure.ok()) break;
+            // Frame i is scored with frame i - 1 of the right eye as the history.
+            scene_frames =
+                std::min<int>(frames, int(std::min(lefts.files.size(), rights.files.size())) - 1);
+            if (scene_frames < 1) {
+                failure = Status::error(dir +
+                                        ": needs two frames of each eye (input/ or left/, "
+                                        "and right/)");
+                break;
+            }
+        } else {
+            failure = server::load_scene(scene_name, scene, path);
+            if (!failure.ok()) break;
+        }
+        const std::string name = fs::path(sequence ? dir : scene_name).filename().stem().string();
         fs::create_directories(out_dir + "/" + name, ec);
         std::vector<Run> runs;
         for (const OurSetting& s : settings) runs.push_back({kOurs, s.setting});
         const std::size_t splat_i = runs.size();
         runs.push_back({kSplatPeer, "nofill"});
+        runs.push_back({kSplatPeer, "telea"});  // the same, holes by cv::inpaint Telea
         runs.push_back({kRemapPeer, "linear"});
         runs.push_back({kCopyPeer, "-"});
         const std::size_t render_i = runs.size();
@@ -415,21 +482,42 @@ Status bench_stereo(const BenchOptions& options) {
         auto render_eye = [&](double t, stereo::Eye e, int times, Frame& out, double& ms) {
             return cli::render_eye(*renderer, scene, path, rig, w, h, t, e, times, out, ms);
         };
+        // Frame i's eyes and the right eye of the frame before: rendered, or read (no render
+        // time then).
+        auto next_frames = [&](int i, double& left_ms, double& right_ms) -> Status {
+            if (sequence) {
+                left_ms = right_ms = NAN;
+                REPRISE_TRY(read_frame(lefts, std::size_t(i) + 1, left));
+                REPRISE_TRY(read_frame(rights, std::size_t(i) + 1, right));
+                REPRISE_TRY(read_frame(rights, std::size_t(i), history));
+                if (right.width() != left.width() || right.height() != left.height() ||
+                    left.depth.width() != left.width() || left.depth.height() != left.height())
+                    return Status::error(dir +
+                                         ": the eyes differ in size or the left has no depth");
+                return {};
+            }
+            const double t = (i + 10) / fps;
+            double unused = 0.0;
+            REPRISE_TRY(render_eye(t, stereo::Eye::Left, repeat, left, left_ms));
+            REPRISE_TRY(render_eye(t, stereo::Eye::Right, repeat, right, right_ms));
+            return render_eye(t - 1.0 / fps, stereo::Eye::Right, 1, history, unused);
+        };
 
-        {  // warm-up (shader compilation, first upload of the scene): not timed
+        if (!sequence) {  // warm-up (shader compilation, first upload of the scene): not timed
             double unused = 0.0;
             failure = render_eye(10 / fps, stereo::Eye::Left, 1, left, unused);
         }
-        for (int i = 0; i < frames && failure.ok(); ++i) {
-            const double t = (i + 10) / fps;
-            double left_ms = 0.0, right_ms = 0.0, unused = 0.0;
-            failure = render_eye(t, stereo::Eye::Left, repeat, left, left_ms);
-            if (failure.ok()) failure = render_eye(t, stereo::Eye::Right, repeat, right, right_ms);
-            if (failure.ok())
-                failure = render_eye(t - 1.0 / fps, stereo::Eye::Right, 1, history, unused);
+        for (int i = 0; i < scene_frames && failure.ok(); ++i) {
+            double left_ms = 0.0, right_ms = 0.0;
+            failure = next_frames(i, left_ms, right_ms);
             if (!failure.ok()) break;
-            render_left += left_ms / frames, render_right += right_ms / frames;
+            const int fw = left.width(), fh = left.height();
+            truth_d.resize(fw, fh), test_d.resize(fw, fh), disoccluded.resize(fw, fh);
+            other_truth_d.resize(fw, fh), holes.resize(fw, fh);
+            render_left += left_ms / scene_frames, render_right += right_ms / scene_frames;
             const Camera& target = right.camera;
+            stereo::StereoRig eye_rig = rig;  // a sequence's eyes stand as far apart as they do
+            if (sequence) eye_rig.ipd = eye_distance(left.camera, right.camera);
 
             probe_synth.synthesize(left, target, probe,
                                    {.warp = stereo::StereoWarp::Splat,
@@ -438,17 +526,20 @@ Status bench_stereo(const BenchOptions& options) {
             std::size_t dis = 0;
             for (std::size_t k = 0; k < disoccluded.pixel_count(); ++k)
                 dis += disoccluded.data()[k] = !probe_synth.coverage().data[k];
-            dis_fraction += double(dis) / double(disoccluded.pixel_count()) / frames;
+            dis_fraction += double(dis) / double(disoccluded.pixel_count()) / scene_frames;
             to_display(right.color.view(), truth_d.view());
 
-            auto record = [&](Run& run, const Image<glm::vec4>& test, double ms) {
-                to_display(test.view(), test_d.view());
+            auto record_display = [&](Run& run, double ms) {
                 Score s{.frame = i, .ms = ms};
                 s.all = image_error(truth_d.view(), test_d.view());
                 s.disoccluded = dis ? image_error(truth_d.view(), test_d.view(), disoccluded.view())
                                     : ImageError{NAN, NAN, NAN};
                 run.scores.push_back(s);
                 to_rgb8(test_d.view(), run.shown[i]);
+            };
+            auto record = [&](Run& run, const Image<glm::vec4>& test, double ms) {
+                to_display(test.view(), test_d.view());
+                record_display(run, ms);
             };
             for (std::size_t k = 0; k < settings.size(); ++k) {
                 const double ms = fastest_ms(repeat, [&] {
@@ -464,10 +555,17 @@ Status bench_stereo(const BenchOptions& options) {
                                         .splat = {.footprint = 1}});
             });
             record(runs[splat_i], made.color, ms);
-            ms = fastest_ms(repeat, [&] { remap_by_disparity(left, rig, remapped); });
-            record(runs[splat_i + 1], remapped, ms);
+            for (std::size_t k = 0; k < holes.pixel_count(); ++k)
+                holes.data()[k] = !synthesizer.coverage().data[k];
+            ms += fastest_ms(repeat, [&] {
+                to_display(made.color.view(), test_d.view());
+                inpaint_telea(test_d.view(), holes.view());
+            });
+            record_display(runs[splat_i + 1], ms);
+            ms = fastest_ms(repeat, [&] { remap_by_disparity(left, eye_rig, remapped); });
+            record(runs[splat_i + 2], remapped, ms);
             ms = fastest_ms(repeat, [&] { copied = left.color; });
-            record(runs[splat_i + 2], copied, ms);
+            record(runs[splat_i + 3], copied, ms);
             record(runs[render_i], right.color, right_ms);
 
             if (i == 0) alternation.next(history, stereo::Eye::Right, history.camera, made);
@@ -481,7 +579,7 @@ Status bench_stereo(const BenchOptions& options) {
                                         .all = image_error(other_truth_d.view(), test_d.view()),
                                         .disoccluded = {NAN, NAN, NAN},
                                         .ms = ms});
-            alternate_render += (eye == stereo::Eye::Left ? left_ms : right_ms) / frames;
+            alternate_render += (eye == stereo::Eye::Left ? left_ms : right_ms) / scene_frames;
             std::printf("[stereo] %s frame %d: render L %.1f ms, R %.1f ms, %.2f%% disoccluded\n",
                         name.c_str(), i, left_ms, right_ms,
                         100.0 * double(dis) / disoccluded.pixel_count());
@@ -504,14 +602,16 @@ Status bench_stereo(const BenchOptions& options) {
                               "previous rendered right eye; ratio = (render of the one eye + "
                               "ms) / (render L + render R)\n" +
                               alternation_table(summaries);
-    std::snprintf(text, sizeof text,
-                  "stereo, %dx%d, %d frames per scene, ipd %.3f, fastest of %d runs, %d threads; "
-                  "PSNR dB (psnr_d: disoccluded pixels only); ms per synthesized eye; splat/remap/"
-                  "copyL: peers' PSNR; render_ms: the renderer's right eye; dis%%: disoccluded "
-                  "pixels; ratio = (render L + ours) / (render L + render R); per scene our best "
-                  "setting by PSNR, "
-                  "then our fastest\n",
-                  w, h, frames, rig.ipd, repeat, thread_count());
+    std::snprintf(
+        text, sizeof text,
+        "stereo, %dx%d (sequences: as read), %d frames per scene, ipd %.3f (sequences: their "
+        "cameras'), fastest of %d runs, %d threads; PSNR dB (psnr_d: disoccluded pixels only); ms "
+        "per synthesized eye; splat/telea/remap/"
+        "copyL: peers' PSNR; render_ms: the renderer's right eye; dis%%: disoccluded "
+        "pixels; ratio = (render L + ours) / (render L + render R); per scene our best "
+        "setting by PSNR, "
+        "then our fastest\n",
+        w, h, frames, rig.ipd, repeat, thread_count());
     report.preformatted = std::string(text) + table;
     const std::string html_path = out_dir + "/index.html";
     REPRISE_TRY(write_html_report(html_path, report));

@@ -4,12 +4,15 @@ multilayer EXR. No reprise default was tuned on them.
 
     blender -b --factory-startup --python-exit-code 1 --python scenes.py -- OUT \
         [--size 320x180] [--frames 6] [--factor 2] [--samples 32] [--scenes tumble,orbit,dolly] \
-        [--cameras 1]
+        [--cameras 1] [--stereo IPD]
 
 Each scene is rendered twice over the same seconds: OUT/blender-<scene>/input/ at 30 Hz (frames
 inputs; their Vector pass spans 1/30 s, as in a real 30 Hz render) and OUT/blender-<scene>/truth/
 at 30 x factor Hz, the frames an upconversion must make; with --cameras 1 a cameras.json beside
-the frames of each (Blender's files carry no camera). scripts/blender-scenes runs this.
+the frames of each (Blender's files carry no camera). With --stereo IPD also
+OUT/blender-<scene>/right/ at 30 Hz: the right eye of a parallel rig whose left eye is the input
+(a camera IPD metres along the camera's own x axis), for `reprise bench stereo --in OUT`.
+scripts/blender-scenes runs this.
 """
 import argparse
 import json
@@ -30,10 +33,11 @@ parser.add_argument("--factor", type=int, default=2)
 parser.add_argument("--samples", type=int, default=32)
 parser.add_argument("--scenes", default="tumble,orbit,dolly")
 parser.add_argument("--cameras", type=int, default=1, help="1: write cameras.json beside the frames")
+parser.add_argument("--stereo", type=float, default=0.0, help="IPD > 0: also render the right eye")
 args = parser.parse_args(sys.argv[sys.argv.index("--") + 1:] if "--" in sys.argv else [])
 width, height = (int(v) for v in args.size.split("x"))
-if args.frames < 2 or args.factor < 1 or width < 1 or height < 1:
-    sys.exit("scenes.py: need --frames >= 2, --factor >= 1 and a positive --size")
+if args.frames < 2 or args.factor < 1 or width < 1 or height < 1 or not args.stereo >= 0.0:
+    sys.exit("scenes.py: need --frames >= 2, --factor >= 1, a positive --size and --stereo >= 0")
 DURATION = (args.frames - 1) / 30.0  # seconds the animation lasts
 LAST = 0  # the last frame of the render being set up (Blender counts from 1)
 
@@ -204,13 +208,27 @@ def write_cameras(scene, folder):
     scene.frame_set(1)
 
 
+def right_eye(ipd):
+    """A camera `ipd` along the scene camera's own x axis, moving with it, made the scene's."""
+    scene = bpy.context.scene
+    left = scene.camera
+    right = bpy.data.objects.new("right eye", left.data)
+    scene.collection.objects.link(right)
+    right.parent = left
+    right.location = (ipd, 0.0, 0.0)
+    scene.camera = right
+
+
 BUILDERS = {"tumble": tumble, "orbit": orbit, "dolly": dolly}
 for name in args.scenes.split(","):
     if name not in BUILDERS:
         sys.exit("scenes.py: unknown scene '%s' (%s)" % (name, ", ".join(BUILDERS)))
-    for folder, rate in (("input", 1), ("truth", args.factor)):
+    passes = [("input", 1), ("truth", args.factor)] + ([("right", 1)] if args.stereo > 0 else [])
+    for folder, rate in passes:
         scene = clear(rate)
         BUILDERS[name]()
+        if folder == "right":
+            right_eye(args.stereo)
         folder = os.path.join(os.path.abspath(args.out), "blender-" + name, folder)
         scene.render.filepath = os.path.join(folder, "")
         if args.cameras:
