@@ -53,9 +53,9 @@ TEST(CliBenchStereo, ReadsAPairFromFoldersAndScoresEverySetting) {
     EXPECT_NE(r.output.find("ratio n/a (read, not rendered)"), std::string::npos) << r.output;
     std::map<std::string, int> rows;
     const std::map<std::string, double> psnr = mean_psnr(dir / "report" / "stereo.csv", rows);
-    for (const char* key : {"ours grid+pullpush", "ours grid+pullpush+history", "ours grid+patch",
-                            "dibr-splat nofill", "dibr-splat telea", "cv-remap linear",
-                            "alternate grid+pullpush"}) {
+    for (const char* key :
+         {"ours grid+pullpush", "ours grid+pullpush+history", "ours grid+patch",
+          "dibr-splat nofill", "dibr-splat telea", "cv-remap linear", "alternate grid+pullpush"}) {
         ASSERT_EQ(rows[key], 2) << key;
         EXPECT_TRUE(std::isfinite(psnr.at(key))) << key;
         std::printf("[bench stereo --in] %s: %.2f dB\n", key, psnr.at(key));
@@ -65,9 +65,8 @@ TEST(CliBenchStereo, ReadsAPairFromFoldersAndScoresEverySetting) {
     EXPECT_TRUE(fs::exists(dir / "report" / "index.html"));
 
     fs::remove_all(dir / "pair" / "right");
-    r = run_reprise("bench stereo --in " + (dir / "pair").string() + " --out " +
-                        (dir / "report").string(),
-                    60);
+    r = run_reprise(
+        "bench stereo --in " + (dir / "pair").string() + " --out " + (dir / "report").string(), 60);
     EXPECT_NE(r.status, 0);
     EXPECT_NE(r.output.find("right"), std::string::npos) << r.output;
     fs::remove_all(dir);

@@ -302,13 +302,19 @@ TEST(StereoTemporal, PreviousOtherEyeFillsDisocclusions) {
         "[stereo] temporal: %.2f dB (without: %.2f dB), %zu pixels from history for %zu "
         "holes and %zu stretched\n",
         b, a, stats.from_history, stats.holes, stats.stretched);
-    // Measured: 40.90 dB against 36.23, 758 pixels from history for 809 holes and 129 stretched
-    // (before stretched pixels were marked, taken from the history and left to pull-push:
-    // 38.86 dB against 35.32).
+    // Measured: 42.92 dB against 36.33, 703 pixels from history for 893 holes. One-pixel
+    // smallest cells tear at silhouettes rather than stretch: nothing is marked stretched.
     EXPECT_GE(double(stats.from_history), 0.7 * double(stats.holes));
+    EXPECT_GT(b, 42.0);
+    EXPECT_GT(b, a + 5.0);
+    // With two-pixel smallest cells the edge triangles stretch, and the eye takes the history
+    // there (measured 40.90 dB, 129 stretched; 38.86 before stretched pixels were marked).
+    const StereoOptions two{.grid = {.min_cell = 2}};
+    stats = synthesizer.synthesize(now.left, now.cameras.right, temporal, two, &before.right);
+    std::printf("[stereo] temporal, 2 px cells: %.2f dB, %zu stretched\n",
+                display_psnr(now.right.color, temporal.color), stats.stretched);
     EXPECT_GT(stats.stretched, 0u);
-    EXPECT_GT(b, 40.0);
-    EXPECT_GT(b, a + 2.5);
+    EXPECT_GT(display_psnr(now.right.color, temporal.color), 40.0);
 }
 
 TEST(StereoTemporal, MovingObjectsOfTheHistoryAreLeftOut) {
@@ -327,7 +333,7 @@ TEST(StereoTemporal, MovingObjectsOfTheHistoryAreLeftOut) {
                  b = display_psnr(now.left.color, stale.color);
     std::printf("[stereo] moving history left out: %.2f dB (kept: %.2f dB), %zu pixels left out\n",
                 a, b, stats.history_moving);
-    // Measured: 43.45 dB against 41.94, 3597 pixels left out.
+    // Measured: 44.08 dB against 42.69, 3597 pixels left out.
     EXPECT_GT(stats.history_moving, 0u);
     EXPECT_GT(a, b + 1.0);
     // Without motion the history is kept whole.
@@ -363,7 +369,7 @@ TEST(StereoAlternation, EyesTakeTurnsAndTheMadeOneFillsFromItsOwnLastRender) {
         if (i == 0 || i == 3) {
             EXPECT_EQ(stats.from_history, 0u);
             EXPECT_EQ(made.color, alone.color);
-        } else {  // measured: 42.00 against 40.99 dB, 41.70 against 41.37
+        } else {  // measured: 42.72 against 41.66 dB, 42.73 against 42.36
             EXPECT_GT(psnr, without + 0.2);
         }
         EXPECT_GT(psnr, 38.0);

@@ -183,11 +183,13 @@ int command_bench(int argc, char** argv) {
                 "the truth has 4)");
     args.option("--repeat", &job.repeat,
                 "fruc, stereo, upsample: timed runs, each frame's fastest counts (default 3)");
-    args.option("--in", &job.in,
-                "codec: also a sequence folder (EXR frames, up to --frames); fruc: comma-separated "
-                "sequence folders (input/ at 30 Hz, truth/ at 30 K Hz, as --exr writes them) or "
-                "folders of them (scripts/blender-scenes), held out; alone unless --scenes is "
-                "given too");
+    args.option(
+        "--in", &job.in,
+        "codec: also a sequence folder (EXR frames, up to --frames); fruc: comma-separated "
+        "sequence folders (input/ at 30 Hz, truth/ at 30 K Hz, as --exr writes them) or "
+        "folders of them (scripts/blender-scenes), held out; stereo: folders of the two eyes "
+        "(input/ or left/, and right/: scripts/blender-scenes --stereo IPD, reprise "
+        "render --stereo) or folders of them; alone unless --scenes is given too");
     args.option("--threads", &job.threads, "codec: threads per codec (default 2)");
     args.option("--qps", &job.qps,
                 "codec: reprise's qp rate points (default 22,28,34,40); stream: the server's qp "
