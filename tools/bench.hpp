@@ -1,6 +1,7 @@
 #pragma once
 // Benchmarks behind `reprise bench WHAT`. Each prints its timings and, for kernels, the ratio
 // against a peer (OpenCV, ffmpeg) measured in the same run on the same input.
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
@@ -46,6 +47,16 @@ struct BenchScene {
     std::unique_ptr<server::Renderer> renderer;
 };
 Status open_bench_scene(const std::string& name, BenchScene& bench);
+
+// Sequence folders given by --in stand among a bench's scenes as "in:DIR".
+inline constexpr const char* kSequencePrefix = "in:";
+bool is_sequence(const std::string& scene);
+bool holds_exr(const std::filesystem::path& dir);
+// Each comma-separated folder of `spec` that `holds` accepts, else the folders inside it that it
+// accepts (natural order), else the folder itself (opening it then names what is missing); each
+// as "in:DIR".
+std::vector<std::string> sequence_folders(const std::string& spec,
+                                          bool (*holds)(const std::filesystem::path&));
 
 Status bench_reproject(const BenchOptions& options);  // reverse reprojection vs cv::remap
 Status bench_grid(const BenchOptions& options);       // splat and adaptive grid warp

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <functional>
 #include <glm/common.hpp>
@@ -40,38 +41,12 @@ const char* const kHeldOut[] = {"2CylinderEngine-glTF-Binary/2CylinderEngine.glb
                                 "glTF-Sample-Models/AnimatedMorphCube-glTF/AnimatedMorphCube.gltf",
                                 "BoxTextured-glTF-Binary/BoxTextured.glb"};
 
-// Sequence folders given by --in are listed as "in:DIR".
-const char* const kSequencePrefix = "in:";
-
-bool is_sequence(const std::string& scene) { return scene.rfind(kSequencePrefix, 0) == 0; }
 bool is_held_out(const std::string& scene) {
     return scene.rfind(kHeldOutDir, 0) == 0 || is_sequence(scene);
 }
 
-bool holds_exr(const fs::path& dir) {
-    std::error_code ec;
-    for (const fs::directory_entry& e : fs::directory_iterator(dir, ec))
-        if (e.path().extension() == ".exr") return true;
-    return false;
-}
-bool holds_sequence(const fs::path& dir) { return holds_exr(dir / "input"); }
-
 // Each --in folder holds a sequence (input/, truth/) or folders that do.
-std::vector<std::string> sequence_list(const std::string& spec) {
-    std::vector<std::string> sequences;
-    for (const std::string& dir : split_list(spec)) {
-        std::error_code ec;
-        std::vector<std::string> inner;
-        if (!holds_sequence(dir))
-            for (const fs::directory_entry& e : fs::directory_iterator(dir, ec))
-                if (e.is_directory() && holds_sequence(e.path()))
-                    inner.push_back(e.path().string());
-        std::sort(inner.begin(), inner.end(), natural_less);
-        if (inner.empty()) inner.push_back(dir);  // read_scene names what is missing
-        for (const std::string& d : inner) sequences.push_back(kSequencePrefix + d);
-    }
-    return sequences;
-}
+bool holds_sequence(const fs::path& dir) { return holds_exr(dir / "input"); }
 
 // The --scenes list with `held-out` expanded, then the --in sequences; with neither, every
 // built-in scene and the held-out ones.
@@ -90,7 +65,8 @@ std::vector<std::string> scene_list(const std::string& spec, const std::string& 
             if (fs::exists(std::string(kHeldOutDir) + model))
                 scenes.push_back(std::string(kHeldOutDir) + model);
     }
-    for (const std::string& sequence : sequence_list(in)) scenes.push_back(sequence);
+    for (const std::string& sequence : sequence_folders(in, holds_sequence))
+        scenes.push_back(sequence);
     return scenes;
 }
 
@@ -785,7 +761,8 @@ Status bench_fruc(const BenchOptions& job) {
     Status failure;
     for (const std::string& scene_name : scenes) {
         SceneFrames scene;
-        const std::string source = is_sequence(scene_name) ? scene_name.substr(3) : scene_name;
+        const std::string source =
+            is_sequence(scene_name) ? scene_name.substr(std::strlen(kSequencePrefix)) : scene_name;
         scene.name = fs::path(source).filename().string();
         if (!is_sequence(scene_name)) scene.name = fs::path(source).stem().string();
         const std::string scene_dir = out_dir + "/" + scene.name;

@@ -363,35 +363,11 @@ Status add_scene(const std::string& scene_name, const std::string& name,
 
 // Sequence folders given by --in: the left eye in DIR/input (scripts/blender-scenes --stereo) or
 // DIR/left (reprise render --stereo), the right eye in DIR/right.
-const char* const kSequencePrefix = "in:";
-
-bool holds_exr(const fs::path& dir) {
-    std::error_code ec;
-    for (const fs::directory_entry& e : fs::directory_iterator(dir, ec))
-        if (e.path().extension() == ".exr") return true;
-    return false;
-}
 fs::path left_eye_dir(const fs::path& dir) {
     return holds_exr(dir / "input") ? dir / "input" : dir / "left";
 }
 bool holds_eyes(const fs::path& dir) {
     return holds_exr(left_eye_dir(dir)) && holds_exr(dir / "right");
-}
-
-// Each --in folder holds the two eyes or folders that do.
-std::vector<std::string> eye_sequences(const std::string& spec) {
-    std::vector<std::string> sequences;
-    for (const std::string& dir : split_list(spec)) {
-        std::error_code ec;
-        std::vector<std::string> inner;
-        if (!holds_eyes(dir))
-            for (const fs::directory_entry& e : fs::directory_iterator(dir, ec))
-                if (e.is_directory() && holds_eyes(e.path())) inner.push_back(e.path().string());
-        std::sort(inner.begin(), inner.end(), natural_less);
-        if (inner.empty()) inner.push_back(dir);  // opening it names what is missing
-        sequences.insert(sequences.end(), inner.begin(), inner.end());
-    }
-    return sequences;
 }
 
 float eye_distance(const Camera& a, const Camera& b) {
@@ -406,8 +382,8 @@ Status bench_stereo(const BenchOptions& options) {
     std::vector<std::string> scenes = split_list(options.scenes);
     if (scenes.empty() && options.in.empty())
         for (const server::SceneInfo& s : server::builtin_scenes()) scenes.push_back(s.name);
-    for (const std::string& dir : eye_sequences(options.in))
-        scenes.push_back(kSequencePrefix + dir);
+    for (const std::string& sequence : sequence_folders(options.in, holds_eyes))
+        scenes.push_back(sequence);
     const std::string out_dir = options.out.empty() ? "out/bench-stereo" : options.out;
     std::error_code ec;
     fs::create_directories(out_dir, ec);
@@ -439,7 +415,7 @@ Status bench_stereo(const BenchOptions& options) {
     for (const std::string& scene_name : scenes) {
         server::Scene scene;
         server::CameraPath path;
-        const bool sequence = scene_name.rfind(kSequencePrefix, 0) == 0;
+        const bool sequence = is_sequence(scene_name);
         const std::string dir = sequence ? scene_name.substr(std::strlen(kSequencePrefix)) : "";
         Sequence lefts, rights;
         int scene_frames = frames;

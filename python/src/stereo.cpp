@@ -72,20 +72,28 @@ py::dict stats_dict(const stereo::StereoStats& s) {
     return d;
 }
 
+// (frame, stats) of `make(out)`, run without the GIL; the frame keeps the rendered one's rate.
+template <class Make>
+py::tuple made_eye(const Frame& rendered, Make&& make) {
+    Frame out;
+    out.fps = rendered.fps;
+    stereo::StereoStats stats;
+    {
+        py::gil_scoped_release release;
+        stats = make(out);
+    }
+    return py::make_tuple(std::move(out), stats_dict(stats));
+}
+
 struct Synthesizer {
     py::tuple synthesize(const Frame& rendered, const Camera& target, const std::string& warp,
                          const std::string& fill, const Frame* history) {
         require_color_and_depth(rendered, "rendered");
         if (history) require_color_and_depth(*history, "history");
         const stereo::StereoOptions options = make_options(warp, fill);
-        Frame out;
-        out.fps = rendered.fps;
-        stereo::StereoStats stats;
-        {
-            py::gil_scoped_release release;
-            stats = synthesizer.synthesize(rendered, target, out, options, history);
-        }
-        return py::make_tuple(std::move(out), stats_dict(stats));
+        return made_eye(rendered, [&](Frame& out) {
+            return synthesizer.synthesize(rendered, target, out, options, history);
+        });
     }
     stereo::StereoSynthesizer synthesizer;
 };
@@ -102,14 +110,9 @@ struct Alternation {
         require_color_and_depth(rendered, "rendered");
         const stereo::StereoOptions options = make_options(warp, fill);
         const stereo::Eye e = make_eye(eye);
-        Frame out;
-        out.fps = rendered.fps;
-        stereo::StereoStats stats;
-        {
-            py::gil_scoped_release release;
-            stats = alternation.next(rendered, e, target, out, options);
-        }
-        return py::make_tuple(std::move(out), stats_dict(stats));
+        return made_eye(rendered, [&](Frame& out) {
+            return alternation.next(rendered, e, target, out, options);
+        });
     }
     stereo::EyeAlternation alternation;
 };
