@@ -116,6 +116,31 @@ TEST(ObjectMotion, TheDefaultStreamOfCrossingIsSmallerWithObjects) {
     EXPECT_LE(double(bits[1]), 0.99 * double(bits[0])) << bits[1] << " against " << bits[0];
 }
 
+// Each pixel's object predicted from the reference (the object it moved with there, at the depth
+// its motion gives): pixels that moved as predicted cost no motion bits, silhouettes included.
+// Measured at 160x96, 5 frames, motion bits of frames 1-4 (the object lists included): courtyard
+// 3224 (5648 without the prediction), crossing 2032 (3552); every decoded pixel within the
+// bound, the decoder bit-identical to the encoder.
+TEST(ObjectMotion, PixelsPredictedToMoveWithTheirObjectCostNoMotionBits) {
+    for (auto [scene, most] : {std::pair{"courtyard", 4000}, std::pair{"crossing", 2600}}) {
+        SCOPED_TRACE(scene);
+        const auto frames = render(scene, 5, 160, 96);
+        const test::Coded key = test::encode_all({frames[0]}, {.qp = 34});
+        const test::Coded coded = test::encode_all(frames, {.qp = 34});
+        EXPECT_LE(coded.stats.motion_bits - key.stats.motion_bits, std::size_t(most));
+        const auto decoded = decode_all(coded.packets);
+        ASSERT_EQ(decoded.size(), frames.size());
+        for (std::size_t i = 0; i < frames.size(); ++i) {
+            EXPECT_TRUE(test::same_bits(decoded[i].motion, coded.reconstructions[i].motion));
+            EXPECT_TRUE(test::same_bits(decoded[i].color, coded.reconstructions[i].color));
+            for (std::size_t p = 0; p < frames[i].motion.pixel_count(); ++p)
+                ASSERT_LE(glm::length(decoded[i].motion.data()[p] - frames[i].motion.data()[p]),
+                          0.25f)
+                    << "frame " << i << " pixel " << p;
+        }
+    }
+}
+
 // The list as the camera section carries it: raw, or against the reference's objects, where an
 // object that kept its motion costs a byte per float.
 TEST(ObjectMotion, ListsRoundTripAndUnchangedMotionCostsLittle) {

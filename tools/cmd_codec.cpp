@@ -5,6 +5,7 @@
 #include <fstream>
 
 #include "args.hpp"
+#include "bench_report.hpp"
 #include "commands.hpp"
 #include "outputs.hpp"
 #include "reprise/codec/codec.hpp"
@@ -103,8 +104,26 @@ void print_stats(const codec::StreamStats& s, double fps) {
                     s.cameras_fitted);
 }
 
+constexpr const char* kFrameStatsColumns =
+    "frame,type,bytes,header_bits,camera_bits,depth_bits,motion_bits,colour_bits,blocks,"
+    "blocks_skipped,intra_blocks,depth_zero_blocks,motion_residual_pixels";
+
+// One frame's row of --frame-stats: the difference of the encoder's running counts.
+void write_frame_stats(CsvFile& csv, std::size_t frame, std::size_t bytes,
+                       const codec::StreamStats& a, const codec::StreamStats& b) {
+    auto d = [](std::size_t after, std::size_t before) { return std::to_string(after - before); };
+    csv.row({std::to_string(frame), b.key_frames > a.key_frames ? "key" : "inter",
+             std::to_string(bytes), d(b.header_bits, a.header_bits),
+             d(b.camera_bits, a.camera_bits), d(b.depth_bits, a.depth_bits),
+             d(b.motion_bits, a.motion_bits), d(b.color_bits, a.color_bits), d(b.blocks, a.blocks),
+             d(b.blocks_skipped, a.blocks_skipped), d(b.intra_blocks, a.intra_blocks),
+             d(b.depth_zero_blocks, a.depth_zero_blocks),
+             d(b.motion_residual_pixels, a.motion_residual_pixels)});
+    csv.flush();
+}
+
 struct EncodeJob {
-    std::string in, out, chroma = "420", depth = "view";
+    std::string in, out, chroma = "420", depth = "view", frame_stats;
     int qp = 28, quality = 0, bitrate = 0, keyint = 0, skip = 2;
     double motion_error = 0.25;
     bool quality_given = false, overwrite_inputs = false, resume = false, no_objects = false;
@@ -175,6 +194,12 @@ Status run_encode(const EncodeJob& job, const codec::EncoderOptions& o) {
         return Status::error("--out " + job.out + " is a folder; the stream is one file (.rps)");
     REPRISE_TRY(check_output("--out", job.out, false,
                              {.inputs = {job.in}, .overwrite_inputs = job.overwrite_inputs}));
+    CsvFile frame_stats;
+    if (!job.frame_stats.empty()) {
+        REPRISE_TRY(
+            check_output("--frame-stats", job.frame_stats, false, {.inputs = {job.in, job.out}}));
+        REPRISE_TRY(frame_stats.open(job.frame_stats, kFrameStatsColumns));
+    }
     Sequence sequence;
     REPRISE_TRY(open_sequence(job.in, sequence));
     REPRISE_TRY(check_one_size(sequence, "encode"));
@@ -207,6 +232,7 @@ Status run_encode(const EncodeJob& job, const codec::EncoderOptions& o) {
         std::vector<uint8_t> out;
         if (i == 0)
             REPRISE_TRY(codec::write_stream_header(out, frame.width(), frame.height(), fps));
+        const codec::StreamStats before = encoder.stats();
         const auto start = Clock::now();
         const Status sent = encoder.send_frame(frame);
         busy_ms += ms_since(start);
@@ -218,6 +244,8 @@ Status run_encode(const EncodeJob& job, const codec::EncoderOptions& o) {
                  .flush())
             return Status::error(job.out + ": cannot write " + partial);
         bytes += out.size();
+        if (frame_stats.file())
+            write_frame_stats(frame_stats, i, out.size(), before, encoder.stats());
         std::fprintf(stderr, "\r[encode] %zu/%zu frames, %zu bytes", i + 1, n, bytes);
     }
     std::fprintf(stderr, "\n");
@@ -352,6 +380,9 @@ int command_encode(int argc, char** argv) {
               "with motion models and depth)");
     args.option("--skip", &job.skip,
                 "blocks within this many 8-bit levels of their prediction are skipped (default 2)");
+    args.option("--frame-stats", &job.frame_stats,
+                "CSV of each frame's bits by section (header, camera, depth, motion, colour) and "
+                "blocks left out");
     args.flag("--overwrite-inputs", &job.overwrite_inputs,
               "allow --out to replace an input file (written after all are read)");
     args.flag("--resume", &job.resume,

@@ -143,7 +143,8 @@ glm::mat4 rigid_to_clip(const Camera& camera, const glm::dmat4& moved) {
 }
 
 void rigid_motion(const Camera& from, ImageView<const float> depth, const glm::mat4& to_clip,
-                  int x0, int y0, ImageView<glm::vec2> out) {
+                  int x0, int y0, ImageView<glm::vec2> out, const glm::mat4& to_camera,
+                  ImageView<float> out_depth) {
     const Unprojector un = unprojector(from, depth.width, depth.height);
     parallel_for(0, out.height, [&](int r0, int r1) {
         for (int r = r0; r < r1; ++r)
@@ -151,13 +152,17 @@ void rigid_motion(const Camera& from, ImageView<const float> depth, const glm::m
                 const int x = x0 + c, y = y0 + r;
                 glm::vec4 point;
                 glm::vec2 m{kNan, kNan};
+                float z = kNan;
                 if (un.point(x, y, depth(x, y), point)) {
                     const glm::vec4 clip = to_clip * point;
-                    if (clip.w > 0.0f)
+                    if (clip.w > 0.0f) {
                         m = {(clip.x / clip.w + 1.0f) * 0.5f * un.width - (float(x) + 0.5f),
                              (1.0f - clip.y / clip.w) * 0.5f * un.height - (float(y) + 0.5f)};
+                        if (!out_depth.empty()) z = -(to_camera * point).z;
+                    }
                 }
                 out(c, r) = m;
+                if (!out_depth.empty()) out_depth(c, r) = z;
             }
     });
 }

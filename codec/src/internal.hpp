@@ -13,7 +13,7 @@ namespace reprise::codec {
 
 inline constexpr uint32_t kPacketMagic = 0x544B5052;  // "RPKT"
 inline constexpr uint32_t kFileMagic = 0x53525052;    // "RPRS"
-inline constexpr uint8_t kVersion = 9;
+inline constexpr uint8_t kVersion = 10;
 inline constexpr std::size_t kPacketHeaderSize = 32;
 inline constexpr std::size_t kMaxPayload = 256u << 20;
 inline constexpr int kMaxSide = 16384;
@@ -131,9 +131,11 @@ bool unproject_pixel(const Camera& camera, int width, int height, int x, int y, 
 // space of `camera` to where it was one frame earlier (same space); then the previous camera.
 glm::mat4 rigid_to_clip(const Camera& camera, const glm::dmat4& moved);
 // The motion camera_motion gives, for the pixels of `out` (placed at x0, y0 in the picture) and
-// a point transform of rigid_to_clip, pixel by pixel (no row form).
+// a point transform of rigid_to_clip, pixel by pixel (no row form); with `out_depth`, also each
+// point's depth in the camera that `to_camera` (camera space -> its camera space) leads to.
 void rigid_motion(const Camera& from, ImageView<const float> depth, const glm::mat4& to_clip,
-                  int x0, int y0, ImageView<glm::vec2> out);
+                  int x0, int y0, ImageView<glm::vec2> out, const glm::mat4& to_camera = {},
+                  ImageView<float> out_depth = {});
 // The reference depth forward-projected into camera `to` (z-buffered, nearest pixel);
 // NaN where nothing landed. A copy when the cameras are identical.
 // Pixels whose `owner` id is one of `objects` (this frame's) move with that object's motion.
@@ -169,6 +171,7 @@ struct Workspace {
     std::vector<MotionResidual> motion_residuals;
     MotionModelScratch motion_models;
     std::vector<ObjectField> object_fields;
+    Image<uint32_t> predicted_owner;  // empty when no pixel is predicted to move with an object
     Planes predicted;
     std::vector<uint8_t> coded_blocks[3];  // per 8x8 block of each plane: intra or with a residual
     std::vector<std::vector<uint8_t>> slice_bytes;

@@ -16,6 +16,15 @@ namespace {
 
 constexpr int kBlock = 8;
 constexpr uint8_t kNoResidual = 1;
+constexpr uint8_t kPredictedObjects = 2;  // a varint follows: the objects that predict the base
+
+// Whether this frame's object motions start at its reference: the frame before, with depth and
+// each pixel's object.
+bool objects_predictable(const FrameContext& fc, const Camera& camera) {
+    const Picture* ref = fc.reference;
+    return !fc.objects.empty() && !fc.key && ref && !ref->owner.empty() && !ref->depth.empty() &&
+           camera.prev_view == ref->camera.view && camera.prev_projection == ref->camera.projection;
+}
 constexpr int64_t kMaxResidual = 1 << 24;  // eighths of a pixel: 2 million pixels
 
 using Residual = MotionResidual;
@@ -167,6 +176,65 @@ void base_motion(const Camera& camera, ImageView<const float> depth, int w, int 
     camera_motion(camera, depth, camera.prev_view, camera.prev_projection, base.view());
 }
 
+// Objects whose pixels are predicted from the reference (bit k: the object list's k-th):
+// where a pixel is predicted to move with one of them (predict_owners), its base is that
+// object's motion, and the cameras' motion joins the fields (id 0) over the box of those pixels
+// so that a node can still choose it. Only with the frame before as the reference. The encoder
+// (`source` given) keeps the objects whose motion holds, within the bound, on at least 3/4 of
+// the pixels predicted to move with them. Returns the objects used.
+uint32_t predict_from_objects(const FrameContext& fc, const Camera& camera, uint32_t objects,
+                              Image<glm::vec2>& base, std::vector<ObjectField>& fields,
+                              Image<uint32_t>& predicted, ImageView<const glm::vec2> source = {}) {
+    predicted = {};
+    if (!objects_predictable(fc, camera)) return 0;
+    const int w = base.width(), h = base.height();
+    ensure_size(predicted, w, h);
+    const Picture& ref = *fc.reference;
+    auto predict = [&] {
+        return objects != 0 && predict_owners(fields, objects, ref.depth.view(), ref.owner.view(),
+                                              predicted.view());
+    };
+    bool any = predict();
+    if (any && !source.empty()) {
+        std::vector<std::size_t> pixels(fields.size()), held(fields.size());
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x)
+                if (const uint32_t id = predicted(x, y))
+                    for (std::size_t k = 0; k < fields.size(); ++k)
+                        if (fields[k].id == id) {
+                            ++pixels[k];
+                            const glm::vec2 d = fields[k].at(x, y) - source(x, y);
+                            held[k] += glm::dot(d, d) <= fc.sp->motion_error * fc.sp->motion_error;
+                        }
+        uint32_t kept = 0;
+        for (std::size_t k = 0; k < fields.size(); ++k)
+            if (pixels[k] > 0 && 4 * held[k] >= 3 * pixels[k]) kept |= 1u << k;
+        if (kept != objects) objects = kept, any = predict();
+    }
+    if (!any) {
+        predicted = {};
+        return 0;
+    }
+    int x0 = w, y0 = h, x1 = 0, y1 = 0;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            if (predicted(x, y) != 0)
+                x0 = std::min(x0, x), y0 = std::min(y0, y), x1 = std::max(x1, x + 1),
+                y1 = std::max(y1, y + 1);
+    ObjectField cameras;
+    cameras.x0 = x0, cameras.y0 = y0;
+    ensure_size(cameras.motion, x1 - x0, y1 - y0);
+    for (int y = y0; y < y1; ++y)
+        for (int x = x0; x < x1; ++x) {
+            cameras.motion(x - x0, y - y0) = base(x, y);
+            if (const uint32_t id = predicted(x, y))
+                for (const ObjectField& f : fields)
+                    if (f.id == id) base(x, y) = f.at(x, y);
+        }
+    fields.push_back(std::move(cameras));
+    return objects;
+}
+
 std::vector<SliceJob> slice_jobs(const SequenceParams& sp, const Image<glm::vec2>& base,
                                  ImageView<const glm::vec2> source, Image<glm::vec2>& out,
                                  std::vector<Residual>& residuals) {
@@ -203,18 +271,25 @@ void encode_motion(const FrameContext& fc, const Camera& camera, ImageView<const
                     any.store(true, std::memory_order_relaxed);
         });
     ByteWriter wr(bytes);
-    wr.u8(any ? 0 : kNoResidual);
     owner = {};
     if (!any) {
+        wr.u8(kNoResidual);
         std::swap(out, base);  // the camera motion is the motion (base is remade every frame)
     } else if (models) {
         const bool objects = !fc.objects.empty();
         if (objects) ensure_size(owner, w, h);
         object_fields(camera, depth, fc.objects, fc.work->object_fields);
-        encode_motion_models(sp, base.view(), source, ids, fc.work->object_fields, out.view(),
+        const uint32_t all = uint32_t((uint64_t(1) << fc.objects.size()) - 1);
+        const uint32_t predicting = predict_from_objects(
+            fc, camera, all, base, fc.work->object_fields, fc.work->predicted_owner, source);
+        wr.u8(predicting ? kPredictedObjects : 0);
+        if (predicting) wr.varint(predicting);
+        encode_motion_models(sp, base.view(), source, ids, fc.work->object_fields,
+                             fc.work->predicted_owner.view(), out.view(),
                              objects ? owner.view() : ImageView<uint32_t>{}, fc.work->motion_models,
                              fc.work->slice_bytes, bytes, stats);
     } else {
+        wr.u8(0);
         std::vector<Residual>& residuals = fc.work->motion_residuals;
         residuals.resize(std::size_t(w) * h);
         std::vector<SliceJob> jobs = slice_jobs(sp, base, source, out, residuals);
@@ -240,8 +315,22 @@ Status decode_motion(const FrameContext& fc, const Camera& camera, ImageView<con
     const uint8_t flags = r.u8();
     if (!r.ok()) return Status::error(r.error());
     owner = {};
-    if (flags & ~kNoResidual)
+    if (flags & ~(kNoResidual | kPredictedObjects) || flags == (kNoResidual | kPredictedObjects))
         return Status::error("motion section: unknown flags " + std::to_string(flags));
+    uint32_t predicting = 0;
+    if (flags & kPredictedObjects) {
+        const uint64_t objects = r.varint();
+        if (!r.ok()) return Status::error(r.error());
+        if (objects == 0 || objects >> fc.objects.size() || sp.motion_error <= 0.0f ||
+            !objects_predictable(fc, camera))
+            return Status::error("motion section: objects " + std::to_string(objects) +
+                                 " predict the base, but the frame has " +
+                                 std::to_string(fc.objects.size()) +
+                                 (objects_predictable(fc, camera)
+                                      ? " objects"
+                                      : " objects without the frame before as reference"));
+        predicting = uint32_t(objects);
+    }
     if (flags & kNoResidual) {
         if (r.remaining()) return Status::error("motion section: bytes after a no-residual flag");
         std::swap(out, base);  // the camera motion is the motion (base is remade every frame)
@@ -252,9 +341,12 @@ Status decode_motion(const FrameContext& fc, const Camera& camera, ImageView<con
             const bool objects = !fc.objects.empty();
             if (objects) ensure_size(owner, w, h);
             object_fields(camera, depth, fc.objects, fc.work->object_fields);
-            REPRISE_TRY(decode_motion_models(
-                sp, base.view(), fc.work->object_fields, slices, out.view(),
-                objects ? owner.view() : ImageView<uint32_t>{}, fc.work->motion_models, stats));
+            predict_from_objects(fc, camera, predicting, base, fc.work->object_fields,
+                                 fc.work->predicted_owner);
+            REPRISE_TRY(decode_motion_models(sp, base.view(), fc.work->object_fields,
+                                             fc.work->predicted_owner.view(), slices, out.view(),
+                                             objects ? owner.view() : ImageView<uint32_t>{},
+                                             fc.work->motion_models, stats));
             stats.motion_bits += 8 * in.size();
             return {};
         }

@@ -66,6 +66,7 @@ struct Job {
     ImageView<const glm::vec2> base, source;  // source: encoder only
     ImageView<const uint32_t> ids;            // encoder only
     std::span<const ObjectField> fields;
+    ImageView<const uint32_t> predicted;  // may be empty
     ImageView<glm::vec2> out;
     ImageView<uint32_t> owner;  // may be empty
     MotionModelScratch* scratch;
@@ -90,16 +91,20 @@ struct Job {
     // m as an affine model at (x, y), what a new model is predicted from: an object's value there,
     // no gradient.
     MotionModel prediction(const MotionModel& m, int x, int y) const;
-    // The object of the pixel's id (encoder), or -1.
+    // The object of the pixel's id (encoder), else the cameras' field when there is one, or -1.
     int object_of(int x, int y) const {
         const uint32_t id = ids(x, y);
         for (std::size_t k = 0; k < fields.size(); ++k)
             if (fields[k].id == id) return int(k);
-        return -1;
+        return !fields.empty() && fields.back().id == 0 ? int(fields.size()) - 1 : -1;
     }
+    // m == nullptr: the pixel took its base.
     void set_owner(int x, int y, const MotionModel* m) const {
-        if (!owner.empty())
-            owner(x, y) = m && m->object >= 0 ? fields[std::size_t(m->object)].id : 0;
+        if (owner.empty()) return;
+        if (m)
+            owner(x, y) = m->object >= 0 ? fields[std::size_t(m->object)].id : 0;
+        else
+            owner(x, y) = predicted.empty() ? 0 : predicted(x, y);
     }
 };
 
@@ -518,7 +523,8 @@ bool code_slice(Job& j, Coder& rc) {
 
 std::vector<Job> slice_jobs(const SequenceParams& sp, ImageView<const glm::vec2> base,
                             ImageView<const glm::vec2> source, ImageView<const uint32_t> ids,
-                            std::span<const ObjectField> fields, ImageView<glm::vec2> out,
+                            std::span<const ObjectField> fields,
+                            ImageView<const uint32_t> predicted, ImageView<glm::vec2> out,
                             ImageView<uint32_t> owner, MotionModelScratch& scratch) {
     scratch.cell_columns = (sp.width + 3) / 4;
     scratch.cells.assign(std::size_t(scratch.cell_columns) * ((sp.height + 3) / 4), {});
@@ -530,7 +536,7 @@ std::vector<Job> slice_jobs(const SequenceParams& sp, ImageView<const glm::vec2>
         const int y0 = std::min(sp.height, sp.slice_begin(s) * kMb);
         const int y1 = std::min(sp.height, sp.slice_begin(s + 1) * kMb);
         jobs.push_back({&sp, y0, y1, sp.motion_error, own_step(sp.motion_error), base, source, ids,
-                        fields, out, owner, &scratch});
+                        fields, predicted, out, owner, &scratch});
     }
     return jobs;
 }
@@ -554,11 +560,13 @@ bool motion_within_bound(ImageView<const glm::vec2> source, ImageView<const glm:
 
 void encode_motion_models(const SequenceParams& sp, ImageView<const glm::vec2> base,
                           ImageView<const glm::vec2> source, ImageView<const uint32_t> ids,
-                          std::span<const ObjectField> fields, ImageView<glm::vec2> out,
-                          ImageView<uint32_t> owner, MotionModelScratch& scratch,
+                          std::span<const ObjectField> fields, ImageView<const uint32_t> predicted,
+                          ImageView<glm::vec2> out, ImageView<uint32_t> owner,
+                          MotionModelScratch& scratch,
                           std::vector<std::vector<uint8_t>>& slice_bytes,
                           std::vector<uint8_t>& bytes, StreamStats& stats) {
-    std::vector<Job> jobs = slice_jobs(sp, base, source, ids, fields, out, owner, scratch);
+    std::vector<Job> jobs =
+        slice_jobs(sp, base, source, ids, fields, predicted, out, owner, scratch);
     encode_slices(sp.slices, slice_bytes, bytes, [&](int s, std::vector<uint8_t>& b) {
         RangeEncoder rc(b);
         code_slice<true>(jobs[s], rc);
@@ -569,10 +577,11 @@ void encode_motion_models(const SequenceParams& sp, ImageView<const glm::vec2> b
 
 Status decode_motion_models(const SequenceParams& sp, ImageView<const glm::vec2> base,
                             std::span<const ObjectField> fields,
+                            ImageView<const uint32_t> predicted,
                             const std::vector<std::span<const uint8_t>>& slices,
                             ImageView<glm::vec2> out, ImageView<uint32_t> owner,
                             MotionModelScratch& scratch, StreamStats& stats) {
-    std::vector<Job> jobs = slice_jobs(sp, base, {}, {}, fields, out, owner, scratch);
+    std::vector<Job> jobs = slice_jobs(sp, base, {}, {}, fields, predicted, out, owner, scratch);
     REPRISE_TRY(decode_slices(slices, "motion section", [&](int s, std::span<const uint8_t> b) {
         RangeDecoder rc(b);
         return code_slice<false>(jobs[s], rc);

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <bit>
 #include <cmath>
 #include <map>
@@ -277,8 +278,53 @@ void object_fields(const Camera& camera, ImageView<const float> depth,
         ObjectField& f = fields[k];
         f.id = o.id, f.x0 = o.x0, f.y0 = o.y0;
         ensure_size(f.motion, o.x1 - o.x0, o.y1 - o.y0);
-        rigid_motion(camera, depth, rigid_to_clip(camera, o.matrix()), o.x0, o.y0, f.motion.view());
+        ensure_size(f.depth, o.x1 - o.x0, o.y1 - o.y0);
+        const glm::mat4 to_camera(glm::dmat4(camera.prev_view) *
+                                  glm::inverse(glm::dmat4(camera.view)) * o.matrix());
+        rigid_motion(camera, depth, rigid_to_clip(camera, o.matrix()), o.x0, o.y0, f.motion.view(),
+                     to_camera, f.depth.view());
     }
+}
+
+bool predict_owners(std::span<const ObjectField> fields, uint32_t objects,
+                    ImageView<const float> reference_depth,
+                    ImageView<const uint32_t> reference_owner, ImageView<uint32_t> out) {
+    const int w = out.width, h = out.height;
+    parallel_for(0, h, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y) std::fill(out.row(y), out.row(y) + w, 0u);
+    });
+    std::atomic<bool> any{false};
+    for (std::size_t k = 0; k < fields.size() && k < 32; ++k) {
+        const ObjectField& f = fields[k];
+        if (!(objects >> k & 1) || f.id == 0 || f.depth.empty()) continue;
+        parallel_for(0, f.motion.height(), [&](int r0, int r1) {
+            bool found = false;
+            for (int r = r0; r < r1; ++r)
+                for (int c = 0; c < f.motion.width(); ++c) {
+                    const int x = f.x0 + c, y = f.y0 + r;
+                    const glm::vec2 m = f.motion(c, r);
+                    const float z = f.depth(c, r);
+                    if (out(x, y) != 0 || !finite(m) || !(z > 0.0f && std::isfinite(z))) continue;
+                    // The four reference pixels around where it was.
+                    const float qx = float(x) + m.x, qy = float(y) + m.y;
+                    if (!(qx >= -1.0f && qy >= -1.0f && qx < float(w) && qy < float(h))) continue;
+                    const int rx = int(std::floor(qx)), ry = int(std::floor(qy));
+                    bool moved = false;
+                    for (int dy = 0; dy < 2 && !moved; ++dy)
+                        for (int dx = 0; dx < 2 && !moved; ++dx) {
+                            const int sx = rx + dx, sy = ry + dy;
+                            moved = sx >= 0 && sy >= 0 && sx < w && sy < h &&
+                                    reference_owner(sx, sy) == f.id &&
+                                    std::abs(reference_depth(sx, sy) - z) <= z * (1.0f / 16.0f);
+                        }
+                    if (!moved) continue;
+                    out(x, y) = f.id;
+                    found = true;
+                }
+            if (found) any.store(true, std::memory_order_relaxed);
+        });
+    }
+    return any.load();
 }
 
 namespace {

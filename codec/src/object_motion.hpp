@@ -28,11 +28,13 @@ struct ObjectMotion {
     glm::dmat4 matrix() const;
 };
 
-// One object's motion at the pixels it may cover (NaN elsewhere).
+// One object's motion at the pixels it may cover (NaN elsewhere), and the depth each pixel's
+// point had in the previous frame's camera. Id 0: the cameras' motion (no depth).
 struct ObjectField {
     uint32_t id = 0;
     int x0 = 0, y0 = 0;
     Image<glm::vec2> motion;
+    Image<float> depth;
     glm::vec2 at(int x, int y) const;
 };
 
@@ -49,6 +51,14 @@ std::vector<ObjectMotion> fit_object_motions(const Camera& camera, ImageView<con
 // Each object's motion field from decoded depth (both sides, bit for bit).
 void object_fields(const Camera& camera, ImageView<const float> depth,
                    std::span<const ObjectMotion> objects, std::vector<ObjectField>& fields);
+
+// The object each pixel is predicted to move with (both sides, bit for bit; 0: none): the first
+// of `fields` in `objects` (bit k: fields[k]) whose motion takes the pixel to a reference pixel
+// that moved with the same object, at the depth the reference has there within 1/16. True when
+// any pixel has one.
+bool predict_owners(std::span<const ObjectField> fields, uint32_t objects,
+                    ImageView<const float> reference_depth,
+                    ImageView<const uint32_t> reference_owner, ImageView<uint32_t> out);
 
 // Each object raw, or, when `reference` (the reference picture's objects) has its id, as the
 // xor of its floats' bits with that one's and the change of its pixels.
