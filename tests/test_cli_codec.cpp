@@ -33,8 +33,9 @@ TEST(CliCodec, EncodeDecodeInfoAndThreadCountIndependence) {
                                                       "--size", "160x96", "--out", frames}),
               0);
     const std::string one = (dir / "one.rps").string(), two = (dir / "two.rps").string();
-    const test::Outcome a =
-        test::run_reprise("encode --in " + frames + " --out " + one + " --qp 24", 120);
+    const std::string per_frame = (dir / "frames.csv").string();
+    const test::Outcome a = test::run_reprise(
+        "encode --in " + frames + " --out " + one + " --qp 24 --frame-stats " + per_frame, 120);
     ASSERT_EQ(a.status, 0) << a.output;
     EXPECT_NE(a.output.find("colour"), std::string::npos) << a.output;
     EXPECT_NE(a.output.find("skipped"), std::string::npos) << a.output;
@@ -53,6 +54,29 @@ TEST(CliCodec, EncodeDecodeInfoAndThreadCountIndependence) {
     ASSERT_EQ(d.status, 0);
     const std::string stream = bytes_of(one);
     EXPECT_GT(stream.size(), 1000u);
+    // --frame-stats: a row per frame, its packet's bytes (the file adds its 24-byte header) and
+    // the bits of its sections within them.
+    std::ifstream rows(per_frame);
+    std::string row;
+    std::getline(rows, row);
+    EXPECT_EQ(row.rfind("frame,type,bytes,header_bits,camera_bits,depth_bits,motion_bits,", 0), 0u);
+    std::size_t packets = 0, bytes = 0;
+    while (std::getline(rows, row)) {
+        int frame = -1;
+        char type[8] = {};
+        std::size_t size = 0, bits[5] = {};
+        ASSERT_EQ(std::sscanf(row.c_str(), "%d,%7[a-z],%zu,%zu,%zu,%zu,%zu,%zu", &frame, type,
+                              &size, &bits[0], &bits[1], &bits[2], &bits[3], &bits[4]),
+                  8)
+            << row;
+        EXPECT_EQ(frame, int(packets));
+        EXPECT_STREQ(type, packets == 0 ? "key" : "inter");
+        EXPECT_EQ(bits[0] + bits[1] + bits[2] + bits[3] + bits[4], 8 * size) << row;
+        EXPECT_GT(bits[2], 0u) << row;
+        ++packets, bytes += size;
+    }
+    EXPECT_EQ(packets, 4u);
+    EXPECT_EQ(bytes + 24, stream.size());
     EXPECT_EQ(stream, bytes_of(two));
     EXPECT_EQ(stream, bytes_of(dir / "t1.rps")) << "1 thread";
     EXPECT_EQ(stream, bytes_of(dir / "t4.rps")) << "4 threads";

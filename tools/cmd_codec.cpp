@@ -238,14 +238,17 @@ Status run_encode(const EncodeJob& job, const codec::EncoderOptions& o) {
         busy_ms += ms_since(start);
         if (!sent.ok()) return Status::error(sequence.files[i] + ": " + sent.message());
         codec::Packet packet;
-        while (encoder.receive_packet(packet) == Result::Ok)
+        std::size_t packet_bytes = 0;
+        while (encoder.receive_packet(packet) == Result::Ok) {
             out.insert(out.end(), packet.data.begin(), packet.data.end());
+            packet_bytes += packet.data.size();
+        }
         if (!stream.write(reinterpret_cast<const char*>(out.data()), std::streamsize(out.size()))
                  .flush())
             return Status::error(job.out + ": cannot write " + partial);
         bytes += out.size();
         if (frame_stats.file())
-            write_frame_stats(frame_stats, i, out.size(), before, encoder.stats());
+            write_frame_stats(frame_stats, i, packet_bytes, before, encoder.stats());
         std::fprintf(stderr, "\r[encode] %zu/%zu frames, %zu bytes", i + 1, n, bytes);
     }
     std::fprintf(stderr, "\n");
