@@ -169,6 +169,11 @@ bool worth_dropping(const Block& levels) {
     return true;
 }
 
+// How much lower an intra macroblock's SAD must be than the reprojection's to be chosen: the
+// bits intra costs beyond inter, weighted like a rate-distortion lambda for SAD (which doubles
+// every 6 qp); 1024 at qp 40.
+int intra_penalty(int qp) { return int(std::lround(1024.0 * std::exp2((qp - 40) / 6.0))); }
+
 // Sum of absolute differences of the block against a prediction.
 int sad(const Block& a, const Block& b) {
     int s = 0;
@@ -218,6 +223,8 @@ bool code_slice(SliceJob& j, Coder& rc) {
             // Encoder decisions: intra when its best SAD (on source neighbours) clearly beats
             // the reprojection, skip when every block stays within the threshold.
             Block src, pred, pred2, coef, levels, residual;
+            Block inter_levels[12];  // encoder: an inter macroblock's blocks in coding order
+            int inter_nonzero[12];
             if constexpr (Encode) {
                 if (!intra) {
                     // Inter error first; intra is only tried where the reprojection is poor
@@ -247,7 +254,32 @@ bool code_slice(SliceJob& j, Coder& rc) {
                             }
                             intra_sad += best;
                         });
-                        intra = intra_sad + 1024 < inter_sad;
+                        intra = intra_sad + intra_penalty(j.qp) < inter_sad;
+                    }
+                    // The inter blocks' levels, before the skip flag: a macroblock none of whose
+                    // blocks keeps a level decodes to its prediction, so it is sent as skipped.
+                    if (!skip && !intra) {
+                        int b = 0;
+                        bool any = false;
+                        for_each_block(j, mx, my, [&](int k, int bx, int by) {
+                            const int limit = k ? 2 * j.skip_threshold : j.skip_threshold;
+                            load(j.source->p[k], bx, by, src);
+                            load(j.predicted->p[k], bx, by, pred);
+                            inter_nonzero[b] = 0;
+                            bool within = true;
+                            for (int i = 0; i < 64 && within; ++i)
+                                within = std::abs(src[i] - pred[i]) <= limit;
+                            if (!within) {
+                                for (int i = 0; i < 64; ++i) residual[i] = src[i] - pred[i];
+                                forward_dct(residual, coef);
+                                inter_nonzero[b] = quantize(coef, scale, 16 / 6, inter_levels[b]);
+                                if (inter_nonzero[b] && worth_dropping(inter_levels[b]))
+                                    inter_nonzero[b] = 0;
+                            }
+                            any = any || inter_nonzero[b] > 0;
+                            ++b;
+                        });
+                        skip = !any;
                     }
                 }
                 if (j.predicted) {
@@ -263,14 +295,16 @@ bool code_slice(SliceJob& j, Coder& rc) {
             above_skip[mx] = left_skip = skip;
             above_intra[mx] = left_intra = intra;
             j.intra += intra;
+            int block = -1;  // in the macroblock, in coding order
             for (int k = 0; k < 3; ++k) {
                 const int n = j.g->blocks_per_side[k];
-                const int lo = k ? -255 : 0, limit = k ? 2 * j.skip_threshold : j.skip_threshold;
+                const int lo = k ? -255 : 0;
                 const int top = j.mb_y0 * 8 * n;
                 const int type = block_type(k, intra);
                 for (int b = 0; b < n * n; ++b) {
                     const int bx = mx * 8 * n + (b % n) * 8, by = my * 8 * n + (b / n) * 8;
                     ++j.blocks;
+                    ++block;
                     if (skip) {
                         load(j.predicted->p[k], bx, by, pred);
                         store(j.out->p[k], bx, by, pred, nullptr, lo, 255);
@@ -298,22 +332,14 @@ bool code_slice(SliceJob& j, Coder& rc) {
                         } else {
                             load(j.predicted->p[k], bx, by, pred);
                         }
-                        bool coded = true;
-                        if (!intra) {
-                            bool within = true;
-                            for (int i = 0; i < 64 && within; ++i)
-                                within = std::abs(src[i] - pred[i]) <= limit;
-                            coded = !within;
-                        }
                         int nonzero = 0;
-                        if (coded) {
+                        if (intra) {
                             for (int i = 0; i < 64; ++i) residual[i] = src[i] - pred[i];
                             forward_dct(residual, coef);
-                            nonzero = quantize(coef, scale, intra ? 16 / 3 : 16 / 6, levels);
-                            if (!intra && nonzero && worth_dropping(levels)) {
-                                levels.fill(0);
-                                nonzero = 0;
-                            }
+                            nonzero = quantize(coef, scale, 16 / 3, levels);
+                        } else {
+                            nonzero = inter_nonzero[block];
+                            if (nonzero) levels = inter_levels[block];
                         }
                         rc.bit(m.cbf[type], nonzero > 0);
                         j.mark(k, bx, by, intra || nonzero);
