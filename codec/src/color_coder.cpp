@@ -174,6 +174,28 @@ bool worth_dropping(const Block& levels) {
 // every 6 qp); 1024 at qp 40.
 int intra_penalty(int qp) { return int(std::lround(1024.0 * std::exp2((qp - 40) / 6.0))); }
 
+// Sum of absolute transformed differences (8x8 Hadamard): what a prediction's residual costs
+// after the transform, closer than the SAD (encoder-only).
+int satd(const Block& a, const Block& b) {
+    int d[64];
+    for (int i = 0; i < 64; ++i) d[i] = a[i] - b[i];
+    for (int pass = 0; pass < 2; ++pass) {
+        const int step = pass ? 8 : 1, line = pass ? 1 : 8;
+        for (int l = 0; l < 8; ++l) {
+            int* v = d + l * line;
+            for (int h = 1; h < 8; h *= 2)
+                for (int i = 0; i < 8; i += 2 * h)
+                    for (int k = i; k < i + h; ++k) {
+                        const int x = v[k * step], y = v[(k + h) * step];
+                        v[k * step] = x + y, v[(k + h) * step] = x - y;
+                    }
+        }
+    }
+    int s = 0;
+    for (int i = 0; i < 64; ++i) s += std::abs(d[i]);
+    return s / 8;
+}
+
 // Sum of absolute differences of the block against a prediction.
 int sad(const Block& a, const Block& b) {
     int s = 0;
@@ -320,7 +342,7 @@ bool code_slice(SliceJob& j, Coder& rc) {
                             for (int candidate = 0; candidate < kModes; ++candidate) {
                                 intra_predict(j.out->p[k], bx, by, top, candidate, k ? 0 : 128,
                                               pred2);
-                                const int s = sad(src, pred2);
+                                const int s = satd(src, pred2);
                                 if (s < best) {
                                     best = s;
                                     mode = candidate;
