@@ -4,6 +4,7 @@
 
 #include <filesystem>
 #include <string>
+#include <utility>
 
 #include "reprise/core/exr.hpp"
 #include "support/cli.hpp"
@@ -14,10 +15,19 @@ namespace fs = std::filesystem;
 
 namespace {
 
+// A spoiled sequence in its own folder, removed with it.
 struct Spoiled {
     fs::path dir;
     std::string in;
     NonfiniteCounts counts;
+    Spoiled() = default;
+    Spoiled(Spoiled&& o) noexcept
+        : dir(std::exchange(o.dir, {})), in(std::move(o.in)), counts(o.counts) {}
+    Spoiled& operator=(Spoiled&&) = delete;
+    ~Spoiled() {
+        std::error_code ec;
+        if (!dir.empty()) fs::remove_all(dir, ec);
+    }
 };
 
 Spoiled write_spoiled(const std::string& name, int frames) {
