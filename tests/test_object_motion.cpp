@@ -30,6 +30,21 @@ std::vector<ObjectMotion> fit(const Frame& f, Image<glm::vec2>& base) {
                               0.25f, {});
 }
 
+// The decoder gives the encoder's motion, depth and colour bit for bit, and every decoded pixel's
+// motion lies within 0.25 px of the renderer's.
+void expect_decoded_as_encoded(const std::vector<Frame>& frames, const test::Coded& coded) {
+    const auto decoded = decode_all(coded.packets);
+    ASSERT_EQ(decoded.size(), frames.size());
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+        EXPECT_TRUE(test::same_bits(decoded[i].motion, coded.reconstructions[i].motion));
+        EXPECT_TRUE(test::same_bits(decoded[i].depth, coded.reconstructions[i].depth));
+        EXPECT_TRUE(test::same_bits(decoded[i].color, coded.reconstructions[i].color));
+        for (std::size_t p = 0; p < frames[i].motion.pixel_count(); ++p)
+            ASSERT_LE(glm::length(decoded[i].motion.data()[p] - frames[i].motion.data()[p]), 0.25f)
+                << "frame " << i << " pixel " << p;
+    }
+}
+
 }  // namespace
 
 // On rendered depth, each fitted object's motion field matches the renderer's motion of its
@@ -83,17 +98,7 @@ TEST(ObjectMotion, ObjectsCutTheMotionBitsOfCrossing) {
             test::encode_all(frames, {.depth = DepthMode::Lossless, .rigid_objects = objects});
         bits[objects] = coded.stats.motion_bits;
         EXPECT_EQ(coded.stats.motion_objects > 0, objects);
-        const auto decoded = decode_all(coded.packets);
-        ASSERT_EQ(decoded.size(), frames.size());
-        for (std::size_t i = 0; i < frames.size(); ++i) {
-            EXPECT_TRUE(test::same_bits(decoded[i].motion, coded.reconstructions[i].motion));
-            EXPECT_TRUE(test::same_bits(decoded[i].depth, coded.reconstructions[i].depth));
-            EXPECT_TRUE(test::same_bits(decoded[i].color, coded.reconstructions[i].color));
-            for (std::size_t p = 0; p < frames[i].motion.pixel_count(); ++p)
-                ASSERT_LE(glm::length(decoded[i].motion.data()[p] - frames[i].motion.data()[p]),
-                          0.25f)
-                    << "frame " << i << " pixel " << p;
-        }
+        expect_decoded_as_encoded(frames, coded);
     }
     EXPECT_LE(double(bits[1]), 0.7 * double(bits[0])) << bits[1] << " against " << bits[0];
 }
@@ -128,16 +133,7 @@ TEST(ObjectMotion, PixelsPredictedToMoveWithTheirObjectCostNoMotionBits) {
         const test::Coded key = test::encode_all({frames[0]}, {.qp = 34});
         const test::Coded coded = test::encode_all(frames, {.qp = 34});
         EXPECT_LE(coded.stats.motion_bits - key.stats.motion_bits, std::size_t(most));
-        const auto decoded = decode_all(coded.packets);
-        ASSERT_EQ(decoded.size(), frames.size());
-        for (std::size_t i = 0; i < frames.size(); ++i) {
-            EXPECT_TRUE(test::same_bits(decoded[i].motion, coded.reconstructions[i].motion));
-            EXPECT_TRUE(test::same_bits(decoded[i].color, coded.reconstructions[i].color));
-            for (std::size_t p = 0; p < frames[i].motion.pixel_count(); ++p)
-                ASSERT_LE(glm::length(decoded[i].motion.data()[p] - frames[i].motion.data()[p]),
-                          0.25f)
-                    << "frame " << i << " pixel " << p;
-        }
+        expect_decoded_as_encoded(frames, coded);
     }
 }
 

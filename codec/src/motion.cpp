@@ -16,15 +16,7 @@ namespace {
 
 constexpr int kBlock = 8;
 constexpr uint8_t kNoResidual = 1;
-constexpr uint8_t kPredictedObjects = 2;  // a varint follows: the objects that predict the base
-
-// Whether this frame's object motions start at its reference: the frame before, with depth and
-// each pixel's object.
-bool objects_predictable(const FrameContext& fc, const Camera& camera) {
-    const Picture* ref = fc.reference;
-    return !fc.objects.empty() && !fc.key && ref && !ref->owner.empty() && !ref->depth.empty() &&
-           camera.prev_view == ref->camera.view && camera.prev_projection == ref->camera.projection;
-}
+constexpr uint8_t kPredictedObjects = 2;   // a varint follows: the objects that predict the base
 constexpr int64_t kMaxResidual = 1 << 24;  // eighths of a pixel: 2 million pixels
 
 using Residual = MotionResidual;
@@ -174,6 +166,14 @@ void base_motion(const Camera& camera, ImageView<const float> depth, int w, int 
         return;
     }
     camera_motion(camera, depth, camera.prev_view, camera.prev_projection, base.view());
+}
+
+// Whether this frame's object motions start at its reference: the frame before, with depth and
+// each pixel's object.
+bool objects_predictable(const FrameContext& fc, const Camera& camera) {
+    const Picture* ref = fc.reference;
+    return !fc.objects.empty() && !fc.key && ref && !ref->owner.empty() && !ref->depth.empty() &&
+           camera.prev_view == ref->camera.view && camera.prev_projection == ref->camera.projection;
 }
 
 // Objects whose pixels are predicted from the reference (bit k: the object list's k-th):
