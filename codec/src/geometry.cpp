@@ -1,9 +1,11 @@
 // Motion and depth that the cameras explain: both sides compute them from decoded depth with the
 // same float arithmetic, so they agree bit for bit.
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include <glm/mat4x4.hpp>
 
@@ -175,7 +177,7 @@ struct Landings {
     Image<float> z, px, py, held;
     Image<float> inverse;  // 1 / z of each landing (plane fit only)
     Image<int> object;     // index into the objects, -1: none
-    // The plane's span in pixels (at_centre): 6 at a height of 360, the best of 3 to 18 there, as
+    // The plane's span in pixels (plane_row): 6 at a height of 360, the best of 3 to 18 there, as
     // 12 was at 720.
     int span = 1;
     void resize(int w, int h) {
@@ -183,53 +185,6 @@ struct Landings {
         for (Image<float>* i : {&z, &px, &py, &held, &inverse}) ensure_size(*i, w, h);
         ensure_size(slot, w, h);
         ensure_size(object, w, h);
-    }
-    // The landing of reference pixel (x, y) on the same surface as (nx, ny): landed, moved the
-    // same way, inverse depth within 1/8 of its own.
-    bool beside(int x, int y, int nx, int ny) const {
-        if (nx < 0 || ny < 0 || nx >= slot.width() || ny >= slot.height() || slot(nx, ny) < 0 ||
-            object(nx, ny) != object(x, y))
-            return false;
-        const float v = inverse(x, y);
-        return std::abs(inverse(nx, ny) - v) <= 0.125f * v;
-    }
-    // The depth at the centre of target pixel (tx, ty) on the plane in (px, py, 1/z) through the
-    // landing of (x, y) and those of a horizontal and a vertical neighbour on its surface, taken
-    // `span` pixels away (a decoded surface is a staircase of kept values: a wider span averages
-    // its steps out), else half as far, down to adjacent ones; its own depth where no span has
-    // both, the plane is degenerate or it would move the value beyond its neighbours'. The value
-    // is the mean of the plane's value at the centre through this landing and through each
-    // adjacent landing on the surface: decoded depth carries errors of up to the bound, and a
-    // prediction from one landing would carry its error on, frame after frame, until the errors
-    // of a surface spread past the bound (each such pixel a residual).
-    float at_centre(int x, int y, int tx, int ty) const {
-        const float own = z(x, y);
-        for (int k = span; k >= 1; k /= 2) {
-            const int dx = beside(x, y, x + k, y) ? k : beside(x, y, x - k, y) ? -k : 0;
-            const int dy = beside(x, y, x, y + k) ? k : beside(x, y, x, y - k) ? -k : 0;
-            if (dx == 0 || dy == 0) continue;
-            const float v = inverse(x, y);
-            const float ax = px(x + dx, y) - px(x, y), ay = py(x + dx, y) - py(x, y);
-            const float bx = px(x, y + dy) - px(x, y), by = py(x, y + dy) - py(x, y);
-            const float av = inverse(x + dx, y) - v, bv = inverse(x, y + dy) - v;
-            const float det = ax * by - ay * bx;
-            if (!(std::abs(det) >= 0.25f * float(k * k))) continue;
-            const float gx = (av * by - bv * ay) / det, gy = (ax * bv - bx * av) / det;
-            const float cx = float(tx) + 0.5f, cy = float(ty) + 0.5f;
-            const float change = gx * (cx - px(x, y)) + gy * (cy - py(x, y));
-            if (!(std::abs(change) <= std::max(std::abs(av), std::abs(bv))) || !(v + change > 0.0f))
-                continue;
-            float sum = v + change;
-            int count = 1;
-            for (const auto [nx, ny] : {std::pair{x - 1, y}, {x + 1, y}, {x, y - 1}, {x, y + 1}}) {
-                if (!beside(x, y, nx, ny)) continue;
-                const float value =
-                    inverse(nx, ny) + gx * (cx - px(nx, ny)) + gy * (cy - py(nx, ny));
-                if (value > 0.0f) sum += value, ++count;
-            }
-            return float(count) / sum;
-        }
-        return own;
     }
 };
 
@@ -371,11 +326,25 @@ void reproject_depth(const Camera& from, ImageView<const float> depth, const Cam
         }
     });
     parallel_for(0, h, [&](int y0, int y1) {
-        for (int y = y0; y < y1; ++y)
+        for (int y = y0; y < y1; ++y) {
+            const float* value = &landings.z(0, y);
+            if (plane_fit) {
+                plane_row({.slot = landings.slot.data(),
+                           .object = landings.object.data(),
+                           .inverse = landings.inverse.data(),
+                           .z = landings.z.data(),
+                           .px = landings.px.data(),
+                           .py = landings.py.data(),
+                           .width = w,
+                           .height = h,
+                           .span = landings.span,
+                           .y = y,
+                           .out = &landings.held(0, y)});
+                value = &landings.held(0, y);
+            }
             for (int x = 0; x < w; ++x)
-                if (const int32_t slot = landings.slot(x, y); slot >= 0)
-                    land(slot, plane_fit ? landings.at_centre(x, y, slot % w, slot / w)
-                                         : landings.z(x, y));
+                if (const int32_t slot = landings.slot(x, y); slot >= 0) land(slot, value[x]);
+        }
     });
     if (plane_fit) {
         fill_cracks(out, landings.held);
@@ -405,6 +374,52 @@ void forward_row_reference(const ForwardRow& r, int i_begin, int i_end) {
         r.px[i] = px;
         r.py[i] = py;
     }
+}
+
+// A decoded surface is a staircase of kept values: a wider span averages its steps out. Decoded
+// depth carries errors of up to the bound, and a prediction from one landing would carry its
+// error on, frame after frame, until the errors of a surface spread past the bound (each such
+// pixel a residual): hence the mean through the adjacent landings.
+void plane_row_reference(const PlaneRow& r, int x_begin, int x_end) {
+    const int w = r.width, y = r.y;
+    auto at = [&](const auto* image, int x, int yy) { return image[std::size_t(yy) * w + x]; };
+    auto beside = [&](int x, int nx, int ny) {
+        if (nx < 0 || ny < 0 || nx >= w || ny >= r.height || at(r.slot, nx, ny) < 0 ||
+            at(r.object, nx, ny) != at(r.object, x, y))
+            return false;
+        const float v = at(r.inverse, x, y);
+        return std::abs(at(r.inverse, nx, ny) - v) <= 0.125f * v;
+    };
+    auto at_centre = [&](int x) {
+        const float v = at(r.inverse, x, y), px = at(r.px, x, y), py = at(r.py, x, y);
+        const float cx = float(int32_t(px)) + 0.5f, cy = float(int32_t(py)) + 0.5f;
+        for (int k = r.span; k >= 1; k /= 2) {
+            const int dx = beside(x, x + k, y) ? k : beside(x, x - k, y) ? -k : 0;
+            const int dy = beside(x, x, y + k) ? k : beside(x, x, y - k) ? -k : 0;
+            if (dx == 0 || dy == 0) continue;
+            const float ax = at(r.px, x + dx, y) - px, ay = at(r.py, x + dx, y) - py;
+            const float bx = at(r.px, x, y + dy) - px, by = at(r.py, x, y + dy) - py;
+            const float av = at(r.inverse, x + dx, y) - v, bv = at(r.inverse, x, y + dy) - v;
+            const float det = ax * by - ay * bx;
+            if (!(std::abs(det) >= 0.25f * float(k * k))) continue;
+            const float gx = (av * by - bv * ay) / det, gy = (ax * bv - bx * av) / det;
+            const float change = gx * (cx - px) + gy * (cy - py);
+            if (!(std::abs(change) <= std::max(std::abs(av), std::abs(bv))) || !(v + change > 0.0f))
+                continue;
+            float sum = v + change;
+            int count = 1;
+            for (const auto [nx, ny] : {std::pair{x - 1, y}, {x + 1, y}, {x, y - 1}, {x, y + 1}}) {
+                if (!beside(x, nx, ny)) continue;
+                const float value = at(r.inverse, nx, ny) + gx * (cx - at(r.px, nx, ny)) +
+                                    gy * (cy - at(r.py, nx, ny));
+                if (value > 0.0f) sum += value, ++count;
+            }
+            return float(count) / sum;
+        }
+        return at(r.z, x, y);
+    };
+    for (int x = x_begin; x < x_end; ++x)
+        if (at(r.slot, x, y) >= 0) r.out[x] = at_centre(x);
 }
 
 namespace {

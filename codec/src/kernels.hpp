@@ -102,6 +102,27 @@ struct ForwardRow {
 void forward_row_reference(const ForwardRow& row, int i_begin, int i_end);
 void forward_row(const ForwardRow& row);
 
+// The plane fit of reproject_depth: the depth each landed pixel of reference row y takes at the
+// centre of the target pixel it lands in (int px, int py), on the plane in (px, py, 1/z) through
+// its landing and those of a horizontal and a vertical neighbour on its surface (landed, same
+// object, 1/z within 1/8 of its own) k pixels away, k = span, span / 2, ... 1; the value is the
+// mean of the plane's value through it and through each adjacent landing on the surface. Its own
+// z where no k has both neighbours, the plane is degenerate or moves the value beyond the
+// neighbours'. Inputs are whole width x height images (row-major); out is row y, written where
+// the pixel landed (slot >= 0).
+struct PlaneRow {
+    const int32_t* slot;   // the target pixel a landing went to, -1: none
+    const int* object;     // the object it moved with, -1: none
+    const float* inverse;  // 1 / z of each landing
+    const float* z;
+    const float* px;
+    const float* py;
+    int width, height, span, y;
+    float* out;
+};
+void plane_row_reference(const PlaneRow& row, int x_begin, int x_end);
+void plane_row(const PlaneRow& row);
+
 // Whether any pixel of a row needs a motion residual (motion.cpp): the renderer's motion differs
 // from the camera motion by 1/16 pixel or more, or exactly one of them is not finite.
 struct MotionResidualRow {

@@ -290,6 +290,93 @@ void ForwardRowSimd(const ForwardRow& r) {
     forward_row_reference(r, i, r.count);
 }
 
+// plane_row_reference, lane by lane over the pixels whose neighbours span pixels away lie in the
+// row; each k only while some landed lane has no value yet.
+void PlaneRowSimd(const PlaneRow& r) {
+    const hn::ScalableTag<float> df;
+    const hn::RebindToSigned<decltype(df)> di;
+    using VF = hn::Vec<decltype(df)>;
+    using VI = hn::Vec<decltype(di)>;
+    using MF = hn::Mask<decltype(df)>;
+    const int n = int(hn::Lanes(df)), w = r.width, y = r.y;
+    const int begin = std::min(w, r.span), end = std::max(begin, w - r.span);
+    const VF zero = hn::Zero(df), half = hn::Set(df, 0.5f), eighth = hn::Set(df, 0.125f);
+    const VI none = hn::Set(di, -1);
+    const MF nothing = hn::FirstN(df, 0);
+    const std::size_t row = std::size_t(y) * w;
+    int x = begin;
+    for (; x + n <= end; x += n) {
+        const std::size_t o = row + std::size_t(x);
+        const VI slot = hn::LoadU(di, r.slot + o);
+        const MF landed = hn::RebindMask(df, slot > none);
+        if (hn::AllFalse(df, landed)) continue;
+        const VI object = hn::LoadU(di, r.object + o);
+        const VF v = hn::LoadU(df, r.inverse + o), px = hn::LoadU(df, r.px + o);
+        const VF py = hn::LoadU(df, r.py + o), tolerance = eighth * v;
+        const VF cx = hn::ConvertTo(df, hn::ConvertTo(di, px)) + half;
+        const VF cy = hn::ConvertTo(df, hn::ConvertTo(di, py)) + half;
+        // The landing at offset `at` (pixels from o) on the same surface.
+        auto beside = [&](std::ptrdiff_t at) {
+            const VI s = hn::LoadU(di, r.slot + o + at);
+            const VI id = hn::LoadU(di, r.object + o + at);
+            const VF other = hn::LoadU(df, r.inverse + o + at);
+            return hn::And(hn::RebindMask(df, hn::And(s > none, id == object)),
+                           hn::Abs(other - v) <= tolerance);
+        };
+        VF result = hn::LoadU(df, r.z + o);
+        MF open = landed;
+        for (int k = r.span; k >= 1 && !hn::AllFalse(df, open); k /= 2) {
+            const std::ptrdiff_t down = std::ptrdiff_t(k) * w;
+            const MF right = beside(k), left = hn::AndNot(right, beside(-k));
+            const bool has_below = y + k < r.height, has_above = y - k >= 0;
+            const MF below = has_below ? beside(down) : nothing;
+            const MF above = hn::AndNot(below, has_above ? beside(-down) : nothing);
+            MF take = hn::And(open, hn::And(hn::Or(right, left), hn::Or(below, above)));
+            if (hn::AllFalse(df, take)) continue;
+            // The neighbour at +a where `first`, else at -a (lanes with neither are masked out
+            // below); a row that does not exist is not read.
+            auto pick = [&](const float* image, MF first, std::ptrdiff_t a, bool has_plus,
+                            bool has_minus) {
+                const VF plus = hn::LoadU(df, image + o + (has_plus ? a : 0));
+                return hn::IfThenElse(first, plus, hn::LoadU(df, image + o - (has_minus ? a : 0)));
+            };
+            const VF ax = pick(r.px, right, k, true, true) - px;
+            const VF ay = pick(r.py, right, k, true, true) - py;
+            const VF bx = pick(r.px, below, down, has_below, has_above) - px;
+            const VF by = pick(r.py, below, down, has_below, has_above) - py;
+            const VF av = pick(r.inverse, right, k, true, true) - v;
+            const VF bv = pick(r.inverse, below, down, has_below, has_above) - v;
+            const VF det = ax * by - ay * bx;
+            take = hn::And(take, hn::Abs(det) >= hn::Set(df, 0.25f * float(k * k)));
+            const VF gx = (av * by - bv * ay) / det, gy = (ax * bv - bx * av) / det;
+            const VF change = gx * (cx - px) + gy * (cy - py);
+            const VF abs_av = hn::Abs(av), abs_bv = hn::Abs(bv);
+            const VF largest = hn::IfThenElse(abs_av < abs_bv, abs_bv, abs_av);  // std::max
+            VF sum = v + change;
+            take = hn::And(take, hn::And(hn::Abs(change) <= largest, sum > zero));
+            if (hn::AllFalse(df, take)) continue;
+            VF count = hn::Set(df, 1.0f);
+            const std::ptrdiff_t adjacent[] = {-1, 1, -std::ptrdiff_t(w), std::ptrdiff_t(w)};
+            const bool exists[] = {true, true, y > 0, y + 1 < r.height};
+            for (int a = 0; a < 4; ++a) {
+                if (!exists[a]) continue;
+                const std::ptrdiff_t at = adjacent[a];
+                const VF value = hn::LoadU(df, r.inverse + o + at) +
+                                 gx * (cx - hn::LoadU(df, r.px + o + at)) +
+                                 gy * (cy - hn::LoadU(df, r.py + o + at));
+                const MF add = hn::And(beside(at), value > zero);
+                sum = hn::IfThenElse(add, sum + value, sum);
+                count = hn::IfThenElse(add, count + hn::Set(df, 1.0f), count);
+            }
+            result = hn::IfThenElse(take, count / sum, result);
+            open = hn::AndNot(take, open);
+        }
+        hn::BlendedStore(result, landed, df, r.out + x);
+    }
+    plane_row_reference(r, 0, begin);
+    plane_row_reference(r, x, w);
+}
+
 bool MotionResidualRowSimd(const MotionResidualRow& r) {
     const hn::ScalableTag<float> df;
     using VF = hn::Vec<decltype(df)>;
@@ -364,12 +451,15 @@ HWY_EXPORT(FromPlanesRowSimd);
 HWY_EXPORT(ForwardRowSimd);
 HWY_EXPORT(MotionResidualRowSimd);
 HWY_EXPORT(ViewKeepRowSimd);
+HWY_EXPORT(PlaneRowSimd);
 
 void view_keep_row(const ViewKeepRow& row) { HWY_DYNAMIC_DISPATCH(ViewKeepRowSimd)(row); }
 
 bool motion_residual_row(const MotionResidualRow& row) {
     return HWY_DYNAMIC_DISPATCH(MotionResidualRowSimd)(row);
 }
+
+void plane_row(const PlaneRow& row) { HWY_DYNAMIC_DISPATCH(PlaneRowSimd)(row); }
 
 void forward_row(const ForwardRow& row) { HWY_DYNAMIC_DISPATCH(ForwardRowSimd)(row); }
 

@@ -460,11 +460,81 @@ private:
     std::vector<uint8_t> reference_, optimized_;
 };
 
+// The plane fit of depth reprojection. Random: landings of one tilted surface, stretched and
+// shifted, with holes (no landing) and a second object; worst case: NaN/Inf/zero/negative and
+// huge inverse depths, landings on a pixel's edge and degenerate planes (neighbours landing on
+// one point).
+class PlaneCase final : public KernelCase {
+public:
+    void generate(int w, int h, KernelInputs inputs, uint32_t seed) override {
+        std::mt19937 rng(seed);
+        width_ = w, height_ = h;
+        span_ = 2 + int(seed % 5);
+        const bool worst = inputs == KernelInputs::WorstCase;
+        const std::size_t n = std::size_t(w) * h;
+        slot_.assign(n, -1), object_.assign(n, 0);
+        inverse_.assign(n, 0.0f), z_.assign(n, 0.0f), px_.assign(n, 0.0f), py_.assign(n, 0.0f);
+        const float base = uniform(rng, 0.02f, 2.0f), gx = uniform(rng, -0.01f, 0.01f);
+        const float gy = uniform(rng, -0.01f, 0.01f), stretch = uniform(rng, 0.7f, 1.4f);
+        const float shift = uniform(rng, -3.0f, 3.0f);
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                const std::size_t i = std::size_t(y) * w + x;
+                if (rng() % 8 == 0) continue;  // nothing landed
+                float px = float(x) * stretch + shift + uniform(rng, -0.2f, 0.2f);
+                float py = float(y) + uniform(rng, -0.3f, 0.3f);
+                if (worst && rng() % 6 == 0) px = float(int(px));  // on the pixel's edge
+                if (worst && rng() % 6 == 0 && x > 0) px = px_[i - 1], py = py_[i - 1];
+                px_[i] = std::clamp(px, 0.0f, std::nextafter(float(w), 0.0f));
+                py_[i] = std::clamp(py, 0.0f, std::nextafter(float(h), 0.0f));
+                slot_[i] = int32_t(py_[i]) * w + int32_t(px_[i]);
+                object_[i] = x > w / 2 && y > h / 3 ? 1 : rng() % 16 == 0 ? -1 : 0;
+                float v = base + gx * float(x) + gy * float(y) + uniform(rng, -0.002f, 0.002f);
+                if (worst && rng() % 5 == 0) v = worst_value(rng);
+                inverse_[i] = v;
+                z_[i] = worst && rng() % 7 == 0 ? worst_value(rng) : 1.0f / v;
+            }
+    }
+    void run_reference() override {
+        run_into(reference_, [](const PlaneRow& r) { plane_row_reference(r, 0, r.width); });
+    }
+    void run() override { run_into(optimized_, plane_row); }
+    std::string compare() const override {
+        return compare_floats("depth at the pixel centre", optimized_, reference_, true);
+    }
+
+private:
+    template <class Kernel>
+    void run_into(std::vector<float>& out, Kernel kernel) {
+        out.assign(slot_.size(), -7.0f);
+        parallel_for(0, height_, [&](int y0, int y1) {
+            for (int y = y0; y < y1; ++y)
+                kernel({.slot = slot_.data(),
+                        .object = object_.data(),
+                        .inverse = inverse_.data(),
+                        .z = z_.data(),
+                        .px = px_.data(),
+                        .py = py_.data(),
+                        .width = width_,
+                        .height = height_,
+                        .span = span_,
+                        .y = y,
+                        .out = out.data() + std::size_t(y) * width_});
+        });
+    }
+
+    int width_ = 0, height_ = 0, span_ = 2;
+    std::vector<int32_t> slot_;
+    std::vector<int> object_;
+    std::vector<float> inverse_, z_, px_, py_, reference_, optimized_;
+};
+
 constexpr KernelEntry kEntries[] = {
     {"codec prediction, luma", "bit-exact", true, make<PredictCase, false>},
     {"codec prediction, 4:2:0 chroma", "bit-exact", true, make<PredictCase, true>},
     {"codec camera motion", "bit-exact", true, make<CameraMotionCase>},
     {"codec depth forward projection", "bit-exact", true, make<ForwardCase>},
+    {"codec depth plane fit", "bit-exact", true, make<PlaneCase>},
     {"codec motion residual test", "bit-exact", true, make<MotionResidualCase>},
     {"codec view depth keeps its prediction", "bit-exact", true, make<ViewKeepCase>},
     {"codec colour to YCoCg-R", "bit-exact", true, make<ToPlanesCase>},
