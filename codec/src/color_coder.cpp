@@ -45,44 +45,56 @@ Geometry geometry(const SequenceParams& sp) {
     return g;
 }
 
-// Intra prediction of the 8x8 block at (bx, by) of plane `rec` from its decoded top row (when
-// by > top, the slice's first row in this plane) and left column.
-void intra_predict(const Image<int16_t>& rec, int bx, int by, int top, int mode, int neutral,
-                   Block& pred) {
+// What intra prediction of the 8x8 block at (bx, by) of plane `rec` predicts from: its decoded
+// top row (when by > top, the slice's first row in this plane) and left column, each the DC value
+// where it is missing, and the DC value (their rounded mean, else `neutral`).
+struct IntraEdges {
+    int t[8], l[8], dc;
+};
+IntraEdges intra_edges(const Image<int16_t>& rec, int bx, int by, int top, int neutral) {
+    IntraEdges e;
     const bool has_top = by > top, has_left = bx > 0;
-    int t[8], l[8];
-    int sum = 0, count = 0;
+    int sum = 0;
     for (int i = 0; i < 8; ++i) {
         if (has_top) {
-            t[i] = rec(bx + i, by - 1);
-            sum += t[i];
+            e.t[i] = rec(bx + i, by - 1);
+            sum += e.t[i];
         }
         if (has_left) {
-            l[i] = rec(bx - 1, by + i);
-            sum += l[i];
+            e.l[i] = rec(bx - 1, by + i);
+            sum += e.l[i];
         }
     }
-    count = 8 * (int(has_top) + int(has_left));
-    int dc = neutral;
+    const int count = 8 * (int(has_top) + int(has_left));
+    e.dc = neutral;
     if (count) {
         const int v = sum + count / 2;  // rounded, floor division for negative chroma
-        dc = v >= 0 ? v / count : -((-v + count - 1) / count);
+        e.dc = v >= 0 ? v / count : -((-v + count - 1) / count);
     }
     for (int i = 0; i < 8; ++i) {
-        if (!has_top) t[i] = dc;
-        if (!has_left) l[i] = dc;
+        if (!has_top) e.t[i] = e.dc;
+        if (!has_left) e.l[i] = e.dc;
     }
+    return e;
+}
+
+void intra_predict(const IntraEdges& e, int mode, Block& pred) {
     for (int y = 0; y < 8; ++y)
         for (int x = 0; x < 8; ++x) {
-            int v = dc;
+            int v = e.dc;
             if (mode == 1)
-                v = t[x];
+                v = e.t[x];
             else if (mode == 2)
-                v = l[y];
+                v = e.l[y];
             else if (mode == 3)
-                v = (t[x] + l[y] + 1) >> 1;
+                v = (e.t[x] + e.l[y] + 1) >> 1;
             pred[y * 8 + x] = v;
         }
+}
+
+void intra_predict(const Image<int16_t>& rec, int bx, int by, int top, int mode, int neutral,
+                   Block& pred) {
+    intra_predict(intra_edges(rec, bx, by, top, neutral), mode, pred);
 }
 
 void load(const Image<int16_t>& p, int bx, int by, Block& b) {
@@ -177,26 +189,58 @@ bool worth_dropping(const Block& levels) {
 // every 6 qp); 1024 at qp 40.
 int intra_penalty(int qp) { return int(std::lround(1024.0 * std::exp2((qp - 40) / 6.0))); }
 
+// The unnormalised Walsh-Hadamard transform of `count` values `step` apart, in place.
+void hadamard8(int* v, int step) {
+    for (int h = 1; h < 8; h *= 2)
+        for (int i = 0; i < 8; i += 2 * h)
+            for (int k = i; k < i + h; ++k) {
+                const int x = v[k * step], y = v[(k + h) * step];
+                v[k * step] = x + y, v[(k + h) * step] = x - y;
+            }
+}
+
+// The 8x8 Hadamard transform of a row-major block, in place: rows, then columns.
+void hadamard(int* d) {
+    for (int l = 0; l < 8; ++l) hadamard8(d + l * 8, 1);
+    for (int l = 0; l < 8; ++l) hadamard8(d + l, 8);
+}
+
 // Sum of absolute transformed differences (8x8 Hadamard): what a prediction's residual costs
 // after the transform, closer than the SAD (encoder-only).
 int satd(const Block& a, const Block& b) {
     int d[64];
     for (int i = 0; i < 64; ++i) d[i] = a[i] - b[i];
-    for (int pass = 0; pass < 2; ++pass) {
-        const int step = pass ? 8 : 1, line = pass ? 1 : 8;
-        for (int l = 0; l < 8; ++l) {
-            int* v = d + l * line;
-            for (int h = 1; h < 8; h *= 2)
-                for (int i = 0; i < 8; i += 2 * h)
-                    for (int k = i; k < i + h; ++k) {
-                        const int x = v[k * step], y = v[(k + h) * step];
-                        v[k * step] = x + y, v[(k + h) * step] = x - y;
-                    }
-        }
-    }
+    hadamard(d);
     int s = 0;
     for (int i = 0; i < 64; ++i) s += std::abs(d[i]);
     return s / 8;
+}
+
+// satd(src, prediction) of each intra mode (encoder-only). The transform is linear, and the DC,
+// vertical and horizontal predictions transform to one coefficient (64 dc), the first row
+// (8 H t) and the first column (8 H l): one transform of the source gives those three exactly.
+void intra_satds(const Block& src, const IntraEdges& e, int (&cost)[kModes]) {
+    int hs[64];
+    std::copy(src.begin(), src.end(), hs);
+    hadamard(hs);
+    int total = 0;
+    for (int i = 0; i < 64; ++i) total += std::abs(hs[i]);
+    int ht[8], hl[8];
+    std::copy_n(e.t, 8, ht);
+    std::copy_n(e.l, 8, hl);
+    hadamard8(ht, 1);
+    hadamard8(hl, 1);
+    int row = total, column = total;
+    for (int i = 0; i < 8; ++i) {
+        row += std::abs(hs[i] - 8 * ht[i]) - std::abs(hs[i]);
+        column += std::abs(hs[8 * i] - 8 * hl[i]) - std::abs(hs[8 * i]);
+    }
+    cost[0] = (total - std::abs(hs[0]) + std::abs(hs[0] - 64 * e.dc)) / 8;
+    cost[1] = row / 8;
+    cost[2] = column / 8;
+    Block smooth;
+    intra_predict(e, 3, smooth);
+    cost[3] = satd(src, smooth);
 }
 
 // Sum of absolute differences of the block against a prediction.
@@ -271,10 +315,11 @@ bool code_slice(SliceJob& j, Coder& rc) {
                         for_each_block(j, mx, my, [&](int k, int bx, int by) {
                             const int n = j.g->blocks_per_side[k];
                             load(j.source->p[k], bx, by, src);
+                            const IntraEdges edges =
+                                intra_edges(j.source->p[k], bx, by, j.mb_y0 * 8 * n, k ? 0 : 128);
                             int best = 1 << 30;
                             for (int mode = 0; mode < kModes; ++mode) {
-                                intra_predict(j.source->p[k], bx, by, j.mb_y0 * 8 * n, mode,
-                                              k ? 0 : 128, pred2);
+                                intra_predict(edges, mode, pred2);
                                 best = std::min(best, sad(src, pred2));
                             }
                             intra_sad += best;
@@ -342,17 +387,13 @@ bool code_slice(SliceJob& j, Coder& rc) {
                     if constexpr (Encode) {
                         load(j.source->p[k], bx, by, src);
                         if (intra) {
-                            int best = 1 << 30;
-                            for (int candidate = 0; candidate < kModes; ++candidate) {
-                                intra_predict(j.out->p[k], bx, by, top, candidate, k ? 0 : 128,
-                                              pred2);
-                                const int s = satd(src, pred2);
-                                if (s < best) {
-                                    best = s;
-                                    mode = candidate;
-                                    pred = pred2;
-                                }
-                            }
+                            const IntraEdges edges =
+                                intra_edges(j.out->p[k], bx, by, top, k ? 0 : 128);
+                            int cost[kModes];
+                            intra_satds(src, edges, cost);
+                            for (int candidate = 1; candidate < kModes; ++candidate)
+                                if (cost[candidate] < cost[mode]) mode = candidate;
+                            intra_predict(edges, mode, pred);
                             rc.bit(m.mode[k > 0][0], mode >> 1);
                             rc.bit(m.mode[k > 0][1], mode & 1);
                         } else {
