@@ -64,10 +64,11 @@ struct Sample {
 struct RunResult {
     std::string codec, setting, group;  // group: the curve it belongs to ("x264 veryfast")
     std::vector<Sample> samples;
-    double mean(double Sample::*field) const {
+    // The mean over the samples from `first` on.
+    double mean(double Sample::*field, std::size_t first = 0) const {
         double sum = 0.0;
-        for (const Sample& s : samples) sum += s.*field;
-        return samples.empty() ? NAN : sum / double(samples.size());
+        for (std::size_t i = first; i < samples.size(); ++i) sum += samples[i].*field;
+        return samples.size() <= first ? NAN : sum / double(samples.size() - first);
     }
     double mean_error(double ImageError::*field) const {
         double sum = 0.0;
@@ -469,10 +470,17 @@ std::string verdict(bool known, bool met) { return !known ? "n/a" : met ? "met" 
 struct SpeedResult {
     bool measured = false;
     int w = 0, h = 0, frames = 0;
-    double ours_encode = NAN, ours_decode = NAN;  // mean ms per frame
+    double ours_encode = NAN, ours_decode = NAN;          // mean ms per frame, the default stream
+    double lossless_encode = NAN, lossless_decode = NAN;  // lossless depth, per-pixel motion
     double x264_veryfast_encode = NAN, x264_veryfast_decode = NAN;
     double rgb_to_yuv = NAN, yuv_to_rgb = NAN;  // x264 veryfast's conversions, inside its times
     double x264_ultrafast_encode = NAN;
+    // The same over the frames after the first kWarmFrom: a long-running encoder's rate, once
+    // its pictures and buffers exist (the first frames also pay for touching their memory).
+    static constexpr std::size_t kWarmFrom = 5;
+    double ours_encode_warm = NAN, ours_decode_warm = NAN;
+    double x264_veryfast_encode_warm = NAN, x264_veryfast_decode_warm = NAN;
+    double x264_ultrafast_encode_warm = NAN;
 };
 
 Status measure_speed(server::Renderer& renderer, const BenchOptions& job, int threads, int mid_qp,
@@ -491,17 +499,26 @@ Status measure_speed(server::Renderer& renderer, const BenchOptions& job, int th
                  run, convert_ms));
     speed.rgb_to_yuv = convert_ms[0];
     speed.yuv_to_rgb = convert_ms[1];
+    const std::size_t warm = SpeedResult::kWarmFrom;
     speed.x264_veryfast_encode = run.mean(&Sample::encode_ms);
     speed.x264_veryfast_decode = run.mean(&Sample::decode_ms);
+    speed.x264_veryfast_encode_warm = run.mean(&Sample::encode_ms, warm);
+    speed.x264_veryfast_decode_warm = run.mean(&Sample::decode_ms, warm);
     std::fprintf(stderr, "[codec] speed: x264 ultrafast\n");
     REPRISE_TRY(run_peer(
         seq, {.kind = PeerKind::X264, .preset = "ultrafast", .crf = 26, .threads = threads}, run));
     speed.x264_ultrafast_encode = run.mean(&Sample::encode_ms);
+    speed.x264_ultrafast_encode_warm = run.mean(&Sample::encode_ms, warm);
     std::fprintf(stderr, "[codec] speed: reprise qp %d\n", mid_qp);
     RunResult color;
     REPRISE_TRY(run_ours(seq, mid_qp, false, run, color, nullptr));
+    speed.lossless_encode = run.mean(&Sample::encode_ms);
+    speed.lossless_decode = run.mean(&Sample::decode_ms);
+    REPRISE_TRY(run_ours(seq, mid_qp, true, run, color, nullptr));
     speed.ours_encode = run.mean(&Sample::encode_ms);
     speed.ours_decode = run.mean(&Sample::decode_ms);
+    speed.ours_encode_warm = run.mean(&Sample::encode_ms, warm);
+    speed.ours_decode_warm = run.mean(&Sample::decode_ms, warm);
     speed.measured = true;
     return {};
 }
@@ -789,14 +806,19 @@ Status speed_run(server::Renderer& renderer, const BenchOptions& job, int qp, Cs
                  SpeedResult& speed, std::string& speed_text) {
     if (job.speed_frames > 0) {
         REPRISE_TRY(measure_speed(renderer, job, job.threads, qp, speed));
-        speed_csv.row({strf("%dx%d", speed.w, speed.h), std::to_string(speed.frames), "x264",
-                       "veryfast crf 26", strf("%.3f", speed.x264_veryfast_encode),
-                       strf("%.3f", speed.x264_veryfast_decode)});
-        speed_csv.row({strf("%dx%d", speed.w, speed.h), std::to_string(speed.frames), "x264",
-                       "ultrafast crf 26", strf("%.3f", speed.x264_ultrafast_encode), ""});
-        speed_csv.row({strf("%dx%d", speed.w, speed.h), std::to_string(speed.frames), kOurs,
-                       strf("qp %d", qp), strf("%.3f", speed.ours_encode),
-                       strf("%.3f", speed.ours_decode)});
+        const std::string size = strf("%dx%d", speed.w, speed.h);
+        const std::string frames = std::to_string(speed.frames);
+        auto ms = [](double v) { return v == v ? strf("%.3f", v) : std::string(); };
+        speed_csv.row({size, frames, "x264", "veryfast crf 26", ms(speed.x264_veryfast_encode),
+                       ms(speed.x264_veryfast_decode), ms(speed.x264_veryfast_encode_warm),
+                       ms(speed.x264_veryfast_decode_warm)});
+        speed_csv.row({size, frames, "x264", "ultrafast crf 26", ms(speed.x264_ultrafast_encode),
+                       "", ms(speed.x264_ultrafast_encode_warm), ""});
+        speed_csv.row({size, frames, kOursStream, strf("qp %d", qp), ms(speed.ours_encode),
+                       ms(speed.ours_decode), ms(speed.ours_encode_warm),
+                       ms(speed.ours_decode_warm)});
+        speed_csv.row({size, frames, kOurs, strf("qp %d", qp), ms(speed.lossless_encode),
+                       ms(speed.lossless_decode), "", ""});
     }
     if (speed.measured) {
         speed_text = strf(
@@ -808,12 +830,25 @@ Status speed_run(server::Renderer& renderer, const BenchOptions& job, int qp, Cs
             speed.x264_veryfast_decode, speed.rgb_to_yuv, speed.yuv_to_rgb,
             speed.x264_ultrafast_encode);
         speed_text += strf(
-            "  reprise qp %d: encode %8.2f  decode %8.2f\n"
+            "  reprise qp %d, the default stream: encode %8.2f  decode %8.2f  (lossless depth "
+            "and per-pixel motion: encode %.2f  decode %.2f)\n"
             "  encode speed reprise / x264 veryfast = %.2fx (>= 1 wanted), / ultrafast = %.2fx\n"
             "  reprise decode speed / its encode speed = %.2fx (>= 2 wanted)\n",
-            qp, speed.ours_encode, speed.ours_decode,
+            qp, speed.ours_encode, speed.ours_decode, speed.lossless_encode, speed.lossless_decode,
             speed.x264_veryfast_encode / speed.ours_encode,
             speed.x264_ultrafast_encode / speed.ours_encode, speed.ours_encode / speed.ours_decode);
+        if (speed.ours_encode_warm == speed.ours_encode_warm)
+            speed_text += strf(
+                "  from frame %zu on (every picture and buffer already made): x264 veryfast encode "
+                "%.2f decode %.2f, ultrafast encode %.2f; reprise encode %.2f decode %.2f; "
+                "encode speed / x264 veryfast = %.2fx, / ultrafast = %.2fx, decode / encode = "
+                "%.2fx\n",
+                SpeedResult::kWarmFrom, speed.x264_veryfast_encode_warm,
+                speed.x264_veryfast_decode_warm, speed.x264_ultrafast_encode_warm,
+                speed.ours_encode_warm, speed.ours_decode_warm,
+                speed.x264_veryfast_encode_warm / speed.ours_encode_warm,
+                speed.x264_ultrafast_encode_warm / speed.ours_encode_warm,
+                speed.ours_encode_warm / speed.ours_decode_warm);
     }
     return {};
 }
@@ -924,8 +959,9 @@ Status bench_codec(const BenchOptions& job) {
         bd_csv.open(out_dir + "/bd_rate.csv", "scene,anchor,metric,reprise_bits,bd_rate_percent"));
     REPRISE_TRY(
         depth_csv.open(out_dir + "/depth.csv", "scene,coder,frame,bytes,encode_ms,decode_ms"));
-    REPRISE_TRY(
-        speed_csv.open(out_dir + "/speed.csv", "size,frames,codec,setting,encode_ms,decode_ms"));
+    REPRISE_TRY(speed_csv.open(
+        out_dir + "/speed.csv",
+        "size,frames,codec,setting,encode_ms,decode_ms,encode_ms_warm,decode_ms_warm"));
 
     std::unique_ptr<server::Renderer> renderer;
     REPRISE_TRY(server::Renderer::create(renderer));
