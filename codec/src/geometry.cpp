@@ -2,10 +2,10 @@
 // same float arithmetic, so they agree bit for bit.
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <cmath>
 #include <limits>
 #include <utility>
+#include <vector>
 
 #include <glm/mat4x4.hpp>
 
@@ -175,8 +175,9 @@ namespace {
 struct Landings {
     Image<int32_t> slot;
     Image<float> z, px, py, held;
-    Image<float> inverse;  // 1 / z of each landing (plane fit only)
-    Image<int> object;     // index into the objects, -1: none
+    Image<float> inverse;               // 1 / z of each landing (plane fit only)
+    Image<int> object;                  // index into the objects, -1: none
+    std::vector<Image<float>> nearest;  // bands beyond the first: their nearest landings
     // The plane's span in pixels (plane_row): 6 at a height of 360, the best of 3 to 18 there, as
     // 12 was at 720.
     int span = 1;
@@ -258,21 +259,9 @@ void reproject_depth(const Camera& from, ImageView<const float> depth, const Cam
         for (int y = 0; y < h; ++y) std::copy(depth.row(y), depth.row(y) + w, out.row(y));
         return;
     }
-    parallel_for(0, h, [&](int y0, int y1) {
-        for (int y = y0; y < y1; ++y) std::fill(out.row(y), out.row(y) + w, kNan);
-    });
     const glm::mat4 to_camera = between(from.view, to.view);
     const glm::mat4 to_clip = glm::mat4(glm::dmat4(to.projection) * glm::dmat4(to_camera));
-    // Each pixel keeps the nearest landing (NaN: none), whatever order they land in: rows are
-    // projected in parallel and a landing takes its slot by compare-and-swap.
-    float* slots = out.data;
     REPRISE_ASSERT(out.stride == w);
-    auto land = [&](int32_t slot, float z) {
-        std::atomic_ref<float> target(slots[slot]);
-        float held = target.load(std::memory_order_relaxed);
-        while (!(z >= held) && !target.compare_exchange_weak(held, z, std::memory_order_relaxed)) {
-        }
-    };
     // Pixels that moved with an object land where its inverse motion takes them.
     std::vector<glm::mat4> object_clip, object_camera;
     for (const ObjectMotion& o : objects) {
@@ -325,27 +314,58 @@ void reproject_depth(const Camera& from, ImageView<const float> depth, const Cam
                     landings.inverse(x, y) = row.slot[x] >= 0 ? 1.0f / row.z[x] : 0.0f;
         }
     });
+    // Each pixel keeps the nearest landing (NaN: none), whatever order they land in. Landings
+    // never come out NaN, and the nearest of several is the same in any order: each band of
+    // source rows (groups of 8 rows dealt out in turn, so that the bands' work is alike) keeps
+    // its own nearest landings, without atomics, and the bands' nearest are merged.
+    const int bands = std::clamp(thread_count(), 1, std::max(1, h / 8));
+    landings.nearest.resize(std::size_t(bands - 1));
+    for (Image<float>& i : landings.nearest) ensure_size(i, w, h);
+    auto band_image = [&](int b) {
+        return b == 0 ? out.data : landings.nearest[std::size_t(b - 1)].data();
+    };
     parallel_for(0, h, [&](int y0, int y1) {
-        for (int y = y0; y < y1; ++y) {
-            const float* value = &landings.z(0, y);
-            if (plane_fit) {
-                plane_row({.slot = landings.slot.data(),
-                           .object = landings.object.data(),
-                           .inverse = landings.inverse.data(),
-                           .z = landings.z.data(),
-                           .px = landings.px.data(),
-                           .py = landings.py.data(),
-                           .width = w,
-                           .height = h,
-                           .span = landings.span,
-                           .y = y,
-                           .out = &landings.held(0, y)});
-                value = &landings.held(0, y);
-            }
-            for (int x = 0; x < w; ++x)
-                if (const int32_t slot = landings.slot(x, y); slot >= 0) land(slot, value[x]);
-        }
+        for (int b = 0; b < bands; ++b)
+            std::fill(band_image(b) + std::size_t(y0) * w, band_image(b) + std::size_t(y1) * w,
+                      kNan);
     });
+    auto land_row = [&](float* nearest, int y) {
+        const float* value = &landings.z(0, y);
+        if (plane_fit) {
+            plane_row({.slot = landings.slot.data(),
+                       .object = landings.object.data(),
+                       .inverse = landings.inverse.data(),
+                       .z = landings.z.data(),
+                       .px = landings.px.data(),
+                       .py = landings.py.data(),
+                       .width = w,
+                       .height = h,
+                       .span = landings.span,
+                       .y = y,
+                       .out = &landings.held(0, y)});
+            value = &landings.held(0, y);
+        }
+        for (int x = 0; x < w; ++x)
+            if (const int32_t slot = landings.slot(x, y); slot >= 0 && !(value[x] >= nearest[slot]))
+                nearest[slot] = value[x];
+    };
+    parallel_for(
+        0, bands,
+        [&](int b0, int b1) {
+            for (int b = b0; b < b1; ++b)
+                for (int group = b; group * 8 < h; group += bands)
+                    for (int y = group * 8; y < std::min(h, group * 8 + 8); ++y)
+                        land_row(band_image(b), y);
+        },
+        1);
+    if (bands > 1)
+        parallel_for(0, h, [&](int y0, int y1) {
+            for (int b = 1; b < bands; ++b) {
+                const float* other = band_image(b);
+                for (std::size_t i = std::size_t(y0) * w; i < std::size_t(y1) * w; ++i)
+                    if (other[i] < out.data[i] || std::isnan(out.data[i])) out.data[i] = other[i];
+            }
+        });
     if (plane_fit) {
         fill_cracks(out, landings.held);
         fill_gaps(out);
