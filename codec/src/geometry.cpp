@@ -205,7 +205,7 @@ void fill_cracks(ImageView<float> depth, Image<float>& scratch) {
             for (int x = 0; x < w; ++x) {
                 float v = kNan;
                 if (std::isnan(depth(x, y)) && x > 0 && y > 0 && x + 1 < w && y + 1 < h)
-                    for (const auto [dx, dy] : {std::pair{1, 0}, {0, 1}, {1, 1}, {1, -1}}) {
+                    for (const auto& [dx, dy] : {std::pair{1, 0}, {0, 1}, {1, 1}, {1, -1}}) {
                         v = mean(depth(x - dx, y - dy), depth(x + dx, y + dy));
                         if (!std::isnan(v)) break;
                     }
@@ -428,7 +428,7 @@ void plane_row_reference(const PlaneRow& r, int x_begin, int x_end) {
                 continue;
             float sum = v + change;
             int count = 1;
-            for (const auto [nx, ny] : {std::pair{x - 1, y}, {x + 1, y}, {x, y - 1}, {x, y + 1}}) {
+            for (const auto& [nx, ny] : {std::pair{x - 1, y}, {x + 1, y}, {x, y - 1}, {x, y + 1}}) {
                 if (!beside(x, nx, ny)) continue;
                 const float value = at(r.inverse, nx, ny) + gx * (cx - at(r.px, nx, ny)) +
                                     gy * (cy - at(r.py, nx, ny));
