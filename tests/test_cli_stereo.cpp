@@ -1,4 +1,5 @@
-// `reprise render --stereo`, `reprise stereo` and `reprise export --stereo` end to end.
+// `reprise render --stereo`, `reprise stereo` and `reprise export --stereo` end to end; the GPU
+// backend of `reprise stereo` and `reprise fruc`.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -138,5 +139,42 @@ TEST(CliStereo, TheGpuBackendMakesTheCpusSplatEye) {
               2);
     EXPECT_EQ(run_command(cli::command_stereo, {"--in", truth, "--out", gles, "--backend", "cuda"}),
               2);
+    fs::remove_all(dir);
+}
+
+// `reprise fruc --backend gles`: the CPU's splat frames (made frames without motion), and the
+// options the GPU lacks named before anything is written.
+TEST(CliStereo, FrucOnTheGpuBackendMakesTheCpusSplatFrames) {
+    const fs::path dir =
+        fs::temp_directory_path() / ("reprise_cli_fruc_gles_" + std::to_string(::getpid()));
+    fs::remove_all(dir);
+    const std::string in = (dir / "in").string();
+    ASSERT_EQ(run_command(cli::command_render, {"--scene", "crossing", "--frames", "3", "--size",
+                                                "160x90", "--out", in}),
+              0);
+    const std::string cpu = (dir / "cpu").string(), gles = (dir / "gles").string();
+    const std::vector<std::string> splat = {"--in",     in,    "--warp",        "splat",
+                                            "--refine", "off", "--true-motion", "off"};
+    auto with = [&](std::vector<std::string> extra) {
+        std::vector<std::string> args = splat;
+        args.insert(args.end(), extra.begin(), extra.end());
+        return args;
+    };
+    ASSERT_EQ(run_command(cli::command_fruc, with({"--out", cpu})), 0);
+    ASSERT_EQ(run_command(cli::command_fruc, with({"--backend", "gles", "--out", gles})), 0);
+    for (int i = 0; i < 5; ++i)
+        EXPECT_GE(psnr_of(frame_path(cpu, i), frame_path(gles, i)), 50.0) << "frame " << i;
+    Frame made;
+    ASSERT_TRUE(read_frame(frame_path(gles, 1), made).ok());
+    EXPECT_TRUE(made.motion.empty());
+    const std::string refused = (dir / "refused").string();
+    EXPECT_EQ(run_command(cli::command_fruc,
+                          {"--in", in, "--backend", "gles", "--warp", "splat", "--out", refused}),
+              1);  // refinement and true motion on
+    EXPECT_EQ(run_command(cli::command_fruc, with({"--backend", "vulkan", "--out", refused})), 1);
+    EXPECT_EQ(
+        run_command(cli::command_fruc, {"--in", in, "--true-motion", "maybe", "--out", refused}),
+        1);
+    EXPECT_FALSE(fs::exists(refused));
     fs::remove_all(dir);
 }

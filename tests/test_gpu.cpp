@@ -15,6 +15,7 @@
 #include <GLES3/gl32.h>
 
 #include "reprise/gpu/context.hpp"
+#include "reprise/gpu/fruc_backend.hpp"
 #include "reprise/stereo/rig.hpp"
 #include "reprise/stereo/synthesize.hpp"
 #include "reprise/warp/fill.hpp"
@@ -634,6 +635,52 @@ TEST(Gpu, InterpolationRepairsNonFiniteInputAsTheCpu) {
     for (std::size_t i = 0; i < gpu.color.pixel_count(); ++i)
         ASSERT_TRUE(test::finite(gpu.color.data()[i])) << "pixel " << i;
     EXPECT_GE(test::display_psnr(cpu.color, gpu.color), 50.0);
+}
+
+// The converter with the GPU making its in-between frames: the CPU's frames at factor 3 (s = 1/3,
+// 2/3), inputs passed through, a cut continued from the old shot on the CPU as before.
+TEST(Gpu, TheConverterWithTheGpuBackendMakesTheCpusFrames) {
+    std::vector<Frame> frames = test::render_scene("crossing", 4, kWidth, kHeight, 30.0, 3);
+    frames[3].camera.cut = Cut::Yes;
+    gpu::FrucBackend backend(shared_gpu());
+    warp::FrucOptions with_gpu = kSplatInterpolation;
+    with_gpu.backend = &backend;
+    auto run = [&](const warp::FrucOptions& options, warp::FrucCounters& counters) {
+        warp::FrameRateConverter converter;
+        EXPECT_TRUE(warp::FrameRateConverter::create(3, options, converter).ok());
+        std::vector<Frame> outputs;
+        for (const Frame& f : frames) {
+            const Status sent = converter.send(f);
+            EXPECT_TRUE(sent.ok()) << sent.message();
+            Frame out;
+            while (converter.receive(out)) outputs.push_back(std::move(out));
+        }
+        counters = converter.counters();
+        return outputs;
+    };
+    warp::FrucCounters cpu_counters, gpu_counters;
+    const std::vector<Frame> cpu = run(kSplatInterpolation, cpu_counters);
+    const std::vector<Frame> gpu = run(with_gpu, gpu_counters);
+    ASSERT_EQ(cpu.size(), 10u);  // 4 inputs, 2 frames after each of the first 3
+    ASSERT_EQ(gpu.size(), cpu.size());
+    for (std::size_t i = 0; i < cpu.size(); ++i) {
+        SCOPED_TRACE("output " + std::to_string(i));
+        EXPECT_GE(test::display_psnr(cpu[i].color, gpu[i].color), 50.0);
+        EXPECT_EQ(gpu[i].camera.view, cpu[i].camera.view);
+    }
+    EXPECT_EQ(backend.frames(), 4u);  // the pairs 0-1 and 1-2; the cut's two come from the CPU
+    EXPECT_TRUE(gpu[1].motion.empty());
+    EXPECT_EQ(gpu_counters.cuts, 1u);
+    EXPECT_EQ(gpu_counters.hole_pixels, cpu_counters.hole_pixels);
+    EXPECT_EQ(gpu_counters.fills + gpu_counters.fills_skipped,
+              cpu_counters.fills + cpu_counters.fills_skipped);
+
+    warp::FrucOptions grid;
+    grid.backend = &backend;
+    warp::FrameRateConverter refused;
+    const Status status = warp::FrameRateConverter::create(2, grid, refused);
+    EXPECT_NE(status.message().find("warp splat, true motion off, refine off"), std::string::npos)
+        << status.message();
 }
 
 TEST(Gpu, InterpolationOnTexturesAndBadArguments) {

@@ -10,6 +10,7 @@
 #include "input_range.hpp"
 #include "outputs.hpp"
 #include "reprise/core/exr.hpp"
+#include "reprise/gpu/fruc_backend.hpp"
 #include "reprise/warp/fruc.hpp"
 
 namespace reprise::cli {
@@ -22,6 +23,8 @@ struct FrucJob {
     std::string mode = "interpolate", warp = "grid", fill = "pullpush";
     std::string layout = "reprise";
     std::string refine = "on";
+    std::string true_motion = "on";
+    std::string backend = "cpu";
     double refine_share = 1.0;
     std::string ui;             // a UI sequence beside the input (its colour: premultiplied RGBA)
     bool ui_composite = false;  // draw the UI into the output colour
@@ -60,6 +63,20 @@ Status run_fruc(const FrucJob& job) {
     if (!(job.refine_share >= 0.0 && job.refine_share <= 1.0))
         return Status::error("--refine-share must be in 0..1");
     options.refine.max_flow_share = float(job.refine_share);
+    if (job.true_motion != "on" && job.true_motion != "off")
+        return Status::error("--true-motion '" + job.true_motion + "': expected on or off");
+    options.true_motion = job.true_motion == "on";
+    if (job.backend != "cpu" && job.backend != "gles")
+        return Status::error("--backend '" + job.backend + "': expected cpu or gles");
+    std::unique_ptr<gpu::Context> gpu;
+    std::unique_ptr<gpu::FrucBackend> backend;
+    if (job.backend == "gles") {
+        if (const Status s = gpu::FrucBackend::check(options, options.splat); !s.ok())
+            return Status::error("--backend gles: " + s.message());
+        REPRISE_TRY(gpu::Context::create(gpu));
+        backend = std::make_unique<gpu::FrucBackend>(*gpu, options.splat);
+        options.backend = backend.get();
+    }
     WriteOptions write;
     if (job.layout == "blender")
         write.layout = ExrLayout::Blender;
@@ -159,14 +176,22 @@ Status run_fruc(const FrucJob& job) {
     REPRISE_TRY(output.finish());
     const warp::FrucCounters& c = converter.counters();
     std::fprintf(stderr, "\n");
-    std::printf("fruc %s x%d, warp %s, fill %s: %zu inputs -> %d frames in %s\n", job.mode.c_str(),
-                job.factor, job.warp.c_str(), job.fill.c_str(), c.inputs,
-                range.all ? made : written, job.out.c_str());
+    std::printf("fruc %s x%d, warp %s, fill %s, %s: %zu inputs -> %d frames in %s\n",
+                job.mode.c_str(), job.factor, job.warp.c_str(), job.fill.c_str(),
+                job.backend.c_str(), c.inputs, range.all ? made : written, job.out.c_str());
     if (!range.all)
         std::printf("  range: input pairs %zu..%zu, frames %d..%d (read from input %zu on)\n",
                     range.first, range.last, wanted.begin, wanted.end - 1, first);
     std::printf("  made %zu frames, %.2f ms each (without file I/O)\n", c.outputs,
                 c.outputs ? busy_ms / double(c.outputs) : 0.0);
+    if (backend && backend->frames() > 0) {
+        const double n_gpu = double(backend->frames());
+        std::printf(
+            "  gles: %zu frames on the GPU, upload %.2f, compute %.2f, download %.2f ms "
+            "each\n",
+            backend->frames(), backend->total().upload_ms / n_gpu,
+            backend->total().compute_ms / n_gpu, backend->total().download_ms / n_gpu);
+    }
     std::printf(
         "  skipped: %zu still frames copied, %zu fills (no holes), %zu dynamic layers (nothing "
         "moving), "
@@ -220,6 +245,13 @@ int command_fruc(int argc, char** argv) {
     args.option("--refine-share", &job.refine_share,
                 "refinement: largest share of the frame's pixels the flow runs on (default 1); "
                 "the\ntiles past it are left out, those that disagree most per pixel go first");
+    args.option("--true-motion", &job.true_motion,
+                "on | off (default on): interpolation moves each side where it truly is at the "
+                "in-between\ninstant (off: each follows its motion linearly)");
+    args.option("--backend", &job.backend,
+                "cpu | gles (default cpu); gles: the in-between frames as OpenGL ES compute "
+                "shaders, with\n--warp splat --fill pullpush --refine off --true-motion off "
+                "(made frames carry no motion)");
     args.option("--warp", &job.warp,
                 "reverse | splat | grid | auto (default grid; grid-bicubic, grid-bilinear pick "
                 "its colour\nfetch; auto: chosen per frame)");

@@ -1,16 +1,20 @@
 // FrameRateConverter: frames in, K times as many out.
 #include <pybind11/stl.h>
 
+#include <memory>
+
 #include "common.hpp"
+#include "reprise/gpu/fruc_backend.hpp"
 #include "reprise/warp/fruc.hpp"
 
 namespace reprise::python {
 namespace {
 
 warp::FrucOptions fruc_options(const std::string& mode, const std::string& warp_method,
-                               const std::string& fill, bool refine) {
+                               const std::string& fill, bool refine, bool true_motion) {
     warp::FrucOptions o;
     o.refine.enabled = refine;
+    o.true_motion = true_motion;
     const Status parsed = warp::fruc_options_from_names(mode, warp_method, fill, o);
     if (!parsed.ok()) value_error(parsed.message());
     return o;
@@ -18,9 +22,18 @@ warp::FrucOptions fruc_options(const std::string& mode, const std::string& warp_
 
 struct Converter {
     Converter(int factor, const std::string& mode, const std::string& warp_method,
-              const std::string& fill, bool refine) {
-        const Status made = warp::FrameRateConverter::create(
-            factor, fruc_options(mode, warp_method, fill, refine), converter);
+              const std::string& fill, bool refine, bool true_motion, const std::string& backend) {
+        warp::FrucOptions options = fruc_options(mode, warp_method, fill, refine, true_motion);
+        if (backend == "gles") {
+            if (const Status s = gpu::FrucBackend::check(options, options.splat); !s.ok())
+                value_error("backend gles: " + s.message());
+            if (const Status s = gpu::Context::create(gpu); !s.ok()) check(s);
+            gpu_backend = std::make_unique<gpu::FrucBackend>(*gpu, options.splat);
+            options.backend = gpu_backend.get();
+        } else if (backend != "cpu") {
+            value_error("backend '" + backend + "': expected cpu or gles");
+        }
+        const Status made = warp::FrameRateConverter::create(factor, options, converter);
         if (!made) value_error(made.message());
     }
 
@@ -81,6 +94,9 @@ struct Converter {
         return d;
     }
 
+    // Declared before the converter, which holds a pointer to the backend: destroyed after it.
+    std::unique_ptr<gpu::Context> gpu;
+    std::unique_ptr<gpu::FrucBackend> gpu_backend;
     warp::FrameRateConverter converter;
 };
 
@@ -92,10 +108,16 @@ void bind_fruc(py::module_& m) {
                           "interpolate: after each frame (but the first), the K-1 frames "
                           "between it and its predecessor, then the frame itself; extrapolate: "
                           "the frame, then K-1 frames beyond it. refine: optical flow where the "
-                          "rendered motion is not what is seen (moving shadows, reflections).")
-        .def(py::init<int, const std::string&, const std::string&, const std::string&, bool>(),
+                          "rendered motion is not what is seen (moving shadows, reflections). "
+                          "true_motion: each side goes where it truly is at the in-between "
+                          "instant (off: linearly). backend 'gles': the in-between frames on the "
+                          "GPU (OpenGL ES), with warp 'splat', fill 'pullpush', refine and "
+                          "true_motion off; its made frames carry no motion.")
+        .def(py::init<int, const std::string&, const std::string&, const std::string&, bool, bool,
+                      const std::string&>(),
              py::arg("factor") = 2, py::arg("mode") = "interpolate", py::arg("warp") = "grid",
-             py::arg("fill") = "pullpush", py::arg("refine") = true)
+             py::arg("fill") = "pullpush", py::arg("refine") = true, py::arg("true_motion") = true,
+             py::arg("backend") = "cpu")
         .def("send", &Converter::send, py::arg("frame"), "Feeds the next rendered frame.")
         .def("receive", &Converter::receive, "The next output frame, or None.")
         .def("convert", &Converter::convert, py::arg("frames"),

@@ -34,6 +34,7 @@ public:
         return f;
     }
     Frame& back() { return slots_[(head_ + count_ - 1) % slots_.size()]; }
+    void drop_back() { --count_; }
     void pop_into(Frame& out) {
         std::swap(out, slots_[head_]);
         head_ = (head_ + 1) % slots_.size();
@@ -426,10 +427,19 @@ Status FrameRateConverter::send_frame(const Frame& given, Frame* owned) {
                     st.emit_copy(frame, a.camera, frame.camera, fps, s);
                 } else {
                     Frame& out = st.ready.push();
-                    interpolate_frame(
-                        a, frame, s, a_warpable, scale,
-                        st.resolve(predicted, std::min(s, 1.0f - s), FrucMode::Interpolate),
-                        st.scratch, out, st.counters);
+                    if (st.options.backend && a_warpable) {
+                        const Status made =
+                            st.options.backend->interpolate(a, frame, s, out, st.counters);
+                        if (!made.ok()) {
+                            st.ready.drop_back();
+                            return made;
+                        }
+                    } else {
+                        interpolate_frame(
+                            a, frame, s, a_warpable, scale,
+                            st.resolve(predicted, std::min(s, 1.0f - s), FrucMode::Interpolate),
+                            st.scratch, out, st.counters);
+                    }
                     st.finish(out, a.camera, frame.camera, fps, s, s - 1.0f / k_max);
                 }
                 st.attach_ui(st.ready.back(), s >= 0.5f ? frame : a, true);

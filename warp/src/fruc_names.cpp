@@ -83,6 +83,7 @@ Status check_fruc_options(const FrucOptions& o) {
              {"auto_choice.slack_db", o.auto_choice.slack_db, 0, 1000},
          })
         REPRISE_TRY(in_range(name, value, lo, hi));
+    if (o.backend) REPRISE_TRY(o.backend->supports(o));
     return {};
 }
 

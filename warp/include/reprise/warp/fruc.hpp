@@ -86,6 +86,23 @@ struct RefineOptions {
     float max_flow_share = 1.0f;
 };
 
+struct FrucCounters;
+struct FrucOptions;
+
+// Makes the in-between frames of a FrameRateConverter elsewhere than on the CPU (a GPU:
+// gpu::FrucBackend). The converter keeps the rest — order, cuts, still pairs, repair, UI —
+// and asks the backend only for what interpolate_frame would make with both sides warpable:
+// the frame at s between a and b, colour and depth (its motion may stay empty). An error from it
+// ends send() with that error (the frames of that input made before it stay queued).
+class InterpolationBackend {
+public:
+    virtual ~InterpolationBackend() = default;
+    // The options the backend makes the same frame for as the CPU; an error says why not.
+    virtual Status supports(const FrucOptions& options) const = 0;
+    virtual Status interpolate(const GBufferView& a, const GBufferView& b, float s, Frame& out,
+                               FrucCounters& counters) = 0;
+};
+
 struct FrucOptions {
     FrucMode mode = FrucMode::Interpolate;
     WarpMethod warp = WarpMethod::Grid;
@@ -114,6 +131,8 @@ struct FrucOptions {
     // the colour of every output (inputs too), which then carries no ui channels.
     bool composite_ui = false;
     AutoOptions auto_choice;  // warp or fill Auto
+    // Not owned; null: the CPU. It must outlive the converter.
+    InterpolationBackend* backend = nullptr;
 };
 
 // What was done and what was left out because the frame did not need it.
