@@ -169,6 +169,60 @@ TEST(Fruc, CreateRefusesBadSettingsNamingThemAndKeepsTheConverter) {
     EXPECT_EQ(outputs, 3);
 }
 
+// A backend that makes in-between frames instead of the CPU (here: b's colour) and fails once
+// on request: the failing send() leaves the converter as it was, and sending the frame again
+// gives what an unbroken run gives.
+class FlakyBackend final : public InterpolationBackend {
+public:
+    int calls = 0, fail_at = -1;
+    Status supports(const FrucOptions& o) const override {
+        return o.warp == WarpMethod::Splat ? Status{} : Status::error("flaky: splat only");
+    }
+    Status interpolate(const GBufferView&, const GBufferView& b, float, Frame& out,
+                       FrucCounters&) override {
+        if (calls++ == fail_at) return Status::error("flaky: the device went away");
+        out.color.resize(b.color.width, b.color.height);
+        for (int y = 0; y < b.color.height; ++y)
+            std::copy_n(b.color.row(y), b.color.width, &out.color(0, y));
+        return {};
+    }
+};
+
+TEST(Fruc, ABackendErrorLeavesTheConverterAsItWas) {
+    const std::vector<Frame> frames = render("crossing", 30.0, 0, 3, 48, 32);
+    FlakyBackend backend;
+    backend.fail_at = 1;  // the second frame between inputs 0 and 1 (the first is made, queued)
+    FrameRateConverter converter;
+    ASSERT_TRUE(
+        FrameRateConverter::create(
+            3, {.warp = WarpMethod::Splat, .true_motion = false, .backend = &backend}, converter)
+            .ok());
+    std::vector<Frame> outputs;
+    Frame out;
+    ASSERT_TRUE(converter.send(frames[0]).ok());
+    while (converter.receive(out)) outputs.push_back(out);
+    const FrucCounters before = converter.counters();
+    const Status failed = converter.send(frames[1]);
+    EXPECT_NE(failed.message().find("the device went away"), std::string::npos) << failed.message();
+    EXPECT_EQ(converter.receive(out), Result::NeedMoreData);  // nothing of the failed input
+    EXPECT_EQ(converter.counters().inputs, before.inputs);
+    EXPECT_EQ(converter.counters().outputs, before.outputs);
+    for (int i = 1; i < 3; ++i) {
+        ASSERT_TRUE(converter.send(frames[std::size_t(i)]).ok());
+        while (converter.receive(out)) outputs.push_back(out);
+    }
+    ASSERT_EQ(outputs.size(), 7u);  // 0, (2 made, 1), (2 made, 2)
+    EXPECT_EQ(converter.counters().inputs, 3u);
+    EXPECT_EQ(converter.counters().outputs, 4u);
+    EXPECT_EQ(backend.calls, 6);  // 4 made frames, and the made and the failed one rolled back
+    EXPECT_EQ(display_psnr(outputs[1].color, frames[1].color), INFINITY);
+    EXPECT_EQ(display_psnr(outputs[3].color, frames[1].color), INFINITY);
+
+    FrameRateConverter refused;
+    const Status grid = FrameRateConverter::create(2, {.backend = &backend}, refused);
+    EXPECT_NE(grid.message().find("splat only"), std::string::npos);
+}
+
 TEST(Fruc, TheCameraSaysWhereCutsAreAndOnlyUnknownFramesAreTested) {
     // Rendered frames 13..16 of `cut`; the renderer marks frame 15 (index 2) Cut::Yes, the others
     // No.

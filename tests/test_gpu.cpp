@@ -10,6 +10,7 @@
 #include <memory>
 #include <random>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include <GLES3/gl32.h>
@@ -681,6 +682,22 @@ TEST(Gpu, TheConverterWithTheGpuBackendMakesTheCpusFrames) {
     const Status status = warp::FrameRateConverter::create(2, grid, refused);
     EXPECT_NE(status.message().find("warp splat, true motion off, refine off"), std::string::npos)
         << status.message();
+}
+
+// A context serves one thread at a time: another thread gets an error, not a crash.
+TEST(Gpu, AnotherThreadGetsAnErrorWhileTheContextIsHeld) {
+    const std::vector<Frame>& frames = scene_frames("crossing");
+    gpu::Context& context = shared_gpu();
+    Frame out;
+    gpu::InterpolateStats stats;
+    ASSERT_TRUE(context.interpolate(frames[0], frames[1], 0.5f, out, stats).ok());
+    Status elsewhere;
+    std::thread([&] {
+        elsewhere = context.interpolate(frames[0], frames[1], 0.5f, out, stats);
+    }).join();
+    EXPECT_NE(elsewhere.message().find("another thread holds it"), std::string::npos)
+        << elsewhere.message();
+    EXPECT_TRUE(context.interpolate(frames[0], frames[1], 0.5f, out, stats).ok());
 }
 
 TEST(Gpu, InterpolationOnTexturesAndBadArguments) {

@@ -156,4 +156,11 @@ void Context::make_current() const {
     eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_);
 }
 
+Status Context::acquire() const {
+    if (eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_) == EGL_TRUE) return {};
+    return Status::error("gl: the context cannot be made current on this thread (EGL error " +
+                         std::to_string(eglGetError()) +
+                         "): another thread holds it; use it from one thread at a time");
+}
+
 }  // namespace reprise::gl

@@ -160,7 +160,7 @@ Status Context::interpolate(const GBufferView& given_a, const GBufferView& given
     out.id.clear();
     out.camera = b.camera;
     if (w <= 0 || h <= 0) return {};
-    s.gl->make_current();
+    REPRISE_TRY(s.gl->acquire());
     auto t = std::chrono::steady_clock::now();
     Texture* textures[6] = {&k.a_color, &k.a_depth, &k.a_motion,
                             &k.b_color, &k.b_depth, &k.b_motion};
@@ -195,7 +195,7 @@ Status Context::interpolate(const GBufferTextures& a, unsigned a_color, const GB
     timings_ = {};
     stats = {};
     ContextState& s = *state_;
-    s.gl->make_current();
+    REPRISE_TRY(s.gl->acquire());
     const int w = b.width, h = b.height;
     if (w <= 0 || h <= 0 || a.width != w || a.height != h)
         return Status::error("gpu interpolate: texture sizes " + std::to_string(a.width) + "x" +

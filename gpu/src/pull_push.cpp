@@ -340,7 +340,7 @@ Status Context::fill(ImageView<glm::vec4> color, ImageView<const uint8_t> valid,
     const int w = color.width, h = color.height;
     if (color.empty()) return {};
     ContextState& s = *state_;
-    s.gl->make_current();
+    REPRISE_TRY(s.gl->acquire());
     using Clock = std::chrono::steady_clock;
     Clock::time_point t = Clock::now();
     s.color.ensure(GL_RGBA32F, w, h);
@@ -366,7 +366,7 @@ Status Context::fill(unsigned color, unsigned valid, unsigned depth, int width, 
                      unsigned out, warp::FillStats& stats) {
     stats = {};
     ContextState& s = *state_;
-    s.gl->make_current();
+    REPRISE_TRY(s.gl->acquire());
     if (width <= 0 || height <= 0)
         return Status::error("gpu pull-push: size " + std::to_string(width) + "x" +
                              std::to_string(height) + " must be positive");

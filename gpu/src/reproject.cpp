@@ -179,7 +179,7 @@ Status Context::reproject(const GBufferView& current, const GBufferView& previou
         return {};
     }
     ContextState& s = *state_;
-    s.gl->make_current();
+    REPRISE_TRY(s.gl->acquire());
     const bool ids = !current.id.empty() && !previous.id.empty();
     const warp::ReprojectSetup k =
         warp::reproject_setup(current.camera, previous.camera, w, h, ids, options);
@@ -226,7 +226,7 @@ Status Context::reproject(const GBufferTextures& current, const GBufferTextures&
                           unsigned payload, unsigned out, unsigned hit,
                           const warp::ReprojectOptions& options, warp::ReprojectCounts& counts) {
     ContextState& s = *state_;
-    s.gl->make_current();
+    REPRISE_TRY(s.gl->acquire());
     const int w = current.width, h = current.height, pw = previous.width, ph = previous.height;
     if (w <= 0 || h <= 0 || pw <= 0 || ph <= 0)
         return Status::error("gpu reproject: texture sizes " + std::to_string(w) + "x" +

@@ -269,7 +269,7 @@ Status Context::splat(const GBufferView& source, float factor, const warp::WarpT
     if (!std::isfinite(factor)) return Status::error("gpu splat: the factor is not finite");
     if (sw <= 0 || sh <= 0 || tw <= 0 || th <= 0) return {};
     ContextState& s = *state_;
-    s.gl->make_current();
+    REPRISE_TRY(s.gl->acquire());
     auto t = std::chrono::steady_clock::now();
     s.payload.ensure(GL_RGBA32F, sw, sh);
     s.previous_depth.ensure(GL_R32F, sw, sh);

@@ -168,7 +168,7 @@ Status Context::stereo_eye(const GBufferView& given, const Camera& target, Frame
         return {};
     }
     if (w <= 0 || h <= 0) return {};
-    s.gl->make_current();
+    REPRISE_TRY(s.gl->acquire());
     auto t = std::chrono::steady_clock::now();
     s.payload.ensure(GL_RGBA32F, w, h);
     s.previous_depth.ensure(GL_R32F, w, h);
@@ -193,7 +193,7 @@ Status Context::stereo_eye(const GBufferTextures& rendered, unsigned color, cons
     stats = {};
     REPRISE_TRY(check_options(options));
     ContextState& s = *state_;
-    s.gl->make_current();
+    REPRISE_TRY(s.gl->acquire());
     const int w = rendered.width, h = rendered.height;
     if (w <= 0 || h <= 0)
         return Status::error("gpu stereo eye: texture size " + std::to_string(w) + "x" +

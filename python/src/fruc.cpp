@@ -103,16 +103,18 @@ struct Converter {
 }  // namespace
 
 void bind_fruc(py::module_& m) {
-    py::class_<Converter>(m, "FrameRateConverter",
-                          "Frame-rate upconversion, K output frames per input frame. "
-                          "interpolate: after each frame (but the first), the K-1 frames "
-                          "between it and its predecessor, then the frame itself; extrapolate: "
-                          "the frame, then K-1 frames beyond it. refine: optical flow where the "
-                          "rendered motion is not what is seen (moving shadows, reflections). "
-                          "true_motion: each side goes where it truly is at the in-between "
-                          "instant (off: linearly). backend 'gles': the in-between frames on the "
-                          "GPU (OpenGL ES), with warp 'splat', fill 'pullpush', refine and "
-                          "true_motion off; its made frames carry no motion.")
+    py::class_<Converter>(
+        m, "FrameRateConverter",
+        "Frame-rate upconversion, K output frames per input frame. "
+        "interpolate: after each frame (but the first), the K-1 frames "
+        "between it and its predecessor, then the frame itself; extrapolate: "
+        "the frame, then K-1 frames beyond it. refine: optical flow where the "
+        "rendered motion is not what is seen (moving shadows, reflections). "
+        "true_motion: each side goes where it truly is at the in-between "
+        "instant (off: linearly). backend 'gles': the in-between frames on the "
+        "GPU (OpenGL ES), with warp 'splat', fill 'pullpush', refine and "
+        "true_motion off; its made frames carry no motion, and it is used from the thread "
+        "that made it (another thread gets an error).")
         .def(py::init<int, const std::string&, const std::string&, const std::string&, bool, bool,
                       const std::string&>(),
              py::arg("factor") = 2, py::arg("mode") = "interpolate", py::arg("warp") = "grid",

@@ -34,7 +34,8 @@ public:
         return f;
     }
     Frame& back() { return slots_[(head_ + count_ - 1) % slots_.size()]; }
-    void drop_back() { --count_; }
+    std::size_t size() const { return count_; }
+    void truncate(std::size_t count) { count_ = std::min(count_, count); }
     void pop_into(Frame& out) {
         std::swap(out, slots_[head_]);
         head_ = (head_ + 1) % slots_.size();
@@ -373,6 +374,9 @@ Status FrameRateConverter::send_frame(const Frame& given, Frame* owned) {
     if (!sized(given.depth) || !sized(given.motion))
         return Status::error("fruc input frame: depth or motion size differs from colour");
     if (!sized(given.ui)) return Status::error("fruc input frame: ui size differs from colour");
+    // What an error of the backend puts back: the converter as it was before this frame.
+    const FrucCounters counters_before = st.counters;
+    const std::size_t queued_before = st.ready.size();
     NonfiniteCounts found;
     const Frame& frame = owned ? *owned : st.nonfinite.clean(given, found);
     if (owned) found = st.nonfinite.repair(*owned);
@@ -431,7 +435,8 @@ Status FrameRateConverter::send_frame(const Frame& given, Frame* owned) {
                         const Status made =
                             st.options.backend->interpolate(a, frame, s, out, st.counters);
                         if (!made.ok()) {
-                            st.ready.drop_back();
+                            st.ready.truncate(queued_before);
+                            st.counters = counters_before;
                             return made;
                         }
                     } else {

@@ -16,6 +16,9 @@ public:
     Context& operator=(const Context&) = delete;
 
     void make_current() const;
+    // The same, or an error when EGL refuses: the context is current on another thread (a
+    // context serves one thread at a time).
+    Status acquire() const;
     const std::string& description() const { return description_; }  // "llvmpipe (LLVM ...)"
 
 private:

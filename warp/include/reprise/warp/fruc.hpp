@@ -93,7 +93,7 @@ struct FrucOptions;
 // gpu::FrucBackend). The converter keeps the rest — order, cuts, still pairs, repair, UI —
 // and asks the backend only for what interpolate_frame would make with both sides warpable:
 // the frame at s between a and b, colour and depth (its motion may stay empty). An error from it
-// ends send() with that error (the frames of that input made before it stay queued).
+// ends send() with that error and leaves the converter as it was before that send().
 class InterpolationBackend {
 public:
     virtual ~InterpolationBackend() = default;
