@@ -314,11 +314,30 @@ void reproject_depth(const Camera& from, ImageView<const float> depth, const Cam
                     landings.inverse(x, y) = row.slot[x] >= 0 ? 1.0f / row.z[x] : 0.0f;
         }
     });
+    // Each landing's value: its depth, or its plane's at the centre of the pixel it lands in.
+    if (plane_fit)
+        parallel_for(0, h, [&](int y0, int y1) {
+            for (int y = y0; y < y1; ++y)
+                plane_row({.slot = landings.slot.data(),
+                           .object = landings.object.data(),
+                           .inverse = landings.inverse.data(),
+                           .z = landings.z.data(),
+                           .px = landings.px.data(),
+                           .py = landings.py.data(),
+                           .width = w,
+                           .height = h,
+                           .span = landings.span,
+                           .y = y,
+                           .out = &landings.held(0, y)});
+        });
+    const Image<float>& value = plane_fit ? landings.held : landings.z;
     // Each pixel keeps the nearest landing (NaN: none), whatever order they land in. Landings
     // never come out NaN, and the nearest of several is the same in any order: each band of
     // source rows (groups of 8 rows dealt out in turn, so that the bands' work is alike) keeps
-    // its own nearest landings, without atomics, and the bands' nearest are merged.
-    const int bands = std::clamp(thread_count(), 1, std::max(1, h / 8));
+    // its own nearest landings, without atomics, and the bands' nearest are merged. At most
+    // kLandingBands: each band beyond the first holds a picture of floats.
+    constexpr int kLandingBands = 4;
+    const int bands = std::clamp(thread_count(), 1, std::min(kLandingBands, std::max(1, h / 8)));
     landings.nearest.resize(std::size_t(bands - 1));
     for (Image<float>& i : landings.nearest) ensure_size(i, w, h);
     auto band_image = [&](int b) {
@@ -329,33 +348,18 @@ void reproject_depth(const Camera& from, ImageView<const float> depth, const Cam
             std::fill(band_image(b) + std::size_t(y0) * w, band_image(b) + std::size_t(y1) * w,
                       kNan);
     });
-    auto land_row = [&](float* nearest, int y) {
-        const float* value = &landings.z(0, y);
-        if (plane_fit) {
-            plane_row({.slot = landings.slot.data(),
-                       .object = landings.object.data(),
-                       .inverse = landings.inverse.data(),
-                       .z = landings.z.data(),
-                       .px = landings.px.data(),
-                       .py = landings.py.data(),
-                       .width = w,
-                       .height = h,
-                       .span = landings.span,
-                       .y = y,
-                       .out = &landings.held(0, y)});
-            value = &landings.held(0, y);
-        }
-        for (int x = 0; x < w; ++x)
-            if (const int32_t slot = landings.slot(x, y); slot >= 0 && !(value[x] >= nearest[slot]))
-                nearest[slot] = value[x];
-    };
     parallel_for(
         0, bands,
         [&](int b0, int b1) {
-            for (int b = b0; b < b1; ++b)
+            for (int b = b0; b < b1; ++b) {
+                float* nearest = band_image(b);
                 for (int group = b; group * 8 < h; group += bands)
                     for (int y = group * 8; y < std::min(h, group * 8 + 8); ++y)
-                        land_row(band_image(b), y);
+                        for (int x = 0; x < w; ++x)
+                            if (const int32_t slot = landings.slot(x, y);
+                                slot >= 0 && !(value(x, y) >= nearest[slot]))
+                                nearest[slot] = value(x, y);
+            }
         },
         1);
     if (bands > 1)
