@@ -145,7 +145,7 @@ TEST(GridWarp, EdgeTrianglesStretchedOverADisocclusionAreMarked) {
     const int w = 96, h = 48, x0 = 41, step = 8;  // a 2 px cell straddles each edge
     const Frame f = sliding_square_frame(w, h, x0, step);
     Output out(w, h);
-    (void)warp_both(f, 1.0f, out);
+    (void)warp_both(f, 1.0f, out, {.min_cell = 2});  // one-pixel cells tear instead
     std::size_t stretched = 0;
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
@@ -160,11 +160,11 @@ TEST(GridWarp, EdgeTrianglesStretchedOverADisocclusionAreMarked) {
             }
         }
     EXPECT_LE(stretched, std::size_t(16 + 2) * (step + 2)) << "only the uncovered strip";
-    (void)warp_both(f, 1.0f, out, {.stretched_area = kInf});
+    (void)warp_both(f, 1.0f, out, {.min_cell = 2, .stretched_area = kInf});
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) ASSERT_EQ(out.covered(x, y), 1) << "none marked";
     // A still frame: nothing stretches.
-    (void)warp_both(sliding_square_frame(w, h, x0, 0), 1.0f, out);
+    (void)warp_both(sliding_square_frame(w, h, x0, 0), 1.0f, out, {.min_cell = 2});
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) ASSERT_EQ(out.covered(x, y), 1);
 }
@@ -208,6 +208,32 @@ TEST(GridWarp, NearerOccluderWinsTheFoldOver) {
                     }
                 }
         }
+}
+
+// The occluder's last column is odd, so a block of two pixels holds both sides of its edge; the
+// background slides 2 px under it. One-pixel cells keep the occluder's column whole; two-pixel
+// cells draw the block as one stretch from the occluder to the background, which covers it.
+TEST(GridWarp, OnePixelCellsKeepAnOccludersColumnOffTheLattice) {
+    Frame f = flat_frame(64, 32, 10.0f, {4.0f, 0.0f});
+    for (int y = 0; y < 32; ++y)
+        for (int x = 0; x < 17; ++x) {
+            f.depth(x, y) = 1.0f;
+            f.motion(x, y) = {0.0f, 0.0f};
+            f.color(x, y) = {1, 0, 1, 1};
+        }
+    for (int min_cell : {1, 2}) {
+        Output out(64, 32);
+        (void)warp_both(f, -0.5f, out, {.min_cell = min_cell});
+        for (int y = 2; y < 30; ++y) {
+            if (min_cell == 1) {
+                ASSERT_EQ(out.depth(16, y), 1.0f) << y;
+                ASSERT_EQ(out.color(16, y), glm::vec4(1, 0, 1, 1)) << y;
+            } else {
+                ASSERT_GT(out.depth(16, y), 1.0f) << y;
+            }
+            ASSERT_EQ(out.depth(17, y), 10.0f) << min_cell << " " << y;
+        }
+    }
 }
 
 TEST(GridWarp, StaysCoarseOnPlanesAndRefinesAtEdges) {

@@ -288,6 +288,12 @@ private:
     }
 
     bool fits(int x, int y, int x1, int y1) const {
+        if (x1 - x <= 2 && y1 - y <= 2) {  // every pixel a corner: the fit would pass any block
+            Range r = Range::of(depth_(x, y), motion_(x, y));
+            for (int j = y; j < y1; ++j)
+                for (int i = x; i < x1; ++i) r.add(Range::of(depth_(i, j), motion_(i, j)));
+            return r.narrow(p_.vertex_z_ratio, p_.vertex_motion);
+        }
         CellFit fit;
         if (!start(x, y, x1, y1, fit)) return false;
         for (int j = 0; j < y1 - y; ++j)

@@ -9,8 +9,10 @@
 namespace reprise::warp {
 
 struct GridOptions {
-    int cell = 32;     // starting cell size in pixels: min_cell * 2^k, at most 64
-    int min_cell = 2;  // smallest cell (1 or 2)
+    int cell = 32;  // starting cell size in pixels: min_cell * 2^k, at most 64
+    // Smallest cell, 1 or 2. One-pixel cells keep a silhouette's last column where the
+    // background slides under it; two-pixel cells draw it as a stretch into the background.
+    int min_cell = 1;
     // How far a pixel may depart from what its cell's corner pixels predict (interpolated over
     // the two triangles the cell is drawn as) before the cell splits:
     // inverse depth (affine in screen space on a plane), relative: |1 - predicted(1/z) * z|;
