@@ -10,6 +10,7 @@
 #include "reprise/server/builtin_scenes.hpp"
 #include "reprise/server/renderer.hpp"
 #include "reprise/warp/fruc.hpp"
+#include "reprise/warp/silhouettes.hpp"
 #include "support/frames.hpp"
 #include "support/renderer.hpp"
 
@@ -386,6 +387,118 @@ TEST(FrucWithoutCameras, ExtrapolationFollowsTheMotionAlone) {
     }
 }
 
+// A disc drawn as the renderer draws it with anti-aliasing (colour: the mean of 4x4 samples over
+// the pixel; depth and motion: the surface at the pixel centre) slides 5.6 px a frame over a
+// still background shaded smoothly, as sky, walls and ground mostly are. Its edge pixels blend
+// the disc with the background: widened, they travel with the disc instead of leaving a ghost
+// ring where it was. (Over per-pixel noise the widened ring's pure background pixels cost more
+// than the blend gains: 29.97 dB widened against 37.48 on this disc.)
+Frame anti_aliased_disc(int w, int h, float cx, float step) {
+    Frame f = test::constant_frame(w, h, 10.0f, {0.0f, 0.0f});
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            f.color(x, y) = {0.2f + 0.005f * float(x), 0.3f + 0.004f * float(y), 0.6f, 1.0f};
+    const float cy = 32.4f, r = 12.3f;
+    auto inside = [&](float x, float y) {
+        return (x - cx) * (x - cx) + (y - cy) * (y - cy) < r * r;
+    };
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            int covered = 0;
+            for (int j = 0; j < 4; ++j)
+                for (int i = 0; i < 4; ++i)
+                    covered += inside(float(x) + (float(i) + 0.5f) / 4.0f,
+                                      float(y) + (float(j) + 0.5f) / 4.0f);
+            const float a = float(covered) / 16.0f;
+            f.color(x, y) = (1.0f - a) * f.color(x, y) + a * glm::vec4(1.0f, 0.2f, 0.2f, 1.0f);
+            if (inside(float(x) + 0.5f, float(y) + 0.5f)) {
+                f.depth(x, y) = 2.0f;
+                f.motion(x, y) = {-step, 0.0f};
+            }
+        }
+    return f;
+}
+
+TEST(FrucSilhouettes, APixelTakesItsNearestNeighboursSurfaceAndBadDepthsNeitherTakeNorGive) {
+    const float nan = std::numeric_limits<float>::quiet_NaN(),
+                inf = std::numeric_limits<float>::infinity();
+    // Row 0: background, geometry at 2, geometry at 1.8 (within 15 %), background.
+    // Row 1: NaN, 0, -1, geometry at 10. Row 2: geometry at 10 beside 1 (above: 10), 5, 4.
+    Frame f = test::constant_frame(4, 3, 10.0f, {0.0f, 0.0f});
+    const float depths[3][4] = {
+        {inf, 2.0f, 1.8f, inf}, {nan, 0.0f, -1.0f, 10.0f}, {10.0f, 1.0f, 5.0f, 4.0f}};
+    for (int y = 0; y < 3; ++y)
+        for (int x = 0; x < 4; ++x) {
+            f.depth(x, y) = depths[y][x];
+            f.motion(x, y) = {float(x), float(y)};
+        }
+    Image<float> depth;
+    Image<glm::vec2> motion;
+    std::size_t changed = 0;
+    const GBufferView wide = widen_silhouettes(f, depth, motion, &changed);
+    auto expect = [&](int x, int y, float z, glm::vec2 m) {
+        if (std::isnan(z))
+            EXPECT_TRUE(std::isnan(wide.depth(x, y))) << x << "," << y;
+        else
+            EXPECT_EQ(wide.depth(x, y), z) << x << "," << y;
+        EXPECT_EQ(wide.motion(x, y), m) << x << "," << y;
+    };
+    expect(0, 0, 2.0f, {1, 0});  // background beside geometry
+    expect(1, 0, 2.0f, {1, 0});  // 1.8 is within 15 % of 2: one surface
+    expect(2, 0, 1.8f, {2, 0});
+    expect(3, 0, 1.8f, {2, 0});
+    expect(0, 1, nan, {0, 1});   // NaN takes nothing
+    expect(1, 1, 0.0f, {1, 1});  // nor do zero and negative depths, nor do they give
+    expect(2, 1, -1.0f, {2, 1});
+    expect(3, 1, 4.0f, {3, 2});  // the nearest of the nearer neighbours (4 below, 1.8 is not one)
+    expect(0, 2, 1.0f, {1, 2});
+    expect(1, 2, 1.0f, {1, 2});
+    expect(2, 2, 1.0f, {1, 2});
+    expect(3, 2, 4.0f, {3, 2});
+    EXPECT_EQ(changed, 5u);
+    EXPECT_EQ(wide.color.data, f.color.data()) << "colour is the frame's";
+    // Without motion only depth is widened; without depth nothing is.
+    Frame bare = f;
+    bare.motion.clear();
+    const GBufferView depth_only = widen_silhouettes(bare, depth, motion, &changed);
+    EXPECT_TRUE(depth_only.motion.empty());
+    EXPECT_EQ(depth_only.depth(0, 0), 2.0f);
+    EXPECT_EQ(changed, 5u);
+    bare.depth.clear();
+    EXPECT_TRUE(widen_silhouettes(bare, depth, motion).depth.empty());
+    // A 1x1 frame has no neighbours.
+    const Frame one = test::constant_frame(1, 1, 1.0f, {0.5f, 0.5f});
+    EXPECT_EQ(widen_silhouettes(one, depth, motion, &changed).depth(0, 0), 1.0f);
+    EXPECT_EQ(changed, 0u);
+}
+
+TEST(FrucSilhouettes, AntiAliasedEdgesTravelWithTheSilhouette) {
+    const int w = 96, h = 64;
+    const float x0 = 36.3f, step = 5.6f;
+    const std::vector<Frame> input = {anti_aliased_disc(w, h, x0, step),
+                                      anti_aliased_disc(w, h, x0 + step, step)};
+    const Frame truth = anti_aliased_disc(w, h, x0 + 0.5f * step, step);
+    double psnr[2];
+    for (bool widen : {false, true}) {
+        FrucOptions options{.mode = FrucMode::Interpolate, .true_motion = false};
+        options.widen_silhouettes = widen;
+        options.refine.enabled = false;
+        FrucCounters counters;
+        const std::vector<Frame> out = convert(input, 2, options, &counters);
+        ASSERT_EQ(out.size(), 3u);
+        psnr[widen] = psnr_of(truth, out[1]);
+        if (widen)
+            EXPECT_GT(counters.silhouette_pixels, 2u * 70u) << "the rings of both inputs";
+        else
+            EXPECT_EQ(counters.silhouette_pixels, 0u);
+    }
+    std::printf("[fruc] anti-aliased disc, in-between frame: %.2f dB widened, %.2f dB not\n",
+                psnr[1], psnr[0]);
+    // Measured 53.70 dB widened, 44.52 not.
+    EXPECT_GT(psnr[1], 50.0);
+    EXPECT_GT(psnr[1], psnr[0] + 5.0);
+}
+
 // A square slides 8 px right per frame over a still background. Halfway, with two-pixel
 // smallest cells each side's grid warp stretches its edge triangles over the strip the square
 // uncovers on its side, in front of the background the other side saw: the in-between frame
@@ -396,7 +509,9 @@ TEST(FrucBlend, TheSideThatSawTheUncoveredStripIsTaken) {
                                       test::sliding_square_frame(w, h, 33 + step, step)};
     const Frame truth = test::sliding_square_frame(w, h, 33 + step / 2, step);
     auto psnr_with = [&](int min_cell, bool marked) {
+        // Without anti-aliasing the square's neighbours are pure background: not widened.
         FrucOptions options{.mode = FrucMode::Interpolate, .true_motion = false};
+        options.widen_silhouettes = false;
         options.refine.enabled = false;
         options.grid.min_cell = min_cell;
         if (!marked) options.grid.stretched_area = std::numeric_limits<float>::infinity();

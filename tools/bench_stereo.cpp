@@ -498,7 +498,8 @@ Status bench_stereo(const BenchOptions& options) {
             probe_synth.synthesize(left, target, probe,
                                    {.warp = stereo::StereoWarp::Splat,
                                     .fill = stereo::StereoFill::None,
-                                    .splat = {.footprint = 1}});
+                                    .splat = {.footprint = 1},
+                                    .widen_silhouettes = false});
             std::size_t dis = 0;
             for (std::size_t k = 0; k < disoccluded.pixel_count(); ++k)
                 dis += disoccluded.data()[k] = !probe_synth.coverage().data[k];
@@ -528,7 +529,8 @@ Status bench_stereo(const BenchOptions& options) {
                 synthesizer.synthesize(left, target, made,
                                        {.warp = stereo::StereoWarp::Splat,
                                         .fill = stereo::StereoFill::None,
-                                        .splat = {.footprint = 1}});
+                                        .splat = {.footprint = 1},
+                                        .widen_silhouettes = false});
             });
             record(runs[splat_i], made.color, ms);
             for (std::size_t k = 0; k < holes.pixel_count(); ++k)

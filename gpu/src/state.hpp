@@ -110,6 +110,8 @@ struct ContextState {
     // Stereo eye: displacement (RG) and the depth seen from the target.
     GLuint displacement_program = 0, finish_program = 0;
     NonfiniteRepair eye_repair;
+    Image<float> wide_depth;  // the rendered eye's depth with its silhouettes widened
+    Image<glm::vec2> wide_motion;
     // Interpolation: the blend of the two splatted sides, a plain copy, and the hole count.
     GLuint blend_program = 0, copy_program = 0, blend_counts = 0;
     Interpolation interpolation;

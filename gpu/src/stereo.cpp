@@ -6,6 +6,7 @@
 #include <string>
 
 #include "reprise/core/camera_math.hpp"
+#include "reprise/warp/silhouettes.hpp"
 #include "state.hpp"
 
 namespace reprise::gpu {
@@ -156,7 +157,7 @@ Status Context::stereo_eye(const GBufferView& given, const Camera& target, Frame
     REPRISE_ASSERT(given.depth.width == w && given.depth.height == h);
     ContextState& s = *state_;
     // NaN and infinities (but background depth) repaired first, as on the CPU.
-    const GBufferView rendered = s.eye_repair.clean(given, stats.nonfinite);
+    GBufferView rendered = s.eye_repair.clean(given, stats.nonfinite);
     out.motion.clear();
     out.normal.clear();
     out.id.clear();
@@ -170,6 +171,9 @@ Status Context::stereo_eye(const GBufferView& given, const Camera& target, Frame
     if (w <= 0 || h <= 0) return {};
     REPRISE_TRY(s.gl->acquire());
     auto t = std::chrono::steady_clock::now();
+    // The silhouettes widened on the CPU, as StereoSynthesizer does (counted as upload time).
+    if (options.widen_silhouettes)
+        rendered = warp::widen_silhouettes(rendered, s.wide_depth, s.wide_motion);
     s.payload.ensure(GL_RGBA32F, w, h);
     s.previous_depth.ensure(GL_R32F, w, h);
     s.upload(s.payload, rendered.color.data, rendered.color.stride);

@@ -7,6 +7,7 @@
 #include "reprise/core/camera_math.hpp"
 #include "reprise/core/parallel.hpp"
 #include "reprise/stereo/synthesize.hpp"
+#include "reprise/warp/silhouettes.hpp"
 
 namespace reprise::stereo {
 
@@ -59,10 +60,12 @@ std::size_t drop_moving(const GBufferView& source, float tolerance,
 
 }  // namespace
 
-std::size_t StereoSynthesizer::warp_into(const GBufferView& source, const Camera& target,
+std::size_t StereoSynthesizer::warp_into(const GBufferView& given, const Camera& target,
                                          const StereoOptions& o, const warp::WarpTarget& into,
                                          std::size_t& cells, bool& maybe_nonfinite,
                                          std::size_t* moving) {
+    const GBufferView source =
+        o.widen_silhouettes ? warp::widen_silhouettes(given, wide_depth_, wide_motion_) : given;
     const int w = source.width(), h = source.height();
     displacement_.resize(w, h);
     target_depth_.resize(w, h);

@@ -109,9 +109,10 @@ std::size_t static_layer_row_reference(const StaticLayerTest& t, int y, int x_be
 namespace {
 
 // Without a camera nothing tells static from moving: every pixel goes along its own motion.
-void extrapolate_along_motion(const GBufferView& f, float s, float motion_scale,
+void extrapolate_along_motion(const GBufferView& given, float s, float motion_scale,
                               const FrucOptions& options, FrucScratch& scratch, Frame& out,
                               FrucCounters& counters) {
+    const GBufferView f = warp_input(given, 0, options, scratch, counters);
     const int w = f.width(), h = f.height();
     out.color.resize(w, h);
     out.depth.resize(w, h);
@@ -176,10 +177,11 @@ void extrapolate_frame(const GBufferView& f, float s, float motion_scale,
                           counters);
 }
 
-void extrapolate_to_camera(const GBufferView& f, const glm::mat4& future_view,
+void extrapolate_to_camera(const GBufferView& given, const glm::mat4& future_view,
                            const glm::mat4& future_projection, float s, float motion_scale,
                            const FrucOptions& options, FrucScratch& scratch, Frame& out,
                            FrucCounters& counters) {
+    const GBufferView f = warp_input(given, 0, options, scratch, counters);
     const int w = f.width(), h = f.height();
     // One warp of the whole frame: static pixels (whose motion the camera alone explains) to
     // where the future camera sees them, the others s periods on along their own motion. Warping

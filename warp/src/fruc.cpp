@@ -432,8 +432,11 @@ Status FrameRateConverter::send_frame(const Frame& given, Frame* owned) {
                 } else {
                     Frame& out = st.ready.push();
                     if (st.options.backend && a_warpable) {
-                        const Status made =
-                            st.options.backend->interpolate(a, frame, s, out, st.counters);
+                        // The inputs the CPU's warps would take.
+                        const Status made = st.options.backend->interpolate(
+                            warp_input(a, 0, st.options, st.scratch, st.counters),
+                            warp_input(frame, 1, st.options, st.scratch, st.counters), s, out,
+                            st.counters);
                         if (!made.ok()) {
                             st.ready.truncate(queued_before);
                             st.counters = counters_before;

@@ -59,6 +59,8 @@ struct FrucScratch {
     Image<glm::vec2> inverted;        // the later frame's moving pixels, at their earlier place
     Image<float> inverted_depth;
     Image<uint8_t> valid;
+    Image<float> wide_depth[2];  // the inputs with their silhouettes widened
+    Image<glm::vec2> wide_motion[2];
     Image<glm::vec4> reprojected;
     GridWarper grid;
     PullPush pull_push;
@@ -71,6 +73,10 @@ struct FrucScratch {
 // number of covered pixels (the target's contract: colour 0, depth +inf, motion 0 elsewhere).
 std::size_t warp_into(const GBufferView& source, float factor, const FrucOptions& options,
                       FrucScratch& scratch, const WarpTarget& out, FrucCounters& counters);
+
+// `f` with its silhouettes widened into scratch slot `slot` (0 or 1) when options ask for it.
+GBufferView warp_input(const GBufferView& f, int slot, const FrucOptions& options,
+                       FrucScratch& scratch, FrucCounters& counters);
 
 // Fills the holes of `color` (valid = 0; `holes` of them, counted by the caller) as options.fill
 // says, using depth for the side to prefer; counts what it did or skipped.

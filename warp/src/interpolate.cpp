@@ -9,6 +9,7 @@
 #include "kernels.hpp"
 #include "reprise/core/parallel.hpp"
 #include "reprise/warp/sample.hpp"
+#include "reprise/warp/silhouettes.hpp"
 
 namespace reprise::warp {
 
@@ -94,6 +95,16 @@ std::size_t warp_into(const GBufferView& source, float factor, const FrucOptions
     return 0;
 }
 
+GBufferView warp_input(const GBufferView& f, int slot, const FrucOptions& options,
+                       FrucScratch& scratch, FrucCounters& counters) {
+    if (!options.widen_silhouettes) return f;
+    std::size_t changed = 0;
+    const GBufferView widened =
+        widen_silhouettes(f, scratch.wide_depth[slot], scratch.wide_motion[slot], &changed);
+    counters.silhouette_pixels += changed;
+    return widened;
+}
+
 void fill_holes(ImageView<glm::vec4> color, ImageView<const uint8_t> valid,
                 ImageView<const float> depth, std::size_t holes, const FrucOptions& options,
                 FrucScratch& scratch, FrucCounters& counters) {
@@ -143,9 +154,11 @@ std::size_t blend_row_reference(const BlendRow& r) {
     return holes;
 }
 
-void interpolate_frame(const GBufferView& a, const GBufferView& b, float s, bool use_a,
+void interpolate_frame(const GBufferView& a_in, const GBufferView& b_in, float s, bool use_a,
                        float motion_scale, const FrucOptions& options, FrucScratch& scratch,
                        Frame& out, FrucCounters& counters) {
+    const GBufferView a = use_a ? warp_input(a_in, 0, options, scratch, counters) : a_in,
+                      b = warp_input(b_in, 1, options, scratch, counters);
     const int w = b.width(), h = b.height();
     out.color.resize(w, h);
     out.depth.resize(w, h);

@@ -94,7 +94,8 @@ public:
     // The same on textures: `rendered.depth` and `color` (GL_RGBA32F) in, `out_color`
     // (GL_RGBA32F) and `out_depth` (GL_R32F) written, all of the rendered size. No repair of
     // NaN/Inf input here (the CPU-image entry repairs as the CPU does): pixels with NaN depth are
-    // left out, colour with a non-finite channel comes out 0.
+    // left out, colour with a non-finite channel comes out 0. The depth texture is warped as it
+    // is (StereoOptions::widen_silhouettes is the CPU-image entry's, done on the CPU).
     Status stereo_eye(const GBufferTextures& rendered, unsigned color, const Camera& target,
                       unsigned out_color, unsigned out_depth, stereo::StereoStats& stats,
                       const stereo::StereoOptions& options = {});

@@ -38,6 +38,9 @@ struct StereoOptions {
     // fill the holes beside them with their stale copy. +inf keeps them; a history without
     // motion keeps them all.
     float history_moving_tolerance = 0.5f;
+    // Edge pixels go with the nearer surface, as in frame-rate conversion
+    // (warp::widen_silhouettes, warp::FrucOptions::widen_silhouettes).
+    bool widen_silhouettes = true;
 };
 
 struct StereoStats {
@@ -89,6 +92,8 @@ private:
 
     Image<glm::vec2> displacement_;  // the source's displacement to the target, as motion
     Image<float> target_depth_;      // and its depth seen from the target
+    Image<float> wide_depth_;        // the source's depth and motion with its silhouettes widened
+    Image<glm::vec2> wide_motion_;
     Image<uint8_t> covered_;
     Image<glm::vec4> history_color_;
     Image<float> history_depth_;

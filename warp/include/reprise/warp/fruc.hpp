@@ -110,6 +110,10 @@ struct FrucOptions {
     // The grid fetches colour bicubically: on anti-aliased renders it measured 0.6-1.1 dB above the
     // bilinear fetch (docs/benchmarks.md). The stereo eye keeps GridOptions' bilinear default.
     GridOptions grid{.bicubic = true};
+    // Edge pixels go with the nearer surface (widen_silhouettes, reprise/warp/silhouettes.hpp):
+    // their blended colour travels with the silhouette instead of staying on the background as a
+    // ghost contour.
+    bool widen_silhouettes = true;
     SplatOptions splat;
     // A new frame whose camera does not say whether a cut came before it (Camera::cut Unknown) and
     // whose reverse reprojection into the previous one misses on more than this fraction of pixels,
@@ -149,6 +153,7 @@ struct FrucCounters {
     std::size_t cuts = 0;               // shot changes (the camera's Cut::Yes, or detected)
     std::size_t cut_tests_skipped = 0;  // frames whose camera said whether a cut came: no test
     std::size_t grid_cells = 0;         // adaptive-grid cells drawn
+    std::size_t silhouette_pixels = 0;  // input pixels warped with a nearer neighbour's surface
     std::size_t true_motion = 0;        // in-between frames whose sides followed the true motion
     std::size_t linear_motion = 0;      // ... that did not need it: a sparse survey found it linear
     std::size_t refined_frames = 0;     // in-between frames whose sides disagreed: flow estimated
