@@ -162,3 +162,32 @@ TEST(CliFruc, BadRangesAreRefusedNamingTheRange) {
     EXPECT_NE(resumed.output.find("cannot be combined"), std::string::npos) << resumed.output;
     fs::remove_all(dir);
 }
+
+// `--silhouettes keep` turns the widening off in both commands: other frames, a count of zero;
+// a value that is neither is refused before anything is written.
+TEST(CliFruc, SilhouettesAreWidenedUnlessKept) {
+    const std::string dir = scratch("silhouettes"), in = render_cut(dir);
+    for (const std::string command : {"fruc", "stereo"}) {
+        const std::string base = command + " --in " + q(in) + " --range 1:2 --out ";
+        const test::Outcome widened = test::run_reprise(base + q(dir + "/widen"), 60);
+        const test::Outcome kept =
+            test::run_reprise(base + q(dir + "/keep") + " --silhouettes keep", 60);
+        ASSERT_EQ(widened.status, 0) << widened.output;
+        ASSERT_EQ(kept.status, 0) << kept.output;
+        EXPECT_NE(differences(frames(dir + "/widen"), frames(dir + "/keep")), "") << command;
+        if (command == "fruc") {
+            EXPECT_EQ(widened.output.find(" 0 input pixels with a nearer"), std::string::npos)
+                << widened.output;
+            EXPECT_NE(kept.output.find(" 0 input pixels with a nearer"), std::string::npos)
+                << kept.output;
+        }
+        const test::Outcome bad =
+            test::run_reprise(base + q(dir + "/bad") + " --silhouettes thin", 60);
+        EXPECT_NE(bad.status, 0) << bad.output;
+        EXPECT_NE(bad.output.find("--silhouettes"), std::string::npos) << bad.output;
+        EXPECT_FALSE(fs::exists(dir + "/bad")) << command;
+        fs::remove_all(dir + "/widen");
+        fs::remove_all(dir + "/keep");
+    }
+    fs::remove_all(dir);
+}

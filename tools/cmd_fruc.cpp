@@ -24,6 +24,7 @@ struct FrucJob {
     std::string layout = "reprise";
     std::string refine = "on";
     std::string true_motion = "on";
+    std::string silhouettes = "widen";
     std::string backend = "cpu";
     double refine_share = 1.0;
     std::string ui;             // a UI sequence beside the input (its colour: premultiplied RGBA)
@@ -66,6 +67,9 @@ Status run_fruc(const FrucJob& job) {
     if (job.true_motion != "on" && job.true_motion != "off")
         return Status::error("--true-motion '" + job.true_motion + "': expected on or off");
     options.true_motion = job.true_motion == "on";
+    if (job.silhouettes != "widen" && job.silhouettes != "keep")
+        return Status::error("--silhouettes '" + job.silhouettes + "': expected widen or keep");
+    options.widen_silhouettes = job.silhouettes == "widen";
     if (job.backend != "cpu" && job.backend != "gles")
         return Status::error("--backend '" + job.backend + "': expected cpu or gles");
     std::unique_ptr<gpu::Context> gpu;
@@ -199,8 +203,9 @@ Status run_fruc(const FrucJob& job) {
         c.copied_still, c.fills_skipped, c.dynamic_skipped, c.linear_motion, c.cut_tests_skipped);
     std::printf(
         "  done: %zu fills (%zu hole pixels), %zu dynamic layers, %zu grid cells, %zu cuts, "
-        "%zu true-motion frames\n",
-        c.fills, c.hole_pixels, c.dynamic_layers, c.grid_cells, c.cuts, c.true_motion);
+        "%zu true-motion frames, %zu input pixels with a nearer neighbour's surface\n",
+        c.fills, c.hole_pixels, c.dynamic_layers, c.grid_cells, c.cuts, c.true_motion,
+        c.silhouette_pixels);
     if (options.mode == warp::FrucMode::Interpolate && options.refine.enabled)
         std::printf(
             "  refinement: %zu frames refined, %zu skipped (sides agree), %zu tiles (%zu left out "
@@ -248,6 +253,9 @@ int command_fruc(int argc, char** argv) {
     args.option("--true-motion", &job.true_motion,
                 "on | off (default on): interpolation moves each side where it truly is at the "
                 "in-between\ninstant (off: each follows its motion linearly)");
+    args.option("--silhouettes", &job.silhouettes,
+                "widen | keep (default widen): pixels beside a nearer surface warp with it, so "
+                "the colour\nanti-aliasing blended into them travels with the silhouette");
     args.option("--backend", &job.backend,
                 "cpu | gles (default cpu); gles: the in-between frames as OpenGL ES compute "
                 "shaders, with\n--warp splat --fill pullpush --refine off --true-motion off "

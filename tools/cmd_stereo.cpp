@@ -25,6 +25,7 @@ namespace {
 struct StereoJob {
     std::string in, out, rig = "parallel", eye = "left", warp = "grid", fill = "pullpush";
     std::string backend = "cpu";
+    std::string silhouettes = "widen";
     double ipd = 0.064;
     double convergence = 10.0;
     double fov = 0.0;  // degrees, for inputs without a camera
@@ -53,6 +54,8 @@ Status check(const StereoJob& j, stereo::StereoRig& rig, stereo::StereoOptions& 
         return Status::error("--fill: '" + j.fill + "' is not pullpush, andreev, patch or none");
     if (j.backend != "cpu" && j.backend != "gles")
         return Status::error("--backend: '" + j.backend + "' is not cpu or gles");
+    if (j.silhouettes != "widen" && j.silhouettes != "keep")
+        return Status::error("--silhouettes: '" + j.silhouettes + "' is not widen or keep");
     if (j.backend == "gles" &&
         (j.warp != "splat" || j.fill == "andreev" || j.fill == "patch" || j.temporal))
         return Status::error(
@@ -68,6 +71,7 @@ Status check(const StereoJob& j, stereo::StereoRig& rig, stereo::StereoOptions& 
                        : j.fill == "patch" ? stereo::StereoFill::Patch
                        : j.fill == "none"  ? stereo::StereoFill::None
                                            : stereo::StereoFill::PullPush};
+    options.widen_silhouettes = j.silhouettes == "widen";
     return {};
 }
 
@@ -195,6 +199,8 @@ int command_stereo(int argc, char** argv) {
                 "reconstruction, slow)");
     args.option("--backend", &job.backend,
                 "cpu|gles (default cpu); gles: OpenGL ES compute shaders, with --warp splat");
+    args.option("--silhouettes", &job.silhouettes,
+                "widen|keep (default widen): pixels beside a nearer surface warp with it");
     args.flag("--temporal", &job.temporal, "fill disocclusions from the previous frame first");
     args.option("--range", &job.range,
                 "A:B: frames A..B only (--temporal reads frame A-1 first); ranges that meet "
