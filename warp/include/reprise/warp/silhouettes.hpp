@@ -17,8 +17,8 @@ namespace reprise::warp {
 //
 // Measured on the built-in renderer's anti-aliased frames (smooth backgrounds): +0.4 to +2.2 dB
 // in-between, up to +3.9 extrapolated, +0.4 to +4.4 in the second eye; on path-traced Blender
-// renders -0.2 to 0 in-between. Over per-pixel noise a widened pixel that held no nearer colour
-// costs more than the blended ones gain (docs/benchmarks.md).
+// renders -0.5 to +0.2 in-between. Over per-pixel noise a widened pixel that held no nearer
+// colour costs more than the blended ones gain (docs/benchmarks.md).
 GBufferView widen_silhouettes(const GBufferView& f, Image<float>& depth, Image<glm::vec2>& motion,
                               std::size_t* changed = nullptr);
 
