@@ -236,6 +236,24 @@ TEST(GridWarp, OnePixelCellsKeepAnOccludersColumnOffTheLattice) {
     }
 }
 
+// The same edge in a starting cell clipped to two pixels at the right border (66 = 2 * 32 + 2):
+// its columns were each tested against their own ends only.
+TEST(GridWarp, ABorderStripTwoPixelsWideSplitsAtAnEdge) {
+    Frame f = flat_frame(66, 40, 10.0f, {4.0f, 0.0f});
+    for (int y = 0; y < 40; ++y)
+        for (int x = 0; x < 65; ++x) {
+            f.depth(x, y) = 1.0f;
+            f.motion(x, y) = {0.0f, 0.0f};
+            f.color(x, y) = {1, 0, 1, 1};
+        }
+    Output out(66, 40);
+    (void)warp_both(f, -0.5f, out, {.min_cell = 1});
+    for (int y = 2; y < 38; ++y) {
+        ASSERT_EQ(out.depth(64, y), 1.0f) << y;
+        ASSERT_EQ(out.color(64, y), glm::vec4(1, 0, 1, 1)) << y;
+    }
+}
+
 TEST(GridWarp, StaysCoarseOnPlanesAndRefinesAtEdges) {
     for (auto [w, h] : {std::pair{320, 180}, std::pair{100, 33}, std::pair{32, 32}}) {
         Frame flat = flat_frame(w, h, 7.0f, {2.3f, -1.1f});

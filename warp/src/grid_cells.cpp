@@ -234,6 +234,14 @@ private:
     // `start` (false when a corner already fails), then run row by row.
     bool start(int x, int y, int x1, int y1, CellFit& fit) const {
         const int n = x1 - x, rows = y1 - y;
+        // Two pixels wide or high (a border strip, a smallest block): each column or row is
+        // predicted from its own ends, so an edge between the two would pass; one surface only.
+        if (n <= 2 || rows <= 2) {
+            Range r = Range::of(depth_(x, y), motion_(x, y));
+            for (int j = y; j < y1; ++j)
+                for (int i = x; i < x1; ++i) r.add(Range::of(depth_(i, j), motion_(i, j)));
+            if (!r.narrow(p_.vertex_z_ratio, p_.vertex_motion)) return false;
+        }
         const int xr = x1 - 1, yb = y1 - 1;
         // Corners top-left, top-right, bottom-right, bottom-left.
         const float z[4] = {depth_(x, y), depth_(xr, y), depth_(xr, yb), depth_(x, yb)};
@@ -288,12 +296,6 @@ private:
     }
 
     bool fits(int x, int y, int x1, int y1) const {
-        if (x1 - x <= 2 && y1 - y <= 2) {  // every pixel a corner: the fit would pass any block
-            Range r = Range::of(depth_(x, y), motion_(x, y));
-            for (int j = y; j < y1; ++j)
-                for (int i = x; i < x1; ++i) r.add(Range::of(depth_(i, j), motion_(i, j)));
-            return r.narrow(p_.vertex_z_ratio, p_.vertex_motion);
-        }
         CellFit fit;
         if (!start(x, y, x1, y1, fit)) return false;
         for (int j = 0; j < y1 - y; ++j)
