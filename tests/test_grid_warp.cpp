@@ -210,17 +210,28 @@ TEST(GridWarp, NearerOccluderWinsTheFoldOver) {
         }
 }
 
-// The occluder's last column is odd, so a block of two pixels holds both sides of its edge; the
-// background slides 2 px under it. One-pixel cells keep the occluder's column whole; two-pixel
-// cells draw the block as one stretch from the occluder to the background, which covers it.
-TEST(GridWarp, OnePixelCellsKeepAnOccludersColumnOffTheLattice) {
-    Frame f = flat_frame(64, 32, 10.0f, {4.0f, 0.0f});
-    for (int y = 0; y < 32; ++y)
-        for (int x = 0; x < 17; ++x) {
+namespace {
+
+// A still magenta occluder (depth 1) over columns [0, edge) and a noise background (depth 10) that
+// slides 2 px under it at factor -0.5.
+Frame occluder_frame(int w, int h, int edge) {
+    Frame f = flat_frame(w, h, 10.0f, {4.0f, 0.0f});
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < edge; ++x) {
             f.depth(x, y) = 1.0f;
             f.motion(x, y) = {0.0f, 0.0f};
             f.color(x, y) = {1, 0, 1, 1};
         }
+    return f;
+}
+
+}  // namespace
+
+// The occluder's last column is odd, so a block of two pixels holds both sides of its edge.
+// One-pixel cells keep the occluder's column whole; two-pixel cells draw the block as one
+// stretch from the occluder to the background, which covers it.
+TEST(GridWarp, OnePixelCellsKeepAnOccludersColumnOffTheLattice) {
+    const Frame f = occluder_frame(64, 32, 17);
     for (int min_cell : {1, 2}) {
         Output out(64, 32);
         (void)warp_both(f, -0.5f, out, {.min_cell = min_cell});
@@ -239,13 +250,7 @@ TEST(GridWarp, OnePixelCellsKeepAnOccludersColumnOffTheLattice) {
 // The same edge in a starting cell clipped to two pixels at the right border (66 = 2 * 32 + 2):
 // its columns were each tested against their own ends only.
 TEST(GridWarp, ABorderStripTwoPixelsWideSplitsAtAnEdge) {
-    Frame f = flat_frame(66, 40, 10.0f, {4.0f, 0.0f});
-    for (int y = 0; y < 40; ++y)
-        for (int x = 0; x < 65; ++x) {
-            f.depth(x, y) = 1.0f;
-            f.motion(x, y) = {0.0f, 0.0f};
-            f.color(x, y) = {1, 0, 1, 1};
-        }
+    const Frame f = occluder_frame(66, 40, 65);
     Output out(66, 40);
     (void)warp_both(f, -0.5f, out, {.min_cell = 1});
     for (int y = 2; y < 38; ++y) {
