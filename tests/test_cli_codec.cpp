@@ -78,6 +78,16 @@ TEST(CliCodec, EncodeDecodeInfoAndThreadCountIndependence) {
     EXPECT_EQ(packets, 4u);
     EXPECT_EQ(bytes + 24, stream.size());
     EXPECT_EQ(stream, bytes_of(two));
+    // At qp 46 the bounds follow the quantiser (4x) unless --fixed-bounds: a smaller stream.
+    const std::string coarse = (dir / "coarse.rps").string(), fixed = (dir / "fixed.rps").string();
+    ASSERT_EQ(
+        test::run_reprise("encode --in " + frames + " --out " + coarse + " --qp 46", 120).status,
+        0);
+    ASSERT_EQ(test::run_reprise(
+                  "encode --in " + frames + " --out " + fixed + " --qp 46 --fixed-bounds", 120)
+                  .status,
+              0);
+    EXPECT_LT(fs::file_size(coarse), fs::file_size(fixed));
     EXPECT_EQ(stream, bytes_of(dir / "t1.rps")) << "1 thread";
     EXPECT_EQ(stream, bytes_of(dir / "t4.rps")) << "4 threads";
 

@@ -310,6 +310,7 @@ std::string synthesized_views_text(const std::vector<ViewDepthRun>& rows) {
 
 Status run_view_depth(server::Renderer& renderer, const Sequence& seq, int qp, ViewDepthRun& run) {
     const codec::EncoderOptions options{.qp = qp, .fps = seq.fps, .depth = codec::DepthMode::View};
+    const float bound_px = codec::coded_bounds(options).view_error_px;
     codec::Encoder encoder;
     REPRISE_TRY(codec::Encoder::create(options, encoder));
     codec::Decoder decoder;
@@ -328,9 +329,8 @@ Status run_view_depth(server::Renderer& renderer, const Sequence& seq, int qp, V
         REPRISE_TRY(decoder.send_packet(packet.data));
         if (decoder.receive_frame(decoded) != Result::Ok)
             return Status::error("reprise codec: no decoded frame for frame " + std::to_string(i));
-        const codec::ViewDepthError e =
-            codec::measure_view_depth_error(frame.camera, frame.depth.view(), decoded.depth(),
-                                            options.view_displacement, options.view_error_px);
+        const codec::ViewDepthError e = codec::measure_view_depth_error(
+            frame.camera, frame.depth.view(), decoded.depth(), options.view_displacement, bound_px);
         if (views) {
             REPRISE_TRY(views->add(int(i), frame, decoded.view(), run.views));
             std::fprintf(stderr, "\r[codec] %s: views from decoded depth %zu/%zu   ",
@@ -371,8 +371,7 @@ Status run_view_depth(server::Renderer& renderer, const Sequence& seq, int qp, V
     }
     run.per_pixel_motion_bytes = reference.stats().motion_bits / 8.0;
     run.step = codec::view_depth_step(seq.frames[0].camera.projection, seq.frames[0].width(),
-                                      seq.frames[0].height(), options.view_error_px,
-                                      options.view_displacement);
+                                      seq.frames[0].height(), bound_px, options.view_displacement);
     // The immersive-video depth peer: x265 Main 10 (4:0:0) of 1/z, lossless and at four rates.
     if (!peer_available(PeerKind::X265)) return {};
     for (int crf : {-1, 8, 16, 24, 32}) {
@@ -382,7 +381,7 @@ Status run_view_depth(server::Renderer& renderer, const Sequence& seq, int qp, V
                                 .lossless = crf < 0};
         DepthVideoRun peer;
         REPRISE_TRY(run_depth_video_peer(seq.frames, seq.fps, config, 10, options.view_displacement,
-                                         options.view_error_px, peer));
+                                         bound_px, peer));
         run.video_peers.push_back(peer);
     }
     return {};
@@ -662,20 +661,21 @@ std::string depth_text(const std::vector<DepthSummary>& depth_rows,
         if (!std::isnan(ratio)) depth_ratio_sum += ratio, ++depth_ratio_n;
     }
 
-    const codec::EncoderOptions view_defaults;
+    const codec::EncoderOptions view_defaults{.qp = qp, .depth = codec::DepthMode::View};
+    const codec::CodedBounds bounds = codec::coded_bounds(view_defaults);
     depth_text += strf(
         "\ndepth to the view bound (--depth view): 1/z step from the intrinsics so that a camera "
         "displaced by up to B = %.3f scene units moves no reprojected pixel by more than E = %.2f "
         "px; qp %d; measured: largest reprojection error of decoded against rendered depth over "
         "28 displacements of length B\n"
         "%-10s %12s %12s %12s %10s %12s %12s %10s\n",
-        view_defaults.view_displacement, view_defaults.view_error_px, qp, "scene", "1/z step",
+        view_defaults.view_displacement, bounds.view_error_px, qp, "scene", "1/z step",
         "view bytes", "lossless", "ratio", "depth share", "max err px", "bg wrong");
     std::string motion_text = strf(
         "\nbits per frame by section at qp %d (depth to the view bound, motion within %.2f px: "
         "rigid objects and affine models per block, pixels alone where none fits; per-pixel = "
         "every pixel to 1/8 px)\n%-10s %9s %9s %9s %9s %9s %8s %8s %11s %8s %9s %9s %10s\n",
-        qp, view_defaults.motion_error_px, "scene", "total", "camera", "depth", "motion", "colour",
+        qp, bounds.motion_error_px, "scene", "total", "camera", "depth", "motion", "colour",
         "depth%", "motion%", "per-pixel", "objects", "models", "alone px", "max err px");
     for (const ViewDepthRun& v : view_rows) {
         const double n = 8.0 / double(std::max<std::size_t>(1, v.frames));
@@ -687,8 +687,8 @@ std::string depth_text(const std::vector<DepthSummary>& depth_rows,
             100.0 * v.motion_bytes / v.total_bytes, v.per_pixel_motion_bytes * n,
             double(v.motion_objects) * n / 8.0, double(v.motion_models) * n / 8.0,
             double(v.motion_own_pixels) * n / 8.0, v.max_motion_error_px,
-            v.max_motion_error_px <= view_defaults.motion_error_px ? "within the bound"
-                                                                   : "OUTSIDE the bound");
+            v.max_motion_error_px <= bounds.motion_error_px ? "within the bound"
+                                                            : "OUTSIDE the bound");
     }
     for (const ViewDepthRun& v : view_rows)
         depth_text +=
@@ -696,7 +696,7 @@ std::string depth_text(const std::vector<DepthSummary>& depth_rows,
                  double(v.step), v.depth_bytes, v.lossless_depth_bytes,
                  v.depth_bytes / v.lossless_depth_bytes, 100.0 * v.depth_bytes / v.total_bytes,
                  v.max_error_px, v.background_mismatches,
-                 v.max_error_px <= view_defaults.view_error_px && v.background_mismatches == 0
+                 v.max_error_px <= bounds.view_error_px && v.background_mismatches == 0
                      ? "within the bound"
                      : "OUTSIDE the bound");
     depth_text += depth_video_text(view_rows, view_defaults);

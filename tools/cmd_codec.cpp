@@ -127,6 +127,7 @@ struct EncodeJob {
     int qp = 28, quality = 0, bitrate = 0, keyint = 0, skip = 2;
     double motion_error = 0.25;
     bool quality_given = false, overwrite_inputs = false, resume = false, no_objects = false;
+    bool fixed_bounds = false;
     std::string line;  // the options given, recorded for --resume
 };
 
@@ -152,6 +153,7 @@ Status encoder_options(const EncodeJob& job, codec::EncoderOptions& o) {
             "encode: --motion-error must be 0 (per pixel, 1/8 px) or in 0.1..8 px");
     o.motion_error_px = float(job.motion_error);
     o.rigid_objects = !job.no_objects;
+    o.bounds_follow_qp = !job.fixed_bounds;
     if (job.chroma == "420")
         o.chroma = codec::Chroma::C420;
     else if (job.chroma == "444")
@@ -378,6 +380,9 @@ int command_encode(int argc, char** argv) {
     args.option("--motion-error", &job.motion_error,
                 "largest error of the decoded motion in px: affine models per block where they "
                 "hold (default 0.25; 0: every pixel to 1/8 px)");
+    args.flag("--fixed-bounds", &job.fixed_bounds,
+              "the view and motion bounds as given at every qp (default: above qp 34 both double "
+              "every 6 qp, as the colour quantiser's step does)");
     args.flag("--no-objects", &job.no_objects,
               "no rigid object motions (default: each object id that moves on its own gets one, "
               "with motion models and depth)");

@@ -215,6 +215,15 @@ struct Encoder::State {
     }
 };
 
+CodedBounds coded_bounds(const EncoderOptions& options) {
+    constexpr int kAnchorQp = 34;  // the middle rate point, where the bounds are as given
+    const float scale = options.bounds_follow_qp && options.qp > kAnchorQp
+                            ? std::exp2(float(options.qp - kAnchorQp) / 6.0f)
+                            : 1.0f;
+    return {.view_error_px = std::min(options.view_error_px * scale, 100.0f),
+            .motion_error_px = std::min(options.motion_error_px * scale, 8.0f)};
+}
+
 Status check_encoder_options(const EncoderOptions& o) {
     auto bad = [](const std::string& what) { return Status::error("encoder option " + what); };
     if (o.qp < 0 || o.qp > 51) return bad("qp " + std::to_string(o.qp) + ": expected 0..51");
@@ -290,9 +299,10 @@ Status Encoder::send_frame(const GBufferView& given) {
     sp.chroma = s.options.chroma;
     sp.depth = s.options.depth;
     sp.depth_error = s.options.depth_error;
-    sp.motion_error = s.options.motion_error_px;
+    const CodedBounds bounds = coded_bounds(s.options);
+    sp.motion_error = bounds.motion_error_px;
     if (sp.depth == DepthMode::View) {
-        sp.view_error = s.options.view_error_px;
+        sp.view_error = bounds.view_error_px;
         sp.view_displacement = s.options.view_displacement;
         // The key frame's step; later frames send their own when it differs (a zoom, a faster
         // camera or object), so that no step change needs a key frame.

@@ -88,6 +88,10 @@ def test_codec_streams_and_bad_packets(pan_60):
         decoder.decode(np.zeros(4, np.float32))
     with pytest.raises(ValueError):
         reprise.Encoder(qp=99)
+    # Above qp 34 the view and motion bounds follow the quantiser unless told not to.
+    coarse = reprise.encode_stream(pan_60[:3], qp=46)
+    fixed = reprise.encode_stream(pan_60[:3], qp=46, bounds_follow_qp=False)
+    assert len(coarse) < len(fixed)
 
 
 def test_anti_aliasing_changes_color_only(renderer):

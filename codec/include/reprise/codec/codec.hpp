@@ -42,6 +42,11 @@ struct EncoderOptions {
     // Largest distance (px) between decoded and rendered motion: affine models per block where
     // they hold (docs/bitstream.md). 0 = every pixel to 1/8 px. Otherwise 0.1 .. 8.
     float motion_error_px = 0.25f;
+    // Above qp 34 both bounds double every 6 qp, as the colour quantiser's step does: depth and
+    // motion finer than the colour they move cost bits the decoded picture does not show
+    // (docs/bitstream.md). false: the bounds as given at every qp. Under rate control they
+    // follow `qp` (the starting quantiser), fixed for the stream.
+    bool bounds_follow_qp = true;
     // A block whose prediction error stays within this many 8-bit display levels on every
     // channel is skipped (Mueller et al. 2021: T = 8/255 stays under one JND). 0 = skip only
     // what quantises to nothing.
@@ -89,6 +94,12 @@ struct StreamStats {
         return header_bits + camera_bits + depth_bits + motion_bits + color_bits;
     }
 };
+
+// The view and motion bounds (px) a stream of these options is coded to (bounds_follow_qp).
+struct CodedBounds {
+    float view_error_px = 0.0f, motion_error_px = 0.0f;
+};
+CodedBounds coded_bounds(const EncoderOptions& options);
 
 // Adds one frame's (or stream's) counts to a running total.
 void add_stats(StreamStats& total, const StreamStats& frame);
