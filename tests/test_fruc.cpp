@@ -499,6 +499,39 @@ TEST(FrucSilhouettes, AntiAliasedEdgesTravelWithTheSilhouette) {
     EXPECT_GT(psnr[1], psnr[0] + 5.0);
 }
 
+// A converter widens each input once however many frames it makes from it (x4: three pairs,
+// each input the later side of one and the earlier of the next), and every frame it makes is the
+// one a converter given that pair alone makes, in both modes.
+TEST(FrucSilhouettes, EachInputIsWidenedOnceForAllTheFramesMadeFromIt) {
+    const std::vector<Frame> input = render("crossing", 30.0, 0, 4, 96, 64);
+    std::size_t widened = 0;
+    for (const Frame& f : input) {
+        Image<float> depth;
+        Image<glm::vec2> motion;
+        std::size_t changed = 0;
+        widen_silhouettes(f.view(), depth, motion, &changed);
+        widened += changed;
+    }
+    ASSERT_GT(widened, 4u * 20u);
+    for (FrucMode mode : {FrucMode::Interpolate, FrucMode::Extrapolate}) {
+        SCOPED_TRACE(mode == FrucMode::Interpolate ? "interpolate" : "extrapolate");
+        const FrucOptions options{.mode = mode};
+        FrucCounters counters;
+        const std::vector<Frame> out = convert(input, 4, options, &counters);
+        ASSERT_EQ(out.size(), mode == FrucMode::Interpolate ? 13u : 16u);
+        EXPECT_EQ(counters.silhouette_pixels, widened);
+        for (std::size_t i = 0; i + 1 < input.size(); ++i) {
+            const std::vector<Frame> alone = convert({input[i], input[i + 1]}, 4, options);
+            ASSERT_EQ(alone.size(), mode == FrucMode::Interpolate ? 5u : 8u);
+            const std::size_t first = mode == FrucMode::Interpolate ? 4 * i : 4 * i + 4;
+            const std::size_t from = mode == FrucMode::Interpolate ? 0 : 4;
+            for (std::size_t k = 1; k < 4; ++k)
+                EXPECT_TRUE(test::same_bits(out[first + k].color, alone[from + k].color))
+                    << "pair " << i << ", frame " << k;
+        }
+    }
+}
+
 // A square slides 8 px right per frame over a still background. Halfway, with two-pixel
 // smallest cells each side's grid warp stretches its edge triangles over the strip the square
 // uncovers on its side, in front of the background the other side saw: the in-between frame

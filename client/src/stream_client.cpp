@@ -56,6 +56,7 @@ struct StreamClient::State {
     bool have_decoded = false;
     int64_t decoded_pose_us = 0;
     uint32_t decoded_frame = 0;
+    uint64_t decoded_count = 0;  // frames decoded: the extrapolator's key for the one shown
     warp::PoseExtrapolator extrapolator;
     uint32_t pose_sequence = 0;
     StreamClientStats stats;
@@ -181,6 +182,7 @@ struct StreamClient::State {
         have_decoded = true;
         decoded_pose_us = packet.pose_time_us;
         decoded_frame = packet.frame;
+        ++decoded_count;
         ++stats.frames_decoded;
         stats.last_rtt_us = now - packet.pose_time_us;
         message.resize(net::kMaxPlaintext);
@@ -428,7 +430,8 @@ const GBufferView* StreamClient::display(const glm::mat4& view, double scene_tim
     }
     const double fps = s.have_info ? s.info.fps : (f.fps > 0 ? f.fps : 30.0);
     const float periods = float(std::clamp((scene_time - f.camera.time) * fps, 0.0, 8.0));
-    s.extrapolator.extrapolate(f.view(), view, f.camera.projection, periods, s.displayed);
+    s.extrapolator.extrapolate(f.view(), view, f.camera.projection, periods, s.displayed,
+                               s.decoded_count);
     s.displayed.camera.time = scene_time;
     s.displayed.fps = f.fps;
     s.shown = s.displayed.view();

@@ -142,7 +142,8 @@ struct FrameRateConverter::State {
     FrucScratch scratch;
     Frame previous;  // colour, depth, motion and ids of the last input (no normals)
     bool has_previous = false;
-    bool previous_starts_shot = false;  // its motion reaches back into another shot: unusable
+    bool previous_starts_shot = false;        // its motion reaches back into another shot: unusable
+    uint64_t next_key = 0, previous_key = 0;  // each input's key (FrucScratch::input_key)
     FrameQueue ready;
     FrucOptions chosen;  // `options` with an auto warp or fill resolved for one frame
     NonfiniteRepair nonfinite;
@@ -389,6 +390,11 @@ Status FrameRateConverter::send_frame(const Frame& given, Frame* owned) {
     st.counters.cuts += cut;
     const int k_max = st.factor;
 
+    const uint64_t key = ++st.next_key;
+    if (st.options.mode == FrucMode::Interpolate)
+        st.scratch.input_key[0] = st.previous_key, st.scratch.input_key[1] = key;
+    else
+        st.scratch.input_key[0] = key, st.scratch.input_key[1] = 0;
     const double fps = frame.fps;
     const float scale = st.motion_scale();
     FramePredictors predicted;  // surveyed only for an auto choice
@@ -478,6 +484,7 @@ Status FrameRateConverter::send_frame(const Frame& given, Frame* owned) {
     if (owned) std::swap(st.previous, *owned);  // the caller gets the old buffers to refill
     st.has_previous = true;
     st.previous_starts_shot = cut;
+    st.previous_key = key;
     return {};
 }
 

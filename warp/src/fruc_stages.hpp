@@ -59,8 +59,13 @@ struct FrucScratch {
     Image<glm::vec2> inverted;        // the later frame's moving pixels, at their earlier place
     Image<float> inverted_depth;
     Image<uint8_t> valid;
-    Image<float> wide_depth[2];  // the inputs with their silhouettes widened
+    Image<float> wide_depth[2];  // inputs with their silhouettes widened (warp_input)
     Image<glm::vec2> wide_motion[2];
+    uint64_t wide_key[2] = {0, 0};  // the input each holds
+    // Set before a stage: which input is in slot 0 (a, or the one extrapolated) and slot 1 (b).
+    // Equal non-zero keys mean the same frame, widened once however many frames it makes;
+    // 0 = not known, widened every time.
+    uint64_t input_key[2] = {0, 0};
     Image<glm::vec4> reprojected;
     GridWarper grid;
     PullPush pull_push;

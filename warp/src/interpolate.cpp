@@ -97,10 +97,23 @@ std::size_t warp_into(const GBufferView& source, float factor, const FrucOptions
 
 GBufferView warp_input(const GBufferView& f, int slot, const FrucOptions& options,
                        FrucScratch& scratch, FrucCounters& counters) {
-    if (!options.widen_silhouettes) return f;
+    if (!options.widen_silhouettes || f.depth.empty()) return f;
+    const uint64_t key = scratch.input_key[slot], other = scratch.input_key[1 - slot];
+    int buffer = slot;
+    if (key != 0) {
+        for (int i = 0; i < 2; ++i) {
+            if (scratch.wide_key[i] != key) continue;
+            GBufferView widened = f;
+            widened.depth = std::as_const(scratch.wide_depth[i]).view();
+            if (!f.motion.empty()) widened.motion = std::as_const(scratch.wide_motion[i]).view();
+            return widened;
+        }
+        if (other != 0 && scratch.wide_key[buffer] == other) buffer = 1 - buffer;
+    }
     std::size_t changed = 0;
     const GBufferView widened =
-        widen_silhouettes(f, scratch.wide_depth[slot], scratch.wide_motion[slot], &changed);
+        widen_silhouettes(f, scratch.wide_depth[buffer], scratch.wide_motion[buffer], &changed);
+    scratch.wide_key[buffer] = key;
     counters.silhouette_pixels += changed;
     return widened;
 }

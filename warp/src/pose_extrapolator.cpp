@@ -18,11 +18,13 @@ PoseExtrapolator::PoseExtrapolator(PoseExtrapolator&&) noexcept = default;
 PoseExtrapolator& PoseExtrapolator::operator=(PoseExtrapolator&&) noexcept = default;
 
 void PoseExtrapolator::extrapolate(const GBufferView& frame, const glm::mat4& view,
-                                   const glm::mat4& projection, float periods, Frame& out) {
+                                   const glm::mat4& projection, float periods, Frame& out,
+                                   uint64_t frame_key) {
     REPRISE_ASSERT(periods >= 0.0f);
     State& s = *state_;
     ++s.counters.inputs;
     ++s.counters.outputs;
+    s.scratch.input_key[0] = frame_key;
     extrapolate_to_camera(frame, view, projection, periods, 1.0f, s.options, s.scratch, out,
                           s.counters);
     out.camera = frame.camera;

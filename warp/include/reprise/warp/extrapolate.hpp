@@ -2,6 +2,7 @@
 // Extrapolation of one frame to any camera (latency hiding, as ASW and Outatime): the static
 // scene is reprojected with depth to the new camera, moving objects are carried `periods` frame
 // periods further along their motion, holes are filled.
+#include <cstdint>
 #include <memory>
 
 #include "reprise/warp/fruc.hpp"
@@ -17,8 +18,10 @@ public:
 
     // `out` gets colour, depth and motion of `frame` as seen by (view, projection) `periods`
     // frame periods after it (periods >= 0; its motion is per period). Scratch is sized once.
+    // A non-zero `frame_key`, the same for the same frame, lets the work that depends on the
+    // frame alone (its widened silhouettes) be done once for all the instants made from it.
     void extrapolate(const GBufferView& frame, const glm::mat4& view, const glm::mat4& projection,
-                     float periods, Frame& out);
+                     float periods, Frame& out, uint64_t frame_key = 0);
     const FrucCounters& counters() const;
 
 private:

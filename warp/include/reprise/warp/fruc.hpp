@@ -153,7 +153,8 @@ struct FrucCounters {
     std::size_t cuts = 0;               // shot changes (the camera's Cut::Yes, or detected)
     std::size_t cut_tests_skipped = 0;  // frames whose camera said whether a cut came: no test
     std::size_t grid_cells = 0;         // adaptive-grid cells drawn
-    std::size_t silhouette_pixels = 0;  // input pixels warped with a nearer neighbour's surface
+    std::size_t silhouette_pixels = 0;  // input pixels given a nearer neighbour's surface (once
+                                        // per input in a converter)
     std::size_t true_motion = 0;        // in-between frames whose sides followed the true motion
     std::size_t linear_motion = 0;      // ... that did not need it: a sparse survey found it linear
     std::size_t refined_frames = 0;     // in-between frames whose sides disagreed: flow estimated
