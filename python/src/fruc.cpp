@@ -11,10 +11,12 @@ namespace reprise::python {
 namespace {
 
 warp::FrucOptions fruc_options(const std::string& mode, const std::string& warp_method,
-                               const std::string& fill, bool refine, bool true_motion) {
+                               const std::string& fill, bool refine, bool true_motion,
+                               bool widen_silhouettes) {
     warp::FrucOptions o;
     o.refine.enabled = refine;
     o.true_motion = true_motion;
+    o.widen_silhouettes = widen_silhouettes;
     const Status parsed = warp::fruc_options_from_names(mode, warp_method, fill, o);
     if (!parsed.ok()) value_error(parsed.message());
     return o;
@@ -22,8 +24,10 @@ warp::FrucOptions fruc_options(const std::string& mode, const std::string& warp_
 
 struct Converter {
     Converter(int factor, const std::string& mode, const std::string& warp_method,
-              const std::string& fill, bool refine, bool true_motion, const std::string& backend) {
-        warp::FrucOptions options = fruc_options(mode, warp_method, fill, refine, true_motion);
+              const std::string& fill, bool refine, bool true_motion, const std::string& backend,
+              bool widen_silhouettes) {
+        warp::FrucOptions options =
+            fruc_options(mode, warp_method, fill, refine, true_motion, widen_silhouettes);
         if (backend == "gles") {
             if (const Status s = gpu::FrucBackend::check(options, options.splat); !s.ok())
                 value_error("backend gles: " + s.message());
@@ -83,6 +87,7 @@ struct Converter {
         d["refined_pixels"] = c.refined_pixels;
         d["refine_ms"] = c.refine_ms;
         d["ui_frames"] = c.ui_frames;
+        d["silhouette_pixels"] = c.silhouette_pixels;
         d["nonfinite"] = nonfinite_dict(c.nonfinite);
         py::dict chosen, left_out;
         for (int k = 0; k < warp::kAutoCandidates; ++k) {
@@ -114,12 +119,14 @@ void bind_fruc(py::module_& m) {
         "instant (off: linearly). backend 'gles': the in-between frames on the "
         "GPU (OpenGL ES), with warp 'splat', fill 'pullpush', refine and "
         "true_motion off; its made frames carry no motion, and it is used from the thread "
-        "that made it (another thread gets an error).")
+        "that made it (another thread gets an error). widen_silhouettes: pixels beside a nearer "
+        "surface warp with it, so the anti-aliasing blended into them travels with the "
+        "silhouette.")
         .def(py::init<int, const std::string&, const std::string&, const std::string&, bool, bool,
-                      const std::string&>(),
+                      const std::string&, bool>(),
              py::arg("factor") = 2, py::arg("mode") = "interpolate", py::arg("warp") = "grid",
              py::arg("fill") = "pullpush", py::arg("refine") = true, py::arg("true_motion") = true,
-             py::arg("backend") = "cpu")
+             py::arg("backend") = "cpu", py::arg("widen_silhouettes") = true)
         .def("send", &Converter::send, py::arg("frame"), "Feeds the next rendered frame.")
         .def("receive", &Converter::receive, "The next output frame, or None.")
         .def("convert", &Converter::convert, py::arg("frames"),

@@ -21,6 +21,11 @@ def test_interpolated_frames_beat_repetition(pan_60):
         print(f"in-between frame {k}: {made:.2f} dB vs repetition {repeated:.2f} dB")
         assert made > repeated + 2.0
     assert np.array_equal(out[2].color, pan_60[2].color)
+    # Each input's silhouettes widened once (the default), or not at all.
+    assert converter.counters["silhouette_pixels"] > 0
+    kept = reprise.FrameRateConverter(factor=2, widen_silhouettes=False)
+    kept.convert(inputs)
+    assert kept.counters["silhouette_pixels"] == 0
 
 
 def test_extrapolation_and_receive(pan_60):
