@@ -22,6 +22,9 @@ def test_synthesized_eye_is_close_to_the_rendered_one(renderer, pan_60):
           f"{psnr(truth, left):.2f} dB")
     assert psnr(truth, made) > psnr(truth, left) + 3.0
     assert psnr(truth, made) > 28.0
+    kept, _ = reprise.StereoSynthesizer().synthesize(left, right_camera, widen_silhouettes=False)
+    print(f"silhouettes kept: {psnr(truth, kept):.2f} dB")
+    assert not np.array_equal(kept.color, made.color)
 
 
 def test_bad_stereo_input_raises(pan_60):
