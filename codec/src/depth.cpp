@@ -1,7 +1,8 @@
 // Depth: each pixel as a 32-bit code (the float's bits in an order-preserving map, the
 // quantised log2 depth, or 1/z in 32nds of the view step), predicted per 8x8 block either
 // from the reference depth forward-projected into this camera or spatially (median edge
-// detector), residuals context-coded. Blocks predicted exactly cost two flags. View mode sends
+// detector), residuals context-coded; in inter frames a pixel the block's prediction misses may
+// take the other one for a flag. Blocks predicted exactly cost two flags. View mode sends
 // the prediction itself wherever it is within the bound and quantises residuals, so decoded
 // depth keeps its error from frame to frame instead of being rounded again each time.
 #include <algorithm>
@@ -119,6 +120,7 @@ struct Models {
     BitModel zero_block[2][3];
     BitModel background[4];
     IntModel<24> residual[2][4];
+    BitModel other[2];
 };
 
 // The pieces one slice needs; codes (V) and residuals (R) are full-frame images.
@@ -187,6 +189,16 @@ inline uint32_t surface_prediction(const SliceJob& j, int x, int y, uint32_t p) 
     return p;
 }
 
+// In an inter frame a pixel the block's prediction misses may take the other prediction instead
+// (temporal in a spatial block, spatial in a temporal one: a silhouette the reprojection put a
+// pixel off, a surface the spatial prediction drifted from), for one flag. Returns p where that
+// prediction is the same or no surface.
+inline uint32_t other_prediction(const SliceJob& j, int x, int y, bool temporal, uint32_t p) {
+    if (j.temporal.empty()) return p;
+    const uint32_t q = predict(j, x, y, !temporal);
+    return j.map->surface(q) ? q : p;
+}
+
 inline int background_context(const SliceJob& j, int x, int y, uint32_t p) {
     const uint32_t empty = j.map->empty();
     return (p == empty) + (x > 0 && j.codes(x - 1, y) == empty) +
@@ -215,12 +227,15 @@ inline uint64_t residual_cost(int32_t r) {
 
 // Cost estimate of one pixel of a block with residuals (its codes to the left and above known):
 // the background flag, then the residual from the surface prediction.
-inline uint64_t pixel_cost(const SliceJob& j, int x, int y, uint32_t p) {
+inline uint64_t pixel_cost(const SliceJob& j, int x, int y, bool temporal, uint32_t p) {
     const uint32_t c = j.codes(x, y);
     if (c == p) return 0;
     if (c == j.map->empty()) return 1;
-    return 1 + residual_cost(int32_t(c - surface_prediction(j, x, y, p)) /
-                             int32_t(j.map->residual_step));
+    const uint32_t other = other_prediction(j, x, y, temporal, p);
+    if (other != p && c == other) return 3;
+    return 1 + (other != p) +
+           residual_cost(int32_t(c - surface_prediction(j, x, y, p)) /
+                         int32_t(j.map->residual_step));
 }
 
 }  // namespace
@@ -242,8 +257,9 @@ namespace {
 // the truth (within q / 2). The allowance shrinks by (1 - B/z)^2 for points near the camera
 // (docs/bitstream.md). A key frame keeps p only within 4/5 of the allowance: every later frame
 // transports its depth, and values left at the edge of the bound would leave it at the first
-// noise of that transport, a residual each.
-uint32_t choose_view_code(const SliceJob& j, int x, int y, uint32_t p) {
+// noise of that transport, a residual each. The other prediction, when it is close enough, costs
+// less than a residual.
+uint32_t choose_view_code(const SliceJob& j, int x, int y, bool temporal, uint32_t p) {
     const Mapping& map = *j.map;
     const float z = j.source.empty() ? INFINITY : j.source(x, y);
     const uint32_t k = map.code(z);
@@ -252,6 +268,12 @@ uint32_t choose_view_code(const SliceJob& j, int x, int y, uint32_t p) {
     if (k != kInvalidCode && p <= kMaxViewCode &&
         view_code_within(1.0 / double(z), p, map.step, map.displacement, share))
         return p;
+    if (k != kInvalidCode) {
+        const uint32_t other = other_prediction(j, x, y, temporal, p);
+        if (other != p && other <= kMaxViewCode &&
+            view_code_within(1.0 / double(z), other, map.step, map.displacement, share))
+            return other;
+    }
     const int64_t base = surface_prediction(j, x, y, p), s = kViewResidualStep;
     if (k == kInvalidCode)  // NaN: any code above 2^30 + 1
         return uint32_t(base + std::max<int64_t>(0, (kInvalidCode - base + s - 1) / s) * s);
@@ -268,8 +290,8 @@ uint64_t block_cost(SliceJob& j, int bx, int by, int bw, int bh, bool temporal) 
     for (int y = by; y < by + bh; ++y)
         for (int x = bx; x < bx + bw; ++x) {
             const uint32_t p = predict(j, x, y, temporal);
-            if (j.map->view) j.codes(x, y) = choose_view_code(j, x, y, p);
-            cost += pixel_cost(j, x, y, p);
+            if (j.map->view) j.codes(x, y) = choose_view_code(j, x, y, temporal, p);
+            cost += pixel_cost(j, x, y, temporal, p);
         }
     return cost;
 }
@@ -349,13 +371,24 @@ void encode_slice(SliceJob& j, std::vector<uint8_t>& bytes, std::vector<uint8_t>
                     const uint32_t p = j.predictions(x, y), c = j.codes(x, y);
                     const bool background = c == j.map->empty();
                     rc.bit(m.background[background_context(j, x, y, p)], background);
-                    j.residuals(x, y) = background
-                                            ? 0
-                                            : uint32_t(int32_t(c - surface_prediction(j, x, y, p)) /
-                                                       int32_t(j.map->residual_step));
-                    if (!background)
-                        encode_int(rc, m.residual[flags & 1][residual_context(j, x, y)],
-                                   int64_t(int32_t(j.residuals(x, y))));
+                    j.residuals(x, y) = 0;
+                    if (background) continue;
+                    const uint32_t base = surface_prediction(j, x, y, p);
+                    IntModel<24>& model = m.residual[flags & 1][residual_context(j, x, y)];
+                    rc.bit(model.zero, c != base);
+                    if (c == base) continue;
+                    const uint32_t other = other_prediction(j, x, y, flags & 1, p);
+                    if (other != p) {
+                        rc.bit(m.other[flags & 1], c == other);
+                        if (c == other) {
+                            j.residuals(x, y) = 1;  // for the contexts: a pixel that missed
+                            continue;
+                        }
+                    }
+                    const int32_t r = int32_t(c - base) / int32_t(j.map->residual_step);
+                    j.residuals(x, y) = uint32_t(r);
+                    rc.bit(model.sign, r < 0);
+                    encode_uint(rc, model.magnitude, uint32_t(std::abs(int64_t(r)) - 1));
                 }
             }
     }
@@ -392,11 +425,23 @@ bool decode_slice(SliceJob& j, std::span<const uint8_t> bytes) {
                     j.codes(x, y) = j.map->empty();
                     continue;
                 }
-                int64_t r = 0;
-                if (!decode_int(rc, m.residual[temporal][residual_context(j, x, y)], r))
-                    return false;
+                IntModel<24>& model = m.residual[temporal][residual_context(j, x, y)];
+                const uint32_t base = surface_prediction(j, x, y, p);
+                j.residuals(x, y) = 0;
+                j.codes(x, y) = base;
+                if (!rc.bit(model.zero)) continue;
+                const uint32_t other = other_prediction(j, x, y, temporal, p);
+                if (other != p && rc.bit(m.other[temporal])) {
+                    j.residuals(x, y) = 1;
+                    j.codes(x, y) = other;
+                    continue;
+                }
+                const bool negative = rc.bit(model.sign);
+                uint32_t a = 0;
+                if (!decode_uint(rc, model.magnitude, a) || a == 0xFFFFFFFFu) return false;
+                const int64_t r = negative ? -(int64_t(a) + 1) : int64_t(a) + 1;
                 j.residuals(x, y) = uint32_t(r);
-                j.codes(x, y) = surface_prediction(j, x, y, p) + uint32_t(r) * j.map->residual_step;
+                j.codes(x, y) = base + uint32_t(r) * j.map->residual_step;
             }
         if (rc.overrun() > 8) return false;
     }
