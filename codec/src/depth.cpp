@@ -1,10 +1,11 @@
 // Depth: each pixel as a 32-bit code (the float's bits in an order-preserving map, the
 // quantised log2 depth, or 1/z in 32nds of the view step), predicted per 8x8 block either
 // from the reference depth forward-projected into this camera or spatially (median edge
-// detector), residuals context-coded; in inter frames a pixel the block's prediction misses may
-// take the other one for a flag. Blocks predicted exactly cost two flags. View mode sends
-// the prediction itself wherever it is within the bound and quantises residuals, so decoded
-// depth keeps its error from frame to frame instead of being rounded again each time.
+// detector), residuals context-coded (by edges, and by what the reprojection shows); in inter
+// frames a pixel the block's prediction misses may take the other one for a flag. Blocks
+// predicted exactly cost two flags. View mode sends the prediction itself wherever it is within
+// the bound and quantises residuals, so decoded depth keeps its error from frame to frame
+// instead of being rounded again each time.
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -116,10 +117,10 @@ inline int magnitude_class(uint32_t left, uint32_t top) {
 constexpr uint8_t kTemporalBlock = 1, kZeroBlock = 2;
 
 struct Models {
-    BitModel temporal[3];
-    BitModel zero_block[2][3];
+    BitModel temporal[3][3];
+    BitModel zero_block[2][3][3];
     BitModel background[4];
-    IntModel<24> residual[2][4];
+    IntModel<24> residual[2][8];
     BitModel other[2];
 };
 
@@ -205,8 +206,18 @@ inline int background_context(const SliceJob& j, int x, int y, uint32_t p) {
            (y > j.y0 && j.codes(x, y - 1) == empty);
 }
 
-inline int residual_context(const SliceJob& j, int x, int y) {
-    return magnitude_class(x > 0 ? j.residuals(x - 1, y) : 0, y > j.y0 ? j.residuals(x, y - 1) : 0);
+// Two codes further apart than one residual step: an edge, where residuals gather.
+inline bool step_between(const Mapping& map, uint32_t a, uint32_t b) {
+    return std::abs(int64_t(a) - int64_t(b)) > int64_t(map.residual_step);
+}
+
+// A residual's class: at an edge (p no surface, or a step from the left or above code) or not,
+// and the magnitude of the residuals to the left and above.
+inline int residual_context(const SliceJob& j, int x, int y, uint32_t p) {
+    const bool edge = !j.map->surface(p) || (x > 0 && step_between(*j.map, j.codes(x - 1, y), p)) ||
+                      (y > j.y0 && step_between(*j.map, j.codes(x, y - 1), p));
+    return 4 * edge +
+           magnitude_class(x > 0 ? j.residuals(x - 1, y) : 0, y > j.y0 ? j.residuals(x, y - 1) : 0);
 }
 
 // A block's flags are coded in the context of its left and above neighbours in the slice: how
@@ -218,6 +229,22 @@ inline int temporal_context(const std::vector<uint8_t>& row, const std::vector<u
 }
 inline int zero_context(const std::vector<uint8_t>& row, const std::vector<uint8_t>& above, int b) {
     return (b > 0 && !(row[b - 1] & kZeroBlock)) + (!above.empty() && !(above[b] & kZeroBlock));
+}
+
+// What the temporal prediction shows of a block, known to both sides before its flags: 0 no
+// step between neighbouring codes, 1 a step (a silhouette, where residuals gather), 2 a pixel
+// nothing landed on, or no temporal prediction (key frames).
+inline int reprojection_class(const SliceJob& j, int bx, int by, int bw, int bh) {
+    if (j.temporal.empty()) return 2;
+    int step = 0;
+    for (int y = by; y < by + bh; ++y)
+        for (int x = bx; x < bx + bw; ++x) {
+            const uint32_t t = j.temporal(x, y);
+            if (t == kNoPrediction) return 2;
+            step |= (x > bx && step_between(*j.map, t, j.temporal(x - 1, y))) ||
+                    (y > by && step_between(*j.map, t, j.temporal(x, y - 1)));
+        }
+    return step;
 }
 
 // Cost estimate of coding a block's residuals.
@@ -350,8 +377,11 @@ void encode_slice(SliceJob& j, std::vector<uint8_t>& bytes, std::vector<uint8_t>
                     block_cost(j, bx, by, bw, bh, true);  // the temporal choice's codes again
                 }
             }
-            if (inter) rc.bit(m.temporal[temporal_context(block_flags, above, b)], use_temporal);
-            rc.bit(m.zero_block[use_temporal][zero_context(block_flags, above, b)], cost == 0);
+            const int shows = reprojection_class(j, bx, by, bw, bh);
+            if (inter)
+                rc.bit(m.temporal[shows][temporal_context(block_flags, above, b)], use_temporal);
+            rc.bit(m.zero_block[use_temporal][shows][zero_context(block_flags, above, b)],
+                   cost == 0);
             j.zero_blocks += cost == 0;
             block_flags[b] = (use_temporal ? kTemporalBlock : 0) | (cost == 0 ? kZeroBlock : 0);
             if (cost == 0) {
@@ -374,7 +404,7 @@ void encode_slice(SliceJob& j, std::vector<uint8_t>& bytes, std::vector<uint8_t>
                     j.residuals(x, y) = 0;
                     if (background) continue;
                     const uint32_t base = surface_prediction(j, x, y, p);
-                    IntModel<24>& model = m.residual[flags & 1][residual_context(j, x, y)];
+                    IntModel<24>& model = m.residual[flags & 1][residual_context(j, x, y, p)];
                     rc.bit(model.zero, c != base);
                     if (c == base) continue;
                     const uint32_t other = other_prediction(j, x, y, flags & 1, p);
@@ -405,8 +435,11 @@ bool decode_slice(SliceJob& j, std::span<const uint8_t> bytes) {
         const int bh = std::min(kBlock, j.y1 - by);
         if (by > j.y0) above = flags;
         for (int b = 0; b < blocks; ++b) {
-            const bool temporal = inter && rc.bit(m.temporal[temporal_context(flags, above, b)]);
-            const bool zero = rc.bit(m.zero_block[temporal][zero_context(flags, above, b)]);
+            const int shows =
+                reprojection_class(j, b * kBlock, by, std::min(kBlock, j.width - b * kBlock), bh);
+            const bool temporal =
+                inter && rc.bit(m.temporal[shows][temporal_context(flags, above, b)]);
+            const bool zero = rc.bit(m.zero_block[temporal][shows][zero_context(flags, above, b)]);
             flags[b] = (temporal ? kTemporalBlock : 0) | (zero ? kZeroBlock : 0);
             j.zero_blocks += zero;
         }
@@ -425,7 +458,7 @@ bool decode_slice(SliceJob& j, std::span<const uint8_t> bytes) {
                     j.codes(x, y) = j.map->empty();
                     continue;
                 }
-                IntModel<24>& model = m.residual[temporal][residual_context(j, x, y)];
+                IntModel<24>& model = m.residual[temporal][residual_context(j, x, y, p)];
                 const uint32_t base = surface_prediction(j, x, y, p);
                 j.residuals(x, y) = 0;
                 j.codes(x, y) = base;
