@@ -48,6 +48,30 @@ TEST_F(CliBenchFruc, RunsAndPrintsTheSummary) {
     ASSERT_EQ(result_.status, 0) << result_.output;
     EXPECT_NE(result_.output.find("best interpolation"), std::string::npos) << result_.output;
     EXPECT_NE(result_.output.find("index.html"), std::string::npos) << result_.output;
+    EXPECT_NE(result_.output.find("fruc x2, 96x54, 3 input frames, 2 scored frames per method;"),
+              std::string::npos)
+        << result_.output;
+}
+
+// A sequence folder (--in) keeps its own size and length, and the summary says so per scene.
+TEST(CliBenchFrucSequences, TheSummarySaysEachSequencesSizeAndLength) {
+    const fs::path dir =
+        fs::temp_directory_path() / ("reprise-cli-bench-fruc-in-" + std::to_string(getpid()));
+    fs::remove_all(dir);
+    const std::string seq = (dir / "seqs" / "s1").string();
+    ASSERT_EQ(run("render --scene pan --frames 3 --size 64x40 --out " + seq + "/input").status, 0);
+    ASSERT_EQ(
+        run("render --scene pan --frames 5 --fps 60 --size 64x40 --out " + seq + "/truth").status,
+        0);
+    const Outcome bench =
+        run("bench fruc --scenes pan --in " + (dir / "seqs").string() +
+            " --size 96x54 --frames 3 --quick --repeat 1 --out " + (dir / "bench").string());
+    ASSERT_EQ(bench.status, 0) << bench.output;
+    EXPECT_NE(bench.output.find("96x54, 3 input frames, 2 scored frames per method (pan); 64x40, "
+                                "3 input frames, 2 scored frames per method (s1);"),
+              std::string::npos)
+        << bench.output;
+    fs::remove_all(dir);
 }
 
 TEST_F(CliBenchFruc, CsvHasFiniteRowsForOursAndTheDisPeer) {

@@ -605,6 +605,9 @@ void describe(const BenchOptions& job, int w, int h, const std::string& device, 
         "scored.",
         job.factor, job.frames, w, h, job.aa, device.c_str(), synthesized, 30 * job.factor);
     report.paragraphs.push_back(text);
+    if (!job.in.empty())
+        report.paragraphs.push_back(
+            "Sequence folders (--in) keep their own size and length: the summary says each.");
     std::snprintf(
         text, sizeof text,
         "ms = wall-clock milliseconds per synthesized frame on this machine (%d threads for "
@@ -682,7 +685,7 @@ Status run_methods(SceneFrames& scene, const std::string& scene_dir,
 // The scene's row of the summary tables; `interpolation` and `peer` get its best interpolation
 // setting and its best peer (null when none ran).
 SceneSummary summarize(const std::string& scene_name, const SceneFrames& scene,
-                       const std::vector<Run>& runs, int w, int h, std::vector<AutoSummary>& autos,
+                       const std::vector<Run>& runs, std::vector<AutoSummary>& autos,
                        const Run*& interpolation, const Run*& peer) {
     SceneSummary row{scene.name + (is_held_out(scene_name) ? " (held)" : "")};
     interpolation = best_of(runs, [](const Run& r) {
@@ -702,7 +705,8 @@ SceneSummary summarize(const std::string& scene_name, const SceneFrames& scene,
             row.region_on = r.region_psnr();
             row.refine_ms = r.refine_ms;
             row.region_share = double(r.region_pixels) /
-                               (double(w) * h * std::max<std::size_t>(1, r.scores.size()));
+                               (double(scene.input[0].width()) * scene.input[0].height() *
+                                double(std::max<std::size_t>(1, r.scores.size())));
         }
         if (r.setting == kRefineOff) {
             row.refine_off = r.mean();
@@ -754,8 +758,9 @@ Status bench_fruc(const BenchOptions& job) {
 
     Report report;
     describe(job, w, h, renderer->device(), report);
-    const int synthesized = (job.frames - 1) * (job.factor - 1);
     char text[2048];
+    // Size and length of what ran, with the scenes of each (sequence folders keep their own).
+    std::vector<std::pair<std::string, std::string>> shapes;
     std::vector<SceneSummary> summaries;
 
     Status failure;
@@ -774,6 +779,17 @@ Status bench_fruc(const BenchOptions& job) {
                                      job.exr ? scene_dir : std::string(), scene);
         if (!failure.ok()) break;
         write_predictors(predictors_csv.file(), scene);
+        const std::string shape =
+            std::to_string(scene.input[0].width()) + "x" + std::to_string(scene.input[0].height()) +
+            ", " + std::to_string(scene.input.size()) + " input frames, " +
+            std::to_string((int(scene.input.size()) - 1) * (scene.factor - 1)) +
+            " scored frames per method";
+        auto same = std::find_if(shapes.begin(), shapes.end(),
+                                 [&](const auto& s) { return s.first == shape; });
+        if (same == shapes.end())
+            shapes.emplace_back(shape, scene.name);
+        else
+            same->second += ", " + scene.name;
 
         std::vector<Run> runs;
         failure = run_methods(scene, scene_dir, settings, job, has_ffmpeg, auto_counts, runs);
@@ -799,8 +815,7 @@ Status bench_fruc(const BenchOptions& job) {
         }
 
         const Run *interpolation = nullptr, *peer = nullptr;
-        const SceneSummary row =
-            summarize(scene_name, scene, runs, w, h, autos, interpolation, peer);
+        const SceneSummary row = summarize(scene_name, scene, runs, autos, interpolation, peer);
         summaries.push_back(row);
         if (interpolation) {
             const std::string picture = scene.name + "/worst_frame.png";
@@ -821,12 +836,13 @@ Status bench_fruc(const BenchOptions& job) {
     }
     REPRISE_TRY(failure);
 
-    std::string table = summary_table(summaries);
-    std::snprintf(
-        text, sizeof text,
-        "fruc x%d, %dx%d, %d input frames, %d scored frames per method; PSNR in dB, ms per "
-        "synthesized frame; margin = best interpolation - better peer\n",
-        job.factor, w, h, job.frames, synthesized);
+    std::string table = summary_table(summaries), shape;
+    for (const auto& [what, names] : shapes)
+        shape += (shape.empty() ? "" : "; ") + what + (shapes.size() > 1 ? " (" + names + ")" : "");
+    std::snprintf(text, sizeof text,
+                  "fruc x%d, %s; PSNR in dB, ms per synthesized frame; margin = best "
+                  "interpolation - better peer\n",
+                  job.factor, shape.c_str());
     const std::string refinement =
         "\nmotion refinement (default grid+pullpush, refine on vs off): region = pixels of the "
         "tiles where\nthe sides warped along rendered motion disagree (share of scored pixels), "
