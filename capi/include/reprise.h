@@ -248,7 +248,8 @@ typedef struct reprise_encoder_options {
     int32_t skip_threshold;     /* 8-bit display levels a skipped block may miss by (default 2) */
     int32_t detect_cuts;        /* 1 (default): key frame when prediction misses most pixels */
     int32_t fit_cameras;        /* 1 (default): frames without a camera get a fitted one */
-    int32_t reserved;           /* 0 */
+    int32_t fixed_bounds;       /* 1: view and motion bounds as given at every qp; 0 (default):
+                                   above qp 34 both double every 6 qp (was `reserved`, 0) */
 } reprise_encoder_options;
 
 REPRISE_API reprise_status reprise_encoder_options_init(reprise_encoder_options* options,

@@ -34,6 +34,7 @@ reprise_encoder_options default_options() {
     o.skip_threshold = d.skip_threshold;
     o.detect_cuts = d.detect_cuts;
     o.fit_cameras = d.fit_cameras;
+    o.fixed_bounds = !d.bounds_follow_qp;
     return o;
 }
 
@@ -55,6 +56,7 @@ reprise_status to_encoder_options(const char* function, const reprise_encoder_op
     REPRISE_CAPI_TRY(check_range(function, "options->skip_threshold", o.skip_threshold, 0, 255));
     REPRISE_CAPI_TRY(check_flag(function, "options->detect_cuts", o.detect_cuts));
     REPRISE_CAPI_TRY(check_flag(function, "options->fit_cameras", o.fit_cameras));
+    REPRISE_CAPI_TRY(check_flag(function, "options->fixed_bounds", o.fixed_bounds));
     e.qp = o.qp;
     e.bitrate_kbps = o.bitrate_kbps;
     e.keyint = o.keyint;
@@ -68,6 +70,7 @@ reprise_status to_encoder_options(const char* function, const reprise_encoder_op
     e.skip_threshold = o.skip_threshold;
     e.detect_cuts = o.detect_cuts != 0;
     e.fit_cameras = o.fit_cameras != 0;
+    e.bounds_follow_qp = o.fixed_bounds == 0;
     return REPRISE_OK;
 }
 

@@ -171,5 +171,52 @@ TEST(CapiMatchesCpp, CodecPacketsAndDecodedFramesAreTheCodecs) {
     reprise_decoder_destroy(cd);
 }
 
+// fixed_bounds is the codec's bounds_follow_qp, inverted: at qp 46 the packets are the C++
+// encoder's either way, and the stream with fixed bounds is larger (finer depth and motion).
+TEST(CapiMatchesCpp, FixedBoundsAreTheCodecsOption) {
+    const std::vector<Frame> input = frames();
+    std::size_t bytes_of[2] = {0, 0};
+    for (const int fixed : {0, 1}) {
+        codec::Encoder encoder;
+        ASSERT_TRUE(codec::Encoder::create(
+                        {.qp = 46, .depth = codec::DepthMode::View, .bounds_follow_qp = fixed == 0},
+                        encoder)
+                        .ok());
+        reprise_encoder_options options;
+        ASSERT_EQ(reprise_encoder_options_init(&options, sizeof options), REPRISE_OK);
+        EXPECT_EQ(options.fixed_bounds, 0);
+        options.qp = 46;
+        options.depth = REPRISE_DEPTH_VIEW;
+        options.fixed_bounds = fixed;
+        reprise_encoder* ce = nullptr;
+        ASSERT_EQ(reprise_encoder_create(REPRISE_ABI_VERSION, &options, &ce), REPRISE_OK)
+            << reprise_last_error();
+        for (std::size_t k = 0; k < input.size(); ++k) {
+            ASSERT_TRUE(encoder.send_frame(input[k]).ok());
+            codec::Packet packet;
+            ASSERT_EQ(encoder.receive_packet(packet), Result::Ok);
+            const reprise_gbuffer g = gbuffer_of(input[k]);
+            ASSERT_EQ(reprise_encoder_send_frame(ce, &g), REPRISE_OK) << reprise_last_error();
+            std::vector<uint8_t> bytes(packet.data.size() + 16);
+            std::size_t size = 0;
+            ASSERT_EQ(reprise_encoder_receive_packet(ce, bytes.data(), bytes.size(), &size),
+                      REPRISE_OK);
+            bytes.resize(size);
+            EXPECT_EQ(bytes, packet.data) << "fixed_bounds " << fixed << ", packet " << k;
+            bytes_of[fixed] += size;
+        }
+        reprise_encoder_destroy(ce);
+    }
+    EXPECT_LT(bytes_of[0], bytes_of[1]);
+    reprise_encoder_options options;
+    reprise_encoder_options_init(&options, sizeof options);
+    options.fixed_bounds = 2;
+    reprise_encoder* ce = nullptr;
+    EXPECT_EQ(reprise_encoder_create(REPRISE_ABI_VERSION, &options, &ce),
+              REPRISE_ERROR_INVALID_ARGUMENT);
+    EXPECT_NE(std::string(reprise_last_error()).find("fixed_bounds"), std::string::npos)
+        << reprise_last_error();
+}
+
 }  // namespace
 }  // namespace reprise
