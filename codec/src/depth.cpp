@@ -417,8 +417,7 @@ void encode_slice(SliceJob& j, std::vector<uint8_t>& bytes, std::vector<uint8_t>
                     }
                     const int32_t r = int32_t(c - base) / int32_t(j.map->residual_step);
                     j.residuals(x, y) = uint32_t(r);
-                    rc.bit(model.sign, r < 0);
-                    encode_uint(rc, model.magnitude, uint32_t(std::abs(int64_t(r)) - 1));
+                    encode_nonzero_int(rc, model, r);
                 }
             }
     }
@@ -469,10 +468,8 @@ bool decode_slice(SliceJob& j, std::span<const uint8_t> bytes) {
                     j.codes(x, y) = other;
                     continue;
                 }
-                const bool negative = rc.bit(model.sign);
-                uint32_t a = 0;
-                if (!decode_uint(rc, model.magnitude, a) || a == 0xFFFFFFFFu) return false;
-                const int64_t r = negative ? -(int64_t(a) + 1) : int64_t(a) + 1;
+                int64_t r = 0;
+                if (!decode_nonzero_int(rc, model, r)) return false;
                 j.residuals(x, y) = uint32_t(r);
                 j.codes(x, y) = base + uint32_t(r) * j.map->residual_step;
             }

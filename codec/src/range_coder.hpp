@@ -172,26 +172,33 @@ struct IntModel {
     UintModel<N> magnitude;
 };
 
+// The part after the zero flag, for callers that code something between (v != 0).
 template <int N>
-void encode_int(RangeEncoder& rc, IntModel<N>& m, int64_t v) {
-    rc.bit(m.zero, v != 0);
-    if (v == 0) return;
+void encode_nonzero_int(RangeEncoder& rc, IntModel<N>& m, int64_t v) {
     rc.bit(m.sign, v < 0);
     const uint64_t a = v < 0 ? uint64_t(-v) : uint64_t(v);
     encode_uint(rc, m.magnitude, uint32_t(a - 1));
 }
 
 template <int N>
-bool decode_int(RangeDecoder& rc, IntModel<N>& m, int64_t& v) {
-    if (!rc.bit(m.zero)) {
-        v = 0;
-        return true;
-    }
+bool decode_nonzero_int(RangeDecoder& rc, IntModel<N>& m, int64_t& v) {
     const int negative = rc.bit(m.sign);
     uint32_t a = 0;
     if (!decode_uint(rc, m.magnitude, a)) return false;
     v = negative ? -(int64_t(a) + 1) : int64_t(a) + 1;
     return true;
+}
+
+template <int N>
+void encode_int(RangeEncoder& rc, IntModel<N>& m, int64_t v) {
+    rc.bit(m.zero, v != 0);
+    if (v != 0) encode_nonzero_int(rc, m, v);
+}
+
+template <int N>
+bool decode_int(RangeDecoder& rc, IntModel<N>& m, int64_t& v) {
+    v = 0;
+    return !rc.bit(m.zero) || decode_nonzero_int(rc, m, v);
 }
 
 }  // namespace reprise::codec

@@ -135,6 +135,17 @@ TEST(CapiMatchesCpp, StereoEyeIsTheSynthesizers) {
     reprise_stereo_destroy(s);
 }
 
+// The C encoder's packet for `frame`, received into a buffer of `capacity` bytes.
+void c_packet(reprise_encoder* ce, const Frame& frame, std::size_t capacity,
+              std::vector<uint8_t>& bytes) {
+    const reprise_gbuffer g = gbuffer_of(frame);
+    ASSERT_EQ(reprise_encoder_send_frame(ce, &g), REPRISE_OK) << reprise_last_error();
+    bytes.resize(capacity);
+    std::size_t size = 0;
+    ASSERT_EQ(reprise_encoder_receive_packet(ce, bytes.data(), bytes.size(), &size), REPRISE_OK);
+    bytes.resize(size);
+}
+
 TEST(CapiMatchesCpp, CodecPacketsAndDecodedFramesAreTheCodecs) {
     const std::vector<Frame> input = frames();
     codec::Encoder encoder;
@@ -147,13 +158,8 @@ TEST(CapiMatchesCpp, CodecPacketsAndDecodedFramesAreTheCodecs) {
         ASSERT_TRUE(encoder.send_frame(input[k]).ok());
         codec::Packet packet;
         ASSERT_EQ(encoder.receive_packet(packet), Result::Ok);
-        const reprise_gbuffer g = gbuffer_of(input[k]);
-        ASSERT_EQ(reprise_encoder_send_frame(ce, &g), REPRISE_OK) << reprise_last_error();
-        std::vector<uint8_t> bytes(packet.data.size() + 16);
-        std::size_t size = 0;
-        ASSERT_EQ(reprise_encoder_receive_packet(ce, bytes.data(), bytes.size(), &size),
-                  REPRISE_OK);
-        bytes.resize(size);
+        std::vector<uint8_t> bytes;
+        ASSERT_NO_FATAL_FAILURE(c_packet(ce, input[k], packet.data.size() + 16, bytes));
         EXPECT_EQ(bytes, packet.data) << "packet " << k;
 
         ASSERT_TRUE(decoder.send_packet(packet.data).ok());
@@ -195,15 +201,10 @@ TEST(CapiMatchesCpp, FixedBoundsAreTheCodecsOption) {
             ASSERT_TRUE(encoder.send_frame(input[k]).ok());
             codec::Packet packet;
             ASSERT_EQ(encoder.receive_packet(packet), Result::Ok);
-            const reprise_gbuffer g = gbuffer_of(input[k]);
-            ASSERT_EQ(reprise_encoder_send_frame(ce, &g), REPRISE_OK) << reprise_last_error();
-            std::vector<uint8_t> bytes(packet.data.size() + 16);
-            std::size_t size = 0;
-            ASSERT_EQ(reprise_encoder_receive_packet(ce, bytes.data(), bytes.size(), &size),
-                      REPRISE_OK);
-            bytes.resize(size);
+            std::vector<uint8_t> bytes;
+            ASSERT_NO_FATAL_FAILURE(c_packet(ce, input[k], packet.data.size() + 16, bytes));
             EXPECT_EQ(bytes, packet.data) << "fixed_bounds " << fixed << ", packet " << k;
-            bytes_of[fixed] += size;
+            bytes_of[fixed] += bytes.size();
         }
         reprise_encoder_destroy(ce);
     }
