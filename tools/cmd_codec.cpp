@@ -97,8 +97,9 @@ void print_stats(const codec::StreamStats& s, double fps) {
         s.depth_zero_blocks, s.motion_residual_pixels, s.motion_objects, s.motion_models,
         s.motion_own_pixels);
     std::printf(
-        "  %zu frames: %zu key, %zu predicted from an older reference, %zu intra macroblocks\n",
-        s.frames, s.key_frames, s.older_reference, s.intra_blocks);
+        "  %zu frames: %zu key, %zu predicted from an older reference, %zu intra macroblocks, "
+        "%zu pixels the reference did not see predicted from the surface beside them\n",
+        s.frames, s.key_frames, s.older_reference, s.intra_blocks, s.revealed_pixels);
     if (s.cameras_fitted > 0)
         std::printf("  %zu frames without a camera coded with one fitted to depth and motion\n",
                     s.cameras_fitted);
@@ -106,7 +107,7 @@ void print_stats(const codec::StreamStats& s, double fps) {
 
 constexpr const char* kFrameStatsColumns =
     "frame,type,bytes,header_bits,camera_bits,depth_bits,motion_bits,colour_bits,blocks,"
-    "blocks_skipped,intra_blocks,depth_zero_blocks,motion_residual_pixels";
+    "blocks_skipped,intra_blocks,depth_zero_blocks,motion_residual_pixels,revealed_pixels";
 
 // One frame's row of --frame-stats: the difference of the encoder's running counts.
 void write_frame_stats(CsvFile& csv, std::size_t frame, std::size_t bytes,
@@ -118,7 +119,8 @@ void write_frame_stats(CsvFile& csv, std::size_t frame, std::size_t bytes,
              d(b.motion_bits, a.motion_bits), d(b.color_bits, a.color_bits), d(b.blocks, a.blocks),
              d(b.blocks_skipped, a.blocks_skipped), d(b.intra_blocks, a.intra_blocks),
              d(b.depth_zero_blocks, a.depth_zero_blocks),
-             d(b.motion_residual_pixels, a.motion_residual_pixels)});
+             d(b.motion_residual_pixels, a.motion_residual_pixels),
+             d(b.revealed_pixels, a.revealed_pixels)});
     csv.flush();
 }
 

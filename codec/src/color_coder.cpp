@@ -445,6 +445,14 @@ std::vector<SliceJob> slice_jobs(const Geometry& g, const Planes* source, const 
     return jobs;
 }
 
+// Inter prediction, revealed pixels filled from the surface beside them.
+void predict(const FrameContext& fc, ImageView<const float> depth,
+             ImageView<const glm::vec2> motion, Planes& predicted, StreamStats& stats) {
+    predict_planes(fc.reference->planes, *fc.sp, motion, predicted);
+    stats.revealed_pixels += fill_revealed(*fc.sp, depth, fc.reference->depth.view(), motion,
+                                           predicted, fc.work->revealed);
+}
+
 void prepare(const SequenceParams& sp, Planes& out, Workspace& work) {
     for (int k = 0; k < 3; ++k) {
         ensure_size(out.p[k], sp.plane_width(k), sp.plane_height(k));
@@ -455,12 +463,13 @@ void prepare(const SequenceParams& sp, Planes& out, Workspace& work) {
 }  // namespace
 
 ColorEncodeResult encode_color(const FrameContext& fc, const Planes& source,
-                               ImageView<const glm::vec2> motion, int qp, int skip_threshold,
-                               Planes& out, std::vector<uint8_t>& bytes, StreamStats& stats) {
+                               ImageView<const float> depth, ImageView<const glm::vec2> motion,
+                               int qp, int skip_threshold, Planes& out, std::vector<uint8_t>& bytes,
+                               StreamStats& stats) {
     const SequenceParams& sp = *fc.sp;
     prepare(sp, out, *fc.work);
     Planes& predicted = fc.work->predicted;
-    if (!fc.key) predict_planes(fc.reference->planes, sp, motion, predicted);
+    if (!fc.key) predict(fc, depth, motion, predicted, stats);
     const std::size_t start = bytes.size();
     ByteWriter w(bytes);
     w.u8(uint8_t(qp));
@@ -495,8 +504,9 @@ ColorEncodeResult encode_color(const FrameContext& fc, const Planes& source,
     return result;
 }
 
-Status decode_color(const FrameContext& fc, ImageView<const glm::vec2> motion,
-                    std::span<const uint8_t> in, Planes& out, StreamStats& stats) {
+Status decode_color(const FrameContext& fc, ImageView<const float> depth,
+                    ImageView<const glm::vec2> motion, std::span<const uint8_t> in, Planes& out,
+                    StreamStats& stats) {
     const SequenceParams& sp = *fc.sp;
     prepare(sp, out, *fc.work);
     ByteReader r(in, "colour section");
@@ -509,7 +519,7 @@ Status decode_color(const FrameContext& fc, ImageView<const glm::vec2> motion,
     if ((flags & kAllSkipped) && fc.key)
         return Status::error("colour section: a key frame cannot skip its blocks");
     Planes& predicted = fc.work->predicted;
-    if (!fc.key) predict_planes(fc.reference->planes, sp, motion, predicted);
+    if (!fc.key) predict(fc, depth, motion, predicted, stats);
     const std::size_t blocks =
         std::size_t(sp.mb_cols()) * sp.mb_rows() * (4 + 2 * (sp.chroma == Chroma::C420 ? 1 : 4));
     if (flags & kAllSkipped) {

@@ -89,7 +89,7 @@ Status Decoder::send_packet(std::span<const uint8_t> packet) {
     const ImageView<const glm::vec2> motion =
         motion_to_reference(sp, camera, pic.depth, pic.motion, ref, h.frame, s.work);
     fs.older_reference = ref && ref->frame + 1 != h.frame;
-    REPRISE_TRY(decode_color(fc, motion, sections[3], pic.planes, fs));
+    REPRISE_TRY(decode_color(fc, pic.depth.view(), motion, sections[3], pic.planes, fs));
     fs.camera_bits += 8 * (sections[0].size() - object_bytes);
     fs.frames = 1;
     fs.key_frames = key;

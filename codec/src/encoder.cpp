@@ -201,8 +201,8 @@ struct Encoder::State {
         const ImageView<const glm::vec2> motion =
             motion_to_reference(sp, camera, pic.depth, pic.motion, ref, next_frame, work);
         section.clear();
-        color = encode_color(fc, source_planes, motion, qp_now, options.skip_threshold, pic.planes,
-                             section, fs);
+        color = encode_color(fc, source_planes, pic.depth.view(), motion, qp_now,
+                             options.skip_threshold, pic.planes, section, fs);
         append_section(payload, section);
         // The packet header, key frame parameters and section lengths.
         fs.header_bits = 8 * (kPacketHeaderSize + payload.size()) -

@@ -13,7 +13,7 @@ namespace reprise::codec {
 
 inline constexpr uint32_t kPacketMagic = 0x544B5052;  // "RPKT"
 inline constexpr uint32_t kFileMagic = 0x53525052;    // "RPRS"
-inline constexpr uint8_t kVersion = 11;
+inline constexpr uint8_t kVersion = 12;
 inline constexpr std::size_t kPacketHeaderSize = 32;
 inline constexpr std::size_t kMaxPayload = 256u << 20;
 inline constexpr int kMaxSide = 16384;
@@ -173,6 +173,7 @@ struct Workspace {
     std::vector<ObjectField> object_fields;
     Image<uint32_t> predicted_owner;  // empty when no pixel is predicted to move with an object
     Planes predicted;
+    Image<uint8_t> revealed;               // per luma pixel: the reference did not see it
     std::vector<uint8_t> coded_blocks[3];  // per 8x8 block of each plane: intra or with a residual
     std::vector<std::vector<uint8_t>> slice_bytes;
     std::vector<std::vector<uint8_t>> slice_flags;  // per slice: a block row's flags
@@ -219,15 +220,18 @@ Status decode_motion(const FrameContext& fc, const Camera& camera, ImageView<con
                      std::span<const uint8_t> in, Image<glm::vec2>& out, Image<uint32_t>& owner,
                      StreamStats& stats);
 
-// Colour. `motion` (to the reference) drives the inter prediction.
+// Colour. `motion` (to the reference) drives the inter prediction; `depth` (this frame's,
+// decoded) finds the pixels the reference did not see.
 struct ColorEncodeResult {
     std::size_t intra_macroblocks = 0, macroblocks = 0;
 };
 ColorEncodeResult encode_color(const FrameContext& fc, const Planes& source,
-                               ImageView<const glm::vec2> motion, int qp, int skip_threshold,
-                               Planes& out, std::vector<uint8_t>& bytes, StreamStats& stats);
-Status decode_color(const FrameContext& fc, ImageView<const glm::vec2> motion,
-                    std::span<const uint8_t> in, Planes& out, StreamStats& stats);
+                               ImageView<const float> depth, ImageView<const glm::vec2> motion,
+                               int qp, int skip_threshold, Planes& out, std::vector<uint8_t>& bytes,
+                               StreamStats& stats);
+Status decode_color(const FrameContext& fc, ImageView<const float> depth,
+                    ImageView<const glm::vec2> motion, std::span<const uint8_t> in, Planes& out,
+                    StreamStats& stats);
 
 // --- deblock.cpp: in-loop filter of the 8x8 edges next to coded blocks.
 void deblock(Planes& planes, const std::vector<uint8_t> (&coded)[3], int qp);
@@ -235,5 +239,12 @@ void deblock(Planes& planes, const std::vector<uint8_t> (&coded)[3], int qp);
 // Inter prediction of all three planes from the reference by `motion` (Catmull-Rom, integer).
 void predict_planes(const Planes& reference, const SequenceParams& sp,
                     ImageView<const glm::vec2> motion, Planes& out);
+// Pixels the reference did not see (its depth where they land is more than 4 % off theirs) take
+// the prediction of the surface beside them: the nearest pixel along their row, within 32 luma
+// pixels, that it saw at the same depth (5 %), mirrored about the strip's edge where possible.
+// Returns how many luma pixels were revealed (marked in `revealed`).
+std::size_t fill_revealed(const SequenceParams& sp, ImageView<const float> depth,
+                          ImageView<const float> reference_depth, ImageView<const glm::vec2> motion,
+                          Planes& predicted, Image<uint8_t>& revealed);
 
 }  // namespace reprise::codec

@@ -1,6 +1,7 @@
 // Inter prediction: every pixel of each plane fetched from the reference picture at p + motion
 // with a Catmull-Rom filter in 1/64-pixel integer arithmetic (bit-exact on every machine).
-// Whole-pixel motion copies exactly; positions outside the plane clamp to its edge.
+// Whole-pixel motion copies exactly; positions outside the plane clamp to its edge. Then pixels
+// the reference did not see (by depth) continue the surface beside them along their row.
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -69,6 +70,14 @@ inline glm::vec2 usable(glm::vec2 m) {
     return std::isfinite(m.x) && std::isfinite(m.y) ? m : glm::vec2(0.0f);
 }
 
+// The reference saw pixel p where its depth at the landing p + m (nearest pixel) is within 4 % of
+// p's own; a pixel off the reference's edge counts as seen (the prediction clamps to that edge).
+inline bool seen(float depth, float landing) {
+    return !(landing * 1.04f < depth || depth * 1.04f < landing);
+}
+
+inline bool same_surface(float a, float b) { return a == b || std::abs(a - b) <= 0.05f * a; }
+
 }  // namespace
 
 const int32_t (&catmull_rom_weights())[64][4] {
@@ -126,6 +135,70 @@ void predict_planes(const Planes& ref, const SequenceParams& sp, ImageView<const
                 }
             }
     });
+}
+
+std::size_t fill_revealed(const SequenceParams& sp, ImageView<const float> depth,
+                          ImageView<const float> reference_depth, ImageView<const glm::vec2> motion,
+                          Planes& predicted, Image<uint8_t>& revealed) {
+    const int w = sp.width, h = sp.height;
+    if (depth.width != w || depth.height != h || reference_depth.width != w ||
+        reference_depth.height != h)
+        return 0;
+    ensure_size(revealed, w, h);
+    const ImageView<uint8_t> mask = revealed.view();
+    std::vector<std::size_t> counts(std::size_t(h), 0);
+    parallel_for(0, h, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y) {
+            const float* d = depth.row(y);
+            const glm::vec2* m = motion.row(y);
+            uint8_t* out = mask.row(y);
+            std::size_t count = 0;
+            for (int x = 0; x < w; ++x) {
+                const glm::vec2 v = usable(m[x]);
+                const int lx = int(std::floor(float(x) + 0.5f + v.x));
+                const int ly = int(std::floor(float(y) + 0.5f + v.y));
+                const bool inside = lx >= 0 && ly >= 0 && lx < w && ly < h;
+                out[x] = inside && !seen(d[x], reference_depth.row(ly)[lx]);
+                count += out[x];
+            }
+            counts[std::size_t(y)] = count;
+        }
+    });
+    std::size_t total = 0;
+    for (std::size_t c : counts) total += c;
+    if (total == 0) return 0;
+    for (int k = 0; k < 3; ++k) {
+        const int s = sp.shift(k);
+        const int pw = (w + (1 << s) - 1) >> s, ph = (h + (1 << s) - 1) >> s;
+        const int reach = 32 >> s;
+        Image<int16_t>& plane = predicted.p[k];
+        parallel_for(0, ph, [&](int y0, int y1) {
+            for (int y = y0; y < y1; ++y) {
+                const int ly = y << s;
+                const uint8_t* r = mask.row(ly);
+                const float* d = depth.row(ly);
+                int16_t* row = plane.data() + std::size_t(y) * plane.width();
+                auto source = [&](int x, int dx) {
+                    const int sx = x + dx;
+                    if (sx < 0 || sx >= pw) return false;
+                    return !r[sx << s] && same_surface(d[x << s], d[sx << s]);
+                };
+                for (int x = 0; x < pw; ++x) {
+                    if (!r[x << s]) continue;
+                    for (int dist = 1; dist <= reach; ++dist) {
+                        const int dir = source(x, -dist) ? -1 : source(x, dist) ? 1 : 0;
+                        if (dir == 0) continue;
+                        // Mirrored about the strip's edge where that pixel qualifies too: the
+                        // surface's texture continues instead of one pixel smeared.
+                        const int mirrored = dir * (2 * dist - 1);
+                        row[x] = row[x + (source(x, mirrored) ? mirrored : dir * dist)];
+                        break;
+                    }
+                }
+            }
+        });
+    }
+    return total;
 }
 
 }  // namespace reprise::codec
