@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 
 #include "../codec/src/internal.hpp"
 
@@ -48,9 +49,10 @@ TEST(ColorPrediction, ARevealedStripMirrorsTheSurfaceBesideIt) {
         for (int x = 0; x < kW; ++x)
             motion(x, y) = depth(x, y) < 5.0f ? glm::vec2(-10.0f, 0.0f) : glm::vec2(0.0f);
     Planes planes = column_planes(sp);
-    Image<uint8_t> revealed;
-    EXPECT_EQ(fill_revealed(sp, depth.view(), reference.view(), motion.view(), planes, revealed),
-              std::size_t(10 * kH));
+    Image<uint8_t> revealed(kW, kH);
+    EXPECT_EQ(
+        fill_revealed(sp, motion.view(), {depth.view(), reference.view(), revealed.view()}, planes),
+        std::size_t(10 * kH));
     for (int y = 0; y < kH; ++y)
         for (int x = 0; x < kW; ++x) {
             const bool strip = x >= 20 && x < 30;
@@ -73,8 +75,9 @@ TEST(ColorPrediction, NothingIsRevealedWhereTheReferenceSawEverything) {
         for (int x = 0; x < kW; ++x) motion(x, y) = {0.0f, 0.0f};
     const Planes before = column_planes(sp);
     Planes planes = before;
-    Image<uint8_t> revealed;
-    EXPECT_EQ(fill_revealed(sp, depth.view(), depth.view(), motion.view(), planes, revealed), 0u);
+    Image<uint8_t> revealed(kW, kH);
+    const Reveal reveal{depth.view(), depth.view(), revealed.view()};
+    EXPECT_EQ(fill_revealed(sp, motion.view(), reveal, planes), 0u);
     for (int y = 0; y < kH; ++y) {
         depth(25, y) = NAN;
         motion(5, y) = {NAN, 0.0f};
@@ -82,12 +85,55 @@ TEST(ColorPrediction, NothingIsRevealedWhereTheReferenceSawEverything) {
         motion(45, y) = {-22.0f, 0.0f};   // lands on the square: revealed, takes the background
                                           // beside it
     }
-    EXPECT_EQ(fill_revealed(sp, depth.view(), depth.view(), motion.view(), planes, revealed),
-              std::size_t(kH));
+    EXPECT_EQ(fill_revealed(sp, motion.view(), reveal, planes), std::size_t(kH));
     for (int y = 0; y < kH; ++y)
         for (int x = 0; x < kW; ++x) {
             EXPECT_EQ(revealed(x, y), x == 45) << x << "," << y;
             EXPECT_EQ(planes.p[0](x, y), x == 45 ? 44 : before.p[0](x, y)) << x << "," << y;
+        }
+}
+
+// The codec fills while it predicts, row by row on the pool's threads; the same fill over the whole
+// prediction afterwards is its reference. Odd sizes, 4:2:0 and 4:4:4, random reference and motion.
+TEST(ColorPrediction, TheFusedFillEqualsTheFillAfterThePrediction) {
+    std::mt19937 rng(7);
+    for (Chroma chroma : {Chroma::C420, Chroma::C444})
+        for (auto [w, h] : {std::pair{61, 37}, std::pair{160, 96}}) {
+            SCOPED_TRACE(std::to_string(w) + "x" + std::to_string(h));
+            SequenceParams sp;
+            sp.width = w;
+            sp.height = h;
+            sp.chroma = chroma;
+            Planes reference;
+            for (int k = 0; k < 3; ++k) {
+                reference.p[k].resize(sp.plane_width(k), sp.plane_height(k));
+                for (std::size_t i = 0; i < reference.p[k].pixel_count(); ++i)
+                    reference.p[k].data()[i] = int16_t(rng() % 256) - (k ? 128 : 0);
+            }
+            Image<float> depth(w, h), reference_depth(w, h);
+            Image<glm::vec2> motion(w, h);
+            std::uniform_real_distribution<float> shift(-6.0f, 6.0f);
+            for (int y = 0; y < h; ++y)
+                for (int x = 0; x < w; ++x) {
+                    const bool near = (x / 12 + y / 9) % 3 == 0, was_near = (x / 12) % 2 == 0;
+                    depth(x, y) = near ? 1.0f + 0.001f * float(x) : 10.0f;
+                    reference_depth(x, y) = was_near ? 1.0f : (y % 11 == 0 ? INFINITY : 10.0f);
+                    motion(x, y) = {shift(rng), shift(rng) * 0.5f};
+                }
+            Image<uint8_t> fused_mask(w, h), mask(w, h);
+            Planes fused, after;
+            const Reveal reveal{depth.view(), reference_depth.view(), fused_mask.view()};
+            const std::size_t n = predict_planes(reference, sp, motion.view(), fused, &reveal);
+            predict_planes(reference, sp, motion.view(), after);
+            EXPECT_EQ(fill_revealed(sp, motion.view(),
+                                    {depth.view(), reference_depth.view(), mask.view()}, after),
+                      n);
+            EXPECT_GT(n, std::size_t(w * h / 10));
+            for (int k = 0; k < 3; ++k)
+                EXPECT_TRUE(std::equal(fused.p[k].data(),
+                                       fused.p[k].data() + fused.p[k].pixel_count(),
+                                       after.p[k].data()))
+                    << "plane " << k;
         }
 }
 

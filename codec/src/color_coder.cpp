@@ -448,9 +448,13 @@ std::vector<SliceJob> slice_jobs(const Geometry& g, const Planes* source, const 
 // Inter prediction, revealed pixels filled from the surface beside them.
 void predict(const FrameContext& fc, ImageView<const float> depth,
              ImageView<const glm::vec2> motion, Planes& predicted, StreamStats& stats) {
-    predict_planes(fc.reference->planes, *fc.sp, motion, predicted);
-    stats.revealed_pixels += fill_revealed(*fc.sp, depth, fc.reference->depth.view(), motion,
-                                           predicted, fc.work->revealed);
+    const SequenceParams& sp = *fc.sp;
+    Reveal reveal{.depth = depth, .reference_depth = fc.reference->depth.view()};
+    if (!depth.empty()) {
+        ensure_size(fc.work->revealed, sp.width, sp.height);
+        reveal.revealed = fc.work->revealed.view();
+    }
+    stats.revealed_pixels += predict_planes(fc.reference->planes, sp, motion, predicted, &reveal);
 }
 
 void prepare(const SequenceParams& sp, Planes& out, Workspace& work) {

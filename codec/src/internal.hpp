@@ -236,15 +236,22 @@ Status decode_color(const FrameContext& fc, ImageView<const float> depth,
 // --- deblock.cpp: in-loop filter of the 8x8 edges next to coded blocks.
 void deblock(Planes& planes, const std::vector<uint8_t> (&coded)[3], int qp);
 
-// Inter prediction of all three planes from the reference by `motion` (Catmull-Rom, integer).
-void predict_planes(const Planes& reference, const SequenceParams& sp,
-                    ImageView<const glm::vec2> motion, Planes& out);
-// Pixels the reference did not see (its depth where they land is more than 4 % off theirs) take
-// the prediction of the surface beside them: the nearest pixel along their row, within 32 luma
-// pixels, that it saw at the same depth (5 %), mirrored about the strip's edge where possible.
-// Returns how many luma pixels were revealed (marked in `revealed`).
-std::size_t fill_revealed(const SequenceParams& sp, ImageView<const float> depth,
-                          ImageView<const float> reference_depth, ImageView<const glm::vec2> motion,
-                          Planes& predicted, Image<uint8_t>& revealed);
+// Revealed pixels (docs/bitstream.md section 9): pixels the reference did not see (its depth where
+// they land is more than 4 % off theirs) take the prediction of the surface beside them: the
+// nearest pixel along their row, within 32 luma pixels, that it saw at the same depth (5 %),
+// mirrored about the strip's edge where possible. `revealed` (picture-sized) marks them.
+struct Reveal {
+    ImageView<const float> depth, reference_depth;
+    ImageView<uint8_t> revealed;
+};
+// Inter prediction of all three planes from the reference by `motion` (Catmull-Rom, integer),
+// with `reveal` (when its images are picture-sized) the revealed pixels filled row by row.
+// Returns how many luma pixels were revealed.
+std::size_t predict_planes(const Planes& reference, const SequenceParams& sp,
+                           ImageView<const glm::vec2> motion, Planes& out,
+                           const Reveal* reveal = nullptr);
+// The same fill alone, over a prediction already made (the reference of the fused pass above).
+std::size_t fill_revealed(const SequenceParams& sp, ImageView<const glm::vec2> motion,
+                          const Reveal& reveal, Planes& predicted);
 
 }  // namespace reprise::codec

@@ -103,13 +103,69 @@ void predict_row_reference(const PredictRow& r, int x_begin, int x_end) {
     }
 }
 
-void predict_planes(const Planes& ref, const SequenceParams& sp, ImageView<const glm::vec2> motion,
-                    Planes& out) {
+namespace {
+
+// Marks row y's revealed luma pixels; returns how many.
+std::size_t reveal_row(const Reveal& r, ImageView<const glm::vec2> motion, int y) {
+    const int w = r.depth.width, h = r.depth.height;
+    const float* d = r.depth.row(y);
+    const glm::vec2* m = motion.row(y);
+    uint8_t* out = r.revealed.row(y);
+    std::size_t count = 0;
+    for (int x = 0; x < w; ++x) {
+        // Inside the picture (never with NaN or infinite motion), truncation is the floor.
+        const float fx = float(x) + 0.5f + m[x].x, fy = float(y) + 0.5f + m[x].y;
+        const bool inside = fx >= 0.0f && fy >= 0.0f && fx < float(w) && fy < float(h);
+        out[x] = inside && !seen(d[x], r.reference_depth.row(int(fy))[int(fx)]);
+        count += out[x];
+    }
+    return count;
+}
+
+// Row y of a plane with subsampling shift s: its revealed samples take their sources'.
+void fill_row(const Reveal& r, int s, int y, int16_t* row) {
+    const int w = r.depth.width;
+    const int ly = y << s;
+    const uint8_t* revealed = r.revealed.row(ly);
+    const float* d = r.depth.row(ly);
+    const int pw = (w + (1 << s) - 1) >> s, reach = 32 >> s;
+    auto source = [&](int x, int dx) {
+        const int sx = x + dx;
+        if (sx < 0 || sx >= pw) return false;
+        return !revealed[sx << s] && same_surface(d[x << s], d[sx << s]);
+    };
+    for (int x = 0; x < pw; ++x) {
+        if (!revealed[x << s]) continue;
+        for (int dist = 1; dist <= reach; ++dist) {
+            const int dir = source(x, -dist) ? -1 : source(x, dist) ? 1 : 0;
+            if (dir == 0) continue;
+            // Mirrored about the strip's edge where that pixel qualifies too: the surface's
+            // texture continues instead of one pixel smeared.
+            const int mirrored = dir * (2 * dist - 1);
+            row[x] = row[x + (source(x, mirrored) ? mirrored : dir * dist)];
+            break;
+        }
+    }
+}
+
+bool usable(const Reveal* r, const SequenceParams& sp) {
+    return r && r->depth.width == sp.width && r->depth.height == sp.height &&
+           r->reference_depth.width == sp.width && r->reference_depth.height == sp.height &&
+           r->revealed.width == sp.width && r->revealed.height == sp.height;
+}
+
+}  // namespace
+
+std::size_t predict_planes(const Planes& ref, const SequenceParams& sp,
+                           ImageView<const glm::vec2> motion, Planes& out, const Reveal* reveal) {
     const int w = sp.width, h = sp.height;
     for (int k = 0; k < 3; ++k) ensure_size(out.p[k], sp.plane_width(k), sp.plane_height(k));
     const int rows = sp.plane_height(0);
     const int chroma_rows = sp.plane_height(1);
-    // One pass over the luma rows; each worker also makes the chroma rows its luma rows cover.
+    if (!usable(reveal, sp)) reveal = nullptr;
+    std::vector<std::size_t> revealed(std::size_t(rows), 0);
+    // One pass over the luma rows; each worker also makes the chroma rows its luma rows cover,
+    // after them, so that the revealed pixels of those luma rows are marked.
     const int s = sp.shift(1);
     parallel_for(0, rows >> s, [&](int r0, int r1) {
         for (int r = r0; r < r1; ++r)
@@ -132,71 +188,31 @@ void predict_planes(const Planes& ref, const SequenceParams& sp, ImageView<const
                         .out = out.p[k].data() + std::size_t(y) * out.p[k].width(),
                     };
                     predict_row(row);
+                    if (!reveal || (y << sub) >= h) continue;
+                    if (k == 0) revealed[std::size_t(y)] = reveal_row(*reveal, motion, y);
+                    if (revealed[std::size_t(y << sub)]) fill_row(*reveal, sub, y, row.out);
                 }
             }
-    });
-}
-
-std::size_t fill_revealed(const SequenceParams& sp, ImageView<const float> depth,
-                          ImageView<const float> reference_depth, ImageView<const glm::vec2> motion,
-                          Planes& predicted, Image<uint8_t>& revealed) {
-    const int w = sp.width, h = sp.height;
-    if (depth.width != w || depth.height != h || reference_depth.width != w ||
-        reference_depth.height != h)
-        return 0;
-    ensure_size(revealed, w, h);
-    const ImageView<uint8_t> mask = revealed.view();
-    std::vector<std::size_t> counts(std::size_t(h), 0);
-    parallel_for(0, h, [&](int y0, int y1) {
-        for (int y = y0; y < y1; ++y) {
-            const float* d = depth.row(y);
-            const glm::vec2* m = motion.row(y);
-            uint8_t* out = mask.row(y);
-            std::size_t count = 0;
-            for (int x = 0; x < w; ++x) {
-                const glm::vec2 v = usable(m[x]);
-                const int lx = int(std::floor(float(x) + 0.5f + v.x));
-                const int ly = int(std::floor(float(y) + 0.5f + v.y));
-                const bool inside = lx >= 0 && ly >= 0 && lx < w && ly < h;
-                out[x] = inside && !seen(d[x], reference_depth.row(ly)[lx]);
-                count += out[x];
-            }
-            counts[std::size_t(y)] = count;
-        }
     });
     std::size_t total = 0;
-    for (std::size_t c : counts) total += c;
-    if (total == 0) return 0;
-    for (int k = 0; k < 3; ++k) {
-        const int s = sp.shift(k);
-        const int pw = (w + (1 << s) - 1) >> s, ph = (h + (1 << s) - 1) >> s;
-        const int reach = 32 >> s;
-        Image<int16_t>& plane = predicted.p[k];
-        parallel_for(0, ph, [&](int y0, int y1) {
-            for (int y = y0; y < y1; ++y) {
-                const int ly = y << s;
-                const uint8_t* r = mask.row(ly);
-                const float* d = depth.row(ly);
-                int16_t* row = plane.data() + std::size_t(y) * plane.width();
-                auto source = [&](int x, int dx) {
-                    const int sx = x + dx;
-                    if (sx < 0 || sx >= pw) return false;
-                    return !r[sx << s] && same_surface(d[x << s], d[sx << s]);
-                };
-                for (int x = 0; x < pw; ++x) {
-                    if (!r[x << s]) continue;
-                    for (int dist = 1; dist <= reach; ++dist) {
-                        const int dir = source(x, -dist) ? -1 : source(x, dist) ? 1 : 0;
-                        if (dir == 0) continue;
-                        // Mirrored about the strip's edge where that pixel qualifies too: the
-                        // surface's texture continues instead of one pixel smeared.
-                        const int mirrored = dir * (2 * dist - 1);
-                        row[x] = row[x + (source(x, mirrored) ? mirrored : dir * dist)];
-                        break;
-                    }
-                }
-            }
-        });
+    for (std::size_t c : revealed) total += c;
+    return total;
+}
+
+std::size_t fill_revealed(const SequenceParams& sp, ImageView<const glm::vec2> motion,
+                          const Reveal& reveal, Planes& predicted) {
+    if (!usable(&reveal, sp)) return 0;
+    std::size_t total = 0;
+    for (int y = 0; y < sp.height; ++y) {
+        const std::size_t count = reveal_row(reveal, motion, y);
+        total += count;
+        if (!count) continue;
+        for (int k = 0; k < 3; ++k) {
+            const int s = sp.shift(k);
+            if (y % (1 << s) == 0)
+                fill_row(reveal, s, y >> s,
+                         predicted.p[k].data() + std::size_t(y >> s) * predicted.p[k].width());
+        }
     }
     return total;
 }
