@@ -522,6 +522,18 @@ void depth_from_codes(const Mapping& map, const Image<uint32_t>& codes, Image<fl
     ensure_size(out, codes.width(), codes.height());
     parallel_for(0, codes.height(), [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y) {
+            if (map.view) {  // map.depth without branches (most codes differ from their left)
+                const uint32_t* row = &codes(0, y);
+                float* o = &out(0, y);
+                for (int x = 0; x < codes.width(); ++x) {
+                    const uint32_t c = row[x];
+                    const float z = float(1.0 / (c == 0 ? 0.5 * map.step : double(c) * map.step));
+                    o[x] = c <= kMaxViewCode ? z
+                           : c == kInfCode   ? std::numeric_limits<float>::infinity()
+                                             : std::numeric_limits<float>::quiet_NaN();
+                }
+                continue;
+            }
             uint32_t last = codes(0, y);
             float z = map.depth(last);
             for (int x = 0; x < codes.width(); ++x) {

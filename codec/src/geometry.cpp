@@ -200,22 +200,23 @@ void fill_cracks(ImageView<float> depth, Image<float>& scratch) {
                    ? 2.0f / (va + vb)
                    : kNan;
     };
-    parallel_for(0, h, [&](int y0, int y1) {
+    // Only the pixels nothing landed on are read or written twice (scratch holds their values).
+    parallel_for(1, h - 1, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y)
-            for (int x = 0; x < w; ++x) {
+            for (int x = 1; x + 1 < w; ++x) {
+                if (!std::isnan(depth(x, y))) continue;
                 float v = kNan;
-                if (std::isnan(depth(x, y)) && x > 0 && y > 0 && x + 1 < w && y + 1 < h)
-                    for (const auto& [dx, dy] : {std::pair{1, 0}, {0, 1}, {1, 1}, {1, -1}}) {
-                        v = mean(depth(x - dx, y - dy), depth(x + dx, y + dy));
-                        if (!std::isnan(v)) break;
-                    }
+                for (const auto& [dx, dy] : {std::pair{1, 0}, {0, 1}, {1, 1}, {1, -1}}) {
+                    v = mean(depth(x - dx, y - dy), depth(x + dx, y + dy));
+                    if (!std::isnan(v)) break;
+                }
                 scratch(x, y) = v;
             }
     });
-    parallel_for(0, h, [&](int y0, int y1) {
+    parallel_for(1, h - 1, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y)
-            for (int x = 0; x < w; ++x)
-                if (!std::isnan(scratch(x, y))) depth(x, y) = scratch(x, y);
+            for (int x = 1; x + 1 < w; ++x)
+                if (std::isnan(depth(x, y))) depth(x, y) = scratch(x, y);
     });
 }
 
