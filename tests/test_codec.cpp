@@ -108,6 +108,19 @@ TEST(CodecPieces, RangeCoderRoundTripsBitsAndIntegers) {
     EXPECT_LT(bytes.size(), 20000 * 0.76 / 8 + 5000 * 6);
 }
 
+// A model learns from its first bits (version 12): 8 zeros take the probability of a 0 from 1/2
+// to 3,646/4096 (a single estimate moving 1/32 of the way reached 2,507); long runs keep it
+// inside 2..4093, so that neither bit ever gets a zero-width range.
+TEST(CodecPieces, AModelLearnsFromItsFirstBitsAndStaysInRange) {
+    BitModel m;
+    for (int i = 0; i < 8; ++i) m.update(0);
+    EXPECT_EQ(m.p(), 3646u);
+    for (int i = 0; i < 100000; ++i) m.update(0);
+    EXPECT_EQ(m.p(), 4093u);
+    for (int i = 0; i < 100000; ++i) m.update(1);
+    EXPECT_EQ(m.p(), 2u);
+}
+
 TEST(CodecPieces, RangeDecoderOnGarbageStaysInBounds) {
     std::mt19937 rng(3);
     for (int trial = 0; trial < 200; ++trial) {
@@ -469,11 +482,11 @@ TEST(Codec, APixelThePredictionMissesTakesTheOtherOneForAFlag) {
 
 // Colour where the reference did not see the surface (version 12): the strips a moving object
 // uncovers take the surface beside them instead of intra macroblocks. Inter-frame colour bits at
-// 160x96, qp 34, 6 frames without that fill (version 11): fence 4,824, courtyard 4,296, crossing
-// 2,120; with it 4,400, 3,184, 1,448.
+// 160x96, qp 34, 6 frames, the fill turned off (measured, not a mode of the codec): fence 4,056,
+// courtyard 3,912, crossing 1,912; with it 3,784, 2,904, 1,272.
 TEST(Codec, ARevealedStripIsPredictedFromTheSurfaceBesideIt) {
     for (auto [scene, most_bits] :
-         {std::pair{"fence", 4500}, std::pair{"courtyard", 3400}, std::pair{"crossing", 1600}}) {
+         {std::pair{"fence", 3900}, std::pair{"courtyard", 3300}, std::pair{"crossing", 1500}}) {
         SCOPED_TRACE(scene);
         const auto frames = render(scene, 6, 160, 96);
         const EncoderOptions options{.qp = 34, .depth = DepthMode::View};

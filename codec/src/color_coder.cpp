@@ -20,16 +20,26 @@ constexpr int kIntraRounding = 6, kInterRounding = 2;
 constexpr int kModes = 4;  // intra: DC, vertical, horizontal, smooth
 constexpr int32_t kMaxLevel = 1 << 16;
 
+// Significance contexts: the first 16 scan positions each their own, then groups of 4.
+constexpr int kSignificanceClasses = 28;
+inline int significance_class(int i) { return i < 16 ? i : 16 + (i - 16) / 4; }
+
 struct Models {
     BitModel mb_skip[3];
     BitModel mb_intra[3];
-    BitModel mode[2][2];
-    BitModel cbf[4];
-    UintModel<7> last[4];
-    BitModel significant[4][16];
-    BitModel greater1[4][3];
-    UintModel<14> remaining[4];
+    BitModel mode[2][4];                               // [chroma][node of the 2-bit binary tree]
+    BitModel cbf[4][3];                                // [type][coded neighbours: left + above]
+    BitModel last[4][64];                              // [type][node of the 6-bit binary tree]
+    BitModel significant[4][kSignificanceClasses][2];  // [..][the next scan position has a level]
+    BitModel greater1[4][3][4];     // [type][position class][levels so far: any > 1, else 0-2 ones]
+    UintModel<14> remaining[4][3];  // [type][position class]
 };
+
+// The greater-than-one context of the next level from what the block's levels so far (coded from
+// the last one down) were.
+inline int greater1_state(int ones, bool any_greater) {
+    return any_greater ? 0 : 1 + std::min(ones, 2);
+}
 
 // Block type for contexts: luma/chroma x intra/inter.
 inline int block_type(int plane, bool intra) { return (plane ? 2 : 0) + (intra ? 0 : 1); }
@@ -102,39 +112,64 @@ void load(const Image<int16_t>& p, int bx, int by, Block& b) {
         for (int x = 0; x < 8; ++x) b[y * 8 + x] = p(bx + x, by + y);
 }
 
-template <class Coder>
-void code_levels(Coder& rc, Models& m, int type, const Block& levels) {
-    int last = -1;
-    for (int i = 63; i >= 0; --i)
+inline int position_class(int i) { return i == 0 ? 0 : i < 6 ? 1 : 2; }
+
+// Levels of a block with at least one: the last's scan position (6 bits, a binary tree of
+// models, high bit first), then from it down to 0 a significance flag (below the last), and for
+// each level a greater-than-one flag, magnitude - 2 where greater, a bypass sign.
+void code_levels(RangeEncoder& rc, Models& m, int type, const Block& levels) {
+    int last = 0;
+    for (int i = 63; i > 0; --i)
         if (levels[kZigzag[i]]) {
             last = i;
             break;
         }
-    encode_uint(rc, m.last[type], uint32_t(last));
+    for (int bit = 5, node = 1; bit >= 0; --bit) {
+        const int b = (last >> bit) & 1;
+        rc.bit(m.last[type][node], b);
+        node = 2 * node + b;
+    }
+    int ones = 0;
+    bool any_greater = false;
     for (int i = last; i >= 0; --i) {
         const int32_t v = levels[kZigzag[i]];
-        if (i < last) rc.bit(m.significant[type][std::min(i, 15)], v != 0);
+        if (i < last)
+            rc.bit(m.significant[type][significance_class(i)][levels[kZigzag[i + 1]] != 0], v != 0);
         if (!v) continue;
         const uint32_t a = uint32_t(std::abs(v));
-        rc.bit(m.greater1[type][i == 0 ? 0 : i < 6 ? 1 : 2], a > 1);
-        if (a > 1) encode_uint(rc, m.remaining[type], a - 2);
+        const int c = position_class(i);
+        rc.bit(m.greater1[type][c][greater1_state(ones, any_greater)], a > 1);
+        if (a > 1) encode_uint(rc, m.remaining[type][c], a - 2);
+        ones += a == 1;
+        any_greater = any_greater || a > 1;
         rc.bypass(v < 0);
     }
 }
 
 bool decode_levels(RangeDecoder& rc, Models& m, int type, Block& levels) {
     levels.fill(0);
-    uint32_t last = 0;
-    if (!decode_uint(rc, m.last[type], last) || last > 63) return false;
-    for (int i = int(last); i >= 0; --i) {
-        if (i < int(last) && !rc.bit(m.significant[type][std::min(i, 15)])) continue;
+    int last = 0;
+    for (int bit = 5, node = 1; bit >= 0; --bit) {
+        const int b = rc.bit(m.last[type][node]);
+        last = (last << 1) | b;
+        node = 2 * node + b;
+    }
+    int ones = 0;
+    bool any_greater = false;
+    for (int i = last; i >= 0; --i) {
+        if (i < last &&
+            !rc.bit(m.significant[type][significance_class(i)][levels[kZigzag[i + 1]] != 0]))
+            continue;
+        const int c = position_class(i);
         uint32_t a = 1;
-        if (rc.bit(m.greater1[type][i == 0 ? 0 : i < 6 ? 1 : 2])) {
+        if (rc.bit(m.greater1[type][c][greater1_state(ones, any_greater)])) {
             uint32_t rest = 0;
-            if (!decode_uint(rc, m.remaining[type], rest) || rest > uint32_t(kMaxLevel))
+            if (!decode_uint(rc, m.remaining[type][c], rest) || rest > uint32_t(kMaxLevel))
                 return false;
             a = rest + 2;
         }
+        ones += a == 1;
+        any_greater = any_greater || a > 1;
         levels[kZigzag[i]] = rc.bypass() ? -int32_t(a) : int32_t(a);
     }
     return true;
@@ -282,6 +317,10 @@ bool code_slice(SliceJob& j, Coder& rc) {
     Models m;
     const int cols = sp.mb_cols();
     std::vector<uint8_t> above_skip(cols, 0), above_intra(cols, 0);
+    // Per 8x8 block of each plane: it has levels (the coded-block flag's context).
+    std::vector<uint8_t> with_levels[3];
+    for (int k = 0; k < 3; ++k)
+        with_levels[k].assign(std::size_t(j.out->p[k].width() / 8) * (j.out->p[k].height() / 8), 0);
     for (int my = j.mb_y0; my < j.mb_y1; ++my) {
         int left_skip = 0, left_intra = 0;
         for (int mx = 0; mx < cols; ++mx) {
@@ -383,6 +422,10 @@ bool code_slice(SliceJob& j, Coder& rc) {
                         ++j.skipped;
                         continue;
                     }
+                    const int stride = j.out->p[k].width() / 8;
+                    uint8_t& has_levels = with_levels[k][std::size_t(by / 8) * stride + bx / 8];
+                    const int ctx_cbf =
+                        (bx > 0 ? (&has_levels)[-1] : 0) + (by > top ? (&has_levels)[-stride] : 0);
                     int mode = 0;
                     if constexpr (Encode) {
                         load(j.source->p[k], bx, by, src);
@@ -394,8 +437,8 @@ bool code_slice(SliceJob& j, Coder& rc) {
                             for (int candidate = 1; candidate < kModes; ++candidate)
                                 if (cost[candidate] < cost[mode]) mode = candidate;
                             intra_predict(edges, mode, pred);
-                            rc.bit(m.mode[k > 0][0], mode >> 1);
-                            rc.bit(m.mode[k > 0][1], mode & 1);
+                            rc.bit(m.mode[k > 0][1], mode >> 1);
+                            rc.bit(m.mode[k > 0][2 + (mode >> 1)], mode & 1);
                         } else {
                             load(j.predicted->p[k], bx, by, pred);
                         }
@@ -408,20 +451,22 @@ bool code_slice(SliceJob& j, Coder& rc) {
                             nonzero = inter_nonzero[block];
                             if (nonzero) levels = inter_levels[block];
                         }
-                        rc.bit(m.cbf[type], nonzero > 0);
+                        rc.bit(m.cbf[type][ctx_cbf], nonzero > 0);
+                        has_levels = nonzero > 0;
                         j.mark(k, bx, by, intra || nonzero);
                         if (nonzero) code_levels(rc, m, type, levels);
                         reconstruct(j, k, bx, by, pred, nonzero ? &levels : nullptr, intra, scale,
                                     lo);
                     } else {
                         if (intra) {
-                            mode = rc.bit(m.mode[k > 0][0]) << 1;
-                            mode |= rc.bit(m.mode[k > 0][1]);
+                            mode = rc.bit(m.mode[k > 0][1]) << 1;
+                            mode |= rc.bit(m.mode[k > 0][2 + (mode >> 1)]);
                             intra_predict(j.out->p[k], bx, by, top, mode, k ? 0 : 128, pred);
                         } else {
                             load(j.predicted->p[k], bx, by, pred);
                         }
-                        const bool cbf = rc.bit(m.cbf[type]);
+                        const bool cbf = rc.bit(m.cbf[type][ctx_cbf]);
+                        has_levels = cbf;
                         j.mark(k, bx, by, intra || cbf);
                         if (cbf && !decode_levels(rc, m, type, levels)) return false;
                         reconstruct(j, k, bx, by, pred, cbf ? &levels : nullptr, intra, scale, lo);

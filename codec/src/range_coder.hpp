@@ -3,6 +3,7 @@
 // integer binarisations built on it. The decoder never reads outside its input: past the end it
 // sees zero bytes and counts them, so a truncated or hostile slice decodes to garbage values that
 // the caller bounds, never to undefined behaviour.
+#include <algorithm>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -11,10 +12,25 @@
 namespace reprise::codec {
 
 inline constexpr int kProbBits = 12;
-inline constexpr int kAdaptShift = 5;
 
+// The probability of a 0 as the mean of two estimates in 1/32768, one moving 1/8 and one 1/32 of
+// the way to each bit seen; a model's first bits move them further (1/2, 1/4, ...), as a model
+// starts at 1/2 in every slice of every frame and most see only a few hundred bits.
 struct BitModel {
-    uint16_t p = 1 << (kProbBits - 1);  // probability of a 0, in 1/4096
+    uint16_t fast = 1 << 14, slow = 1 << 14;
+    uint8_t seen = 0;                                            // bits seen, up to 4
+    uint32_t p() const { return (uint32_t(fast) + slow) >> 4; }  // in 1/4096, 2..4093
+    void update(int b) {
+        const int f = std::min(int(seen) + 1, 3), s = std::min(int(seen) + 1, 5);
+        if (seen < 4) ++seen;
+        if (!b) {
+            fast += ((1 << 15) - fast) >> f;
+            slow += ((1 << 15) - slow) >> s;
+        } else {
+            fast -= fast >> f;
+            slow -= slow >> s;
+        }
+    }
 };
 
 class RangeEncoder {
@@ -22,15 +38,14 @@ public:
     explicit RangeEncoder(std::vector<uint8_t>& out) : out_(out) {}
 
     void bit(BitModel& m, int b) {
-        const uint32_t bound = (range_ >> kProbBits) * m.p;
+        const uint32_t bound = (range_ >> kProbBits) * m.p();
         if (!b) {
             range_ = bound;
-            m.p += ((1 << kProbBits) - m.p) >> kAdaptShift;
         } else {
             low_ += bound;
             range_ -= bound;
-            m.p -= m.p >> kAdaptShift;
         }
+        m.update(b);
         normalize();
     }
     void bypass(int b) {
@@ -80,18 +95,17 @@ public:
     }
 
     int bit(BitModel& m) {
-        const uint32_t bound = (range_ >> kProbBits) * m.p;
+        const uint32_t bound = (range_ >> kProbBits) * m.p();
         int b;
         if (code_ < bound) {
             range_ = bound;
-            m.p += ((1 << kProbBits) - m.p) >> kAdaptShift;
             b = 0;
         } else {
             code_ -= bound;
             range_ -= bound;
-            m.p -= m.p >> kAdaptShift;
             b = 1;
         }
+        m.update(b);
         normalize();
         return b;
     }
