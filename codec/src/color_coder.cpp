@@ -27,9 +27,10 @@ inline int significance_class(int i) { return i < 16 ? i : 16 + (i - 16) / 4; }
 struct Models {
     BitModel mb_skip[3];
     BitModel mb_intra[3];
-    BitModel mode[2][4];                               // [chroma][node of the 2-bit binary tree]
-    BitModel cbf[4][3];                                // [type][coded neighbours: left + above]
-    BitModel last[4][64];                              // [type][node of the 6-bit binary tree]
+    BitModel mode[2][25][4];  // [chroma][left and above blocks' modes + 1, 0: none][node]
+    BitModel cbf[4][6];       // [type][left + above have levels, + 3: an earlier block of the
+                              // macroblock has (chroma)]
+    BitModel last[4][64];     // [type][node of the 6-bit binary tree]
     BitModel significant[4][kSignificanceClasses][2];  // [..][the next scan position has a level]
     BitModel greater1[4][3][4];     // [type][position class][levels so far: any > 1, else 0-2 ones]
     UintModel<14> remaining[4][3];  // [type][position class]
@@ -318,9 +319,11 @@ bool code_slice(SliceJob& j, Coder& rc) {
     const int cols = sp.mb_cols();
     std::vector<uint8_t> above_skip(cols, 0), above_intra(cols, 0);
     // Per 8x8 block of each plane: it has levels (the coded-block flag's context).
-    std::vector<uint8_t> with_levels[3];
-    for (int k = 0; k < 3; ++k)
+    std::vector<uint8_t> with_levels[3], modes[3];  // modes: intra mode + 1, 0 for inter blocks
+    for (int k = 0; k < 3; ++k) {
         with_levels[k].assign(std::size_t(j.out->p[k].width() / 8) * (j.out->p[k].height() / 8), 0);
+        modes[k].assign(with_levels[k].size(), 0);
+    }
     for (int my = j.mb_y0; my < j.mb_y1; ++my) {
         int left_skip = 0, left_intra = 0;
         for (int mx = 0; mx < cols; ++mx) {
@@ -405,7 +408,8 @@ bool code_slice(SliceJob& j, Coder& rc) {
             above_skip[mx] = left_skip = skip;
             above_intra[mx] = left_intra = intra;
             j.intra += intra;
-            int block = -1;  // in the macroblock, in coding order
+            int block = -1;              // in the macroblock, in coding order
+            bool levels_before = false;  // an earlier block of this macroblock has levels
             for (int k = 0; k < 3; ++k) {
                 const int n = j.g->blocks_per_side[k];
                 const int lo = k ? -255 : 0;
@@ -423,9 +427,13 @@ bool code_slice(SliceJob& j, Coder& rc) {
                         continue;
                     }
                     const int stride = j.out->p[k].width() / 8;
-                    uint8_t& has_levels = with_levels[k][std::size_t(by / 8) * stride + bx / 8];
-                    const int ctx_cbf =
-                        (bx > 0 ? (&has_levels)[-1] : 0) + (by > top ? (&has_levels)[-stride] : 0);
+                    const std::size_t at = std::size_t(by / 8) * stride + bx / 8;
+                    uint8_t& has_levels = with_levels[k][at];
+                    const int ctx_mode = (bx > 0 ? modes[k][at - 1] : 0) +
+                                         5 * (by > top ? modes[k][at - stride] : 0);
+                    const int ctx_cbf = (bx > 0 ? (&has_levels)[-1] : 0) +
+                                        (by > top ? (&has_levels)[-stride] : 0) +
+                                        (k > 0 && levels_before ? 3 : 0);
                     int mode = 0;
                     if constexpr (Encode) {
                         load(j.source->p[k], bx, by, src);
@@ -437,8 +445,9 @@ bool code_slice(SliceJob& j, Coder& rc) {
                             for (int candidate = 1; candidate < kModes; ++candidate)
                                 if (cost[candidate] < cost[mode]) mode = candidate;
                             intra_predict(edges, mode, pred);
-                            rc.bit(m.mode[k > 0][1], mode >> 1);
-                            rc.bit(m.mode[k > 0][2 + (mode >> 1)], mode & 1);
+                            rc.bit(m.mode[k > 0][ctx_mode][1], mode >> 1);
+                            rc.bit(m.mode[k > 0][ctx_mode][2 + (mode >> 1)], mode & 1);
+                            modes[k][at] = uint8_t(mode + 1);
                         } else {
                             load(j.predicted->p[k], bx, by, pred);
                         }
@@ -453,20 +462,23 @@ bool code_slice(SliceJob& j, Coder& rc) {
                         }
                         rc.bit(m.cbf[type][ctx_cbf], nonzero > 0);
                         has_levels = nonzero > 0;
+                        levels_before = levels_before || nonzero > 0;
                         j.mark(k, bx, by, intra || nonzero);
                         if (nonzero) code_levels(rc, m, type, levels);
                         reconstruct(j, k, bx, by, pred, nonzero ? &levels : nullptr, intra, scale,
                                     lo);
                     } else {
                         if (intra) {
-                            mode = rc.bit(m.mode[k > 0][1]) << 1;
-                            mode |= rc.bit(m.mode[k > 0][2 + (mode >> 1)]);
+                            mode = rc.bit(m.mode[k > 0][ctx_mode][1]) << 1;
+                            mode |= rc.bit(m.mode[k > 0][ctx_mode][2 + (mode >> 1)]);
+                            modes[k][at] = uint8_t(mode + 1);
                             intra_predict(j.out->p[k], bx, by, top, mode, k ? 0 : 128, pred);
                         } else {
                             load(j.predicted->p[k], bx, by, pred);
                         }
                         const bool cbf = rc.bit(m.cbf[type][ctx_cbf]);
                         has_levels = cbf;
+                        levels_before = levels_before || cbf;
                         j.mark(k, bx, by, intra || cbf);
                         if (cbf && !decode_levels(rc, m, type, levels)) return false;
                         reconstruct(j, k, bx, by, pred, cbf ? &levels : nullptr, intra, scale, lo);
