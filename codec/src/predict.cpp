@@ -148,7 +148,7 @@ void fill_row(const Reveal& r, int s, int y, int16_t* row) {
     }
 }
 
-bool usable(const Reveal* r, const SequenceParams& sp) {
+bool picture_sized(const Reveal* r, const SequenceParams& sp) {
     return r && r->depth.width == sp.width && r->depth.height == sp.height &&
            r->reference_depth.width == sp.width && r->reference_depth.height == sp.height &&
            r->revealed.width == sp.width && r->revealed.height == sp.height;
@@ -162,7 +162,7 @@ std::size_t predict_planes(const Planes& ref, const SequenceParams& sp,
     for (int k = 0; k < 3; ++k) ensure_size(out.p[k], sp.plane_width(k), sp.plane_height(k));
     const int rows = sp.plane_height(0);
     const int chroma_rows = sp.plane_height(1);
-    if (!usable(reveal, sp)) reveal = nullptr;
+    if (!picture_sized(reveal, sp)) reveal = nullptr;
     std::vector<std::size_t> revealed(std::size_t(rows), 0);
     // One pass over the luma rows; each worker also makes the chroma rows its luma rows cover,
     // after them, so that the revealed pixels of those luma rows are marked.
@@ -201,7 +201,7 @@ std::size_t predict_planes(const Planes& ref, const SequenceParams& sp,
 
 std::size_t fill_revealed(const SequenceParams& sp, ImageView<const glm::vec2> motion,
                           const Reveal& reveal, Planes& predicted) {
-    if (!usable(&reveal, sp)) return 0;
+    if (!picture_sized(&reveal, sp)) return 0;
     std::size_t total = 0;
     for (int y = 0; y < sp.height; ++y) {
         const std::size_t count = reveal_row(reveal, motion, y);
