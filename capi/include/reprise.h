@@ -38,9 +38,10 @@ extern "C" {
 /* The ABI version: a new major breaks callers built against an older one (a struct or a
  * function changed); a new minor only adds (fields at the end of structs, functions). Every
  * create takes the caller's REPRISE_ABI_VERSION: the major must equal the library's and the
- * minor be at most the library's. libreprise.so's SONAME carries the major. */
+ * minor be at most the library's. A struct_size of an older minor's struct is taken: the fields
+ * it lacks keep their defaults. libreprise.so's SONAME carries the major. */
 #define REPRISE_ABI_VERSION_MAJOR 1
-#define REPRISE_ABI_VERSION_MINOR 1
+#define REPRISE_ABI_VERSION_MINOR 2
 #define REPRISE_ABI_VERSION \
     ((uint32_t)((REPRISE_ABI_VERSION_MAJOR << 16) | REPRISE_ABI_VERSION_MINOR))
 
@@ -155,14 +156,15 @@ enum {
 };
 
 typedef struct reprise_converter_options {
-    uint32_t struct_size;   /* sizeof(reprise_converter_options) */
-    int32_t factor;         /* 2..16 (default 2) */
-    reprise_fruc_mode mode; /* default interpolate (one input frame of latency) */
-    reprise_warp warp;      /* default grid */
-    reprise_fill fill;      /* default pull-push */
-    int32_t refine;         /* optical-flow refinement of interpolation: 1 on (default), 0 off */
-    float budget_db;        /* warp or fill auto: PSNR to reach, 0 = relative (default) */
-    int32_t composite_ui;   /* 1: draw the UI layer into every output's colour (default 0) */
+    uint32_t struct_size;      /* sizeof(reprise_converter_options) */
+    int32_t factor;            /* 2..16 (default 2) */
+    reprise_fruc_mode mode;    /* default interpolate (one input frame of latency) */
+    reprise_warp warp;         /* default grid */
+    reprise_fill fill;         /* default pull-push */
+    int32_t refine;            /* optical-flow refinement of interpolation: 1 on (default), 0 off */
+    float budget_db;           /* warp or fill auto: PSNR to reach, 0 = relative (default) */
+    int32_t composite_ui;      /* 1: draw the UI layer into every output's colour (default 0) */
+    int32_t widen_silhouettes; /* 1: edge pixels go with the nearer surface (default); minor 2 */
 } reprise_converter_options;
 
 /* Sets the defaults above and struct_size. */
@@ -198,14 +200,15 @@ typedef int32_t reprise_eye;
 enum { REPRISE_EYE_LEFT = 0, REPRISE_EYE_RIGHT = 1 };
 
 typedef struct reprise_stereo_options {
-    uint32_t struct_size;     /* sizeof(reprise_stereo_options) */
-    float ipd;                /* eye separation, scene units (default 0.064) */
-    float convergence;        /* zero-disparity distance of the off-axis rig (default 10) */
-    reprise_rig rig;          /* default parallel */
-    reprise_eye rendered_eye; /* the eye the input is (default left): the other is made */
-    reprise_warp warp;        /* grid (default) or splat */
-    reprise_fill fill;        /* pull-push (default), none, Andreev or patch (not auto) */
-    int32_t temporal;         /* 1: the previous rendered frame fills holes first (default 0) */
+    uint32_t struct_size;      /* sizeof(reprise_stereo_options) */
+    float ipd;                 /* eye separation, scene units (default 0.064) */
+    float convergence;         /* zero-disparity distance of the off-axis rig (default 10) */
+    reprise_rig rig;           /* default parallel */
+    reprise_eye rendered_eye;  /* the eye the input is (default left): the other is made */
+    reprise_warp warp;         /* grid (default) or splat */
+    reprise_fill fill;         /* pull-push (default), none, Andreev or patch (not auto) */
+    int32_t temporal;          /* 1: the previous rendered frame fills holes first (default 0) */
+    int32_t widen_silhouettes; /* 1: edge pixels go with the nearer surface (default); minor 2 */
 } reprise_stereo_options;
 
 REPRISE_API reprise_status reprise_stereo_options_init(reprise_stereo_options* options,

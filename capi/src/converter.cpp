@@ -46,6 +46,7 @@ reprise_status to_fruc_options(const char* function, const reprise_converter_opt
     REPRISE_CAPI_TRY(check_flag(function, "options->refine", o.refine));
     REPRISE_CAPI_TRY(check_range(function, "options->budget_db", o.budget_db, 0.0, 100.0));
     REPRISE_CAPI_TRY(check_flag(function, "options->composite_ui", o.composite_ui));
+    REPRISE_CAPI_TRY(check_flag(function, "options->widen_silhouettes", o.widen_silhouettes));
     constexpr warp::WarpMethod warps[] = {warp::WarpMethod::Grid, warp::WarpMethod::Reverse,
                                           warp::WarpMethod::Splat, warp::WarpMethod::Auto};
     constexpr warp::FillMethod fills[] = {warp::FillMethod::PullPush, warp::FillMethod::None,
@@ -58,6 +59,7 @@ reprise_status to_fruc_options(const char* function, const reprise_converter_opt
     fruc.refine.enabled = o.refine != 0;
     fruc.auto_choice.budget_db = o.budget_db;
     fruc.composite_ui = o.composite_ui != 0;
+    fruc.widen_silhouettes = o.widen_silhouettes != 0;
     return REPRISE_OK;
 }
 
@@ -75,6 +77,7 @@ reprise_converter_options default_options() {
     o.warp = REPRISE_WARP_GRID;
     o.fill = REPRISE_FILL_PULLPUSH;
     o.refine = 1;
+    o.widen_silhouettes = 1;
     return o;
 }
 

@@ -2,6 +2,7 @@
 // What every C entry point shares: this thread's last error, the guard that keeps C++
 // exceptions from crossing the C boundary, and the checks of the ABI version and of the
 // caller's option structs.
+#include <cstddef>
 #include <cstring>
 #include <exception>
 #include <memory>
@@ -48,9 +49,20 @@ reprise_status check_abi(const char* function, uint32_t abi_version);
 // memory limit.
 void name_the_memory_setter();
 reprise_status check_pointer(const char* function, const void* pointer, const char* name);
-// Checks that a struct the caller filled has this library's struct_size.
+// Checks that a struct the caller filled has a struct_size this library takes: oldest (the
+// struct of the first minor that had it) up to its own.
 reprise_status check_struct_size(const char* function, const char* name, std::size_t given,
-                                 std::size_t expected);
+                                 std::size_t oldest, std::size_t newest);
+
+// The smallest struct_size taken for each options struct; the fields past it keep their defaults.
+template <class Options>
+inline constexpr std::size_t kOldestSize = sizeof(Options);
+template <>
+inline constexpr std::size_t kOldestSize<reprise_converter_options> =
+    offsetof(reprise_converter_options, widen_silhouettes);  // minor 2 added it
+template <>
+inline constexpr std::size_t kOldestSize<reprise_stereo_options> =
+    offsetof(reprise_stereo_options, widen_silhouettes);  // minor 2 added it
 
 // reprise_*_options_init: `defaults` with struct_size set, into the caller's struct.
 template <class Options>
@@ -58,9 +70,10 @@ reprise_status init_options(const char* function, Options* options, std::size_t 
                             Options defaults) {
     return guarded(function, [&] {
         REPRISE_CAPI_TRY(check_pointer(function, options, "options"));
-        REPRISE_CAPI_TRY(check_struct_size(function, "struct_size", struct_size, sizeof(Options)));
-        defaults.struct_size = uint32_t(sizeof(Options));
-        std::memcpy(static_cast<void*>(options), &defaults, sizeof(Options));
+        REPRISE_CAPI_TRY(check_struct_size(function, "struct_size", struct_size,
+                                           kOldestSize<Options>, sizeof(Options)));
+        defaults.struct_size = uint32_t(struct_size);
+        std::memcpy(static_cast<void*>(options), &defaults, struct_size);
         return reprise_status(REPRISE_OK);
     });
 }
@@ -76,8 +89,8 @@ reprise_status check_create(const char* function, uint32_t abi_version, const Op
     name_the_memory_setter();
     if (given) {
         REPRISE_CAPI_TRY(check_struct_size(function, "options->struct_size", given->struct_size,
-                                           sizeof(Options)));
-        options = *given;
+                                           kOldestSize<Options>, sizeof(Options)));
+        std::memcpy(static_cast<void*>(&options), given, given->struct_size);
     }
     return REPRISE_OK;
 }

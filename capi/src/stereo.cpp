@@ -30,6 +30,7 @@ reprise_stereo_options default_options() {
     o.rendered_eye = REPRISE_EYE_LEFT;
     o.warp = REPRISE_WARP_GRID;
     o.fill = REPRISE_FILL_PULLPUSH;
+    o.widen_silhouettes = 1;
     return o;
 }
 
@@ -47,6 +48,7 @@ reprise_status configure(const char* function, const reprise_stereo_options& o, 
         return fail(REPRISE_ERROR_INVALID_ARGUMENT, function,
                     "options->fill REPRISE_FILL_AUTO: the eye has no automatic fill");
     REPRISE_CAPI_TRY(check_flag(function, "options->temporal", o.temporal));
+    REPRISE_CAPI_TRY(check_flag(function, "options->widen_silhouettes", o.widen_silhouettes));
     constexpr stereo::StereoFill fills[] = {stereo::StereoFill::PullPush, stereo::StereoFill::None,
                                             stereo::StereoFill::Andreev, stereo::StereoFill::None,
                                             stereo::StereoFill::Patch};
@@ -58,6 +60,7 @@ reprise_status configure(const char* function, const reprise_stereo_options& o, 
         o.warp == REPRISE_WARP_SPLAT ? stereo::StereoWarp::Splat : stereo::StereoWarp::Grid;
     s.options.fill = fills[o.fill];
     s.temporal = o.temporal != 0;
+    s.options.widen_silhouettes = o.widen_silhouettes != 0;
     return REPRISE_OK;
 }
 

@@ -5,6 +5,7 @@
 
 #include <math.h>
 #include <pthread.h>
+#include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -345,14 +346,37 @@ static void test_abi_mismatch(void) {
     reprise_decoder* decoder = NULL;
     EXPECT_STATUS(reprise_decoder_create(REPRISE_ABI_VERSION + 1, NULL, &decoder),
                   REPRISE_ERROR_ABI_MISMATCH);
+    /* A struct from a newer reprise.h (larger) or smaller than the first minor's is refused. */
     reprise_stereo_options options;
     reprise_stereo_options_init(&options, sizeof options);
-    options.struct_size -= 4;
+    options.struct_size += 4;
     reprise_stereo* stereo = NULL;
     EXPECT_STATUS(reprise_stereo_create(REPRISE_ABI_VERSION, &options, &stereo),
                   REPRISE_ERROR_ABI_MISMATCH);
     CHECK(strstr(reprise_last_error(), "options->struct_size") != NULL, "message: %s",
           reprise_last_error());
+    options.struct_size = offsetof(reprise_stereo_options, temporal);
+    EXPECT_STATUS(reprise_stereo_create(REPRISE_ABI_VERSION, &options, &stereo),
+                  REPRISE_ERROR_ABI_MISMATCH);
+    /* A minor-1 caller's struct ends before widen_silhouettes: init writes only its bytes and
+     * create takes it. */
+    unsigned char old[sizeof(reprise_stereo_options) + 8];
+    memset(old, 0xab, sizeof old);
+    const size_t old_size = offsetof(reprise_stereo_options, widen_silhouettes);
+    EXPECT_STATUS(reprise_stereo_options_init((reprise_stereo_options*)old, old_size), REPRISE_OK);
+    CHECK(old[old_size] == 0xab && old[sizeof old - 1] == 0xab, "init wrote past struct_size");
+    EXPECT_STATUS(reprise_stereo_create(REPRISE_ABI_VERSION, (reprise_stereo_options*)old, &stereo),
+                  REPRISE_OK);
+    reprise_stereo_destroy(stereo);
+    reprise_converter_options old_converter;
+    memset(&old_converter, 0xab, sizeof old_converter);
+    EXPECT_STATUS(reprise_converter_options_init(
+                      &old_converter, offsetof(reprise_converter_options, widen_silhouettes)),
+                  REPRISE_OK);
+    reprise_converter* taken = NULL;
+    EXPECT_STATUS(reprise_converter_create(REPRISE_ABI_VERSION, &old_converter, &taken),
+                  REPRISE_OK);
+    reprise_converter_destroy(taken);
     CHECK(reprise_abi_version() == REPRISE_ABI_VERSION, "library ABI %x", reprise_abi_version());
 }
 

@@ -3,6 +3,7 @@
 // frames.
 #include <gtest/gtest.h>
 
+#include <cstddef>
 #include <cstring>
 #include <vector>
 
@@ -133,6 +134,39 @@ TEST(CapiMatchesCpp, StereoEyeIsTheSynthesizers) {
     EXPECT_TRUE(test::same_bits(want.depth, got.depth));
     EXPECT_EQ(0, std::memcmp(&eyes.right.view[0][0], out.camera.view, 64));
     reprise_stereo_destroy(s);
+}
+
+// widen_silhouettes is the synthesizer's option; a minor-1 caller's struct, which ends before
+// it, gets the default (on). The frame has a near square, whose edges the option moves.
+TEST(CapiMatchesCpp, WidenSilhouettesIsTheSynthesizersOption) {
+    Frame left = frames()[1];
+    for (int y = 16; y < 32; ++y)
+        for (int x = 20; x < 40; ++x) left.depth(x, y) = 1.5f;
+    const stereo::EyeCameras eyes = stereo::eye_cameras(left.camera, {}, stereo::Anchor::Left);
+    Frame want[2];
+    for (const bool widen : {false, true}) {
+        stereo::StereoOptions o;
+        o.widen_silhouettes = widen;
+        stereo::StereoSynthesizer().synthesize(left, eyes.right, want[widen], o);
+    }
+    ASSERT_FALSE(test::same_bits(want[0].color, want[1].color)) << "the option changes nothing";
+    const reprise_gbuffer g = gbuffer_of(left);
+    for (const int given : {0, 1, -1}) {  // -1: a minor-1 struct, without the field
+        reprise_stereo_options options;
+        const std::size_t size =
+            given < 0 ? offsetof(reprise_stereo_options, widen_silhouettes) : sizeof options;
+        ASSERT_EQ(reprise_stereo_options_init(&options, size), REPRISE_OK);
+        if (given >= 0) options.widen_silhouettes = given;
+        reprise_stereo* s = nullptr;
+        ASSERT_EQ(reprise_stereo_create(REPRISE_ABI_VERSION, &options, &s), REPRISE_OK)
+            << reprise_last_error();
+        Frame got;
+        reprise_gbuffer out = output_into(got);
+        out.motion = {};
+        ASSERT_EQ(reprise_stereo_synthesize(s, &g, &out), REPRISE_OK) << reprise_last_error();
+        EXPECT_TRUE(test::same_bits(want[given != 0].color, got.color)) << "given " << given;
+        reprise_stereo_destroy(s);
+    }
 }
 
 // The C encoder's packet for `frame`, received into a buffer of `capacity` bytes.
