@@ -2,6 +2,7 @@
 // scenes; lossless depth; what a still scene costs; loss recovery; hostile packets; extremes.
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cstring>
 #include <random>
 
@@ -212,6 +213,43 @@ TEST(Codec, SimdAndScalarLevelsCodeTheSameStream) {
         EXPECT_TRUE(same_frame(decoded_portable[i], best.reconstructions[i])) << "frame " << i;
         EXPECT_TRUE(same_frame(decoded_best[i], portable.reconstructions[i])) << "frame " << i;
     }
+}
+
+// Where the time goes (StreamStats::ms): every stage an inter frame runs is counted on both
+// sides, the decoder's counts none of the encoder's own stages, and the stages add up to no more
+// than the calls took.
+TEST(Codec, EveryStagesTimeIsCountedAndTheyAddUpToTheCalls) {
+    const auto frames = render("crossing", 3, 160, 96);
+    Encoder encoder;
+    Decoder decoder;
+    double encode_ms = 0.0, decode_ms = 0.0;
+    using Clock = std::chrono::steady_clock;
+    auto ms_since = [](Clock::time_point t) {
+        return std::chrono::duration<double, std::milli>(Clock::now() - t).count();
+    };
+    for (const Frame& f : frames) {
+        Packet packet;
+        DecodedFrame decoded;
+        auto start = Clock::now();
+        ASSERT_TRUE(encoder.send_frame(f).ok());
+        ASSERT_EQ(encoder.receive_packet(packet), Result::Ok);
+        encode_ms += ms_since(start);
+        start = Clock::now();
+        ASSERT_TRUE(decoder.send_packet(packet.data).ok());
+        ASSERT_EQ(decoder.receive_frame(decoded), Result::Ok);
+        decode_ms += ms_since(start);
+    }
+    const StreamStats::Milliseconds& e = encoder.stats().ms;
+    const StreamStats::Milliseconds& d = decoder.stats().ms;
+    for (double t :
+         {e.input, e.convert, e.objects, e.reproject, e.depth, e.motion, e.predict, e.color})
+        EXPECT_GT(t, 0.0);
+    for (double t : {d.convert, d.reproject, d.depth, d.motion, d.predict, d.color})
+        EXPECT_GT(t, 0.0);
+    EXPECT_EQ(d.input, 0.0);
+    EXPECT_EQ(d.objects, 0.0);
+    EXPECT_LE(e.total(), encode_ms);
+    EXPECT_LE(d.total(), decode_ms);
 }
 
 // 4:2:0 halves chroma resolution: on a 160x96 render the cap is 32.5 dB even at qp 0 (43 dB at

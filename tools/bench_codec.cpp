@@ -187,7 +187,9 @@ Status run_peer(const Sequence& seq, const PeerConfig& config, RunResult& run,
 // `color` gets the same frames counted with their colour bits only; `depth_bits` the depth
 // stream's bits per frame.
 Status run_ours(const Sequence& seq, int qp, bool default_stream, RunResult& total,
-                RunResult& color, std::vector<double>* depth_bits) {
+                RunResult& color, std::vector<double>* depth_bits,
+                codec::StreamStats* encoder_stats = nullptr,
+                codec::StreamStats* decoder_stats = nullptr) {
     const std::string setting = "qp " + std::to_string(qp);
     const char* name = default_stream ? kOursStream : kOurs;
     total = {name, setting, name, {}};
@@ -226,6 +228,8 @@ Status run_ours(const Sequence& seq, int qp, bool default_stream, RunResult& tot
         color.samples.push_back(s);
         if (depth_bits) depth_bits->push_back(double(stats.depth_bits));
     }
+    if (encoder_stats) *encoder_stats = encoder.stats();
+    if (decoder_stats) *decoder_stats = decoder.stats();
     return {};
 }
 
@@ -480,6 +484,8 @@ struct SpeedResult {
     double ours_encode_warm = NAN, ours_decode_warm = NAN;
     double x264_veryfast_encode_warm = NAN, x264_veryfast_decode_warm = NAN;
     double x264_ultrafast_encode_warm = NAN;
+    // The default stream's coders over all frames: their stages' milliseconds.
+    codec::StreamStats encoder_stats, decoder_stats;
 };
 
 Status measure_speed(server::Renderer& renderer, const BenchOptions& job, int threads, int mid_qp,
@@ -513,7 +519,8 @@ Status measure_speed(server::Renderer& renderer, const BenchOptions& job, int th
     REPRISE_TRY(run_ours(seq, mid_qp, false, run, color, nullptr));
     speed.lossless_encode = run.mean(&Sample::encode_ms);
     speed.lossless_decode = run.mean(&Sample::decode_ms);
-    REPRISE_TRY(run_ours(seq, mid_qp, true, run, color, nullptr));
+    REPRISE_TRY(run_ours(seq, mid_qp, true, run, color, nullptr, &speed.encoder_stats,
+                         &speed.decoder_stats));
     speed.ours_encode = run.mean(&Sample::encode_ms);
     speed.ours_decode = run.mean(&Sample::decode_ms);
     speed.ours_encode_warm = run.mean(&Sample::encode_ms, warm);
@@ -802,6 +809,18 @@ Report codec_report(const BenchOptions& job, int w, int h) {
 }
 
 // The speed run at 1080p (when --speed-frames > 0): its CSV rows and its text.
+// One coder's stages, mean ms per frame; "other" is what the stages leave of `whole_ms`
+// (packet framing, the decoder's frame hand-out, the bench's own calls).
+std::string stage_line(const char* coder, const codec::StreamStats& stats, double whole_ms) {
+    const codec::StreamStats::Milliseconds& t = stats.ms;
+    const double n = double(std::max<std::size_t>(stats.frames, 1));
+    return strf(
+        "    %s: input %.1f, colour conversion %.1f, objects %.1f, depth reprojection %.1f, "
+        "depth %.1f, motion %.1f, colour prediction %.1f, colour %.1f, other %.1f\n",
+        coder, t.input / n, t.convert / n, t.objects / n, t.reproject / n, t.depth / n,
+        t.motion / n, t.predict / n, t.color / n, whole_ms - t.total() / n);
+}
+
 Status speed_run(server::Renderer& renderer, const BenchOptions& job, int qp, CsvFile& speed_csv,
                  SpeedResult& speed, std::string& speed_text) {
     if (job.speed_frames > 0) {
@@ -849,6 +868,9 @@ Status speed_run(server::Renderer& renderer, const BenchOptions& job, int qp, Cs
                 speed.x264_veryfast_encode_warm / speed.ours_encode_warm,
                 speed.x264_ultrafast_encode_warm / speed.ours_encode_warm,
                 speed.ours_encode_warm / speed.ours_decode_warm);
+        speed_text += "  where reprise's milliseconds go (mean per frame):\n" +
+                      stage_line("encode", speed.encoder_stats, speed.ours_encode) +
+                      stage_line("decode", speed.decoder_stats, speed.ours_decode);
     }
     return {};
 }

@@ -505,6 +505,7 @@ std::vector<SliceJob> slice_jobs(const Geometry& g, const Planes* source, const 
 // Inter prediction, revealed pixels filled from the surface beside them.
 void predict(const FrameContext& fc, ImageView<const float> depth,
              ImageView<const glm::vec2> motion, Planes& predicted, StreamStats& stats) {
+    const StageTimer timer(stats.ms.predict);
     const SequenceParams& sp = *fc.sp;
     Reveal reveal{.depth = depth, .reference_depth = fc.reference->depth.view()};
     if (!depth.empty()) {
@@ -531,6 +532,7 @@ ColorEncodeResult encode_color(const FrameContext& fc, const Planes& source,
     prepare(sp, out, *fc.work);
     Planes& predicted = fc.work->predicted;
     if (!fc.key) predict(fc, depth, motion, predicted, stats);
+    const StageTimer timer(stats.ms.color);
     const std::size_t start = bytes.size();
     ByteWriter w(bytes);
     w.u8(uint8_t(qp));
@@ -581,6 +583,7 @@ Status decode_color(const FrameContext& fc, ImageView<const float> depth,
         return Status::error("colour section: a key frame cannot skip its blocks");
     Planes& predicted = fc.work->predicted;
     if (!fc.key) predict(fc, depth, motion, predicted, stats);
+    const StageTimer timer(stats.ms.color);
     const std::size_t blocks =
         std::size_t(sp.mb_cols()) * sp.mb_rows() * (4 + 2 * (sp.chroma == Chroma::C420 ? 1 : 4));
     if (flags & kAllSkipped) {

@@ -84,10 +84,13 @@ Status Decoder::send_packet(std::span<const uint8_t> packet) {
     fs.motion_bits += 8 * object_bytes;
     fs.motion_objects = objects.size();
     REPRISE_TRY(decode_depth(fc, camera, sections[1], pic.depth, fs));
-    REPRISE_TRY(
-        decode_motion(fc, camera, pic.depth.view(), sections[2], pic.motion, pic.owner, fs));
-    const ImageView<const glm::vec2> motion =
-        motion_to_reference(sp, camera, pic.depth, pic.motion, ref, h.frame, s.work);
+    ImageView<const glm::vec2> motion;
+    {
+        const StageTimer timer(fs.ms.motion);
+        REPRISE_TRY(
+            decode_motion(fc, camera, pic.depth.view(), sections[2], pic.motion, pic.owner, fs));
+        motion = motion_to_reference(sp, camera, pic.depth, pic.motion, ref, h.frame, s.work);
+    }
     fs.older_reference = ref && ref->frame + 1 != h.frame;
     REPRISE_TRY(decode_color(fc, pic.depth.view(), motion, sections[3], pic.planes, fs));
     fs.camera_bits += 8 * (sections[0].size() - object_bytes);
@@ -112,18 +115,21 @@ Status Decoder::send_packet(std::span<const uint8_t> packet) {
     if (s.scratch.use_count() > 1) s.scratch = std::make_shared<Picture>();
     s.have_newest = true;
     s.newest = h.frame;
-    add_stats(s.stats, fs);
 
     State::Output out{.picture = s.refs[slot], .fps = s.sp.fps};
     if (!s.spare.empty()) {
         out.color = std::move(s.spare.back());
         s.spare.pop_back();
     }
-    if (s.options.color)
-        linear_from_planes(out.picture->planes, s.sp, out.picture->depth.view(), out.color);
-    else
-        out.color.clear();
+    {
+        const StageTimer timer(fs.ms.convert);
+        if (s.options.color)
+            linear_from_planes(out.picture->planes, s.sp, out.picture->depth.view(), out.color);
+        else
+            out.color.clear();
+    }
     s.queue.push_back(std::move(out));
+    add_stats(s.stats, fs);
     return {};
 }
 

@@ -572,7 +572,11 @@ void encode_depth(const FrameContext& fc, const Camera& camera, ImageView<const 
     Image<uint32_t>& residuals = fc.work->depth_residuals;
     ensure_size(codes, w, h);
     ensure_size(residuals, w, h);
-    temporal_codes(fc, camera, map, temporal);
+    {
+        const StageTimer timer(stats.ms.reproject);
+        temporal_codes(fc, camera, map, temporal);
+    }
+    const StageTimer timer(stats.ms.depth);
     if (!map.view)
         parallel_for(0, h, [&](int y0, int y1) {
             for (int y = y0; y < y1; ++y)
@@ -637,7 +641,11 @@ Status decode_depth(const FrameContext& fc, const Camera& camera, std::span<cons
     Image<uint32_t>& residuals = fc.work->depth_residuals;
     ensure_size(codes, w, h);
     ensure_size(residuals, w, h);
-    temporal_codes(fc, camera, map, temporal);
+    {
+        const StageTimer timer(stats.ms.reproject);
+        temporal_codes(fc, camera, map, temporal);
+    }
+    const StageTimer timer(stats.ms.depth);
     if (flags & kAllPredicted) {
         if (temporal.empty())
             return Status::error("depth section: predicted from a reference on a key frame");

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <deque>
+#include <optional>
 #include <set>
 
 #include <glm/geometric.hpp>
@@ -181,25 +182,31 @@ struct Encoder::State {
         if (key) write_params(sp, payload);
 
         std::vector<uint8_t> depth_section, motion_section;
-        std::vector<ObjectMotion> objects = fit_objects(frame, camera, ref);
-        fc.objects = objects;
-        if (sp.depth == DepthMode::View) fc.view_step = frame_view_step(sp, camera, objects);
+        std::vector<ObjectMotion> objects;
+        {
+            const StageTimer timer(fs.ms.objects);
+            objects = fit_objects(frame, camera, ref);
+            fc.objects = objects;
+            if (sp.depth == DepthMode::View) fc.view_step = frame_view_step(sp, camera, objects);
+        }
         encode_depth(fc, camera, frame.depth, pic.depth, depth_section, fs);
-        encode_motion(fc, camera, pic.depth.view(), frame.motion, frame.id, pic.motion, pic.owner,
-                      motion_section, fs);
-        pic.objects = objects;
-
         std::vector<uint8_t> section;
-        const std::size_t object_bytes = encode_camera(camera, camera.time, ref, objects, section);
-        fs.camera_bits += 8 * (section.size() - object_bytes);
-        fs.motion_bits += 8 * object_bytes;
-        fs.motion_objects = objects.size();
-        append_section(payload, section);
-        append_section(payload, depth_section);
-        append_section(payload, motion_section);
-
-        const ImageView<const glm::vec2> motion =
-            motion_to_reference(sp, camera, pic.depth, pic.motion, ref, next_frame, work);
+        ImageView<const glm::vec2> motion;
+        {
+            const StageTimer timer(fs.ms.motion);
+            encode_motion(fc, camera, pic.depth.view(), frame.motion, frame.id, pic.motion,
+                          pic.owner, motion_section, fs);
+            pic.objects = objects;
+            const std::size_t object_bytes =
+                encode_camera(camera, camera.time, ref, objects, section);
+            fs.camera_bits += 8 * (section.size() - object_bytes);
+            fs.motion_bits += 8 * object_bytes;
+            fs.motion_objects = objects.size();
+            append_section(payload, section);
+            append_section(payload, depth_section);
+            append_section(payload, motion_section);
+            motion = motion_to_reference(sp, camera, pic.depth, pic.motion, ref, next_frame, work);
+        }
         section.clear();
         color = encode_color(fc, source_planes, pic.depth.view(), motion, qp_now,
                              options.skip_threshold, pic.planes, section, fs);
@@ -287,11 +294,14 @@ Status Encoder::send_frame(const GBufferView& given) {
     // The codec codes no normals: they are neither scanned nor repaired.
     GBufferView coded = given;
     coded.normal = {};
+    StreamStats::Milliseconds ms;
     NonfiniteCounts nonfinite;
-    const GBufferView frame = s.repair.clean(coded, nonfinite);
     State::Chain next_chain;
     StreamStats fitted;
+    std::optional<StageTimer> timer(ms.input);
+    const GBufferView frame = s.repair.clean(coded, nonfinite);
     const Camera camera = s.camera_for(frame, next_chain, fitted);
+    timer.reset();
 
     SequenceParams sp;
     sp.width = w;
@@ -322,7 +332,9 @@ Status Encoder::send_frame(const GBufferView& given) {
     }
     s.sp = sp;
 
+    timer.emplace(ms.convert);
     planes_from_linear(frame.color, sp, s.source_planes);
+    timer.reset();
     // A cut the frame's camera reports starts a key frame; one it does not say is detected below.
     int ref = frame.camera.cut == Cut::Yes ? -1 : s.choose_reference();
     const bool detect_cut = s.options.detect_cuts && frame.camera.cut == Cut::Unknown;
@@ -334,7 +346,7 @@ Status Encoder::send_frame(const GBufferView& given) {
     std::vector<uint8_t> payload;
     StreamStats fs;
     for (int attempt = 0;; ++attempt) {
-        fs = {};
+        fs = {.ms = fs.ms};  // a frame coded again (a cut, rate control) counts every try's time
         ColorEncodeResult color;
         const int qp_now = std::clamp(ref < 0 ? qp - 3 : qp, 0, 51);
         REPRISE_TRY(s.encode(frame, camera, ref, qp_now, pic, payload, fs, color));
@@ -396,6 +408,8 @@ Status Encoder::send_frame(const GBufferView& given) {
     fs.frames = 1;
     fs.cameras_fitted = fitted.cameras_fitted;
     fs.nonfinite = nonfinite;
+    fs.ms.input += ms.input;
+    fs.ms.convert += ms.convert;
     s.last = fs;
     add_stats(s.stats, fs);
     s.recon_ready = false;

@@ -1,5 +1,6 @@
 #pragma once
 // What encoder and decoder share: stream parameters, the reference picture, per-stage entry points.
+#include <chrono>
 #include <cstdint>
 #include <string>
 #include <vector>
@@ -86,6 +87,22 @@ Status read_params(ByteReader& r, SequenceParams& sp);
 int default_slices(int height);
 
 struct Workspace;
+
+// Adds the milliseconds from its making to its end to `into` (StreamStats::ms).
+class StageTimer {
+public:
+    explicit StageTimer(double& into) : into_(into) {}
+    ~StageTimer() {
+        into_ += std::chrono::duration<double, std::milli>(Clock::now() - start_).count();
+    }
+    StageTimer(const StageTimer&) = delete;
+    StageTimer& operator=(const StageTimer&) = delete;
+
+private:
+    using Clock = std::chrono::steady_clock;
+    double& into_;
+    Clock::time_point start_ = Clock::now();
+};
 
 // Held pictures: values in the encoder, shared with the frames handed out in the decoder.
 inline const Picture& held(const Picture& p) { return p; }

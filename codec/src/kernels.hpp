@@ -33,6 +33,25 @@ void predict_row(const PredictRow& row);
 
 // Catmull-Rom weights per 1/64 phase, in 1/128, summing to 128 ([phase][tap]).
 const int32_t (&catmull_rom_weights())[64][4];
+// The same, one word per phase: tap i's weight + kPackedWeightBias in byte i (weights lie in
+// -9..128), so that one gather fetches a lane's four taps.
+inline constexpr int32_t kPackedWeightBias = 16;
+const uint32_t (&catmull_rom_packed())[64];
+
+// Revealed luma pixels of one row (predict.cpp): a pixel whose landing floor(p + 0.5 + m) lies
+// inside the picture (never with NaN or infinite motion) and whose reference depth there is more
+// than 4 % off its own, either way (NaN compares false: not revealed).
+struct RevealRow {
+    const float* depth;            // the row's decoded depth
+    const glm::vec2* motion;       // the row's motion to the reference
+    const float* reference_depth;  // the reference's whole depth picture, width x height
+    int width, height, y;
+    int reference_stride;  // of reference_depth's rows, in floats
+    uint8_t* out;          // 1: revealed, 0: not
+};
+// Both return how many of their pixels are revealed.
+std::size_t reveal_row_reference(const RevealRow& row, int x_begin, int x_end);
+std::size_t reveal_row(const RevealRow& row);
 
 // Camera motion of one row (geometry.cpp, camera_motion): under perspective a pixel's clip
 // position in the other camera is (a0 + x a1) + z (b0 + x b1) for finite depth z >= 0; other

@@ -85,6 +85,22 @@ const int32_t (&catmull_rom_weights())[64][4] {
     return table.w;
 }
 
+const uint32_t (&catmull_rom_packed())[64] {
+    struct Packed {
+        uint32_t words[kPhases] = {};
+        Packed() {
+            for (int p = 0; p < kPhases; ++p)
+                for (int i = 0; i < 4; ++i) {
+                    const int32_t biased = catmull_rom_weights()[p][i] + kPackedWeightBias;
+                    REPRISE_ASSERT(biased >= 0 && biased < 256);
+                    words[p] |= uint32_t(biased) << (8 * i);
+                }
+        }
+    };
+    static const Packed table;
+    return table.words;
+}
+
 void predict_row_reference(const PredictRow& r, int x_begin, int x_end) {
     const int last = r.motion_width - 1;
     const float cy = float(r.y) + 0.5f;
@@ -103,23 +119,34 @@ void predict_row_reference(const PredictRow& r, int x_begin, int x_end) {
     }
 }
 
+std::size_t reveal_row_reference(const RevealRow& r, int x_begin, int x_end) {
+    const int w = r.width, h = r.height, y = r.y;
+    std::size_t count = 0;
+    for (int x = x_begin; x < x_end; ++x) {
+        // Inside the picture (never with NaN or infinite motion), truncation is the floor.
+        const glm::vec2 m = r.motion[x];
+        const float fx = float(x) + 0.5f + m.x, fy = float(y) + 0.5f + m.y;
+        const bool inside = fx >= 0.0f && fy >= 0.0f && fx < float(w) && fy < float(h);
+        r.out[x] = inside &&
+                   !seen(r.depth[x], r.reference_depth[std::size_t(int(fy)) * r.reference_stride +
+                                                       std::size_t(int(fx))]);
+        count += r.out[x];
+    }
+    return count;
+}
+
 namespace {
 
 // Marks row y's revealed luma pixels; returns how many.
-std::size_t reveal_row(const Reveal& r, ImageView<const glm::vec2> motion, int y) {
-    const int w = r.depth.width, h = r.depth.height;
-    const float* d = r.depth.row(y);
-    const glm::vec2* m = motion.row(y);
-    uint8_t* out = r.revealed.row(y);
-    std::size_t count = 0;
-    for (int x = 0; x < w; ++x) {
-        // Inside the picture (never with NaN or infinite motion), truncation is the floor.
-        const float fx = float(x) + 0.5f + m[x].x, fy = float(y) + 0.5f + m[x].y;
-        const bool inside = fx >= 0.0f && fy >= 0.0f && fx < float(w) && fy < float(h);
-        out[x] = inside && !seen(d[x], r.reference_depth.row(int(fy))[int(fx)]);
-        count += out[x];
-    }
-    return count;
+std::size_t mark_revealed(const Reveal& r, ImageView<const glm::vec2> motion, int y) {
+    return reveal_row({.depth = r.depth.row(y),
+                       .motion = motion.row(y),
+                       .reference_depth = r.reference_depth.data,
+                       .width = r.depth.width,
+                       .height = r.depth.height,
+                       .y = y,
+                       .reference_stride = int(r.reference_depth.stride),
+                       .out = r.revealed.row(y)});
 }
 
 // Row y of a plane with subsampling shift s: its revealed samples take their sources'.
@@ -189,7 +216,7 @@ std::size_t predict_planes(const Planes& ref, const SequenceParams& sp,
                     };
                     predict_row(row);
                     if (!reveal || (y << sub) >= h) continue;
-                    if (k == 0) revealed[std::size_t(y)] = reveal_row(*reveal, motion, y);
+                    if (k == 0) revealed[std::size_t(y)] = mark_revealed(*reveal, motion, y);
                     if (revealed[std::size_t(y << sub)]) fill_row(*reveal, sub, y, row.out);
                 }
             }
@@ -204,7 +231,7 @@ std::size_t fill_revealed(const SequenceParams& sp, ImageView<const glm::vec2> m
     if (!picture_sized(&reveal, sp)) return 0;
     std::size_t total = 0;
     for (int y = 0; y < sp.height; ++y) {
-        const std::size_t count = reveal_row(reveal, motion, y);
+        const std::size_t count = mark_revealed(reveal, motion, y);
         total += count;
         if (!count) continue;
         for (int k = 0; k < 3; ++k) {

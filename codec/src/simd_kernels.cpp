@@ -39,7 +39,7 @@ void PredictRowSimd(const PredictRow& r) {
     const VI w_minus2 = hn::Set(di, r.width - 2), h_minus2 = hn::Set(di, r.height - 2);
     const VI stride = hn::Set(di, r.width), round = hn::Set(di, 1 << 13);
     const VI lo = hn::Set(di, r.lo), hi = hn::Set(di, r.hi), zero_i = hn::Zero(di);
-    const int32_t* weights = &catmull_rom_weights()[0][0];
+    const int32_t* weights = reinterpret_cast<const int32_t*>(&catmull_rom_packed()[0]);
     const int32_t* base = reinterpret_cast<const int32_t*>(r.reference);
 
     auto usable = [&](VF& mx, VF& my) {  // non-finite motion counts as 0
@@ -79,12 +79,18 @@ void PredictRowSimd(const PredictRow& r) {
             continue;
         }
         const VI px = hn::And(qx, mask63), py = hn::And(qy, mask63);
-        const VI px4 = hn::ShiftLeft<2>(px), py4 = hn::ShiftLeft<2>(py);
-        VI wx[4], wy[4];
-        for (int i = 0; i < 4; ++i) {
-            wx[i] = hn::GatherIndex(di, weights, px4 + hn::Set(di, i));
-            wy[i] = hn::GatherIndex(di, weights, py4 + hn::Set(di, i));
-        }
+        // One gather per axis fetches a lane's four taps, a biased byte each.
+        const VI packed_x = hn::GatherIndex(di, weights, px);
+        const VI packed_y = hn::GatherIndex(di, weights, py);
+        const VI byte = hn::Set(di, 255), bias = hn::Set(di, kPackedWeightBias);
+        const VI wx[4] = {hn::And(packed_x, byte) - bias,
+                          hn::And(hn::ShiftRight<8>(packed_x), byte) - bias,
+                          hn::And(hn::ShiftRight<16>(packed_x), byte) - bias,
+                          hn::And(hn::ShiftRight<24>(packed_x), byte) - bias};
+        const VI wy[4] = {hn::And(packed_y, byte) - bias,
+                          hn::And(hn::ShiftRight<8>(packed_y), byte) - bias,
+                          hn::And(hn::ShiftRight<16>(packed_y), byte) - bias,
+                          hn::And(hn::ShiftRight<24>(packed_y), byte) - bias};
         VI sum = zero_i;
         const int ix0 = hn::GetLane(ix), iy0 = hn::GetLane(iy);
         if (hn::AllTrue(di, hn::And(ix == hn::Iota(di, ix0), iy == hn::Set(di, iy0)))) {
@@ -377,6 +383,39 @@ void PlaneRowSimd(const PlaneRow& r) {
     plane_row_reference(r, x, w);
 }
 
+std::size_t RevealRowSimd(const RevealRow& r) {
+    const hn::ScalableTag<float> df;
+    const hn::RebindToSigned<decltype(df)> di;
+    const hn::Rebind<uint8_t, decltype(df)> d8;
+    using VF = hn::Vec<decltype(df)>;
+    using VI = hn::Vec<decltype(di)>;
+    const int n = int(hn::Lanes(df));
+    const VF zero = hn::Zero(df), half = hn::Set(df, 0.5f), margin = hn::Set(df, 1.04f);
+    const VF width = hn::Set(df, float(r.width)), height = hn::Set(df, float(r.height));
+    const VF fy_base = hn::Set(df, float(r.y) + 0.5f);
+    const VI stride = hn::Set(di, r.reference_stride), one = hn::Set(di, 1);
+    std::size_t count = 0;
+    int x = 0;
+    for (; x + n <= r.width; x += n) {
+        VF mx, my;
+        hn::LoadInterleaved2(df, &r.motion[x].x, mx, my);
+        const VF fx = (hn::Iota(df, float(x)) + half) + mx, fy = fy_base + my;
+        const auto inside =
+            hn::And(hn::And(fx >= zero, fy >= zero), hn::And(fx < width, fy < height));
+        // Lanes outside read pixel 0 and are masked out below.
+        const VI at = hn::IfThenElseZero(hn::RebindMask(di, inside),
+                                         hn::ConvertTo(di, fy) * stride + hn::ConvertTo(di, fx));
+        const VF landing = hn::GatherIndex(df, r.reference_depth, at);
+        const VF depth = hn::LoadU(df, r.depth + x);
+        const auto seen = hn::Not(hn::Or(landing * margin < depth, depth * margin < landing));
+        const auto revealed = hn::AndNot(seen, inside);
+        count += hn::CountTrue(df, revealed);
+        const VI flag = hn::IfThenElseZero(hn::RebindMask(di, revealed), one);
+        hn::StoreU(hn::DemoteTo(d8, flag), d8, r.out + x);
+    }
+    return count + reveal_row_reference(r, x, r.width);
+}
+
 bool MotionResidualRowSimd(const MotionResidualRow& r) {
     const hn::ScalableTag<float> df;
     using VF = hn::Vec<decltype(df)>;
@@ -452,6 +491,7 @@ HWY_EXPORT(ForwardRowSimd);
 HWY_EXPORT(MotionResidualRowSimd);
 HWY_EXPORT(ViewKeepRowSimd);
 HWY_EXPORT(PlaneRowSimd);
+HWY_EXPORT(RevealRowSimd);
 
 void view_keep_row(const ViewKeepRow& row) { HWY_DYNAMIC_DISPATCH(ViewKeepRowSimd)(row); }
 
@@ -460,6 +500,8 @@ bool motion_residual_row(const MotionResidualRow& row) {
 }
 
 void plane_row(const PlaneRow& row) { HWY_DYNAMIC_DISPATCH(PlaneRowSimd)(row); }
+
+std::size_t reveal_row(const RevealRow& row) { return HWY_DYNAMIC_DISPATCH(RevealRowSimd)(row); }
 
 void forward_row(const ForwardRow& row) { HWY_DYNAMIC_DISPATCH(ForwardRowSimd)(row); }
 

@@ -23,6 +23,14 @@ void add_stats(StreamStats& total, const StreamStats& f) {
     total.depth_zero_blocks += f.depth_zero_blocks;
     total.revealed_pixels += f.revealed_pixels;
     total.cameras_fitted += f.cameras_fitted;
+    total.ms.input += f.ms.input;
+    total.ms.convert += f.ms.convert;
+    total.ms.objects += f.ms.objects;
+    total.ms.reproject += f.ms.reproject;
+    total.ms.depth += f.ms.depth;
+    total.ms.motion += f.ms.motion;
+    total.ms.predict += f.ms.predict;
+    total.ms.color += f.ms.color;
 }
 
 }  // namespace reprise::codec

@@ -73,6 +73,16 @@ py::dict stats_dict(const codec::StreamStats& s) {
     d["motion_models"] = s.motion_models;
     d["motion_own_pixels"] = s.motion_own_pixels;
     d["cameras_fitted"] = s.cameras_fitted;
+    py::dict ms;  // milliseconds by stage, summed over the frames
+    ms["input"] = s.ms.input;
+    ms["convert"] = s.ms.convert;
+    ms["objects"] = s.ms.objects;
+    ms["reproject"] = s.ms.reproject;
+    ms["depth"] = s.ms.depth;
+    ms["motion"] = s.ms.motion;
+    ms["predict"] = s.ms.predict;
+    ms["color"] = s.ms.color;
+    d["ms"] = ms;
     return d;
 }
 

@@ -84,6 +84,81 @@ private:
     std::vector<int16_t> reference_, optimized_;
 };
 
+// Revealed pixels of each row. Random: depth with a near band the motion moves by 3-12 px (its
+// uncovered strip is revealed), landings inside and outside the picture; worst case: NaN/Inf depth
+// and motion, huge motion, zero and negative depth.
+class RevealCase final : public KernelCase {
+public:
+    void generate(int w, int h, KernelInputs inputs, uint32_t seed) override {
+        std::mt19937 rng(seed);
+        width_ = w, height_ = h;
+        const bool worst = inputs == KernelInputs::WorstCase;
+        random_ = !worst;
+        const std::size_t n = std::size_t(w) * h;
+        depth_.resize(n), reference_depth_.resize(n), motion_.resize(n);
+        const glm::vec2 pan{uniform(rng, 3, 12), uniform(rng, -2, 2)};
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                const std::size_t i = std::size_t(y) * w + x;
+                const bool near = x > w / 3 && x < w / 2;
+                depth_[i] = near ? 2.0f : uniform(rng, 9.5f, 10.5f);
+                reference_depth_[i] = (x + int(pan.x)) > w / 3 && (x + int(pan.x)) < w / 2
+                                          ? 2.0f
+                                          : uniform(rng, 9.0f, 11.0f);
+                motion_[i] = near ? glm::vec2(0.0f) : pan + glm::vec2(uniform(rng, -0.5f, 0.5f));
+                if (worst && rng() % 3 == 0) {
+                    const int what = int(rng() % 3);
+                    if (what == 0) motion_[i][int(rng() % 2)] = worst_value(rng);
+                    if (what == 1) depth_[i] = worst_value(rng);
+                    if (what == 2) reference_depth_[i] = worst_value(rng);
+                }
+            }
+    }
+    void run_reference() override {
+        run_into(reference_,
+                 [](const RevealRow& r) { return reveal_row_reference(r, 0, r.width); });
+    }
+    void run() override {
+        run_into(optimized_, [](const RevealRow& r) { return reveal_row(r); });
+    }
+    std::string compare() const override {
+        if (random_ && width_ >= 32 && counts_[0] == 0)
+            return "no pixel revealed: the case tests nothing";
+        if (counts_[0] != counts_[1])
+            return "revealed counts " + std::to_string(counts_[1]) + " against the reference's " +
+                   std::to_string(counts_[0]);
+        return compare_elements("revealed", optimized_, reference_);
+    }
+
+private:
+    template <class Kernel>
+    void run_into(std::vector<uint8_t>& out, Kernel kernel) {
+        out.assign(depth_.size(), 7);
+        std::vector<std::size_t> rows(std::size_t(height_), 0);
+        parallel_for(0, height_, [&](int y0, int y1) {
+            for (int y = y0; y < y1; ++y)
+                rows[std::size_t(y)] = kernel({.depth = depth_.data() + std::size_t(y) * width_,
+                                               .motion = motion_.data() + std::size_t(y) * width_,
+                                               .reference_depth = reference_depth_.data(),
+                                               .width = width_,
+                                               .height = height_,
+                                               .y = y,
+                                               .reference_stride = width_,
+                                               .out = out.data() + std::size_t(y) * width_});
+        });
+        std::size_t total = 0;
+        for (std::size_t c : rows) total += c;
+        counts_[&out == &optimized_] = total;
+    }
+
+    int width_ = 0, height_ = 0;
+    bool random_ = true;
+    std::vector<float> depth_, reference_depth_;
+    std::vector<glm::vec2> motion_;
+    std::vector<uint8_t> reference_, optimized_;
+    std::size_t counts_[2] = {0, 0};
+};
+
 // Camera motion of each row. Random: depths of a scene in front of both cameras with some
 // background; worst case: NaN/Inf/negative/signed-zero depths, points behind the other camera,
 // an orthographic row.
@@ -532,6 +607,7 @@ private:
 constexpr KernelEntry kEntries[] = {
     {"codec prediction, luma", "bit-exact", true, make<PredictCase, false>},
     {"codec prediction, 4:2:0 chroma", "bit-exact", true, make<PredictCase, true>},
+    {"codec revealed pixels", "bit-exact", true, make<RevealCase>},
     {"codec camera motion", "bit-exact", true, make<CameraMotionCase>},
     {"codec depth forward projection", "bit-exact", true, make<ForwardCase>},
     {"codec depth plane fit", "bit-exact", true, make<PlaneCase>},

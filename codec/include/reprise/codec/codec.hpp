@@ -92,6 +92,20 @@ struct StreamStats {
     // Encoder input: NaN/Inf repaired before coding (colour: holes; depth NaN/-inf and motion:
     // unknown; reprise/core/nonfinite.hpp).
     NonfiniteCounts nonfinite;
+    // Wall-clock milliseconds by stage, on the coder's threads: where the time goes.
+    struct Milliseconds {
+        double input = 0.0;      // encoder: NaN/Inf repair and the camera fit
+        double convert = 0.0;    // colour between linear RGB and the coded planes
+        double objects = 0.0;    // encoder: rigid object motions fitted
+        double reproject = 0.0;  // the reference's depth reprojected (depth's prediction)
+        double depth = 0.0;      // depth predicted and coded, without the reprojection
+        double motion = 0.0;     // motion coded, then turned into motion to the reference
+        double predict = 0.0;    // colour predicted from the reference (revealed pixels filled)
+        double color = 0.0;      // colour transformed, coded and deblocked, without prediction
+        double total() const {
+            return input + convert + objects + reproject + depth + motion + predict + color;
+        }
+    } ms;
     std::size_t total_bits() const {
         return header_bits + camera_bits + depth_bits + motion_bits + color_bits;
     }
