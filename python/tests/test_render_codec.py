@@ -68,6 +68,10 @@ def test_codec_round_trip(pan_60):
         assert np.array_equal(exact.decode(lossless.encode(frame)).depth, frame.depth)
     assert encoder.stats["frames"] == 3 and encoder.stats["key_frames"] == 1
     assert encoder.stats["depth_bits"] < 0.25 * lossless.stats["depth_bits"]
+    # Milliseconds by stage: the inter frames' shared stages ran on both sides.
+    for stats in (encoder.stats, decoder.stats):
+        assert stats["ms"]["reproject"] > 0 and stats["ms"]["predict"] > 0, stats["ms"]
+    assert decoder.stats["ms"]["objects"] == 0
 
 
 def test_codec_streams_and_bad_packets(pan_60):
