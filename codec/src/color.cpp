@@ -22,16 +22,20 @@ inline void chroma_taps(int x, int size, int& near, int& other) {
 }  // namespace
 
 // The display code of a linear value: a table over 4096 steps of [0, 1] gives the code at the
-// step's start; the thresholds then move it up (at most two steps: the curve is steepest at 0).
+// step's start; the thresholds then move it up (at most one code: the curve is steepest at 0).
 const SrgbTables& srgb_tables() {
     static const SrgbTables tables = [] {
         SrgbTables t{};
         for (int k = 0; k < 255; ++k) t.thresholds[k] = srgb_to_linear((float(k) + 0.5f) / 255.0f);
         t.thresholds[255] = INFINITY;
-        for (int i = 0; i <= kSrgbSteps; ++i)
+        for (int i = 0; i <= kSrgbSteps; ++i) {
             t.start[i] =
                 int32_t(std::upper_bound(t.thresholds, t.thresholds + 255, float(i) / kSrgbSteps) -
                         t.thresholds);
+            t.start_threshold[i] = t.thresholds[t.start[i]];
+            REPRISE_ASSERT(t.start[i] == 255 ||
+                           t.thresholds[t.start[i] + 1] >= float(i + 1) / kSrgbSteps);
+        }
         for (int k = 0; k < 256; ++k) t.to_linear[k] = srgb_to_linear(float(k) / 255.0f);
         return t;
     }();

@@ -82,10 +82,13 @@ struct ToPlanesRow {
 void to_planes_row_reference(const ToPlanesRow& row, int x_begin, int x_end);
 void to_planes_row(const ToPlanesRow& row);
 // The 8-bit code's table: start[i] is the code of i / kSrgbSteps, thresholds[k] the linear
-// value where code k + 1 begins.
+// value where code k + 1 begins. No step holds two thresholds (the steepest codes, at 0, are
+// 1 / (255 * 12.92) apart, more than a step), so a value's code is start[i], plus one from
+// start_threshold[i] = thresholds[start[i]] on.
 inline constexpr int kSrgbSteps = 4096;
 struct SrgbTables {
     int32_t start[kSrgbSteps + 1];
+    float start_threshold[kSrgbSteps + 1];
     float thresholds[256];  // [255] = +inf
     float to_linear[256];
 };

@@ -196,12 +196,12 @@ void ToPlanesRowSimd(const ToPlanesRow& r) {
     auto code = [&](VF v) {
         const auto positive = v > zero, saturated = v >= one;
         const VF inside = hn::IfThenElseZero(hn::AndNot(saturated, positive), v);
-        VI c = hn::GatherIndex(di, t.start, hn::ConvertTo(di, inside * steps));
-        for (;;) {  // up the thresholds (thresholds[255] = +inf stops every lane)
-            const auto up = hn::RebindMask(di, inside >= hn::GatherIndex(df, t.thresholds, c));
-            if (hn::AllFalse(di, up)) break;
-            c = c + hn::IfThenElseZero(up, one_i);
-        }
+        // The step's code, one more from its threshold on (two gathers, neither waits on the
+        // other).
+        const VI step = hn::ConvertTo(di, inside * steps);
+        const VI start = hn::GatherIndex(di, t.start, step);
+        const auto up = hn::RebindMask(di, inside >= hn::GatherIndex(df, t.start_threshold, step));
+        const VI c = start + hn::IfThenElseZero(up, one_i);
         return hn::IfThenElse(hn::RebindMask(di, saturated), top,
                               hn::IfThenElse(hn::RebindMask(di, positive), c, zero_i));
     };
