@@ -181,10 +181,12 @@ struct Landings {
     // The plane's span in pixels (plane_row): 6 at a height of 360, the best of 3 to 18 there, as
     // 12 was at 720.
     int span = 1;
+    bool no_objects = false;  // every pixel of `object` is -1
     void resize(int w, int h) {
         span = std::max(2, int(std::lround(double(h) / 60.0)));
         for (Image<float>* i : {&z, &px, &py, &held, &inverse}) ensure_size(*i, w, h);
         ensure_size(slot, w, h);
+        if (object.width() != w || object.height() != h) no_objects = false;
         ensure_size(object, w, h);
     }
 };
@@ -292,8 +294,10 @@ void reproject_depth(const Camera& from, ImageView<const float> depth, const Cam
                            .py = &landings.py(0, y)};
             int* object = &landings.object(0, y);
             bool moved = false;
-            for (int x = 0; x < w; ++x)
-                moved |= (object[x] = objects.empty() ? -1 : object_of(x, y)) >= 0;
+            if (!objects.empty())
+                for (int x = 0; x < w; ++x) moved |= (object[x] = object_of(x, y)) >= 0;
+            else if (!landings.no_objects)
+                std::fill(object, object + w, -1);
             if (!moved) {
                 forward_row(row);
             } else {
@@ -315,6 +319,7 @@ void reproject_depth(const Camera& from, ImageView<const float> depth, const Cam
                     landings.inverse(x, y) = row.slot[x] >= 0 ? 1.0f / row.z[x] : 0.0f;
         }
     });
+    landings.no_objects = objects.empty();
     // Each landing's value: its depth, or its plane's at the centre of the pixel it lands in.
     if (plane_fit)
         parallel_for(0, h, [&](int y0, int y1) {
