@@ -43,10 +43,10 @@ reprise_status check_pointer(const char* function, const void* pointer, const ch
 
 reprise_status check_struct_size(const char* function, const char* name, std::size_t given,
                                  std::size_t oldest, std::size_t newest) {
-    if (given >= oldest && given <= newest) return REPRISE_OK;
+    if (given == oldest || given == newest) return REPRISE_OK;
     const std::string sizes =
-        oldest == newest ? "this library's " + std::to_string(newest)
-                         : "between " + std::to_string(oldest) + " and " + std::to_string(newest);
+        "this library's " + std::to_string(newest) +
+        (oldest == newest ? std::string() : " or an older minor's " + std::to_string(oldest));
     return fail(REPRISE_ERROR_ABI_MISMATCH, function,
                 std::string(name) + " " + std::to_string(given) + " is not " + sizes +
                     " bytes: the caller was built against another reprise.h");

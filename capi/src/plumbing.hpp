@@ -49,8 +49,8 @@ reprise_status check_abi(const char* function, uint32_t abi_version);
 // memory limit.
 void name_the_memory_setter();
 reprise_status check_pointer(const char* function, const void* pointer, const char* name);
-// Checks that a struct the caller filled has a struct_size this library takes: oldest (the
-// struct of the first minor that had it) up to its own.
+// Checks that a struct the caller filled has a struct_size this library takes: its own, or
+// `oldest`, the struct of the minors before its last field was added.
 reprise_status check_struct_size(const char* function, const char* name, std::size_t given,
                                  std::size_t oldest, std::size_t newest);
 

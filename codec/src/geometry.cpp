@@ -277,6 +277,7 @@ void reproject_depth(const Camera& from, ImageView<const float> depth, const Cam
     thread_local Landings scratch;  // the workers below use this thread's, by reference
     Landings& landings = scratch;
     landings.resize(w, h);
+    if (!objects.empty()) landings.no_objects = false;
     parallel_for(0, h, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y) {
             ForwardRow row{.projection = from.projection,

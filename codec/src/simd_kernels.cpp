@@ -402,9 +402,9 @@ std::size_t RevealRowSimd(const RevealRow& r) {
         const VF fx = (hn::Iota(df, float(x)) + half) + mx, fy = fy_base + my;
         const auto inside =
             hn::And(hn::And(fx >= zero, fy >= zero), hn::And(fx < width, fy < height));
-        // Lanes outside read pixel 0 and are masked out below.
-        const VI at = hn::IfThenElseZero(hn::RebindMask(di, inside),
-                                         hn::ConvertTo(di, fy) * stride + hn::ConvertTo(di, fx));
+        // Lanes outside (NaN among them) convert 0 and read pixel 0; they are masked out below.
+        const VI at = hn::ConvertTo(di, hn::IfThenElseZero(inside, fy)) * stride +
+                      hn::ConvertTo(di, hn::IfThenElseZero(inside, fx));
         const VF landing = hn::GatherIndex(df, r.reference_depth, at);
         const VF depth = hn::LoadU(df, r.depth + x);
         const auto seen = hn::Not(hn::Or(landing * margin < depth, depth * margin < landing));

@@ -358,6 +358,10 @@ static void test_abi_mismatch(void) {
     options.struct_size = offsetof(reprise_stereo_options, temporal);
     EXPECT_STATUS(reprise_stereo_create(REPRISE_ABI_VERSION, &options, &stereo),
                   REPRISE_ERROR_ABI_MISMATCH);
+    /* Between the two sizes: no header ever had such a struct. */
+    options.struct_size = offsetof(reprise_stereo_options, widen_silhouettes) + 1;
+    EXPECT_STATUS(reprise_stereo_create(REPRISE_ABI_VERSION, &options, &stereo),
+                  REPRISE_ERROR_ABI_MISMATCH);
     /* A minor-1 caller's struct ends before widen_silhouettes: init writes only its bytes and
      * create takes it. */
     unsigned char old[sizeof(reprise_stereo_options) + 8];
