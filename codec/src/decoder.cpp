@@ -163,8 +163,10 @@ Result Decoder::receive_frame(DecodedFrame& frame) {
     frame.picture_ = std::move(out.picture);
     s.queue.pop_front();
     // A stream can spell NaN (lossless depth keeps float bits): repaired in copies, so the
-    // references stay the encoder's.
-    NonfiniteCounts counts = count_nonfinite(frame.view());
+    // references stay the encoder's. Colour comes from a table of finite values: not scanned.
+    GBufferView scanned = frame.view();
+    scanned.color = {};
+    NonfiniteCounts counts = count_nonfinite(scanned);
     if (counts.depth) {
         frame.repaired_depth_.assign(frame.depth_);
         s.repair.repair_depth(frame.repaired_depth_.view());
@@ -175,7 +177,6 @@ Result Decoder::receive_frame(DecodedFrame& frame) {
         s.repair.repair_motion(frame.repaired_motion_.view());
         frame.motion_ = frame.repaired_motion_.view();
     }
-    if (counts.color) s.repair.repair_color(frame.color.view());
     counts.frames = counts.total() > 0;
     s.stats.nonfinite += counts;
     return Result::Ok;
