@@ -173,7 +173,7 @@ TEST(Fruc, CreateRefusesBadSettingsNamingThemAndKeepsTheConverter) {
 // A backend that makes in-between frames instead of the CPU (here: b's colour) and fails once
 // on request: the failing send() leaves the converter as it was, and sending the frame again
 // gives what an unbroken run gives.
-class FlakyBackend final : public InterpolationBackend {
+class FlakyBackend final : public WarpBackend {
 public:
     int calls = 0, fail_at = -1;
     Status supports(const FrucOptions& o) const override {
@@ -186,6 +186,10 @@ public:
         for (int y = 0; y < b.color.height; ++y)
             std::copy_n(b.color.row(y), b.color.width, &out.color(0, y));
         return {};
+    }
+    Status extrapolate(const GBufferView&, const glm::mat4&, const glm::mat4&, float, float,
+                       const FrucOptions&, Frame&, FrucCounters&) override {
+        return Status::error("flaky: no extrapolation");
     }
 };
 

@@ -19,6 +19,7 @@
 #include "reprise/gpu/fruc_backend.hpp"
 #include "reprise/stereo/rig.hpp"
 #include "reprise/stereo/synthesize.hpp"
+#include "reprise/warp/extrapolate.hpp"
 #include "reprise/warp/fill.hpp"
 #include "reprise/warp/fruc.hpp"
 #include "reprise/warp/reproject.hpp"
@@ -675,7 +676,7 @@ TEST(Gpu, TheConverterWithTheGpuBackendMakesTheCpusFrames) {
         EXPECT_GE(test::display_psnr(cpu[i].color, gpu[i].color), 50.0);
         EXPECT_EQ(gpu[i].camera.view, cpu[i].camera.view);
     }
-    EXPECT_EQ(backend.frames(), 4u);  // the pairs 0-1 and 1-2; the cut's two come from the CPU
+    EXPECT_EQ(backend.frames(), 6u);  // the pairs 0-1 and 1-2, and the cut's two extrapolated
     EXPECT_TRUE(gpu[1].motion.empty());
     EXPECT_EQ(gpu_counters.cuts, 1u);
     EXPECT_EQ(gpu_counters.hole_pixels, cpu_counters.hole_pixels);
@@ -736,6 +737,188 @@ TEST(Gpu, InterpolationOnTexturesAndBadArguments) {
     EXPECT_NE(context.interpolate(frames[0], frames[1], 1.5f, unused, texture_stats)
                   .message()
                   .find("s must lie in [0, 1]"),
+              std::string::npos);
+}
+
+// --- Extrapolation against warp::PoseExtrapolator and the converter with the same options.
+
+const warp::FrucOptions kSplatExtrapolation{.mode = warp::FrucMode::Extrapolate,
+                                            .warp = warp::WarpMethod::Splat,
+                                            .widen_silhouettes = false};
+
+// Pixels whose depth differs in bits, and the largest motion difference.
+struct Differences {
+    std::size_t depth = 0;
+    float motion = 0.0f;
+};
+Differences differences(const Frame& cpu, const Frame& gpu) {
+    Differences d;
+    for (std::size_t i = 0; i < cpu.depth.pixel_count(); ++i) {
+        d.depth += std::memcmp(&cpu.depth.data()[i], &gpu.depth.data()[i], sizeof(float)) != 0;
+        const glm::vec2 m = cpu.motion.data()[i] - gpu.motion.data()[i];
+        d.motion = std::max({d.motion, std::abs(m.x), std::abs(m.y)});
+    }
+    return d;
+}
+
+// `frame` seen by the next frame's camera `periods` on, on the CPU and on the GPU: colour within
+// 50 dB, depth in bits on all but 0.1 % of the pixels, motion within 1e-4 px.
+// The CPU gets `frame` with its NaN/Inf repaired (the converter repairs, PoseExtrapolator does
+// not).
+void expect_extrapolation_matches(const Frame& frame, const Camera& to, float periods,
+                                  gpu::ExtrapolateStats& stats) {
+    warp::PoseExtrapolator extrapolator(kSplatExtrapolation);
+    Frame cpu, gpu;
+    NonfiniteRepair repair;
+    NonfiniteCounts found;
+    const GBufferView repaired = repair.clean(frame, found);
+    ASSERT_TRUE(extrapolator.extrapolate(repaired, to.view, to.projection, periods, cpu).ok());
+    const Status status = shared_gpu().extrapolate(frame, to.view, to.projection, periods, gpu,
+                                                   stats, kSplatExtrapolation);
+    ASSERT_TRUE(status.ok()) << status.message();
+    ASSERT_EQ(gpu.motion.width(), cpu.motion.width());
+    const double db = test::display_psnr(cpu.color, gpu.color);
+    EXPECT_GE(db, 50.0);
+    const Differences d = differences(cpu, gpu);
+    EXPECT_LE(d.depth, cpu.depth.pixel_count() / 1000);
+    EXPECT_LE(d.motion, 1e-4f);
+    EXPECT_EQ(stats.holes, extrapolator.counters().hole_pixels);
+    if (has_projection(frame.camera))
+        EXPECT_EQ(stats.moving > 0, extrapolator.counters().dynamic_layers == 1);
+    std::printf(
+        "  %.2f periods on: moving %zu, covered %zu, holes %zu, %.1f dB, depth %zu "
+        "differ, motion within %g\n",
+        periods, stats.moving, stats.covered, stats.holes, db, d.depth, double(d.motion));
+}
+
+TEST(Gpu, ExtrapolationMatchesTheCpuOnEveryBuiltInScene) {
+    std::size_t moving = 0, holes = 0;
+    for (const server::SceneInfo& info : server::builtin_scenes()) {
+        SCOPED_TRACE(info.name);
+        std::printf("%s\n", info.name);
+        const std::vector<Frame>& frames = scene_frames(info.name);
+        for (float periods : {0.5f, 1.0f}) {
+            gpu::ExtrapolateStats stats;
+            expect_extrapolation_matches(frames[0], frames[1].camera, periods, stats);
+            moving += stats.moving;
+            holes += stats.holes;
+        }
+    }
+    EXPECT_GT(moving, 0u);  // not vacuous: objects moved on their own and holes were filled
+    EXPECT_GT(holes, 0u);
+}
+
+TEST(Gpu, ExtrapolationWithoutACameraAndOnNonFiniteInput) {
+    // Without a projection every pixel goes along its own motion.
+    Frame cameraless = scene_frames("crossing")[0];
+    cameraless.camera = Camera{};
+    gpu::ExtrapolateStats stats;
+    expect_extrapolation_matches(cameraless, scene_frames("crossing")[1].camera, 1.0f, stats);
+    EXPECT_EQ(stats.moving, cameraless.color.pixel_count());
+
+    NonfiniteCounts spoiled;
+    const std::vector<Frame> frames = test::spoiled_sequence(2, spoiled);
+    expect_extrapolation_matches(frames[1], frames[0].camera, 1.0f, stats);
+    EXPECT_GT(stats.nonfinite.total(), 0u);
+    EXPECT_GT(stats.holes, 0u);
+}
+
+// The converter extrapolating at factor 3 through a cut: the CPU's frames, made on the GPU.
+TEST(Gpu, TheExtrapolatingConverterWithTheGpuBackendMakesTheCpusFrames) {
+    std::vector<Frame> frames = test::render_scene("crossing", 3, kWidth, kHeight, 30.0, 3);
+    frames[2].camera.cut = Cut::Yes;
+    warp::FrucOptions cpu_options = kSplatExtrapolation;
+    cpu_options.widen_silhouettes = true;
+    gpu::FrucBackend backend(shared_gpu());
+    warp::FrucOptions gpu_options = cpu_options;
+    gpu_options.backend = &backend;
+    auto run = [&](const warp::FrucOptions& options, warp::FrucCounters& counters) {
+        warp::FrameRateConverter converter;
+        const Status made = warp::FrameRateConverter::create(3, options, converter);
+        EXPECT_TRUE(made.ok()) << made.message();
+        std::vector<Frame> outputs;
+        for (const Frame& f : frames) {
+            const Status sent = converter.send(f);
+            EXPECT_TRUE(sent.ok()) << sent.message();
+            Frame out;
+            while (converter.receive(out)) outputs.push_back(std::move(out));
+        }
+        counters = converter.counters();
+        return outputs;
+    };
+    warp::FrucCounters cpu_counters, gpu_counters;
+    const std::vector<Frame> cpu = run(cpu_options, cpu_counters);
+    const std::vector<Frame> gpu = run(gpu_options, gpu_counters);
+    ASSERT_EQ(cpu.size(), 9u);  // each input and two frames beyond it
+    ASSERT_EQ(gpu.size(), cpu.size());
+    for (std::size_t i = 0; i < cpu.size(); ++i) {
+        SCOPED_TRACE("output " + std::to_string(i));
+        EXPECT_GE(test::display_psnr(cpu[i].color, gpu[i].color), 50.0);
+        EXPECT_LE(differences(cpu[i], gpu[i]).motion, 1e-4f);
+        EXPECT_EQ(gpu[i].camera.view, cpu[i].camera.view);
+    }
+    EXPECT_EQ(backend.frames(), 4u);  // the cut's two are copies
+    EXPECT_EQ(gpu_counters.hole_pixels, cpu_counters.hole_pixels);
+    EXPECT_EQ(gpu_counters.dynamic_layers, cpu_counters.dynamic_layers);
+    EXPECT_EQ(gpu_counters.fills, cpu_counters.fills);
+
+    warp::FrucOptions andreev = gpu_options;
+    andreev.fill = warp::FillMethod::Andreev;
+    warp::FrameRateConverter refused;
+    const Status status = warp::FrameRateConverter::create(2, andreev, refused);
+    EXPECT_NE(status.message().find("extrapolated frames with fill pullpush or none"),
+              std::string::npos)
+        << status.message();
+}
+
+TEST(Gpu, ExtrapolationOnTexturesAndBadArguments) {
+    const std::vector<Frame>& frames = scene_frames("crossing");
+    const Camera& to = frames[1].camera;
+    gpu::Context& context = shared_gpu();
+    Frame from_images;
+    gpu::ExtrapolateStats image_stats, texture_stats;
+    ASSERT_TRUE(context
+                    .extrapolate(frames[0], to.view, to.projection, 1.0f, from_images, image_stats,
+                                 kSplatExtrapolation)
+                    .ok());
+    context.make_current();
+    Textures t;
+    const gpu::GBufferTextures frame = t.gbuffer(frames[0]);
+    const GLuint color =
+        t.make(GL_RGBA32F, kWidth, kHeight, GL_RGBA, GL_FLOAT, frames[0].color.data());
+    const GLuint out = t.make(GL_RGBA32F, kWidth, kHeight, GL_RGBA, GL_FLOAT, nullptr);
+    const GLuint depth = t.make(GL_R32F, kWidth, kHeight, GL_RED, GL_FLOAT, nullptr);
+    const GLuint motion = t.make(GL_RGBA32F, kWidth, kHeight, GL_RGBA, GL_FLOAT, nullptr);
+    const Status status = context.extrapolate(frame, color, to.view, to.projection, 1.0f, out,
+                                              depth, motion, texture_stats, kSplatExtrapolation);
+    ASSERT_TRUE(status.ok()) << status.message();
+    EXPECT_EQ(texture_stats.holes, image_stats.holes);
+    EXPECT_EQ(texture_stats.moving, image_stats.moving);
+    EXPECT_EQ(test::display_psnr(read_rgba(out), from_images.color), INFINITY);
+    const Image<glm::vec4> read_motion = read_rgba(motion);
+    for (std::size_t i = 0; i < read_motion.pixel_count(); ++i)
+        ASSERT_EQ(glm::vec2(read_motion.data()[i]), from_images.motion.data()[i]) << "pixel " << i;
+
+    auto message = [&](const warp::FrucOptions& options, float periods, const Frame& f) {
+        Frame unused;
+        gpu::ExtrapolateStats unused_stats;
+        return context
+            .extrapolate(f, to.view, to.projection, periods, unused, unused_stats, options)
+            .message();
+    };
+    warp::FrucOptions grid = kSplatExtrapolation;
+    grid.warp = warp::WarpMethod::Grid;
+    EXPECT_NE(message(grid, 1.0f, frames[0]).find("warp splat only"), std::string::npos);
+    EXPECT_NE(message(kSplatExtrapolation, -1.0f, frames[0]).find("periods"), std::string::npos);
+    Frame skewed = frames[0];
+    skewed.camera.projection[1][0] = 0.1f;
+    skewed.camera.prev_projection = skewed.camera.projection;
+    EXPECT_NE(message(kSplatExtrapolation, 1.0f, skewed).find("skewed"), std::string::npos);
+    EXPECT_NE(context
+                  .extrapolate(frame, color, to.view, to.projection, 1.0f, color, depth, motion,
+                               texture_stats, kSplatExtrapolation)
+                  .message()
+                  .find("the output is the input colour"),
               std::string::npos);
 }
 

@@ -373,7 +373,8 @@ struct StreamBench {
                 receive_peer_frame(*video_frame, depth_video.decoded[si], source_camera[si],
                                    received);
                 const float periods = float(std::clamp((k.t - source_times[si]) * fps, 0.0, 8.0));
-                extrapolator.extrapolate(received, k.view, projection, periods, extrapolated);
+                REPRISE_TRY(
+                    extrapolator.extrapolate(received, k.view, projection, periods, extrapolated));
                 visualize_color(extrapolated.color.view(), warped_depth.view());
             }
             const std::array<const Image<Rgb8>*, 6> candidates = {

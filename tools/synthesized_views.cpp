@@ -54,9 +54,9 @@ Status SynthesizedViewScorer::add(int index, const Frame& rendered, const GBuffe
             at.projection = eyes.right.projection;
         }
         REPRISE_TRY(renderer_.render(scene_, at, before, settings, truth_));
-        extrapolator.extrapolate(decoded, at.view, at.projection, periods, warped_);
+        REPRISE_TRY(extrapolator.extrapolate(decoded, at.view, at.projection, periods, warped_));
         views.decoded_psnr[v] += display_psnr(truth_, warped_, a, b);
-        extrapolator.extrapolate(lossless_, at.view, at.projection, periods, warped_);
+        REPRISE_TRY(extrapolator.extrapolate(lossless_, at.view, at.projection, periods, warped_));
         views.rendered_psnr[v] += display_psnr(truth_, warped_, a, b);
     }
     ++views.frames;

@@ -67,7 +67,11 @@ struct StreamClient::State {
     bool resuming = false;
 
     State(const StreamClientOptions& o)
-        : options(o), uplink(o.uplink), downlink(o.downlink), ticket(o.ticket) {}
+        : options(o),
+          uplink(o.uplink),
+          downlink(o.downlink),
+          extrapolator(o.extrapolation),
+          ticket(o.ticket) {}
 
     // A ticket the server no longer knows (restarted, expired) costs one handshake time-out.
     void forget_ticket() {
@@ -329,6 +333,9 @@ Status StreamClient::create(const StreamClientOptions& options,
     if (!options.scene.empty() && !net::valid_scene_name(options.scene))
         return Status::error("--scene: a catalogue name (1..32 of [a-z0-9_-]), never a path");
     if (options.server.port == 0) return Status::error("server address: port 0");
+    warp::FrucOptions extrapolation = options.extrapolation;
+    extrapolation.mode = warp::FrucMode::Extrapolate;
+    REPRISE_TRY(warp::check_fruc_options(extrapolation));
     std::unique_ptr<StreamClient> c(new StreamClient());
     c->state_ = std::make_unique<State>(options);
     REPRISE_TRY(c->state_->socket.bind({options.server.loopback() ? 0x7f000001u : 0u, 0}));
@@ -430,8 +437,15 @@ const GBufferView* StreamClient::display(const glm::mat4& view, double scene_tim
     }
     const double fps = s.have_info ? s.info.fps : (f.fps > 0 ? f.fps : 30.0);
     const float periods = float(std::clamp((scene_time - f.camera.time) * fps, 0.0, 8.0));
-    s.extrapolator.extrapolate(f.view(), view, f.camera.projection, periods, s.displayed,
-                               s.decoded_count);
+    const Status made = s.extrapolator.extrapolate(f.view(), view, f.camera.projection, periods,
+                                                   s.displayed, s.decoded_count);
+    if (!made.ok()) {  // the backend failed: the decoded frame as it is
+        ++s.stats.extrapolation_errors;
+        s.stats.extrapolation_error = made.message();
+        info.extrapolated = false;
+        s.shown = f.view();
+        return &s.shown;
+    }
     s.displayed.camera.time = scene_time;
     s.displayed.fps = f.fps;
     s.shown = s.displayed.view();

@@ -16,6 +16,7 @@ Status create_fill_programs(ContextState& state);
 Status create_splat_programs(ContextState& state);
 Status create_stereo_programs(ContextState& state);
 Status create_interpolate_programs(ContextState& state);
+Status create_extrapolate_programs(ContextState& state);
 
 double finish_ms(std::chrono::steady_clock::time_point& since) {
     glFinish();
@@ -77,6 +78,16 @@ void dispatch(int w, int h) {
     // Read-backs put their own barriers (download, read_counters).
     glMemoryBarrier(GL_SHADER_IMAGE_ACCESS_BARRIER_BIT | GL_TEXTURE_FETCH_BARRIER_BIT |
                     GL_SHADER_STORAGE_BARRIER_BIT);
+}
+
+void set_view_point(GLuint program, const Unprojector& unproject, int w, int h) {
+    glUniformMatrix4fv(glGetUniformLocation(program, "P"), 1, GL_FALSE,
+                       &unproject.projection()[0][0]);
+    glUniform1f(glGetUniformLocation(program, "background_zv"),
+                unproject.perspective() ? -1.0f : -unproject.far_plane());
+    glUniform1f(glGetUniformLocation(program, "background_w"),
+                unproject.perspective() ? 0.0f : 1.0f);
+    glUniform2i(glGetUniformLocation(program, "size"), w, h);
 }
 
 GLuint ContextState::make_counters(std::size_t bytes) {
@@ -211,16 +222,21 @@ Context::~Context() {
     for (Texture* t : {&state_->depth, &state_->motion, &state_->id, &state_->previous_depth,
                        &state_->previous_id, &state_->payload, &state_->out, &state_->hit,
                        &state_->color, &state_->valid, &state_->splat_motion, &state_->displacement,
-                       &state_->target_depth, &state_->eye_color})
+                       &state_->target_depth, &state_->eye_color, &state_->source_color,
+                       &state_->source_depth, &state_->source_motion, &state_->made_motion})
         glDeleteTextures(1, &t->name);
+    for (Texture* t : state_->interpolation.all) glDeleteTextures(1, &t->name);
     for (auto* chain :
          {&state_->pulled, &state_->pulled_depth, &state_->filled, &state_->filled_depth})
         for (Texture& t : *chain) glDeleteTextures(1, &t.name);
     for (GLuint program :
          {state_->pull_image_program, state_->pull_level_program, state_->push_program,
           state_->final_program, state_->splat_scatter_program, state_->splat_clear_program,
-          state_->splat_gather_program, state_->displacement_program, state_->finish_program})
+          state_->splat_gather_program, state_->displacement_program, state_->finish_program,
+          state_->blend_program, state_->copy_program, state_->static_layer_program})
         glDeleteProgram(program);
+    for (GLuint buffer : {state_->blend_counts, state_->extrapolate_counts})
+        glDeleteBuffers(1, &buffer);
     glDeleteBuffers(1, &state_->splat_counts);
     glDeleteBuffers(1, &state_->splat_lists);
     glDeleteBuffers(1, &state_->fill_counts);
@@ -248,6 +264,7 @@ Status Context::create(std::unique_ptr<Context>& context) {
     REPRISE_TRY(create_splat_programs(s));
     REPRISE_TRY(create_stereo_programs(s));
     REPRISE_TRY(create_interpolate_programs(s));
+    REPRISE_TRY(create_extrapolate_programs(s));
     s.counts_buffer = s.make_counters(8 * sizeof(GLuint));
     glGenBuffers(1, &s.readback_buffer);
     glBindBuffer(GL_COPY_WRITE_BUFFER, s.readback_buffer);

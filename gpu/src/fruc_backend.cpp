@@ -2,6 +2,8 @@
 
 #include <string>
 
+#include "reprise/core/camera_math.hpp"
+
 namespace reprise::gpu {
 
 Status FrucBackend::check(const warp::FrucOptions& o, const warp::SplatOptions& splat) {
@@ -9,31 +11,53 @@ Status FrucBackend::check(const warp::FrucOptions& o, const warp::SplatOptions& 
     auto need = [&](bool ok, const char* what) {
         if (!ok) unsupported += std::string(unsupported.empty() ? "" : ", ") + what;
     };
-    need(o.mode == warp::FrucMode::Interpolate, "mode interpolate");
     need(o.warp == warp::WarpMethod::Splat, "warp splat");
-    need(o.fill == warp::FillMethod::PullPush, "fill pullpush");
-    need(!o.true_motion, "true motion off");
-    need(!o.refine.enabled, "refine off");
+    if (o.mode == warp::FrucMode::Interpolate) {
+        need(o.fill == warp::FillMethod::PullPush, "fill pullpush");
+        need(!o.true_motion, "true motion off");
+        need(!o.refine.enabled, "refine off");
+    } else {
+        need(o.fill == warp::FillMethod::PullPush || o.fill == warp::FillMethod::None,
+             "fill pullpush or none");
+    }
     need(o.splat.footprint == splat.footprint && o.splat.depth_tolerance == splat.depth_tolerance,
          "the backend's splat options");
     if (unsupported.empty()) return {};
-    return Status::error("gpu: the GPU makes in-between frames with " + unsupported +
-                         " only (docs/gpu.md)");
+    return Status::error(std::string("gpu: the GPU makes ") +
+                         (o.mode == warp::FrucMode::Interpolate ? "in-between" : "extrapolated") +
+                         " frames with " + unsupported + " only (docs/gpu.md)");
 }
 
 Status FrucBackend::interpolate(const GBufferView& a, const GBufferView& b, float s, Frame& out,
                                 warp::FrucCounters& counters) {
     InterpolateStats stats;
     REPRISE_TRY(context_.interpolate(a, b, s, out, stats, splat_));
+    count(stats.holes, stats.holes > 0, counters);
+    return {};
+}
+
+Status FrucBackend::extrapolate(const GBufferView& f, const glm::mat4& view,
+                                const glm::mat4& projection, float periods, float motion_scale,
+                                const warp::FrucOptions& options, Frame& out,
+                                warp::FrucCounters& counters) {
+    ExtrapolateStats stats;
+    REPRISE_TRY(
+        context_.extrapolate(f, view, projection, periods, out, stats, options, motion_scale));
+    if (has_projection(f.camera))
+        ++(stats.moving ? counters.dynamic_layers : counters.dynamic_skipped);
+    count(stats.holes, stats.holes > 0 && options.fill != warp::FillMethod::None, counters);
+    return {};
+}
+
+void FrucBackend::count(std::size_t holes, bool filled, warp::FrucCounters& counters) {
     const Timings& t = context_.timings();
     total_.upload_ms += t.upload_ms;
     total_.compute_ms += t.compute_ms;
     total_.download_ms += t.download_ms;
     ++frames_;
-    counters.hole_pixels += stats.holes;
-    counters.fills += stats.holes > 0;
-    counters.fills_skipped += stats.holes == 0;
-    return {};
+    counters.hole_pixels += holes;
+    counters.fills += filled;
+    counters.fills_skipped += holes == 0;
 }
 
 }  // namespace reprise::gpu

@@ -26,8 +26,6 @@ layout(std430, binding = 0) buffer Counts { uint counts[]; };
 uniform ivec2 size;
 uniform highp float s;
 
-bool positive_inf(highp float v) { return floatBitsToUint(v) == 0x7f800000u; }
-
 // Whether pixel p is a hole. blend_row_reference's rule (kSameSurface 0.15); the splat marks no
 // pixel kCoveredStretched, so its rule for stretched sides never applies here.
 bool blend(ivec2 p) {
@@ -60,28 +58,31 @@ void main() {
 }
 )";
 
+}  // namespace
+
+// `from` times `scale` into `to` (GL_RGBA32F), w x h: a made frame's colour as it is, or the
+// motion it carried scaled per output period.
 constexpr const char* kCopy = R"(
 layout(binding = 0) uniform highp sampler2D from;
 layout(binding = 0, rgba32f) writeonly uniform highp image2D to;
 uniform ivec2 size;
+uniform highp float scale;
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
-    if (p.x < size.x && p.y < size.y) imageStore(to, p, texelFetch(from, p, 0));
+    if (p.x < size.x && p.y < size.y) imageStore(to, p, texelFetch(from, p, 0) * scale);
 }
 )";
 
-Status copy_color(ContextState& s, GLuint from, GLuint to, int w, int h) {
+void copy_scaled(ContextState& s, GLuint from, GLuint to, int w, int h, float scale) {
     glUseProgram(s.copy_program);
     s.bind_inputs({from});
     glBindImageTexture(0, to, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     glUniform2i(glGetUniformLocation(s.copy_program, "size"), w, h);
+    glUniform1f(glGetUniformLocation(s.copy_program, "scale"), scale);
     dispatch(w, h);
     ContextState::unbind_inputs();
     glUseProgram(0);
-    return {};
 }
-
-}  // namespace
 
 Status create_interpolate_programs(ContextState& s) {
     REPRISE_TRY(
@@ -132,7 +133,7 @@ Status interpolate_passes(ContextState& s, const SplatTextures& a, const SplatTe
         REPRISE_TRY(
             fill_passes(s, k.blended.name, k.valid.name, out_depth, w, h, out_color, stats.fill));
     else
-        REPRISE_TRY(copy_color(s, k.blended.name, out_color, w, h));
+        copy_scaled(s, k.blended.name, out_color, w, h, 1.0f);
     return gl::check_errors("gpu interpolate");
 }
 

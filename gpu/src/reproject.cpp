@@ -28,9 +28,6 @@ uniform int step;
 
 const uint HIT = 0u, OFFSCREEN = 1u, BEHIND = 2u, OCCLUDED = 3u, OTHER_ID = 4u, INVALID = 5u;
 
-// By bits: a shader compiler may assume that no float is NaN or infinite.
-bool finite(highp float v) { return (floatBitsToUint(v) & 0x7f800000u) != 0x7f800000u; }
-bool positive_inf(highp float v) { return floatBitsToUint(v) == 0x7f800000u; }
 
 uint classify(ivec2 p) {
     highp float z = texelFetch(depth_map, p, 0).r;

@@ -26,12 +26,6 @@ uniform ivec2 source_size, target_size;
 uniform highp float factor, tol_lo, tol_hi;
 uniform int footprint;
 
-bool finite(highp float v) { return (floatBitsToUint(v) & 0x7f800000u) != 0x7f800000u; }
-// z >= 0 (+inf included) by its bits: NaN fails, and -0 counts as 0.
-bool nonnegative(highp float z) {
-    uint b = floatBitsToUint(z);
-    return b <= 0x7f800000u || b == 0x80000000u;
-}
 
 struct Landing { ivec2 p0; ivec2 n; highp vec2 o; };
 

@@ -7,6 +7,7 @@
 
 #include <glm/vec4.hpp>
 
+#include "reprise/core/camera_math.hpp"
 #include "reprise/core/nonfinite.hpp"
 #include "reprise/gl/context.hpp"
 #include "reprise/gl/program.hpp"
@@ -37,6 +38,14 @@ inline constexpr const char* kComputeHeader = R"(#version 310 es
 #define PRECISE
 #endif
 layout(local_size_x = 8, local_size_y = 8) in;
+// Tested by bits: a shader compiler may assume that no float is NaN or infinite.
+bool finite(highp float v) { return (floatBitsToUint(v) & 0x7f800000u) != 0x7f800000u; }
+bool positive_inf(highp float v) { return floatBitsToUint(v) == 0x7f800000u; }
+// z >= 0 (+inf included): NaN fails, and -0 counts as 0.
+bool nonnegative(highp float z) {
+    uint b = floatBitsToUint(z);
+    return b <= 0x7f800000u || b == 0x80000000u;
+}
 // COUNT_IN_GROUP(condition, counter) as the whole body of main(): counts where `condition` holds
 // in the work group (each invocation's flag in shared memory, added up by the first), then adds
 // the group's count to `counter` with one atomic. barrier() may not sit in control flow, so every
@@ -51,6 +60,44 @@ shared uint group_flags[64];
         if (n != 0u) atomicAdd(counter, n); \
     }
 )";
+
+// A pixel's view-space point through its depth and where a camera sees it, in warp/'s arithmetic
+// (reproject_setup's Unprojector for an axis-aligned projection P, transform_row's sums): the
+// stereo eye's displacement and extrapolation's static-layer test. Background (+inf) is the
+// direction (background_zv, background_w).
+inline constexpr const char* kViewPoint = R"(
+uniform highp mat4 P;
+uniform highp float background_zv, background_w;
+uniform ivec2 size;
+
+highp float row(highp mat4 m, int r, highp vec4 v) {
+    PRECISE highp float t = (m[0][r] * v.x + m[1][r] * v.y) + (m[2][r] * v.z + m[3][r] * v.w);
+    return t;
+}
+highp vec2 center(ivec2 p) { return vec2(float(p.x) + 0.5, float(p.y) + 0.5); }
+highp vec4 view_point(ivec2 p, highp float z) {
+    highp vec2 c = center(p);
+    PRECISE highp float ny = 1.0 - 2.0 * c.y / float(size.y);
+    PRECISE highp float nx = 2.0 * c.x / float(size.x) - 1.0;
+    bool background = positive_inf(z);
+    highp float zv = background ? background_zv : -z;
+    highp float w = background ? background_w : 1.0;
+    PRECISE highp float wc = P[2][3] * zv + P[3][3] * w;
+    PRECISE highp float vx = (nx * wc - P[2][0] * zv - P[3][0] * w) / P[0][0];
+    PRECISE highp float vy = (ny * wc - P[2][1] * zv - P[3][1] * w) / P[1][1];
+    return vec4(vx, vy, zv, w);
+}
+// The pixel position where clip matrix M sees view point v; `cw` its clip w (> 0: in front).
+highp vec2 seen_at(highp mat4 M, highp vec4 v, out highp float cw) {
+    cw = row(M, 3, v);
+    PRECISE highp float x = (row(M, 0, v) / cw * 0.5 + 0.5) * float(size.x);
+    PRECISE highp float y = (0.5 - 0.5 * row(M, 1, v) / cw) * float(size.y);
+    return vec2(x, y);
+}
+)";
+
+// Sets kViewPoint's uniforms of `program` (in use) for `unproject` over w x h.
+void set_view_point(GLuint program, const Unprojector& unproject, int w, int h);
 
 // A splat's source on the GPU: colour GL_RGBA32F, depth GL_R32F, motion (RG of any float format).
 struct SplatTextures {
@@ -67,6 +114,13 @@ Status interpolate_passes(ContextState& s, const SplatTextures& a, const SplatTe
 Status splat_passes(ContextState& s, const SplatTextures& in, float factor,
                     const warp::SplatOptions& options, int tw, int th, GLuint out_color,
                     GLuint out_depth, GLuint out_covered, bool carry_motion, std::size_t& covered);
+
+Status extrapolate_passes(ContextState& s, const SplatTextures& frame, const Camera& camera,
+                          const glm::mat4& view, const glm::mat4& projection, float periods,
+                          float motion_scale, const warp::FrucOptions& options, GLuint out_color,
+                          GLuint out_depth, GLuint out_motion, ExtrapolateStats& stats);
+// `from` times `scale` into `to` (GL_RGBA32F), w x h.
+void copy_scaled(ContextState& s, GLuint from, GLuint to, int w, int h, float scale);
 
 // The bound program over w x h in 8x8 groups, its writes visible to whatever comes next.
 void dispatch(int w, int h);
@@ -116,6 +170,11 @@ struct ContextState {
     GLuint blend_program = 0, copy_program = 0, blend_counts = 0;
     Interpolation interpolation;
     Texture displacement, target_depth, eye_color;
+    // Extrapolation: the static-layer test (its moving pixels counted), the input frame's
+    // textures and the made frame's motion.
+    GLuint static_layer_program = 0, extrapolate_counts = 0;
+    NonfiniteRepair extrapolate_repair;
+    Texture source_color, source_depth, source_motion, made_motion;
 
     // Counters live in GPU memory (a buffer hinted for reading may be placed in the host's, where
     // every shader atomic crosses the bus: reprojection took 39-90 ms at 1920x1080 on an H200,

@@ -17,42 +17,20 @@ constexpr const char* kDisplacement = R"(
 layout(binding = 0) uniform highp sampler2D depth_map;
 layout(binding = 0, rgba32f) writeonly uniform highp image2D displacement;
 layout(binding = 1, r32f) writeonly uniform highp image2D target_depth;
-uniform highp mat4 P, M, V;
-uniform highp float background_zv, background_w;
-uniform ivec2 size;
-
-bool positive_inf(highp float v) { return floatBitsToUint(v) == 0x7f800000u; }
-bool finite(highp float v) { return (floatBitsToUint(v) & 0x7f800000u) != 0x7f800000u; }
-bool nonnegative(highp float z) {
-    uint b = floatBitsToUint(z);
-    return b <= 0x7f800000u || b == 0x80000000u;
-}
-highp float row(highp mat4 m, int r, highp float x, highp float y, highp float z, highp float w) {
-    PRECISE highp float v = (m[0][r] * x + m[1][r] * y) + (m[2][r] * z + m[3][r] * w);
-    return v;
-}
+uniform highp mat4 M, V;
 
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     if (p.x >= size.x || p.y >= size.y) return;
-    highp float fw = float(size.x), fh = float(size.y);
     highp float z = texelFetch(depth_map, p, 0).r;
-    PRECISE highp float py = float(p.y) + 0.5, ny = 1.0 - 2.0 * py / fh;
-    PRECISE highp float px = float(p.x) + 0.5, nx = 2.0 * px / fw - 1.0;
-    bool background = positive_inf(z);
-    highp float zv = background ? background_zv : -z;
-    highp float w = background ? background_w : 1.0;
-    PRECISE highp float wc = P[2][3] * zv + P[3][3] * w;
-    PRECISE highp float vx = (nx * wc - P[2][0] * zv - P[3][0] * w) / P[0][0];
-    PRECISE highp float vy = (ny * wc - P[2][1] * zv - P[3][1] * w) / P[1][1];
-    PRECISE highp float cw = row(M, 3, vx, vy, zv, w);
-    PRECISE highp float lx = (row(M, 0, vx, vy, zv, w) / cw * 0.5 + 0.5) * fw;
-    PRECISE highp float ly = (0.5 - 0.5 * row(M, 1, vx, vy, zv, w) / cw) * fh;
-    PRECISE highp float tz = -row(V, 2, vx, vy, zv, w);
-    bool ok = nonnegative(z) && cw > 0.0 && finite(lx) && finite(ly);
+    highp vec4 v = view_point(p, z);
+    highp float cw;
+    highp vec2 l = seen_at(M, v, cw);
+    PRECISE highp float tz = -row(V, 2, v);
+    bool ok = nonnegative(z) && cw > 0.0 && finite(l.x) && finite(l.y);
     highp float nan = uintBitsToFloat(0x7fc00000u);
-    imageStore(displacement, p, ok ? vec4(lx - px, ly - py, 0.0, 0.0) : vec4(nan));
-    imageStore(target_depth, p, vec4(ok ? (background ? uintBitsToFloat(0x7f800000u) : tz) : nan));
+    imageStore(displacement, p, ok ? vec4(l - center(p), 0.0, 0.0) : vec4(nan));
+    imageStore(target_depth, p, vec4(ok ? (positive_inf(z) ? uintBitsToFloat(0x7f800000u) : tz) : nan));
 }
 )";
 
@@ -61,7 +39,6 @@ constexpr const char* kFinish = R"(
 layout(binding = 0) uniform highp sampler2D filled;
 layout(binding = 0, rgba32f) writeonly uniform highp image2D out_color;
 uniform ivec2 size;
-bool finite(highp float v) { return (floatBitsToUint(v) & 0x7f800000u) != 0x7f800000u; }
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     if (p.x >= size.x || p.y >= size.y) return;
@@ -89,8 +66,8 @@ Status check_options(const stereo::StereoOptions& o) {
 
 Status create_stereo_programs(ContextState& s) {
     const std::string header = kComputeHeader;
-    REPRISE_TRY(gl::link_compute((header + kDisplacement).c_str(), "stereo displacement",
-                                 s.displacement_program));
+    REPRISE_TRY(gl::link_compute((header + kViewPoint + kDisplacement).c_str(),
+                                 "stereo displacement", s.displacement_program));
     return gl::link_compute((header + kFinish).c_str(), "stereo finish", s.finish_program);
 }
 
@@ -113,15 +90,10 @@ Status eye_passes(ContextState& s, GLuint color, GLuint depth, int w, int h, con
     s.bind_inputs({depth});
     glBindImageTexture(0, s.displacement.name, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     glBindImageTexture(1, s.target_depth.name, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
-    glUniformMatrix4fv(glGetUniformLocation(program, "P"), 1, GL_FALSE,
-                       &unproject.projection()[0][0]);
+    set_view_point(program, unproject, w, h);
     glUniformMatrix4fv(glGetUniformLocation(program, "M"), 1, GL_FALSE, &to_target.to_clip()[0][0]);
     glUniformMatrix4fv(glGetUniformLocation(program, "V"), 1, GL_FALSE, &to_target.to_view()[0][0]);
-    glUniform1f(glGetUniformLocation(program, "background_zv"),
-                unproject.perspective() ? -1.0f : -unproject.far_plane());
-    glUniform1f(glGetUniformLocation(program, "background_w"),
-                unproject.perspective() ? 0.0f : 1.0f);
-    run(program, w, h);
+    dispatch(w, h);
 
     std::size_t covered = 0;
     REPRISE_TRY(splat_passes(s, {color, s.target_depth.name, s.displacement.name, w, h}, 1.0f,

@@ -160,27 +160,34 @@ std::size_t static_layer(const GBufferView& f, const glm::mat4& to_view,
     return dynamic.load();
 }
 
-void extrapolate_frame(const GBufferView& f, float s, float motion_scale,
-                       const FrucOptions& options, FrucScratch& scratch, Frame& out,
-                       FrucCounters& counters) {
-    if (!has_projection(f.camera)) {
-        extrapolate_along_motion(f, s, motion_scale, options, scratch, out, counters);
-        return;
-    }
+Status extrapolate_frame(const GBufferView& f, float s, float motion_scale,
+                         const FrucOptions& options, FrucScratch& scratch, Frame& out,
+                         FrucCounters& counters) {
+    if (!has_projection(f.camera))
+        return extrapolate_to_camera(f, glm::mat4(1.0f), glm::mat4(1.0f), s, motion_scale, options,
+                                     scratch, out, counters);
     const Camera& c = f.camera;
     Camera previous = c;
     previous.view = c.prev_view;
     previous.projection = c.prev_projection;
     previous.time = c.time - 1.0;
     const Camera future = camera_between(previous, c, 1.0f + s);
-    extrapolate_to_camera(f, future.view, future.projection, s, motion_scale, options, scratch, out,
-                          counters);
+    return extrapolate_to_camera(f, future.view, future.projection, s, motion_scale, options,
+                                 scratch, out, counters);
 }
 
-void extrapolate_to_camera(const GBufferView& given, const glm::mat4& future_view,
-                           const glm::mat4& future_projection, float s, float motion_scale,
-                           const FrucOptions& options, FrucScratch& scratch, Frame& out,
-                           FrucCounters& counters) {
+Status extrapolate_to_camera(const GBufferView& given, const glm::mat4& future_view,
+                             const glm::mat4& future_projection, float s, float motion_scale,
+                             const FrucOptions& options, FrucScratch& scratch, Frame& out,
+                             FrucCounters& counters) {
+    if (options.backend)
+        return options.backend->extrapolate(warp_input(given, 0, options, scratch, counters),
+                                            future_view, future_projection, s, motion_scale,
+                                            options, out, counters);
+    if (!has_projection(given.camera)) {
+        extrapolate_along_motion(given, s, motion_scale, options, scratch, out, counters);
+        return {};
+    }
     const GBufferView f = warp_input(given, 0, options, scratch, counters);
     const int w = f.width(), h = f.height();
     // One warp of the whole frame: static pixels (whose motion the camera alone explains) to
@@ -227,6 +234,7 @@ void extrapolate_to_camera(const GBufferView& given, const glm::mat4& future_vie
             for (int x = 0; x < w; ++x) m[x] *= to_backward;
         }
     });
+    return {};
 }
 
 }  // namespace reprise::warp

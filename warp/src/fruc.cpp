@@ -379,6 +379,13 @@ Status FrameRateConverter::send_frame(const Frame& given, Frame* owned) {
     // What an error of the backend puts back: the converter as it was before this frame.
     const FrucCounters counters_before = st.counters;
     const std::size_t queued_before = st.ready.size();
+    auto undone_unless = [&](const Status& made) {
+        if (!made.ok()) {
+            st.ready.truncate(queued_before);
+            st.counters = counters_before;
+        }
+        return made;
+    };
     NonfiniteCounts found;
     const Frame& frame = owned ? *owned : st.nonfinite.clean(given, found);
     if (owned) found = st.nonfinite.repair(*owned);
@@ -426,8 +433,9 @@ Status FrameRateConverter::send_frame(const Frame& given, Frame* owned) {
                     // The new shot starts at the new frame: the frames before it belong to the
                     // old one, continued from its last frame alone; nothing is blended across.
                     Frame& out = st.ready.push();
-                    extrapolate_frame(a, s, scale, st.resolve(predicted, s, FrucMode::Extrapolate),
-                                      st.scratch, out, st.counters);
+                    REPRISE_TRY(undone_unless(extrapolate_frame(
+                        a, s, scale, st.resolve(predicted, s, FrucMode::Extrapolate), st.scratch,
+                        out, st.counters)));
                     st.finish(out, a_before, a.camera, a.fps, 1.0f + s, 1.0f + s - 1.0f / k_max);
                 } else if (!warpable || a.depth.empty() || a.motion.empty()) {
                     st.emit_copy(s < 0.5f ? a.view() : frame.view(), a.camera, frame.camera, fps,
@@ -440,15 +448,10 @@ Status FrameRateConverter::send_frame(const Frame& given, Frame* owned) {
                     Frame& out = st.ready.push();
                     if (st.options.backend && a_warpable) {
                         // The inputs the CPU's warps would take.
-                        const Status made = st.options.backend->interpolate(
+                        REPRISE_TRY(undone_unless(st.options.backend->interpolate(
                             warp_input(a, 0, st.options, st.scratch, st.counters),
                             warp_input(frame, 1, st.options, st.scratch, st.counters), s, out,
-                            st.counters);
-                        if (!made.ok()) {
-                            st.ready.truncate(queued_before);
-                            st.counters = counters_before;
-                            return made;
-                        }
+                            st.counters)));
                     } else {
                         interpolate_frame(
                             a, frame, s, a_warpable, scale,
@@ -474,8 +477,9 @@ Status FrameRateConverter::send_frame(const Frame& given, Frame* owned) {
                 st.emit_copy(frame, before, frame.camera, fps, 1.0f + s);
             } else {
                 Frame& out = st.ready.push();
-                extrapolate_frame(frame, s, scale, st.resolve(predicted, s, FrucMode::Extrapolate),
-                                  st.scratch, out, st.counters);
+                REPRISE_TRY(undone_unless(extrapolate_frame(
+                    frame, s, scale, st.resolve(predicted, s, FrucMode::Extrapolate), st.scratch,
+                    out, st.counters)));
                 st.finish(out, before, frame.camera, fps, 1.0f + s, 1.0f + s - 1.0f / k_max);
             }
             st.attach_ui(st.ready.back(), frame, true);

@@ -98,10 +98,11 @@ void interpolate_frame(const GBufferView& a, const GBufferView& b, float s, bool
 
 // Frame s frame periods after f: static pixels (camera-only motion, Andreev's test) where the
 // camera s periods on sees them, moving ones s periods along their motion, in one warp, holes
-// filled; its backward motion per input period times motion_scale.
-void extrapolate_frame(const GBufferView& f, float s, float motion_scale,
-                       const FrucOptions& options, FrucScratch& scratch, Frame& out,
-                       FrucCounters& counters);
+// filled; its backward motion per input period times motion_scale. Made by options.backend when
+// one is set (its error returned).
+Status extrapolate_frame(const GBufferView& f, float s, float motion_scale,
+                         const FrucOptions& options, FrucScratch& scratch, Frame& out,
+                         FrucCounters& counters);
 
 // The static-layer test of f against its own previous camera: static pixels (the camera alone
 // explains their motion within `tolerance` px) keep their depth in depth_out and get their
@@ -130,10 +131,11 @@ void invert_motion(const GBufferView& b, float tolerance, Image<float>& static_d
                    Image<glm::vec2>& inverted, Image<float>& depth);
 
 // The same towards an explicit camera (view, projection): static pixels land where that camera
-// sees them, moving ones go s periods along their motion (constant screen velocity).
-void extrapolate_to_camera(const GBufferView& f, const glm::mat4& future_view,
-                           const glm::mat4& future_projection, float s, float motion_scale,
-                           const FrucOptions& options, FrucScratch& scratch, Frame& out,
-                           FrucCounters& counters);
+// sees them, moving ones go s periods along their motion (constant screen velocity). A frame
+// without a projection goes along its motion alone (view and projection unused).
+Status extrapolate_to_camera(const GBufferView& f, const glm::mat4& future_view,
+                             const glm::mat4& future_projection, float s, float motion_scale,
+                             const FrucOptions& options, FrucScratch& scratch, Frame& out,
+                             FrucCounters& counters);
 
 }  // namespace reprise::warp

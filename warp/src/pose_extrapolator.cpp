@@ -17,22 +17,28 @@ PoseExtrapolator::~PoseExtrapolator() = default;
 PoseExtrapolator::PoseExtrapolator(PoseExtrapolator&&) noexcept = default;
 PoseExtrapolator& PoseExtrapolator::operator=(PoseExtrapolator&&) noexcept = default;
 
-void PoseExtrapolator::extrapolate(const GBufferView& frame, const glm::mat4& view,
-                                   const glm::mat4& projection, float periods, Frame& out,
-                                   uint64_t frame_key) {
+Status PoseExtrapolator::extrapolate(const GBufferView& frame, const glm::mat4& view,
+                                     const glm::mat4& projection, float periods, Frame& out,
+                                     uint64_t frame_key) {
     REPRISE_ASSERT(periods >= 0.0f);
     State& s = *state_;
+    s.scratch.input_key[0] = frame_key;
+    const FrucCounters before = s.counters;
+    const Status made = extrapolate_to_camera(frame, view, projection, periods, 1.0f, s.options,
+                                              s.scratch, out, s.counters);
+    if (!made.ok()) {
+        s.counters = before;
+        return made;
+    }
     ++s.counters.inputs;
     ++s.counters.outputs;
-    s.scratch.input_key[0] = frame_key;
-    extrapolate_to_camera(frame, view, projection, periods, 1.0f, s.options, s.scratch, out,
-                          s.counters);
     out.camera = frame.camera;
     out.camera.prev_view = frame.camera.view;
     out.camera.prev_projection = frame.camera.projection;
     out.camera.view = view;
     out.camera.projection = projection;
     out.camera.jitter = glm::vec2(0.0f);
+    return {};
 }
 
 const FrucCounters& PoseExtrapolator::counters() const { return state_->counters; }

@@ -14,14 +14,18 @@
 #include "reprise/net/secure.hpp"
 #include "reprise/net/udp.hpp"
 #include "reprise/net/wire.hpp"
+#include "reprise/warp/fruc.hpp"
 
 namespace reprise::client {
 
 struct StreamClientOptions {
     net::Endpoint server{0x7f000001u, 0};
     std::string secret;
-    std::string scene;           // from the server's catalogue; empty: the server's default
-    bool extrapolate = true;     // false: show the newest decoded frame (frame repetition)
+    std::string scene;        // from the server's catalogue; empty: the server's default
+    bool extrapolate = true;  // false: show the newest decoded frame (frame repetition)
+    // How (warp, fill, a backend such as the GPU's: gpu::FrucBackend, which must outlive the
+    // client and be used from the thread that calls display()); the mode is extrapolate.
+    warp::FrucOptions extrapolation{.mode = warp::FrucMode::Extrapolate};
     bool inject_faults = false;  // put the in-process fault injector on both directions
     net::FaultOptions uplink, downlink;
     double reconnect_after_s = 2.0;  // silence from the server that ends the connection
@@ -38,6 +42,9 @@ struct StreamClientStats {
     std::size_t key_frame_requests = 0;
     std::size_t datagrams_received = 0, datagrams_dropped = 0, bytes_received = 0;
     std::size_t fec_recovered = 0;
+    // Display frames the extrapolation's backend failed on (shown as decoded) and its last error.
+    std::size_t extrapolation_errors = 0;
+    std::string extrapolation_error;
     int64_t last_rtt_us = 0;   // pose sampled -> frame decoded
     std::string refused;       // the server's reason when it refused the session
     bool server_full = false;  // refused by the server's --max-sessions (docs/protocol.md)

@@ -13,6 +13,7 @@
 #include "reprise/core/status.hpp"
 #include "reprise/stereo/synthesize.hpp"
 #include "reprise/warp/fill.hpp"
+#include "reprise/warp/fruc.hpp"
 #include "reprise/warp/reproject.hpp"
 #include "reprise/warp/splat.hpp"
 
@@ -40,6 +41,15 @@ struct GBufferTextures {
 // repaired in its inputs (as the CPU converter does).
 struct InterpolateStats {
     std::size_t covered_a = 0, covered_b = 0, holes = 0;
+    warp::FillStats fill;
+    NonfiniteCounts nonfinite;
+};
+
+// What an extrapolated frame took: pixels its camera does not explain (carried along their own
+// motion; every pixel when the frame has no camera), covered pixels, pixels nothing covered, the
+// fill's stats (zero when nothing was a hole) and the NaN/Inf the CPU-image entry repaired.
+struct ExtrapolateStats {
+    std::size_t moving = 0, covered = 0, holes = 0;
     warp::FillStats fill;
     NonfiniteCounts nonfinite;
 };
@@ -113,6 +123,26 @@ public:
     Status interpolate(const GBufferTextures& a, unsigned a_color, const GBufferTextures& b,
                        unsigned b_color, float s, unsigned out_color, unsigned out_depth,
                        InterpolateStats& stats, const warp::SplatOptions& options = {});
+
+    // warp::PoseExtrapolator (and the converter's extrapolation) for FrucOptions with warp Splat
+    // and fill PullPush or None (others are an error): `frame` as seen by (view, projection)
+    // `periods` frame periods after it. Static pixels (their motion within
+    // options.static_tolerance px of the camera's alone) go where that camera sees them, the
+    // others `periods` along their own motion, in one splat; pull-push over what nothing covers.
+    // A frame without a projection goes along its motion alone (view and projection unused).
+    // out gets colour, depth and backward motion per period times motion_scale (0 at periods
+    // 0); out.normal and id cleared, out.camera untouched. NaN/Inf are repaired first, as on the
+    // CPU; the silhouettes are warped as they are (the CPU widens them before a backend).
+    Status extrapolate(const GBufferView& frame, const glm::mat4& view, const glm::mat4& projection,
+                       float periods, Frame& out, ExtrapolateStats& stats,
+                       const warp::FrucOptions& options, float motion_scale = 1.0f);
+    // The same on textures: `color` GL_RGBA32F beside frame's depth and motion; `out_color`
+    // (GL_RGBA32F), `out_depth` (GL_R32F) and `out_motion` (GL_RGBA32F with the motion in RG, as
+    // GL ES has no RG32F image format; 0: not written), all of the frame's size. No repair.
+    Status extrapolate(const GBufferTextures& frame, unsigned color, const glm::mat4& view,
+                       const glm::mat4& projection, float periods, unsigned out_color,
+                       unsigned out_depth, unsigned out_motion, ExtrapolateStats& stats,
+                       const warp::FrucOptions& options, float motion_scale = 1.0f);
 
 private:
     Context();

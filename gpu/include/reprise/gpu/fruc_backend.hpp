@@ -1,7 +1,8 @@
 #pragma once
-// The GPU as the maker of warp::FrameRateConverter's in-between frames (`reprise fruc --backend
-// gles`, Python's Converter(backend="gles")): the converter keeps order, cuts, still pairs,
-// repair and UI on the CPU; each in-between frame is Context::interpolate.
+// The GPU as the maker of warp::FrameRateConverter's and warp::PoseExtrapolator's frames
+// (`reprise fruc --backend gles`, `reprise connect --backend gles`, Python's
+// Converter(backend="gles")): the caller keeps order, cuts, still pairs, repair and UI on the
+// CPU; each in-between frame is Context::interpolate, each extrapolated one Context::extrapolate.
 #include <cstddef>
 
 #include "reprise/gpu/context.hpp"
@@ -9,13 +10,14 @@
 
 namespace reprise::gpu {
 
-class FrucBackend final : public warp::InterpolationBackend {
+class FrucBackend final : public warp::WarpBackend {
 public:
     // `context` must outlive the backend.
     explicit FrucBackend(Context& context, const warp::SplatOptions& splat = {})
         : context_(context), splat_(splat) {}
-    // Interpolation with warp splat (these splat options), fill pull-push, true motion and
-    // refinement off: what Context::interpolate makes the CPU's frame for.
+    // Warp splat with these splat options; interpolation with fill pull-push, true motion and
+    // refinement off, extrapolation with fill pull-push or none: what the GPU makes the CPU's
+    // frames for.
     static Status check(const warp::FrucOptions& options, const warp::SplatOptions& splat = {});
     Status supports(const warp::FrucOptions& options) const override {
         return check(options, splat_);
@@ -23,12 +25,18 @@ public:
     // Colour and depth; the made frame carries no motion.
     Status interpolate(const GBufferView& a, const GBufferView& b, float s, Frame& out,
                        warp::FrucCounters& counters) override;
+    // Colour, depth and motion.
+    Status extrapolate(const GBufferView& f, const glm::mat4& view, const glm::mat4& projection,
+                       float periods, float motion_scale, const warp::FrucOptions& options,
+                       Frame& out, warp::FrucCounters& counters) override;
 
-    // The phases of every frame made so far, summed, and how many.
+    // The phases of every frame made so far (interpolated or extrapolated), summed, and how many.
     const Timings& total() const { return total_; }
     std::size_t frames() const { return frames_; }
 
 private:
+    // Adds the last call's timings and what its frame took.
+    void count(std::size_t holes, bool filled, warp::FrucCounters& counters);
     Context& context_;
     warp::SplatOptions splat_;
     Timings total_;

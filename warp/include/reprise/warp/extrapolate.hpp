@@ -17,11 +17,13 @@ public:
     PoseExtrapolator& operator=(PoseExtrapolator&&) noexcept;
 
     // `out` gets colour, depth and motion of `frame` as seen by (view, projection) `periods`
-    // frame periods after it (periods >= 0; its motion is per period). Scratch is sized once.
+    // frame periods after it (periods >= 0; its motion is per period); a frame without a
+    // projection goes along its motion alone. Scratch is sized once.
     // A non-zero `frame_key`, the same for the same frame, lets the work that depends on the
     // frame alone (its widened silhouettes) be done once for all the instants made from it.
-    void extrapolate(const GBufferView& frame, const glm::mat4& view, const glm::mat4& projection,
-                     float periods, Frame& out, uint64_t frame_key = 0);
+    // With FrucOptions::backend the backend makes it; its error is returned (counters unchanged).
+    Status extrapolate(const GBufferView& frame, const glm::mat4& view, const glm::mat4& projection,
+                       float periods, Frame& out, uint64_t frame_key = 0);
     const FrucCounters& counters() const;
 
 private:

@@ -89,18 +89,26 @@ struct RefineOptions {
 struct FrucCounters;
 struct FrucOptions;
 
-// Makes the in-between frames of a FrameRateConverter elsewhere than on the CPU (a GPU:
-// gpu::FrucBackend). The converter keeps the rest — order, cuts, still pairs, repair, UI —
-// and asks the backend only for what interpolate_frame would make with both sides warpable:
-// the frame at s between a and b, colour and depth (its motion may stay empty). An error from it
-// ends send() with that error and leaves the converter as it was before that send().
-class InterpolationBackend {
+// Makes the warped frames of a FrameRateConverter or a PoseExtrapolator elsewhere than on the
+// CPU (a GPU: gpu::FrucBackend). The caller keeps the rest — order, cuts, still pairs, repair,
+// widened silhouettes, UI — and hands the backend the inputs its own warps would take. An error
+// from it ends send() (or extrapolate()) with that error and leaves the converter as it was
+// before that send().
+class WarpBackend {
 public:
-    virtual ~InterpolationBackend() = default;
-    // The options the backend makes the same frame for as the CPU; an error says why not.
+    virtual ~WarpBackend() = default;
+    // The options the backend makes the same frames for as the CPU; an error says why not.
     virtual Status supports(const FrucOptions& options) const = 0;
+    // What interpolate_frame makes with both sides warpable: the frame at s between a and b,
+    // colour and depth (its motion may stay empty).
     virtual Status interpolate(const GBufferView& a, const GBufferView& b, float s, Frame& out,
                                FrucCounters& counters) = 0;
+    // What the CPU's extrapolation makes: f as seen by (view, projection) `periods` frame
+    // periods after it (without a projection on f: along its motion alone), colour, depth and
+    // backward motion per period times motion_scale.
+    virtual Status extrapolate(const GBufferView& f, const glm::mat4& view,
+                               const glm::mat4& projection, float periods, float motion_scale,
+                               const FrucOptions& options, Frame& out, FrucCounters& counters) = 0;
 };
 
 struct FrucOptions {
@@ -136,7 +144,7 @@ struct FrucOptions {
     bool composite_ui = false;
     AutoOptions auto_choice;  // warp or fill Auto
     // Not owned; null: the CPU. It must outlive the converter.
-    InterpolationBackend* backend = nullptr;
+    WarpBackend* backend = nullptr;
 };
 
 // What was done and what was left out because the frame did not need it.

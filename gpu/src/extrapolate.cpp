@@ -1,0 +1,199 @@
+// Extrapolation on the GPU: warp's extrapolate_to_camera for the splat. The static-layer test
+// (warp's static_layer_row_reference: a pixel is static when the camera alone explains its
+// motion) gives each pixel its displacement, to where the target camera sees it or `periods`
+// along its own motion; one splat carries colour, depth and that displacement; pull-push fills
+// what nothing covers; the carried displacement becomes backward motion per period.
+#include <chrono>
+#include <cmath>
+#include <string>
+
+#include "state.hpp"
+
+namespace reprise::gpu {
+
+namespace {
+
+constexpr const char* kStaticLayer = R"(
+layout(binding = 0) uniform highp sampler2D depth_map;
+layout(binding = 1) uniform highp sampler2D motion_map;
+layout(binding = 0, rgba32f) writeonly uniform highp image2D displacement;
+layout(std430, binding = 0) buffer Counts { uint counts[]; };
+uniform highp mat4 to_previous, to_target;
+uniform highp float tolerance2, periods;
+
+// Whether pixel p moves on its own; its displacement written either way.
+bool moving(ivec2 p) {
+    highp float z = texelFetch(depth_map, p, 0).r;
+    highp vec2 m = texelFetch(motion_map, p, 0).rg;
+    highp vec4 v = view_point(p, z);
+    highp float before_w, later_w;
+    highp vec2 before = seen_at(to_previous, v, before_w), later = seen_at(to_target, v, later_w);
+    highp vec2 c = center(p);
+    PRECISE highp vec2 e = before - c - m;
+    PRECISE highp float e2 = e.x * e.x + e.y * e.y;
+    bool nan_depth = (floatBitsToUint(z) & 0x7fffffffu) > 0x7f800000u;
+    bool still = !nan_depth && finite(m.x) && finite(m.y) && before_w > 0.0 && later_w > 0.0 &&
+                 e2 <= tolerance2;
+    PRECISE highp vec2 along = -periods * m;
+    imageStore(displacement, p, vec4(still ? later - c : along, 0.0, 0.0));
+    return !still;
+}
+
+void main() {
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    bool inside = p.x < size.x && p.y < size.y;
+    COUNT_IN_GROUP(inside && moving(p), counts[0])
+}
+)";
+
+Status check_options(const warp::FrucOptions& o) {
+    if (o.warp != warp::WarpMethod::Splat)
+        return Status::error("gpu extrapolate: the GPU warps with warp splat only (docs/gpu.md)");
+    if (o.fill != warp::FillMethod::PullPush && o.fill != warp::FillMethod::None)
+        return Status::error("gpu extrapolate: the GPU fills with pullpush or none only");
+    if (o.splat.footprint != 1 && o.splat.footprint != 2)
+        return Status::error("gpu extrapolate: splat footprint " +
+                             std::to_string(o.splat.footprint) + ": expected 1 or 2");
+    return {};
+}
+
+Status check_periods(float periods) {
+    if (!(periods >= 0.0f) || !std::isfinite(periods))
+        return Status::error("gpu extrapolate: periods must be finite and >= 0");
+    return {};
+}
+
+}  // namespace
+
+Status create_extrapolate_programs(ContextState& s) {
+    s.extrapolate_counts = s.make_counters(sizeof(GLuint));
+    return gl::link_compute((std::string(kComputeHeader) + kViewPoint + kStaticLayer).c_str(),
+                            "static layer", s.static_layer_program);
+}
+
+Status extrapolate_passes(ContextState& s, const SplatTextures& frame, const Camera& camera,
+                          const glm::mat4& view, const glm::mat4& projection, float periods,
+                          float motion_scale, const warp::FrucOptions& options, GLuint out_color,
+                          GLuint out_depth, GLuint out_motion, ExtrapolateStats& stats) {
+    const int w = frame.width, h = frame.height;
+    const std::size_t pixels = std::size_t(w) * std::size_t(h);
+    s.displacement.ensure(GL_RGBA32F, w, h);
+    s.eye_color.ensure(GL_RGBA32F, w, h);
+    s.hit.ensure(GL_R32UI, w, h);
+    SplatTextures along = frame;
+    float factor = 1.0f, to_backward = periods > 1e-6f ? -motion_scale / periods : 0.0f;
+    if (has_projection(camera)) {
+        const StaticReprojection to_previous = camera_only_motion(camera, w, h);
+        const StaticReprojection to_target(camera, view, projection, w, h);
+        if (!to_previous.unprojector().axis_aligned())
+            return Status::error("gpu extrapolate: the frame's projection is skewed");
+        const GLuint program = s.static_layer_program;
+        glUseProgram(program);
+        s.bind_inputs({frame.depth, frame.motion});
+        glBindImageTexture(0, s.displacement.name, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+        ContextState::reset_counters(s.extrapolate_counts, 1);
+        set_view_point(program, to_previous.unprojector(), w, h);
+        glUniformMatrix4fv(glGetUniformLocation(program, "to_previous"), 1, GL_FALSE,
+                           &to_previous.to_clip()[0][0]);
+        glUniformMatrix4fv(glGetUniformLocation(program, "to_target"), 1, GL_FALSE,
+                           &to_target.to_clip()[0][0]);
+        const float tolerance = options.static_tolerance;
+        glUniform1f(glGetUniformLocation(program, "tolerance2"), tolerance * tolerance);
+        glUniform1f(glGetUniformLocation(program, "periods"), periods);
+        dispatch(w, h);
+        ContextState::unbind_inputs();
+        glUseProgram(0);
+        GLuint moving = 0;
+        s.read_counters(s.extrapolate_counts, &moving, sizeof moving);
+        stats.moving = moving;
+        along.motion = s.displacement.name;
+    } else {
+        // Without a camera nothing tells static from moving: every pixel follows its motion.
+        stats.moving = pixels;
+        factor = -periods;
+        to_backward = motion_scale;
+    }
+    REPRISE_TRY(splat_passes(s, along, factor, options.splat, w, h, s.eye_color.name, out_depth,
+                             s.hit.name, out_motion != 0, stats.covered));
+    stats.holes = pixels - stats.covered;
+    if (stats.holes && options.fill == warp::FillMethod::PullPush)
+        REPRISE_TRY(
+            fill_passes(s, s.eye_color.name, s.hit.name, out_depth, w, h, out_color, stats.fill));
+    else
+        copy_scaled(s, s.eye_color.name, out_color, w, h, 1.0f);
+    if (out_motion) copy_scaled(s, s.splat_motion.name, out_motion, w, h, to_backward);
+    return gl::check_errors("gpu extrapolate");
+}
+
+Status Context::extrapolate(const GBufferView& given, const glm::mat4& view,
+                            const glm::mat4& projection, float periods, Frame& out,
+                            ExtrapolateStats& stats, const warp::FrucOptions& options,
+                            float motion_scale) {
+    timings_ = {};
+    stats = {};
+    REPRISE_TRY(check_options(options));
+    REPRISE_TRY(check_periods(periods));
+    ContextState& s = *state_;
+    const GBufferView frame = s.extrapolate_repair.clean(given, stats.nonfinite);
+    const int w = frame.width(), h = frame.height();
+    if (frame.depth.width != w || frame.depth.height != h || frame.motion.width != w ||
+        frame.motion.height != h)
+        return Status::error("gpu extrapolate: the frame needs depth and motion of its size");
+    out.normal.clear();
+    out.id.clear();
+    if (w <= 0 || h <= 0) return {};
+    REPRISE_TRY(s.gl->acquire());
+    auto t = std::chrono::steady_clock::now();
+    s.source_color.ensure(GL_RGBA32F, w, h);
+    s.source_depth.ensure(GL_R32F, w, h);
+    s.source_motion.ensure(GL_RG32F, w, h);
+    s.upload(s.source_color, frame.color.data, frame.color.stride);
+    s.upload(s.source_depth, frame.depth.data, frame.depth.stride);
+    s.upload(s.source_motion, frame.motion.data, frame.motion.stride);
+    s.color.ensure(GL_RGBA32F, w, h);
+    s.depth.ensure(GL_R32F, w, h);
+    s.made_motion.ensure(GL_RGBA32F, w, h);
+    timings_.upload_ms = finish_ms(t);
+    REPRISE_TRY(extrapolate_passes(
+        s, {s.source_color.name, s.source_depth.name, s.source_motion.name, w, h}, frame.camera,
+        view, projection, periods, motion_scale, options, s.color.name, s.depth.name,
+        s.made_motion.name, stats));
+    timings_.compute_ms = finish_ms(t);
+    s.download_made(out);
+    out.motion.resize(w, h);
+    s.download_channels(s.made_motion, &out.motion.data()->x, 2, w);
+    REPRISE_TRY(gl::check_errors("gpu extrapolate download"));
+    timings_.download_ms = finish_ms(t);
+    return {};
+}
+
+Status Context::extrapolate(const GBufferTextures& frame, unsigned color, const glm::mat4& view,
+                            const glm::mat4& projection, float periods, unsigned out_color,
+                            unsigned out_depth, unsigned out_motion, ExtrapolateStats& stats,
+                            const warp::FrucOptions& options, float motion_scale) {
+    timings_ = {};
+    stats = {};
+    REPRISE_TRY(check_options(options));
+    REPRISE_TRY(check_periods(periods));
+    ContextState& s = *state_;
+    REPRISE_TRY(s.gl->acquire());
+    const int w = frame.width, h = frame.height;
+    if (w <= 0 || h <= 0)
+        return Status::error("gpu extrapolate: texture size " + std::to_string(w) + "x" +
+                             std::to_string(h) + " must be positive");
+    REPRISE_TRY(check_texture(frame.depth, GL_R32F, w, h, "frame depth"));
+    REPRISE_TRY(check_texture(frame.motion, GL_RG32F, w, h, "frame motion"));
+    REPRISE_TRY(check_texture(color, GL_RGBA32F, w, h, "frame colour"));
+    REPRISE_TRY(check_texture(out_color, GL_RGBA32F, w, h, "output colour"));
+    REPRISE_TRY(check_texture(out_depth, GL_R32F, w, h, "output depth"));
+    if (out_motion) REPRISE_TRY(check_texture(out_motion, GL_RGBA32F, w, h, "output motion"));
+    if (out_color == color) return Status::error("gpu extrapolate: the output is the input colour");
+    auto t = std::chrono::steady_clock::now();
+    REPRISE_TRY(extrapolate_passes(s, {color, frame.depth, frame.motion, w, h}, frame.camera, view,
+                                   projection, periods, motion_scale, options, out_color,
+                                   out_depth, out_motion, stats));
+    timings_.compute_ms = finish_ms(t);
+    return {};
+}
+
+}  // namespace reprise::gpu
