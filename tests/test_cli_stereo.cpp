@@ -167,6 +167,25 @@ TEST(CliStereo, FrucOnTheGpuBackendMakesTheCpusSplatFrames) {
     Frame made;
     ASSERT_TRUE(read_frame(frame_path(gles, 1), made).ok());
     EXPECT_TRUE(made.motion.empty());
+    // Extrapolated on the GPU: the CPU's frames, motion included.
+    const std::vector<std::string> ahead = {"--in",        in,         "--warp", "splat", "--mode",
+                                            "extrapolate", "--factor", "3"};
+    const std::string cpu_ahead = (dir / "cpu_ahead").string(),
+                      gles_ahead = (dir / "gles_ahead").string();
+    std::vector<std::string> args = ahead;
+    args.insert(args.end(), {"--out", cpu_ahead});
+    ASSERT_EQ(run_command(cli::command_fruc, args), 0);
+    args = ahead;
+    args.insert(args.end(), {"--backend", "gles", "--out", gles_ahead});
+    ASSERT_EQ(run_command(cli::command_fruc, args), 0);
+    for (int i = 0; i < 9; ++i)
+        EXPECT_GE(psnr_of(frame_path(cpu_ahead, i), frame_path(gles_ahead, i)), 50.0)
+            << "extrapolated frame " << i;
+    Frame cpu_made;
+    ASSERT_TRUE(read_frame(frame_path(cpu_ahead, 2), cpu_made).ok());
+    ASSERT_TRUE(read_frame(frame_path(gles_ahead, 2), made).ok());
+    ASSERT_FALSE(made.motion.empty());
+    EXPECT_EQ(made.motion(80, 45), cpu_made.motion(80, 45));
     const std::string refused = (dir / "refused").string();
     EXPECT_EQ(run_command(cli::command_fruc,
                           {"--in", in, "--backend", "gles", "--warp", "splat", "--out", refused}),

@@ -50,6 +50,31 @@ TEST(CliStream, ServeAndConnectWriteDisplayedFrames) {
     EXPECT_GE(std::count(log.begin(), log.end(), '\n'), 10) << log;
 }
 
+// --backend gles: every display frame extrapolated by the GPU (llvmpipe here), none shown as
+// decoded because the backend failed.
+TEST(CliStream, ConnectExtrapolatesOnTheGpuBackend) {
+    const fs::path out =
+        reprise::test::fresh_directory(fs::temp_directory_path() / "reprise-cli-stream-gles");
+    const std::string port = std::to_string(20000 + (getpid() + 7) % 20000);
+    Outcome served;
+    std::thread server([&] {
+        served = run_reprise(
+            "serve --pin 445566 --listen 127.0.0.1:" + port + " --size 96x64 --duration 5", 60);
+    });
+    const Outcome connected = run_reprise("connect 127.0.0.1:" + port +
+                                              " --pin 445566 --display-rate 30 --duration 2 "
+                                              "--backend gles --out " +
+                                              out.string(),
+                                          60);
+    server.join();
+    EXPECT_EQ(connected.status, 0) << connected.output;
+    EXPECT_EQ(served.status, 0) << served.output;
+    EXPECT_NE(connected.output.find("extrapolated on the GPU"), std::string::npos)
+        << connected.output;
+    EXPECT_EQ(connected.output.find("shown as decoded"), std::string::npos) << connected.output;
+    EXPECT_TRUE(fs::exists(out / "frame_00000.exr")) << connected.output;
+}
+
 TEST(CliStream, BadArgumentsAreRefused) {
     auto expect_refused = [](const std::string& args, const std::string& mention) {
         const Outcome r = run_reprise(args, 30);
@@ -64,6 +89,7 @@ TEST(CliStream, BadArgumentsAreRefused) {
                    "never a path");
     expect_refused("connect 127.0.0.1 --pin 123456", "HOST:PORT");
     expect_refused("connect 127.0.0.1:9", "--pin");
+    expect_refused("connect 127.0.0.1:9 --pin 123456 --backend cuda --duration 1", "--backend");
     // Short PINs only when asked for; one source of the PIN at a time.
     expect_refused("serve --listen 127.0.0.1:0 --pin 1234 --duration 1", "--allow-weak-pin");
     expect_refused("connect 127.0.0.1:9 --pin 1234 --duration 1", "--allow-weak-pin");

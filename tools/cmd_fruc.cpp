@@ -257,9 +257,9 @@ int command_fruc(int argc, char** argv) {
                 "widen | keep (default widen): pixels beside a nearer surface warp with it, so "
                 "the colour\nanti-aliasing blended into them travels with the silhouette");
     args.option("--backend", &job.backend,
-                "cpu | gles (default cpu); gles: the in-between frames as OpenGL ES compute "
-                "shaders, with\n--warp splat --fill pullpush --refine off --true-motion off "
-                "(made frames carry no motion)");
+                "cpu | gles (default cpu); gles: the made frames as OpenGL ES compute shaders, "
+                "with --warp splat;\ninterpolated with --fill pullpush --refine off --true-motion "
+                "off (they carry no motion),\nextrapolated with --fill pullpush or none");
     args.option("--warp", &job.warp,
                 "reverse | splat | grid | auto (default grid; grid-bicubic, grid-bilinear pick "
                 "its colour\nfetch; auto: chosen per frame)");

@@ -13,6 +13,7 @@
 #include "frame_writer.hpp"
 #include "reprise/client/stream_client.hpp"
 #include "reprise/core/exr.hpp"
+#include "reprise/gpu/fruc_backend.hpp"
 #include "reprise/server/builtin_scenes.hpp"
 #include "reprise/server/renderer.hpp"
 #include "reprise/server/stream_server.hpp"
@@ -154,6 +155,7 @@ struct ConnectJob {
     double display_rate = 120.0, duration = 10.0;
     bool no_extrapolate = false, window = false, interactive = false;
     double loss = 0.0, delay = 0.0, jitter = 0.0;
+    std::string backend = "cpu";
 };
 
 // --poses FILE: lines "t m00 m01 ... m33" (scene time, then the world -> camera matrix column by
@@ -194,6 +196,17 @@ Status run_connect(const ConnectJob& job) {
             "': a name from the server's catalogue (1..32 of [a-z0-9_-]), never a path");
     o.scene = job.scene;
     o.extrapolate = !job.no_extrapolate;
+    // --backend gles: each display frame extrapolated on the GPU (warp splat, pull-push).
+    if (job.backend != "cpu" && job.backend != "gles")
+        return Status::error("--backend '" + job.backend + "': expected cpu or gles");
+    std::unique_ptr<gpu::Context> gpu;
+    std::unique_ptr<gpu::FrucBackend> backend;
+    if (job.backend == "gles") {
+        REPRISE_TRY(gpu::Context::create(gpu));
+        backend = std::make_unique<gpu::FrucBackend>(*gpu);
+        o.extrapolation.warp = warp::WarpMethod::Splat;
+        o.extrapolation.backend = backend.get();
+    }
     if (job.loss > 0 || job.delay > 0 || job.jitter > 0) {
         if (!(job.loss >= 0 && job.loss <= 1)) return Status::error("--loss must be in [0, 1]");
         o.inject_faults = true;
@@ -218,7 +231,9 @@ Status run_connect(const ConnectJob& job) {
     if (job.window || job.interactive) {
         const glm::mat4 start =
             poses.empty() ? server::camera_view(path, scene, 0.0) : poses.front().second;
-        REPRISE_TRY(StreamWindow::open(job.interactive, start, window));
+        // The GPU's context is made current on this thread each display frame: SDL's window
+        // then draws without a GL context of its own.
+        REPRISE_TRY(StreamWindow::open(job.interactive, start, bool(backend), window));
     }
     double last_t = 0.0;
     bool window_open = true;
@@ -281,6 +296,17 @@ Status run_connect(const ConnectJob& job) {
         "mean motion-to-photon %.2f ms, last round trip %.1f ms\n",
         index, st.frames_decoded, st.frames_lost, st.fec_recovered, st.connects,
         index ? latency_sum / index : 0.0, st.last_rtt_us / 1000.0);
+    if (backend && backend->frames() > 0) {
+        const double n = double(backend->frames());
+        std::fprintf(stderr,
+                     "[connect] %zu frames extrapolated on the GPU (%s): upload %.2f, compute "
+                     "%.2f, download %.2f ms a frame\n",
+                     backend->frames(), gpu->description().c_str(), backend->total().upload_ms / n,
+                     backend->total().compute_ms / n, backend->total().download_ms / n);
+    }
+    if (st.extrapolation_errors > 0)
+        std::fprintf(stderr, "[connect] %zu display frames shown as decoded: %s\n",
+                     st.extrapolation_errors, st.extrapolation_error.c_str());
     if (index == 0) return Status::error("no frame was decoded from " + job.server);
     return {};
 }
@@ -350,6 +376,9 @@ int command_connect(int argc, char** argv) {
     args.flag("--interactive", &job.interactive,
               "window with a free camera: WASD, Q/E, arrows, mouse drag");
     args.flag("--no-extrapolate", &job.no_extrapolate, "show the newest decoded frame as it is");
+    args.option("--backend", &job.backend,
+                "cpu | gles (default cpu); gles: each display frame extrapolated by OpenGL ES "
+                "compute shaders\n(warp splat, pull-push)");
     args.option("--loss", &job.loss, "fault injector: random loss each way (0..1)");
     args.option("--delay", &job.delay, "fault injector: round-trip delay in ms");
     args.option("--jitter", &job.jitter, "fault injector: jitter in ms each way");

@@ -36,7 +36,7 @@ struct StreamWindow::State {
 StreamWindow::StreamWindow() : state_(std::make_unique<State>()) {}
 StreamWindow::~StreamWindow() = default;
 
-Status StreamWindow::open(bool interactive, const glm::mat4& start_view,
+Status StreamWindow::open(bool interactive, const glm::mat4& start_view, bool software,
                           std::unique_ptr<StreamWindow>& window) {
     if (SDL_InitSubSystem(SDL_INIT_VIDEO) != 0)
         return Status::error(std::string("SDL2: ") + SDL_GetError());
@@ -45,7 +45,7 @@ Status StreamWindow::open(bool interactive, const glm::mat4& start_view,
     s.window = SDL_CreateWindow("reprise connect", SDL_WINDOWPOS_UNDEFINED, SDL_WINDOWPOS_UNDEFINED,
                                 960, 540, SDL_WINDOW_RESIZABLE);
     if (!s.window) return Status::error(std::string("SDL2 window: ") + SDL_GetError());
-    s.renderer = SDL_CreateRenderer(s.window, -1, 0);
+    s.renderer = SDL_CreateRenderer(s.window, -1, software ? SDL_RENDERER_SOFTWARE : 0);
     if (!s.renderer) return Status::error(std::string("SDL2 renderer: ") + SDL_GetError());
     s.interactive = interactive;
     // The free camera starts where the path's camera is: position and heading of its inverse.

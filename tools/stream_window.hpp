@@ -10,8 +10,9 @@ namespace reprise::cli {
 
 class StreamWindow {
 public:
-    // Fails (a Status, no crash) where SDL2 finds no display.
-    static Status open(bool interactive, const glm::mat4& start_view,
+    // Fails (a Status, no crash) where SDL2 finds no display. `software`: SDL's software
+    // renderer (no GL context of its own, for a thread that makes another GL context current).
+    static Status open(bool interactive, const glm::mat4& start_view, bool software,
                        std::unique_ptr<StreamWindow>& window);
     ~StreamWindow();
 

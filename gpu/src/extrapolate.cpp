@@ -190,8 +190,8 @@ Status Context::extrapolate(const GBufferTextures& frame, unsigned color, const 
     if (out_color == color) return Status::error("gpu extrapolate: the output is the input colour");
     auto t = std::chrono::steady_clock::now();
     REPRISE_TRY(extrapolate_passes(s, {color, frame.depth, frame.motion, w, h}, frame.camera, view,
-                                   projection, periods, motion_scale, options, out_color,
-                                   out_depth, out_motion, stats));
+                                   projection, periods, motion_scale, options, out_color, out_depth,
+                                   out_motion, stats));
     timings_.compute_ms = finish_ms(t);
     return {};
 }
