@@ -15,7 +15,8 @@ namespace {
 // Each GPU stage's row: size, stage (two words), 9 figures, the last the GPU's PSNR against the
 // CPU's (inf on llvmpipe: identical).
 void expect_gles_rows(const std::string& output) {
-    for (const char* stage : {"reproject RGBA", "pull-push (depth)"}) {
+    for (const char* stage : {"reproject RGBA", "pull-push (depth)", "stereo-eye splat+pp",
+                              "interpolate splat+pp", "extrapolate splat+pp"}) {
         const std::size_t at = output.find(std::string("96x64      ") + stage);
         ASSERT_NE(at, std::string::npos) << stage << "\n" << output;
         std::istringstream row(output.substr(at, output.find('\n', at) - at));

@@ -15,6 +15,7 @@
 #include "reprise/gpu/context.hpp"
 #include "reprise/stereo/rig.hpp"
 #include "reprise/stereo/synthesize.hpp"
+#include "reprise/warp/extrapolate.hpp"
 #include "reprise/warp/fill.hpp"
 #include "reprise/warp/fruc.hpp"
 #include "reprise/warp/reproject.hpp"
@@ -63,11 +64,16 @@ struct Textures {
     ~Textures() { glDeleteTextures(GLsizei(names.size()), names.data()); }
 };
 
+// Extrapolation as the GPU makes it (warp splat, pull-push), the silhouettes as they are.
+const warp::FrucOptions kExtrapolation{.mode = warp::FrucMode::Extrapolate,
+                                       .warp = warp::WarpMethod::Splat,
+                                       .widen_silhouettes = false};
+
 // Both stages on textures already on the GPU (the last pair of frames), `runs` times each:
 // compute alone, as an application that keeps its frames on the GPU pays it.
 Status time_texture_path(gpu::Context& context, const Frame& current, const Frame& previous,
                          const Image<uint8_t>& hit_mask, int runs, Timing& reproject, Timing& fill,
-                         Timing& eye, Timing& between) {
+                         Timing& eye, Timing& between, Timing& ahead) {
     context.make_current();
     const int w = current.width(), h = current.height();
     Textures t;
@@ -97,6 +103,11 @@ Status time_texture_path(gpu::Context& context, const Frame& current, const Fram
         REPRISE_TRY(context.interpolate(before, previous_color, now, color, 0.5f, filled, eye_depth,
                                         between_stats));
         if (i) between.ms.push_back(context.timings().compute_ms);
+        gpu::ExtrapolateStats ahead_stats;
+        REPRISE_TRY(context.extrapolate(before, previous_color, current.camera.view,
+                                        current.camera.projection, 1.0f, filled, eye_depth, out,
+                                        ahead_stats, kExtrapolation));
+        if (i) ahead.ms.push_back(context.timings().compute_ms);
     }
     return {};
 }
@@ -117,14 +128,18 @@ Status bench_gles_stages(const std::vector<Frame>& frames, const std::string& si
     Image<glm::vec4> cpu_out(w, h), gpu_out(w, h), cpu_filled(w, h), gpu_filled(w, h);
     Image<uint8_t> cpu_hit(w, h), gpu_hit(w, h);
     warp::PullPush pull_push;
-    StageTimes stages[5] = {{"reproject RGBA"},
-                            {"pull-push (depth)"},
-                            {"splat x-0.5"},
-                            {"stereo-eye splat+pp"},
-                            {"interpolate splat+pp"}};
-    // The CPU's in-between frame with the same method (both sides splatted, blended, pull-push).
-    const warp::FrucOptions between_options{
-        .warp = warp::WarpMethod::Splat, .true_motion = false, .refine = {.enabled = false}};
+    StageTimes stages[6] = {{"reproject RGBA"},       {"pull-push (depth)"},
+                            {"splat x-0.5"},          {"stereo-eye splat+pp"},
+                            {"interpolate splat+pp"}, {"extrapolate splat+pp"}};
+    // The previous frame one period on, seen by the current camera.
+    warp::PoseExtrapolator extrapolator(kExtrapolation);
+    Frame cpu_ahead, gpu_ahead;
+    // The CPU's in-between frame with the same method (both sides splatted, blended, pull-push),
+    // its inputs' silhouettes as they are (a backend gets them widened by the converter).
+    const warp::FrucOptions between_options{.warp = warp::WarpMethod::Splat,
+                                            .widen_silhouettes = false,
+                                            .true_motion = false,
+                                            .refine = {.enabled = false}};
     warp::FrameRateConverter converter;
     REPRISE_TRY(warp::FrameRateConverter::create(2, between_options, converter));
     Frame between_in, gpu_between;
@@ -225,10 +240,27 @@ Status bench_gles_stages(const std::vector<Frame>& frames, const std::string& si
         if (count == 2)
             stages[4].worst_db =
                 std::min(stages[4].worst_db, display_psnr(received[0].color, gpu_between.color));
+
+        const Camera& to = current.camera;
+        Timing& cpu_ahead_time = timing ? stages[5].cpu : scratch;
+        time_once(cpu_ahead_time, [&] {
+            status = extrapolator.extrapolate(previous, to.view, to.projection, 1.0f, cpu_ahead);
+        });
+        REPRISE_TRY(status);
+        Timing ahead_total;
+        gpu::ExtrapolateStats ahead_stats;
+        time_once(ahead_total, [&] {
+            status = context->extrapolate(previous, to.view, to.projection, 1.0f, gpu_ahead,
+                                          ahead_stats, kExtrapolation);
+        });
+        REPRISE_TRY(status);
+        if (timing) record(stages[5], context->timings(), ahead_total.ms[0]);
+        stages[5].worst_db =
+            std::min(stages[5].worst_db, display_psnr(cpu_ahead.color, gpu_ahead.color));
     }
     REPRISE_TRY(time_texture_path(*context, frames.back(), frames[frames.size() - 2], cpu_hit,
                                   int(frames.size()) - 2, stages[0].textures, stages[1].textures,
-                                  stages[3].textures, stages[4].textures));
+                                  stages[3].textures, stages[4].textures, stages[5].textures));
     std::printf(
         "gles: %s; GPU columns are medians; textures: the texture entry point on "
         "textures already on the GPU (compute alone)\n",
