@@ -142,7 +142,7 @@ TEST(CliStereo, TheGpuBackendMakesTheCpusSplatEye) {
     fs::remove_all(dir);
 }
 
-// `reprise fruc --backend gles`: the CPU's splat frames (made frames without motion), and the
+// `reprise fruc --backend gles`: the CPU's splat frames, motion included, and the
 // options the GPU lacks named before anything is written.
 TEST(CliStereo, FrucOnTheGpuBackendMakesTheCpusSplatFrames) {
     const fs::path dir =
@@ -164,9 +164,11 @@ TEST(CliStereo, FrucOnTheGpuBackendMakesTheCpusSplatFrames) {
     ASSERT_EQ(run_command(cli::command_fruc, with({"--backend", "gles", "--out", gles})), 0);
     for (int i = 0; i < 5; ++i)
         EXPECT_GE(psnr_of(frame_path(cpu, i), frame_path(gles, i)), 50.0) << "frame " << i;
-    Frame made;
+    Frame made, cpu_made;
     ASSERT_TRUE(read_frame(frame_path(gles, 1), made).ok());
-    EXPECT_TRUE(made.motion.empty());
+    ASSERT_TRUE(read_frame(frame_path(cpu, 1), cpu_made).ok());
+    ASSERT_FALSE(made.motion.empty());  // per output period, as the CPU's
+    EXPECT_EQ(made.motion(80, 45), cpu_made.motion(80, 45));
     // Extrapolated on the GPU: the CPU's frames, motion included.
     const std::vector<std::string> ahead = {"--in",        in,         "--warp", "splat", "--mode",
                                             "extrapolate", "--factor", "3"};
@@ -181,7 +183,6 @@ TEST(CliStereo, FrucOnTheGpuBackendMakesTheCpusSplatFrames) {
     for (int i = 0; i < 9; ++i)
         EXPECT_GE(psnr_of(frame_path(cpu_ahead, i), frame_path(gles_ahead, i)), 50.0)
             << "extrapolated frame " << i;
-    Frame cpu_made;
     ASSERT_TRUE(read_frame(frame_path(cpu_ahead, 2), cpu_made).ok());
     ASSERT_TRUE(read_frame(frame_path(gles_ahead, 2), made).ok());
     ASSERT_FALSE(made.motion.empty());

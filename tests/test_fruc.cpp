@@ -179,7 +179,7 @@ public:
     Status supports(const FrucOptions& o) const override {
         return o.warp == WarpMethod::Splat ? Status{} : Status::error("flaky: splat only");
     }
-    Status interpolate(const GBufferView&, const GBufferView& b, float, Frame& out,
+    Status interpolate(const GBufferView&, const GBufferView& b, float, float, Frame& out,
                        FrucCounters&) override {
         if (calls++ == fail_at) return Status::error("flaky: the device went away");
         out.color.resize(b.color.width, b.color.height);

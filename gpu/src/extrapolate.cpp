@@ -113,8 +113,9 @@ Status extrapolate_passes(ContextState& s, const SplatTextures& frame, const Cam
         factor = -periods;
         to_backward = motion_scale;
     }
+    if (out_motion) s.splat_motion.ensure(GL_RGBA32F, w, h);
     REPRISE_TRY(splat_passes(s, along, factor, options.splat, w, h, s.eye_color.name, out_depth,
-                             s.hit.name, out_motion != 0, stats.covered));
+                             s.hit.name, out_motion ? s.splat_motion.name : 0, stats.covered));
     stats.holes = pixels - stats.covered;
     if (stats.holes && options.fill == warp::FillMethod::PullPush)
         REPRISE_TRY(

@@ -28,10 +28,10 @@ Status FrucBackend::check(const warp::FrucOptions& o, const warp::SplatOptions& 
                          " frames with " + unsupported + " only (docs/gpu.md)");
 }
 
-Status FrucBackend::interpolate(const GBufferView& a, const GBufferView& b, float s, Frame& out,
-                                warp::FrucCounters& counters) {
+Status FrucBackend::interpolate(const GBufferView& a, const GBufferView& b, float s,
+                                float motion_scale, Frame& out, warp::FrucCounters& counters) {
     InterpolateStats stats;
-    REPRISE_TRY(context_.interpolate(a, b, s, out, stats, splat_));
+    REPRISE_TRY(context_.interpolate(a, b, s, out, stats, splat_, motion_scale));
     count(stats.holes, stats.holes > 0, counters);
     return {};
 }

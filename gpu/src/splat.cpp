@@ -203,9 +203,8 @@ Status create_splat_programs(ContextState& s) {
 
 Status splat_passes(ContextState& s, const SplatTextures& in, float factor,
                     const warp::SplatOptions& options, int tw, int th, GLuint out_color,
-                    GLuint out_depth, GLuint out_covered, bool carry_motion, std::size_t& covered) {
-    // Everything made before anything is bound: making a texture binds it.
-    s.splat_motion.ensure(GL_RGBA32F, carry_motion ? tw : 1, carry_motion ? th : 1);
+                    GLuint out_depth, GLuint out_covered, GLuint out_motion, std::size_t& covered) {
+    const bool carry_motion = out_motion != 0;
     // Two counters, a head per target pixel, two words per landing (at most 4 per source pixel).
     const std::size_t capacity = 4 * std::size_t(in.width) * std::size_t(in.height);
     const std::size_t list_bytes =
@@ -224,7 +223,7 @@ Status splat_passes(ContextState& s, const SplatTextures& in, float factor,
     glBindImageTexture(3, out_color, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     glBindImageTexture(4, out_depth, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
     glBindImageTexture(5, out_covered, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32UI);
-    glBindImageTexture(6, s.splat_motion.name, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glBindImageTexture(6, out_motion, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     const float tol = std::clamp(options.depth_tolerance, 0.0f, 0.5f);
     auto pass = [&](GLuint program, int w, int h) {
         glUseProgram(program);
@@ -276,9 +275,10 @@ Status Context::splat(const GBufferView& source, float factor, const warp::WarpT
     s.depth.ensure(GL_R32F, tw, th);
     s.hit.ensure(GL_R32UI, tw, th);
     const bool carry_motion = !target.motion.empty();
+    if (carry_motion) s.splat_motion.ensure(GL_RGBA32F, tw, th);
     REPRISE_TRY(splat_passes(s, {s.payload.name, s.previous_depth.name, s.motion.name, sw, sh},
                              factor, options, tw, th, s.out.name, s.depth.name, s.hit.name,
-                             carry_motion, covered));
+                             carry_motion ? s.splat_motion.name : 0, covered));
     timings_.compute_ms = finish_ms(t);
     s.download(s.out, target.color.data, target.color.stride);
     s.download_channels(s.depth, target.depth.data, 1, target.depth.stride);

@@ -110,10 +110,12 @@ Status fill_passes(ContextState& s, GLuint color, GLuint valid, GLuint depth, in
                    GLuint out, warp::FillStats& stats);
 Status interpolate_passes(ContextState& s, const SplatTextures& a, const SplatTextures& b,
                           float s_between, int w, int h, const warp::SplatOptions& options,
-                          GLuint out_color, GLuint out_depth, InterpolateStats& stats);
+                          GLuint out_color, GLuint out_depth, GLuint out_motion, float motion_scale,
+                          InterpolateStats& stats);
+// `out_motion` (GL_RGBA32F, motion in RG; 0: none) gets the motion each winner carried.
 Status splat_passes(ContextState& s, const SplatTextures& in, float factor,
                     const warp::SplatOptions& options, int tw, int th, GLuint out_color,
-                    GLuint out_depth, GLuint out_covered, bool carry_motion, std::size_t& covered);
+                    GLuint out_depth, GLuint out_covered, GLuint out_motion, std::size_t& covered);
 
 Status extrapolate_passes(ContextState& s, const SplatTextures& frame, const Camera& camera,
                           const glm::mat4& view, const glm::mat4& projection, float periods,
@@ -131,13 +133,14 @@ double finish_ms(std::chrono::steady_clock::time_point& since);
 // The in-between frame's inputs (a, b) and intermediates.
 struct Interpolation {
     Texture a_color, a_depth, a_motion, b_color, b_depth, b_motion;
-    Texture side_a_color, side_a_depth, side_a_covered, side_b_color, side_b_depth, side_b_covered,
-        blended, valid;
+    Texture side_a_color, side_a_depth, side_a_covered, side_a_motion, side_b_color, side_b_depth,
+        side_b_covered, side_b_motion, blended, valid, made_motion;
     NonfiniteRepair repair_a, repair_b;  // each keeps its repaired copy until the next call
-    Texture* all[14] = {&a_color,        &a_depth,      &a_motion,     &b_color,
-                        &b_depth,        &b_motion,     &side_a_color, &side_a_depth,
-                        &side_a_covered, &side_b_color, &side_b_depth, &side_b_covered,
-                        &blended,        &valid};
+    Texture* all[17] = {&a_color,        &a_depth,       &a_motion,     &b_color,
+                        &b_depth,        &b_motion,      &side_a_color, &side_a_depth,
+                        &side_a_covered, &side_a_motion, &side_b_color, &side_b_depth,
+                        &side_b_covered, &side_b_motion, &blended,      &valid,
+                        &made_motion};
 };
 
 struct ContextState {

@@ -97,8 +97,7 @@ Status eye_passes(ContextState& s, GLuint color, GLuint depth, int w, int h, con
 
     std::size_t covered = 0;
     REPRISE_TRY(splat_passes(s, {color, s.target_depth.name, s.displacement.name, w, h}, 1.0f,
-                             o.splat, w, h, s.eye_color.name, out_depth, s.hit.name, false,
-                             covered));
+                             o.splat, w, h, s.eye_color.name, out_depth, s.hit.name, 0, covered));
     const std::size_t n = std::size_t(w) * std::size_t(h);
     stats.covered = covered;
     stats.holes = n - covered;

@@ -113,16 +113,21 @@ public:
     // The frame at `s` in [0, 1] between a (0) and b (1) with b's backward motion: warp's
     // interpolate_frame for FrucOptions{.warp = Splat, .true_motion = false, .refine off} and
     // pull-push: b splatted by 1 - s, a by -s, blended by s where both land on one surface (depths
-    // within 2 %), the nearer or the only one elsewhere, pull-push over what neither covers.
-    // Colour and depth out (out.motion, normal and id cleared; out.camera is b's). NaN/Inf in a
-    // and b are repaired first, as the CPU converter does; the texture entry does not repair.
+    // within 15 %), the nearer or the only one elsewhere, pull-push over what neither covers.
+    // Colour, depth and motion out: the motion the winning side carried (b's where both are
+    // blended) times motion_scale, as the CPU's (normal and id cleared; out.camera is b's).
+    // NaN/Inf in a and b are repaired first, as the CPU converter does; the texture entry does
+    // not repair.
     Status interpolate(const GBufferView& a, const GBufferView& b, float s, Frame& out,
-                       InterpolateStats& stats, const warp::SplatOptions& options = {});
+                       InterpolateStats& stats, const warp::SplatOptions& options = {},
+                       float motion_scale = 1.0f);
     // The same on textures: colour GL_RGBA32F, depth GL_R32F, motion GL_RG32F, all one size;
-    // `out_color` and `out_depth` written.
+    // `out_color` and `out_depth` written, and `out_motion` (GL_RGBA32F, the motion in RG; 0:
+    // not written).
     Status interpolate(const GBufferTextures& a, unsigned a_color, const GBufferTextures& b,
                        unsigned b_color, float s, unsigned out_color, unsigned out_depth,
-                       InterpolateStats& stats, const warp::SplatOptions& options = {});
+                       InterpolateStats& stats, const warp::SplatOptions& options = {},
+                       unsigned out_motion = 0, float motion_scale = 1.0f);
 
     // warp::PoseExtrapolator (and the converter's extrapolation) for FrucOptions with warp Splat
     // and fill PullPush or None (others are an error): `frame` as seen by (view, projection)

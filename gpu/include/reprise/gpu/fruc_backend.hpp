@@ -22,10 +22,9 @@ public:
     Status supports(const warp::FrucOptions& options) const override {
         return check(options, splat_);
     }
-    // Colour and depth; the made frame carries no motion.
-    Status interpolate(const GBufferView& a, const GBufferView& b, float s, Frame& out,
-                       warp::FrucCounters& counters) override;
-    // Colour, depth and motion.
+    // Colour, depth and motion, as the CPU's.
+    Status interpolate(const GBufferView& a, const GBufferView& b, float s, float motion_scale,
+                       Frame& out, warp::FrucCounters& counters) override;
     Status extrapolate(const GBufferView& f, const glm::mat4& view, const glm::mat4& projection,
                        float periods, float motion_scale, const warp::FrucOptions& options,
                        Frame& out, warp::FrucCounters& counters) override;

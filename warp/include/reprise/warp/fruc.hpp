@@ -100,9 +100,9 @@ public:
     // The options the backend makes the same frames for as the CPU; an error says why not.
     virtual Status supports(const FrucOptions& options) const = 0;
     // What interpolate_frame makes with both sides warpable: the frame at s between a and b,
-    // colour and depth (its motion may stay empty).
-    virtual Status interpolate(const GBufferView& a, const GBufferView& b, float s, Frame& out,
-                               FrucCounters& counters) = 0;
+    // colour, depth and motion times motion_scale (its motion may stay empty).
+    virtual Status interpolate(const GBufferView& a, const GBufferView& b, float s,
+                               float motion_scale, Frame& out, FrucCounters& counters) = 0;
     // What the CPU's extrapolation makes: f as seen by (view, projection) `periods` frame
     // periods after it (without a projection on f: along its motion alone), colour, depth and
     // backward motion per period times motion_scale.
