@@ -2,6 +2,7 @@
 #include <pybind11/stl.h>
 
 #include "common.hpp"
+#include "reprise/gpu/context.hpp"
 #include "reprise/stereo/alternate.hpp"
 #include "reprise/stereo/rig.hpp"
 #include "reprise/stereo/synthesize.hpp"
@@ -87,17 +88,36 @@ py::tuple made_eye(const Frame& rendered, Make&& make) {
     return py::make_tuple(std::move(out), stats_dict(stats));
 }
 
+// backend "gles": the eye made by OpenGL ES compute shaders (gpu::Context::stereo_eye: warp
+// splat, fill pullpush or none, no history), the CPU's eye within 50 dB.
 struct Synthesizer {
+    explicit Synthesizer(const std::string& backend = "cpu") {
+        if (backend == "gles")
+            check(gpu::Context::create(gpu));
+        else if (backend != "cpu")
+            value_error("backend '" + backend + "': expected cpu or gles");
+    }
     py::tuple synthesize(const Frame& rendered, const Camera& target, const std::string& warp,
                          const std::string& fill, const Frame* history, bool widen_silhouettes) {
         require_color_and_depth(rendered, "rendered");
         if (history) require_color_and_depth(*history, "history");
         const stereo::StereoOptions options = make_options(warp, fill, widen_silhouettes);
-        return made_eye(rendered, [&](Frame& out) {
-            return synthesizer.synthesize(rendered, target, out, options, history);
+        if (!gpu)
+            return made_eye(rendered, [&](Frame& out) {
+                return synthesizer.synthesize(rendered, target, out, options, history);
+            });
+        if (history) value_error("backend gles: the eye's history is not on the GPU yet");
+        Status made;
+        py::tuple result = made_eye(rendered, [&](Frame& out) {
+            stereo::StereoStats stats;
+            made = gpu->stereo_eye(rendered, target, out, stats, options);
+            return stats;
         });
+        if (!made.ok()) value_error("backend gles: " + made.message());
+        return result;
     }
     stereo::StereoSynthesizer synthesizer;
+    std::unique_ptr<gpu::Context> gpu;
 };
 
 stereo::Eye make_eye(const std::string& eye) {
@@ -138,7 +158,9 @@ void bind_stereo(py::module_& m) {
     py::class_<Synthesizer>(m, "StereoSynthesizer",
                             "Makes another view from a rendered one; keeps its scratch between "
                             "frames of one size.")
-        .def(py::init<>())
+        .def(py::init<const std::string&>(), py::arg("backend") = "cpu",
+             "backend 'gles': eyes made by OpenGL ES compute shaders (warp 'splat', fill "
+             "'pullpush' or 'none', no history)")
         .def("synthesize", &Synthesizer::synthesize, py::arg("rendered"), py::arg("target"),
              py::arg("warp") = "grid", py::arg("fill") = "pullpush", py::arg("history") = nullptr,
              py::arg("widen_silhouettes") = true,

@@ -84,6 +84,15 @@ def test_gpu_backend_makes_the_cpus_splat_frames(pan_60):
     for k in range(5):
         # The bar for the GPU backend; on llvmpipe the frames are bit-identical.
         assert reprise.psnr(reprise.to_display(gpu[k].color), reprise.to_display(cpu[k].color)) >= 50.0
+    assert np.array_equal(gpu[1].motion, cpu[1].motion)  # per output period, as the CPU's
+    # Extrapolated on the GPU: the CPU's frames, motion included.
+    ahead = dict(factor=2, mode="extrapolate", warp="splat")
+    cpu = reprise.FrameRateConverter(**ahead).convert(inputs)
+    gpu = reprise.FrameRateConverter(**ahead, backend="gles").convert(inputs)
+    assert len(gpu) == len(cpu) == 6
+    for k in range(6):
+        assert reprise.psnr(reprise.to_display(gpu[k].color), reprise.to_display(cpu[k].color)) >= 50.0
+    assert np.array_equal(gpu[1].motion, cpu[1].motion)
     with pytest.raises(ValueError, match="true motion off"):
         reprise.FrameRateConverter(factor=2, warp="splat", refine=False, backend="gles")
     with pytest.raises(ValueError, match="expected cpu or gles"):
