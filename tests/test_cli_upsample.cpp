@@ -48,6 +48,22 @@ TEST(CliUpsample, RenderLowresThenUpsample) {
     ASSERT_EQ(out.width(), 128);
     EXPECT_FALSE(out.depth.empty());  // the G-buffer travels with the upsampled colour
     EXPECT_GT(display_psnr(full.color, out.color), 30.0);
+    // --backend gles: the CPU's frames (the bar, 50 dB; identical on llvmpipe).
+    const std::string on_gpu = (dir / "gles").string();
+    ASSERT_EQ(run_command(cli::command_upsample,
+                          {"--in", rendered, "--out", on_gpu, "--backend", "gles"}),
+              0);
+    for (int i = 0; i < 6; ++i) {
+        Frame cpu, gpu;
+        ASSERT_TRUE(read_frame(frame_path(made, i), cpu).ok());
+        ASSERT_TRUE(read_frame(frame_path(on_gpu, i), gpu).ok());
+        EXPECT_GE(display_psnr(cpu.color, gpu.color), 50.0) << "frame " << i;
+    }
+    EXPECT_NE(
+        run_command(cli::command_upsample,
+                    {"--in", rendered, "--out", (dir / "refused").string(), "--backend", "metal"}),
+        0);
+    EXPECT_FALSE(fs::exists(dir / "refused"));
     fs::remove_all(dir);
 }
 

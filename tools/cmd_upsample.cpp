@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 
 #include "args.hpp"
 #include "commands.hpp"
@@ -11,6 +12,7 @@
 #include "reprise/core/exr.hpp"
 #include "reprise/core/memory_limit.hpp"
 #include "reprise/core/metrics.hpp"
+#include "reprise/gpu/upsampler.hpp"
 #include "reprise/warp/upsample.hpp"
 
 namespace reprise::cli {
@@ -23,7 +25,7 @@ struct UpsampleJob {
     double history_weight = 1.0;
     double gamma_max = 4.0, max_history_weight = 16.0, gradient_gain = 1.0, history_clamp = 0.25;
     bool overwrite_inputs = false;
-    std::string line;
+    std::string line, backend = "cpu";
 };
 
 Status run_upsample(const UpsampleJob& job) {
@@ -38,6 +40,8 @@ Status run_upsample(const UpsampleJob& job) {
     if (!(job.history_clamp <= 1e3)) return Status::error("--history-clamp must be at most 1000");
     if (!(job.history_weight >= 0.0 && job.history_weight <= 1.0))
         return Status::error("--history-weight must be in [0, 1]");
+    if (job.backend != "cpu" && job.backend != "gles")
+        return Status::error("--backend '" + job.backend + "': expected cpu or gles");
     const std::string low_dir = job.low.empty() ? job.in + "/lowres" : job.low;
     Sequence full_sequence, low_sequence;
     REPRISE_TRY(open_sequence(job.in, full_sequence));
@@ -46,12 +50,7 @@ Status run_upsample(const UpsampleJob& job) {
         return Status::error(low_dir + ": " + std::to_string(low_sequence.files.size()) +
                              " low-resolution frames for " +
                              std::to_string(full_sequence.files.size()) + " full-resolution ones");
-    OutputFolder output;
-    REPRISE_TRY(output.open(job.out,
-                            {.inputs = {job.in, low_dir}, .overwrite_inputs = job.overwrite_inputs},
-                            job.line, false));
-
-    warp::SpatioTemporalUpsampler upsampler({
+    const warp::UpsampleOptions options{
         .history_weight = job.spatial_only ? 0.0f : float(job.history_weight),
         .max_history_weight = float(job.max_history_weight),
         .gamma_max = float(job.gamma_max),
@@ -60,7 +59,20 @@ Status run_upsample(const UpsampleJob& job) {
         .gradient_gain = float(job.gradient_gain),
         .history_clamp = float(job.history_clamp),
         .separable_filter = !job.radial,
-    });
+    };
+    warp::SpatioTemporalUpsampler upsampler(options);
+    // --backend gles: the same passes as OpenGL ES compute shaders.
+    std::unique_ptr<gpu::Context> gpu;
+    std::unique_ptr<gpu::Upsampler> gpu_upsampler;
+    if (job.backend == "gles") {
+        REPRISE_TRY(gpu::Context::create(gpu));
+        REPRISE_TRY(gpu::Upsampler::create(*gpu, options, gpu_upsampler));
+    }
+    gpu::Timings gpu_total;
+    OutputFolder output;
+    REPRISE_TRY(output.open(job.out,
+                            {.inputs = {job.in, low_dir}, .overwrite_inputs = job.overwrite_inputs},
+                            job.line, false));
     Frame full, low;
     Image<glm::vec4> out;
     Image<glm::vec3> truth_display, out_display;
@@ -99,7 +111,15 @@ Status run_upsample(const UpsampleJob& job) {
         out.resize(full.width(), full.height());
         warp::UpsampleStats stats;
         const auto start = std::chrono::steady_clock::now();
-        upsampler.upsample(low.color.view(), jitter, guides, out.view(), &stats);
+        if (gpu_upsampler) {
+            REPRISE_TRY(
+                gpu_upsampler->upsample(low.color.view(), jitter, guides, out.view(), &stats));
+            gpu_total.upload_ms += gpu_upsampler->timings().upload_ms;
+            gpu_total.compute_ms += gpu_upsampler->timings().compute_ms;
+            gpu_total.download_ms += gpu_upsampler->timings().download_ms;
+        } else {
+            upsampler.upsample(low.color.view(), jitter, guides, out.view(), &stats);
+        }
         busy_ms +=
             std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
                 .count();
@@ -142,6 +162,10 @@ Status run_upsample(const UpsampleJob& job) {
         "pixels\n",
         (long long)total.history_used, (long long)total.history_rejected,
         (long long)total.nonfinite_samples, (long long)total.unresolved);
+    if (gpu && n > 0)
+        std::printf("  on the GPU (%s): upload %.2f, compute %.2f, download %.2f ms a frame\n",
+                    gpu->description().c_str(), gpu_total.upload_ms / double(n),
+                    gpu_total.compute_ms / double(n), gpu_total.download_ms / double(n));
     if (total.nonfinite.total() > 0)
         std::fprintf(stderr, "[upsample] input: %s\n", describe_nonfinite(total.nonfinite).c_str());
     return {};
@@ -160,6 +184,8 @@ int command_upsample(int argc, char** argv) {
         "full frames' own colour.");
     args.option("--in", &job.in, "full-resolution G-buffer sequence (required)");
     args.option("--low", &job.low, "low-resolution colour sequence (default IN/lowres)");
+    args.option("--backend", &job.backend,
+                "cpu | gles (default cpu); gles: the same passes as OpenGL ES compute shaders");
     args.option("--out", &job.out, "output folder (required)");
     args.option("--history-weight", &job.history_weight,
                 "a of the temporal weight, 0..1 (default 1)");

@@ -57,6 +57,9 @@ void transfer_format(GLenum internal_format, GLenum& format, GLenum& type) {
         case GL_RGBA32F:
             format = GL_RGBA, type = GL_FLOAT;
             return;
+        case GL_RGB32F:
+            format = GL_RGB, type = GL_FLOAT;
+            return;
         case GL_RG32F:
             format = GL_RG, type = GL_FLOAT;
             return;

@@ -40,6 +40,8 @@ std::size_t texel_bytes(GLenum format) {
     switch (format) {
         case GL_RGBA32F:
             return 16;
+        case GL_RGB32F:
+            return 12;
         case GL_RG32F:
             return 8;
         case GL_R8UI:
@@ -52,6 +54,7 @@ std::size_t texel_bytes(GLenum format) {
 }  // namespace
 
 void ContextState::bind_inputs(std::initializer_list<GLuint> textures) const {
+    REPRISE_ASSERT(textures.size() <= kInputUnits);
     GLuint unit = 0;
     for (GLuint t : textures) {
         glActiveTexture(GL_TEXTURE0 + unit);
@@ -63,7 +66,7 @@ void ContextState::bind_inputs(std::initializer_list<GLuint> textures) const {
 }
 
 void ContextState::unbind_inputs() {
-    for (GLuint unit = 0; unit < 8; ++unit) glBindSampler(unit, 0);
+    for (GLuint unit = 0; unit < kInputUnits; ++unit) glBindSampler(unit, 0);
 }
 
 void ContextState::reset_counters(GLuint buffer, std::size_t count) {

@@ -186,8 +186,9 @@ struct ContextState {
     GLuint unpack_buffer = 0;  // uploads go through it: the GPU lays the texels out, not the CPU
 
     // Binds `textures` to units 0, 1, ... for texelFetch through the nearest sampler (0: none).
+    static constexpr unsigned kInputUnits = 16;  // GL ES 3.1's least for compute shaders
     void bind_inputs(std::initializer_list<GLuint> textures) const;
-    // Units 0..7 without a sampler again (the application's own filtering applies).
+    // Units 0..15 without a sampler again (the application's own filtering applies).
     static void unbind_inputs();
     // Zeroes the first `count` counters of `buffer` and binds it as storage buffer 0.
     static void reset_counters(GLuint buffer, std::size_t count);

@@ -150,6 +150,7 @@ public:
                        const warp::FrucOptions& options, float motion_scale = 1.0f);
 
 private:
+    friend class Upsampler;  // its passes run on this context's state
     Context();
     std::unique_ptr<ContextState> state_;
     Timings timings_;

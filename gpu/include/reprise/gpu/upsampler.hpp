@@ -1,0 +1,37 @@
+#pragma once
+// Spatio-temporal upsampling (Herzog et al. 2010) on the GPU: warp::SpatioTemporalUpsampler's
+// passes as OpenGL ES compute shaders, its history kept in textures between frames.
+#include <memory>
+
+#include "reprise/gpu/context.hpp"
+#include "reprise/warp/upsample.hpp"
+
+namespace reprise::gpu {
+
+class Upsampler {
+public:
+    // `context` must outlive the upsampler; its programs are linked here, once.
+    static Status create(Context& context, const warp::UpsampleOptions& options,
+                         std::unique_ptr<Upsampler>& upsampler);
+    ~Upsampler();
+    Upsampler(const Upsampler&) = delete;
+    Upsampler& operator=(const Upsampler&) = delete;
+
+    // warp::SpatioTemporalUpsampler::upsample: the same inputs, output and stats (the guides'
+    // NaN/Inf repaired on the CPU first); an error instead of an assertion for sizes and options
+    // it cannot take, and for a full camera whose projection is skewed (with history).
+    Status upsample(ImageView<const glm::vec4> low_color, glm::vec2 jitter_px,
+                    const GBufferView& full, ImageView<glm::vec4> out,
+                    warp::UpsampleStats* stats = nullptr);
+    void reset();  // forgets the history (a cut, a new stream)
+
+    const Timings& timings() const;
+
+    struct State;
+
+private:
+    Upsampler();
+    std::unique_ptr<State> state_;
+};
+
+}  // namespace reprise::gpu
