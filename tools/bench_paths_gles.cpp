@@ -4,6 +4,7 @@
 // the texture entry point on textures already on the GPU, and how far the GPU's result is from the
 // CPU's.
 #include <cstdio>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -13,6 +14,7 @@
 
 #include "reprise/core/metrics.hpp"
 #include "reprise/gpu/context.hpp"
+#include "reprise/gpu/upsampler.hpp"
 #include "reprise/stereo/rig.hpp"
 #include "reprise/stereo/synthesize.hpp"
 #include "reprise/warp/extrapolate.hpp"
@@ -20,6 +22,7 @@
 #include "reprise/warp/fruc.hpp"
 #include "reprise/warp/reproject.hpp"
 #include "reprise/warp/splat.hpp"
+#include "reprise/warp/upsample.hpp"
 
 namespace reprise::cli {
 
@@ -128,9 +131,16 @@ Status bench_gles_stages(const std::vector<Frame>& frames, const std::string& si
     Image<glm::vec4> cpu_out(w, h), gpu_out(w, h), cpu_filled(w, h), gpu_filled(w, h);
     Image<uint8_t> cpu_hit(w, h), gpu_hit(w, h);
     warp::PullPush pull_push;
-    StageTimes stages[6] = {{"reproject RGBA"},       {"pull-push (depth)"},
+    StageTimes stages[7] = {{"reproject RGBA"},       {"pull-push (depth)"},
                             {"splat x-0.5"},          {"stereo-eye splat+pp"},
-                            {"interpolate splat+pp"}, {"extrapolate splat+pp"}};
+                            {"interpolate splat+pp"}, {"extrapolate splat+pp"},
+                            {"upsample 1/4 Herzog"}};
+    // Herzog upsampling of every other pixel of every other row (jitter -0.5 px: the low pixel
+    // (u, v) is the full pixel (2u, 2v)), guided by the frame's full G-buffer, with history.
+    warp::SpatioTemporalUpsampler cpu_upsampler;
+    std::unique_ptr<gpu::Upsampler> gpu_upsampler;
+    REPRISE_TRY(gpu::Upsampler::create(*context, {}, gpu_upsampler));
+    Image<glm::vec4> low((w + 1) / 2, (h + 1) / 2), cpu_up(w, h), gpu_up(w, h);
     // The previous frame one period on, seen by the current camera.
     warp::PoseExtrapolator extrapolator(kExtrapolation);
     Frame cpu_ahead, gpu_ahead;
@@ -257,6 +267,20 @@ Status bench_gles_stages(const std::vector<Frame>& frames, const std::string& si
         if (timing) record(stages[5], context->timings(), ahead_total.ms[0]);
         stages[5].worst_db =
             std::min(stages[5].worst_db, display_psnr(cpu_ahead.color, gpu_ahead.color));
+
+        for (int v = 0; v < low.height(); ++v)
+            for (int u = 0; u < low.width(); ++u) low(u, v) = current.color(2 * u, 2 * v);
+        const glm::vec2 jitter(-0.5f);
+        Timing& cpu_up_time = timing ? stages[6].cpu : scratch;
+        time_once(cpu_up_time,
+                  [&] { cpu_upsampler.upsample(low.view(), jitter, current, cpu_up.view()); });
+        Timing up_total;
+        time_once(up_total, [&] {
+            status = gpu_upsampler->upsample(low.view(), jitter, current, gpu_up.view());
+        });
+        REPRISE_TRY(status);
+        if (timing) record(stages[6], gpu_upsampler->timings(), up_total.ms[0]);
+        stages[6].worst_db = std::min(stages[6].worst_db, display_psnr(cpu_up, gpu_up));
     }
     REPRISE_TRY(time_texture_path(*context, frames.back(), frames[frames.size() - 2], cpu_hit,
                                   int(frames.size()) - 2, stages[0].textures, stages[1].textures,

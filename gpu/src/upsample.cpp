@@ -445,10 +445,10 @@ Upsampler::~Upsampler() {
     State& u = *state_;
     if (!u.context) return;
     u.context->make_current();
-    for (Texture* t : {&u.low, &u.depth, &u.normal, &u.id, &u.motion, &u.history_depth,
-                       &u.history_id, &u.history, &u.next_history, &u.deltas, &u.next_deltas,
-                       &u.reprojected, &u.gradient, &u.gradient_tmp, &u.tap_geometric,
-                       &u.tap_base, &u.out})
+    for (Texture* t :
+         {&u.low, &u.depth, &u.normal, &u.id, &u.motion, &u.history_depth, &u.history_id,
+          &u.history, &u.next_history, &u.deltas, &u.next_deltas, &u.reprojected, &u.gradient,
+          &u.gradient_tmp, &u.tap_geometric, &u.tap_base, &u.out})
         glDeleteTextures(1, &t->name);
     for (GLuint program : {u.fetch_program, u.box_program, u.filter_program})
         glDeleteProgram(program);
@@ -468,12 +468,11 @@ Status Upsampler::create(Context& context, const warp::UpsampleOptions& options,
     u.context = &context;
     u.options = options;
     const std::string common = std::string(kComputeHeader) + kCommon;
-    REPRISE_TRY(gl::link_compute((common + kFetchHistory).c_str(),
-                                 "upsample history", u.fetch_program));
+    REPRISE_TRY(
+        gl::link_compute((common + kFetchHistory).c_str(), "upsample history", u.fetch_program));
     REPRISE_TRY(gl::link_compute((std::string(kComputeHeader) + kBox).c_str(), "upsample box",
                                  u.box_program));
-    REPRISE_TRY(gl::link_compute((common + kFilter).c_str(), "upsample filter",
-                                 u.filter_program));
+    REPRISE_TRY(gl::link_compute((common + kFilter).c_str(), "upsample filter", u.filter_program));
     u.counts = s.make_counters(3 * sizeof(GLuint));
     upsampler = std::move(made);
     return {};
@@ -513,8 +512,8 @@ Status Upsampler::upsample(ImageView<const glm::vec4> low_color, glm::vec2 jitte
 
     if (!sized(u.history.width, u.history.height)) u.has_history = false;
     u.low.ensure(GL_RGBA32F, low_color.width, low_color.height);
-    for (Texture* texture : {&u.history, &u.next_history, &u.deltas, &u.next_deltas,
-                             &u.reprojected, &u.tap_geometric, &u.tap_base, &u.out})
+    for (Texture* texture : {&u.history, &u.next_history, &u.deltas, &u.next_deltas, &u.reprojected,
+                             &u.tap_geometric, &u.tap_base, &u.out})
         texture->ensure(GL_RGBA32F, width, height);
     for (Texture* texture : {&u.depth, &u.history_depth, &u.gradient, &u.gradient_tmp})
         texture->ensure(GL_R32F, width, height);
@@ -540,8 +539,8 @@ Status Upsampler::upsample(ImageView<const glm::vec4> low_color, glm::vec2 jitte
     const bool ids = o.id_test && !full.id.empty();
     const bool temporal = u.has_history && !full.motion.empty() && o.history_weight > 0.0f;
     const bool history_ids = ids && u.history_has_ids;
-    const StaticReprojection camera(full.camera, full.camera.prev_view,
-                                    full.camera.prev_projection, width, height);
+    const StaticReprojection camera(full.camera, full.camera.prev_view, full.camera.prev_projection,
+                                    width, height);
     if (temporal && !camera.unprojector().axis_aligned())
         return Status::error("gpu upsample: the full camera's projection is skewed");
     // The frame's constants of kCommon, set on `program` (in use).
@@ -589,9 +588,8 @@ Status Upsampler::upsample(ImageView<const glm::vec4> low_color, glm::vec2 jitte
         ContextState::reset_counters(u.counts, 3);
     }
     if (temporal && o.gradient_steering) {  // (B)
-        const int radius = o.gradient_radius > 0
-                               ? o.gradient_radius
-                               : int(std::ceil(std::max(scale.x, scale.y))) + 1;
+        const int radius = o.gradient_radius > 0 ? o.gradient_radius
+                                                 : int(std::ceil(std::max(scale.x, scale.y))) + 1;
         glUseProgram(u.box_program);
         glUniform2i(glGetUniformLocation(u.box_program, "size"), width, height);
         uniform_int(u.box_program, "radius", radius);
