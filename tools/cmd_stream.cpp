@@ -14,6 +14,7 @@
 #include "reprise/client/stream_client.hpp"
 #include "reprise/core/exr.hpp"
 #include "reprise/gpu/fruc_backend.hpp"
+#include "reprise/gpu/upsampler.hpp"
 #include "reprise/server/builtin_scenes.hpp"
 #include "reprise/server/renderer.hpp"
 #include "reprise/server/stream_server.hpp"
@@ -196,16 +197,20 @@ Status run_connect(const ConnectJob& job) {
             "': a name from the server's catalogue (1..32 of [a-z0-9_-]), never a path");
     o.scene = job.scene;
     o.extrapolate = !job.no_extrapolate;
-    // --backend gles: each display frame extrapolated on the GPU (warp splat, pull-push).
+    // --backend gles: each display frame extrapolated on the GPU (warp splat, pull-push), a
+    // lowres stream's colour upsampled there.
     if (job.backend != "cpu" && job.backend != "gles")
         return Status::error("--backend '" + job.backend + "': expected cpu or gles");
     std::unique_ptr<gpu::Context> gpu;
     std::unique_ptr<gpu::FrucBackend> backend;
+    std::unique_ptr<gpu::Upsampler> upsampler;
     if (job.backend == "gles") {
         REPRISE_TRY(gpu::Context::create(gpu));
         backend = std::make_unique<gpu::FrucBackend>(*gpu);
         o.extrapolation.warp = warp::WarpMethod::Splat;
         o.extrapolation.backend = backend.get();
+        REPRISE_TRY(gpu::Upsampler::create(*gpu, {}, upsampler));
+        o.upsampler = upsampler.get();
     }
     if (job.loss > 0 || job.delay > 0 || job.jitter > 0) {
         if (!(job.loss >= 0 && job.loss <= 1)) return Status::error("--loss must be in [0, 1]");
@@ -304,9 +309,19 @@ Status run_connect(const ConnectJob& job) {
                      backend->frames(), gpu->description().c_str(), backend->total().upload_ms / n,
                      backend->total().compute_ms / n, backend->total().download_ms / n);
     }
-    if (st.extrapolation_errors > 0)
-        std::fprintf(stderr, "[connect] %zu display frames shown as decoded: %s\n",
-                     st.extrapolation_errors, st.extrapolation_error.c_str());
+    if (upsampler && upsampler->frames() > 0) {
+        const double n = double(upsampler->frames());
+        std::fprintf(stderr,
+                     "[connect] %zu frames upsampled on the GPU: upload %.2f, compute %.2f, "
+                     "download %.2f ms a frame\n",
+                     upsampler->frames(), upsampler->total().upload_ms / n,
+                     upsampler->total().compute_ms / n, upsampler->total().download_ms / n);
+    }
+    if (st.backend_errors > 0)
+        std::fprintf(stderr,
+                     "[connect] %zu frames the GPU failed on (extrapolated ones shown as decoded, "
+                     "upsampled ones made on the CPU): %s\n",
+                     st.backend_errors, st.backend_error.c_str());
     if (index == 0) return Status::error("no frame was decoded from " + job.server);
     return {};
 }
@@ -377,8 +392,8 @@ int command_connect(int argc, char** argv) {
               "window with a free camera: WASD, Q/E, arrows, mouse drag");
     args.flag("--no-extrapolate", &job.no_extrapolate, "show the newest decoded frame as it is");
     args.option("--backend", &job.backend,
-                "cpu | gles (default cpu); gles: each display frame extrapolated by OpenGL ES "
-                "compute shaders\n(warp splat, pull-push)");
+                "cpu | gles (default cpu); gles: each display frame extrapolated (warp splat, "
+                "pull-push) and\na lowres stream's colour upsampled by OpenGL ES compute shaders");
     args.option("--loss", &job.loss, "fault injector: random loss each way (0..1)");
     args.option("--delay", &job.delay, "fault injector: round-trip delay in ms");
     args.option("--jitter", &job.jitter, "fault injector: jitter in ms each way");

@@ -105,6 +105,7 @@ struct StreamClient::State {
         colorless_decoder = false;
         color_decoder = std::make_unique<codec::Decoder>();
         upsampler.reset();
+        if (options.upsampler) options.upsampler->reset();
         newest_completed = -1;
         consecutive_decode_errors = 0;
         received_sealed = 0;
@@ -177,8 +178,19 @@ struct StreamClient::State {
                                      .motion = scratch_decoded.motion(),
                                      .camera = scratch_decoded.camera};
             upsampled.resize(w, h);
-            upsampler.upsample(low_decoded.color.view(), low_decoded.camera.jitter * footprint,
-                               guides, upsampled.view());
+            const glm::vec2 jitter = low_decoded.camera.jitter * footprint;
+            bool done = false;
+            if (options.upsampler) {
+                const Status on_backend = options.upsampler->upsample(
+                    low_decoded.color.view(), jitter, guides, upsampled.view());
+                done = on_backend.ok();
+                if (!done) {
+                    ++stats.backend_errors;
+                    stats.backend_error = on_backend.message();
+                }
+            }
+            if (!done)
+                upsampler.upsample(low_decoded.color.view(), jitter, guides, upsampled.view());
             std::swap(upsampled, scratch_decoded.color);
         }
         consecutive_decode_errors = 0;
@@ -440,8 +452,8 @@ const GBufferView* StreamClient::display(const glm::mat4& view, double scene_tim
     const Status made = s.extrapolator.extrapolate(f.view(), view, f.camera.projection, periods,
                                                    s.displayed, s.decoded_count);
     if (!made.ok()) {  // the backend failed: the decoded frame as it is
-        ++s.stats.extrapolation_errors;
-        s.stats.extrapolation_error = made.message();
+        ++s.stats.backend_errors;
+        s.stats.backend_error = made.message();
         info.extrapolated = false;
         s.shown = f.view();
         return &s.shown;

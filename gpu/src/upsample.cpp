@@ -436,7 +436,8 @@ struct Upsampler::State {
     glm::vec2 history_jitter{0.0f};
     bool history_has_ids = false, has_history = false;
     NonfiniteRepair guide_repair;
-    Timings timings;
+    Timings timings, total;
+    std::size_t frames = 0;
 };
 
 Upsampler::Upsampler() : state_(std::make_unique<State>()) {}
@@ -481,6 +482,8 @@ Status Upsampler::create(Context& context, const warp::UpsampleOptions& options,
 void Upsampler::reset() { state_->has_history = false; }
 
 const Timings& Upsampler::timings() const { return state_->timings; }
+const Timings& Upsampler::total() const { return state_->total; }
+std::size_t Upsampler::frames() const { return state_->frames; }
 
 Status Upsampler::upsample(ImageView<const glm::vec4> low_color, glm::vec2 jitter_px,
                            const GBufferView& given, ImageView<glm::vec4> out,
@@ -641,6 +644,10 @@ Status Upsampler::upsample(ImageView<const glm::vec4> low_color, glm::vec2 jitte
     u.history_jitter = full_jitter;
     u.history_has_ids = !full.id.empty();
     u.has_history = true;
+    u.total.upload_ms += u.timings.upload_ms;
+    u.total.compute_ms += u.timings.compute_ms;
+    u.total.download_ms += u.timings.download_ms;
+    ++u.frames;
     if (stats)
         *stats = {.history_rejected = counts[0],
                   .history_used = filtered[0],

@@ -15,6 +15,7 @@
 #include "reprise/net/udp.hpp"
 #include "reprise/net/wire.hpp"
 #include "reprise/warp/fruc.hpp"
+#include "reprise/warp/upsample.hpp"
 
 namespace reprise::client {
 
@@ -26,6 +27,9 @@ struct StreamClientOptions {
     // How (warp, fill, a backend such as the GPU's: gpu::FrucBackend, which must outlive the
     // client and be used from the thread that calls display()); the mode is extrapolate.
     warp::FrucOptions extrapolation{.mode = warp::FrucMode::Extrapolate};
+    // Lowres streams: where the colour is upsampled (null: the CPU; gpu::Upsampler, not owned,
+    // used from the thread that calls poll()).
+    warp::UpsampleBackend* upsampler = nullptr;
     bool inject_faults = false;  // put the in-process fault injector on both directions
     net::FaultOptions uplink, downlink;
     double reconnect_after_s = 2.0;  // silence from the server that ends the connection
@@ -42,9 +46,10 @@ struct StreamClientStats {
     std::size_t key_frame_requests = 0;
     std::size_t datagrams_received = 0, datagrams_dropped = 0, bytes_received = 0;
     std::size_t fec_recovered = 0;
-    // Display frames the extrapolation's backend failed on (shown as decoded) and its last error.
-    std::size_t extrapolation_errors = 0;
-    std::string extrapolation_error;
+    // Frames a backend failed on (extrapolation: shown as decoded; upsampling: upsampled on the
+    // CPU instead) and the last error.
+    std::size_t backend_errors = 0;
+    std::string backend_error;
     int64_t last_rtt_us = 0;   // pose sampled -> frame decoded
     std::string refused;       // the server's reason when it refused the session
     bool server_full = false;  // refused by the server's --max-sessions (docs/protocol.md)

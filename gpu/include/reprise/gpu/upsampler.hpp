@@ -8,7 +8,7 @@
 
 namespace reprise::gpu {
 
-class Upsampler {
+class Upsampler final : public warp::UpsampleBackend {
 public:
     // `context` must outlive the upsampler; its programs are linked here, once.
     static Status create(Context& context, const warp::UpsampleOptions& options,
@@ -22,10 +22,12 @@ public:
     // it cannot take, and for a full camera whose projection is skewed (with history).
     Status upsample(ImageView<const glm::vec4> low_color, glm::vec2 jitter_px,
                     const GBufferView& full, ImageView<glm::vec4> out,
-                    warp::UpsampleStats* stats = nullptr);
-    void reset();  // forgets the history (a cut, a new stream)
+                    warp::UpsampleStats* stats = nullptr) override;
+    void reset() override;  // forgets the history (a cut, a new stream)
 
-    const Timings& timings() const;
+    const Timings& timings() const;  // the last call's
+    const Timings& total() const;    // every call's, summed, and how many
+    std::size_t frames() const;
 
     struct State;
 

@@ -32,6 +32,7 @@
 #include "reprise/core/gbuffer.hpp"
 #include "reprise/core/image.hpp"
 #include "reprise/core/nonfinite.hpp"
+#include "reprise/core/status.hpp"
 
 namespace reprise::warp {
 
@@ -75,6 +76,17 @@ struct UpsampleStats {
     // Non-finite values in: the low-resolution colour (pixels; invalid samples, skipped as above)
     // and the guides (depth NaN/-inf, motion, normals: unknown, repaired before use).
     NonfiniteCounts nonfinite;
+};
+
+// Upsampling elsewhere than on the CPU (a GPU: gpu::Upsampler) with SpatioTemporalUpsampler's
+// inputs, output and history; an error (the device went away, an input it cannot take) says why.
+class UpsampleBackend {
+public:
+    virtual ~UpsampleBackend() = default;
+    virtual Status upsample(ImageView<const glm::vec4> low_color, glm::vec2 jitter_px,
+                            const GBufferView& full, ImageView<glm::vec4> out,
+                            UpsampleStats* stats = nullptr) = 0;
+    virtual void reset() = 0;
 };
 
 class SpatioTemporalUpsampler {
