@@ -56,13 +56,10 @@ Status check(const StereoJob& j, stereo::StereoRig& rig, stereo::StereoOptions& 
         return Status::error("--backend: '" + j.backend + "' is not cpu or gles");
     if (j.silhouettes != "widen" && j.silhouettes != "keep")
         return Status::error("--silhouettes: '" + j.silhouettes + "' is not widen or keep");
-    if (j.backend == "gles" &&
-        (j.warp != "splat" || j.fill == "andreev" || j.fill == "patch" || j.temporal))
+    if (j.backend == "gles" && (j.warp != "splat" || j.fill == "andreev" || j.fill == "patch"))
         return Status::error(
             "--backend gles: the GPU makes the eye with --warp splat and --fill pullpush or "
-            "none, without --temporal (the grid warp, Andreev's and the patch fill and the history "
-            "are not on "
-            "the GPU yet)");
+            "none (the grid warp, Andreev's and the patch fill are not on the GPU yet)");
     rig = {.ipd = float(j.ipd),
            .convergence = float(j.convergence),
            .rig = j.rig == "offaxis" ? stereo::Rig::OffAxis : stereo::Rig::Parallel};
@@ -143,9 +140,11 @@ Status run_stereo(const StereoJob& job, const stereo::StereoRig& rig,
         auto start = std::chrono::steady_clock::now();
         // Nothing of another shot fills this one's holes.
         const bool history = job.temporal && have_previous && frame.camera.cut != Cut::Yes;
+        const GBufferView previous_view = previous.view();
         stereo::StereoStats stats;
         if (gpu)
-            REPRISE_TRY(gpu->stereo_eye(frame, target, made, stats, options));
+            REPRISE_TRY(gpu->stereo_eye(frame, target, made, stats, options,
+                                        history ? &previous_view : nullptr));
         else
             stats =
                 synthesizer.synthesize(frame, target, made, options, history ? &previous : nullptr);

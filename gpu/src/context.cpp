@@ -222,11 +222,33 @@ Context::Context() : state_(std::make_unique<ContextState>()) {}
 Context::~Context() {
     if (!state_->gl) return;
     state_->gl->make_current();
-    for (Texture* t : {&state_->depth, &state_->motion, &state_->id, &state_->previous_depth,
-                       &state_->previous_id, &state_->payload, &state_->out, &state_->hit,
-                       &state_->color, &state_->valid, &state_->splat_motion, &state_->displacement,
-                       &state_->target_depth, &state_->eye_color, &state_->source_color,
-                       &state_->source_depth, &state_->source_motion, &state_->made_motion})
+    for (Texture* t : {&state_->depth,
+                       &state_->motion,
+                       &state_->id,
+                       &state_->previous_depth,
+                       &state_->previous_id,
+                       &state_->payload,
+                       &state_->out,
+                       &state_->hit,
+                       &state_->color,
+                       &state_->valid,
+                       &state_->splat_motion,
+                       &state_->displacement,
+                       &state_->target_depth,
+                       &state_->eye_color,
+                       &state_->source_color,
+                       &state_->source_depth,
+                       &state_->source_motion,
+                       &state_->made_motion,
+                       &state_->history_color,
+                       &state_->history_depth,
+                       &state_->history_motion,
+                       &state_->history_displacement,
+                       &state_->history_target_depth,
+                       &state_->history_warped,
+                       &state_->history_warped_depth,
+                       &state_->history_covered,
+                       &state_->merged})
         glDeleteTextures(1, &t->name);
     for (Texture* t : state_->interpolation.all) glDeleteTextures(1, &t->name);
     for (auto* chain :
@@ -236,9 +258,10 @@ Context::~Context() {
          {state_->pull_image_program, state_->pull_level_program, state_->push_program,
           state_->final_program, state_->splat_scatter_program, state_->splat_clear_program,
           state_->splat_gather_program, state_->displacement_program, state_->finish_program,
-          state_->blend_program, state_->copy_program, state_->static_layer_program})
+          state_->blend_program, state_->copy_program, state_->static_layer_program,
+          state_->merge_program})
         glDeleteProgram(program);
-    for (GLuint buffer : {state_->blend_counts, state_->extrapolate_counts})
+    for (GLuint buffer : {state_->blend_counts, state_->extrapolate_counts, state_->eye_counts})
         glDeleteBuffers(1, &buffer);
     glDeleteBuffers(1, &state_->splat_counts);
     glDeleteBuffers(1, &state_->splat_lists);

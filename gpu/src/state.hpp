@@ -96,6 +96,25 @@ highp vec2 seen_at(highp mat4 M, highp vec4 v, out highp float cw) {
 }
 )";
 
+// Several counts per work group: count_begin() first and count_end() last in main() (both
+// reached by every invocation), atomicAdd(group_counts[k], n) between them; each group adds its
+// counts to the global `counts` once.
+inline constexpr const char* kGroupCounts = R"(
+layout(std430, binding = 0) buffer Counts { uint counts[]; };
+shared uint group_counts[4];
+void count_begin() {
+    if (gl_LocalInvocationIndex == 0u)
+        group_counts[0] = group_counts[1] = group_counts[2] = group_counts[3] = 0u;
+    barrier();
+}
+void count_end() {
+    barrier();
+    if (gl_LocalInvocationIndex == 0u)
+        for (int k = 0; k < 4; ++k)
+            if (group_counts[k] != 0u) atomicAdd(counts[k], group_counts[k]);
+}
+)";
+
 // Sets kViewPoint's uniforms of `program` (in use) for `unproject` over w x h.
 void set_view_point(GLuint program, const Unprojector& unproject, int w, int h);
 
@@ -173,6 +192,13 @@ struct ContextState {
     GLuint blend_program = 0, copy_program = 0, blend_counts = 0;
     Interpolation interpolation;
     Texture displacement, target_depth, eye_color;
+    // The eye's history: its displacement and depth, warped colour, depth and coverage, the merge.
+    GLuint merge_program = 0, eye_counts = 0;
+    Texture history_color, history_depth, history_motion, history_displacement,
+        history_target_depth, history_warped, history_warped_depth, history_covered, merged;
+    NonfiniteRepair eye_history_repair;
+    Image<float> wide_history_depth;
+    Image<glm::vec2> wide_history_motion;
     // Extrapolation: the static-layer test (its moving pixels counted), the input frame's
     // textures and the made frame's motion.
     GLuint static_layer_program = 0, extrapolate_counts = 0;

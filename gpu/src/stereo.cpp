@@ -13,24 +13,87 @@ namespace reprise::gpu {
 
 namespace {
 
+// Each pixel's displacement to the target camera and its depth there; for the history
+// (drop_moving), NaN also where its motion is not its camera's alone (drop_moving in
+// stereo/src/synthesize.cpp), counted.
 constexpr const char* kDisplacement = R"(
 layout(binding = 0) uniform highp sampler2D depth_map;
+layout(binding = 1) uniform highp sampler2D motion_map;
 layout(binding = 0, rgba32f) writeonly uniform highp image2D displacement;
 layout(binding = 1, r32f) writeonly uniform highp image2D target_depth;
-uniform highp mat4 M, V;
+uniform highp mat4 M, V, to_previous;
+uniform bool drop_moving;
+uniform highp float tolerance2;
 
-void main() {
-    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
-    if (p.x >= size.x || p.y >= size.y) return;
+void displace(ivec2 p) {
     highp float z = texelFetch(depth_map, p, 0).r;
     highp vec4 v = view_point(p, z);
     highp float cw;
     highp vec2 l = seen_at(M, v, cw);
     PRECISE highp float tz = -row(V, 2, v);
     bool ok = nonnegative(z) && cw > 0.0 && finite(l.x) && finite(l.y);
+    if (ok && drop_moving) {
+        highp vec2 m = texelFetch(motion_map, p, 0).rg;
+        highp float before_w;
+        highp vec2 before = seen_at(to_previous, v, before_w);
+        PRECISE highp vec2 e = before - center(p) - m;
+        PRECISE highp float e2 = e.x * e.x + e.y * e.y;
+        if (!(finite(m.x) && finite(m.y) && before_w > 0.0 && e2 <= tolerance2)) {
+            ok = false;
+            atomicAdd(group_counts[0], 1u);
+        }
+    }
     highp float nan = uintBitsToFloat(0x7fc00000u);
     imageStore(displacement, p, ok ? vec4(l - center(p), 0.0, 0.0) : vec4(nan));
     imageStore(target_depth, p, vec4(ok ? (positive_inf(z) ? uintBitsToFloat(0x7f800000u) : tz) : nan));
+}
+
+void main() {
+    count_begin();
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    if (p.x < size.x && p.y < size.y) displace(p);
+    count_end();
+}
+)";
+
+// The history warped to the target where the rendered eye left a hole (or, history_replaces and
+// the history's camera nearer, where both see one surface): colour into `merged`, depth and
+// coverage in place; counts taken pixels and the holes among them.
+constexpr const char* kMerge = R"(
+layout(binding = 0) uniform highp sampler2D eye;
+layout(binding = 1) uniform highp sampler2D history;
+layout(binding = 2) uniform highp sampler2D history_depth;
+layout(binding = 3) uniform highp usampler2D history_covered;
+layout(binding = 0, rgba32f) writeonly uniform highp image2D merged;
+layout(binding = 1, r32f) uniform highp image2D depth;
+layout(binding = 2, r32ui) uniform highp uimage2D covered;
+uniform ivec2 size;
+uniform bool closer;
+uniform highp float tolerance;
+
+void merge(ivec2 p) {
+    highp vec4 c = texelFetch(eye, p, 0);
+    if (texelFetch(history_covered, p, 0).r != 0u) {
+        highp float zh = texelFetch(history_depth, p, 0).r, zc = imageLoad(depth, p).r;
+        bool hole = imageLoad(covered, p).r == 0u;
+        PRECISE highp float gap = abs(zh - zc), allowed = tolerance * min(zh, zc);
+        bool same = zh == zc || gap <= allowed;
+        if (hole || (closer && same)) {
+            c = texelFetch(history, p, 0);
+            imageStore(depth, p, vec4(zh));
+            imageStore(covered, p, uvec4(1u));
+            atomicAdd(group_counts[1], 1u);
+            if (hole) atomicAdd(group_counts[2], 1u);
+        }
+    }
+    imageStore(merged, p, c);
+}
+
+void main() {
+    count_begin();
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    if (p.x < size.x && p.y < size.y) merge(p);
+    count_end();
 }
 )";
 
@@ -66,52 +129,121 @@ Status check_options(const stereo::StereoOptions& o) {
 
 Status create_stereo_programs(ContextState& s) {
     const std::string header = kComputeHeader;
-    REPRISE_TRY(gl::link_compute((header + kViewPoint + kDisplacement).c_str(),
+    REPRISE_TRY(gl::link_compute((header + kGroupCounts + kViewPoint + kDisplacement).c_str(),
                                  "stereo displacement", s.displacement_program));
+    REPRISE_TRY(gl::link_compute((header + kGroupCounts + kMerge).c_str(), "stereo merge",
+                                 s.merge_program));
+    s.eye_counts = s.make_counters(4 * sizeof(GLuint));
     return gl::link_compute((header + kFinish).c_str(), "stereo finish", s.finish_program);
 }
 
-// Colour `color` and depth `depth` (w x h) seen from `target` into out_color / out_depth.
+// The history's textures and camera (motion 0: none).
+struct EyeHistory {
+    GLuint color = 0, depth = 0, motion = 0;
+    Camera camera;
+};
+
+// The displacement of `depth` (w x h, seen from `from`) to `target` into `displacement` and
+// `target_depth`; with `motion`, pixels whose motion `from`'s camera does not explain within
+// `moving_tolerance` px left out (NaN) and returned.
+std::size_t displace(ContextState& s, GLuint depth, GLuint motion, int w, int h, const Camera& from,
+                     const Camera& target, float moving_tolerance, GLuint displacement,
+                     GLuint target_depth) {
+    const StaticReprojection to_target(from, target.view, target.projection, w, h);
+    const StaticReprojection to_previous = camera_only_motion(from, w, h);
+    const GLuint program = s.displacement_program;
+    glUseProgram(program);
+    s.bind_inputs({depth, motion});
+    glBindImageTexture(0, displacement, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glBindImageTexture(1, target_depth, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+    ContextState::reset_counters(s.eye_counts, 4);
+    set_view_point(program, to_target.unprojector(), w, h);
+    glUniformMatrix4fv(glGetUniformLocation(program, "M"), 1, GL_FALSE, &to_target.to_clip()[0][0]);
+    glUniformMatrix4fv(glGetUniformLocation(program, "V"), 1, GL_FALSE, &to_target.to_view()[0][0]);
+    glUniformMatrix4fv(glGetUniformLocation(program, "to_previous"), 1, GL_FALSE,
+                       &to_previous.to_clip()[0][0]);
+    const bool drop = motion != 0 && moving_tolerance < INFINITY;
+    glUniform1i(glGetUniformLocation(program, "drop_moving"), drop);
+    glUniform1f(glGetUniformLocation(program, "tolerance2"), moving_tolerance * moving_tolerance);
+    dispatch(w, h);
+    GLuint moving = 0;
+    if (drop) s.read_counters(s.eye_counts, &moving, sizeof moving);
+    return moving;
+}
+
+// Colour `color` and depth `depth` (w x h) seen from `target` into out_color / out_depth; with
+// `history`, its warp fills the rendered eye's holes first.
 Status eye_passes(ContextState& s, GLuint color, GLuint depth, int w, int h, const Camera& from,
                   const Camera& target, const stereo::StereoOptions& o, GLuint out_color,
-                  GLuint out_depth, stereo::StereoStats& stats) {
+                  GLuint out_depth, stereo::StereoStats& stats, const EyeHistory* history) {
     const StaticReprojection to_target(from, target.view, target.projection, w, h);
-    const Unprojector& unproject = to_target.unprojector();
-    if (!unproject.axis_aligned())
+    if (!to_target.unprojector().axis_aligned() ||
+        (history && !Unprojector(history->camera.projection, w, h).axis_aligned()))
         return Status::error("gpu stereo eye: the rendered camera's projection is skewed");
     s.displacement.ensure(GL_RGBA32F, w, h);
     s.target_depth.ensure(GL_R32F, w, h);
     s.eye_color.ensure(GL_RGBA32F, w, h);
     s.hit.ensure(GL_R32UI, w, h);
     s.out.ensure(GL_RGBA32F, w, h);
+    if (history) {
+        s.history_displacement.ensure(GL_RGBA32F, w, h);
+        s.history_target_depth.ensure(GL_R32F, w, h);
+        s.history_warped.ensure(GL_RGBA32F, w, h);
+        s.history_warped_depth.ensure(GL_R32F, w, h);
+        s.history_covered.ensure(GL_R32UI, w, h);
+        s.merged.ensure(GL_RGBA32F, w, h);
+    }
 
-    const GLuint program = s.displacement_program;
-    glUseProgram(program);
-    s.bind_inputs({depth});
-    glBindImageTexture(0, s.displacement.name, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-    glBindImageTexture(1, s.target_depth.name, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
-    set_view_point(program, unproject, w, h);
-    glUniformMatrix4fv(glGetUniformLocation(program, "M"), 1, GL_FALSE, &to_target.to_clip()[0][0]);
-    glUniformMatrix4fv(glGetUniformLocation(program, "V"), 1, GL_FALSE, &to_target.to_view()[0][0]);
-    dispatch(w, h);
-
+    displace(s, depth, 0, w, h, from, target, INFINITY, s.displacement.name, s.target_depth.name);
     std::size_t covered = 0;
     REPRISE_TRY(splat_passes(s, {color, s.target_depth.name, s.displacement.name, w, h}, 1.0f,
                              o.splat, w, h, s.eye_color.name, out_depth, s.hit.name, 0, covered));
     const std::size_t n = std::size_t(w) * std::size_t(h);
     stats.covered = covered;
     stats.holes = n - covered;
+    GLuint warped = s.eye_color.name;
+    std::size_t history_holes_filled = 0;
+    if (history) {
+        stats.history_moving = displace(s, history->depth, history->motion, w, h, history->camera,
+                                        target, o.history_moving_tolerance,
+                                        s.history_displacement.name, s.history_target_depth.name);
+        std::size_t seen = 0;
+        REPRISE_TRY(splat_passes(
+            s, {history->color, s.history_target_depth.name, s.history_displacement.name, w, h},
+            1.0f, o.splat, w, h, s.history_warped.name, s.history_warped_depth.name,
+            s.history_covered.name, 0, seen));
+        auto distance = [](const Camera& a, const Camera& b) {
+            return glm::length(glm::vec3(glm::inverse(a.view)[3]) -
+                               glm::vec3(glm::inverse(b.view)[3]));
+        };
+        glUseProgram(s.merge_program);
+        s.bind_inputs({s.eye_color.name, s.history_warped.name, s.history_warped_depth.name,
+                       s.history_covered.name});
+        glBindImageTexture(0, s.merged.name, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+        glBindImageTexture(1, out_depth, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32F);
+        glBindImageTexture(2, s.hit.name, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
+        ContextState::reset_counters(s.eye_counts, 4);
+        glUniform1i(
+            glGetUniformLocation(s.merge_program, "closer"),
+            o.history_replaces && distance(history->camera, target) < distance(from, target));
+        glUniform1f(glGetUniformLocation(s.merge_program, "tolerance"), o.history_depth_tolerance);
+        run(s.merge_program, w, h);
+        GLuint taken[3] = {0, 0, 0};
+        s.read_counters(s.eye_counts, taken, sizeof taken);
+        stats.from_history = taken[1];
+        history_holes_filled = taken[2];
+        warped = s.merged.name;
+    }
     warp::FillStats filled;
     if (o.fill == stereo::StereoFill::PullPush)
-        REPRISE_TRY(
-            fill_passes(s, s.eye_color.name, s.hit.name, out_depth, w, h, s.out.name, filled));
+        REPRISE_TRY(fill_passes(s, warped, s.hit.name, out_depth, w, h, s.out.name, filled));
     else
-        filled.holes = filled.unfilled = stats.holes;
+        filled.holes = filled.unfilled = stats.holes - history_holes_filled;
     stats.filled = filled.holes - filled.unfilled;
     stats.unfilled = filled.unfilled;
 
     glUseProgram(s.finish_program);
-    s.bind_inputs({stats.filled ? s.out.name : s.eye_color.name});
+    s.bind_inputs({stats.filled ? s.out.name : warped});
     glBindImageTexture(0, out_color, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     run(s.finish_program, w, h);
     ContextState::unbind_inputs();
@@ -120,7 +252,8 @@ Status eye_passes(ContextState& s, GLuint color, GLuint depth, int w, int h, con
 }
 
 Status Context::stereo_eye(const GBufferView& given, const Camera& target, Frame& out,
-                           stereo::StereoStats& stats, const stereo::StereoOptions& options) {
+                           stereo::StereoStats& stats, const stereo::StereoOptions& options,
+                           const GBufferView* given_history) {
     timings_ = {};
     stats = {};
     REPRISE_TRY(check_options(options));
@@ -129,31 +262,65 @@ Status Context::stereo_eye(const GBufferView& given, const Camera& target, Frame
     ContextState& s = *state_;
     // NaN and infinities (but background depth) repaired first, as on the CPU.
     GBufferView rendered = s.eye_repair.clean(given, stats.nonfinite);
+    GBufferView history;
+    const bool with_history = given_history && given_history->width() == w &&
+                              given_history->height() == h && given_history->depth.width == w &&
+                              given_history->depth.height == h;
+    if (given_history) {
+        NonfiniteCounts found;
+        history = s.eye_history_repair.clean(*given_history, found);
+        stats.nonfinite += found;
+    }
     out.motion.clear();
     out.normal.clear();
     out.id.clear();
     out.camera = target;
-    if (rendered.camera.view == target.view && rendered.camera.projection == target.projection) {
-        out.color.assign(rendered.color);
-        out.depth.assign(rendered.depth);
-        stats.covered = std::size_t(w) * std::size_t(h);
+    auto same_camera = [&](const Camera& c) {
+        return c.view == target.view && c.projection == target.projection;
+    };
+    // The same viewpoint: nothing to warp.
+    const std::size_t n = std::size_t(w) * std::size_t(h);
+    const GBufferView* exact =
+        same_camera(rendered.camera)                                               ? &rendered
+        : with_history && same_camera(history.camera) && rendered.motion_is_zero() ? &history
+                                                                                   : nullptr;
+    if (exact) {
+        out.color.assign(exact->color);
+        out.depth.assign(exact->depth);
+        (exact == &rendered ? stats.covered : stats.from_history) = n;
         return {};
     }
     if (w <= 0 || h <= 0) return {};
     REPRISE_TRY(s.gl->acquire());
     auto t = std::chrono::steady_clock::now();
     // The silhouettes widened on the CPU, as StereoSynthesizer does (counted as upload time).
-    if (options.widen_silhouettes)
+    if (options.widen_silhouettes) {
         rendered = warp::widen_silhouettes(rendered, s.wide_depth, s.wide_motion);
+        if (with_history)
+            history = warp::widen_silhouettes(history, s.wide_history_depth, s.wide_history_motion);
+    }
     s.payload.ensure(GL_RGBA32F, w, h);
     s.previous_depth.ensure(GL_R32F, w, h);
     s.upload(s.payload, rendered.color.data, rendered.color.stride);
     s.upload(s.previous_depth, rendered.depth.data, rendered.depth.stride);
+    EyeHistory textures;
+    if (with_history) {
+        const bool motion = history.motion.width == w && history.motion.height == h;
+        s.history_color.ensure(GL_RGBA32F, w, h);
+        s.history_depth.ensure(GL_R32F, w, h);
+        s.history_motion.ensure(GL_RG32F, motion ? w : 1, motion ? h : 1);
+        s.upload(s.history_color, history.color.data, history.color.stride);
+        s.upload(s.history_depth, history.depth.data, history.depth.stride);
+        if (motion) s.upload(s.history_motion, history.motion.data, history.motion.stride);
+        textures = {s.history_color.name, s.history_depth.name, motion ? s.history_motion.name : 0u,
+                    history.camera};
+    }
     s.color.ensure(GL_RGBA32F, w, h);
     s.depth.ensure(GL_R32F, w, h);
     timings_.upload_ms = finish_ms(t);
     REPRISE_TRY(eye_passes(s, s.payload.name, s.previous_depth.name, w, h, rendered.camera, target,
-                           options, s.color.name, s.depth.name, stats));
+                           options, s.color.name, s.depth.name, stats,
+                           with_history ? &textures : nullptr));
     timings_.compute_ms = finish_ms(t);
     s.download_made(out);
     REPRISE_TRY(gl::check_errors("gpu stereo eye download"));
@@ -181,7 +348,7 @@ Status Context::stereo_eye(const GBufferTextures& rendered, unsigned color, cons
         return Status::error("gpu stereo eye: the output is the rendered colour");
     auto t = std::chrono::steady_clock::now();
     REPRISE_TRY(eye_passes(s, color, rendered.depth, w, h, rendered.camera, target, options,
-                           out_color, out_depth, stats));
+                           out_color, out_depth, stats, nullptr));
     timings_.compute_ms = finish_ms(t);
     return {};
 }

@@ -198,19 +198,6 @@ highp float luminance(highp vec4 c) {
     return y;
 }
 
-// Per work group: each invocation adds to shared counters, the first adds them to the global ones.
-layout(std430, binding = 0) buffer Counts { uint counts[]; };
-shared uint group_counts[3];
-void count_begin() {
-    if (gl_LocalInvocationIndex == 0u) group_counts[0] = group_counts[1] = group_counts[2] = 0u;
-    barrier();
-}
-void count_end() {
-    barrier();
-    if (gl_LocalInvocationIndex == 0u)
-        for (int k = 0; k < 3; ++k)
-            if (group_counts[k] != 0u) atomicAdd(counts[k], group_counts[k]);
-}
 )";
 
 // (A) The history at p + motion (bilinear, taps rejected by depth and id), the taps, the raw
@@ -468,13 +455,13 @@ Status Upsampler::create(Context& context, const warp::UpsampleOptions& options,
     REPRISE_TRY(s.gl->acquire());
     u.context = &context;
     u.options = options;
-    const std::string common = std::string(kComputeHeader) + kCommon;
+    const std::string common = std::string(kComputeHeader) + kGroupCounts + kCommon;
     REPRISE_TRY(
         gl::link_compute((common + kFetchHistory).c_str(), "upsample history", u.fetch_program));
     REPRISE_TRY(gl::link_compute((std::string(kComputeHeader) + kBox).c_str(), "upsample box",
                                  u.box_program));
     REPRISE_TRY(gl::link_compute((common + kFilter).c_str(), "upsample filter", u.filter_program));
-    u.counts = s.make_counters(3 * sizeof(GLuint));
+    u.counts = s.make_counters(4 * sizeof(GLuint));
     upsampler = std::move(made);
     return {};
 }
@@ -564,7 +551,7 @@ Status Upsampler::upsample(ImageView<const glm::vec4> low_color, glm::vec2 jitte
         uniform_float(program, "gamma_unsteered", o.gamma_unsteered);
     };
     GLuint counts[3] = {0, 0, 0};
-    ContextState::reset_counters(u.counts, 3);
+    ContextState::reset_counters(u.counts, 4);
     if (temporal) {  // (A)
         const GLuint program = u.fetch_program;
         glUseProgram(program);
@@ -588,7 +575,7 @@ Status Upsampler::upsample(ImageView<const glm::vec4> low_color, glm::vec2 jitte
         uniform_int(program, "steering", o.gradient_steering);
         dispatch(width, height);
         s.read_counters(u.counts, counts, sizeof counts);
-        ContextState::reset_counters(u.counts, 3);
+        ContextState::reset_counters(u.counts, 4);
     }
     if (temporal && o.gradient_steering) {  // (B)
         const int radius = o.gradient_radius > 0 ? o.gradient_radius

@@ -89,7 +89,7 @@ py::tuple made_eye(const Frame& rendered, Make&& make) {
 }
 
 // backend "gles": the eye made by OpenGL ES compute shaders (gpu::Context::stereo_eye: warp
-// splat, fill pullpush or none, no history), the CPU's eye within 50 dB.
+// splat, fill pullpush or none), the CPU's eye within 50 dB.
 struct Synthesizer {
     explicit Synthesizer(const std::string& backend = "cpu") {
         if (backend == "gles")
@@ -106,11 +106,12 @@ struct Synthesizer {
             return made_eye(rendered, [&](Frame& out) {
                 return synthesizer.synthesize(rendered, target, out, options, history);
             });
-        if (history) value_error("backend gles: the eye's history is not on the GPU yet");
         Status made;
         py::tuple result = made_eye(rendered, [&](Frame& out) {
             stereo::StereoStats stats;
-            made = gpu->stereo_eye(rendered, target, out, stats, options);
+            const GBufferView history_view = history ? history->view() : GBufferView{};
+            made = gpu->stereo_eye(rendered, target, out, stats, options,
+                                   history ? &history_view : nullptr);
             return stats;
         });
         if (!made.ok()) value_error("backend gles: " + made.message());
@@ -160,7 +161,7 @@ void bind_stereo(py::module_& m) {
                             "frames of one size.")
         .def(py::init<const std::string&>(), py::arg("backend") = "cpu",
              "backend 'gles': eyes made by OpenGL ES compute shaders (warp 'splat', fill "
-             "'pullpush' or 'none', no history)")
+             "'pullpush' or 'none')")
         .def("synthesize", &Synthesizer::synthesize, py::arg("rendered"), py::arg("target"),
              py::arg("warp") = "grid", py::arg("fill") = "pullpush", py::arg("history") = nullptr,
              py::arg("widen_silhouettes") = true,

@@ -38,8 +38,12 @@ def test_the_gpu_backend_makes_the_cpus_splat_eye(pan_60):
     assert gpu_stats["holes"] == cpu_stats["holes"] and gpu_stats["holes"] > 0
     with pytest.raises(ValueError, match="grid warp is not on the GPU"):
         gles.synthesize(left, right_camera)
-    with pytest.raises(ValueError, match="history is not on the GPU"):
-        gles.synthesize(left, right_camera, warp="splat", history=left)
+    # With the previous frame as history, filling the holes first: the CPU's eye too.
+    cpu, cpu_stats = reprise.StereoSynthesizer().synthesize(left, right_camera, warp="splat",
+                                                            history=pan_60[3])
+    gpu, gpu_stats = gles.synthesize(left, right_camera, warp="splat", history=pan_60[3])
+    assert reprise.psnr(reprise.to_display(gpu.color), reprise.to_display(cpu.color)) >= 50.0
+    assert gpu_stats["from_history"] == cpu_stats["from_history"] > 0
     with pytest.raises(ValueError, match="expected cpu or gles"):
         reprise.StereoSynthesizer(backend="vulkan")
 

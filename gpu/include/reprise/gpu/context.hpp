@@ -96,16 +96,19 @@ public:
     Status splat(const GBufferView& source, float factor, const warp::WarpTarget& target,
                  const warp::SplatOptions& options, std::size_t& covered);
 
-    // stereo::StereoSynthesizer::synthesize without history, for StereoWarp::Splat and
-    // StereoFill::PullPush or None (others are an error): displacement through depth, the
-    // splat, pull-push, non-finite colour to 0. Cameras without jitter, projections without skew.
+    // stereo::StereoSynthesizer::synthesize for StereoWarp::Splat and StereoFill::PullPush or
+    // None (others are an error): displacement through depth, the splat, the `history` (e.g. the
+    // previous frame's other eye, its moving pixels left out) warped the same way into the
+    // holes, pull-push, non-finite colour to 0. Cameras without jitter, projections without skew.
     Status stereo_eye(const GBufferView& rendered, const Camera& target, Frame& out,
-                      stereo::StereoStats& stats, const stereo::StereoOptions& options = {});
+                      stereo::StereoStats& stats, const stereo::StereoOptions& options = {},
+                      const GBufferView* history = nullptr);
     // The same on textures: `rendered.depth` and `color` (GL_RGBA32F) in, `out_color`
     // (GL_RGBA32F) and `out_depth` (GL_R32F) written, all of the rendered size. No repair of
     // NaN/Inf input here (the CPU-image entry repairs as the CPU does): pixels with NaN depth are
     // left out, colour with a non-finite channel comes out 0. The depth texture is warped as it
-    // is (StereoOptions::widen_silhouettes is the CPU-image entry's, done on the CPU).
+    // is (StereoOptions::widen_silhouettes is the CPU-image entry's, done on the CPU). No
+    // history here yet.
     Status stereo_eye(const GBufferTextures& rendered, unsigned color, const Camera& target,
                       unsigned out_color, unsigned out_depth, stereo::StereoStats& stats,
                       const stereo::StereoOptions& options = {});
