@@ -1020,6 +1020,39 @@ TEST(Gpu, UpsamplingOptionsAndNonFiniteSamples) {
         r.full[i].motion(9, 9) = glm::vec2(INFINITY);
     }
     expect_upsampling_matches(r, {});
+    // Textures in and out: the CPU-image entry's frames, history included.
+    const Lowres clean = render_lowres("crossing", 3, 4);
+    std::unique_ptr<gpu::Upsampler> from_images, from_textures;
+    ASSERT_TRUE(gpu::Upsampler::create(shared_gpu(), {}, from_images).ok());
+    ASSERT_TRUE(gpu::Upsampler::create(shared_gpu(), {}, from_textures).ok());
+    Image<glm::vec4> expected(kWidth, kHeight);
+    for (std::size_t i = 0; i < clean.full.size(); ++i) {
+        warp::UpsampleStats a, b;
+        ASSERT_TRUE(
+            from_images
+                ->upsample(clean.low[i].view(), clean.jitter[i], clean.full[i], expected.view(), &a)
+                .ok());
+        shared_gpu().make_current();
+        Textures t;
+        const Image<glm::vec4>& low = clean.low[i];
+        const GLuint low_color =
+            t.make(GL_RGBA32F, low.width(), low.height(), GL_RGBA, GL_FLOAT, low.data());
+        const GLuint normal =
+            t.make(GL_RGB32F, kWidth, kHeight, GL_RGB, GL_FLOAT, clean.full[i].normal.data());
+        const GLuint out = t.make(GL_RGBA32F, kWidth, kHeight, GL_RGBA, GL_FLOAT, nullptr);
+        const Status status =
+            from_textures->upsample(low_color, low.width(), low.height(), clean.jitter[i],
+                                    t.gbuffer(clean.full[i]), normal, out, &b);
+        ASSERT_TRUE(status.ok()) << status.message();
+        EXPECT_EQ(test::display_psnr(read_rgba(out), expected), INFINITY) << "frame " << i;
+        EXPECT_EQ(b.history_used, a.history_used);
+        EXPECT_NE(from_textures
+                      ->upsample(low_color, low.width(), low.height(), clean.jitter[i],
+                                 t.gbuffer(clean.full[i]), normal, low_color, &b)
+                      .message()
+                      .find("(output colour) is"),
+                  std::string::npos);
+    }
     std::unique_ptr<gpu::Upsampler> refused;
     EXPECT_NE(
         gpu::Upsampler::create(shared_gpu(), {.epsilon = 0.0f}, refused).message().find("epsilon"),

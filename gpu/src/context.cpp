@@ -166,11 +166,12 @@ Status check_texture(unsigned name, GLenum format, int w, int h, const char* wha
                              std::to_string(height) + ", expected " + std::to_string(w) + "x" +
                              std::to_string(h));
     if (GLenum(internal) != format) {
-        const char* expected = format == GL_RGBA32F ? "GL_RGBA32F"
-                               : format == GL_RG32F ? "GL_RG32F"
-                               : format == GL_R32F  ? "GL_R32F"
-                               : format == GL_R8UI  ? "GL_R8UI"
-                                                    : "GL_R32UI";
+        const char* expected = format == GL_RGBA32F  ? "GL_RGBA32F"
+                               : format == GL_RGB32F ? "GL_RGB32F"
+                               : format == GL_RG32F  ? "GL_RG32F"
+                               : format == GL_R32F   ? "GL_R32F"
+                               : format == GL_R8UI   ? "GL_R8UI"
+                                                     : "GL_R32UI";
         char found[16];
         std::snprintf(found, sizeof found, "0x%04x", unsigned(internal));
         return Status::error(where() + " has internal format " + found + ", expected " + expected);

@@ -400,6 +400,22 @@ void main() {
 }
 )";
 
+// (D) This frame's depth and ids become the next one's history.
+constexpr const char* kKeepGuides = R"(
+layout(binding = 0) uniform highp sampler2D depth_map;
+layout(binding = 1) uniform highp usampler2D id_map;
+layout(binding = 0, r32f) writeonly uniform highp image2D kept_depth;
+layout(binding = 1, r32ui) writeonly uniform highp uimage2D kept_id;
+uniform ivec2 size;
+uniform bool ids;
+void main() {
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    if (p.x >= size.x || p.y >= size.y) return;
+    imageStore(kept_depth, p, vec4(texelFetch(depth_map, p, 0).r));
+    if (ids) imageStore(kept_id, p, uvec4(texelFetch(id_map, p, 0).r));
+}
+)";
+
 void uniform_float(GLuint program, const char* name, float v) {
     glUniform1f(glGetUniformLocation(program, name), v);
 }
@@ -415,7 +431,7 @@ void uniform_vec2(GLuint program, const char* name, glm::vec2 v) {
 struct Upsampler::State {
     Context* context = nullptr;
     warp::UpsampleOptions options;
-    GLuint fetch_program = 0, box_program = 0, filter_program = 0, counts = 0;
+    GLuint fetch_program = 0, box_program = 0, filter_program = 0, keep_program = 0, counts = 0;
     // Inputs, and the history double-buffered: this frame's guides become the next one's history.
     Texture low, depth, normal, id, motion, history_depth, history_id;
     Texture history, next_history, deltas, next_deltas;
@@ -425,6 +441,13 @@ struct Upsampler::State {
     NonfiniteRepair guide_repair;
     Timings timings, total;
     std::size_t frames = 0;
+
+    void count_frame() {
+        total.upload_ms += timings.upload_ms;
+        total.compute_ms += timings.compute_ms;
+        total.download_ms += timings.download_ms;
+        ++frames;
+    }
 };
 
 Upsampler::Upsampler() : state_(std::make_unique<State>()) {}
@@ -438,7 +461,7 @@ Upsampler::~Upsampler() {
           &u.history, &u.next_history, &u.deltas, &u.next_deltas, &u.reprojected, &u.gradient,
           &u.gradient_tmp, &u.tap_geometric, &u.tap_base, &u.out})
         glDeleteTextures(1, &t->name);
-    for (GLuint program : {u.fetch_program, u.box_program, u.filter_program})
+    for (GLuint program : {u.fetch_program, u.box_program, u.filter_program, u.keep_program})
         glDeleteProgram(program);
     glDeleteBuffers(1, &u.counts);
 }
@@ -461,6 +484,8 @@ Status Upsampler::create(Context& context, const warp::UpsampleOptions& options,
     REPRISE_TRY(gl::link_compute((std::string(kComputeHeader) + kBox).c_str(), "upsample box",
                                  u.box_program));
     REPRISE_TRY(gl::link_compute((common + kFilter).c_str(), "upsample filter", u.filter_program));
+    REPRISE_TRY(gl::link_compute((std::string(kComputeHeader) + kKeepGuides).c_str(),
+                                 "upsample history guides", u.keep_program));
     u.counts = s.make_counters(4 * sizeof(GLuint));
     upsampler = std::move(made);
     return {};
@@ -472,71 +497,46 @@ const Timings& Upsampler::timings() const { return state_->timings; }
 const Timings& Upsampler::total() const { return state_->total; }
 std::size_t Upsampler::frames() const { return state_->frames; }
 
-Status Upsampler::upsample(ImageView<const glm::vec4> low_color, glm::vec2 jitter_px,
-                           const GBufferView& given, ImageView<glm::vec4> out,
-                           warp::UpsampleStats* stats) {
-    State& u = *state_;
-    ContextState& s = *u.context->state_;
+// The frame's inputs on the GPU (motion, id and normal 0 where absent).
+struct UpsampleInputs {
+    GLuint low = 0;
+    int low_width = 0, low_height = 0;
+    GLuint depth = 0, motion = 0, id = 0, normal = 0;
+    int width = 0, height = 0;
+    Camera camera;
+    glm::vec2 jitter{0.0f};
+};
+
+// The three passes and the history kept, `out` written; counts into stats.
+Status upsample_passes(Upsampler::State& u, ContextState& s, const UpsampleInputs& in, GLuint out,
+                       warp::UpsampleStats& stats) {
     const warp::UpsampleOptions& o = u.options;
-    u.timings = {};
-    GBufferView guides = given;
-    guides.color = {};
-    NonfiniteCounts input_nonfinite;
-    const GBufferView full = u.guide_repair.clean(guides, input_nonfinite);
-    input_nonfinite.color = count_nonfinite({.color = low_color}).color;
-    input_nonfinite.frames = input_nonfinite.total() > 0;
-    const int width = full.depth.width, height = full.depth.height;
-    auto sized = [&](int w, int h) { return w == width && h == height; };
-    if (full.depth.empty() || low_color.empty())
-        return Status::error("gpu upsample: needs the low colour and the full depth");
-    if (!sized(out.width, out.height))
-        return Status::error("gpu upsample: the output is not the full size");
-    if (low_color.width > width || low_color.height > height)
-        return Status::error("gpu upsample: the low colour is larger than the full image");
-    if ((!full.normal.empty() && !sized(full.normal.width, full.normal.height)) ||
-        (!full.id.empty() && !sized(full.id.width, full.id.height)) ||
-        (!full.motion.empty() && !sized(full.motion.width, full.motion.height)))
-        return Status::error("gpu upsample: a guide's size differs from the depth's");
-    REPRISE_TRY(s.gl->acquire());
-    auto t = std::chrono::steady_clock::now();
-
-    if (!sized(u.history.width, u.history.height)) u.has_history = false;
-    u.low.ensure(GL_RGBA32F, low_color.width, low_color.height);
+    const int width = in.width, height = in.height;
+    if (!(u.history.width == width && u.history.height == height)) u.has_history = false;
     for (Texture* texture : {&u.history, &u.next_history, &u.deltas, &u.next_deltas, &u.reprojected,
-                             &u.tap_geometric, &u.tap_base, &u.out})
+                             &u.tap_geometric, &u.tap_base})
         texture->ensure(GL_RGBA32F, width, height);
-    for (Texture* texture : {&u.depth, &u.history_depth, &u.gradient, &u.gradient_tmp})
+    for (Texture* texture : {&u.history_depth, &u.gradient, &u.gradient_tmp})
         texture->ensure(GL_R32F, width, height);
-    u.id.ensure(GL_R32UI, full.id.empty() ? 1 : width, full.id.empty() ? 1 : height);
     u.history_id.ensure(GL_R32UI, width, height);
-    u.motion.ensure(GL_RG32F, full.motion.empty() ? 1 : width, full.motion.empty() ? 1 : height);
-    u.normal.ensure(GL_RGB32F, full.normal.empty() ? 1 : width, full.normal.empty() ? 1 : height);
-    s.upload(u.low, low_color.data, low_color.stride);
-    s.upload(u.depth, full.depth.data, full.depth.stride);
-    if (!full.id.empty()) s.upload(u.id, full.id.data, full.id.stride);
-    if (!full.motion.empty()) s.upload(u.motion, full.motion.data, full.motion.stride);
-    if (!full.normal.empty()) s.upload(u.normal, full.normal.data, full.normal.stride);
-    u.timings.upload_ms = finish_ms(t);
-
     auto bounded = [](glm::vec2 v) {
         const float limit = float(kMaxImageSide);
         if (!std::isfinite(v.x) || !std::isfinite(v.y)) return glm::vec2(0.0f);
         return glm::clamp(v, glm::vec2(-limit), glm::vec2(limit));
     };
-    const glm::vec2 jitter = bounded(jitter_px), full_jitter = bounded(full.camera.jitter);
-    const glm::vec2 scale(float(width) / float(low_color.width),
-                          float(height) / float(low_color.height));
-    const bool ids = o.id_test && !full.id.empty();
-    const bool temporal = u.has_history && !full.motion.empty() && o.history_weight > 0.0f;
+    const glm::vec2 jitter = bounded(in.jitter), full_jitter = bounded(in.camera.jitter);
+    const glm::vec2 scale(float(width) / float(in.low_width), float(height) / float(in.low_height));
+    const bool ids = o.id_test && in.id != 0;
+    const bool temporal = u.has_history && in.motion != 0 && o.history_weight > 0.0f;
     const bool history_ids = ids && u.history_has_ids;
-    const StaticReprojection camera(full.camera, full.camera.prev_view, full.camera.prev_projection,
+    const StaticReprojection camera(in.camera, in.camera.prev_view, in.camera.prev_projection,
                                     width, height);
     if (temporal && !camera.unprojector().axis_aligned())
         return Status::error("gpu upsample: the full camera's projection is skewed");
     // The frame's constants of kCommon, set on `program` (in use).
     auto set_common = [&](GLuint program) {
         glUniform2i(glGetUniformLocation(program, "size"), width, height);
-        glUniform2i(glGetUniformLocation(program, "low_size"), low_color.width, low_color.height);
+        glUniform2i(glGetUniformLocation(program, "low_size"), in.low_width, in.low_height);
         uniform_vec2(program, "jitter", jitter);
         uniform_vec2(program, "full_jitter", full_jitter);
         uniform_vec2(program, "scale", scale);
@@ -545,7 +545,7 @@ Status Upsampler::upsample(ImageView<const glm::vec4> low_color, glm::vec2 jitte
         uniform_float(program, "floor3", o.epsilon * o.epsilon * o.epsilon);
         uniform_float(program, "depth_sigma", o.depth_sigma);
         uniform_float(program, "normal_sigma", o.normal_sigma);
-        uniform_int(program, "has_normals", !full.normal.empty());
+        uniform_int(program, "has_normals", in.normal != 0);
         uniform_int(program, "ids", ids);
         uniform_int(program, "separable", o.separable_filter);
         uniform_float(program, "gamma_unsteered", o.gamma_unsteered);
@@ -555,8 +555,8 @@ Status Upsampler::upsample(ImageView<const glm::vec4> low_color, glm::vec2 jitte
     if (temporal) {  // (A)
         const GLuint program = u.fetch_program;
         glUseProgram(program);
-        s.bind_inputs({u.low.name, u.depth.name, u.normal.name, u.id.name, u.motion.name,
-                       u.history.name, u.deltas.name, u.history_depth.name, u.history_id.name});
+        s.bind_inputs({in.low, in.depth, in.normal, in.id, in.motion, u.history.name, u.deltas.name,
+                       u.history_depth.name, u.history_id.name});
         glBindImageTexture(0, u.reprojected.name, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
         glBindImageTexture(1, u.next_deltas.name, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
         glBindImageTexture(2, u.gradient.name, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
@@ -595,9 +595,9 @@ Status Upsampler::upsample(ImageView<const glm::vec4> low_color, glm::vec2 jitte
     {  // (C)
         const GLuint program = u.filter_program;
         glUseProgram(program);
-        s.bind_inputs({u.low.name, u.depth.name, u.normal.name, u.id.name, u.reprojected.name,
-                       u.gradient.name, u.tap_geometric.name, u.tap_base.name});
-        glBindImageTexture(0, u.out.name, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+        s.bind_inputs({in.low, in.depth, in.normal, in.id, u.reprojected.name, u.gradient.name,
+                       u.tap_geometric.name, u.tap_base.name});
+        glBindImageTexture(0, out, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
         glBindImageTexture(1, u.next_history.name, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
         glBindImageTexture(2, u.next_deltas.name, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
         set_common(program);
@@ -617,30 +617,129 @@ Status Upsampler::upsample(ImageView<const glm::vec4> low_color, glm::vec2 jitte
     glUseProgram(0);
     GLuint filtered[3] = {0, 0, 0};  // used, non-finite samples, unresolved
     s.read_counters(u.counts, filtered, sizeof filtered);
+    {  // (D) the history of the next frame: this one's result (swapped below), depth and ids
+        glUseProgram(u.keep_program);
+        s.bind_inputs({in.depth, in.id});
+        glBindImageTexture(0, u.history_depth.name, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32F);
+        glBindImageTexture(1, u.history_id.name, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_R32UI);
+        glUniform2i(glGetUniformLocation(u.keep_program, "size"), width, height);
+        uniform_int(u.keep_program, "ids", in.id != 0);
+        dispatch(width, height);
+        ContextState::unbind_inputs();
+        glUseProgram(0);
+    }
     REPRISE_TRY(gl::check_errors("gpu upsample"));
+    std::swap(u.history, u.next_history);
+    std::swap(u.deltas, u.next_deltas);
+    u.history_jitter = full_jitter;
+    u.history_has_ids = in.id != 0;
+    u.has_history = true;
+    stats.history_rejected = counts[0];
+    stats.history_used = filtered[0];
+    stats.nonfinite_samples = filtered[1];
+    stats.unresolved = filtered[2];
+    return {};
+}
+
+Status Upsampler::upsample(ImageView<const glm::vec4> low_color, glm::vec2 jitter_px,
+                           const GBufferView& given, ImageView<glm::vec4> out,
+                           warp::UpsampleStats* stats) {
+    State& u = *state_;
+    ContextState& s = *u.context->state_;
+    u.timings = {};
+    GBufferView guides = given;
+    guides.color = {};
+    NonfiniteCounts input_nonfinite;
+    const GBufferView full = u.guide_repair.clean(guides, input_nonfinite);
+    input_nonfinite.color = count_nonfinite({.color = low_color}).color;
+    input_nonfinite.frames = input_nonfinite.total() > 0;
+    const int width = full.depth.width, height = full.depth.height;
+    auto sized = [&](int w, int h) { return w == width && h == height; };
+    if (full.depth.empty() || low_color.empty())
+        return Status::error("gpu upsample: needs the low colour and the full depth");
+    if (!sized(out.width, out.height))
+        return Status::error("gpu upsample: the output is not the full size");
+    if (low_color.width > width || low_color.height > height)
+        return Status::error("gpu upsample: the low colour is larger than the full image");
+    if ((!full.normal.empty() && !sized(full.normal.width, full.normal.height)) ||
+        (!full.id.empty() && !sized(full.id.width, full.id.height)) ||
+        (!full.motion.empty() && !sized(full.motion.width, full.motion.height)))
+        return Status::error("gpu upsample: a guide's size differs from the depth's");
+    REPRISE_TRY(s.gl->acquire());
+    auto t = std::chrono::steady_clock::now();
+    u.low.ensure(GL_RGBA32F, low_color.width, low_color.height);
+    u.depth.ensure(GL_R32F, width, height);
+    u.out.ensure(GL_RGBA32F, width, height);
+    if (!full.id.empty()) u.id.ensure(GL_R32UI, width, height);
+    if (!full.motion.empty()) u.motion.ensure(GL_RG32F, width, height);
+    if (!full.normal.empty()) u.normal.ensure(GL_RGB32F, width, height);
+    s.upload(u.low, low_color.data, low_color.stride);
+    s.upload(u.depth, full.depth.data, full.depth.stride);
+    if (!full.id.empty()) s.upload(u.id, full.id.data, full.id.stride);
+    if (!full.motion.empty()) s.upload(u.motion, full.motion.data, full.motion.stride);
+    if (!full.normal.empty()) s.upload(u.normal, full.normal.data, full.normal.stride);
+    u.timings.upload_ms = finish_ms(t);
+    warp::UpsampleStats counted;
+    REPRISE_TRY(upsample_passes(u, s,
+                                {.low = u.low.name,
+                                 .low_width = low_color.width,
+                                 .low_height = low_color.height,
+                                 .depth = u.depth.name,
+                                 .motion = full.motion.empty() ? 0u : u.motion.name,
+                                 .id = full.id.empty() ? 0u : u.id.name,
+                                 .normal = full.normal.empty() ? 0u : u.normal.name,
+                                 .width = width,
+                                 .height = height,
+                                 .camera = full.camera,
+                                 .jitter = jitter_px},
+                                u.out.name, counted));
     u.timings.compute_ms = finish_ms(t);
     s.download(u.out, out.data, out.stride);
     REPRISE_TRY(gl::check_errors("gpu upsample download"));
     u.timings.download_ms = finish_ms(t);
+    u.count_frame();
+    counted.nonfinite = input_nonfinite;
+    if (stats) *stats = counted;
+    return {};
+}
 
-    // This frame's result, depth and ids become the next one's history.
-    std::swap(u.history, u.next_history);
-    std::swap(u.deltas, u.next_deltas);
-    std::swap(u.depth, u.history_depth);
-    if (!full.id.empty()) std::swap(u.id, u.history_id);
-    u.history_jitter = full_jitter;
-    u.history_has_ids = !full.id.empty();
-    u.has_history = true;
-    u.total.upload_ms += u.timings.upload_ms;
-    u.total.compute_ms += u.timings.compute_ms;
-    u.total.download_ms += u.timings.download_ms;
-    ++u.frames;
-    if (stats)
-        *stats = {.history_rejected = counts[0],
-                  .history_used = filtered[0],
-                  .nonfinite_samples = filtered[1],
-                  .unresolved = filtered[2],
-                  .nonfinite = input_nonfinite};
+Status Upsampler::upsample(unsigned low_color, int low_width, int low_height, glm::vec2 jitter_px,
+                           const GBufferTextures& full, unsigned normal, unsigned out,
+                           warp::UpsampleStats* stats) {
+    State& u = *state_;
+    ContextState& s = *u.context->state_;
+    u.timings = {};
+    REPRISE_TRY(s.gl->acquire());
+    const int w = full.width, h = full.height;
+    if (w <= 0 || h <= 0 || low_width <= 0 || low_height <= 0 || low_width > w || low_height > h)
+        return Status::error("gpu upsample: sizes " + std::to_string(low_width) + "x" +
+                             std::to_string(low_height) + " (low) and " + std::to_string(w) + "x" +
+                             std::to_string(h) + " (full) must be positive, the low one no larger");
+    REPRISE_TRY(check_texture(low_color, GL_RGBA32F, low_width, low_height, "low colour"));
+    REPRISE_TRY(check_texture(full.depth, GL_R32F, w, h, "full depth"));
+    if (full.motion) REPRISE_TRY(check_texture(full.motion, GL_RG32F, w, h, "full motion"));
+    if (full.id) REPRISE_TRY(check_texture(full.id, GL_R32UI, w, h, "full ids"));
+    if (normal) REPRISE_TRY(check_texture(normal, GL_RGB32F, w, h, "full normals"));
+    REPRISE_TRY(check_texture(out, GL_RGBA32F, w, h, "output colour"));
+    if (out == low_color) return Status::error("gpu upsample: the output is the low colour");
+    auto t = std::chrono::steady_clock::now();
+    warp::UpsampleStats counted;
+    REPRISE_TRY(upsample_passes(u, s,
+                                {.low = low_color,
+                                 .low_width = low_width,
+                                 .low_height = low_height,
+                                 .depth = full.depth,
+                                 .motion = full.motion,
+                                 .id = full.id,
+                                 .normal = normal,
+                                 .width = w,
+                                 .height = h,
+                                 .camera = full.camera,
+                                 .jitter = jitter_px},
+                                out, counted));
+    u.timings.compute_ms = finish_ms(t);
+    u.count_frame();
+    if (stats) *stats = counted;
     return {};
 }
 

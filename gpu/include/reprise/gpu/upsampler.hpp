@@ -23,6 +23,12 @@ public:
     Status upsample(ImageView<const glm::vec4> low_color, glm::vec2 jitter_px,
                     const GBufferView& full, ImageView<glm::vec4> out,
                     warp::UpsampleStats* stats = nullptr) override;
+    // The same on textures: `low_color` GL_RGBA32F of low_width x low_height, the full G-buffer's
+    // depth (motion GL_RG32F and id GL_R32UI where non-zero), `normal` GL_RGB32F (0: none),
+    // `out` GL_RGBA32F of the full size. No repair here: NaN/Inf guides are the caller's to avoid.
+    Status upsample(unsigned low_color, int low_width, int low_height, glm::vec2 jitter_px,
+                    const GBufferTextures& full, unsigned normal, unsigned out,
+                    warp::UpsampleStats* stats = nullptr);
     void reset() override;  // forgets the history (a cut, a new stream)
 
     const Timings& timings() const;  // the last call's
