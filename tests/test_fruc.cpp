@@ -187,9 +187,13 @@ public:
             std::copy_n(b.color.row(y), b.color.width, &out.color(0, y));
         return {};
     }
-    Status extrapolate(const GBufferView&, const glm::mat4&, const glm::mat4&, float, float,
-                       const FrucOptions&, Frame&, FrucCounters&) override {
-        return Status::error("flaky: no extrapolation");
+    Status extrapolate(const GBufferView& f, const glm::mat4&, const glm::mat4&, float, float,
+                       const FrucOptions&, Frame& out, FrucCounters&) override {
+        if (calls++ == fail_at) return Status::error("flaky: the device went away");
+        out.color.resize(f.color.width, f.color.height);
+        for (int y = 0; y < f.color.height; ++y)
+            std::copy_n(f.color.row(y), f.color.width, &out.color(0, y));
+        return {};
     }
 };
 
@@ -226,6 +230,44 @@ TEST(Fruc, ABackendErrorLeavesTheConverterAsItWas) {
     FrameRateConverter refused;
     const Status grid = FrameRateConverter::create(2, {.backend = &backend}, refused);
     EXPECT_NE(grid.message().find("splat only"), std::string::npos);
+}
+
+// The same when extrapolating: a failed send leaves the converter (its previous frame too) as it
+// was, and sending the frame again gives what an unbroken run gives.
+TEST(Fruc, ABackendErrorWhileExtrapolatingLeavesTheConverterAsItWas) {
+    const std::vector<Frame> frames = render("crossing", 30.0, 0, 3, 48, 32);
+    auto run = [&](int fail_at, std::vector<Frame>& outputs) {
+        FlakyBackend backend;
+        backend.fail_at = fail_at;
+        FrameRateConverter converter;
+        EXPECT_TRUE(
+            FrameRateConverter::create(
+                3, {.mode = FrucMode::Extrapolate, .warp = WarpMethod::Splat, .backend = &backend},
+                converter)
+                .ok());
+        Frame out;
+        for (const Frame& f : frames) {
+            Status sent = converter.send(f);
+            if (!sent.ok()) {
+                EXPECT_NE(sent.message().find("went away"), std::string::npos);
+                EXPECT_EQ(converter.receive(out), Result::NeedMoreData);
+                sent = converter.send(f);
+            }
+            EXPECT_TRUE(sent.ok()) << sent.message();
+            while (converter.receive(out)) outputs.push_back(out);
+        }
+        return converter.counters();
+    };
+    std::vector<Frame> unbroken, broken;
+    const FrucCounters a = run(-1, unbroken), b = run(3, broken);  // the 2nd of input 1
+    ASSERT_EQ(broken.size(), unbroken.size());
+    ASSERT_EQ(unbroken.size(), 9u);
+    for (std::size_t i = 0; i < unbroken.size(); ++i)
+        EXPECT_EQ(display_psnr(broken[i].color, unbroken[i].color), INFINITY) << i;
+    EXPECT_EQ(b.inputs, a.inputs);
+    EXPECT_EQ(b.outputs, a.outputs);
+    EXPECT_EQ(b.cuts, a.cuts);
+    EXPECT_EQ(b.cut_tests_skipped, a.cut_tests_skipped);
 }
 
 TEST(Fruc, TheCameraSaysWhereCutsAreAndOnlyUnknownFramesAreTested) {

@@ -15,6 +15,7 @@
 
 #include <GLES3/gl32.h>
 
+#include "reprise/gl/context.hpp"
 #include "reprise/gpu/context.hpp"
 #include "reprise/gpu/fruc_backend.hpp"
 #include "reprise/gpu/upsampler.hpp"
@@ -601,6 +602,11 @@ struct Differences {
 };
 Differences differences(const Frame& cpu, const Frame& gpu) {
     Differences d;
+    EXPECT_EQ(gpu.depth.pixel_count(), cpu.depth.pixel_count());
+    EXPECT_EQ(gpu.motion.pixel_count(), cpu.motion.pixel_count());
+    if (gpu.depth.pixel_count() != cpu.depth.pixel_count() ||
+        gpu.motion.pixel_count() != cpu.motion.pixel_count())
+        return {.depth = cpu.depth.pixel_count(), .motion = INFINITY};
     for (std::size_t i = 0; i < cpu.depth.pixel_count(); ++i) {
         d.depth += std::memcmp(&cpu.depth.data()[i], &gpu.depth.data()[i], sizeof(float)) != 0;
         const glm::vec2 m = cpu.motion.data()[i] - gpu.motion.data()[i];
@@ -933,7 +939,7 @@ TEST(Gpu, ExtrapolationOnTexturesAndBadArguments) {
                   .extrapolate(frame, color, to.view, to.projection, 1.0f, color, depth, motion,
                                texture_stats, kSplatExtrapolation)
                   .message()
-                  .find("the output is the input colour"),
+                  .find("an output is an input"),
               std::string::npos);
 }
 
@@ -1052,6 +1058,12 @@ TEST(Gpu, UpsamplingOptionsAndNonFiniteSamples) {
                       .message()
                       .find("(output colour) is"),
                   std::string::npos);
+        EXPECT_NE(from_textures
+                      ->upsample(out, kWidth, kHeight, clean.jitter[i], t.gbuffer(clean.full[i]),
+                                 normal, out, &b)
+                      .message()
+                      .find("the output is the low colour"),
+                  std::string::npos);
     }
     std::unique_ptr<gpu::Upsampler> refused;
     EXPECT_NE(
@@ -1094,6 +1106,48 @@ TEST(Gpu, StereoEyeWithHistoryMatchesTheCpuOnEveryBuiltInScene) {
     }
     EXPECT_GT(from_history, 0u);  // not vacuous: holes were filled from the history
     EXPECT_GT(moving, 0u);        // ... and moving history pixels left out
+}
+
+// --- A gpu::Context working in the application's own OpenGL ES context.
+
+TEST(Gpu, AContextAdoptedFromTheApplication) {
+    const std::vector<Frame>& frames = scene_frames("crossing");
+    Frame expected;
+    gpu::InterpolateStats expected_stats, stats;
+    ASSERT_TRUE(
+        shared_gpu().interpolate(frames[0], frames[1], 0.5f, expected, expected_stats).ok());
+    // The application's context (made here as an engine would have one), current on this thread.
+    std::unique_ptr<gl::Context> application;
+    ASSERT_TRUE(gl::Context::create(application).ok());
+    std::unique_ptr<gpu::Context> adopted;
+    const Status made = gpu::Context::adopt_current(adopted);
+    ASSERT_TRUE(made.ok()) << made.message();
+    {
+        Textures t;  // the application's textures, used as they are
+        const gpu::GBufferTextures a = t.gbuffer(frames[0]), b = t.gbuffer(frames[1]);
+        const GLuint a_color =
+            t.make(GL_RGBA32F, kWidth, kHeight, GL_RGBA, GL_FLOAT, frames[0].color.data());
+        const GLuint b_color =
+            t.make(GL_RGBA32F, kWidth, kHeight, GL_RGBA, GL_FLOAT, frames[1].color.data());
+        const GLuint out = t.make(GL_RGBA32F, kWidth, kHeight, GL_RGBA, GL_FLOAT, nullptr);
+        const GLuint depth = t.make(GL_R32F, kWidth, kHeight, GL_RED, GL_FLOAT, nullptr);
+        const Status status = adopted->interpolate(a, a_color, b, b_color, 0.5f, out, depth, stats);
+        ASSERT_TRUE(status.ok()) << status.message();
+        EXPECT_EQ(test::display_psnr(read_rgba(out), expected.color), INFINITY);
+        EXPECT_EQ(stats.holes, expected_stats.holes);
+        // With another context current the adopted one refuses, and makes nothing current.
+        shared_gpu().make_current();
+        EXPECT_NE(adopted->interpolate(a, a_color, b, b_color, 0.5f, out, depth, stats)
+                      .message()
+                      .find("not current on this thread"),
+                  std::string::npos);
+        application->make_current();
+    }
+    adopted.reset();  // its objects deleted in the application's context, which stays
+    EXPECT_EQ(glGetError(), GLenum(GL_NO_ERROR));
+    application.reset();  // nothing current now
+    EXPECT_NE(gpu::Context::adopt_current(adopted).message().find("no EGL context is current"),
+              std::string::npos);
 }
 
 }  // namespace

@@ -184,9 +184,11 @@ struct StreamClient::State {
                 const Status on_backend = options.upsampler->upsample(
                     low_decoded.color.view(), jitter, guides, upsampled.view());
                 done = on_backend.ok();
-                if (!done) {
+                if (!done) {  // neither history follows on from this frame: both start over
                     ++stats.backend_errors;
                     stats.backend_error = on_backend.message();
+                    options.upsampler->reset();
+                    upsampler.reset();
                 }
             }
             if (!done)

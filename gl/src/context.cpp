@@ -126,37 +126,65 @@ Status Context::create(std::unique_ptr<Context>& context) {
     context.reset(new Context());
     context->display_ = display;
     context->context_ = egl_context;
+    const Status usable = context->describe(false);
+    if (!usable.ok()) context.reset();
+    return usable;
+}
+
+Status Context::adopt_current(std::unique_ptr<Context>& context) {
+    EGLContext current = eglGetCurrentContext();
+    if (current == EGL_NO_CONTEXT)
+        return Status::error("gl: no EGL context is current on this thread to adopt");
+    if (eglQueryAPI() != EGL_OPENGL_ES_API)
+        return Status::error("gl: the current EGL context is not an OpenGL ES one");
+    std::unique_ptr<Context> made(new Context());
+    made->display_ = eglGetCurrentDisplay();
+    made->context_ = current;
+    made->adopted_ = true;
+    REPRISE_TRY(made->describe(true));
+    context = std::move(made);
+    return {};
+}
+
+Status Context::describe(bool compute) {
     const char* renderer = reinterpret_cast<const char*>(glGetString(GL_RENDERER));
     const char* version = reinterpret_cast<const char*>(glGetString(GL_VERSION));
-    context->description_ =
-        std::string(renderer ? renderer : "?") + ", " + (version ? version : "?");
+    description_ = std::string(renderer ? renderer : "?") + ", " + (version ? version : "?");
     const char* gl_extensions = reinterpret_cast<const char*>(glGetString(GL_EXTENSIONS));
     GLint gl_major = 0, gl_minor = 0;
     glGetIntegerv(GL_MAJOR_VERSION, &gl_major);
     glGetIntegerv(GL_MINOR_VERSION, &gl_minor);
-    bool float_targets = gl_major > 3 || (gl_major == 3 && gl_minor >= 2) ||
-                         has_extension(gl_extensions, "GL_EXT_color_buffer_float");
-    if (!float_targets) {
-        context.reset();
+    if (compute && !(gl_major > 3 || (gl_major == 3 && gl_minor >= 1)))
+        return Status::error("OpenGL ES " + std::to_string(gl_major) + "." +
+                             std::to_string(gl_minor) + ": compute shaders need OpenGL ES 3.1 (" +
+                             description_ + ")");
+    const bool float_targets = gl_major > 3 || (gl_major == 3 && gl_minor >= 2) ||
+                               has_extension(gl_extensions, "GL_EXT_color_buffer_float");
+    if (!float_targets)
         return Status::error(
             "OpenGL ES: float render targets (GL_EXT_color_buffer_float) are "
             "not supported");
-    }
     return {};
 }
 
 Context::~Context() {
-    if (!display_) return;
+    if (!display_ || adopted_) return;
     eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
     if (context_) eglDestroyContext(display_, context_);
     release(static_cast<EGLDisplay>(display_));
 }
 
 void Context::make_current() const {
-    eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_);
+    if (!adopted_) eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_);
 }
 
 Status Context::acquire() const {
+    if (adopted_) {
+        if (eglGetCurrentContext() == context_) return {};
+        return Status::error(
+            "gl: the adopted OpenGL ES context is not current on this thread; make it current "
+            "before each call");
+    }
     if (eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, context_) == EGL_TRUE) return {};
     return Status::error("gl: the context cannot be made current on this thread (EGL error " +
                          std::to_string(eglGetError()) +

@@ -221,8 +221,8 @@ void ContextState::download_made(Frame& made) {
 Context::Context() : state_(std::make_unique<ContextState>()) {}
 
 Context::~Context() {
-    if (!state_->gl) return;
-    state_->gl->make_current();
+    // An adopted context that is not current here: its objects cannot be reached (left to it).
+    if (!state_->gl || !state_->gl->acquire().ok()) return;
     for (Texture* t : {&state_->depth,
                        &state_->motion,
                        &state_->id,
@@ -276,9 +276,21 @@ Context::~Context() {
 }
 
 Status Context::create(std::unique_ptr<Context>& context) {
+    std::unique_ptr<gl::Context> gl;
+    REPRISE_TRY(gl::Context::create(gl));
+    return create_on(std::move(gl), context);
+}
+
+Status Context::adopt_current(std::unique_ptr<Context>& context) {
+    std::unique_ptr<gl::Context> gl;
+    REPRISE_TRY(gl::Context::adopt_current(gl));
+    return create_on(std::move(gl), context);
+}
+
+Status Context::create_on(std::unique_ptr<gl::Context> gl, std::unique_ptr<Context>& context) {
     std::unique_ptr<Context> made(new Context());
     ContextState& s = *made->state_;
-    REPRISE_TRY(gl::Context::create(s.gl));
+    s.gl = std::move(gl);
     GLint major = 0, minor = 0;
     glGetIntegerv(GL_MAJOR_VERSION, &major);
     glGetIntegerv(GL_MINOR_VERSION, &minor);
@@ -286,6 +298,15 @@ Status Context::create(std::unique_ptr<Context>& context) {
         return Status::error("gpu: OpenGL ES 3.1 (compute shaders) is needed; " +
                              s.gl->description() + " has " + std::to_string(major) + "." +
                              std::to_string(minor));
+    // The passes write up to 5 images in one dispatch (the upsampler's history pass) at units up
+    // to 6 (the splat's gather); GL ES 3.1 promises 4 of each.
+    GLint images = 0, units = 0;
+    glGetIntegerv(GL_MAX_COMPUTE_IMAGE_UNIFORMS, &images);
+    glGetIntegerv(GL_MAX_IMAGE_UNITS, &units);
+    if (images < 5 || units < 7)
+        return Status::error("gpu: " + s.gl->description() + " offers " + std::to_string(images) +
+                             " compute image uniforms and " + std::to_string(units) +
+                             " image units; the GPU paths need 5 and 7");
     REPRISE_TRY(create_programs(s));
     REPRISE_TRY(create_fill_programs(s));
     REPRISE_TRY(create_splat_programs(s));

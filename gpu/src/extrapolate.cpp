@@ -188,7 +188,8 @@ Status Context::extrapolate(const GBufferTextures& frame, unsigned color, const 
     REPRISE_TRY(check_texture(out_color, GL_RGBA32F, w, h, "output colour"));
     REPRISE_TRY(check_texture(out_depth, GL_R32F, w, h, "output depth"));
     if (out_motion) REPRISE_TRY(check_texture(out_motion, GL_RGBA32F, w, h, "output motion"));
-    if (out_color == color) return Status::error("gpu extrapolate: the output is the input colour");
+    if (out_color == color || out_depth == frame.depth)
+        return Status::error("gpu extrapolate: an output is an input (colour or depth)");
     auto t = std::chrono::steady_clock::now();
     REPRISE_TRY(extrapolate_passes(s, {color, frame.depth, frame.motion, w, h}, frame.camera, view,
                                    projection, periods, motion_scale, options, out_color, out_depth,

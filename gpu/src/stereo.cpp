@@ -1,7 +1,7 @@
-// The second eye on the GPU: stereo::StereoSynthesizer with StereoWarp::Splat, without history.
-// Each pixel's displacement to the target camera through its depth (warp/'s
-// displacement_row_reference, same arithmetic), the splat, pull-push over its holes, and
-// non-finite colour to 0 on the way into the output.
+// The second eye on the GPU: stereo::StereoSynthesizer with StereoWarp::Splat. Each pixel's
+// displacement to the target camera through its depth (warp/'s displacement_row_reference, same
+// arithmetic), the splat; with a history, its warp merged into the holes; pull-push over what is
+// left, and non-finite colour to 0 on the way into the output.
 #include <chrono>
 #include <string>
 

@@ -528,6 +528,7 @@ Status upsample_passes(Upsampler::State& u, ContextState& s, const UpsampleInput
     const glm::vec2 scale(float(width) / float(in.low_width), float(height) / float(in.low_height));
     const bool ids = o.id_test && in.id != 0;
     const bool temporal = u.has_history && in.motion != 0 && o.history_weight > 0.0f;
+    u.has_history = false;  // until this frame's passes all succeeded
     const bool history_ids = ids && u.history_has_ids;
     const StaticReprojection camera(in.camera, in.camera.prev_view, in.camera.prev_projection,
                                     width, height);

@@ -465,7 +465,9 @@ Status FrameRateConverter::send_frame(const Frame& given, Frame* owned) {
         }
         st.emit_input(frame, owned ? nullptr : &st.previous);
     } else {
-        st.emit_input(frame, owned ? nullptr : &st.previous);
+        // With a backend, which may fail, the frame becomes `previous` only once its frames are
+        // made (a failed send leaves the converter as it was).
+        st.emit_input(frame, owned || st.options.backend ? nullptr : &st.previous);
         if (st.automatic() && warpable && !cut) predicted = survey_predictors(frame);
         const Camera before = State::previous_instant(frame.camera, fps);
         for (int k = 1; k < k_max; ++k) {
@@ -485,7 +487,10 @@ Status FrameRateConverter::send_frame(const Frame& given, Frame* owned) {
             st.attach_ui(st.ready.back(), frame, true);
         }
     }
-    if (owned) std::swap(st.previous, *owned);  // the caller gets the old buffers to refill
+    if (owned)
+        std::swap(st.previous, *owned);  // the caller gets the old buffers to refill
+    else if (st.options.mode == FrucMode::Extrapolate && st.options.backend)
+        st.previous = frame;
     st.has_previous = true;
     st.previous_starts_shot = cut;
     st.previous_key = key;

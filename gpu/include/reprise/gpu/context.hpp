@@ -17,6 +17,10 @@
 #include "reprise/warp/reproject.hpp"
 #include "reprise/warp/splat.hpp"
 
+namespace reprise::gl {
+class Context;
+}
+
 namespace reprise::gpu {
 
 // What the last call spent, in milliseconds, each phase finished (glFinish) before the next.
@@ -60,6 +64,12 @@ class Context {
 public:
     // Creates its own EGL context (gl::Context: a GPU's EGL device, else Mesa llvmpipe).
     static Status create(std::unique_ptr<Context>& context);
+    // Works in the application's OpenGL ES 3.1+ context current on this thread instead: its
+    // textures are used as they are, nothing is made current, and every call (and the
+    // destruction, which deletes this Context's GL objects) needs that context current on the
+    // calling thread. A call leaves the texture, sampler, program, image, buffer and framebuffer
+    // bindings it used at 0.
+    static Status adopt_current(std::unique_ptr<Context>& context);
     ~Context();
     Context(const Context&) = delete;
     Context& operator=(const Context&) = delete;
@@ -139,8 +149,9 @@ public:
     // others `periods` along their own motion, in one splat; pull-push over what nothing covers.
     // A frame without a projection goes along its motion alone (view and projection unused).
     // out gets colour, depth and backward motion per period times motion_scale (0 at periods
-    // 0); out.normal and id cleared, out.camera untouched. NaN/Inf are repaired first, as on the
-    // CPU; the silhouettes are warped as they are (the CPU widens them before a backend).
+    // 0); out.normal and id cleared, out.camera untouched. NaN/Inf are repaired first, as the
+    // converter does (PoseExtrapolator does not: on such input the GPU makes the CPU's frame of
+    // the repaired input); the silhouettes are warped as they are (the CPU widens them first).
     Status extrapolate(const GBufferView& frame, const glm::mat4& view, const glm::mat4& projection,
                        float periods, Frame& out, ExtrapolateStats& stats,
                        const warp::FrucOptions& options, float motion_scale = 1.0f);
@@ -155,6 +166,7 @@ public:
 private:
     friend class Upsampler;  // its passes run on this context's state
     Context();
+    static Status create_on(std::unique_ptr<gl::Context> gl, std::unique_ptr<Context>& context);
     std::unique_ptr<ContextState> state_;
     Timings timings_;
 };

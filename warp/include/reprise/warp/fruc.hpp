@@ -105,7 +105,8 @@ public:
                                float motion_scale, Frame& out, FrucCounters& counters) = 0;
     // What the CPU's extrapolation makes: f as seen by (view, projection) `periods` frame
     // periods after it (without a projection on f: along its motion alone), colour, depth and
-    // backward motion per period times motion_scale.
+    // backward motion per period times motion_scale. A backend may repair NaN/Inf in f first
+    // (gpu::FrucBackend does; the converter's inputs are repaired already).
     virtual Status extrapolate(const GBufferView& f, const glm::mat4& view,
                                const glm::mat4& projection, float periods, float motion_scale,
                                const FrucOptions& options, Frame& out, FrucCounters& counters) = 0;
