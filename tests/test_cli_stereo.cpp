@@ -179,6 +179,19 @@ TEST(CliStereo, FrucOnTheGpuBackendMakesTheCpusSplatFrames) {
     ASSERT_TRUE(read_frame(frame_path(cpu, 1), cpu_made).ok());
     ASSERT_FALSE(made.motion.empty());  // per output period, as the CPU's
     EXPECT_EQ(made.motion(80, 45), cpu_made.motion(80, 45));
+    // With true motion (the default) too.
+    const std::string cpu_true = (dir / "cpu_true").string(),
+                      gles_true = (dir / "gles_true").string();
+    const std::vector<std::string> true_motion = {"--in", in, "--warp", "splat", "--refine", "off"};
+    std::vector<std::string> run = true_motion;
+    run.insert(run.end(), {"--out", cpu_true});
+    ASSERT_EQ(run_command(cli::command_fruc, run), 0);
+    run = true_motion;
+    run.insert(run.end(), {"--backend", "gles", "--out", gles_true});
+    ASSERT_EQ(run_command(cli::command_fruc, run), 0);
+    for (int i = 0; i < 5; ++i)
+        EXPECT_GE(psnr_of(frame_path(cpu_true, i), frame_path(gles_true, i)), 50.0)
+            << "true motion, frame " << i;
     // Extrapolated on the GPU: the CPU's frames, motion included.
     const std::vector<std::string> ahead = {"--in",        in,         "--warp", "splat", "--mode",
                                             "extrapolate", "--factor", "3"};
@@ -200,7 +213,7 @@ TEST(CliStereo, FrucOnTheGpuBackendMakesTheCpusSplatFrames) {
     const std::string refused = (dir / "refused").string();
     EXPECT_EQ(run_command(cli::command_fruc,
                           {"--in", in, "--backend", "gles", "--warp", "splat", "--out", refused}),
-              1);  // refinement and true motion on
+              1);  // refinement on
     EXPECT_EQ(run_command(cli::command_fruc, with({"--backend", "vulkan", "--out", refused})), 1);
     EXPECT_EQ(
         run_command(cli::command_fruc, {"--in", in, "--true-motion", "maybe", "--out", refused}),

@@ -179,8 +179,8 @@ public:
     Status supports(const FrucOptions& o) const override {
         return o.warp == WarpMethod::Splat ? Status{} : Status::error("flaky: splat only");
     }
-    Status interpolate(const GBufferView&, const GBufferView& b, float, float, Frame& out,
-                       FrucCounters&) override {
+    Status interpolate(const GBufferView&, const GBufferView& b, float, float, const FrucOptions&,
+                       Frame& out, FrucCounters&) override {
         if (calls++ == fail_at) return Status::error("flaky: the device went away");
         out.color.resize(b.color.width, b.color.height);
         for (int y = 0; y < b.color.height; ++y)

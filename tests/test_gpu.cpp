@@ -624,9 +624,11 @@ const warp::FrucOptions kSplatInterpolation{
 
 // The frame the CPU makes halfway between `a` and `b` from the inputs as they are (the converter
 // widens their silhouettes before it hands them to a backend; Context::interpolate does not).
-Frame cpu_between(const Frame& a, const Frame& b) {
+Frame cpu_between(const Frame& a, const Frame& b, bool true_motion = false,
+                  warp::FrucCounters* counters = nullptr) {
     warp::FrucOptions options = kSplatInterpolation;
     options.widen_silhouettes = false;
+    options.true_motion = true_motion;
     warp::FrameRateConverter converter;
     EXPECT_TRUE(warp::FrameRateConverter::create(2, options, converter).ok());
     std::vector<Frame> outputs;
@@ -637,33 +639,43 @@ Frame cpu_between(const Frame& a, const Frame& b) {
     }
     EXPECT_EQ(converter.counters().outputs, 1u);
     EXPECT_EQ(outputs.size(), 3u);  // a, the made frame, b
+    if (counters) *counters = converter.counters();
     return outputs.size() == 3 ? outputs[1] : Frame{};
 }
 
 TEST(Gpu, InterpolationMatchesTheCpuOnEveryBuiltInScene) {
-    std::size_t holes = 0;
-    for (const server::SceneInfo& info : server::builtin_scenes()) {
-        SCOPED_TRACE(info.name);
-        const std::vector<Frame>& frames = scene_frames(info.name);
-        const Frame cpu = cpu_between(frames[0], frames[1]);
-        Frame gpu;
-        gpu::InterpolateStats stats;
-        const Status status =
-            shared_gpu().interpolate(frames[0], frames[1], 0.5f, gpu, stats, {}, 0.5f);
-        ASSERT_TRUE(status.ok()) << status.message();
-        const double db = test::display_psnr(cpu.color, gpu.color);
-        EXPECT_GE(db, 50.0);
-        // Motion as the CPU's but where its SIMD blend rounds the same-surface test otherwise.
-        const Differences d = differences(cpu, gpu);
-        EXPECT_LE(d.motion_pixels, cpu.motion.pixel_count() / 1000);
-        holes += stats.holes;
-        std::printf(
-            "%-10s between: covered a %zu b %zu, holes %zu, %.1f dB, motion of %zu pixels "
-            "differs (at most %g px)\n",
-            info.name, stats.covered_a, stats.covered_b, stats.holes, db, d.motion_pixels,
-            double(d.motion));
-    }
-    EXPECT_GT(holes, 0u);  // not vacuous: some holes filled
+    std::size_t holes = 0, true_motion = 0;
+    for (const server::SceneInfo& info : server::builtin_scenes())
+        for (const bool follow : {false, true}) {
+            SCOPED_TRACE(std::string(info.name) + (follow ? ", true motion" : ""));
+            const std::vector<Frame>& frames = scene_frames(info.name);
+            warp::FrucCounters counters;
+            const Frame cpu = cpu_between(frames[0], frames[1], follow, &counters);
+            Frame gpu;
+            gpu::InterpolateStats stats;
+            const Status status = shared_gpu().interpolate(
+                frames[0], frames[1], 0.5f, gpu, stats,
+                {.true_motion = follow, .static_tolerance = 0.25f, .motion_scale = 0.5f});
+            ASSERT_TRUE(status.ok()) << status.message();
+            if (counters.copied_still == 0) {  // (shadows: a still pair, which the CPU copies)
+                EXPECT_EQ(std::size_t(stats.true_motion), counters.true_motion);
+                EXPECT_EQ(std::size_t(stats.linear_motion), counters.linear_motion);
+            }
+            true_motion += stats.true_motion;
+            const double db = test::display_psnr(cpu.color, gpu.color);
+            EXPECT_GE(db, 50.0);
+            // Motion as the CPU's but where its SIMD blend rounds the same-surface test otherwise.
+            const Differences d = differences(cpu, gpu);
+            EXPECT_LE(d.motion_pixels, cpu.motion.pixel_count() / 1000);
+            holes += stats.holes;
+            std::printf(
+                "%-10s between%s: covered a %zu b %zu, holes %zu, %.1f dB, motion of %zu pixels "
+                "differs (at most %g px)\n",
+                info.name, stats.true_motion ? " (true motion)" : "", stats.covered_a,
+                stats.covered_b, stats.holes, db, d.motion_pixels, double(d.motion));
+        }
+    EXPECT_GT(true_motion, 0u);  // not vacuous: some pairs followed their true motion
+    EXPECT_GT(holes, 0u);        // not vacuous: some holes filled
 }
 
 TEST(Gpu, InterpolationRepairsNonFiniteInputAsTheCpu) {
@@ -723,7 +735,7 @@ TEST(Gpu, TheConverterWithTheGpuBackendMakesTheCpusFrames) {
     grid.backend = &backend;
     warp::FrameRateConverter refused;
     const Status status = warp::FrameRateConverter::create(2, grid, refused);
-    EXPECT_NE(status.message().find("warp splat, true motion off, refine off"), std::string::npos)
+    EXPECT_NE(status.message().find("warp splat, refine off"), std::string::npos)
         << status.message();
 }
 

@@ -93,6 +93,21 @@ void set_view_point(GLuint program, const Unprojector& unproject, int w, int h) 
     glUniform2i(glGetUniformLocation(program, "size"), w, h);
 }
 
+Status set_still_test(GLuint program, const Camera& frame, const glm::mat4& view,
+                      const glm::mat4& projection, int w, int h, float tolerance) {
+    const StaticReprojection to_previous = camera_only_motion(frame, w, h);
+    const StaticReprojection to_target(frame, view, projection, w, h);
+    if (!to_previous.unprojector().axis_aligned())
+        return Status::error("gpu: the frame's projection is skewed");
+    set_view_point(program, to_previous.unprojector(), w, h);
+    glUniformMatrix4fv(glGetUniformLocation(program, "to_previous"), 1, GL_FALSE,
+                       &to_previous.to_clip()[0][0]);
+    glUniformMatrix4fv(glGetUniformLocation(program, "to_target"), 1, GL_FALSE,
+                       &to_target.to_clip()[0][0]);
+    glUniform1f(glGetUniformLocation(program, "tolerance2"), tolerance * tolerance);
+    return {};
+}
+
 GLuint ContextState::make_counters(std::size_t bytes) {
     GLuint buffer = 0;
     glGenBuffers(1, &buffer);

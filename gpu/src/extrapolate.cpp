@@ -18,24 +18,16 @@ layout(binding = 0) uniform highp sampler2D depth_map;
 layout(binding = 1) uniform highp sampler2D motion_map;
 layout(binding = 0, rgba32f) writeonly uniform highp image2D displacement;
 layout(std430, binding = 0) buffer Counts { uint counts[]; };
-uniform highp mat4 to_previous, to_target;
-uniform highp float tolerance2, periods;
+uniform highp float periods;
 
 // Whether pixel p moves on its own; its displacement written either way.
 bool moving(ivec2 p) {
     highp float z = texelFetch(depth_map, p, 0).r;
     highp vec2 m = texelFetch(motion_map, p, 0).rg;
-    highp vec4 v = view_point(p, z);
-    highp float before_w, later_w;
-    highp vec2 before = seen_at(to_previous, v, before_w), later = seen_at(to_target, v, later_w);
-    highp vec2 c = center(p);
-    PRECISE highp vec2 e = before - c - m;
-    PRECISE highp float e2 = e.x * e.x + e.y * e.y;
-    bool nan_depth = (floatBitsToUint(z) & 0x7fffffffu) > 0x7f800000u;
-    bool still = !nan_depth && finite(m.x) && finite(m.y) && before_w > 0.0 && later_w > 0.0 &&
-                 e2 <= tolerance2;
+    highp vec2 later;
+    bool still = still_pixel(p, z, m, later);
     PRECISE highp vec2 along = -periods * m;
-    imageStore(displacement, p, vec4(still ? later - c : along, 0.0, 0.0));
+    imageStore(displacement, p, vec4(still ? later : along, 0.0, 0.0));
     return !still;
 }
 
@@ -67,8 +59,9 @@ Status check_periods(float periods) {
 
 Status create_extrapolate_programs(ContextState& s) {
     s.extrapolate_counts = s.make_counters(sizeof(GLuint));
-    return gl::link_compute((std::string(kComputeHeader) + kViewPoint + kStaticLayer).c_str(),
-                            "static layer", s.static_layer_program);
+    return gl::link_compute(
+        (std::string(kComputeHeader) + kViewPoint + kStillTest + kStaticLayer).c_str(),
+        "static layer", s.static_layer_program);
 }
 
 Status extrapolate_passes(ContextState& s, const SplatTextures& frame, const Camera& camera,
@@ -83,22 +76,13 @@ Status extrapolate_passes(ContextState& s, const SplatTextures& frame, const Cam
     SplatTextures along = frame;
     float factor = 1.0f, to_backward = periods > 1e-6f ? -motion_scale / periods : 0.0f;
     if (has_projection(camera)) {
-        const StaticReprojection to_previous = camera_only_motion(camera, w, h);
-        const StaticReprojection to_target(camera, view, projection, w, h);
-        if (!to_previous.unprojector().axis_aligned())
-            return Status::error("gpu extrapolate: the frame's projection is skewed");
         const GLuint program = s.static_layer_program;
         glUseProgram(program);
+        REPRISE_TRY(
+            set_still_test(program, camera, view, projection, w, h, options.static_tolerance));
         s.bind_inputs({frame.depth, frame.motion});
         glBindImageTexture(0, s.displacement.name, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
         ContextState::reset_counters(s.extrapolate_counts, 1);
-        set_view_point(program, to_previous.unprojector(), w, h);
-        glUniformMatrix4fv(glGetUniformLocation(program, "to_previous"), 1, GL_FALSE,
-                           &to_previous.to_clip()[0][0]);
-        glUniformMatrix4fv(glGetUniformLocation(program, "to_target"), 1, GL_FALSE,
-                           &to_target.to_clip()[0][0]);
-        const float tolerance = options.static_tolerance;
-        glUniform1f(glGetUniformLocation(program, "tolerance2"), tolerance * tolerance);
         glUniform1f(glGetUniformLocation(program, "periods"), periods);
         dispatch(w, h);
         ContextState::unbind_inputs();

@@ -14,7 +14,6 @@ Status FrucBackend::check(const warp::FrucOptions& o, const warp::SplatOptions& 
     need(o.warp == warp::WarpMethod::Splat, "warp splat");
     if (o.mode == warp::FrucMode::Interpolate) {
         need(o.fill == warp::FillMethod::PullPush, "fill pullpush");
-        need(!o.true_motion, "true motion off");
         need(!o.refine.enabled, "refine off");
     } else {
         need(o.fill == warp::FillMethod::PullPush || o.fill == warp::FillMethod::None,
@@ -29,9 +28,16 @@ Status FrucBackend::check(const warp::FrucOptions& o, const warp::SplatOptions& 
 }
 
 Status FrucBackend::interpolate(const GBufferView& a, const GBufferView& b, float s,
-                                float motion_scale, Frame& out, warp::FrucCounters& counters) {
+                                float motion_scale, const warp::FrucOptions& options, Frame& out,
+                                warp::FrucCounters& counters) {
     InterpolateStats stats;
-    REPRISE_TRY(context_.interpolate(a, b, s, out, stats, splat_, motion_scale));
+    REPRISE_TRY(context_.interpolate(a, b, s, out, stats,
+                                     {.splat = splat_,
+                                      .true_motion = options.true_motion,
+                                      .static_tolerance = options.static_tolerance,
+                                      .motion_scale = motion_scale}));
+    counters.true_motion += stats.true_motion;
+    counters.linear_motion += stats.linear_motion;
     count(stats.holes, stats.holes > 0, counters);
     return {};
 }

@@ -69,6 +69,89 @@ void main() {
 }
 )";
 
+// Each side's true motion (warp's motion_toward): a static pixel's displacement to the in-between
+// camera divided by its side's factor, a moving one's motion as it is or, for a, b's motion
+// inverted where some pixel of b landed. Without cameras only the latter.
+constexpr const char* kTrueMotion = R"(
+layout(binding = 0) uniform highp sampler2D depth_map;
+layout(binding = 1) uniform highp sampler2D motion_map;
+layout(binding = 2) uniform highp sampler2D inverted;
+layout(binding = 0, rgba32f) writeonly uniform highp image2D true_motion;
+uniform highp float per_factor;
+uniform bool cameras, use_inverted;
+void main() {
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    if (p.x >= size.x || p.y >= size.y) return;
+    highp float z = texelFetch(depth_map, p, 0).r;
+    highp vec2 m = texelFetch(motion_map, p, 0).rg, to, result = m;
+    if (cameras && still_pixel(p, z, m, to)) {
+        PRECISE highp vec2 scaled = to * per_factor;
+        result = scaled;
+    } else if (use_inverted) {
+        highp vec2 i = texelFetch(inverted, p, 0).rg;
+        if (finite(i.x) && finite(i.y)) result = i;
+    }
+    imageStore(true_motion, p, vec4(result, 0.0, 0.0));
+}
+)";
+
+// b's moving pixels splatted to where they were (warp's invert_motion), nearest first, ties to
+// the first in raster order: STAGE 0 empties the per-pixel (depth key, source index) pairs, 1 keeps
+// the nearest depth, 2 the first index at it, 3 writes the motion found (NaN where none).
+constexpr const char* kInvert = R"(
+layout(binding = 0) uniform highp sampler2D depth_map;
+layout(binding = 1) uniform highp sampler2D motion_map;
+layout(binding = 0, rgba32f) writeonly uniform highp image2D inverted;
+layout(std430, binding = 1) buffer Nearest { uint nearest[]; };  // key, index per pixel
+uniform bool cameras;
+const uint NONE = 0xffffffffu;
+
+// Depths in the order of their values as unsigned keys (-0 as +0).
+uint key_of(highp float z) {
+    uint b = floatBitsToUint(z);
+    if (b == 0x80000000u) b = 0u;
+    return (b & 0x80000000u) != 0u ? ~b : b | 0x80000000u;
+}
+bool lands(ivec2 p, out ivec2 t0, out highp float z) {
+    z = texelFetch(depth_map, p, 0).r;
+    highp vec2 m = texelFetch(motion_map, p, 0).rg, to;
+    if (cameras && still_pixel(p, z, m, to)) return false;
+    if (!finite(z) || !finite(m.x) || !finite(m.y)) return false;
+    PRECISE highp vec2 q = (center(p) + m) - 0.5;
+    if (!(q.x > -1.0 && q.y > -1.0 && q.x < float(size.x) && q.y < float(size.y))) return false;
+    t0 = ivec2(floor(q));
+    return true;
+}
+void main() {
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    if (p.x >= size.x || p.y >= size.y) return;
+    uint at = uint(p.y * size.x + p.x);
+#if STAGE == 0
+    nearest[2u * at] = NONE;
+    nearest[2u * at + 1u] = NONE;
+#elif STAGE == 3
+    uint index = nearest[2u * at + 1u];
+    highp vec2 m = vec2(uintBitsToFloat(0x7fc00000u));
+    if (index != NONE) m = texelFetch(motion_map, ivec2(int(index % uint(size.x)), int(index / uint(size.x))), 0).rg;
+    imageStore(inverted, p, vec4(m, 0.0, 0.0));
+#else
+    ivec2 t0;
+    highp float z;
+    if (!lands(p, t0, z)) return;
+    uint key = key_of(z);
+    for (int ty = max(t0.y, 0); ty <= min(t0.y + 1, size.y - 1); ++ty)
+        for (int tx = max(t0.x, 0); tx <= min(t0.x + 1, size.x - 1); ++tx) {
+            uint t = uint(ty * size.x + tx);
+#if STAGE == 1
+            atomicMin(nearest[2u * t], key);
+#else
+            if (nearest[2u * t] == key) atomicMin(nearest[2u * t + 1u], at);
+#endif
+        }
+#endif
+}
+)";
+
 }  // namespace
 
 // `from` times `scale` into `to` (GL_RGBA32F), w x h: a made frame's colour as it is, or the
@@ -96,6 +179,13 @@ void copy_scaled(ContextState& s, GLuint from, GLuint to, int w, int h, float sc
 }
 
 Status create_interpolate_programs(ContextState& s) {
+    const std::string still = std::string(kComputeHeader) + kViewPoint + kStillTest;
+    REPRISE_TRY(
+        gl::link_compute((still + kTrueMotion).c_str(), "true motion", s.true_motion_program));
+    for (int stage = 0; stage < 4; ++stage)
+        REPRISE_TRY(gl::link_compute(
+            (still + "#define STAGE " + std::to_string(stage) + "\n" + kInvert).c_str(),
+            "invert motion", s.invert_programs[stage]));
     REPRISE_TRY(
         gl::link_compute((std::string(kComputeHeader) + kBlend).c_str(), "blend", s.blend_program));
     REPRISE_TRY(
@@ -106,11 +196,72 @@ Status create_interpolate_programs(ContextState& s) {
 
 // a and b (w x h, on the GPU) made into the frame at s: colour and depth into out_color /
 // out_depth.
-Status interpolate_passes(ContextState& s, const SplatTextures& a, const SplatTextures& b,
-                          float s_between, int w, int h, const warp::SplatOptions& options,
-                          GLuint out_color, GLuint out_depth, GLuint out_motion, float motion_scale,
-                          InterpolateStats& stats) {
+// b's moving pixels inverted into k.inverted, then each side's true motion (a's from b's inverted
+// motion where it has one) into k.true_a and k.true_b: `at` the in-between camera, or null
+// without cameras (a follows b's inverted motion, b its own).
+void true_motion_passes(ContextState& s, const SplatTextures& a, const SplatTextures& b,
+                        const Camera& a_camera, const Camera& b_camera, const Camera* at,
+                        float s_between, int w, int h, float tolerance) {
     Interpolation& k = s.interpolation;
+    k.inverted.ensure(GL_RGBA32F, w, h);
+    k.true_a.ensure(GL_RGBA32F, w, h);
+    k.true_b.ensure(GL_RGBA32F, w, h);
+    const std::size_t bytes = 2 * sizeof(GLuint) * std::size_t(w) * std::size_t(h);
+    if (s.invert_bytes != bytes) {
+        if (s.invert_buffer) glDeleteBuffers(1, &s.invert_buffer);
+        s.invert_buffer = s.make_counters(bytes);
+        s.invert_bytes = bytes;
+    }
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, s.invert_buffer);
+    for (GLuint program : s.invert_programs) {
+        glUseProgram(program);
+        if (at)
+            (void)set_still_test(program, b_camera, b_camera.view, b_camera.projection, w, h,
+                                 tolerance);
+        else
+            glUniform2i(glGetUniformLocation(program, "size"), w, h);
+        glUniform1i(glGetUniformLocation(program, "cameras"), at != nullptr);
+        s.bind_inputs({b.depth, b.motion});
+        glBindImageTexture(0, k.inverted.name, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+        dispatch(w, h);
+    }
+    const GLuint program = s.true_motion_program;
+    glUseProgram(program);
+    glBindImageTexture(0, k.true_a.name, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    // a toward the in-between instant -s periods on; without cameras, b's motion inverted.
+    if (at)
+        (void)set_still_test(program, a_camera, at->view, at->projection, w, h, tolerance);
+    else
+        glUniform2i(glGetUniformLocation(program, "size"), w, h);
+    glUniform1i(glGetUniformLocation(program, "cameras"), at != nullptr);
+    glUniform1i(glGetUniformLocation(program, "use_inverted"), 1);
+    glUniform1f(glGetUniformLocation(program, "per_factor"), 1.0f / -s_between);
+    s.bind_inputs({a.depth, a.motion, k.inverted.name});
+    dispatch(w, h);
+    if (at) {  // b toward it 1 - s periods back, along its own motion where it moves
+        glBindImageTexture(0, k.true_b.name, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+        (void)set_still_test(program, b_camera, at->view, at->projection, w, h, tolerance);
+        glUniform1i(glGetUniformLocation(program, "use_inverted"), 0);
+        glUniform1f(glGetUniformLocation(program, "per_factor"), 1.0f / (1.0f - s_between));
+        s.bind_inputs({b.depth, b.motion, 0});
+        dispatch(w, h);
+    }
+    ContextState::unbind_inputs();
+    glUseProgram(0);
+}
+
+Status interpolate_passes(ContextState& s, const SplatTextures& given_a,
+                          const SplatTextures& given_b, float s_between, int w, int h,
+                          const InterpolateOptions& options, GLuint out_color, GLuint out_depth,
+                          GLuint out_motion, InterpolateStats& stats, const TrueMotion& plan) {
+    Interpolation& k = s.interpolation;
+    SplatTextures a = given_a, b = given_b;
+    if (plan.follow) {
+        true_motion_passes(s, a, b, plan.a_camera, plan.b_camera, plan.cameras ? &plan.at : nullptr,
+                           s_between, w, h, options.static_tolerance);
+        a.motion = k.true_a.name;
+        if (plan.cameras) b.motion = k.true_b.name;
+    }
     k.side_a_color.ensure(GL_RGBA32F, w, h);
     k.side_a_depth.ensure(GL_R32F, w, h);
     k.side_a_covered.ensure(GL_R32UI, w, h);
@@ -120,12 +271,13 @@ Status interpolate_passes(ContextState& s, const SplatTextures& a, const SplatTe
     k.blended.ensure(GL_RGBA32F, w, h);
     k.valid.ensure(GL_R32UI, w, h);
     const bool motion = out_motion != 0;
+    const float motion_scale = options.motion_scale;
     k.side_a_motion.ensure(GL_RGBA32F, motion ? w : 1, motion ? h : 1);
     k.side_b_motion.ensure(GL_RGBA32F, motion ? w : 1, motion ? h : 1);
-    REPRISE_TRY(splat_passes(s, b, 1.0f - s_between, options, w, h, k.side_b_color.name,
+    REPRISE_TRY(splat_passes(s, b, 1.0f - s_between, options.splat, w, h, k.side_b_color.name,
                              k.side_b_depth.name, k.side_b_covered.name,
                              motion ? k.side_b_motion.name : 0, stats.covered_b));
-    REPRISE_TRY(splat_passes(s, a, -s_between, options, w, h, k.side_a_color.name,
+    REPRISE_TRY(splat_passes(s, a, -s_between, options.splat, w, h, k.side_a_color.name,
                              k.side_a_depth.name, k.side_a_covered.name,
                              motion ? k.side_a_motion.name : 0, stats.covered_a));
 
@@ -159,8 +311,8 @@ Status interpolate_passes(ContextState& s, const SplatTextures& a, const SplatTe
 }
 
 Status Context::interpolate(const GBufferView& given_a, const GBufferView& given_b, float s_between,
-                            Frame& out, InterpolateStats& stats, const warp::SplatOptions& options,
-                            float motion_scale) {
+                            Frame& out, InterpolateStats& stats,
+                            const InterpolateOptions& options) {
     timings_ = {};
     stats = {};
     ContextState& s = *state_;
@@ -181,6 +333,27 @@ Status Context::interpolate(const GBufferView& given_a, const GBufferView& given
     out.id.clear();
     out.camera = b.camera;
     if (w <= 0 || h <= 0) return {};
+    // warp's interpolate_frame's choice (both sides warpable): through the cameras unless the
+    // survey finds the motion linear; without b's camera, a along b's motion inverted.
+    TrueMotion plan{.a_camera = a.camera, .b_camera = b.camera};
+    if (options.true_motion) {
+        const bool cameras = has_projection(a.camera) && has_projection(b.camera);
+        if (cameras) {
+            plan.at = warp::camera_between(a.camera, b.camera, s_between);
+            stats.linear_motion =
+                warp::motion_is_linear(b, plan.at, 1.0f - s_between, options.static_tolerance) &&
+                warp::motion_is_linear(a, plan.at, -s_between, options.static_tolerance);
+            plan.follow = plan.cameras = !stats.linear_motion;
+            auto skewed = [&](const Camera& c) {
+                return !Unprojector(c.projection, w, h).axis_aligned();
+            };
+            if (plan.cameras && (skewed(a.camera) || skewed(b.camera)))
+                return Status::error("gpu interpolate: a frame's projection is skewed");
+        } else {
+            plan.follow = !has_projection(b.camera);
+        }
+        stats.true_motion = plan.follow;
+    }
     REPRISE_TRY(s.gl->acquire());
     auto t = std::chrono::steady_clock::now();
     Texture* textures[6] = {&k.a_color, &k.a_depth, &k.a_motion,
@@ -203,7 +376,7 @@ Status Context::interpolate(const GBufferView& given_a, const GBufferView& given
     REPRISE_TRY(interpolate_passes(s, {k.a_color.name, k.a_depth.name, k.a_motion.name, w, h},
                                    {k.b_color.name, k.b_depth.name, k.b_motion.name, w, h},
                                    s_between, w, h, options, s.color.name, s.depth.name,
-                                   k.made_motion.name, motion_scale, stats));
+                                   k.made_motion.name, stats, plan));
     timings_.compute_ms = finish_ms(t);
     s.download_made(out);
     out.motion.resize(w, h);
@@ -216,8 +389,7 @@ Status Context::interpolate(const GBufferView& given_a, const GBufferView& given
 Status Context::interpolate(const GBufferTextures& a, unsigned a_color, const GBufferTextures& b,
                             unsigned b_color, float s_between, unsigned out_color,
                             unsigned out_depth, InterpolateStats& stats,
-                            const warp::SplatOptions& options, unsigned out_motion,
-                            float motion_scale) {
+                            const InterpolateOptions& options, unsigned out_motion) {
     timings_ = {};
     stats = {};
     ContextState& s = *state_;
@@ -229,6 +401,9 @@ Status Context::interpolate(const GBufferTextures& a, unsigned a_color, const GB
                              std::to_string(h) + " must be equal and positive");
     if (!(s_between >= 0.0f && s_between <= 1.0f))
         return Status::error("gpu interpolate: s must lie in [0, 1]");
+    if (options.true_motion)
+        return Status::error(
+            "gpu interpolate: true motion needs CPU images (its linearity survey reads them)");
     REPRISE_TRY(check_texture(a.depth, GL_R32F, w, h, "a depth"));
     REPRISE_TRY(check_texture(a.motion, GL_RG32F, w, h, "a motion"));
     REPRISE_TRY(check_texture(a_color, GL_RGBA32F, w, h, "a colour"));
@@ -243,7 +418,7 @@ Status Context::interpolate(const GBufferTextures& a, unsigned a_color, const GB
     auto t = std::chrono::steady_clock::now();
     REPRISE_TRY(interpolate_passes(s, {a_color, a.depth, a.motion, w, h},
                                    {b_color, b.depth, b.motion, w, h}, s_between, w, h, options,
-                                   out_color, out_depth, out_motion, motion_scale, stats));
+                                   out_color, out_depth, out_motion, stats, TrueMotion{}));
     timings_.compute_ms = finish_ms(t);
     return {};
 }

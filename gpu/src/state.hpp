@@ -115,6 +115,32 @@ void count_end() {
 }
 )";
 
+// warp's static-layer test (static_layer_row_reference) after kViewPoint: pixel p (depth z,
+// motion m) is static when its camera alone explains its motion within sqrt(tolerance2) px;
+// `to` gets its displacement to the target camera either way.
+inline constexpr const char* kStillTest = R"(
+uniform highp mat4 to_previous, to_target;
+uniform highp float tolerance2;
+bool still_pixel(ivec2 p, highp float z, highp vec2 m, out highp vec2 to) {
+    highp vec4 v = view_point(p, z);
+    highp float before_w, later_w;
+    highp vec2 before = seen_at(to_previous, v, before_w), later = seen_at(to_target, v, later_w);
+    highp vec2 c = center(p);
+    PRECISE highp vec2 e = before - c - m;
+    PRECISE highp float e2 = e.x * e.x + e.y * e.y;
+    PRECISE highp vec2 d = later - c;
+    to = d;
+    bool nan_depth = (floatBitsToUint(z) & 0x7fffffffu) > 0x7f800000u;
+    return !nan_depth && finite(m.x) && finite(m.y) && before_w > 0.0 && later_w > 0.0 &&
+           e2 <= tolerance2;
+}
+)";
+
+// Sets kStillTest's uniforms of `program` (in use) for `frame` seen by (view, projection), and
+// kViewPoint's; an error where the frame's projection is skewed.
+Status set_still_test(GLuint program, const Camera& frame, const glm::mat4& view,
+                      const glm::mat4& projection, int w, int h, float tolerance);
+
 // Sets kViewPoint's uniforms of `program` (in use) for `unproject` over w x h.
 void set_view_point(GLuint program, const Unprojector& unproject, int w, int h);
 
@@ -127,10 +153,17 @@ struct SplatTextures {
 // The passes of each path over textures, shared by its CPU-image and texture entry points.
 Status fill_passes(ContextState& s, GLuint color, GLuint valid, GLuint depth, int w, int h,
                    GLuint out, warp::FillStats& stats);
+// Whether and how the in-between frame's sides follow their true motion (warp's
+// interpolate_frame decides it from the cameras and a CPU survey of linearity).
+struct TrueMotion {
+    bool follow = false;
+    bool cameras = false;  // through the cameras, `at` the in-between one; else a along b inverted
+    Camera a_camera, b_camera, at;
+};
 Status interpolate_passes(ContextState& s, const SplatTextures& a, const SplatTextures& b,
-                          float s_between, int w, int h, const warp::SplatOptions& options,
-                          GLuint out_color, GLuint out_depth, GLuint out_motion, float motion_scale,
-                          InterpolateStats& stats);
+                          float s_between, int w, int h, const InterpolateOptions& options,
+                          GLuint out_color, GLuint out_depth, GLuint out_motion,
+                          InterpolateStats& stats, const TrueMotion& plan);
 // `out_motion` (GL_RGBA32F, motion in RG; 0: none) gets the motion each winner carried.
 Status splat_passes(ContextState& s, const SplatTextures& in, float factor,
                     const warp::SplatOptions& options, int tw, int th, GLuint out_color,
@@ -153,13 +186,13 @@ double finish_ms(std::chrono::steady_clock::time_point& since);
 struct Interpolation {
     Texture a_color, a_depth, a_motion, b_color, b_depth, b_motion;
     Texture side_a_color, side_a_depth, side_a_covered, side_a_motion, side_b_color, side_b_depth,
-        side_b_covered, side_b_motion, blended, valid, made_motion;
+        side_b_covered, side_b_motion, blended, valid, made_motion, true_a, true_b, inverted;
     NonfiniteRepair repair_a, repair_b;  // each keeps its repaired copy until the next call
-    Texture* all[17] = {&a_color,        &a_depth,       &a_motion,     &b_color,
+    Texture* all[20] = {&a_color,        &a_depth,       &a_motion,     &b_color,
                         &b_depth,        &b_motion,      &side_a_color, &side_a_depth,
                         &side_a_covered, &side_a_motion, &side_b_color, &side_b_depth,
                         &side_b_covered, &side_b_motion, &blended,      &valid,
-                        &made_motion};
+                        &made_motion,    &true_a,        &true_b,       &inverted};
 };
 
 struct ContextState {
@@ -190,6 +223,9 @@ struct ContextState {
     Image<glm::vec2> wide_motion;
     // Interpolation: the blend of the two splatted sides, a plain copy, and the hole count.
     GLuint blend_program = 0, copy_program = 0, blend_counts = 0;
+    // True motion: each side's, and b's moving pixels inverted (stages of kInvert).
+    GLuint true_motion_program = 0, invert_programs[4] = {0, 0, 0, 0}, invert_buffer = 0;
+    std::size_t invert_bytes = 0;
     Interpolation interpolation;
     Texture displacement, target_depth, eye_color;
     // The eye's history: its displacement and depth, warped colour, depth and coverage, the merge.

@@ -96,7 +96,13 @@ def test_gpu_backend_makes_the_cpus_splat_frames(pan_60):
     for k in range(6):
         assert reprise.psnr(reprise.to_display(gpu[k].color), reprise.to_display(cpu[k].color)) >= 50.0
     assert np.array_equal(gpu[1].motion, cpu[1].motion)
-    with pytest.raises(ValueError, match="true motion off"):
-        reprise.FrameRateConverter(factor=2, warp="splat", refine=False, backend="gles")
+    # True motion (the default) on the GPU too: the CPU's frames.
+    cpu = reprise.FrameRateConverter(factor=2, warp="splat", refine=False).convert(inputs)
+    gpu = reprise.FrameRateConverter(factor=2, warp="splat", refine=False,
+                                     backend="gles").convert(inputs)
+    for k in range(5):
+        assert reprise.psnr(reprise.to_display(gpu[k].color), reprise.to_display(cpu[k].color)) >= 50.0
+    with pytest.raises(ValueError, match="refine off"):
+        reprise.FrameRateConverter(factor=2, warp="splat", refine=True, backend="gles")
     with pytest.raises(ValueError, match="expected cpu or gles"):
         reprise.FrameRateConverter(factor=2, backend="vulkan")

@@ -112,11 +112,6 @@ std::size_t static_layer(const GBufferView& f, const glm::mat4& to_view,
                          const glm::mat4& to_projection, float tolerance,
                          ImageView<float> depth_out, ImageView<glm::vec2> motion_out);
 
-// True when a survey of every 8th pixel of every 8th row finds nothing moving on its own and every
-// static pixel landing within 0.02 px of p + factor * motion in camera `to`: the true motion is
-// then the linear one.
-bool motion_is_linear(const GBufferView& f, const Camera& to, float factor, float tolerance);
-
 // The motion m for which p + factor * m is where pixel p of `f` is seen by camera `to`: exact
 // for what f's camera explains (static pixels, from depth and both cameras); elsewhere the
 // `inverted` motion where it is finite (may be empty), else f's own. Returns the moving pixels.

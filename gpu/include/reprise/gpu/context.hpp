@@ -45,6 +45,8 @@ struct GBufferTextures {
 // repaired in its inputs (as the CPU converter does).
 struct InterpolateStats {
     std::size_t covered_a = 0, covered_b = 0, holes = 0;
+    bool true_motion = false;    // the sides followed their true motion
+    bool linear_motion = false;  // ... had it been asked for, but a survey found it linear
     warp::FillStats fill;
     NonfiniteCounts nonfinite;
 };
@@ -56,6 +58,17 @@ struct ExtrapolateStats {
     std::size_t moving = 0, covered = 0, holes = 0;
     warp::FillStats fill;
     NonfiniteCounts nonfinite;
+};
+
+// How Context::interpolate makes the in-between frame (FrucOptions' fields of the same names).
+struct InterpolateOptions {
+    warp::SplatOptions splat;
+    // Each side along its true motion (static pixels through depth to the in-between camera,
+    // a's moving ones along b's motion inverted) unless the CPU's survey finds it linear; CPU
+    // images only.
+    bool true_motion = false;
+    float static_tolerance = 0.25f;
+    float motion_scale = 1.0f;  // the made frame's motion: per output period
 };
 
 struct ContextState;  // GL objects and scratch (private)
@@ -124,23 +137,23 @@ public:
                       const stereo::StereoOptions& options = {});
 
     // The frame at `s` in [0, 1] between a (0) and b (1) with b's backward motion: warp's
-    // interpolate_frame for FrucOptions{.warp = Splat, .true_motion = false, .refine off} and
-    // pull-push: b splatted by 1 - s, a by -s, blended by s where both land on one surface (depths
-    // within 15 %), the nearer or the only one elsewhere, pull-push over what neither covers.
-    // Colour, depth and motion out: the motion the winning side carried (b's where both are
-    // blended) times motion_scale, as the CPU's (normal and id cleared; out.camera is b's).
+    // interpolate_frame for FrucOptions{.warp = Splat, .refine off} and pull-push: b splatted by
+    // 1 - s, a by -s (along their true motion with options.true_motion), blended by s where both
+    // land on one surface (depths within 15 %), the nearer or the only one elsewhere, pull-push
+    // over what neither covers. Colour, depth and motion out: the motion the winning side
+    // carried (b's where both are blended) times motion_scale, as the CPU's (normal and id
+    // cleared; out.camera is b's).
     // NaN/Inf in a and b are repaired first, as the CPU converter does; the texture entry does
     // not repair.
     Status interpolate(const GBufferView& a, const GBufferView& b, float s, Frame& out,
-                       InterpolateStats& stats, const warp::SplatOptions& options = {},
-                       float motion_scale = 1.0f);
+                       InterpolateStats& stats, const InterpolateOptions& options = {});
     // The same on textures: colour GL_RGBA32F, depth GL_R32F, motion GL_RG32F, all one size;
     // `out_color` and `out_depth` written, and `out_motion` (GL_RGBA32F, the motion in RG; 0:
-    // not written).
+    // not written). Without true motion (its linearity survey reads CPU images).
     Status interpolate(const GBufferTextures& a, unsigned a_color, const GBufferTextures& b,
                        unsigned b_color, float s, unsigned out_color, unsigned out_depth,
-                       InterpolateStats& stats, const warp::SplatOptions& options = {},
-                       unsigned out_motion = 0, float motion_scale = 1.0f);
+                       InterpolateStats& stats, const InterpolateOptions& options = {},
+                       unsigned out_motion = 0);
 
     // warp::PoseExtrapolator (and the converter's extrapolation) for FrucOptions with warp Splat
     // and fill PullPush or None (others are an error): `frame` as seen by (view, projection)

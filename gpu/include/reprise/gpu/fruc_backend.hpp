@@ -15,16 +15,16 @@ public:
     // `context` must outlive the backend.
     explicit FrucBackend(Context& context, const warp::SplatOptions& splat = {})
         : context_(context), splat_(splat) {}
-    // Warp splat with these splat options; interpolation with fill pull-push, true motion and
-    // refinement off, extrapolation with fill pull-push or none: what the GPU makes the CPU's
-    // frames for.
+    // Warp splat with these splat options; interpolation with fill pull-push and refinement off,
+    // extrapolation with fill pull-push or none: what the GPU makes the CPU's frames for.
     static Status check(const warp::FrucOptions& options, const warp::SplatOptions& splat = {});
     Status supports(const warp::FrucOptions& options) const override {
         return check(options, splat_);
     }
     // Colour, depth and motion, as the CPU's.
     Status interpolate(const GBufferView& a, const GBufferView& b, float s, float motion_scale,
-                       Frame& out, warp::FrucCounters& counters) override;
+                       const warp::FrucOptions& options, Frame& out,
+                       warp::FrucCounters& counters) override;
     Status extrapolate(const GBufferView& f, const glm::mat4& view, const glm::mat4& projection,
                        float periods, float motion_scale, const warp::FrucOptions& options,
                        Frame& out, warp::FrucCounters& counters) override;

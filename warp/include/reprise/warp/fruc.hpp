@@ -102,7 +102,8 @@ public:
     // What interpolate_frame makes with both sides warpable: the frame at s between a and b,
     // colour, depth and motion times motion_scale (its motion may stay empty).
     virtual Status interpolate(const GBufferView& a, const GBufferView& b, float s,
-                               float motion_scale, Frame& out, FrucCounters& counters) = 0;
+                               float motion_scale, const FrucOptions& options, Frame& out,
+                               FrucCounters& counters) = 0;
     // What the CPU's extrapolation makes: f as seen by (view, projection) `periods` frame
     // periods after it (without a projection on f: along its motion alone), colour, depth and
     // backward motion per period times motion_scale. A backend may repair NaN/Inf in f first
@@ -194,6 +195,11 @@ Status check_fruc_factor(int factor);
 // The camera between or beyond two instants: view matrices blended as rigid motions (rotation
 // slerp, translation lerp, s may exceed 1), the projection taken from `b`.
 Camera camera_between(const Camera& a, const Camera& b, float s);
+
+// True when a survey of every 8th pixel of every 8th row finds nothing moving on its own and every
+// static pixel landing within 0.02 px of p + factor * motion in camera `to`: the true motion is
+// then the linear one (an in-between frame with FrucOptions::true_motion takes the linear path).
+bool motion_is_linear(const GBufferView& f, const Camera& to, float factor, float tolerance);
 
 // The options' values in their ranges: an error naming the first that is not.
 Status check_fruc_options(const FrucOptions& options);
