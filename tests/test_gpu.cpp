@@ -625,10 +625,12 @@ const warp::FrucOptions kSplatInterpolation{
 // The frame the CPU makes halfway between `a` and `b` from the inputs as they are (the converter
 // widens their silhouettes before it hands them to a backend; Context::interpolate does not).
 Frame cpu_between(const Frame& a, const Frame& b, bool true_motion = false,
-                  warp::FrucCounters* counters = nullptr) {
+                  warp::FrucCounters* counters = nullptr,
+                  warp::WarpMethod method = warp::WarpMethod::Splat) {
     warp::FrucOptions options = kSplatInterpolation;
     options.widen_silhouettes = false;
     options.true_motion = true_motion;
+    options.warp = method;
     warp::FrameRateConverter converter;
     EXPECT_TRUE(warp::FrameRateConverter::create(2, options, converter).ok());
     std::vector<Frame> outputs;
@@ -645,37 +647,45 @@ Frame cpu_between(const Frame& a, const Frame& b, bool true_motion = false,
 
 TEST(Gpu, InterpolationMatchesTheCpuOnEveryBuiltInScene) {
     std::size_t holes = 0, true_motion = 0;
-    for (const server::SceneInfo& info : server::builtin_scenes())
-        for (const bool follow : {false, true}) {
-            SCOPED_TRACE(std::string(info.name) + (follow ? ", true motion" : ""));
-            const std::vector<Frame>& frames = scene_frames(info.name);
-            warp::FrucCounters counters;
-            const Frame cpu = cpu_between(frames[0], frames[1], follow, &counters);
-            Frame gpu;
-            gpu::InterpolateStats stats;
-            const Status status = shared_gpu().interpolate(
-                frames[0], frames[1], 0.5f, gpu, stats,
-                {.true_motion = follow, .static_tolerance = 0.25f, .motion_scale = 0.5f});
-            ASSERT_TRUE(status.ok()) << status.message();
-            if (counters.copied_still == 0) {  // (shadows: a still pair, which the CPU copies)
-                EXPECT_EQ(std::size_t(stats.true_motion), counters.true_motion);
-                EXPECT_EQ(std::size_t(stats.linear_motion), counters.linear_motion);
+    for (const server::SceneInfo& info : server::builtin_scenes()) {
+        const std::vector<Frame>& frames = scene_frames(info.name);
+        for (const bool reverse : {false, true}) {
+            for (const bool follow : {false, true}) {
+                SCOPED_TRACE(std::string(info.name) + (reverse ? ", reverse" : "") +
+                             (follow ? ", true motion" : ""));
+                warp::FrucCounters counters;
+                const Frame cpu =
+                    cpu_between(frames[0], frames[1], follow, &counters,
+                                reverse ? warp::WarpMethod::Reverse : warp::WarpMethod::Splat);
+                Frame gpu;
+                gpu::InterpolateStats stats;
+                const Status status = shared_gpu().interpolate(
+                    frames[0], frames[1], 0.5f, gpu, stats,
+                    {.reverse = reverse, .true_motion = follow, .motion_scale = 0.5f});
+                ASSERT_TRUE(status.ok()) << status.message();
+                if (counters.copied_still == 0) {  // (shadows: a still pair, the CPU copies it)
+                    EXPECT_EQ(std::size_t(stats.true_motion), counters.true_motion);
+                    EXPECT_EQ(std::size_t(stats.linear_motion), counters.linear_motion);
+                }
+                true_motion += stats.true_motion;
+                const double db = test::display_psnr(cpu.color, gpu.color);
+                EXPECT_GE(db, 50.0);
+                // Motion as the CPU's but where its SIMD blend rounds the same-surface test
+                // otherwise.
+                const Differences d = differences(cpu, gpu);
+                EXPECT_LE(d.motion_pixels, cpu.motion.pixel_count() / 1000);
+                holes += stats.holes;
+                std::printf(
+                    "%-10s between%s%s: covered a %zu b %zu, holes %zu, %.1f dB, motion "
+                    "of %zu pixels differs (at most %g px)\n",
+                    info.name, reverse ? " reverse" : "", stats.true_motion ? " (true motion)" : "",
+                    stats.covered_a, stats.covered_b, stats.holes, db, d.motion_pixels,
+                    double(d.motion));
             }
-            true_motion += stats.true_motion;
-            const double db = test::display_psnr(cpu.color, gpu.color);
-            EXPECT_GE(db, 50.0);
-            // Motion as the CPU's but where its SIMD blend rounds the same-surface test otherwise.
-            const Differences d = differences(cpu, gpu);
-            EXPECT_LE(d.motion_pixels, cpu.motion.pixel_count() / 1000);
-            holes += stats.holes;
-            std::printf(
-                "%-10s between%s: covered a %zu b %zu, holes %zu, %.1f dB, motion of %zu pixels "
-                "differs (at most %g px)\n",
-                info.name, stats.true_motion ? " (true motion)" : "", stats.covered_a,
-                stats.covered_b, stats.holes, db, d.motion_pixels, double(d.motion));
         }
-    EXPECT_GT(true_motion, 0u);  // not vacuous: some pairs followed their true motion
+    }
     EXPECT_GT(holes, 0u);        // not vacuous: some holes filled
+    EXPECT_GT(true_motion, 0u);  // ... and some pairs followed their true motion
 }
 
 TEST(Gpu, InterpolationRepairsNonFiniteInputAsTheCpu) {
@@ -735,7 +745,7 @@ TEST(Gpu, TheConverterWithTheGpuBackendMakesTheCpusFrames) {
     grid.backend = &backend;
     warp::FrameRateConverter refused;
     const Status status = warp::FrameRateConverter::create(2, grid, refused);
-    EXPECT_NE(status.message().find("warp splat, refine off"), std::string::npos)
+    EXPECT_NE(status.message().find("warp splat or reverse, refine off"), std::string::npos)
         << status.message();
 }
 
@@ -799,15 +809,18 @@ const warp::FrucOptions kSplatExtrapolation{.mode = warp::FrucMode::Extrapolate,
 // The CPU gets `frame` with its NaN/Inf repaired (the converter repairs, PoseExtrapolator does
 // not).
 void expect_extrapolation_matches(const Frame& frame, const Camera& to, float periods,
-                                  gpu::ExtrapolateStats& stats) {
-    warp::PoseExtrapolator extrapolator(kSplatExtrapolation);
+                                  gpu::ExtrapolateStats& stats,
+                                  warp::WarpMethod method = warp::WarpMethod::Splat) {
+    warp::FrucOptions options = kSplatExtrapolation;
+    options.warp = method;
+    warp::PoseExtrapolator extrapolator(options);
     Frame cpu, gpu;
     NonfiniteRepair repair;
     NonfiniteCounts found;
     const GBufferView repaired = repair.clean(frame, found);
     ASSERT_TRUE(extrapolator.extrapolate(repaired, to.view, to.projection, periods, cpu).ok());
-    const Status status = shared_gpu().extrapolate(frame, to.view, to.projection, periods, gpu,
-                                                   stats, kSplatExtrapolation);
+    const Status status =
+        shared_gpu().extrapolate(frame, to.view, to.projection, periods, gpu, stats, options);
     ASSERT_TRUE(status.ok()) << status.message();
     ASSERT_EQ(gpu.motion.width(), cpu.motion.width());
     const double db = test::display_psnr(cpu.color, gpu.color);
@@ -833,6 +846,8 @@ TEST(Gpu, ExtrapolationMatchesTheCpuOnEveryBuiltInScene) {
         for (float periods : {0.5f, 1.0f}) {
             gpu::ExtrapolateStats stats;
             expect_extrapolation_matches(frames[0], frames[1].camera, periods, stats);
+            expect_extrapolation_matches(frames[0], frames[1].camera, periods, stats,
+                                         warp::WarpMethod::Reverse);
             moving += stats.moving;
             holes += stats.holes;
         }
@@ -941,7 +956,7 @@ TEST(Gpu, ExtrapolationOnTexturesAndBadArguments) {
     };
     warp::FrucOptions grid = kSplatExtrapolation;
     grid.warp = warp::WarpMethod::Grid;
-    EXPECT_NE(message(grid, 1.0f, frames[0]).find("warp splat only"), std::string::npos);
+    EXPECT_NE(message(grid, 1.0f, frames[0]).find("warp splat or reverse only"), std::string::npos);
     EXPECT_NE(message(kSplatExtrapolation, -1.0f, frames[0]).find("periods"), std::string::npos);
     Frame skewed = frames[0];
     skewed.camera.projection[1][0] = 0.1f;

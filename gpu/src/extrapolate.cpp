@@ -39,8 +39,9 @@ void main() {
 )";
 
 Status check_options(const warp::FrucOptions& o) {
-    if (o.warp != warp::WarpMethod::Splat)
-        return Status::error("gpu extrapolate: the GPU warps with warp splat only (docs/gpu.md)");
+    if (o.warp != warp::WarpMethod::Splat && o.warp != warp::WarpMethod::Reverse)
+        return Status::error(
+            "gpu extrapolate: the GPU warps with warp splat or reverse only (docs/gpu.md)");
     if (o.fill != warp::FillMethod::PullPush && o.fill != warp::FillMethod::None)
         return Status::error("gpu extrapolate: the GPU fills with pullpush or none only");
     if (o.splat.footprint != 1 && o.splat.footprint != 2)
@@ -97,9 +98,16 @@ Status extrapolate_passes(ContextState& s, const SplatTextures& frame, const Cam
         factor = -periods;
         to_backward = motion_scale;
     }
-    if (out_motion) s.splat_motion.ensure(GL_RGBA32F, w, h);
-    REPRISE_TRY(splat_passes(s, along, factor, options.splat, w, h, s.eye_color.name, out_depth,
-                             s.hit.name, out_motion ? s.splat_motion.name : 0, stats.covered));
+    // The reverse warp: a footprint-2 splat, each covered pixel's colour then refetched.
+    const bool reverse = options.warp == warp::WarpMethod::Reverse;
+    const bool carry = out_motion || reverse;
+    if (carry) s.splat_motion.ensure(GL_RGBA32F, w, h);
+    REPRISE_TRY(splat_passes(
+        s, along, factor, reverse ? warp::SplatOptions{.footprint = 2} : options.splat, w, h,
+        s.eye_color.name, out_depth, s.hit.name, carry ? s.splat_motion.name : 0, stats.covered));
+    if (reverse)
+        REPRISE_TRY(refetch_pass(s, along, factor, s.splat_motion.name, s.hit.name, w, h,
+                                 s.eye_color.name));
     stats.holes = pixels - stats.covered;
     if (stats.holes && options.fill == warp::FillMethod::PullPush)
         REPRISE_TRY(

@@ -11,7 +11,8 @@ Status FrucBackend::check(const warp::FrucOptions& o, const warp::SplatOptions& 
     auto need = [&](bool ok, const char* what) {
         if (!ok) unsupported += std::string(unsupported.empty() ? "" : ", ") + what;
     };
-    need(o.warp == warp::WarpMethod::Splat, "warp splat");
+    need(o.warp == warp::WarpMethod::Splat || o.warp == warp::WarpMethod::Reverse,
+         "warp splat or reverse");
     if (o.mode == warp::FrucMode::Interpolate) {
         need(o.fill == warp::FillMethod::PullPush, "fill pullpush");
         need(!o.refine.enabled, "refine off");
@@ -19,7 +20,8 @@ Status FrucBackend::check(const warp::FrucOptions& o, const warp::SplatOptions& 
         need(o.fill == warp::FillMethod::PullPush || o.fill == warp::FillMethod::None,
              "fill pullpush or none");
     }
-    need(o.splat.footprint == splat.footprint && o.splat.depth_tolerance == splat.depth_tolerance,
+    need(o.warp == warp::WarpMethod::Reverse || (o.splat.footprint == splat.footprint &&
+                                                 o.splat.depth_tolerance == splat.depth_tolerance),
          "the backend's splat options");
     if (unsupported.empty()) return {};
     return Status::error(std::string("gpu: the GPU makes ") +
@@ -33,6 +35,7 @@ Status FrucBackend::interpolate(const GBufferView& a, const GBufferView& b, floa
     InterpolateStats stats;
     REPRISE_TRY(context_.interpolate(a, b, s, out, stats,
                                      {.splat = splat_,
+                                      .reverse = options.warp == warp::WarpMethod::Reverse,
                                       .true_motion = options.true_motion,
                                       .static_tolerance = options.static_tolerance,
                                       .motion_scale = motion_scale}));

@@ -271,15 +271,25 @@ Status interpolate_passes(ContextState& s, const SplatTextures& given_a,
     k.blended.ensure(GL_RGBA32F, w, h);
     k.valid.ensure(GL_R32UI, w, h);
     const bool motion = out_motion != 0;
+    const bool carry = motion || options.reverse;  // the refetch reads the carried motion
     const float motion_scale = options.motion_scale;
-    k.side_a_motion.ensure(GL_RGBA32F, motion ? w : 1, motion ? h : 1);
-    k.side_b_motion.ensure(GL_RGBA32F, motion ? w : 1, motion ? h : 1);
-    REPRISE_TRY(splat_passes(s, b, 1.0f - s_between, options.splat, w, h, k.side_b_color.name,
+    k.side_a_motion.ensure(GL_RGBA32F, carry ? w : 1, carry ? h : 1);
+    k.side_b_motion.ensure(GL_RGBA32F, carry ? w : 1, carry ? h : 1);
+    // The reverse warp: a footprint-2 splat, each covered pixel's colour then refetched.
+    const warp::SplatOptions splat =
+        options.reverse ? warp::SplatOptions{.footprint = 2} : options.splat;
+    REPRISE_TRY(splat_passes(s, b, 1.0f - s_between, splat, w, h, k.side_b_color.name,
                              k.side_b_depth.name, k.side_b_covered.name,
-                             motion ? k.side_b_motion.name : 0, stats.covered_b));
-    REPRISE_TRY(splat_passes(s, a, -s_between, options.splat, w, h, k.side_a_color.name,
+                             carry ? k.side_b_motion.name : 0, stats.covered_b));
+    REPRISE_TRY(splat_passes(s, a, -s_between, splat, w, h, k.side_a_color.name,
                              k.side_a_depth.name, k.side_a_covered.name,
-                             motion ? k.side_a_motion.name : 0, stats.covered_a));
+                             carry ? k.side_a_motion.name : 0, stats.covered_a));
+    if (options.reverse) {
+        REPRISE_TRY(refetch_pass(s, b, 1.0f - s_between, k.side_b_motion.name,
+                                 k.side_b_covered.name, w, h, k.side_b_color.name));
+        REPRISE_TRY(refetch_pass(s, a, -s_between, k.side_a_motion.name, k.side_a_covered.name, w,
+                                 h, k.side_a_color.name));
+    }
 
     glUseProgram(s.blend_program);
     s.bind_inputs({k.side_a_color.name, k.side_a_depth.name, k.side_a_covered.name,

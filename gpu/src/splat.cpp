@@ -187,9 +187,95 @@ void main() {
 }
 )";
 
+// The reverse warp's refetch (warp's refetch_row_reference): at each covered target pixel q the
+// splat's carried motion gives a first source position, the source's own motion bilinear there
+// the final one, where colour is fetched as a Catmull-Rom bicubic (written where finite).
+constexpr const char* kRefetch = R"(
+layout(binding = 0) uniform highp sampler2D source_color;
+layout(binding = 1) uniform highp sampler2D source_motion;
+layout(binding = 2) uniform highp sampler2D carried;
+layout(binding = 3) uniform highp usampler2D covered;
+layout(binding = 0, rgba32f) writeonly uniform highp image2D out_color;
+uniform ivec2 source_size, target_size;
+uniform highp float factor;
+
+int floor_small(highp float v) {
+    int i = int(v);
+    return i - (v < float(i) ? 1 : 0);
+}
+void weights(highp float t, out highp vec4 w) {
+    PRECISE highp float t2 = t * t, t3 = t2 * t;
+    PRECISE highp float w0 = 0.5 * (-t3 + 2.0 * t2 - t);
+    PRECISE highp float w1 = 0.5 * (3.0 * t3 - 5.0 * t2 + 2.0);
+    PRECISE highp float w2 = 0.5 * (-3.0 * t3 + 4.0 * t2 + t);
+    PRECISE highp float w3 = 0.5 * (t3 - t2);
+    w = vec4(w0, w1, w2, w3);
+}
+highp vec4 bicubic(highp vec2 p) {
+    PRECISE highp float sx = p.x - 0.5, sy = p.y - 0.5;
+    int ix = floor_small(sx), iy = floor_small(sy);
+    PRECISE highp float tx = sx - float(ix), ty = sy - float(iy);
+    highp vec4 wx, wy;
+    weights(tx, wx);
+    weights(ty, wy);
+    PRECISE highp vec4 sum = vec4(0.0);
+    for (int j = 0; j < 4; ++j) {
+        int y = clamp(iy - 1 + j, 0, source_size.y - 1);
+        PRECISE highp vec4 line = vec4(0.0);
+        for (int i = 0; i < 4; ++i)
+            line = line + wx[i] * texelFetch(source_color, ivec2(clamp(ix - 1 + i, 0, source_size.x - 1), y), 0);
+        sum = sum + wy[j] * line;
+    }
+    return sum;
+}
+void main() {
+    ivec2 t = ivec2(gl_GlobalInvocationID.xy);
+    if (t.x >= target_size.x || t.y >= target_size.y) return;
+    if (texelFetch(covered, t, 0).r == 0u) return;
+    highp vec2 q = vec2(float(t.x) + 0.5, float(t.y) + 0.5);
+    PRECISE highp vec2 p = q - factor * texelFetch(carried, t, 0).rg;
+    highp float w = float(source_size.x), h = float(source_size.y);
+    if (!(p.x >= 0.0 && p.y >= 0.0 && p.x <= w && p.y <= h)) return;
+    PRECISE highp float sx = p.x - 0.5, sy = p.y - 0.5;
+    int ix = floor_small(sx), iy = floor_small(sy);
+    PRECISE highp float fx = sx - float(ix), fy = sy - float(iy);
+    int x0 = clamp(ix, 0, source_size.x - 1), x1 = clamp(ix + 1, 0, source_size.x - 1);
+    int y0 = clamp(iy, 0, source_size.y - 1), y1 = clamp(iy + 1, 0, source_size.y - 1);
+    highp vec2 a = texelFetch(source_motion, ivec2(x0, y0), 0).rg;
+    highp vec2 b = texelFetch(source_motion, ivec2(x1, y0), 0).rg;
+    highp vec2 c = texelFetch(source_motion, ivec2(x0, y1), 0).rg;
+    highp vec2 d = texelFetch(source_motion, ivec2(x1, y1), 0).rg;
+    PRECISE highp vec2 top = a + (b - a) * fx, bottom = c + (d - c) * fx;
+    PRECISE highp vec2 m = top + (bottom - top) * fy;
+    if (!finite(m.x) || !finite(m.y)) return;
+    PRECISE highp vec2 r = q - factor * m;
+    if (!(r.x >= 0.0 && r.y >= 0.0 && r.x <= w && r.y <= h)) return;
+    highp vec4 color = bicubic(r);
+    PRECISE highp float total = color.r + color.g + color.b + color.a;
+    if (finite(total)) imageStore(out_color, t, color);
+}
+)";
+
 }  // namespace
 
+Status refetch_pass(ContextState& s, const SplatTextures& source, float factor, GLuint carried,
+                    GLuint covered, int tw, int th, GLuint out_color) {
+    glUseProgram(s.refetch_program);
+    s.bind_inputs({source.color, source.motion, carried, covered});
+    glBindImageTexture(0, out_color, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glUniform2i(glGetUniformLocation(s.refetch_program, "source_size"), source.width,
+                source.height);
+    glUniform2i(glGetUniformLocation(s.refetch_program, "target_size"), tw, th);
+    glUniform1f(glGetUniformLocation(s.refetch_program, "factor"), factor);
+    dispatch(tw, th);
+    ContextState::unbind_inputs();
+    glUseProgram(0);
+    return gl::check_errors("gpu refetch");
+}
+
 Status create_splat_programs(ContextState& s) {
+    REPRISE_TRY(gl::link_compute((std::string(kComputeHeader) + kRefetch).c_str(), "refetch",
+                                 s.refetch_program));
     const std::string landing = std::string(kComputeHeader) + kLanding;
     REPRISE_TRY(
         gl::link_compute((landing + kScatter).c_str(), "splat scatter", s.splat_scatter_program));

@@ -176,6 +176,11 @@ Status extrapolate_passes(ContextState& s, const SplatTextures& frame, const Cam
 // `from` times `scale` into `to` (GL_RGBA32F), w x h.
 void copy_scaled(ContextState& s, GLuint from, GLuint to, int w, int h, float scale);
 
+// The reverse warp's refetch after a footprint-2 splat of `source` by `factor` that carried its
+// motion into `carried` and marked `covered`: the refetched colour into `out_color` (tw x th).
+Status refetch_pass(ContextState& s, const SplatTextures& source, float factor, GLuint carried,
+                    GLuint covered, int tw, int th, GLuint out_color);
+
 // The bound program over w x h in 8x8 groups, its writes visible to whatever comes next.
 void dispatch(int w, int h);
 
@@ -212,7 +217,8 @@ struct ContextState {
     std::vector<glm::vec4> float_readback;  // so do float ones of fewer channels
     // Splat: the lists of landings per target pixel, the motion carried, and how many pixels of
     // the last splat had more candidates than the shader sorts (taken by the rule instead).
-    GLuint splat_scatter_program = 0, splat_clear_program = 0, splat_gather_program = 0;
+    GLuint splat_scatter_program = 0, splat_clear_program = 0, splat_gather_program = 0,
+           refetch_program = 0;
     GLuint splat_counts = 0, splat_lists = 0;
     std::size_t splat_list_bytes = 0, splat_by_rule = 0;
     Texture splat_motion;

@@ -63,6 +63,7 @@ struct ExtrapolateStats {
 // How Context::interpolate makes the in-between frame (FrucOptions' fields of the same names).
 struct InterpolateOptions {
     warp::SplatOptions splat;
+    bool reverse = false;  // WarpMethod::Reverse: a footprint-2 splat whose colour is refetched
     // Each side along its true motion (static pixels through depth to the in-between camera,
     // a's moving ones along b's motion inverted) unless the CPU's survey finds it linear; CPU
     // images only.
@@ -156,8 +157,8 @@ public:
                        unsigned out_motion = 0);
 
     // warp::PoseExtrapolator (and the converter's extrapolation) for FrucOptions with warp Splat
-    // and fill PullPush or None (others are an error): `frame` as seen by (view, projection)
-    // `periods` frame periods after it. Static pixels (their motion within
+    // or Reverse and fill PullPush or None (others are an error): `frame` as seen by (view,
+    // projection) `periods` frame periods after it. Static pixels (their motion within
     // options.static_tolerance px of the camera's alone) go where that camera sees them, the
     // others `periods` along their own motion, in one splat; pull-push over what nothing covers.
     // A frame without a projection goes along its motion alone (view and projection unused).
