@@ -81,5 +81,6 @@ void bind_stereo(py::module_& m);
 void bind_metrics(py::module_& m);
 void bind_render(py::module_& m);
 void bind_codec(py::module_& m);
+void bind_upsample(py::module_& m);
 
 }  // namespace reprise::python

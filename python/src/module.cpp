@@ -18,6 +18,7 @@ PYBIND11_MODULE(_native, m) {
     rp::bind_metrics(m);
     rp::bind_render(m);
     rp::bind_codec(m);
+    rp::bind_upsample(m);
     reprise::set_memory_limit_hint("reprise.set_max_memory() to change");
     m.def(
         "set_max_memory",
