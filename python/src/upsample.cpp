@@ -44,8 +44,7 @@ struct Upsampler {
         if (low.color.empty()) value_error("low: needs colour");
         if (full.depth.empty() || full.depth.width() != w || full.depth.height() != h)
             value_error("full: needs depth of its size");
-        if (low.width() > w || low.height() > h)
-            value_error("low: larger than the full frame");
+        if (low.width() > w || low.height() > h) value_error("low: larger than the full frame");
         GBufferView guides = full.view();
         auto sized = [&](const auto& image) { return image.width() == w && image.height() == h; };
         if (!sized(full.motion)) guides.motion = {};
