@@ -702,6 +702,23 @@ TEST(Gpu, InterpolationRepairsNonFiniteInputAsTheCpu) {
     EXPECT_GE(test::display_psnr(cpu.color, gpu.color), 50.0);
 }
 
+// Every output of a converter at `factor` over `frames`, and its counters.
+std::vector<Frame> convert(const std::vector<Frame>& frames, int factor,
+                           const warp::FrucOptions& options, warp::FrucCounters& counters) {
+    warp::FrameRateConverter converter;
+    const Status made = warp::FrameRateConverter::create(factor, options, converter);
+    EXPECT_TRUE(made.ok()) << made.message();
+    std::vector<Frame> outputs;
+    for (const Frame& f : frames) {
+        const Status sent = converter.send(f);
+        EXPECT_TRUE(sent.ok()) << sent.message();
+        Frame out;
+        while (converter.receive(out)) outputs.push_back(std::move(out));
+    }
+    counters = converter.counters();
+    return outputs;
+}
+
 // The converter with the GPU making its in-between frames: the CPU's frames at factor 3 (s = 1/3,
 // 2/3), inputs passed through, a cut continued from the old shot on the CPU as before.
 TEST(Gpu, TheConverterWithTheGpuBackendMakesTheCpusFrames) {
@@ -710,22 +727,9 @@ TEST(Gpu, TheConverterWithTheGpuBackendMakesTheCpusFrames) {
     gpu::FrucBackend backend(shared_gpu());
     warp::FrucOptions with_gpu = kSplatInterpolation;
     with_gpu.backend = &backend;
-    auto run = [&](const warp::FrucOptions& options, warp::FrucCounters& counters) {
-        warp::FrameRateConverter converter;
-        EXPECT_TRUE(warp::FrameRateConverter::create(3, options, converter).ok());
-        std::vector<Frame> outputs;
-        for (const Frame& f : frames) {
-            const Status sent = converter.send(f);
-            EXPECT_TRUE(sent.ok()) << sent.message();
-            Frame out;
-            while (converter.receive(out)) outputs.push_back(std::move(out));
-        }
-        counters = converter.counters();
-        return outputs;
-    };
     warp::FrucCounters cpu_counters, gpu_counters;
-    const std::vector<Frame> cpu = run(kSplatInterpolation, cpu_counters);
-    const std::vector<Frame> gpu = run(with_gpu, gpu_counters);
+    const std::vector<Frame> cpu = convert(frames, 3, kSplatInterpolation, cpu_counters);
+    const std::vector<Frame> gpu = convert(frames, 3, with_gpu, gpu_counters);
     ASSERT_EQ(cpu.size(), 10u);  // 4 inputs, 2 frames after each of the first 3
     ASSERT_EQ(gpu.size(), cpu.size());
     for (std::size_t i = 0; i < cpu.size(); ++i) {
@@ -880,23 +884,9 @@ TEST(Gpu, TheExtrapolatingConverterWithTheGpuBackendMakesTheCpusFrames) {
     gpu::FrucBackend backend(shared_gpu());
     warp::FrucOptions gpu_options = cpu_options;
     gpu_options.backend = &backend;
-    auto run = [&](const warp::FrucOptions& options, warp::FrucCounters& counters) {
-        warp::FrameRateConverter converter;
-        const Status made = warp::FrameRateConverter::create(3, options, converter);
-        EXPECT_TRUE(made.ok()) << made.message();
-        std::vector<Frame> outputs;
-        for (const Frame& f : frames) {
-            const Status sent = converter.send(f);
-            EXPECT_TRUE(sent.ok()) << sent.message();
-            Frame out;
-            while (converter.receive(out)) outputs.push_back(std::move(out));
-        }
-        counters = converter.counters();
-        return outputs;
-    };
     warp::FrucCounters cpu_counters, gpu_counters;
-    const std::vector<Frame> cpu = run(cpu_options, cpu_counters);
-    const std::vector<Frame> gpu = run(gpu_options, gpu_counters);
+    const std::vector<Frame> cpu = convert(frames, 3, cpu_options, cpu_counters);
+    const std::vector<Frame> gpu = convert(frames, 3, gpu_options, gpu_counters);
     ASSERT_EQ(cpu.size(), 9u);  // each input and two frames beyond it
     ASSERT_EQ(gpu.size(), cpu.size());
     for (std::size_t i = 0; i < cpu.size(); ++i) {
