@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "common.hpp"
+#include "reprise/core/memory_limit.hpp"
 #include "reprise/gpu/upsampler.hpp"
 #include "reprise/warp/upsample.hpp"
 
@@ -45,6 +46,9 @@ struct Upsampler {
         if (full.depth.empty() || full.depth.width() != w || full.depth.height() != h)
             value_error("full: needs depth of its size");
         if (low.width() > w || low.height() > h) value_error("low: larger than the full frame");
+        // History, taps, gradients and the output: measured 298 bytes a full pixel (reprise
+        // upsample's estimate).
+        check(check_image_memory(w, h, 300, "upsample"));
         GBufferView guides = full.view();
         auto sized = [&](const auto& image) { return image.width() == w && image.height() == h; };
         if (!sized(full.motion)) guides.motion = {};

@@ -44,3 +44,12 @@ def test_bad_upsampling_input_raises(pan_60):
     big = reprise.Frame(np.zeros((pan_60[0].height * 2, pan_60[0].width, 4)))
     with pytest.raises(ValueError, match="larger"):
         up.upsample(big, pan_60[0])
+
+
+def test_upsampling_past_the_memory_limit_is_refused(pan_60):
+    reprise.set_max_memory("1M")
+    try:
+        with pytest.raises(reprise.Error, match="upsample"):
+            reprise.Upsampler().upsample(every_other_pixel(pan_60[0]), pan_60[0])
+    finally:
+        reprise.set_max_memory("4G")
