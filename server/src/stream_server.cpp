@@ -452,11 +452,13 @@ struct StreamServer::State {
     // copy of every frame of one fragment.
     void adapt(Session& session, const net::ReceiverReportMessage& m, int64_t now) {
         Session::Net& s = session.net;
+        // `missing` (newest heard minus received) falls when a reordered datagram arrives late:
+        // only an older `received` marks a stale report, and missing counts from its highest.
+        if (m.received < s.report_received) return;
         const uint32_t received = m.received - s.report_received,
-                       missing = m.missing - s.report_missing;
-        if (m.received < s.report_received || m.missing < s.report_missing) return;  // stale report
+                       missing = m.missing > s.report_missing ? m.missing - s.report_missing : 0;
         s.report_received = m.received;
-        s.report_missing = m.missing;
+        s.report_missing = std::max(s.report_missing, m.missing);
         if (missing > 0) s.parity_until_us = now + detail::kParityAfterLossUs;
         {
             std::lock_guard lock(session.mutex);
