@@ -27,6 +27,7 @@
 #include "reprise/warp/fruc.hpp"
 #include "reprise/warp/reproject.hpp"
 #include "reprise/warp/splat.hpp"
+#include "reprise/warp/true_motion.hpp"
 #include "reprise/warp/upsample.hpp"
 #include "support/frames.hpp"
 #include "support/nonfinite.hpp"
@@ -228,6 +229,12 @@ struct Textures {
                 .height = h,
                 .camera = f.camera};
     }
+    // A frame's colour as GL_RGBA32F; empty textures of the test size.
+    GLuint color(const Frame& f) {
+        return make(GL_RGBA32F, f.width(), f.height(), GL_RGBA, GL_FLOAT, f.color.data());
+    }
+    GLuint rgba() { return make(GL_RGBA32F, kWidth, kHeight, GL_RGBA, GL_FLOAT, nullptr); }
+    GLuint r32f() { return make(GL_R32F, kWidth, kHeight, GL_RED, GL_FLOAT, nullptr); }
     ~Textures() { glDeleteTextures(GLsizei(names.size()), names.data()); }
 };
 
@@ -251,8 +258,7 @@ TEST(Gpu, TextureEntryPointWritesTheCallersTextures) {
     context.make_current();
     Textures t;
     const gpu::GBufferTextures current = t.gbuffer(frames[1]), previous = t.gbuffer(frames[0]);
-    const GLuint payload =
-        t.make(GL_RGBA32F, kWidth, kHeight, GL_RGBA, GL_FLOAT, frames[0].color.data());
+    const GLuint payload = t.color(frames[0]);
     const Image<glm::vec4> zeros(kWidth, kHeight, glm::vec4(0.0f));
     const GLuint out = t.make(GL_RGBA32F, kWidth, kHeight, GL_RGBA, GL_FLOAT, zeros.data());
     const GLuint hit = t.make(GL_R32UI, kWidth, kHeight, GL_RED_INTEGER, GL_UNSIGNED_INT, nullptr);
@@ -285,7 +291,7 @@ TEST(Gpu, BadTexturesAndPayloadsAreNamed) {
     Textures t;
     const gpu::GBufferTextures current = t.gbuffer(frames[1]), previous = t.gbuffer(frames[0]);
     const GLuint small = t.make(GL_RGBA32F, 8, 8, GL_RGBA, GL_FLOAT, nullptr);
-    const GLuint out = t.make(GL_RGBA32F, kWidth, kHeight, GL_RGBA, GL_FLOAT, nullptr);
+    const GLuint out = t.rgba();
     warp::ReprojectCounts counts;
     Status status = context.reproject(current, previous, small, out, 0, {}, counts);
     EXPECT_EQ(status.message(), "gpu: texture " + std::to_string(small) +
@@ -418,7 +424,7 @@ TEST(Gpu, PullPushOnTexturesWritesTheOutputTexture) {
     const GLuint valid =
         t.make(GL_R8UI, kWidth, kHeight, GL_RED_INTEGER, GL_UNSIGNED_BYTE, r.hit.data());
     const GLuint depth = t.make(GL_R32F, kWidth, kHeight, GL_RED, GL_FLOAT, frames[1].depth.data());
-    const GLuint out = t.make(GL_RGBA32F, kWidth, kHeight, GL_RGBA, GL_FLOAT, nullptr);
+    const GLuint out = t.rgba();
     warp::FillStats got;
     Status status = context.fill(color, valid, depth, kWidth, kHeight, out, got);
     ASSERT_TRUE(status.ok()) << status.message();
@@ -565,9 +571,9 @@ TEST(Gpu, StereoEyeOnTexturesAndOptionsTheGpuLacks) {
     context.make_current();
     Textures t;
     const gpu::GBufferTextures rendered = t.gbuffer(f);
-    const GLuint color = t.make(GL_RGBA32F, kWidth, kHeight, GL_RGBA, GL_FLOAT, f.color.data());
-    const GLuint out = t.make(GL_RGBA32F, kWidth, kHeight, GL_RGBA, GL_FLOAT, nullptr);
-    const GLuint depth = t.make(GL_R32F, kWidth, kHeight, GL_RED, GL_FLOAT, nullptr);
+    const GLuint color = t.color(f);
+    const GLuint out = t.rgba();
+    const GLuint depth = t.r32f();
     const Status status =
         context.stereo_eye(rendered, color, right, out, depth, texture_stats, as_is);
     ASSERT_TRUE(status.ok()) << status.message();
@@ -586,7 +592,8 @@ TEST(Gpu, StereoEyeOnTexturesAndOptionsTheGpuLacks) {
     EXPECT_NE(andreev.message().find("Andreev"), std::string::npos);
     const Status same_texture =
         context.stereo_eye(rendered, color, right, color, depth, s, kSplatEye);
-    EXPECT_NE(same_texture.message().find("the output is the rendered colour"), std::string::npos);
+    EXPECT_NE(same_texture.message().find("the output is the rendered or the history colour"),
+              std::string::npos);
 }
 
 }  // namespace
@@ -778,12 +785,10 @@ TEST(Gpu, InterpolationOnTexturesAndBadArguments) {
     context.make_current();
     Textures t;
     const gpu::GBufferTextures a = t.gbuffer(frames[0]), b = t.gbuffer(frames[1]);
-    const GLuint a_color =
-        t.make(GL_RGBA32F, kWidth, kHeight, GL_RGBA, GL_FLOAT, frames[0].color.data());
-    const GLuint b_color =
-        t.make(GL_RGBA32F, kWidth, kHeight, GL_RGBA, GL_FLOAT, frames[1].color.data());
-    const GLuint out = t.make(GL_RGBA32F, kWidth, kHeight, GL_RGBA, GL_FLOAT, nullptr);
-    const GLuint depth = t.make(GL_R32F, kWidth, kHeight, GL_RED, GL_FLOAT, nullptr);
+    const GLuint a_color = t.color(frames[0]);
+    const GLuint b_color = t.color(frames[1]);
+    const GLuint out = t.rgba();
+    const GLuint depth = t.r32f();
     const Status status =
         context.interpolate(a, a_color, b, b_color, 0.25f, out, depth, texture_stats);
     ASSERT_TRUE(status.ok()) << status.message();
@@ -800,6 +805,69 @@ TEST(Gpu, InterpolationOnTexturesAndBadArguments) {
                   .message()
                   .find("s must lie in [0, 1]"),
               std::string::npos);
+}
+
+// True motion on textures: the linearity survey reads back the sampled pixels alone and decides
+// as on CPU images (crossing's cars move: true motion; pan's camera alone: linear).
+TEST(Gpu, TrueMotionOnTexturesDecidesAndWarpsAsTheImageEntry) {
+    gpu::Context& context = shared_gpu();
+    for (const char* scene : {"crossing", "pan"}) {
+        SCOPED_TRACE(scene);
+        const std::vector<Frame>& frames = scene_frames(scene);
+        const gpu::InterpolateOptions options{.true_motion = true, .motion_scale = 0.5f};
+        Frame from_images;
+        gpu::InterpolateStats image_stats, texture_stats;
+        ASSERT_TRUE(
+            context.interpolate(frames[0], frames[1], 0.5f, from_images, image_stats, options)
+                .ok());
+        EXPECT_EQ(image_stats.true_motion, std::string(scene) == "crossing");
+        EXPECT_EQ(image_stats.linear_motion, std::string(scene) == "pan");
+        context.make_current();
+        Textures t;
+        const gpu::GBufferTextures a = t.gbuffer(frames[0]), b = t.gbuffer(frames[1]);
+        const GLuint a_color = t.color(frames[0]);
+        const GLuint b_color = t.color(frames[1]);
+        const GLuint out = t.rgba();
+        const GLuint depth = t.r32f();
+        const GLuint motion = t.rgba();
+        const Status status = context.interpolate(a, a_color, b, b_color, 0.5f, out, depth,
+                                                  texture_stats, options, motion);
+        ASSERT_TRUE(status.ok()) << status.message();
+        EXPECT_EQ(texture_stats.true_motion, image_stats.true_motion);
+        EXPECT_EQ(texture_stats.linear_motion, image_stats.linear_motion);
+        EXPECT_EQ(texture_stats.holes, image_stats.holes);
+        EXPECT_EQ(test::display_psnr(read_rgba(out), from_images.color), INFINITY);
+        const Image<glm::vec4> read_motion = read_rgba(motion);
+        std::size_t differ = 0;
+        for (int y = 0; y < kHeight; ++y)
+            for (int x = 0; x < kWidth; ++x)
+                differ += glm::vec2(read_motion(x, y)) != from_images.motion(x, y);
+        EXPECT_EQ(differ, 0u);
+    }
+}
+
+TEST(Gpu, LinearitySurveyOfSamplesIsTheSurveyOfTheFrame) {
+    for (const char* scene : {"crossing", "pan", "fast"}) {
+        const Frame& f = scene_frames(scene)[1];
+        const Camera to = warp::camera_between(scene_frames(scene)[0].camera, f.camera, 0.5f);
+        const int cw = warp::linear_survey_samples(kWidth),
+                  ch = warp::linear_survey_samples(kHeight);
+        Image<glm::vec4> samples(cw, ch);
+        for (int j = 0; j < ch; ++j)
+            for (int i = 0; i < cw; ++i) {
+                const int x = 4 + 8 * i, y = 4 + 8 * j;
+                samples(i, j) = {f.depth(x, y), f.motion(x, y), 0.0f};
+            }
+        for (const float tolerance : {0.25f, 1e-6f, 100.0f})
+            EXPECT_EQ(warp::motion_is_linear(f.camera, kWidth, kHeight,
+                                             std::as_const(samples).view(), to, 0.5f, tolerance),
+                      warp::motion_is_linear(f.view(), to, 0.5f, tolerance))
+                << scene << " " << tolerance;
+    }
+    EXPECT_EQ(warp::linear_survey_samples(4), 0);
+    EXPECT_EQ(warp::linear_survey_samples(5), 1);
+    EXPECT_EQ(warp::linear_survey_samples(13), 2);
+    EXPECT_EQ(warp::linear_survey_samples(0), 0);
 }
 
 // --- Extrapolation against warp::PoseExtrapolator and the converter with the same options.
@@ -833,8 +901,9 @@ void expect_extrapolation_matches(const Frame& frame, const Camera& to, float pe
     EXPECT_LE(d.depth, cpu.depth.pixel_count() / 1000);
     EXPECT_LE(d.motion, 1e-4f);
     EXPECT_EQ(stats.holes, extrapolator.counters().hole_pixels);
-    if (has_projection(frame.camera))
+    if (has_projection(frame.camera)) {
         EXPECT_EQ(stats.moving > 0, extrapolator.counters().dynamic_layers == 1);
+    }
     std::printf(
         "  %.2f periods on: moving %zu, covered %zu, holes %zu, %.1f dB, depth %zu "
         "differ, motion within %g\n",
@@ -922,11 +991,10 @@ TEST(Gpu, ExtrapolationOnTexturesAndBadArguments) {
     context.make_current();
     Textures t;
     const gpu::GBufferTextures frame = t.gbuffer(frames[0]);
-    const GLuint color =
-        t.make(GL_RGBA32F, kWidth, kHeight, GL_RGBA, GL_FLOAT, frames[0].color.data());
-    const GLuint out = t.make(GL_RGBA32F, kWidth, kHeight, GL_RGBA, GL_FLOAT, nullptr);
-    const GLuint depth = t.make(GL_R32F, kWidth, kHeight, GL_RED, GL_FLOAT, nullptr);
-    const GLuint motion = t.make(GL_RGBA32F, kWidth, kHeight, GL_RGBA, GL_FLOAT, nullptr);
+    const GLuint color = t.color(frames[0]);
+    const GLuint out = t.rgba();
+    const GLuint depth = t.r32f();
+    const GLuint motion = t.rgba();
     const Status status = context.extrapolate(frame, color, to.view, to.projection, 1.0f, out,
                                               depth, motion, texture_stats, kSplatExtrapolation);
     ASSERT_TRUE(status.ok()) << status.message();
@@ -1062,7 +1130,7 @@ TEST(Gpu, UpsamplingOptionsAndNonFiniteSamples) {
             t.make(GL_RGBA32F, low.width(), low.height(), GL_RGBA, GL_FLOAT, low.data());
         const GLuint normal =
             t.make(GL_RGB32F, kWidth, kHeight, GL_RGB, GL_FLOAT, clean.full[i].normal.data());
-        const GLuint out = t.make(GL_RGBA32F, kWidth, kHeight, GL_RGBA, GL_FLOAT, nullptr);
+        const GLuint out = t.rgba();
         const Status status =
             from_textures->upsample(low_color, low.width(), low.height(), clean.jitter[i],
                                     t.gbuffer(clean.full[i]), normal, out, &b);
@@ -1125,6 +1193,54 @@ TEST(Gpu, StereoEyeWithHistoryMatchesTheCpuOnEveryBuiltInScene) {
     EXPECT_GT(moving, 0u);        // ... and moving history pixels left out
 }
 
+TEST(Gpu, StereoEyeWithHistoryOnTexturesIsTheImageEntrys) {
+    // Mirror: holes filled from the history (55 pixels) and moving history pixels left out (897).
+    const std::vector<Frame>& frames = scene_frames("mirror");
+    const Camera right =
+        stereo::eye_cameras(frames[1].camera, {.ipd = 0.2f}, stereo::Anchor::Left).right;
+    // The texture entry warps the depth as it is: silhouettes not widened on either.
+    const stereo::StereoOptions options{.warp = stereo::StereoWarp::Splat,
+                                        .widen_silhouettes = false};
+    gpu::Context& context = shared_gpu();
+    Frame from_images;
+    stereo::StereoStats image_stats, texture_stats;
+    const GBufferView history_view = frames[0].view();
+    ASSERT_TRUE(
+        context.stereo_eye(frames[1], right, from_images, image_stats, options, &history_view)
+            .ok());
+    ASSERT_GT(image_stats.from_history, 0u);
+    ASSERT_GT(image_stats.history_moving, 0u);
+    context.make_current();
+    Textures t;
+    const gpu::GBufferTextures rendered = t.gbuffer(frames[1]), history = t.gbuffer(frames[0]);
+    const GLuint color = t.color(frames[1]);
+    const GLuint history_color = t.color(frames[0]);
+    const GLuint out = t.rgba();
+    const GLuint depth = t.r32f();
+    const Status status = context.stereo_eye(rendered, color, right, out, depth, texture_stats,
+                                             options, &history, history_color);
+    ASSERT_TRUE(status.ok()) << status.message();
+    EXPECT_EQ(texture_stats.from_history, image_stats.from_history);
+    EXPECT_EQ(texture_stats.history_moving, image_stats.history_moving);
+    EXPECT_EQ(texture_stats.holes, image_stats.holes);
+    EXPECT_EQ(test::display_psnr(read_rgba(out), from_images.color), INFINITY);
+    // A history of another size, or whose colour is the output, is refused.
+    gpu::GBufferTextures small = history;
+    small.width = kWidth / 2;
+    EXPECT_NE(context
+                  .stereo_eye(rendered, color, right, out, depth, texture_stats, options, &small,
+                              history_color)
+                  .message()
+                  .find("the history is"),
+              std::string::npos);
+    EXPECT_NE(context
+                  .stereo_eye(rendered, color, right, history_color, depth, texture_stats, options,
+                              &history, history_color)
+                  .message()
+                  .find("the history colour"),
+              std::string::npos);
+}
+
 // --- A gpu::Context working in the application's own OpenGL ES context.
 
 TEST(Gpu, AContextAdoptedFromTheApplication) {
@@ -1142,12 +1258,10 @@ TEST(Gpu, AContextAdoptedFromTheApplication) {
     {
         Textures t;  // the application's textures, used as they are
         const gpu::GBufferTextures a = t.gbuffer(frames[0]), b = t.gbuffer(frames[1]);
-        const GLuint a_color =
-            t.make(GL_RGBA32F, kWidth, kHeight, GL_RGBA, GL_FLOAT, frames[0].color.data());
-        const GLuint b_color =
-            t.make(GL_RGBA32F, kWidth, kHeight, GL_RGBA, GL_FLOAT, frames[1].color.data());
-        const GLuint out = t.make(GL_RGBA32F, kWidth, kHeight, GL_RGBA, GL_FLOAT, nullptr);
-        const GLuint depth = t.make(GL_R32F, kWidth, kHeight, GL_RED, GL_FLOAT, nullptr);
+        const GLuint a_color = t.color(frames[0]);
+        const GLuint b_color = t.color(frames[1]);
+        const GLuint out = t.rgba();
+        const GLuint depth = t.r32f();
         const Status status = adopted->interpolate(a, a_color, b, b_color, 0.5f, out, depth, stats);
         ASSERT_TRUE(status.ok()) << status.message();
         EXPECT_EQ(test::display_psnr(read_rgba(out), expected.color), INFINITY);

@@ -271,13 +271,16 @@ Context::~Context() {
          {&state_->pulled, &state_->pulled_depth, &state_->filled, &state_->filled_depth})
         for (Texture& t : *chain) glDeleteTextures(1, &t.name);
     for (GLuint program :
-         {state_->pull_image_program, state_->pull_level_program, state_->push_program,
-          state_->final_program, state_->splat_scatter_program, state_->splat_clear_program,
-          state_->splat_gather_program, state_->displacement_program, state_->finish_program,
-          state_->blend_program, state_->copy_program, state_->static_layer_program,
-          state_->merge_program})
+         {state_->pull_image_program,   state_->pull_level_program,    state_->push_program,
+          state_->final_program,        state_->splat_scatter_program, state_->splat_clear_program,
+          state_->splat_gather_program, state_->displacement_program,  state_->finish_program,
+          state_->blend_program,        state_->copy_program,          state_->static_layer_program,
+          state_->merge_program,        state_->refetch_program,       state_->true_motion_program,
+          state_->survey_program,       state_->invert_programs[0],    state_->invert_programs[1],
+          state_->invert_programs[2],   state_->invert_programs[3]})
         glDeleteProgram(program);
-    for (GLuint buffer : {state_->blend_counts, state_->extrapolate_counts, state_->eye_counts})
+    for (GLuint buffer : {state_->blend_counts, state_->extrapolate_counts, state_->eye_counts,
+                          state_->invert_buffer})
         glDeleteBuffers(1, &buffer);
     glDeleteBuffers(1, &state_->splat_counts);
     glDeleteBuffers(1, &state_->splat_lists);

@@ -1,10 +1,12 @@
-// The in-between frame on the GPU: warp's interpolate_frame for the splat without refinement and
-// without true motion (FrucOptions{.warp = Splat, .true_motion = false, .refine = off}): b
-// splatted by 1 - s, a by -s, the two blended where both see one surface, pull-push over what
-// neither covers.
+// The in-between frame on the GPU: warp's interpolate_frame for the splat or the reverse warp
+// without refinement (FrucOptions{.warp = Splat or Reverse, .refine = off}): b splatted by
+// 1 - s, a by -s (along their true motion when asked), the two blended where both see one
+// surface, pull-push over what neither covers.
 #include <chrono>
 #include <string>
+#include <utility>
 
+#include "reprise/warp/true_motion.hpp"
 #include "state.hpp"
 
 namespace reprise::gpu {
@@ -92,6 +94,21 @@ void main() {
         if (finite(i.x) && finite(i.y)) result = i;
     }
     imageStore(true_motion, p, vec4(result, 0.0, 0.0));
+}
+)";
+
+// The pixels warp's linearity survey looks at, (4 + 8 i, 4 + 8 j), gathered as (depth, motion).
+constexpr const char* kSurvey = R"(
+layout(binding = 0) uniform highp sampler2D depth_map;
+layout(binding = 1) uniform highp sampler2D motion_map;
+layout(binding = 0, rgba32f) writeonly uniform highp image2D samples;
+uniform ivec2 count;
+void main() {
+    ivec2 i = ivec2(gl_GlobalInvocationID.xy);
+    if (i.x >= count.x || i.y >= count.y) return;
+    ivec2 p = 4 + 8 * i;
+    imageStore(samples, i, vec4(texelFetch(depth_map, p, 0).r, texelFetch(motion_map, p, 0).rg,
+                                0.0));
 }
 )";
 
@@ -186,6 +203,8 @@ Status create_interpolate_programs(ContextState& s) {
         REPRISE_TRY(gl::link_compute(
             (still + "#define STAGE " + std::to_string(stage) + "\n" + kInvert).c_str(),
             "invert motion", s.invert_programs[stage]));
+    REPRISE_TRY(gl::link_compute((std::string(kComputeHeader) + kSurvey).c_str(), "survey",
+                                 s.survey_program));
     REPRISE_TRY(
         gl::link_compute((std::string(kComputeHeader) + kBlend).c_str(), "blend", s.blend_program));
     REPRISE_TRY(
@@ -320,6 +339,55 @@ Status interpolate_passes(ContextState& s, const SplatTextures& given_a,
     return gl::check_errors("gpu interpolate");
 }
 
+namespace {
+
+// warp::motion_is_linear of a frame on the GPU: its sampled pixels gathered and read back.
+bool motion_is_linear(ContextState& s, const SplatTextures& f, const Camera& camera,
+                      const Camera& to, float factor, float tolerance) {
+    const int cw = warp::linear_survey_samples(f.width), ch = warp::linear_survey_samples(f.height);
+    Interpolation& k = s.interpolation;
+    k.survey_samples.resize(cw, ch);
+    if (cw > 0 && ch > 0) {
+        k.survey.ensure(GL_RGBA32F, cw, ch);
+        glUseProgram(s.survey_program);
+        s.bind_inputs({f.depth, f.motion});
+        glBindImageTexture(0, k.survey.name, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+        glUniform2i(glGetUniformLocation(s.survey_program, "count"), cw, ch);
+        dispatch(cw, ch);
+        ContextState::unbind_inputs();
+        glUseProgram(0);
+        s.download(k.survey, k.survey_samples.data(), cw);
+    }
+    return warp::motion_is_linear(camera, f.width, f.height, std::as_const(k.survey_samples).view(),
+                                  to, factor, tolerance);
+}
+
+// warp's interpolate_frame's choice (both sides warpable): through the cameras unless the survey
+// finds the motion linear (`linear(side, factor)`, side 0 a, 1 b); without b's camera, a along
+// b's motion inverted.
+template <class Linear>
+Status plan_true_motion(const Camera& a, const Camera& b, float s_between, int w, int h,
+                        const Linear& linear, TrueMotion& plan, InterpolateStats& stats) {
+    plan = {.a_camera = a, .b_camera = b};
+    const bool cameras = has_projection(a) && has_projection(b);
+    if (cameras) {
+        plan.at = warp::camera_between(a, b, s_between);
+        stats.linear_motion = linear(1, 1.0f - s_between) && linear(0, -s_between);
+        plan.follow = plan.cameras = !stats.linear_motion;
+        auto skewed = [&](const Camera& c) {
+            return !Unprojector(c.projection, w, h).axis_aligned();
+        };
+        if (plan.cameras && (skewed(a) || skewed(b)))
+            return Status::error("gpu interpolate: a frame's projection is skewed");
+    } else {
+        plan.follow = !has_projection(b);
+    }
+    stats.true_motion = plan.follow;
+    return {};
+}
+
+}  // namespace
+
 Status Context::interpolate(const GBufferView& given_a, const GBufferView& given_b, float s_between,
                             Frame& out, InterpolateStats& stats,
                             const InterpolateOptions& options) {
@@ -343,27 +411,15 @@ Status Context::interpolate(const GBufferView& given_a, const GBufferView& given
     out.id.clear();
     out.camera = b.camera;
     if (w <= 0 || h <= 0) return {};
-    // warp's interpolate_frame's choice (both sides warpable): through the cameras unless the
-    // survey finds the motion linear; without b's camera, a along b's motion inverted.
-    TrueMotion plan{.a_camera = a.camera, .b_camera = b.camera};
-    if (options.true_motion) {
-        const bool cameras = has_projection(a.camera) && has_projection(b.camera);
-        if (cameras) {
-            plan.at = warp::camera_between(a.camera, b.camera, s_between);
-            stats.linear_motion =
-                warp::motion_is_linear(b, plan.at, 1.0f - s_between, options.static_tolerance) &&
-                warp::motion_is_linear(a, plan.at, -s_between, options.static_tolerance);
-            plan.follow = plan.cameras = !stats.linear_motion;
-            auto skewed = [&](const Camera& c) {
-                return !Unprojector(c.projection, w, h).axis_aligned();
-            };
-            if (plan.cameras && (skewed(a.camera) || skewed(b.camera)))
-                return Status::error("gpu interpolate: a frame's projection is skewed");
-        } else {
-            plan.follow = !has_projection(b.camera);
-        }
-        stats.true_motion = plan.follow;
-    }
+    TrueMotion plan;
+    if (options.true_motion)
+        REPRISE_TRY(plan_true_motion(
+            a.camera, b.camera, s_between, w, h,
+            [&](int side, float factor) {
+                return warp::motion_is_linear(side ? b : a, plan.at, factor,
+                                              options.static_tolerance);
+            },
+            plan, stats));
     REPRISE_TRY(s.gl->acquire());
     auto t = std::chrono::steady_clock::now();
     Texture* textures[6] = {&k.a_color, &k.a_depth, &k.a_motion,
@@ -411,9 +467,6 @@ Status Context::interpolate(const GBufferTextures& a, unsigned a_color, const GB
                              std::to_string(h) + " must be equal and positive");
     if (!(s_between >= 0.0f && s_between <= 1.0f))
         return Status::error("gpu interpolate: s must lie in [0, 1]");
-    if (options.true_motion)
-        return Status::error(
-            "gpu interpolate: true motion needs CPU images (its linearity survey reads them)");
     REPRISE_TRY(check_texture(a.depth, GL_R32F, w, h, "a depth"));
     REPRISE_TRY(check_texture(a.motion, GL_RG32F, w, h, "a motion"));
     REPRISE_TRY(check_texture(a_color, GL_RGBA32F, w, h, "a colour"));
@@ -426,9 +479,19 @@ Status Context::interpolate(const GBufferTextures& a, unsigned a_color, const GB
     if (out_color == a_color || out_color == b_color)
         return Status::error("gpu interpolate: the output is an input colour");
     auto t = std::chrono::steady_clock::now();
-    REPRISE_TRY(interpolate_passes(s, {a_color, a.depth, a.motion, w, h},
-                                   {b_color, b.depth, b.motion, w, h}, s_between, w, h, options,
-                                   out_color, out_depth, out_motion, stats, TrueMotion{}));
+    const SplatTextures sides[2] = {{a_color, a.depth, a.motion, w, h},
+                                    {b_color, b.depth, b.motion, w, h}};
+    TrueMotion plan;
+    if (options.true_motion)
+        REPRISE_TRY(plan_true_motion(
+            a.camera, b.camera, s_between, w, h,
+            [&](int side, float factor) {
+                return motion_is_linear(s, sides[side], side ? b.camera : a.camera, plan.at, factor,
+                                        options.static_tolerance);
+            },
+            plan, stats));
+    REPRISE_TRY(interpolate_passes(s, sides[0], sides[1], s_between, w, h, options, out_color,
+                                   out_depth, out_motion, stats, plan));
     timings_.compute_ms = finish_ms(t);
     return {};
 }

@@ -191,13 +191,16 @@ double finish_ms(std::chrono::steady_clock::time_point& since);
 struct Interpolation {
     Texture a_color, a_depth, a_motion, b_color, b_depth, b_motion;
     Texture side_a_color, side_a_depth, side_a_covered, side_a_motion, side_b_color, side_b_depth,
-        side_b_covered, side_b_motion, blended, valid, made_motion, true_a, true_b, inverted;
+        side_b_covered, side_b_motion, blended, valid, made_motion, true_a, true_b, inverted,
+        survey;
     NonfiniteRepair repair_a, repair_b;  // each keeps its repaired copy until the next call
-    Texture* all[20] = {&a_color,        &a_depth,       &a_motion,     &b_color,
+    Image<glm::vec4> survey_samples;     // the linearity survey's samples, read back
+    Texture* all[21] = {&a_color,        &a_depth,       &a_motion,     &b_color,
                         &b_depth,        &b_motion,      &side_a_color, &side_a_depth,
                         &side_a_covered, &side_a_motion, &side_b_color, &side_b_depth,
                         &side_b_covered, &side_b_motion, &blended,      &valid,
-                        &made_motion,    &true_a,        &true_b,       &inverted};
+                        &made_motion,    &true_a,        &true_b,       &inverted,
+                        &survey};
 };
 
 struct ContextState {
@@ -231,6 +234,7 @@ struct ContextState {
     GLuint blend_program = 0, copy_program = 0, blend_counts = 0;
     // True motion: each side's, and b's moving pixels inverted (stages of kInvert).
     GLuint true_motion_program = 0, invert_programs[4] = {0, 0, 0, 0}, invert_buffer = 0;
+    GLuint survey_program = 0;  // gathers the pixels warp's linearity survey looks at
     std::size_t invert_bytes = 0;
     Interpolation interpolation;
     Texture displacement, target_depth, eye_color;

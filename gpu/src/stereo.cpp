@@ -330,7 +330,8 @@ Status Context::stereo_eye(const GBufferView& given, const Camera& target, Frame
 
 Status Context::stereo_eye(const GBufferTextures& rendered, unsigned color, const Camera& target,
                            unsigned out_color, unsigned out_depth, stereo::StereoStats& stats,
-                           const stereo::StereoOptions& options) {
+                           const stereo::StereoOptions& options, const GBufferTextures* history,
+                           unsigned history_color) {
     timings_ = {};
     stats = {};
     REPRISE_TRY(check_options(options));
@@ -344,11 +345,24 @@ Status Context::stereo_eye(const GBufferTextures& rendered, unsigned color, cons
     REPRISE_TRY(check_texture(color, GL_RGBA32F, w, h, "rendered colour"));
     REPRISE_TRY(check_texture(out_color, GL_RGBA32F, w, h, "eye colour"));
     REPRISE_TRY(check_texture(out_depth, GL_R32F, w, h, "eye depth"));
-    if (out_color == color)
-        return Status::error("gpu stereo eye: the output is the rendered colour");
+    EyeHistory textures;
+    if (history) {
+        if (history->width != w || history->height != h)
+            return Status::error("gpu stereo eye: the history is " +
+                                 std::to_string(history->width) + "x" +
+                                 std::to_string(history->height) + ", the rendered eye " +
+                                 std::to_string(w) + "x" + std::to_string(h));
+        REPRISE_TRY(check_texture(history->depth, GL_R32F, w, h, "history depth"));
+        REPRISE_TRY(check_texture(history_color, GL_RGBA32F, w, h, "history colour"));
+        if (history->motion != 0)
+            REPRISE_TRY(check_texture(history->motion, GL_RG32F, w, h, "history motion"));
+        textures = {history_color, history->depth, history->motion, history->camera};
+    }
+    if (out_color == color || (history && out_color == history_color))
+        return Status::error("gpu stereo eye: the output is the rendered or the history colour");
     auto t = std::chrono::steady_clock::now();
     REPRISE_TRY(eye_passes(s, color, rendered.depth, w, h, rendered.camera, target, options,
-                           out_color, out_depth, stats, nullptr));
+                           out_color, out_depth, stats, history ? &textures : nullptr));
     timings_.compute_ms = finish_ms(t);
     return {};
 }

@@ -6,6 +6,7 @@
 #include "fruc_stages.hpp"
 #include "reprise/core/camera_math.hpp"
 #include "reprise/core/parallel.hpp"
+#include "reprise/warp/true_motion.hpp"
 
 namespace reprise::warp {
 
@@ -15,12 +16,16 @@ bool finite(glm::vec2 m) { return std::isfinite(m.x) && std::isfinite(m.y); }
 
 }  // namespace
 
-bool motion_is_linear(const GBufferView& f, const Camera& to, float factor, float tolerance) {
-    constexpr int kStep = 8;             // every 8th pixel of every 8th row
+namespace {
+
+// The survey over the sampled pixels: sample(x, y, z, m) gives the depth and motion at (x, y).
+template <class Sample>
+bool linear_survey(const Camera& camera, int w, int h, const Sample& sample, const Camera& to,
+                   float factor, float tolerance) {
+    constexpr int kStep = kLinearSurveyStep;
     constexpr float kDeviation = 0.02f;  // px between the true and the linear landing
-    const int w = f.width(), h = f.height();
-    const StaticReprojection to_previous = camera_only_motion(f.camera, w, h);
-    const StaticReprojection to_instant(f.camera, to.view, to.projection, w, h);
+    const StaticReprojection to_previous = camera_only_motion(camera, w, h);
+    const StaticReprojection to_instant(camera, to.view, to.projection, w, h);
     const Unprojector& unproject = to_previous.unprojector();
     std::atomic<bool> linear{true};
     const int rows = (h + kStep / 2) / kStep;  // sampled rows kStep/2, kStep/2 + kStep, ...
@@ -31,8 +36,10 @@ bool motion_is_linear(const GBufferView& f, const Camera& to, float factor, floa
                  y += kStep) {
                 if (!linear.load(std::memory_order_relaxed)) return;
                 for (int x = kStep / 2; x < w; x += kStep) {
-                    const glm::vec2 p(float(x) + 0.5f, float(y) + 0.5f), m = f.motion(x, y);
-                    const float z = f.depth(x, y);
+                    float z;
+                    glm::vec2 m;
+                    sample(x, y, z, m);
+                    const glm::vec2 p(float(x) + 0.5f, float(y) + 0.5f);
                     if (std::isnan(z)) continue;
                     const glm::vec4 point = unproject.point(p.x, p.y, z);
                     glm::vec2 before, landed;
@@ -49,6 +56,34 @@ bool motion_is_linear(const GBufferView& f, const Camera& to, float factor, floa
         },
         8);
     return linear.load();
+}
+
+}  // namespace
+
+bool motion_is_linear(const GBufferView& f, const Camera& to, float factor, float tolerance) {
+    return linear_survey(
+        f.camera, f.width(), f.height(),
+        [&](int x, int y, float& z, glm::vec2& m) {
+            z = f.depth(x, y);
+            m = f.motion(x, y);
+        },
+        to, factor, tolerance);
+}
+
+bool motion_is_linear(const Camera& camera, int width, int height,
+                      ImageView<const glm::vec4> samples, const Camera& to, float factor,
+                      float tolerance) {
+    constexpr int kStep = kLinearSurveyStep;
+    REPRISE_ASSERT(samples.width == linear_survey_samples(width) &&
+                   samples.height == linear_survey_samples(height));
+    return linear_survey(
+        camera, width, height,
+        [&](int x, int y, float& z, glm::vec2& m) {
+            const glm::vec4 v = samples(x / kStep, y / kStep);
+            z = v.x;
+            m = {v.y, v.z};
+        },
+        to, factor, tolerance);
 }
 
 std::size_t motion_toward(const GBufferView& f, const Camera& to, float factor,

@@ -65,8 +65,8 @@ struct InterpolateOptions {
     warp::SplatOptions splat;
     bool reverse = false;  // WarpMethod::Reverse: a footprint-2 splat whose colour is refetched
     // Each side along its true motion (static pixels through depth to the in-between camera,
-    // a's moving ones along b's motion inverted) unless the CPU's survey finds it linear; CPU
-    // images only.
+    // a's moving ones along b's motion inverted) unless warp's survey finds it linear (on
+    // textures, its sampled pixels are gathered and read back: 1/64 of the depth and motion).
     bool true_motion = false;
     float static_tolerance = 0.25f;
     float motion_scale = 1.0f;  // the made frame's motion: per output period
@@ -131,11 +131,13 @@ public:
     // (GL_RGBA32F) and `out_depth` (GL_R32F) written, all of the rendered size. No repair of
     // NaN/Inf input here (the CPU-image entry repairs as the CPU does): pixels with NaN depth are
     // left out, colour with a non-finite channel comes out 0. The depth texture is warped as it
-    // is (StereoOptions::widen_silhouettes is the CPU-image entry's, done on the CPU). No
-    // history here yet.
+    // is (StereoOptions::widen_silhouettes is the CPU-image entry's, done on the CPU). A
+    // `history` (its depth, motion (0: none, nothing left out) and camera, colour
+    // `history_color`, of the rendered size) fills the holes as in the CPU-image entry.
     Status stereo_eye(const GBufferTextures& rendered, unsigned color, const Camera& target,
                       unsigned out_color, unsigned out_depth, stereo::StereoStats& stats,
-                      const stereo::StereoOptions& options = {});
+                      const stereo::StereoOptions& options = {},
+                      const GBufferTextures* history = nullptr, unsigned history_color = 0);
 
     // The frame at `s` in [0, 1] between a (0) and b (1) with b's backward motion: warp's
     // interpolate_frame for FrucOptions{.warp = Splat, .refine off} and pull-push: b splatted by
@@ -150,7 +152,7 @@ public:
                        InterpolateStats& stats, const InterpolateOptions& options = {});
     // The same on textures: colour GL_RGBA32F, depth GL_R32F, motion GL_RG32F, all one size;
     // `out_color` and `out_depth` written, and `out_motion` (GL_RGBA32F, the motion in RG; 0:
-    // not written). Without true motion (its linearity survey reads CPU images).
+    // not written).
     Status interpolate(const GBufferTextures& a, unsigned a_color, const GBufferTextures& b,
                        unsigned b_color, float s, unsigned out_color, unsigned out_depth,
                        InterpolateStats& stats, const InterpolateOptions& options = {},
