@@ -26,6 +26,7 @@
 #include "reprise/warp/fill.hpp"
 #include "reprise/warp/fruc.hpp"
 #include "reprise/warp/reproject.hpp"
+#include "reprise/warp/shot_change.hpp"
 #include "reprise/warp/splat.hpp"
 #include "reprise/warp/true_motion.hpp"
 #include "reprise/warp/upsample.hpp"
@@ -1238,6 +1239,71 @@ TEST(Gpu, StereoEyeWithHistoryOnTexturesIsTheImageEntrys) {
                               &history, history_color)
                   .message()
                   .find("the history colour"),
+              std::string::npos);
+}
+
+// --- The shot-change test.
+
+TEST(Gpu, ShotChangeDecidesAsTheCpu) {
+    gpu::Context& context = shared_gpu();
+    std::size_t cuts = 0, kept = 0;
+    auto check = [&](const Frame& frame, const Frame& previous, float misses, float color,
+                     const std::string& what) -> warp::ShotChange {
+        SCOPED_TRACE(what);
+        warp::ShotChangeScratch scratch;
+        const warp::ShotChange cpu = warp::shot_change(frame, previous, misses, color, scratch);
+        warp::ShotChange gpu;
+        const Status status = context.shot_change(frame, previous, misses, color, gpu);
+        EXPECT_TRUE(status.ok()) << status.message();
+        EXPECT_EQ(gpu.counts, cpu.counts);
+        EXPECT_EQ(gpu.difference, cpu.difference);
+        EXPECT_EQ(gpu.cut, cpu.cut);
+        ++(cpu.cut ? cuts : kept);
+        return cpu;
+    };
+    for (const server::SceneInfo& info : server::builtin_scenes()) {
+        const std::vector<Frame>& frames = scene_frames(info.name);
+        const warp::ShotChange same = check(frames[1], frames[0], 0.6f, 0.12f, info.name);
+        EXPECT_FALSE(same.cut);
+        // Just under the pair's mean colour difference: a cut by colour alone.
+        if (same.counts.hits > 0 && same.difference > 0) {
+            const double mean = double(same.difference) / 1048576.0 / (3.0 * same.counts.hits);
+            EXPECT_TRUE(check(frames[1], frames[0], 0.6f, float(mean * 0.99),
+                              std::string(info.name) + ", colour threshold")
+                            .cut);
+        }
+    }
+    // The cut scene across its cut, and two unrelated scenes.
+    const std::vector<Frame> across = test::render_scene("cut", 2, kWidth, kHeight, 30.0, 14);
+    EXPECT_TRUE(check(across[1], across[0], 0.6f, 0.12f, "cut scene across the cut").cut);
+    EXPECT_TRUE(check(scene_frames("fence")[1], scene_frames("shadows")[1], 0.6f, 0.12f,
+                      "fence after shadows")
+                    .cut);
+    std::printf("shot changes: %zu cuts, %zu kept, decided alike\n", cuts, kept);
+    EXPECT_GT(cuts, 10u);
+    EXPECT_GT(kept, 10u);
+
+    // On textures: the same counts, sum and decision.
+    const std::vector<Frame>& frames = scene_frames("crossing");
+    warp::ShotChange images, textures;
+    ASSERT_TRUE(context.shot_change(frames[1], frames[0], 0.6f, 0.12f, images).ok());
+    context.make_current();
+    Textures t;
+    const gpu::GBufferTextures a = t.gbuffer(frames[0]), b = t.gbuffer(frames[1]);
+    const Status status =
+        context.shot_change(b, t.color(frames[1]), a, t.color(frames[0]), 0.6f, 0.12f, textures);
+    ASSERT_TRUE(status.ok()) << status.message();
+    EXPECT_EQ(textures.counts, images.counts);
+    EXPECT_EQ(textures.difference, images.difference);
+    EXPECT_GT(textures.difference, 0u);
+    EXPECT_EQ(context.timings().upload_ms, 0.0);
+    gpu::GBufferTextures no_motion = b;
+    no_motion.motion = 0;
+    EXPECT_NE(context
+                  .shot_change(no_motion, t.color(frames[1]), a, t.color(frames[0]), 0.6f, 0.12f,
+                               textures)
+                  .message()
+                  .find("frame motion"),
               std::string::npos);
 }
 

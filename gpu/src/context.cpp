@@ -17,6 +17,7 @@ Status create_splat_programs(ContextState& state);
 Status create_stereo_programs(ContextState& state);
 Status create_interpolate_programs(ContextState& state);
 Status create_extrapolate_programs(ContextState& state);
+Status create_shot_change_program(ContextState& state);
 
 double finish_ms(std::chrono::steady_clock::time_point& since) {
     glFinish();
@@ -264,7 +265,10 @@ Context::~Context() {
                        &state_->history_warped,
                        &state_->history_warped_depth,
                        &state_->history_covered,
-                       &state_->merged})
+                       &state_->merged,
+                       &state_->display_table,
+                       &state_->shot_reprojected,
+                       &state_->shot_hit})
         glDeleteTextures(1, &t->name);
     for (Texture* t : state_->interpolation.all) glDeleteTextures(1, &t->name);
     for (auto* chain :
@@ -277,10 +281,10 @@ Context::~Context() {
           state_->blend_program,        state_->copy_program,          state_->static_layer_program,
           state_->merge_program,        state_->refetch_program,       state_->true_motion_program,
           state_->survey_program,       state_->invert_programs[0],    state_->invert_programs[1],
-          state_->invert_programs[2],   state_->invert_programs[3]})
+          state_->invert_programs[2],   state_->invert_programs[3],    state_->shot_change_program})
         glDeleteProgram(program);
     for (GLuint buffer : {state_->blend_counts, state_->extrapolate_counts, state_->eye_counts,
-                          state_->invert_buffer})
+                          state_->invert_buffer, state_->shot_change_counts})
         glDeleteBuffers(1, &buffer);
     glDeleteBuffers(1, &state_->splat_counts);
     glDeleteBuffers(1, &state_->splat_lists);
@@ -340,6 +344,7 @@ Status Context::create_on(std::unique_ptr<gl::Context> gl, std::unique_ptr<Conte
     glGenSamplers(1, &s.nearest_sampler);
     glSamplerParameteri(s.nearest_sampler, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     glSamplerParameteri(s.nearest_sampler, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+    REPRISE_TRY(create_shot_change_program(s));  // uploads its table: after the unpack buffer
     REPRISE_TRY(gl::check_errors("gpu context"));
     context = std::move(made);
     return {};

@@ -108,7 +108,8 @@ void main() {
 
 using Clock = std::chrono::steady_clock;
 
-// Binds the inputs and runs the shader over `width` x `height`; returns the counts.
+}  // namespace
+
 Status reproject_pass(ContextState& s, GLuint depth, GLuint motion, GLuint id,
                       GLuint previous_depth, GLuint previous_id, GLuint payload, GLuint out,
                       GLuint hit, int width, int height, int previous_width, int previous_height,
@@ -147,8 +148,6 @@ Status reproject_pass(ContextState& s, GLuint depth, GLuint motion, GLuint id,
               .invalid = n[5]};
     return {};
 }
-
-}  // namespace
 
 Status create_programs(ContextState& state) {
     return gl::link_compute((std::string(kComputeHeader) + kReprojectShader).c_str(),

@@ -150,6 +150,13 @@ struct SplatTextures {
     int width = 0, height = 0;
 };
 
+// warp::reproject over the looked-up pixels (every step-th of every step-th row) of `width` x
+// `height`: binds the inputs, runs the shader, returns the counts.
+Status reproject_pass(ContextState& s, GLuint depth, GLuint motion, GLuint id,
+                      GLuint previous_depth, GLuint previous_id, GLuint payload, GLuint out,
+                      GLuint hit, int width, int height, int previous_width, int previous_height,
+                      const warp::ReprojectSetup& k, int step, warp::ReprojectCounts& counts);
+
 // The passes of each path over textures, shared by its CPU-image and texture entry points.
 Status fill_passes(ContextState& s, GLuint color, GLuint valid, GLuint depth, int w, int h,
                    GLuint out, warp::FillStats& stats);
@@ -235,6 +242,10 @@ struct ContextState {
     // True motion: each side's, and b's moving pixels inverted (stages of kInvert).
     GLuint true_motion_program = 0, invert_programs[4] = {0, 0, 0, 0}, invert_buffer = 0;
     GLuint survey_program = 0;  // gathers the pixels warp's linearity survey looks at
+    // The shot-change test: each hit's display difference summed (64 bits as two words), the
+    // display table, the survey's reprojected colour and hits.
+    GLuint shot_change_program = 0, shot_change_counts = 0;
+    Texture display_table, shot_reprojected, shot_hit;
     std::size_t invert_bytes = 0;
     Interpolation interpolation;
     Texture displacement, target_depth, eye_color;

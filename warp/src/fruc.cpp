@@ -11,6 +11,7 @@
 #include "reprise/core/memory_limit.hpp"
 #include "reprise/core/metrics.hpp"
 #include "reprise/core/parallel.hpp"
+#include "reprise/warp/shot_change.hpp"
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -52,27 +53,6 @@ private:
     }
     std::vector<Frame> slots_;
     std::size_t head_ = 0, count_ = 0;
-};
-
-constexpr int kCutStep = 4;  // the shot-change test looks at every 4th pixel of every 4th row
-
-// linear_to_srgb from a table with linear interpolation (within 4e-4 of it; exact on the linear
-// segment near 0): the shot-change test compares thousands of pixels against a 0.12 threshold.
-class DisplayTable {
-public:
-    DisplayTable() {
-        for (int i = 0; i <= kSize; ++i) values_[i] = linear_to_srgb(float(i) / kSize);
-    }
-    float operator()(float linear) const {
-        const float c = linear >= 0.0f ? std::min(linear, 1.0f) * kSize : 0.0f;  // NaN -> 0
-        const int i = std::min(int(c), kSize - 1);
-        const float t = c - float(i);
-        return values_[i] + (values_[i + 1] - values_[i]) * t;
-    }
-
-private:
-    static constexpr int kSize = 1024;
-    float values_[kSize + 1];
 };
 
 template <class T>
@@ -184,46 +164,10 @@ struct FrameRateConverter::State {
     }
 
     // Most of the new frame has no counterpart in the old one, or what does differs in colour.
-    // Surveyed on every 4th pixel of every 4th row.
     bool is_cut(const Frame& frame) {
-        const int w = frame.width(), h = frame.height();
-        if (frame.depth.empty() || frame.motion.empty() || previous.depth.empty()) return false;
-        scratch.reprojected.resize(w, h);
-        scratch.valid.resize(w, h);
-        ReprojectCounts counts =
-            reproject(frame, previous, payload_of(std::as_const(previous.color).view()),
-                      payload_of(scratch.reprojected.view()), scratch.valid.view(),
-                      {.depth_tolerance = 0.05f, .step = kCutStep});
-        const double pixels =
-            double((w + kCutStep - 1) / kCutStep) * ((h + kCutStep - 1) / kCutStep);
-        const double lost =
-            double(counts.behind + counts.occluded + counts.other_id + counts.invalid);
-        if (lost > options.cut_misses * pixels) return true;
-        if (counts.hits == 0) return counts.offscreen > options.cut_misses * pixels;
-        // Mean display-colour difference over the hits.
-        static const DisplayTable display;
-        std::atomic<std::size_t> sampled{0};
-        std::atomic<long long> difference{0};  // in units of 2^-20, summed exactly in any order
-        const int rows = (h + kCutStep - 1) / kCutStep;
-        parallel_for(
-            0, rows,
-            [&](int r0, int r1) {
-                double local = 0.0;
-                std::size_t count = 0;
-                for (int y = r0 * kCutStep; y < std::min(r1 * kCutStep, h); y += kCutStep)
-                    for (int x = 0; x < w; x += kCutStep) {
-                        if (!scratch.valid(x, y)) continue;
-                        const glm::vec4 a = frame.color(x, y), b = scratch.reprojected(x, y);
-                        for (int k = 0; k < 3; ++k)
-                            local += std::abs(display(a[k]) - display(b[k]));
-                        ++count;
-                    }
-                difference += std::llround(local * 1048576.0);
-                sampled += count;
-            },
-            8);
-        if (sampled == 0) return false;
-        return double(difference) / 1048576.0 / (3.0 * double(sampled)) > options.cut_color;
+        return shot_change(frame, previous, options.cut_misses, options.cut_color,
+                           scratch.shot_change)
+            .cut;
     }
 
     // Stamps the camera and time of a made frame (its motion is already per output period).

@@ -5,6 +5,7 @@
 
 #include "reprise/core/gbuffer.hpp"
 #include "reprise/warp/fruc.hpp"
+#include "reprise/warp/shot_change.hpp"
 
 namespace reprise::warp {
 
@@ -66,7 +67,7 @@ struct FrucScratch {
     // Equal non-zero keys mean the same frame, widened once however many frames it makes;
     // 0 = not known, widened every time.
     uint64_t input_key[2] = {0, 0};
-    Image<glm::vec4> reprojected;
+    ShotChangeScratch shot_change;
     GridWarper grid;
     PullPush pull_push;
     AndreevInpaint andreev;

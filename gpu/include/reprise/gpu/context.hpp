@@ -15,6 +15,7 @@
 #include "reprise/warp/fill.hpp"
 #include "reprise/warp/fruc.hpp"
 #include "reprise/warp/reproject.hpp"
+#include "reprise/warp/shot_change.hpp"
 #include "reprise/warp/splat.hpp"
 
 namespace reprise::gl {
@@ -178,6 +179,17 @@ public:
                        const glm::mat4& projection, float periods, unsigned out_color,
                        unsigned out_depth, unsigned out_motion, ExtrapolateStats& stats,
                        const warp::FrucOptions& options, float motion_scale = 1.0f);
+
+    // warp::shot_change on the GPU: the survey's reprojection, then each hit's display difference
+    // (the CPU's table and arithmetic) summed exactly; the same counts, sum and decision as the
+    // CPU. Frames without depth or motion, or a previous frame without depth, are never a cut.
+    Status shot_change(const GBufferView& frame, const GBufferView& previous, float cut_misses,
+                       float cut_color, warp::ShotChange& result);
+    // The same on textures: each frame's colour (GL_RGBA32F) beside its G-buffer (ids where both
+    // have them).
+    Status shot_change(const GBufferTextures& frame, unsigned frame_color,
+                       const GBufferTextures& previous, unsigned previous_color, float cut_misses,
+                       float cut_color, warp::ShotChange& result);
 
 private:
     friend class Upsampler;  // its passes run on this context's state
