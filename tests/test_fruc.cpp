@@ -188,7 +188,7 @@ public:
         return {};
     }
     Status extrapolate(const GBufferView& f, const glm::mat4&, const glm::mat4&, float, float,
-                       const FrucOptions&, Frame& out, FrucCounters&) override {
+                       const FrucOptions&, Frame& out, FrucCounters&, uint64_t) override {
         if (calls++ == fail_at) return Status::error("flaky: the device went away");
         out.color.resize(f.color.width, f.color.height);
         for (int y = 0; y < f.color.height; ++y)

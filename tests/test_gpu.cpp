@@ -945,6 +945,43 @@ TEST(Gpu, ExtrapolationWithoutACameraAndOnNonFiniteInput) {
     EXPECT_GT(stats.holes, 0u);
 }
 
+// A frame extrapolated again under the same key is not uploaded again; the frame is the same.
+TEST(Gpu, ExtrapolationKeepsTheUploadOfTheSameFrameKey) {
+    NonfiniteCounts spoiled;
+    const std::vector<Frame> frames = test::spoiled_sequence(2, spoiled);
+    const Camera& to = frames[0].camera;
+    gpu::Context& context = shared_gpu();
+    Frame fresh, again, other;
+    gpu::ExtrapolateStats first, second, third;
+    ASSERT_TRUE(context
+                    .extrapolate(frames[1], to.view, to.projection, 0.5f, fresh, first,
+                                 kSplatExtrapolation, 1.0f, 41)
+                    .ok());
+    EXPECT_FALSE(first.upload_kept);
+    ASSERT_TRUE(context
+                    .extrapolate(frames[1], to.view, to.projection, 1.0f, again, second,
+                                 kSplatExtrapolation, 1.0f, 41)
+                    .ok());
+    EXPECT_TRUE(second.upload_kept);
+    EXPECT_EQ(second.nonfinite.total(), first.nonfinite.total());
+    EXPECT_GT(second.nonfinite.total(), 0u);
+    Frame keyless;
+    gpu::ExtrapolateStats keyless_stats;
+    ASSERT_TRUE(context
+                    .extrapolate(frames[1], to.view, to.projection, 1.0f, keyless, keyless_stats,
+                                 kSplatExtrapolation)
+                    .ok());
+    EXPECT_FALSE(keyless_stats.upload_kept);
+    EXPECT_EQ(test::display_psnr(again.color, keyless.color), INFINITY);
+    EXPECT_EQ(differences(again, keyless).motion, 0.0f);
+    // A keyless call in between replaced the upload: key 41 is uploaded again.
+    ASSERT_TRUE(context
+                    .extrapolate(frames[1], to.view, to.projection, 1.0f, other, third,
+                                 kSplatExtrapolation, 1.0f, 41)
+                    .ok());
+    EXPECT_FALSE(third.upload_kept);
+}
+
 // The converter extrapolating at factor 3 through a cut: the CPU's frames, made on the GPU.
 TEST(Gpu, TheExtrapolatingConverterWithTheGpuBackendMakesTheCpusFrames) {
     std::vector<Frame> frames = test::render_scene("crossing", 3, kWidth, kHeight, 30.0, 3);
@@ -965,7 +1002,8 @@ TEST(Gpu, TheExtrapolatingConverterWithTheGpuBackendMakesTheCpusFrames) {
         EXPECT_LE(differences(cpu[i], gpu[i]).motion, 1e-4f);
         EXPECT_EQ(gpu[i].camera.view, cpu[i].camera.view);
     }
-    EXPECT_EQ(backend.frames(), 4u);  // the cut's two are copies
+    EXPECT_EQ(backend.frames(), 4u);        // the cut's two are copies
+    EXPECT_EQ(backend.uploads_kept(), 2u);  // each input's second frame warps its first upload
     EXPECT_EQ(gpu_counters.hole_pixels, cpu_counters.hole_pixels);
     EXPECT_EQ(gpu_counters.dynamic_layers, cpu_counters.dynamic_layers);
     EXPECT_EQ(gpu_counters.fills, cpu_counters.fills);

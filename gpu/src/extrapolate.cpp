@@ -121,34 +121,44 @@ Status extrapolate_passes(ContextState& s, const SplatTextures& frame, const Cam
 Status Context::extrapolate(const GBufferView& given, const glm::mat4& view,
                             const glm::mat4& projection, float periods, Frame& out,
                             ExtrapolateStats& stats, const warp::FrucOptions& options,
-                            float motion_scale) {
+                            float motion_scale, uint64_t frame_key) {
     timings_ = {};
     stats = {};
     REPRISE_TRY(check_options(options));
     REPRISE_TRY(check_periods(periods));
     ContextState& s = *state_;
-    const GBufferView frame = s.extrapolate_repair.clean(given, stats.nonfinite);
-    const int w = frame.width(), h = frame.height();
-    if (frame.depth.width != w || frame.depth.height != h || frame.motion.width != w ||
-        frame.motion.height != h)
+    const int w = given.width(), h = given.height();
+    if (given.depth.width != w || given.depth.height != h || given.motion.width != w ||
+        given.motion.height != h)
         return Status::error("gpu extrapolate: the frame needs depth and motion of its size");
     out.normal.clear();
     out.id.clear();
     if (w <= 0 || h <= 0) return {};
     REPRISE_TRY(s.gl->acquire());
     auto t = std::chrono::steady_clock::now();
-    s.source_color.ensure(GL_RGBA32F, w, h);
-    s.source_depth.ensure(GL_R32F, w, h);
-    s.source_motion.ensure(GL_RG32F, w, h);
-    s.upload(s.source_color, frame.color.data, frame.color.stride);
-    s.upload(s.source_depth, frame.depth.data, frame.depth.stride);
-    s.upload(s.source_motion, frame.motion.data, frame.motion.stride);
+    // The same frame as the last call's: its repaired pixels are uploaded already.
+    const bool kept = frame_key != 0 && frame_key == s.extrapolate_key &&
+                      s.source_color.width == w && s.source_color.height == h;
+    if (kept) {
+        stats.nonfinite = s.extrapolate_nonfinite;
+        stats.upload_kept = true;
+    } else {
+        const GBufferView frame = s.extrapolate_repair.clean(given, stats.nonfinite);
+        s.source_color.ensure(GL_RGBA32F, w, h);
+        s.source_depth.ensure(GL_R32F, w, h);
+        s.source_motion.ensure(GL_RG32F, w, h);
+        s.upload(s.source_color, frame.color.data, frame.color.stride);
+        s.upload(s.source_depth, frame.depth.data, frame.depth.stride);
+        s.upload(s.source_motion, frame.motion.data, frame.motion.stride);
+        s.extrapolate_key = frame_key;
+        s.extrapolate_nonfinite = stats.nonfinite;
+    }
     s.color.ensure(GL_RGBA32F, w, h);
     s.depth.ensure(GL_R32F, w, h);
     s.made_motion.ensure(GL_RGBA32F, w, h);
     timings_.upload_ms = finish_ms(t);
     REPRISE_TRY(extrapolate_passes(
-        s, {s.source_color.name, s.source_depth.name, s.source_motion.name, w, h}, frame.camera,
+        s, {s.source_color.name, s.source_depth.name, s.source_motion.name, w, h}, given.camera,
         view, projection, periods, motion_scale, options, s.color.name, s.depth.name,
         s.made_motion.name, stats));
     timings_.compute_ms = finish_ms(t);

@@ -48,10 +48,11 @@ Status FrucBackend::interpolate(const GBufferView& a, const GBufferView& b, floa
 Status FrucBackend::extrapolate(const GBufferView& f, const glm::mat4& view,
                                 const glm::mat4& projection, float periods, float motion_scale,
                                 const warp::FrucOptions& options, Frame& out,
-                                warp::FrucCounters& counters) {
+                                warp::FrucCounters& counters, uint64_t frame_key) {
     ExtrapolateStats stats;
-    REPRISE_TRY(
-        context_.extrapolate(f, view, projection, periods, out, stats, options, motion_scale));
+    REPRISE_TRY(context_.extrapolate(f, view, projection, periods, out, stats, options,
+                                     motion_scale, frame_key));
+    uploads_kept_ += stats.upload_kept;
     if (has_projection(f.camera))
         ++(stats.moving ? counters.dynamic_layers : counters.dynamic_skipped);
     count(stats.holes, stats.holes > 0 && options.fill != warp::FillMethod::None, counters);

@@ -261,6 +261,8 @@ struct ContextState {
     GLuint static_layer_program = 0, extrapolate_counts = 0;
     NonfiniteRepair extrapolate_repair;
     Texture source_color, source_depth, source_motion, made_motion;
+    uint64_t extrapolate_key = 0;  // the frame key of what the source textures hold (0: none)
+    NonfiniteCounts extrapolate_nonfinite;  // ... and what its repair found
 
     // Counters live in GPU memory (a buffer hinted for reading may be placed in the host's, where
     // every shader atomic crosses the bus: reprojection took 39-90 ms at 1920x1080 on an H200,

@@ -183,7 +183,7 @@ Status extrapolate_to_camera(const GBufferView& given, const glm::mat4& future_v
     if (options.backend)
         return options.backend->extrapolate(warp_input(given, 0, options, scratch, counters),
                                             future_view, future_projection, s, motion_scale,
-                                            options, out, counters);
+                                            options, out, counters, scratch.input_key[0]);
     if (!has_projection(given.camera)) {
         extrapolate_along_motion(given, s, motion_scale, options, scratch, out, counters);
         return {};

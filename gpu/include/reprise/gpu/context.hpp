@@ -59,6 +59,7 @@ struct ExtrapolateStats {
     std::size_t moving = 0, covered = 0, holes = 0;
     warp::FillStats fill;
     NonfiniteCounts nonfinite;
+    bool upload_kept = false;  // the frame key matched: the last call's upload was reused
 };
 
 // How Context::interpolate makes the in-between frame (FrucOptions' fields of the same names).
@@ -169,9 +170,12 @@ public:
     // 0); out.normal and id cleared, out.camera untouched. NaN/Inf are repaired first, as the
     // converter does (PoseExtrapolator does not: on such input the GPU makes the CPU's frame of
     // the repaired input); the silhouettes are warped as they are (the CPU widens them first).
+    // A non-zero `frame_key` equal to the last call's reuses that call's upload (and its repair
+    // counts): the caller promises the same frame, pixels unchanged.
     Status extrapolate(const GBufferView& frame, const glm::mat4& view, const glm::mat4& projection,
                        float periods, Frame& out, ExtrapolateStats& stats,
-                       const warp::FrucOptions& options, float motion_scale = 1.0f);
+                       const warp::FrucOptions& options, float motion_scale = 1.0f,
+                       uint64_t frame_key = 0);
     // The same on textures: `color` GL_RGBA32F beside frame's depth and motion; `out_color`
     // (GL_RGBA32F), `out_depth` (GL_R32F) and `out_motion` (GL_RGBA32F with the motion in RG, as
     // GL ES has no RG32F image format; 0: not written), all of the frame's size. No repair.

@@ -27,11 +27,13 @@ public:
                        warp::FrucCounters& counters) override;
     Status extrapolate(const GBufferView& f, const glm::mat4& view, const glm::mat4& projection,
                        float periods, float motion_scale, const warp::FrucOptions& options,
-                       Frame& out, warp::FrucCounters& counters) override;
+                       Frame& out, warp::FrucCounters& counters, uint64_t frame_key) override;
 
     // The phases of every frame made so far (interpolated or extrapolated), summed, and how many.
     const Timings& total() const { return total_; }
     std::size_t frames() const { return frames_; }
+    // Extrapolated frames made from the frame already uploaded for the previous one (same key).
+    std::size_t uploads_kept() const { return uploads_kept_; }
 
 private:
     // Adds the last call's timings and what its frame took.
@@ -39,7 +41,7 @@ private:
     Context& context_;
     warp::SplatOptions splat_;
     Timings total_;
-    std::size_t frames_ = 0;
+    std::size_t frames_ = 0, uploads_kept_ = 0;
 };
 
 }  // namespace reprise::gpu

@@ -107,10 +107,14 @@ public:
     // What the CPU's extrapolation makes: f as seen by (view, projection) `periods` frame
     // periods after it (without a projection on f: along its motion alone), colour, depth and
     // backward motion per period times motion_scale. A backend may repair NaN/Inf in f first
-    // (gpu::FrucBackend does; the converter's inputs are repaired already).
+    // (gpu::FrucBackend does; the converter's inputs are repaired already). A non-zero
+    // `frame_key` equal to the previous call's says f is that frame again, pixels unchanged (a
+    // display loop extrapolates one decoded frame many times): a backend may keep what it made
+    // of it (gpu::FrucBackend keeps it uploaded).
     virtual Status extrapolate(const GBufferView& f, const glm::mat4& view,
                                const glm::mat4& projection, float periods, float motion_scale,
-                               const FrucOptions& options, Frame& out, FrucCounters& counters) = 0;
+                               const FrucOptions& options, Frame& out, FrucCounters& counters,
+                               uint64_t frame_key) = 0;
 };
 
 struct FrucOptions {
