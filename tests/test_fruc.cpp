@@ -180,7 +180,7 @@ public:
         return o.warp == WarpMethod::Splat ? Status{} : Status::error("flaky: splat only");
     }
     Status interpolate(const GBufferView&, const GBufferView& b, float, float, const FrucOptions&,
-                       Frame& out, FrucCounters&) override {
+                       Frame& out, FrucCounters&, uint64_t, uint64_t) override {
         if (calls++ == fail_at) return Status::error("flaky: the device went away");
         out.color.resize(b.color.width, b.color.height);
         for (int y = 0; y < b.color.height; ++y)

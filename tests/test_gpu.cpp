@@ -746,6 +746,9 @@ TEST(Gpu, TheConverterWithTheGpuBackendMakesTheCpusFrames) {
         EXPECT_EQ(gpu[i].camera.view, cpu[i].camera.view);
     }
     EXPECT_EQ(backend.frames(), 6u);  // the pairs 0-1 and 1-2, and the cut's two extrapolated
+    // Inputs uploaded once: a pair's second frame keeps both (2 + 2), pair 1-2 takes 1 from 0-1's
+    // b (1), the cut's second extrapolated frame keeps the first's upload (1).
+    EXPECT_EQ(backend.uploads_kept(), 6u);
     EXPECT_LE(differences(cpu[1], gpu[1]).motion_pixels,
               cpu[1].motion.pixel_count() / 1000);  // per output period, as the CPU's
     EXPECT_EQ(gpu_counters.cuts, 1u);

@@ -304,10 +304,12 @@ Status run_connect(const ConnectJob& job) {
     if (backend && backend->frames() > 0) {
         const double n = double(backend->frames());
         std::fprintf(stderr,
-                     "[connect] %zu frames extrapolated on the GPU (%s): upload %.2f, compute "
-                     "%.2f, download %.2f ms a frame\n",
-                     backend->frames(), gpu->description().c_str(), backend->total().upload_ms / n,
-                     backend->total().compute_ms / n, backend->total().download_ms / n);
+                     "[connect] %zu frames extrapolated on the GPU (%s; %zu from the frame "
+                     "uploaded for the one before): upload %.2f, compute %.2f, download %.2f ms a "
+                     "frame\n",
+                     backend->frames(), gpu->description().c_str(), backend->uploads_kept(),
+                     backend->total().upload_ms / n, backend->total().compute_ms / n,
+                     backend->total().download_ms / n);
     }
     if (upsampler && upsampler->frames() > 0) {
         const double n = double(upsampler->frames());

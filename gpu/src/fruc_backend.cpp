@@ -31,14 +31,16 @@ Status FrucBackend::check(const warp::FrucOptions& o, const warp::SplatOptions& 
 
 Status FrucBackend::interpolate(const GBufferView& a, const GBufferView& b, float s,
                                 float motion_scale, const warp::FrucOptions& options, Frame& out,
-                                warp::FrucCounters& counters) {
+                                warp::FrucCounters& counters, uint64_t a_key, uint64_t b_key) {
     InterpolateStats stats;
     REPRISE_TRY(context_.interpolate(a, b, s, out, stats,
                                      {.splat = splat_,
                                       .reverse = options.warp == warp::WarpMethod::Reverse,
                                       .true_motion = options.true_motion,
                                       .static_tolerance = options.static_tolerance,
-                                      .motion_scale = motion_scale}));
+                                      .motion_scale = motion_scale},
+                                     a_key, b_key));
+    uploads_kept_ += stats.uploads_kept;
     counters.true_motion += stats.true_motion;
     counters.linear_motion += stats.linear_motion;
     count(stats.holes, stats.holes > 0, counters);

@@ -389,8 +389,8 @@ Status plan_true_motion(const Camera& a, const Camera& b, float s_between, int w
 }  // namespace
 
 Status Context::interpolate(const GBufferView& given_a, const GBufferView& given_b, float s_between,
-                            Frame& out, InterpolateStats& stats,
-                            const InterpolateOptions& options) {
+                            Frame& out, InterpolateStats& stats, const InterpolateOptions& options,
+                            uint64_t a_key, uint64_t b_key) {
     timings_ = {};
     stats = {};
     ContextState& s = *state_;
@@ -422,22 +422,33 @@ Status Context::interpolate(const GBufferView& given_a, const GBufferView& given
             plan, stats));
     REPRISE_TRY(s.gl->acquire());
     auto t = std::chrono::steady_clock::now();
+    // The last pair's b as this pair's a: its textures change sides instead of uploading again.
+    if (a_key != 0 && a_key == k.key[1] && a_key != k.key[0] && b_key != k.key[1]) {
+        std::swap(k.a_color, k.b_color);
+        std::swap(k.a_depth, k.b_depth);
+        std::swap(k.a_motion, k.b_motion);
+        std::swap(k.key[0], k.key[1]);
+    }
     Texture* textures[6] = {&k.a_color, &k.a_depth, &k.a_motion,
                             &k.b_color, &k.b_depth, &k.b_motion};
     const GBufferView* frames[2] = {&a, &b};
+    const uint64_t keys[2] = {a_key, b_key};
     for (int f = 0; f < 2; ++f) {
+        const bool kept = keys[f] != 0 && keys[f] == k.key[f] && textures[3 * f]->width == w &&
+                          textures[3 * f]->height == h;
+        stats.uploads_kept += kept;
+        if (kept) continue;
         textures[3 * f]->ensure(GL_RGBA32F, w, h);
         textures[3 * f + 1]->ensure(GL_R32F, w, h);
         textures[3 * f + 2]->ensure(GL_RG32F, w, h);
+        s.upload(*textures[3 * f], frames[f]->color.data, frames[f]->color.stride);
+        s.upload(*textures[3 * f + 1], frames[f]->depth.data, frames[f]->depth.stride);
+        s.upload(*textures[3 * f + 2], frames[f]->motion.data, frames[f]->motion.stride);
+        k.key[f] = keys[f];
     }
     s.color.ensure(GL_RGBA32F, w, h);
     s.depth.ensure(GL_R32F, w, h);
     k.made_motion.ensure(GL_RGBA32F, w, h);
-    for (int f = 0; f < 2; ++f) {
-        s.upload(*textures[3 * f], frames[f]->color.data, frames[f]->color.stride);
-        s.upload(*textures[3 * f + 1], frames[f]->depth.data, frames[f]->depth.stride);
-        s.upload(*textures[3 * f + 2], frames[f]->motion.data, frames[f]->motion.stride);
-    }
     timings_.upload_ms = finish_ms(t);
     REPRISE_TRY(interpolate_passes(s, {k.a_color.name, k.a_depth.name, k.a_motion.name, w, h},
                                    {k.b_color.name, k.b_depth.name, k.b_motion.name, w, h},

@@ -202,6 +202,7 @@ struct Interpolation {
         survey;
     NonfiniteRepair repair_a, repair_b;  // each keeps its repaired copy until the next call
     Image<glm::vec4> survey_samples;     // the linearity survey's samples, read back
+    uint64_t key[2] = {0, 0};            // the frame keys a's and b's textures hold (0: none)
     Texture* all[21] = {&a_color,        &a_depth,       &a_motion,     &b_color,
                         &b_depth,        &b_motion,      &side_a_color, &side_a_depth,
                         &side_a_covered, &side_a_motion, &side_b_color, &side_b_depth,

@@ -50,6 +50,7 @@ struct InterpolateStats {
     bool linear_motion = false;  // ... had it been asked for, but a survey found it linear
     warp::FillStats fill;
     NonfiniteCounts nonfinite;
+    int uploads_kept = 0;  // inputs whose key matched: an earlier call's upload reused (0-2)
 };
 
 // What an extrapolated frame took: pixels its camera does not explain (carried along their own
@@ -149,9 +150,11 @@ public:
     // carried (b's where both are blended) times motion_scale, as the CPU's (normal and id
     // cleared; out.camera is b's).
     // NaN/Inf in a and b are repaired first, as the CPU converter does; the texture entry does
-    // not repair.
+    // not repair. Non-zero keys equal to the last call's a or b key reuse that input's upload
+    // (b's becoming a's when the next pair starts): the caller promises the same frame.
     Status interpolate(const GBufferView& a, const GBufferView& b, float s, Frame& out,
-                       InterpolateStats& stats, const InterpolateOptions& options = {});
+                       InterpolateStats& stats, const InterpolateOptions& options = {},
+                       uint64_t a_key = 0, uint64_t b_key = 0);
     // The same on textures: colour GL_RGBA32F, depth GL_R32F, motion GL_RG32F, all one size;
     // `out_color` and `out_depth` written, and `out_motion` (GL_RGBA32F, the motion in RG; 0:
     // not written).

@@ -23,8 +23,8 @@ public:
     }
     // Colour, depth and motion, as the CPU's.
     Status interpolate(const GBufferView& a, const GBufferView& b, float s, float motion_scale,
-                       const warp::FrucOptions& options, Frame& out,
-                       warp::FrucCounters& counters) override;
+                       const warp::FrucOptions& options, Frame& out, warp::FrucCounters& counters,
+                       uint64_t a_key, uint64_t b_key) override;
     Status extrapolate(const GBufferView& f, const glm::mat4& view, const glm::mat4& projection,
                        float periods, float motion_scale, const warp::FrucOptions& options,
                        Frame& out, warp::FrucCounters& counters, uint64_t frame_key) override;
@@ -32,7 +32,8 @@ public:
     // The phases of every frame made so far (interpolated or extrapolated), summed, and how many.
     const Timings& total() const { return total_; }
     std::size_t frames() const { return frames_; }
-    // Extrapolated frames made from the frame already uploaded for the previous one (same key).
+    // Frames made from inputs already uploaded for an earlier frame (same key), counted per input:
+    // an extrapolated frame adds up to 1, an in-between frame up to 2.
     std::size_t uploads_kept() const { return uploads_kept_; }
 
 private:

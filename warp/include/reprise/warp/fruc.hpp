@@ -100,10 +100,13 @@ public:
     // The options the backend makes the same frames for as the CPU; an error says why not.
     virtual Status supports(const FrucOptions& options) const = 0;
     // What interpolate_frame makes with both sides warpable: the frame at s between a and b,
-    // colour, depth and motion times motion_scale (its motion may stay empty).
+    // colour, depth and motion times motion_scale (its motion may stay empty). Non-zero keys,
+    // the same for the same frame, say which frames a and b are (the converter's input keys: a
+    // pair gives several frames at x3 and more, and b becomes the next pair's a): a backend may
+    // keep what it made of them (gpu::FrucBackend keeps them uploaded).
     virtual Status interpolate(const GBufferView& a, const GBufferView& b, float s,
                                float motion_scale, const FrucOptions& options, Frame& out,
-                               FrucCounters& counters) = 0;
+                               FrucCounters& counters, uint64_t a_key, uint64_t b_key) = 0;
     // What the CPU's extrapolation makes: f as seen by (view, projection) `periods` frame
     // periods after it (without a projection on f: along its motion alone), colour, depth and
     // backward motion per period times motion_scale. A backend may repair NaN/Inf in f first
