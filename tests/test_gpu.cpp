@@ -1320,6 +1320,12 @@ TEST(Gpu, ShotChangeDecidesAsTheCpu) {
     EXPECT_TRUE(check(scene_frames("fence")[1], scene_frames("shadows")[1], 0.6f, 0.12f,
                       "fence after shadows")
                     .cut);
+    // NaN/Inf in colour, depth and motion (the entry does not repair): alike too.
+    NonfiniteCounts spoiled;
+    const std::vector<Frame> nonfinite = test::spoiled_sequence(2, spoiled);
+    const warp::ShotChange spoiled_change =
+        check(nonfinite[1], nonfinite[0], 0.6f, 0.12f, "NaN/Inf input");
+    EXPECT_GT(spoiled_change.counts.invalid, 0u);
     std::printf("shot changes: %zu cuts, %zu kept, decided alike\n", cuts, kept);
     EXPECT_GT(cuts, 10u);
     EXPECT_GT(kept, 10u);

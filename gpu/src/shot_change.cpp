@@ -20,7 +20,9 @@ uniform ivec2 count;  // looked-up pixels across and down
 shared uint group_sum[64];
 
 highp float display(highp float linear) {
-    PRECISE highp float c = linear >= 0.0 ? min(linear, 1.0) * float(TABLE_SIZE) : 0.0;
+    // NaN and negatives to 0, as on the CPU (NaN tested on bits: a compiler may assume none).
+    bool nan = (floatBitsToUint(linear) & 0x7fffffffu) > 0x7f800000u;
+    PRECISE highp float c = !nan && linear >= 0.0 ? min(linear, 1.0) * float(TABLE_SIZE) : 0.0;
     int i = min(int(c), TABLE_SIZE - 1);
     PRECISE highp float t = c - float(i);
     highp float v0 = texelFetch(display_table, ivec2(i, 0), 0).r;
@@ -118,10 +120,12 @@ Status Context::shot_change(const GBufferView& frame, const GBufferView& previou
     REPRISE_ASSERT(frame.depth.width == w && frame.depth.height == h && frame.motion.width == w &&
                    frame.motion.height == h);
     REPRISE_ASSERT(previous.depth.width == pw && previous.depth.height == ph);
+    const bool ids = !frame.id.empty() && !previous.id.empty();
+    REPRISE_ASSERT(!ids || (frame.id.width == w && frame.id.height == h &&
+                            previous.id.width == pw && previous.id.height == ph));
     ContextState& s = *state_;
     REPRISE_TRY(s.gl->acquire());
     auto t = std::chrono::steady_clock::now();
-    const bool ids = !frame.id.empty() && !previous.id.empty();
     s.color.ensure(GL_RGBA32F, w, h);
     s.depth.ensure(GL_R32F, w, h);
     s.motion.ensure(GL_RG32F, w, h);

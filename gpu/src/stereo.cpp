@@ -360,6 +360,9 @@ Status Context::stereo_eye(const GBufferTextures& rendered, unsigned color, cons
     }
     if (out_color == color || (history && out_color == history_color))
         return Status::error("gpu stereo eye: the output is the rendered or the history colour");
+    if (out_depth == rendered.depth || (history && out_depth == history->depth))
+        return Status::error(
+            "gpu stereo eye: the output depth is the rendered or the history depth");
     auto t = std::chrono::steady_clock::now();
     REPRISE_TRY(eye_passes(s, color, rendered.depth, w, h, rendered.camera, target, options,
                            out_color, out_depth, stats, history ? &textures : nullptr));

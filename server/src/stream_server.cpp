@@ -453,12 +453,13 @@ struct StreamServer::State {
     void adapt(Session& session, const net::ReceiverReportMessage& m, int64_t now) {
         Session::Net& s = session.net;
         // `missing` (newest heard minus received) falls when a reordered datagram arrives late:
-        // only an older `received` marks a stale report, and missing counts from its highest.
+        // only an older `received` marks a stale report, and only a rise of missing counts (a
+        // late datagram counted once while it was out may count again, a real loss never hides).
         if (m.received < s.report_received) return;
         const uint32_t received = m.received - s.report_received,
                        missing = m.missing > s.report_missing ? m.missing - s.report_missing : 0;
         s.report_received = m.received;
-        s.report_missing = std::max(s.report_missing, m.missing);
+        s.report_missing = m.missing;
         if (missing > 0) s.parity_until_us = now + detail::kParityAfterLossUs;
         {
             std::lock_guard lock(session.mutex);

@@ -122,8 +122,8 @@ struct FrameRateConverter::State {
     FrucScratch scratch;
     Frame previous;  // colour, depth, motion and ids of the last input (no normals)
     bool has_previous = false;
-    bool previous_starts_shot = false;        // its motion reaches back into another shot: unusable
-    uint64_t next_key = 0, previous_key = 0;  // each input's key (FrucScratch::input_key)
+    bool previous_starts_shot = false;  // its motion reaches back into another shot: unusable
+    uint64_t previous_key = 0;          // the last input's key (FrucScratch::input_key)
     FrameQueue ready;
     FrucOptions chosen;  // `options` with an auto warp or fill resolved for one frame
     NonfiniteRepair nonfinite;
@@ -341,7 +341,7 @@ Status FrameRateConverter::send_frame(const Frame& given, Frame* owned) {
     st.counters.cuts += cut;
     const int k_max = st.factor;
 
-    const uint64_t key = ++st.next_key;
+    const uint64_t key = next_frame_key();
     if (st.options.mode == FrucMode::Interpolate)
         st.scratch.input_key[0] = st.previous_key, st.scratch.input_key[1] = key;
     else

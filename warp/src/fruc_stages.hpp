@@ -65,7 +65,8 @@ struct FrucScratch {
     uint64_t wide_key[2] = {0, 0};  // the input each holds
     // Set before a stage: which input is in slot 0 (a, or the one extrapolated) and slot 1 (b).
     // Equal non-zero keys mean the same frame, widened once however many frames it makes;
-    // 0 = not known, widened every time.
+    // 0 = not known, widened every time. Keys are unique in the process (next_frame_key): a
+    // backend shared by several converters or extrapolators keeps their uploads apart.
     uint64_t input_key[2] = {0, 0};
     ShotChangeScratch shot_change;
     GridWarper grid;
@@ -81,6 +82,9 @@ std::size_t warp_into(const GBufferView& source, float factor, const FrucOptions
                       FrucScratch& scratch, const WarpTarget& out, FrucCounters& counters);
 
 // `f` with its silhouettes widened into scratch slot `slot` (0 or 1) when options ask for it.
+// A frame key no other frame of this process has had (never 0).
+uint64_t next_frame_key();
+
 GBufferView warp_input(const GBufferView& f, int slot, const FrucOptions& options,
                        FrucScratch& scratch, FrucCounters& counters);
 

@@ -95,6 +95,11 @@ std::size_t warp_into(const GBufferView& source, float factor, const FrucOptions
     return 0;
 }
 
+uint64_t next_frame_key() {
+    static std::atomic<uint64_t> last{0};
+    return ++last;
+}
+
 GBufferView warp_input(const GBufferView& f, int slot, const FrucOptions& options,
                        FrucScratch& scratch, FrucCounters& counters) {
     if (!options.widen_silhouettes || f.depth.empty()) return f;

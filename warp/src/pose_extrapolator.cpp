@@ -7,6 +7,7 @@ struct PoseExtrapolator::State {
     FrucOptions options;
     FrucScratch scratch;
     FrucCounters counters;
+    uint64_t caller_key = 0, key = 0;  // the caller's last frame key and its unique one
 };
 
 PoseExtrapolator::PoseExtrapolator(const FrucOptions& options) : state_(std::make_unique<State>()) {
@@ -22,7 +23,13 @@ Status PoseExtrapolator::extrapolate(const GBufferView& frame, const glm::mat4& 
                                      uint64_t frame_key) {
     REPRISE_ASSERT(periods >= 0.0f);
     State& s = *state_;
-    s.scratch.input_key[0] = frame_key;
+    // The caller's keys are its own (a count of decoded frames): each new one becomes a key
+    // unique in the process, so that a backend shared with others keeps the frames apart.
+    if (frame_key != s.caller_key || frame_key == 0) {
+        s.caller_key = frame_key;
+        s.key = frame_key ? next_frame_key() : 0;
+    }
+    s.scratch.input_key[0] = s.key;
     const FrucCounters before = s.counters;
     const Status made = extrapolate_to_camera(frame, view, projection, periods, 1.0f, s.options,
                                               s.scratch, out, s.counters);

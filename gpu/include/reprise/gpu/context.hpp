@@ -193,7 +193,7 @@ public:
     Status shot_change(const GBufferView& frame, const GBufferView& previous, float cut_misses,
                        float cut_color, warp::ShotChange& result);
     // The same on textures: each frame's colour (GL_RGBA32F) beside its G-buffer (ids where both
-    // have them).
+    // have them); the frame's depth and motion and the previous depth are required here.
     Status shot_change(const GBufferTextures& frame, unsigned frame_color,
                        const GBufferTextures& previous, unsigned previous_color, float cut_misses,
                        float cut_color, warp::ShotChange& result);

@@ -79,8 +79,9 @@ struct LossReportMessage {
 };
 struct ReceiverReportMessage {
     uint32_t received = 0;  // media datagrams received since the session started
-    uint32_t missing = 0;   // media datagrams never received (after reordering settled)
-    uint32_t rtt_us = 0;    // newest measured pose round trip (pose sampled -> frame decoded)
+    uint32_t missing =
+        0;                // newest media sequence heard minus received: falls when a late one comes
+    uint32_t rtt_us = 0;  // newest measured pose round trip (pose sampled -> frame decoded)
 };
 constexpr std::size_t kTicketIdSize = 16, kTicketSecretSize = 32;
 struct TicketMessage {
