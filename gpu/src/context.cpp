@@ -195,6 +195,17 @@ Status check_texture(unsigned name, GLenum format, int w, int h, const char* wha
     return {};
 }
 
+void ContextState::upload_frame(const GBufferView& frame, Texture& color_texture,
+                                Texture& depth_texture, Texture& motion_texture) {
+    const int w = frame.width(), h = frame.height();
+    color_texture.ensure(GL_RGBA32F, w, h);
+    depth_texture.ensure(GL_R32F, w, h);
+    motion_texture.ensure(GL_RG32F, w, h);
+    upload(color_texture, frame.color.data, frame.color.stride);
+    upload(depth_texture, frame.depth.data, frame.depth.stride);
+    upload(motion_texture, frame.motion.data, frame.motion.stride);
+}
+
 void ContextState::download(const Texture& texture, void* data, std::ptrdiff_t stride) {
     // Shader image stores become visible to reads through a framebuffer only after this.
     glMemoryBarrier(GL_FRAMEBUFFER_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);

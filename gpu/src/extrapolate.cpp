@@ -144,12 +144,7 @@ Status Context::extrapolate(const GBufferView& given, const glm::mat4& view,
         stats.upload_kept = true;
     } else {
         const GBufferView frame = s.extrapolate_repair.clean(given, stats.nonfinite);
-        s.source_color.ensure(GL_RGBA32F, w, h);
-        s.source_depth.ensure(GL_R32F, w, h);
-        s.source_motion.ensure(GL_RG32F, w, h);
-        s.upload(s.source_color, frame.color.data, frame.color.stride);
-        s.upload(s.source_depth, frame.depth.data, frame.depth.stride);
-        s.upload(s.source_motion, frame.motion.data, frame.motion.stride);
+        s.upload_frame(frame, s.source_color, s.source_depth, s.source_motion);
         s.extrapolate_key = frame_key;
         s.extrapolate_nonfinite = stats.nonfinite;
     }

@@ -438,12 +438,7 @@ Status Context::interpolate(const GBufferView& given_a, const GBufferView& given
                           textures[3 * f]->height == h;
         stats.uploads_kept += kept;
         if (kept) continue;
-        textures[3 * f]->ensure(GL_RGBA32F, w, h);
-        textures[3 * f + 1]->ensure(GL_R32F, w, h);
-        textures[3 * f + 2]->ensure(GL_RG32F, w, h);
-        s.upload(*textures[3 * f], frames[f]->color.data, frames[f]->color.stride);
-        s.upload(*textures[3 * f + 1], frames[f]->depth.data, frames[f]->depth.stride);
-        s.upload(*textures[3 * f + 2], frames[f]->motion.data, frames[f]->motion.stride);
+        s.upload_frame(*frames[f], *textures[3 * f], *textures[3 * f + 1], *textures[3 * f + 2]);
         k.key[f] = keys[f];
     }
     s.color.ensure(GL_RGBA32F, w, h);

@@ -126,14 +126,9 @@ Status Context::shot_change(const GBufferView& frame, const GBufferView& previou
     ContextState& s = *state_;
     REPRISE_TRY(s.gl->acquire());
     auto t = std::chrono::steady_clock::now();
-    s.color.ensure(GL_RGBA32F, w, h);
-    s.depth.ensure(GL_R32F, w, h);
-    s.motion.ensure(GL_RG32F, w, h);
+    s.upload_frame(frame, s.color, s.depth, s.motion);
     s.payload.ensure(GL_RGBA32F, pw, ph);
     s.previous_depth.ensure(GL_R32F, pw, ph);
-    s.upload(s.color, frame.color.data, frame.color.stride);
-    s.upload(s.depth, frame.depth.data, frame.depth.stride);
-    s.upload(s.motion, frame.motion.data, frame.motion.stride);
     s.upload(s.payload, previous.color.data, previous.color.stride);
     s.upload(s.previous_depth, previous.depth.data, previous.depth.stride);
     if (ids) {

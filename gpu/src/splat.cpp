@@ -350,12 +350,7 @@ Status Context::splat(const GBufferView& source, float factor, const warp::WarpT
     ContextState& s = *state_;
     REPRISE_TRY(s.gl->acquire());
     auto t = std::chrono::steady_clock::now();
-    s.payload.ensure(GL_RGBA32F, sw, sh);
-    s.previous_depth.ensure(GL_R32F, sw, sh);
-    s.motion.ensure(GL_RG32F, sw, sh);
-    s.upload(s.payload, source.color.data, source.color.stride);
-    s.upload(s.previous_depth, source.depth.data, source.depth.stride);
-    s.upload(s.motion, source.motion.data, source.motion.stride);
+    s.upload_frame(source, s.payload, s.previous_depth, s.motion);
     timings_.upload_ms = finish_ms(t);
     s.out.ensure(GL_RGBA32F, tw, th);
     s.depth.ensure(GL_R32F, tw, th);

@@ -284,6 +284,9 @@ struct ContextState {
     void read_counters(GLuint buffer, void* counts, std::size_t bytes);
     // Uploads the texture's rows, `stride` pixels apart, into `texture` (already sized).
     void upload(const Texture& texture, const void* data, std::ptrdiff_t stride);
+    // A frame's colour, depth and motion into `color` (RGBA32F), `depth` (R32F) and `motion`
+    // (RG32F), sized to the frame.
+    void upload_frame(const GBufferView& frame, Texture& color, Texture& depth, Texture& motion);
     // Reads `texture` (GL_RGBA32F into floats, GL_R32UI into hit_readback) through the
     // framebuffer; `stride` in pixels for float targets.
     void download(const Texture& texture, void* data, std::ptrdiff_t stride);
