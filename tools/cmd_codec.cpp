@@ -89,13 +89,13 @@ void print_stats(const codec::StreamStats& s, double fps) {
     line("total", s.total_bits());
     std::printf(
         "  left out: %zu of %zu colour blocks skipped (%.1f %%), %zu depth blocks predicted "
-        "exactly, "
+        "exactly (%zu depth blocks by a plane), "
         "motion beyond the cameras' on %zu pixels (%zu rigid objects, %zu models, %zu pixels "
         "alone)\n",
         s.blocks_skipped, s.blocks,
         100.0 * double(s.blocks_skipped) / double(std::max<std::size_t>(1, s.blocks)),
-        s.depth_zero_blocks, s.motion_residual_pixels, s.motion_objects, s.motion_models,
-        s.motion_own_pixels);
+        s.depth_zero_blocks, s.depth_plane_blocks, s.motion_residual_pixels, s.motion_objects,
+        s.motion_models, s.motion_own_pixels);
     std::printf(
         "  %zu frames: %zu key, %zu predicted from an older reference, %zu intra macroblocks, "
         "%zu pixels the reference did not see predicted from the surface beside them\n",

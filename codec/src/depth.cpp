@@ -1,11 +1,12 @@
 // Depth: each pixel as a 32-bit code (the float's bits in an order-preserving map, the
-// quantised log2 depth, or 1/z in 32nds of the view step), predicted per 8x8 block either
-// from the reference depth forward-projected into this camera or spatially (median edge
-// detector), residuals context-coded (by edges, and by what the reprojection shows); in inter
-// frames a pixel the block's prediction misses may take the other one for a flag. Blocks
-// predicted exactly cost two flags. View mode sends the prediction itself wherever it is within
-// the bound and quantises residuals, so decoded depth keeps its error from frame to frame
-// instead of being rounded again each time.
+// quantised log2 depth, or 1/z in 32nds of the view step), predicted per 8x8 block from the
+// reference depth forward-projected into this camera, spatially (median edge detector) or, in
+// view mode, by a plane the block sends (offset and slopes); residuals context-coded (by edges,
+// and by what the reprojection shows). A pixel the block's prediction misses may take another
+// one for a flag (inter frames: the other of temporal and spatial; view-mode key frames: the
+// neighbour across an edge). Blocks predicted exactly cost two flags. View mode sends the
+// prediction itself wherever it is within the bound and quantises residuals, so decoded depth
+// keeps its error from frame to frame instead of being rounded again each time.
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -14,6 +15,7 @@
 
 #include "internal.hpp"
 #include "kernels.hpp"
+#include "least_squares.hpp"
 #include "slices.hpp"
 
 namespace reprise::codec {
@@ -113,15 +115,37 @@ inline int magnitude_class(uint32_t left, uint32_t top) {
     return s == 0 ? 0 : s <= 8 ? 1 : s <= 256 ? 2 : 3;
 }
 
-// Block flags: bit 0 temporal, bit 1 zero (no residuals).
-constexpr uint8_t kTemporalBlock = 1, kZeroBlock = 2;
+// Block flags: bit 0 temporal, bit 1 zero (no residuals), bit 2 plane (view mode).
+constexpr uint8_t kTemporalBlock = 1, kZeroBlock = 2, kPlaneBlock = 4;
+
+// A plane block's prediction (view mode): codes c at the block's centre, gx and gy codes per
+// pixel; the offset is sent in steps of kPlaneOffsetStep codes. The limits keep every sum in
+// 64 bits whatever a stream says; no plane of real codes comes near them.
+struct Plane {
+    int64_t c = 0, gx = 0, gy = 0;
+};
+constexpr int64_t kPlaneOffsetStep = 16;
+constexpr uint64_t kZeroFlags = 24;  // encoder: the estimated bits of a block's zero flags
+constexpr int64_t kMaxPlaneOffset = int64_t(1) << 32, kMaxPlaneSlope = int64_t(1) << 30;
+
+inline bool plane_in_range(const Plane& q) {
+    return std::abs(q.c) <= kMaxPlaneOffset && std::abs(q.gx) <= kMaxPlaneSlope &&
+           std::abs(q.gy) <= kMaxPlaneSlope;
+}
+
+inline uint32_t plane_code(const Plane& q, int dx, int dy) {
+    const int64_t v = q.c + ((q.gx * (2 * dx - 7) + q.gy * (2 * dy - 7)) >> 1);
+    return uint32_t(std::clamp<int64_t>(v, 0, kMaxViewCode));
+}
 
 struct Models {
     BitModel temporal[3][3];
-    BitModel zero_block[2][3][3];
+    BitModel plane[3];
+    BitModel zero_block[3][3][3];
     BitModel background[4];
     IntModel<24> residual[2][8];
     BitModel other[2];
+    IntModel<24> plane_offset[2], plane_slope[2][2];
 };
 
 // The pieces one slice needs; codes (V) and residuals (R) are full-frame images.
@@ -134,6 +158,9 @@ struct SliceJob {
     ImageView<uint32_t> predictions;  // encoder: the block's prediction of each pixel
     ImageView<const float> source;    // encoder, view mode: the depth to code
     std::size_t zero_blocks = 0;
+    std::size_t plane_blocks = 0;
+    Plane plane;  // the plane of the block being predicted
+    int plane_x = 0, plane_y = 0;
 };
 
 // Lossless depth is predicted in inverse depth, which is affine across a plane in screen space:
@@ -174,6 +201,43 @@ inline uint32_t predict(const SliceJob& j, int x, int y, bool temporal) {
     return spatial(j, x, y);
 }
 
+// How a block is predicted: spatially, from the reprojected reference, or by a plane it sends.
+enum BlockMode { kSpatialMode = 0, kTemporalMode = 1, kPlaneMode = 2 };
+
+inline uint32_t block_prediction(const SliceJob& j, int x, int y, int mode) {
+    return mode == kPlaneMode ? plane_code(j.plane, x - j.plane_x, y - j.plane_y)
+                              : predict(j, x, y, mode == kTemporalMode);
+}
+
+// A plane block's parameters are predicted from the plane blocks to its left and above (the
+// surface continued), else flat at the code above the block's middle.
+Plane predicted_plane(const SliceJob& j, int b, int by, const std::vector<uint8_t>& row,
+                      const std::vector<uint8_t>& above, const std::vector<Plane>& planes,
+                      const std::vector<Plane>& above_planes) {
+    const bool left = b > 0 && (row[b - 1] & kPlaneBlock);
+    const bool up = !above.empty() && (above[b] & kPlaneBlock);
+    if (left && up) {
+        const Plane &l = planes[b - 1], &a = above_planes[b];
+        return {(l.c + kBlock * l.gx + a.c + kBlock * a.gy) >> 1, (l.gx + a.gx) >> 1,
+                (l.gy + a.gy) >> 1};
+    }
+    if (left)
+        return {planes[b - 1].c + kBlock * planes[b - 1].gx, planes[b - 1].gx, planes[b - 1].gy};
+    if (up)
+        return {above_planes[b].c + kBlock * above_planes[b].gy, above_planes[b].gx,
+                above_planes[b].gy};
+    if (by > j.y0) {
+        const uint32_t m = j.codes(std::min(b * kBlock + kBlock / 2, j.width - 1), by - 1);
+        if (m <= kMaxViewCode) return {int64_t(m), 0, 0};
+    }
+    return {};
+}
+
+inline int plane_context(const std::vector<uint8_t>& row, const std::vector<uint8_t>& above,
+                         int b) {
+    return (b > 0 && (row[b - 1] & kPlaneBlock)) + (!above.empty() && (above[b] & kPlaneBlock));
+}
+
 // In a block with residuals, a pixel is first said to be background or not; a surface pixel whose
 // prediction is not a surface (a silhouette the prediction missed) is predicted from its nearest
 // surface neighbour instead, so an edge one pixel off costs a flag, not a jump across 2^30.
@@ -190,12 +254,25 @@ inline uint32_t surface_prediction(const SliceJob& j, int x, int y, uint32_t p) 
     return p;
 }
 
-// In an inter frame a pixel the block's prediction misses may take the other prediction instead
-// (temporal in a spatial block, spatial in a temporal one: a silhouette the reprojection put a
-// pixel off, a surface the spatial prediction drifted from), for one flag. Returns p where that
-// prediction is the same or no surface.
+// Two codes further apart than one residual step: an edge, where residuals gather.
+inline bool step_between(const Mapping& map, uint32_t a, uint32_t b) {
+    return std::abs(int64_t(a) - int64_t(b)) > int64_t(map.residual_step);
+}
+
+// A pixel the block's prediction misses may take the other prediction instead, for one flag. In
+// an inter frame that is the temporal one in a spatial or plane block and the spatial one in a
+// temporal block (a silhouette the reprojection put a pixel off, a surface the spatial prediction
+// drifted from); in a key frame's view depth, of the left and above codes the one farther from p
+// when it is a step away (an edge the median or the plane put on the wrong side). Returns p where
+// that prediction is the same or no surface.
 inline uint32_t other_prediction(const SliceJob& j, int x, int y, bool temporal, uint32_t p) {
-    if (j.temporal.empty()) return p;
+    if (j.temporal.empty()) {
+        if (!j.map->view || x == 0 || y == j.y0) return p;
+        const uint32_t a = j.codes(x - 1, y), b = j.codes(x, y - 1);
+        const uint32_t q =
+            std::abs(int64_t(p) - int64_t(a)) <= std::abs(int64_t(p) - int64_t(b)) ? b : a;
+        return j.map->surface(q) && step_between(*j.map, q, p) ? q : p;
+    }
     const uint32_t q = predict(j, x, y, !temporal);
     return j.map->surface(q) ? q : p;
 }
@@ -204,11 +281,6 @@ inline int background_context(const SliceJob& j, int x, int y, uint32_t p) {
     const uint32_t empty = j.map->empty();
     return (p == empty) + (x > 0 && j.codes(x - 1, y) == empty) +
            (y > j.y0 && j.codes(x, y - 1) == empty);
-}
-
-// Two codes further apart than one residual step: an edge, where residuals gather.
-inline bool step_between(const Mapping& map, uint32_t a, uint32_t b) {
-    return std::abs(int64_t(a) - int64_t(b)) > int64_t(map.residual_step);
 }
 
 // A residual's class: at an edge (p no surface, or a step from the left or above code) or not,
@@ -312,19 +384,79 @@ uint32_t choose_view_code(const SliceJob& j, int x, int y, bool temporal, uint32
 
 // The estimated cost of a block predicted temporally or spatially; in view mode, its codes are
 // chosen for that prediction on the way.
-uint64_t block_cost(SliceJob& j, int bx, int by, int bw, int bh, bool temporal) {
+uint64_t block_cost(SliceJob& j, int bx, int by, int bw, int bh, int mode) {
+    const bool temporal = mode == kTemporalMode;
     uint64_t cost = 0;
     for (int y = by; y < by + bh; ++y)
         for (int x = bx; x < bx + bw; ++x) {
-            const uint32_t p = predict(j, x, y, temporal);
+            const uint32_t p = block_prediction(j, x, y, mode);
             if (j.map->view) j.codes(x, y) = choose_view_code(j, x, y, temporal, p);
             cost += pixel_cost(j, x, y, temporal, p);
         }
     return cost;
 }
 
-// The encoder decides each block before coding any: temporal prediction first, and the spatial
-// one (the costly inverse-depth median) only where the temporal one is not exact. Residuals of
+// The least-squares plane through the inverse depth of a block's surface pixels, in codes, its
+// offset in whole steps from the prediction's; false where fewer than three pixels are surface or
+// the plane leaves the limits.
+bool fit_plane(const SliceJob& j, int bx, int by, int bw, int bh, const Plane& predicted,
+               Plane& out) {
+    std::array<std::array<double, 7>, 7> a{};
+    std::array<double, 7> rhs{}, sol{};
+    int n = 0;
+    for (int y = by; y < by + bh; ++y)
+        for (int x = bx; x < bx + bw; ++x) {
+            const float z = j.source(x, y);
+            if (!(z > 0.0f && z < INFINITY)) continue;
+            const double k = 1.0 / double(z) / j.map->step;
+            const double v[3] = {1.0, x - bx - 3.5, y - by - 3.5};
+            for (int r = 0; r < 3; ++r) {
+                for (int c = 0; c < 3; ++c) a[r][c] += v[r] * v[c];
+                rhs[r] += v[r] * k;
+            }
+            ++n;
+        }
+    if (n < 3 || !fit::solve(a, rhs, 3, sol)) return false;
+    const double limit = double(kMaxPlaneSlope);
+    if (!(std::abs(sol[1]) < limit && std::abs(sol[2]) < limit && std::abs(sol[0]) < limit))
+        return false;
+    out.gx = std::llround(sol[1]);
+    out.gy = std::llround(sol[2]);
+    out.c = predicted.c + std::llround((sol[0] - double(predicted.c)) / double(kPlaneOffsetStep)) *
+                              kPlaneOffsetStep;
+    return plane_in_range(out);
+}
+
+// The estimated cost of a plane's parameters against their prediction.
+uint64_t plane_cost(const Plane& q, const Plane& predicted) {
+    auto one = [](int64_t r) {
+        return r == 0 ? 1 : 2 + 2 * uint64_t(std::bit_width(uint64_t(std::abs(r))));
+    };
+    return 1 + one((q.c - predicted.c) / kPlaneOffsetStep) + one(q.gx - predicted.gx) +
+           one(q.gy - predicted.gy);
+}
+
+void encode_plane(RangeEncoder& rc, Models& m, const Plane& q, const Plane& predicted,
+                  bool from_neighbour) {
+    encode_int(rc, m.plane_offset[from_neighbour], (q.c - predicted.c) / kPlaneOffsetStep);
+    encode_int(rc, m.plane_slope[from_neighbour][0], q.gx - predicted.gx);
+    encode_int(rc, m.plane_slope[from_neighbour][1], q.gy - predicted.gy);
+}
+
+bool decode_plane(RangeDecoder& rc, Models& m, const Plane& predicted, bool from_neighbour,
+                  Plane& q) {
+    int64_t dc = 0, dx = 0, dy = 0;
+    if (!decode_int(rc, m.plane_offset[from_neighbour], dc) ||
+        !decode_int(rc, m.plane_slope[from_neighbour][0], dx) ||
+        !decode_int(rc, m.plane_slope[from_neighbour][1], dy))
+        return false;
+    q = {predicted.c + dc * kPlaneOffsetStep, predicted.gx + dx, predicted.gy + dy};
+    return plane_in_range(q);
+}
+
+// The encoder decides each block before coding any: temporal prediction first, the spatial one
+// (the costly inverse-depth median) only where the temporal one is not exact, and in view mode a
+// plane fitted to the block where neither is. Residuals of
 // the whole block row are stored before they are coded; the contexts read the same values the
 // decoder has at that point.
 void encode_slice(SliceJob& j, std::vector<uint8_t>& bytes, std::vector<uint8_t>& block_flags) {
@@ -334,11 +466,16 @@ void encode_slice(SliceJob& j, std::vector<uint8_t>& bytes, std::vector<uint8_t>
     const int blocks = (j.width + kBlock - 1) / kBlock;
     block_flags.assign(std::size_t(blocks), 0);
     std::vector<uint8_t> above;
+    std::vector<Plane> planes(static_cast<std::size_t>(blocks)), above_planes;
+    const bool try_planes = j.map->view && !j.source.empty();
     // View mode: which pixels of the block row keep their temporal prediction (most of them).
     const bool keep_test = inter && j.map->view && !j.source.empty();
     std::vector<uint8_t> keep(keep_test ? std::size_t(kBlock) * j.width : 0);
     for (int by = j.y0; by < j.y1; by += kBlock) {
-        if (by > j.y0) above = block_flags;
+        if (by > j.y0) {
+            above = block_flags;
+            above_planes = planes;
+        }
         const int bh = std::min(kBlock, j.y1 - by);
         if (keep_test)
             for (int y = by; y < by + bh; ++y)
@@ -350,7 +487,7 @@ void encode_slice(SliceJob& j, std::vector<uint8_t>& bytes, std::vector<uint8_t>
                                .keep = &keep[std::size_t(y - by) * j.width]});
         for (int b = 0; b < blocks; ++b) {
             const int bx = b * kBlock, bw = std::min(kBlock, j.width - bx);
-            bool use_temporal = inter;
+            int mode = inter ? kTemporalMode : kSpatialMode, last = mode;
             uint64_t cost = 0;
             if (inter) {
                 // Most blocks of a moving camera's depth are predicted exactly (no code equals
@@ -366,24 +503,55 @@ void encode_slice(SliceJob& j, std::vector<uint8_t>& bytes, std::vector<uint8_t>
                 if (exact && j.map->view)  // the codes are the predictions
                     for (int y = by; y < by + bh; ++y)
                         std::copy_n(&j.temporal(bx, y), bw, &j.codes(bx, y));
-                if (!exact) cost = block_cost(j, bx, by, bw, bh, true);
+                if (!exact) cost = block_cost(j, bx, by, bw, bh, kTemporalMode);
             }
             if (!inter || cost > 0) {
-                const uint64_t spatial_cost = block_cost(j, bx, by, bw, bh, false);
+                const uint64_t spatial_cost = block_cost(j, bx, by, bw, bh, kSpatialMode);
+                last = kSpatialMode;
                 if (!inter || spatial_cost < cost) {
-                    use_temporal = false;
+                    mode = kSpatialMode;
                     cost = spatial_cost;
-                } else if (j.map->view) {
-                    block_cost(j, bx, by, bw, bh, true);  // the temporal choice's codes again
                 }
             }
+            // A plane, where the block's surface is smooth enough that its parameters cost less
+            // than the residuals of the median's drift.
+            const Plane predicted =
+                try_planes && cost > 0
+                    ? predicted_plane(j, b, by, block_flags, above, planes, above_planes)
+                    : Plane{};
+            Plane fitted;
+            if (try_planes && cost > 0 && fit_plane(j, bx, by, bw, bh, predicted, fitted)) {
+                j.plane = fitted;
+                j.plane_x = bx;
+                j.plane_y = by;
+                const uint64_t pixels = block_cost(j, bx, by, bw, bh, kPlaneMode);
+                last = kPlaneMode;
+                // The estimates leave out the zero flags of a block with residuals (~64 of them);
+                // a plane that leaves none saves them.
+                if (pixels + plane_cost(fitted, predicted) + (pixels > 0 ? kZeroFlags : 0) <
+                    cost + kZeroFlags) {
+                    mode = kPlaneMode;
+                    cost = pixels;
+                }
+            }
+            if (j.map->view && mode != last)
+                block_cost(j, bx, by, bw, bh, mode);  // the chosen prediction's codes again
             const int shows = reprojection_class(j, bx, by, bw, bh);
             if (inter)
-                rc.bit(m.temporal[shows][temporal_context(block_flags, above, b)], use_temporal);
-            rc.bit(m.zero_block[use_temporal][shows][zero_context(block_flags, above, b)],
-                   cost == 0);
+                rc.bit(m.temporal[shows][temporal_context(block_flags, above, b)],
+                       mode == kTemporalMode);
+            if (j.map->view && mode != kTemporalMode) {
+                rc.bit(m.plane[plane_context(block_flags, above, b)], mode == kPlaneMode);
+                if (mode == kPlaneMode)
+                    encode_plane(rc, m, fitted, predicted,
+                                 plane_context(block_flags, above, b) > 0);
+            }
+            planes[std::size_t(b)] = mode == kPlaneMode ? fitted : Plane{};
+            j.plane_blocks += mode == kPlaneMode;
+            rc.bit(m.zero_block[mode][shows][zero_context(block_flags, above, b)], cost == 0);
             j.zero_blocks += cost == 0;
-            block_flags[b] = (use_temporal ? kTemporalBlock : 0) | (cost == 0 ? kZeroBlock : 0);
+            block_flags[b] = (mode == kTemporalMode ? kTemporalBlock : 0) |
+                             (mode == kPlaneMode ? kPlaneBlock : 0) | (cost == 0 ? kZeroBlock : 0);
             if (cost == 0) {
                 for (int y = by; y < by + bh; ++y)
                     std::fill(&j.residuals(bx, y), &j.residuals(bx, y) + bw, 0u);
@@ -391,7 +559,7 @@ void encode_slice(SliceJob& j, std::vector<uint8_t>& bytes, std::vector<uint8_t>
             }
             for (int y = by; y < by + bh; ++y)
                 for (int x = bx; x < bx + bw; ++x)
-                    j.predictions(x, y) = predict(j, x, y, use_temporal);
+                    j.predictions(x, y) = block_prediction(j, x, y, mode);
         }
         for (int y = by; y < by + bh; ++y)
             for (int b = 0; b < blocks; ++b) {
@@ -430,23 +598,39 @@ bool decode_slice(SliceJob& j, std::span<const uint8_t> bytes) {
     const bool inter = !j.temporal.empty();
     const int blocks = (j.width + kBlock - 1) / kBlock;
     std::vector<uint8_t> flags(std::size_t(blocks), 0), above;
+    std::vector<Plane> planes(static_cast<std::size_t>(blocks)), above_planes;
     for (int by = j.y0; by < j.y1; by += kBlock) {
         const int bh = std::min(kBlock, j.y1 - by);
-        if (by > j.y0) above = flags;
+        if (by > j.y0) {
+            above = flags;
+            above_planes = planes;
+        }
         for (int b = 0; b < blocks; ++b) {
             const int shows =
                 reprojection_class(j, b * kBlock, by, std::min(kBlock, j.width - b * kBlock), bh);
             const bool temporal =
                 inter && rc.bit(m.temporal[shows][temporal_context(flags, above, b)]);
-            const bool zero = rc.bit(m.zero_block[temporal][shows][zero_context(flags, above, b)]);
-            flags[b] = (temporal ? kTemporalBlock : 0) | (zero ? kZeroBlock : 0);
+            const int context = plane_context(flags, above, b);
+            const bool plane = j.map->view && !temporal && rc.bit(m.plane[context]);
+            planes[std::size_t(b)] = {};
+            if (plane &&
+                !decode_plane(rc, m, predicted_plane(j, b, by, flags, above, planes, above_planes),
+                              context > 0, planes[std::size_t(b)]))
+                return false;
+            const int mode = temporal ? kTemporalMode : plane ? kPlaneMode : kSpatialMode;
+            const bool zero = rc.bit(m.zero_block[mode][shows][zero_context(flags, above, b)]);
+            flags[b] = (temporal ? kTemporalBlock : 0) | (plane ? kPlaneBlock : 0) |
+                       (zero ? kZeroBlock : 0);
             j.zero_blocks += zero;
+            j.plane_blocks += plane;
         }
         for (int y = by; y < by + bh; ++y)
             for (int x = 0; x < j.width; ++x) {
                 const int b = x / kBlock;
                 const bool temporal = flags[b] & kTemporalBlock;
-                const uint32_t p = predict(j, x, y, temporal);
+                const uint32_t p = (flags[b] & kPlaneBlock)
+                                       ? plane_code(planes[std::size_t(b)], x - b * kBlock, y - by)
+                                       : predict(j, x, y, temporal);
                 if (flags[b] & kZeroBlock) {
                     j.residuals(x, y) = 0;
                     j.codes(x, y) = p;
@@ -606,7 +790,10 @@ void encode_depth(const FrameContext& fc, const Camera& camera, ImageView<const 
         stats.depth_zero_blocks +=
             std::size_t((w + kBlock - 1) / kBlock) * ((h + kBlock - 1) / kBlock);
     } else {
-        for (const SliceJob& j : jobs) stats.depth_zero_blocks += j.zero_blocks;
+        for (const SliceJob& j : jobs) {
+            stats.depth_zero_blocks += j.zero_blocks;
+            stats.depth_plane_blocks += j.plane_blocks;
+        }
     }
     stats.depth_bits += 8 * (bytes.size() - start);
     depth_from_codes(map, codes, out);
@@ -663,7 +850,10 @@ Status decode_depth(const FrameContext& fc, const Camera& camera, std::span<cons
         REPRISE_TRY(decode_slices(
             slices, "depth section",
             [&](int s, std::span<const uint8_t> bytes) { return decode_slice(jobs[s], bytes); }));
-        for (const SliceJob& j : jobs) stats.depth_zero_blocks += j.zero_blocks;
+        for (const SliceJob& j : jobs) {
+            stats.depth_zero_blocks += j.zero_blocks;
+            stats.depth_plane_blocks += j.plane_blocks;
+        }
     }
     stats.depth_bits += 8 * in.size();
     depth_from_codes(map, codes, out);

@@ -67,6 +67,7 @@ py::dict stats_dict(const codec::StreamStats& s) {
     d["blocks_skipped"] = s.blocks_skipped;
     d["intra_blocks"] = s.intra_blocks;
     d["depth_zero_blocks"] = s.depth_zero_blocks;
+    d["depth_plane_blocks"] = s.depth_plane_blocks;
     d["revealed_pixels"] = s.revealed_pixels;
     d["motion_residual_pixels"] = s.motion_residual_pixels;
     d["motion_objects"] = s.motion_objects;

@@ -86,6 +86,7 @@ struct StreamStats {
     std::size_t motion_own_pixels = 0;       // pixels whose motion no model gives, sent alone
     std::size_t motion_objects = 0;          // rigid object motions sent
     std::size_t depth_zero_blocks = 0;       // depth blocks predicted exactly
+    std::size_t depth_plane_blocks = 0;      // depth blocks predicted by a plane they send
     std::size_t revealed_pixels =
         0;                           // colour predicted from beside: the reference did not see them
     std::size_t cameras_fitted = 0;  // encoder: frames without a camera coded with a fitted one
