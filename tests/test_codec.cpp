@@ -554,6 +554,24 @@ TEST(Codec, ASmoothSurfaceCostsItsPlanesNotTheMediansDrift) {
         EXPECT_LE(s.key.stats.depth_bits, std::size_t(most_bits));
         EXPECT_GE(s.key.stats.depth_plane_blocks, 10u);
     }
+    // Two slices, blocks cut at the right and at the bottom: the decoder makes the encoder's
+    // pictures and counts the same planes.
+    const auto frames = render("shadows", 2, 172, 140);
+    const EncoderOptions options{.qp = 34, .depth = DepthMode::View};
+    const Coded coded = encode_all(frames, options);
+    Decoder decoder;
+    for (std::size_t i = 0; i < coded.packets.size(); ++i) {
+        ASSERT_TRUE(decoder.send_packet(coded.packets[i].data).ok());
+        Frame f;
+        ASSERT_EQ(decoder.receive_frame(f), Result::Ok);
+        EXPECT_TRUE(same_frame(f, coded.reconstructions[i])) << "frame " << i;
+        EXPECT_LE(measure_view_depth_error(frames[i].camera, frames[i].depth.view(), f.depth.view(),
+                                           options.view_displacement)
+                      .max_px,
+                  options.view_error_px);
+    }
+    EXPECT_GE(coded.stats.depth_plane_blocks, 10u);
+    EXPECT_EQ(decoder.stats().depth_plane_blocks, coded.stats.depth_plane_blocks);
 }
 
 // Colour where the reference did not see the surface (version 12): the strips a moving object

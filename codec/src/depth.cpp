@@ -125,7 +125,7 @@ struct Plane {
     int64_t c = 0, gx = 0, gy = 0;
 };
 constexpr int64_t kPlaneOffsetStep = 16;
-constexpr uint64_t kZeroFlags = 24;  // encoder: the estimated bits of a block's zero flags
+constexpr uint64_t kZeroFlags = 24;  // encoder: the estimated bits of a block's 64 zero flags
 constexpr int64_t kMaxPlaneOffset = int64_t(1) << 32, kMaxPlaneSlope = int64_t(1) << 30;
 
 inline bool plane_in_range(const Plane& q) {
@@ -526,8 +526,8 @@ void encode_slice(SliceJob& j, std::vector<uint8_t>& bytes, std::vector<uint8_t>
                 j.plane_y = by;
                 const uint64_t pixels = block_cost(j, bx, by, bw, bh, kPlaneMode);
                 last = kPlaneMode;
-                // The estimates leave out the zero flags of a block with residuals (~64 of them);
-                // a plane that leaves none saves them.
+                // The estimates leave out the zero flags of a block with residuals (one per
+                // pixel, kZeroFlags bits in all); a plane that leaves none saves them.
                 if (pixels + plane_cost(fitted, predicted) + (pixels > 0 ? kZeroFlags : 0) <
                     cost + kZeroFlags) {
                     mode = kPlaneMode;
