@@ -42,8 +42,9 @@ std::vector<ObjectMotion> frame_objects(const EncoderOptions& options, const Seq
 // object relative to it, travels further than B since the previous frame, so that the motion both
 // sides derive from decoded depth stays within the motion bound (docs/bitstream.md, section 6).
 // An object counts up to kObjectTravel times the larger of B and the camera's travel: beyond,
-// the depth it would need costs more than its motion saves.
-constexpr float kObjectTravel = 3.0f;
+// the depth it would need costs more than its motion saves. (With plane blocks, version 13, fine
+// depth costs less: `fast`'s ball, 12-20x the camera's travel, now pays for its depth.)
+constexpr float kObjectTravel = 20.0f;
 float frame_view_step(const SequenceParams& sp, const Camera& camera,
                       std::span<const ObjectMotion> objects) {
     const int w = sp.width, h = sp.height;
