@@ -43,6 +43,11 @@ Image<float> ground_depth(const Camera& c) {
     return depth;
 }
 
+// The 1/z step the codec takes for this camera at its default bound (0.25 px for a displacement
+// of 0.164), as it passes it: two landings d pixels apart whose 1/z differ by d of these are one
+// surface.
+float surface_step(const Camera& c) { return view_depth_step(c.projection, kW, kH, 0.25f, 0.164f); }
+
 // Largest relative error of 1/z over the pixels where something landed, away from the border.
 double largest_inverse_depth_error(const Image<float>& got, const Image<float>& truth) {
     double worst = 0.0;
@@ -62,7 +67,7 @@ TEST(DepthReprojection, ThePlaneFitGivesAPlanesDepthAtPixelCentres) {
     const Image<float> source = ground_depth(from), truth = ground_depth(to);
     Image<float> landed(kW, kH), fitted(kW, kH);
     reproject_depth(from, source.view(), to, landed.view());
-    reproject_depth(from, source.view(), to, fitted.view(), {}, {}, true);
+    reproject_depth(from, source.view(), to, fitted.view(), {}, {}, surface_step(to));
     std::size_t covered = 0;
     for (std::size_t i = 0; i < fitted.pixel_count(); ++i) covered += !std::isnan(fitted.data()[i]);
     EXPECT_GT(covered, fitted.pixel_count() * 3 / 4);
@@ -96,7 +101,7 @@ TEST(DepthReprojection, ThePlaneFitDampsDecodedErrorsAndFillsCracks) {
         source_error += double(e) * e, ++noisy;
     }
     Image<float> fitted(kW, kH);
-    reproject_depth(from, source.view(), to, fitted.view(), {}, {}, true);
+    reproject_depth(from, source.view(), to, fitted.view(), {}, {}, surface_step(to));
     double error = 0.0;
     std::size_t ground = 0, holes = 0, compared = 0;
     for (int y = 4; y < kH - 4; ++y)
@@ -117,9 +122,9 @@ TEST(DepthReprojection, ThePlaneFitDampsDecodedErrorsAndFillsCracks) {
     EXPECT_LT(holes, ground / 200);
 }
 
-// A box 4 units in front of the camera before a wall at 10, the camera moved sideways by `x`: the
-// view depth at every pixel centre.
-Image<float> box_before_wall(float x, Camera& camera) {
+// A box (2 units wide and high at 4 units) `near` units in front of the camera before a wall at
+// `far`, the camera moved sideways by `x`: the view depth at every pixel centre.
+Image<float> box_before_wall(float x, Camera& camera, float near = 4.0f, float far = 10.0f) {
     camera.view = glm::lookAt(glm::vec3(x, 0, 0), glm::vec3(x, 0, -1), glm::vec3(0, 1, 0));
     camera.projection = glm::perspective(0.9f, float(kW) / float(kH), 0.1f, 100.0f);
     Image<float> depth(kW, kH);
@@ -127,8 +132,9 @@ Image<float> box_before_wall(float x, Camera& camera) {
         for (int px = 0; px < kW; ++px) {
             const float rx = (2.0f * (float(px) + 0.5f) / kW - 1.0f) / camera.projection[0][0];
             const float ry = (1.0f - 2.0f * (float(py) + 0.5f) / kH) / camera.projection[1][1];
+            const float half = 0.25f * near;
             depth(px, py) =
-                std::abs(x + 4.0f * rx) <= 1.0f && std::abs(4.0f * ry) <= 1.0f ? 4.0f : 10.0f;
+                std::abs(x + near * rx) <= half && std::abs(near * ry) <= half ? near : far;
         }
     return depth;
 }
@@ -144,7 +150,7 @@ TEST(DepthReprojection, AGapThatComesIntoViewTakesTheFartherSidesDepth) {
     to.prev_projection = from.projection;
     Image<float> landed(kW, kH), fitted(kW, kH);
     reproject_depth(from, source.view(), to, landed.view());
-    reproject_depth(from, source.view(), to, fitted.view(), {}, {}, true);
+    reproject_depth(from, source.view(), to, fitted.view(), {}, {}, surface_step(to));
     std::size_t revealed = 0;
     for (int y = 0; y < kH; ++y)
         for (int x = 10; x < kW - 10; ++x)  // the wall coming in at the picture's edge is no gap
@@ -153,6 +159,32 @@ TEST(DepthReprojection, AGapThatComesIntoViewTakesTheFartherSidesDepth) {
                 EXPECT_NEAR(fitted(x, y), 10.0f, 1e-3f) << x << ", " << y;
             }
     EXPECT_GT(revealed, std::size_t(150));  // measured: 200 (a strip 4 pixels wide)
+}
+
+// A box at 2 before a wall at 2.2: 1/z differs by 9 % (3.8 view steps), which the version-13
+// test (1/8 of 1/z) took for one surface, so that the plane through a landing on the box's edge and
+// one on the wall gave pixels near its edges depths between the two (measured: 494 pixels, each a
+// residual in the codec). Now every pixel is the box's or the wall's.
+TEST(DepthReprojection, ABoxJustBeforeAWallStaysItsOwnSurface) {
+    Camera from, to;
+    const Image<float> source = box_before_wall(0.0f, from, 2.0f, 2.2f);
+    box_before_wall(0.05f, to, 2.0f, 2.2f);
+    to.prev_view = from.view;
+    to.prev_projection = from.projection;
+    const float step = surface_step(to);
+    EXPECT_GT(1.0f / 2.0f - 1.0f / 2.2f, 3.0f * step);
+    Image<float> fitted(kW, kH);
+    reproject_depth(from, source.view(), to, fitted.view(), {}, {}, step);
+    std::size_t between = 0, box = 0;
+    for (int y = 0; y < kH; ++y)
+        for (int x = 0; x < kW; ++x) {
+            const float z = fitted(x, y);
+            if (std::isnan(z)) continue;
+            box += std::abs(z - 2.0f) < 1e-3f;
+            between += std::abs(z - 2.0f) >= 1e-3f && std::abs(z - 2.2f) >= 1e-3f;
+        }
+    EXPECT_GT(box, std::size_t(1000));
+    EXPECT_EQ(between, std::size_t(0));
 }
 
 }  // namespace

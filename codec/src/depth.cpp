@@ -3,8 +3,9 @@
 // reference depth forward-projected into this camera, spatially (median edge detector) or, in
 // view mode, by a plane the block sends (offset and slopes); residuals context-coded (by edges,
 // and by what the reprojection shows). A pixel the block's prediction misses may take another
-// one for a flag (inter frames: the other of temporal and spatial; view-mode key frames: the
-// neighbour across an edge). Blocks predicted exactly cost two flags. View mode sends the
+// one for a flag (inter frames: the other of temporal and spatial, then in view mode the
+// neighbour's temporal code across an edge; view-mode key frames: the neighbour across an edge).
+// Blocks predicted exactly cost two flags. View mode sends the
 // prediction itself wherever it is within the bound and quantises residuals, so decoded depth
 // keeps its error from frame to frame instead of being rounded again each time.
 #include <algorithm>
@@ -145,6 +146,7 @@ struct Models {
     BitModel background[4];
     IntModel<24> residual[2][8];
     BitModel other[2];
+    BitModel across[2];  // version 14
     IntModel<24> plane_offset[2], plane_slope[2][2];
 };
 
@@ -277,6 +279,24 @@ inline uint32_t other_prediction(const SliceJob& j, int x, int y, bool temporal,
     return j.map->surface(q) ? q : p;
 }
 
+// A third prediction in inter frames in view mode, for a pixel both others miss: of its four
+// neighbours' temporal codes, the one farthest from p when it is more than a residual step away
+// (a silhouette the reprojection put a pixel off, which the spatial prediction, reading only
+// codes to the left and above, places wrongly too); p where none is.
+inline uint32_t across_prediction(const SliceJob& j, int x, int y, uint32_t p) {
+    if (j.temporal.empty() || !j.map->view) return p;
+    uint32_t q = p;
+    int64_t farthest = 0;
+    for (const auto& [dx, dy] : {std::pair{-1, 0}, {1, 0}, {0, -1}, {0, 1}}) {
+        const int nx = x + dx, ny = y + dy;
+        if (nx < 0 || ny < 0 || nx >= j.width || ny >= j.temporal.height) continue;
+        const uint32_t t = j.temporal(nx, ny);
+        const int64_t d = std::abs(int64_t(t) - int64_t(p));
+        if (j.map->surface(t) && d > farthest) farthest = d, q = t;
+    }
+    return step_between(*j.map, q, p) ? q : p;
+}
+
 inline int background_context(const SliceJob& j, int x, int y, uint32_t p) {
     const uint32_t empty = j.map->empty();
     return (p == empty) + (x > 0 && j.codes(x - 1, y) == empty) +
@@ -332,7 +352,10 @@ inline uint64_t pixel_cost(const SliceJob& j, int x, int y, bool temporal, uint3
     if (c == j.map->empty()) return 1;
     const uint32_t other = other_prediction(j, x, y, temporal, p);
     if (other != p && c == other) return 3;
-    return 1 + (other != p) +
+    const uint32_t across = across_prediction(j, x, y, p);
+    const bool has_across = across != p && across != other;
+    if (has_across && c == across) return 3 + (other != p);
+    return 1 + (other != p) + has_across +
            residual_cost(int32_t(c - surface_prediction(j, x, y, p)) /
                          int32_t(j.map->residual_step));
 }
@@ -372,6 +395,10 @@ uint32_t choose_view_code(const SliceJob& j, int x, int y, bool temporal, uint32
         if (other != p && other <= kMaxViewCode &&
             view_code_within(1.0 / double(z), other, map.step, map.displacement, share))
             return other;
+        const uint32_t across = across_prediction(j, x, y, p);
+        if (across != p && across != other && across <= kMaxViewCode &&
+            view_code_within(1.0 / double(z), across, map.step, map.displacement, share))
+            return across;
     }
     const int64_t base = surface_prediction(j, x, y, p), s = kViewResidualStep;
     if (k == kInvalidCode)  // NaN: any code above 2^30 + 1
@@ -583,6 +610,14 @@ void encode_slice(SliceJob& j, std::vector<uint8_t>& bytes, std::vector<uint8_t>
                             continue;
                         }
                     }
+                    const uint32_t across = across_prediction(j, x, y, p);
+                    if (across != p && across != other) {
+                        rc.bit(m.across[flags & 1], c == across);
+                        if (c == across) {
+                            j.residuals(x, y) = 1;
+                            continue;
+                        }
+                    }
                     const int32_t r = int32_t(c - base) / int32_t(j.map->residual_step);
                     j.residuals(x, y) = uint32_t(r);
                     encode_nonzero_int(rc, model, r);
@@ -652,6 +687,12 @@ bool decode_slice(SliceJob& j, std::span<const uint8_t> bytes) {
                     j.codes(x, y) = other;
                     continue;
                 }
+                const uint32_t across = across_prediction(j, x, y, p);
+                if (across != p && across != other && rc.bit(m.across[temporal])) {
+                    j.residuals(x, y) = 1;
+                    j.codes(x, y) = across;
+                    continue;
+                }
                 int64_t r = 0;
                 if (!decode_nonzero_int(rc, model, r)) return false;
                 j.residuals(x, y) = uint32_t(r);
@@ -660,6 +701,15 @@ bool decode_slice(SliceJob& j, std::span<const uint8_t> bytes) {
         if (rc.overrun() > 8) return false;
     }
     return rc.overrun() <= 8;
+}
+
+// Two landings d pixels apart whose 1/z differ by at most d of this are one surface in the plane
+// fit and the crack fill (beside the relative test, kSameSurface): the step a bound of 0.25 px
+// takes, whatever coarser bound the stream has. A far ground seen at a grazing angle changes by
+// about that much a pixel and by far more than 1/32 of its 1/z; with the stream's own step, the
+// coarser bounds above qp 34 bridged silhouettes (stroll 160x96, qp 46: colour -0.45 dB).
+float surface_step(const SequenceParams& sp, const Mapping& map) {
+    return float(map.step * kViewCodesPerStep * std::min(1.0, 0.25 / double(sp.view_error)));
 }
 
 // Codes of the reference depth seen from `camera`; empty on key frames or without reference depth.
@@ -677,7 +727,8 @@ void temporal_codes(const FrameContext& fc, const Camera& camera, const Mapping&
     const bool previous = camera.prev_view == rc.view && camera.prev_projection == rc.projection;
     reproject_depth(rc, fc.reference->depth.view(), camera, projected.view(),
                     previous ? fc.reference->owner.view() : ImageView<const uint32_t>{},
-                    previous ? fc.objects : std::span<const ObjectMotion>{}, map.view);
+                    previous ? fc.objects : std::span<const ObjectMotion>{},
+                    map.view ? surface_step(*fc.sp, map) : 0.0f);
     ensure_size(out, w, h);
     parallel_for(0, h, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y)

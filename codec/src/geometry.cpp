@@ -194,11 +194,12 @@ struct Landings {
 // A pixel no landing reached between two on one surface, across, down or diagonally (a crack
 // where the reference was stretched, or where two cracks cross), takes their mean inverse depth:
 // exact on a plane, as both are values at pixel centres.
-void fill_cracks(ImageView<float> depth, Image<float>& scratch) {
+void fill_cracks(ImageView<float> depth, Image<float>& scratch, float step) {
     const int w = depth.width, h = depth.height;
-    auto mean = [](float a, float b) {
+    auto mean = [step](float a, float b) {
         const float va = 1.0f / a, vb = 1.0f / b;
-        return a < kInf && b < kInf && std::abs(va - vb) <= 0.125f * std::max(va, vb)
+        return a < kInf && b < kInf &&
+                       std::abs(va - vb) <= std::max(kSameSurface * std::max(va, vb), 2.0f * step)
                    ? 2.0f / (va + vb)
                    : kNan;
     };
@@ -246,7 +247,8 @@ void fill_gaps(ImageView<float> depth) {
 
 void reproject_depth(const Camera& from, ImageView<const float> depth, const Camera& to,
                      ImageView<float> out, ImageView<const uint32_t> owner,
-                     std::span<const ObjectMotion> objects, bool plane_fit) {
+                     std::span<const ObjectMotion> objects, float plane_step) {
+    const bool plane_fit = plane_step > 0.0f;
     const int w = depth.width, h = depth.height;
     REPRISE_ASSERT(out.width == w && out.height == h);
     if (owner.empty()) objects = {};
@@ -335,6 +337,7 @@ void reproject_depth(const Camera& from, ImageView<const float> depth, const Cam
                            .height = h,
                            .span = landings.span,
                            .y = y,
+                           .step = plane_step,
                            .out = &landings.held(0, y)});
         });
     const Image<float>& value = plane_fit ? landings.held : landings.z;
@@ -378,7 +381,7 @@ void reproject_depth(const Camera& from, ImageView<const float> depth, const Cam
             }
         });
     if (plane_fit) {
-        fill_cracks(out, landings.held);
+        fill_cracks(out, landings.held, plane_step);
         fill_gaps(out);
     }
 }
@@ -419,7 +422,8 @@ void plane_row_reference(const PlaneRow& r, int x_begin, int x_end) {
             at(r.object, nx, ny) != at(r.object, x, y))
             return false;
         const float v = at(r.inverse, x, y);
-        return std::abs(at(r.inverse, nx, ny) - v) <= 0.125f * v;
+        const float d = float(std::abs(nx - x) + std::abs(ny - y));
+        return std::abs(at(r.inverse, nx, ny) - v) <= std::max(kSameSurface * v, r.step * d);
     };
     auto at_centre = [&](int x) {
         const float v = at(r.inverse, x, y), px = at(r.px, x, y), py = at(r.py, x, y);

@@ -14,7 +14,7 @@ namespace reprise::codec {
 
 inline constexpr uint32_t kPacketMagic = 0x544B5052;  // "RPKT"
 inline constexpr uint32_t kFileMagic = 0x53525052;    // "RPRS"
-inline constexpr uint8_t kVersion = 13;
+inline constexpr uint8_t kVersion = 14;
 inline constexpr std::size_t kPacketHeaderSize = 32;
 inline constexpr std::size_t kMaxPayload = 256u << 20;
 inline constexpr int kMaxSide = 16384;
@@ -156,12 +156,14 @@ void rigid_motion(const Camera& from, ImageView<const float> depth, const glm::m
 // The reference depth forward-projected into camera `to` (z-buffered, nearest pixel);
 // NaN where nothing landed. A copy when the cameras are identical.
 // Pixels whose `owner` id is one of `objects` (this frame's) move with that object's motion.
-// `plane_fit`: each landing takes the value of its surface's plane at the centre of the pixel it
-// lands in, instead of the value where it landed, and cracks and narrow gaps between landings are
-// filled (docs/bitstream.md, section 6).
+// `plane_step` > 0 (view mode: the 1/z step q): each landing takes the value of its surface's
+// plane at the centre of the pixel it lands in, instead of the value where it landed, and cracks
+// and narrow gaps between landings are filled; two landings d pixels apart are one surface when
+// their 1/z differ by at most max(kSameSurface of the larger, d plane_step) (docs/bitstream.md,
+// section 6).
 void reproject_depth(const Camera& from, ImageView<const float> depth, const Camera& to,
                      ImageView<float> out, ImageView<const uint32_t> owner = {},
-                     std::span<const ObjectMotion> objects = {}, bool plane_fit = false);
+                     std::span<const ObjectMotion> objects = {}, float plane_step = 0.0f);
 // What drives colour prediction: the decoded motion when the reference is the previous frame,
 // else the camera motion from this frame to the reference's camera (0 without depth).
 ImageView<const glm::vec2> motion_to_reference(const SequenceParams& sp, const Camera& camera,

@@ -127,11 +127,15 @@ void forward_row(const ForwardRow& row);
 // The plane fit of reproject_depth: the depth each landed pixel of reference row y takes at the
 // centre of the target pixel it lands in (int px, int py), on the plane in (px, py, 1/z) through
 // its landing and those of a horizontal and a vertical neighbour on its surface (landed, same
-// object, 1/z within 1/8 of its own) k pixels away, k = span, span / 2, ... 1; the value is the
-// mean of the plane's value through it and through each adjacent landing on the surface. Its own
-// z where no k has both neighbours, the plane is degenerate or moves the value beyond the
-// neighbours'. Inputs are whole width x height images (row-major); out is row y, written where
-// the pixel landed (slot >= 0).
+// object, 1/z within max(kSameSurface of its own, k step)) k pixels away, k = span, span / 2, ...
+// 1; the value is the mean of the plane's value through it and through each adjacent landing on the
+// surface. Its own z where no k has both neighbours, the plane is degenerate or moves the value
+// beyond the neighbours'. Inputs are whole width x height images (row-major); out is row y, written
+// where the pixel landed (slot >= 0). Two landings d pixels apart are one surface when their
+// inverse depths differ by at most this share of the larger, or by d view steps (a far surface seen
+// at a grazing angle changes by more than a share per pixel). A post standing on the ground meets
+// it within a few per cent: with 1/8, the version-13 share, the fit bridged such silhouettes.
+inline constexpr float kSameSurface = 1.0f / 32;
 struct PlaneRow {
     const int32_t* slot;   // the target pixel a landing went to, -1: none
     const int* object;     // the object it moved with, -1: none
@@ -140,6 +144,7 @@ struct PlaneRow {
     const float* px;
     const float* py;
     int width, height, span, y;
+    float step;  // 1/z per pixel of distance that counts as one surface (the view step)
     float* out;
 };
 void plane_row_reference(const PlaneRow& row, int x_begin, int x_end);

@@ -129,6 +129,8 @@ Status read_params(ByteReader& r, SequenceParams& sp) {
         return Status::error("key frame parameters: depth error bound outside 1e-7..0.1");
     if (sp.depth == DepthMode::View && !(sp.view_step >= 1e-12f && sp.view_step <= 1e6f))
         return Status::error("key frame parameters: inverse depth step outside 1e-12..1e6");
+    if (sp.depth == DepthMode::View && !(sp.view_error >= 1e-3f && sp.view_error <= 100.0f))
+        return Status::error("key frame parameters: view bound outside 0.001..100 px");
     if (!(sp.motion_error == 0.0f ||
           (sp.motion_error >= kMinMotionError && sp.motion_error <= 8.0f)))
         return Status::error("key frame parameters: motion error bound outside 0.1..8 px (or 0)");

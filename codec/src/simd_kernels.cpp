@@ -306,7 +306,7 @@ void PlaneRowSimd(const PlaneRow& r) {
     using MF = hn::Mask<decltype(df)>;
     const int n = int(hn::Lanes(df)), w = r.width, y = r.y;
     const int begin = std::min(w, r.span), end = std::max(begin, w - r.span);
-    const VF zero = hn::Zero(df), half = hn::Set(df, 0.5f), eighth = hn::Set(df, 0.125f);
+    const VF zero = hn::Zero(df), half = hn::Set(df, 0.5f);
     const VI none = hn::Set(di, -1);
     const MF nothing = hn::FirstN(df, 0);
     const std::size_t row = std::size_t(y) * w;
@@ -318,7 +318,8 @@ void PlaneRowSimd(const PlaneRow& r) {
         if (hn::AllFalse(df, landed)) continue;
         const VI object = hn::LoadU(di, r.object + o);
         const VF v = hn::LoadU(df, r.inverse + o), px = hn::LoadU(df, r.px + o);
-        const VF py = hn::LoadU(df, r.py + o), tolerance = eighth * v;
+        const VF py = hn::LoadU(df, r.py + o), share = hn::Set(df, kSameSurface) * v;
+        VF tolerance = hn::Max(share, hn::Set(df, r.step));
         const VF cx = hn::ConvertTo(df, hn::ConvertTo(di, px)) + half;
         const VF cy = hn::ConvertTo(df, hn::ConvertTo(di, py)) + half;
         // The landing at offset `at` (pixels from o) on the same surface.
@@ -332,6 +333,7 @@ void PlaneRowSimd(const PlaneRow& r) {
         VF result = hn::LoadU(df, r.z + o);
         MF open = landed;
         for (int k = r.span; k >= 1 && !hn::AllFalse(df, open); k /= 2) {
+            tolerance = hn::Max(share, hn::Set(df, r.step * float(k)));
             const std::ptrdiff_t down = std::ptrdiff_t(k) * w;
             const MF right = beside(k), left = hn::AndNot(right, beside(-k));
             const bool has_below = y + k < r.height, has_above = y - k >= 0;
@@ -362,6 +364,7 @@ void PlaneRowSimd(const PlaneRow& r) {
             take = hn::And(take, hn::And(hn::Abs(change) <= largest, sum > zero));
             if (hn::AllFalse(df, take)) continue;
             VF count = hn::Set(df, 1.0f);
+            tolerance = hn::Max(share, hn::Set(df, r.step));
             const std::ptrdiff_t adjacent[] = {-1, 1, -std::ptrdiff_t(w), std::ptrdiff_t(w)};
             const bool exists[] = {true, true, y > 0, y + 1 < r.height};
             for (int a = 0; a < 4; ++a) {

@@ -545,6 +545,7 @@ public:
         std::mt19937 rng(seed);
         width_ = w, height_ = h;
         span_ = 2 + int(seed % 5);
+        step_ = seed % 3 == 0 ? 0.0f : uniform(rng, 0.0f, 0.01f);  // the view step, or none
         const bool worst = inputs == KernelInputs::WorstCase;
         const std::size_t n = std::size_t(w) * h;
         slot_.assign(n, -1), object_.assign(n, 0);
@@ -594,11 +595,13 @@ private:
                         .height = height_,
                         .span = span_,
                         .y = y,
+                        .step = step_,
                         .out = out.data() + std::size_t(y) * width_});
         });
     }
 
     int width_ = 0, height_ = 0, span_ = 2;
+    float step_ = 0.0f;
     std::vector<int32_t> slot_;
     std::vector<int> object_;
     std::vector<float> inverse_, z_, px_, py_, reference_, optimized_;
