@@ -144,7 +144,7 @@ struct Models {
     BitModel plane[3];
     BitModel zero_block[3][3][3];
     BitModel background[4];
-    IntModel<24> residual[2][8];
+    IntModel<24> residual[2][16];
     BitModel other[2];
     BitModel across[2];  // version 14
     IntModel<24> plane_offset[2], plane_slope[2][2];
@@ -304,11 +304,13 @@ inline int background_context(const SliceJob& j, int x, int y, uint32_t p) {
 }
 
 // A residual's class: at an edge (p no surface, or a step from the left or above code) or not,
-// and the magnitude of the residuals to the left and above.
+// beside a step in the temporal prediction (a third prediction exists, version 14) or not, and
+// the magnitude of the residuals to the left and above.
 inline int residual_context(const SliceJob& j, int x, int y, uint32_t p) {
     const bool edge = !j.map->surface(p) || (x > 0 && step_between(*j.map, j.codes(x - 1, y), p)) ||
                       (y > j.y0 && step_between(*j.map, j.codes(x, y - 1), p));
-    return 4 * edge +
+    const bool across = across_prediction(j, x, y, p) != p;
+    return 4 * (edge + 2 * across) +
            magnitude_class(x > 0 ? j.residuals(x - 1, y) : 0, y > j.y0 ? j.residuals(x, y - 1) : 0);
 }
 
@@ -379,8 +381,8 @@ namespace {
 // the truth (within q / 2). The allowance shrinks by (1 - B/z)^2 for points near the camera
 // (docs/bitstream.md). A key frame keeps p only within 4/5 of the allowance: every later frame
 // transports its depth, and values left at the edge of the bound would leave it at the first
-// noise of that transport, a residual each. The other prediction, when it is close enough, costs
-// less than a residual.
+// noise of that transport, a residual each. The other prediction, then the third (inter frames),
+// when it is close enough, costs less than a residual.
 uint32_t choose_view_code(const SliceJob& j, int x, int y, bool temporal, uint32_t p) {
     const Mapping& map = *j.map;
     const float z = j.source.empty() ? INFINITY : j.source(x, y);

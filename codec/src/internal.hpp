@@ -158,9 +158,9 @@ void rigid_motion(const Camera& from, ImageView<const float> depth, const glm::m
 // Pixels whose `owner` id is one of `objects` (this frame's) move with that object's motion.
 // `plane_step` > 0 (view mode: the 1/z step q): each landing takes the value of its surface's
 // plane at the centre of the pixel it lands in, instead of the value where it landed, and cracks
-// and narrow gaps between landings are filled; two landings d pixels apart are one surface when
-// their 1/z differ by at most max(kSameSurface of the larger, d plane_step) (docs/bitstream.md,
-// section 6).
+// and narrow gaps between landings are filled; two landings are one surface when their 1/z differ
+// by at most max(kSameSurface of the larger, d plane_step), d their distance in pixels in the
+// plane fit and 2 in the crack fill (docs/bitstream.md, section 6).
 void reproject_depth(const Camera& from, ImageView<const float> depth, const Camera& to,
                      ImageView<float> out, ImageView<const uint32_t> owner = {},
                      std::span<const ObjectMotion> objects = {}, float plane_step = 0.0f);

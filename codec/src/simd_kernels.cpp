@@ -319,7 +319,7 @@ void PlaneRowSimd(const PlaneRow& r) {
         const VI object = hn::LoadU(di, r.object + o);
         const VF v = hn::LoadU(df, r.inverse + o), px = hn::LoadU(df, r.px + o);
         const VF py = hn::LoadU(df, r.py + o), share = hn::Set(df, kSameSurface) * v;
-        VF tolerance = hn::Max(share, hn::Set(df, r.step));
+        VF tolerance = share;  // set for each distance below
         const VF cx = hn::ConvertTo(df, hn::ConvertTo(di, px)) + half;
         const VF cy = hn::ConvertTo(df, hn::ConvertTo(di, py)) + half;
         // The landing at offset `at` (pixels from o) on the same surface.
