@@ -159,6 +159,7 @@ struct SliceJob {
     ImageView<uint32_t> residuals;
     ImageView<uint32_t> predictions;  // encoder: the block's prediction of each pixel
     ImageView<const float> source;    // encoder, view mode: the depth to code
+    ImageView<const float> share;     // encoder, view mode: each pixel's multiple of the bound
     std::size_t zero_blocks = 0;
     std::size_t plane_blocks = 0;
     Plane plane;  // the plane of the block being predicted
@@ -369,7 +370,8 @@ void view_keep_row_reference(const ViewKeepRow& r, int i_begin, int i_end) {
         const float z = r.source[i];
         const uint32_t t = r.temporal[i];
         r.keep[i] = t <= kMaxViewCode && z > 0.0f && z < INFINITY &&
-                    view_code_within(1.0 / double(z), t, r.step, r.displacement);
+                    view_code_within(1.0 / double(z), t, r.step, r.displacement,
+                                     r.share ? double(r.share[i]) : 1.0);
     }
 }
 
@@ -382,13 +384,16 @@ namespace {
 // (docs/bitstream.md). A key frame keeps p only within 4/5 of the allowance: every later frame
 // transports its depth, and values left at the edge of the bound would leave it at the first
 // noise of that transport, a residual each. The other prediction, then the third (inter frames),
-// when it is close enough, costs less than a residual.
+// when it is close enough, costs less than a residual. A pixel may be allowed a multiple of the
+// bound (`SliceJob::share`); its residual still takes it nearest the truth (the smallest residual
+// within the wider bound left the next frames' predictions farther off: key depth +4 %).
 uint32_t choose_view_code(const SliceJob& j, int x, int y, bool temporal, uint32_t p) {
     const Mapping& map = *j.map;
     const float z = j.source.empty() ? INFINITY : j.source(x, y);
     const uint32_t k = map.code(z);
     if (k > kMaxViewCode && k != kInvalidCode) return k;  // background: a flag
-    const double share = j.temporal.empty() ? 0.8 : 1.0;
+    const double share =
+        (j.temporal.empty() ? 0.8 : 1.0) * (j.share.empty() ? 1.0 : double(j.share(x, y)));
     if (k != kInvalidCode && p <= kMaxViewCode &&
         view_code_within(1.0 / double(z), p, map.step, map.displacement, share))
         return p;
@@ -513,7 +518,8 @@ void encode_slice(SliceJob& j, std::vector<uint8_t>& bytes, std::vector<uint8_t>
                                .count = j.width,
                                .step = j.map->step,
                                .displacement = j.map->displacement,
-                               .keep = &keep[std::size_t(y - by) * j.width]});
+                               .keep = &keep[std::size_t(y - by) * j.width],
+                               .share = j.share.empty() ? nullptr : j.share.row(y)});
         for (int b = 0; b < blocks; ++b) {
             const int bx = b * kBlock, bw = std::min(kBlock, j.width - bx);
             int mode = inter ? kTemporalMode : kSpatialMode, last = mode;
@@ -793,6 +799,32 @@ double SequenceParams::depth_step() const {
     return 2.0 * exact_log2(1.0 + 0.999 * double(depth_error));
 }
 
+namespace {
+
+// View mode: the multiple of the frame's bound each pixel may use, or empty (1 everywhere). Where
+// an object's travel made the frame's step finer than the cameras' (frame_view_step), only the
+// objects' pixels need it; the others keep the cameras' bound, as many times coarser.
+ImageView<const float> view_share(const FrameContext& fc, const Mapping& map) {
+    const double ratio = double(fc.camera_step) / (map.step * kViewCodesPerStep);
+    if (!map.view || fc.ids.empty() || fc.objects.empty() || !(ratio > 1.0)) return {};
+    Image<float>& share = fc.work->view_share;
+    ensure_size(share, fc.ids.width, fc.ids.height);
+    parallel_for(0, fc.ids.height, [&](int y0, int y1) {
+        for (int y = y0; y < y1; ++y)
+            for (int x = 0; x < fc.ids.width; ++x) {
+                const uint32_t id = fc.ids(x, y);
+                share(x, y) =
+                    id != 0 && std::any_of(fc.objects.begin(), fc.objects.end(),
+                                           [&](const ObjectMotion& o) { return o.id == id; })
+                        ? 1.0f
+                        : float(ratio);
+            }
+    });
+    return share.view();
+}
+
+}  // namespace
+
 void encode_depth(const FrameContext& fc, const Camera& camera, ImageView<const float> source,
                   Image<float>& out, std::vector<uint8_t>& bytes, StreamStats& stats) {
     const SequenceParams& sp = *fc.sp;
@@ -828,7 +860,8 @@ void encode_depth(const FrameContext& fc, const Camera& camera, ImageView<const 
     Image<uint32_t>& predictions = fc.work->depth_predictions;
     ensure_size(predictions, w, h);
     std::vector<SliceJob> jobs = slice_jobs(sp, map, codes, temporal, residuals, &predictions);
-    for (SliceJob& j : jobs) j.source = source;
+    const ImageView<const float> share = view_share(fc, map);
+    for (SliceJob& j : jobs) j.source = source, j.share = share;
     std::vector<std::vector<uint8_t>>& flags = fc.work->slice_flags;
     flags.resize(std::size_t(sp.slices));
     encode_slices(sp.slices, fc.work->slice_bytes, bytes,

@@ -188,7 +188,11 @@ struct Encoder::State {
             const StageTimer timer(fs.ms.objects);
             objects = fit_objects(frame, camera, ref);
             fc.objects = objects;
-            if (sp.depth == DepthMode::View) fc.view_step = frame_view_step(sp, camera, objects);
+            if (sp.depth == DepthMode::View) {
+                fc.view_step = frame_view_step(sp, camera, objects);
+                fc.camera_step = frame_view_step(sp, camera, {});
+                fc.ids = frame.id;
+            }
         }
         encode_depth(fc, camera, frame.depth, pic.depth, depth_section, fs);
         std::vector<uint8_t> section;

@@ -185,7 +185,7 @@ struct MotionResidual {
 // Per-frame scratch, sized on the first frame and reused while the size stays the same.
 struct Workspace {
     Image<uint32_t> depth_codes, temporal_codes, depth_residuals, depth_predictions;
-    Image<float> projected_depth;
+    Image<float> projected_depth, view_share;
     Image<glm::vec2> base_motion, to_reference;
     std::vector<MotionResidual> motion_residuals;
     MotionModelScratch motion_models;
@@ -214,6 +214,10 @@ struct FrameContext {
     Workspace* work = nullptr;
     std::span<const ObjectMotion> objects;  // this frame's, from the camera section
     float view_step = 0.0f;  // encoder, view depth: this frame's step (0: the sequence's)
+    // Encoder, view depth: the step the cameras alone ask for, and the source's object ids. A
+    // finer step for a fast object is the object's need: the other pixels keep the cameras' bound.
+    float camera_step = 0.0f;
+    ImageView<const uint32_t> ids;
 };
 
 // The camera and the objects' rigid motions (their bytes returned; counted as motion).

@@ -163,15 +163,16 @@ bool motion_residual_row(const MotionResidualRow& row);
 // View-mode depth (depth.cpp, choose_view_code): whether each pixel keeps its temporal prediction,
 // that is, the prediction exists (not kNoPrediction), the depth to code is finite and positive,
 // and the prediction's inverse depth w_c (c step, or step / 2 for c = 0) is within the bound of
-// w = 1 / z: |w_c - w| <= kViewCodesPerStep step near^2, near = max(0, 1 - displacement max(w,
-// w_c)). In binary64.
+// w = 1 / z: |w_c - w| <= share kViewCodesPerStep step near^2, near = max(0, 1 - displacement
+// max(w, w_c)), share the pixel's multiple of the bound (1 without `share`). In binary64.
 struct ViewKeepRow {
     const float* source;       // the depth to code
     const uint32_t* temporal;  // the temporal prediction's codes
     int count;
     double step;  // 1/z per code
     double displacement;
-    uint8_t* keep;  // 1: the code is the prediction
+    uint8_t* keep;                 // 1: the code is the prediction
+    const float* share = nullptr;  // per pixel, or null
 };
 void view_keep_row_reference(const ViewKeepRow& row, int i_begin, int i_end);
 void view_keep_row(const ViewKeepRow& row);

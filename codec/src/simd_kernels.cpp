@@ -458,6 +458,7 @@ void ViewKeepRowSimd(const ViewKeepRow& r) {
     const VD step = hn::Set(dd, r.step), half_step = hn::Set(dd, 0.5 * r.step);
     const VD bound = hn::Set(dd, kViewCodesPerStep * r.step),
              displacement = hn::Set(dd, r.displacement);
+    const VD codes_per_step = hn::Set(dd, double(kViewCodesPerStep));
     const VD max_code = hn::Set(dd, double(1u << 30));
     int i = 0;
     for (; i + n <= r.count; i += n) {
@@ -469,9 +470,11 @@ void ViewKeepRowSimd(const ViewKeepRow& r) {
         const VD wc = hn::IfThenElse(c == zero, half_step, c * step);
         const VD w = one / z;
         const VD near = hn::Max(zero, one - displacement * hn::Max(w, wc));
+        const VD allowed =
+            r.share ? hn::PromoteTo(dd, hn::LoadU(df, r.share + i)) * codes_per_step * step : bound;
         const auto keep =
             hn::And(hn::And(c >= zero, c <= max_code),
-                    hn::And(hn::And(z > zero, z < inf), hn::Abs(wc - w) <= bound * near * near));
+                    hn::And(hn::And(z > zero, z < inf), hn::Abs(wc - w) <= allowed * near * near));
         uint8_t bits[HWY_MAX_BYTES / 8 + 8] = {};
         hn::StoreMaskBits(dd, keep, bits);
         for (int k = 0; k < n; ++k) r.keep[i + k] = (bits[k / 8] >> (k % 8)) & 1;

@@ -477,6 +477,10 @@ public:
         if (exact_edges) step_ = 0x1p-12;
         source_.resize(std::size_t(w) * h);
         temporal_.resize(source_.size());
+        share_.clear();  // per-pixel multiples of the bound on every other seed
+        if (seed % 2)
+            for (std::size_t i = 0; i < source_.size(); ++i)
+                share_.push_back(rng() % 2 ? 1.0f : uniform(rng, 1.0f, 20.0f));
         for (std::size_t i = 0; i < source_.size(); ++i) {
             const float z = random_depth(rng, 0.2f, 60.0f, worst);
             source_[i] = z;
@@ -523,14 +527,15 @@ private:
                         .count = width_,
                         .step = step_,
                         .displacement = displacement_,
-                        .keep = out.data() + o});
+                        .keep = out.data() + o,
+                        .share = share_.empty() ? nullptr : share_.data() + o});
             }
         });
     }
 
     int width_ = 0, height_ = 0;
     double step_ = 1e-4, displacement_ = 0.164;
-    std::vector<float> source_;
+    std::vector<float> source_, share_;
     std::vector<uint32_t> temporal_;
     std::vector<uint8_t> reference_, optimized_;
 };
