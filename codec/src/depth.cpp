@@ -642,6 +642,8 @@ bool decode_slice(SliceJob& j, std::span<const uint8_t> bytes) {
     const int blocks = (j.width + kBlock - 1) / kBlock;
     std::vector<uint8_t> flags(std::size_t(blocks), 0), above;
     std::vector<Plane> planes(static_cast<std::size_t>(blocks)), above_planes;
+    // Blocks whose codes are their temporal prediction, which every pixel has: copied.
+    std::vector<uint8_t> copied(std::size_t(blocks) + 1, 0);
     for (int by = j.y0; by < j.y1; by += kBlock) {
         const int bh = std::min(kBlock, j.y1 - by);
         if (by > j.y0) {
@@ -664,12 +666,21 @@ bool decode_slice(SliceJob& j, std::span<const uint8_t> bytes) {
             const bool zero = rc.bit(m.zero_block[mode][shows][zero_context(flags, above, b)]);
             flags[b] = (temporal ? kTemporalBlock : 0) | (plane ? kPlaneBlock : 0) |
                        (zero ? kZeroBlock : 0);
+            copied[std::size_t(b)] = temporal && zero && shows != 2;
             j.zero_blocks += zero;
             j.plane_blocks += plane;
         }
         for (int y = by; y < by + bh; ++y)
             for (int x = 0; x < j.width; ++x) {
-                const int b = x / kBlock;
+                int b = x / kBlock;
+                if (copied[std::size_t(b)]) {  // x starts the block: a run of such blocks at once
+                    while (copied[std::size_t(b) + 1]) ++b;
+                    const int end = std::min(j.width, (b + 1) * kBlock);
+                    std::copy(&j.temporal(x, y), &j.temporal(x, y) + (end - x), &j.codes(x, y));
+                    std::fill(&j.residuals(x, y), &j.residuals(x, y) + (end - x), 0u);
+                    x = end - 1;
+                    continue;
+                }
                 const bool temporal = flags[b] & kTemporalBlock;
                 const uint32_t p = (flags[b] & kPlaneBlock)
                                        ? plane_code(planes[std::size_t(b)], x - b * kBlock, y - by)
