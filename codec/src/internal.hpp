@@ -14,7 +14,7 @@ namespace reprise::codec {
 
 inline constexpr uint32_t kPacketMagic = 0x544B5052;  // "RPKT"
 inline constexpr uint32_t kFileMagic = 0x53525052;    // "RPRS"
-inline constexpr uint8_t kVersion = 14;
+inline constexpr uint8_t kVersion = 15;
 inline constexpr std::size_t kPacketHeaderSize = 32;
 inline constexpr std::size_t kMaxPayload = 256u << 20;
 inline constexpr int kMaxSide = 16384;

@@ -1,8 +1,9 @@
 #pragma once
 // Adaptive binary range coder (LZMA-style carry propagation, 12-bit probabilities) and the
-// integer binarisations built on it. The decoder never reads outside its input: past the end it
-// sees zero bytes and counts them, so a truncated or hostile slice decodes to garbage values that
-// the caller bounds, never to undefined behaviour.
+// integer binarisations built on it. The encoder leaves out the leading zero byte and the
+// trailing zero bytes of its last value; the decoder never reads outside its input: past the end
+// it sees zero bytes and counts them (an honest slice: at most 4), so a truncated or hostile
+// slice decodes to garbage values that the caller bounds, never to undefined behaviour.
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
@@ -35,7 +36,7 @@ struct BitModel {
 
 class RangeEncoder {
 public:
-    explicit RangeEncoder(std::vector<uint8_t>& out) : out_(out) {}
+    explicit RangeEncoder(std::vector<uint8_t>& out) : out_(out), start_(out.size()) {}
 
     void bit(BitModel& m, int b) {
         const uint32_t bound = (range_ >> kProbBits) * m.p();
@@ -56,8 +57,21 @@ public:
     void bypass_bits(uint32_t v, int n) {
         for (int i = n - 1; i >= 0; --i) bypass((v >> i) & 1);
     }
+    // Ends the slice on the value in [low, low + range) with the most trailing zero bits and
+    // leaves its trailing zero bytes out (at least 3, as range >= 2^24): the decoder reads zeros
+    // past the end.
     void finish() {
+        for (int k = 32; k >= 0; --k) {
+            const uint64_t mask = (uint64_t(1) << k) - 1, v = (low_ + mask) & ~mask;
+            if (v < low_ + range_) {
+                low_ = v;
+                break;
+            }
+        }
+        const uint32_t last = uint32_t(low_);
         for (int i = 0; i < 5; ++i) shift_low();
+        for (int i = 0; i < 4 && !(last >> (8 * i) & 0xFF) && out_.size() > start_; ++i)
+            out_.pop_back();
     }
 
 private:
@@ -72,7 +86,8 @@ private:
             const uint8_t carry = uint8_t(low_ >> 32);
             uint8_t temp = cache_;
             do {
-                out_.push_back(uint8_t(temp + carry));
+                if (!first_) out_.push_back(uint8_t(temp + carry));  // the first is always 0
+                first_ = false;
                 temp = 0xFF;
             } while (--cache_size_ != 0);
             cache_ = uint8_t(low_ >> 24);
@@ -82,6 +97,8 @@ private:
     }
 
     std::vector<uint8_t>& out_;
+    std::size_t start_;
+    bool first_ = true;
     uint64_t low_ = 0;
     uint32_t range_ = 0xFFFFFFFFu;
     uint8_t cache_ = 0;
@@ -91,7 +108,7 @@ private:
 class RangeDecoder {
 public:
     explicit RangeDecoder(std::span<const uint8_t> in) : in_(in) {
-        for (int i = 0; i < 5; ++i) code_ = (code_ << 8) | next();
+        for (int i = 0; i < 4; ++i) code_ = (code_ << 8) | next();
     }
 
     int bit(BitModel& m) {
@@ -124,7 +141,7 @@ public:
         for (int i = 0; i < n; ++i) v = (v << 1) | uint32_t(bypass());
         return v;
     }
-    // Bytes read beyond the input (an honest stream reads none).
+    // Bytes read beyond the input (an honest slice: at most 4, its trailing zeros).
     std::size_t overrun() const { return overrun_; }
 
 private:
