@@ -167,6 +167,27 @@ TEST(CliCodec, EncodeDecodeInfoAndThreadCountIndependence) {
 
 // A damaged file: every decodable frame is written under its own number, bit-identical to the
 // undamaged decode; one line says which bytes were skipped and which frames are missing; exit 1.
+// --slices: more slices for many-core decoders, decoded as any stream; out of range refused.
+TEST(CliCodec, SlicesAreChosenOrRefused) {
+    const fs::path dir = test::fresh_directory(
+        fs::temp_directory_path() / ("reprise_cli_slices_" + std::to_string(::getpid())));
+    const std::string frames = (dir / "frames").string(), stream = (dir / "s.rps").string();
+    ASSERT_EQ(test::run_command(cli::command_render, {"--scene", "pan", "--frames", "2", "--size",
+                                                      "64x64", "--out", frames}),
+              0);
+    const test::Outcome four =
+        test::run_reprise("encode --in " + frames + " --out " + stream + " --slices 4", 120);
+    ASSERT_EQ(four.status, 0) << four.output;
+    const test::Outcome decoded =
+        test::run_reprise("decode " + stream + " --out " + (dir / "d").string(), 120);
+    EXPECT_EQ(decoded.status, 0) << decoded.output;
+    const test::Outcome bad = test::run_reprise(
+        "encode --in " + frames + " --out " + (dir / "t.rps").string() + " --slices 65", 120);
+    EXPECT_EQ(bad.status, 2) << bad.output;
+    EXPECT_NE(bad.output.find("--slices"), std::string::npos) << bad.output;
+    fs::remove_all(dir);
+}
+
 TEST(CliCodec, DecodeWritesEveryDecodableFrameOfADamagedStream) {
     const fs::path dir = test::fresh_directory(
         fs::temp_directory_path() / ("reprise_cli_recover_" + std::to_string(::getpid())));

@@ -126,7 +126,7 @@ void write_frame_stats(CsvFile& csv, std::size_t frame, std::size_t bytes,
 
 struct EncodeJob {
     std::string in, out, chroma = "420", depth = "view", frame_stats;
-    int qp = 28, quality = 0, bitrate = 0, keyint = 0, skip = 2;
+    int qp = 28, quality = 0, bitrate = 0, keyint = 0, skip = 2, slices = 0;
     double motion_error = 0.25;
     bool quality_given = false, overwrite_inputs = false, resume = false, no_objects = false;
     bool fixed_bounds = false;
@@ -147,6 +147,9 @@ Status encoder_options(const EncodeJob& job, codec::EncoderOptions& o) {
     if (job.bitrate < 0) return Status::error("encode: --bitrate must be positive");
     if (job.keyint < 0) return Status::error("encode: --keyint must be 0 or more");
     if (job.skip < 0 || job.skip > 255) return Status::error("encode: --skip must be in 0..255");
+    if (job.slices < 0 || job.slices > 64)
+        return Status::error("encode: --slices must be in 0..64 (0: one per 24 macroblock rows)");
+    o.slices = job.slices;
     o.bitrate_kbps = job.bitrate;
     o.keyint = job.keyint;
     o.skip_threshold = job.skip;
@@ -390,6 +393,10 @@ int command_encode(int argc, char** argv) {
               "with motion models and depth)");
     args.option("--skip", &job.skip,
                 "blocks within this many 8-bit levels of their prediction are skipped (default 2)");
+    args.option("--slices", &job.slices,
+                "slices coded in parallel, each with its own models (default 0: one per 24 "
+                "macroblock rows, 720p: 2, 1080p: 3; more for many-core decoders, fewer bits with "
+                "fewer)");
     args.option("--frame-stats", &job.frame_stats,
                 "CSV of each frame's bits by section (header, camera, depth, motion, colour) and "
                 "blocks left out");

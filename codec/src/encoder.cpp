@@ -256,6 +256,9 @@ Status check_encoder_options(const EncoderOptions& o) {
         return bad("motion_error_px: 0 or 0.1..8 px");
     if (o.skip_threshold < 0 || o.skip_threshold > 255)
         return bad("skip_threshold " + std::to_string(o.skip_threshold) + ": expected 0..255");
+    if (o.slices < 0 || o.slices > kMaxSlices)
+        return bad("slices " + std::to_string(o.slices) + ": expected 0 (automatic) .. " +
+                   std::to_string(kMaxSlices));
     return {};
 }
 
@@ -326,7 +329,8 @@ Status Encoder::send_frame(const GBufferView& given) {
                                                    frame_objects(s.options, sp, frame, camera,
                                                                  nullptr, s.work.base_motion));
     }
-    sp.slices = default_slices(h);
+    sp.slices =
+        s.options.slices > 0 ? std::min(s.options.slices, (h + kMb - 1) / kMb) : default_slices(h);
     // A new frame rate (a server stepping down) needs no key frame: the sequence keeps its key
     // frame's fps, rate control takes the frame's own.
     const double fps = frame.fps > 0.0 ? frame.fps : s.options.fps;

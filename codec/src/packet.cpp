@@ -8,8 +8,11 @@
 namespace reprise::codec {
 
 int default_slices(int height) {
+    // One slice per 24 macroblock rows (720p: 2, 1080p: 3, 2160p: 6): each slice's models start
+    // at 1/2, so one per 8 rows cost 3-5 % of an inter frame at 1280x720, and the two cores' tasks
+    // ran no faster at 1080p.
     const int mb_rows = (height + kMb - 1) / kMb;
-    return std::clamp((mb_rows + 7) / 8, 1, kMaxSlices);
+    return std::clamp((mb_rows + 23) / 24, 1, kMaxSlices);
 }
 
 void write_packet(const PacketHeader& h, std::span<const uint8_t> payload,

@@ -61,6 +61,9 @@ struct EncoderOptions {
     // gets a rigid motion fitted to its pixels, from which both sides derive its pixels' motion
     // and predict its depth (docs/bitstream.md).
     bool rigid_objects = true;
+    // Slices coded in parallel, each with its own models (fewer cost fewer bits): 0 = one per 24
+    // macroblock rows (720p: 2, 1080p: 3); at most 64 and one per macroblock row.
+    int slices = 0;
 };
 
 enum class PacketType : uint8_t { Key = 0, Inter = 1 };
