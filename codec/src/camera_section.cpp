@@ -27,20 +27,19 @@ constexpr uint8_t kAllFlags =
 // then the f32s of code 3: a projection's zeros and a view's last row cost a quarter byte each.
 constexpr uint32_t kCodedBits[3] = {0x00000000u, 0x3F800000u, 0xBF800000u};
 
+int float_code(float v) {
+    int code = 0;
+    while (code < 3 && kCodedBits[code] != std::bit_cast<uint32_t>(v)) ++code;
+    return code;
+}
 void write_floats(ByteWriter& w, const float* v, int n) {
     uint8_t packed = 0;
     for (int i = 0; i < n; ++i) {
-        const uint32_t bits = std::bit_cast<uint32_t>(v[i]);
-        int code = 0;
-        while (code < 3 && kCodedBits[code] != bits) ++code;
-        packed |= uint8_t(code << (2 * (i % 4)));
+        packed |= uint8_t(float_code(v[i]) << (2 * (i % 4)));
         if (i % 4 == 3 || i == n - 1) w.u8(packed), packed = 0;
     }
     for (int i = 0; i < n; ++i)
-        if (std::bit_cast<uint32_t>(v[i]) != kCodedBits[0] &&
-            std::bit_cast<uint32_t>(v[i]) != kCodedBits[1] &&
-            std::bit_cast<uint32_t>(v[i]) != kCodedBits[2])
-            w.f32(v[i]);
+        if (float_code(v[i]) == 3) w.f32(v[i]);
 }
 void read_floats(ByteReader& r, float* v, int n) {
     uint8_t codes[16];

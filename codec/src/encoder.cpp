@@ -329,8 +329,7 @@ Status Encoder::send_frame(const GBufferView& given) {
                                                    frame_objects(s.options, sp, frame, camera,
                                                                  nullptr, s.work.base_motion));
     }
-    sp.slices =
-        s.options.slices > 0 ? std::min(s.options.slices, (h + kMb - 1) / kMb) : default_slices(h);
+    sp.slices = s.options.slices > 0 ? std::min(s.options.slices, sp.mb_rows()) : default_slices(h);
     // A new frame rate (a server stepping down) needs no key frame: the sequence keeps its key
     // frame's fps, rate control takes the frame's own.
     const double fps = frame.fps > 0.0 ? frame.fps : s.options.fps;
