@@ -5,7 +5,7 @@
 #include <cstring>
 #include <vector>
 
-#include "../codec/src/crc32c.hpp"
+#include "../codec/src/internal.hpp"
 #include "reprise/codec/codec.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
@@ -22,13 +22,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         const std::size_t n = std::min(length, size - at);
         packet.assign(data + at, data + at + n);
         at += n;
-        if (packet.size() >= 32) {
-            const uint32_t payload = uint32_t(packet.size() - 32);
-            std::memcpy(packet.data() + 24, &payload, 4);
-            uint32_t crc = reprise::codec::crc32c(std::span(packet).first(28), 0);
-            crc = reprise::codec::crc32c(std::span(packet).subspan(32), crc);
-            std::memcpy(packet.data() + 28, &crc, 4);
-        }
+        (void)reprise::codec::reseal_packet(packet);
         (void)decoder.send_packet(packet);
         while (decoder.receive_frame(frame) == reprise::Result::Ok) {
         }

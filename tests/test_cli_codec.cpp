@@ -201,12 +201,14 @@ TEST(CliCodec, DecodeWritesEveryDecodableFrameOfADamagedStream) {
     const std::string intact = (dir / "intact").string();
     ASSERT_EQ(test::run_reprise("decode " + rps + " --out " + intact, 120).status, 0);
     std::string stream = bytes_of(rps);
-    std::vector<std::size_t> offsets;  // of each packet: 32-byte header, payload length at 24
-    for (std::size_t at = 24; at + 32 <= stream.size();) {
-        offsets.push_back(at);
-        uint32_t length;
-        std::memcpy(&length, stream.data() + at + 24, 4);
-        at += 32 + length;
+    std::vector<std::size_t> offsets;  // of each packet
+    {
+        const std::span<const uint8_t> file(reinterpret_cast<const uint8_t*>(stream.data()),
+                                            stream.size());
+        codec::StreamInfo info;
+        std::vector<std::span<const uint8_t>> packets;
+        ASSERT_TRUE(codec::split_stream(file, info, packets).ok());
+        for (const auto& p : packets) offsets.push_back(std::size_t(p.data() - file.data()));
     }
     ASSERT_EQ(offsets.size(), 8u);
     // Frame 2 damaged (3 predicted from it, 4 a key frame), the file cut inside frame 7.

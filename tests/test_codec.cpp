@@ -10,6 +10,7 @@
 #include <glm/gtc/matrix_transform.hpp>
 
 #include "../codec/src/crc32c.hpp"
+#include "../codec/src/internal.hpp"
 #include "../codec/src/range_coder.hpp"
 #include "../codec/src/transform.hpp"
 #include "reprise/codec/codec.hpp"
@@ -58,11 +59,14 @@ using test::encode_all;
 
 using test::decode_all;
 
-void fix_crc(std::vector<uint8_t>& packet) {
-    if (packet.size() < 32) return;
-    uint32_t crc = crc32c(std::span(packet).first(28), 0);
-    crc = crc32c(std::span(packet).subspan(32), crc);
-    std::memcpy(packet.data() + 28, &crc, 4);
+void fix_crc(std::vector<uint8_t>& packet) { ASSERT_TRUE(reseal_packet(packet)); }
+
+// Where a packet's payload starts (its header's length varies with its fields).
+std::size_t payload_offset(const std::vector<uint8_t>& packet) {
+    PacketHeader h;
+    std::span<const uint8_t> payload;
+    EXPECT_TRUE(parse_packet(packet, h, payload).ok());
+    return std::size_t(payload.data() - packet.data());
 }
 
 }  // namespace
@@ -1011,7 +1015,7 @@ TEST(Codec, AKeyFrameWithAnAbsurdViewBoundIsRefused) {
     const Coded coded = encode_all(frames, {.depth = DepthMode::View});
     for (float bound : {0.0f, -1.0f, NAN, 1000.0f}) {
         auto bad = coded.packets[0].data;
-        std::memcpy(bad.data() + 32 + 10, &bound, 4);  // header; size, modes, depth bound
+        std::memcpy(bad.data() + payload_offset(bad) + 10, &bound, 4);  // size, modes, bound
         fix_crc(bad);
         Decoder decoder;
         const Status s = decoder.send_packet(bad);
@@ -1165,11 +1169,13 @@ TEST(Codec, BadPacketsGiveAStatusAndTheDecoderResumes) {
     rejected({}, "empty");
     rejected(std::vector<uint8_t>(good.begin(), good.begin() + 20), "truncated header");
     rejected(std::vector<uint8_t>(good.begin(), good.end() - 1), "truncated payload");
+    const std::size_t start = payload_offset(good);
     auto flipped = good;
-    flipped[40] ^= 0x10;
+    flipped[start + 8] ^= 0x10;
     rejected(flipped, "wrong CRC");
-    auto absurd = good;
-    absurd[24] = absurd[25] = absurd[26] = absurd[27] = 0xFF;
+    std::vector<uint8_t> absurd(good.begin(), good.begin() + std::ptrdiff_t(start) - 1);
+    for (uint8_t b : {0xFF, 0xFF, 0xFF, 0x7F}) absurd.push_back(b);  // a length above 2^34
+    absurd.insert(absurd.end(), good.begin() + std::ptrdiff_t(start), good.end());
     rejected(absurd, "absurd length");
     auto version = good;
     version[4] = uint8_t(good[4] + 1);
@@ -1180,11 +1186,10 @@ TEST(Codec, BadPacketsGiveAStatusAndTheDecoderResumes) {
     for (int trial = 0; trial < 300; ++trial) {
         auto damaged = coded.packets[1 + trial % 3].data;
         const int flips = 1 + int(rng() % 8);
+        const std::size_t at = payload_offset(damaged), end = damaged.size() - 4;
         for (int f = 0; f < flips; ++f)
-            damaged[32 + rng() % (damaged.size() - 32)] ^= uint8_t(1 + rng() % 255);
-        if (trial % 5 == 0) damaged.resize(32 + rng() % (damaged.size() - 32));
-        uint32_t length = uint32_t(damaged.size() - 32);
-        std::memcpy(damaged.data() + 24, &length, 4);
+            damaged[at + rng() % (end - at)] ^= uint8_t(1 + rng() % 255);
+        if (trial % 5 == 0) damaged.resize(at + rng() % (end - at) + 4);
         fix_crc(damaged);
         Decoder fresh;
         ASSERT_TRUE(fresh.send_packet(coded.packets[0].data).ok());

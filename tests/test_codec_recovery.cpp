@@ -86,14 +86,41 @@ void expect_lost(const LostFrames& l, uint32_t first, uint32_t last, bool open,
     EXPECT_EQ(l.reason, reason);
 }
 
-void put_u32(std::vector<uint8_t>& file, std::size_t at, uint32_t v) {
-    std::memcpy(file.data() + at, &v, 4);  // little-endian host
+// The payload length of the packet at `at` (the fifth varint after magic, version and type):
+// its offset and byte count.
+std::pair<std::size_t, std::size_t> length_field(const std::vector<uint8_t>& file, std::size_t at) {
+    std::size_t pos = at + 6;
+    for (int field = 0; field < 4; ++field)
+        while (file[pos++] & 0x80) {
+        }
+    std::size_t end = pos;
+    while (file[end++] & 0x80) {
+    }
+    return {pos, end - pos};
 }
 
-uint32_t get_u32(const std::vector<uint8_t>& file, std::size_t at) {
-    uint32_t v;
-    std::memcpy(&v, file.data() + at, 4);
-    return v;
+uint64_t varint_at(const std::vector<uint8_t>& file, std::size_t pos) {
+    uint64_t v = 0;
+    for (int shift = 0;; shift += 7) {
+        v |= uint64_t(file[pos] & 0x7F) << shift;
+        if (!(file[pos++] & 0x80)) return v;
+    }
+}
+
+// v as a varint of exactly n bytes (high groups zero where v is small).
+std::vector<uint8_t> varint_of(uint64_t v, std::size_t n) {
+    std::vector<uint8_t> out;
+    for (std::size_t i = 0; i < n; ++i, v >>= 7)
+        out.push_back(uint8_t((v & 0x7F) | (i + 1 < n ? 0x80 : 0)));
+    return out;
+}
+
+// A false packet header (an inter frame 1 from frame 0) claiming `length` payload bytes: 14 bytes.
+std::vector<uint8_t> fake_header(uint8_t version, uint32_t length) {
+    std::vector<uint8_t> fake = {'R', 'P', 'K', 'T', version, 1, 1, 1, 0, 0};
+    const std::vector<uint8_t> l = varint_of(length, 4);
+    fake.insert(fake.end(), l.begin(), l.end());
+    return fake;
 }
 
 }  // namespace
@@ -150,10 +177,14 @@ TEST(CodecRecovery, TruncatedTailKeepsTheWholePackets) {
 
 TEST(CodecRecovery, BadLengthInTheMiddleLosesThatFrameAndItsDependants) {
     const Stream s = make_stream();
-    const std::size_t length_at = s.offsets[3] + 24;
-    for (const uint32_t delta : {1000u, 7u, uint32_t(-9)}) {  // longer, shorter
+    const auto [length_at, length_bytes] = length_field(s.file, s.offsets[3]);
+    const uint64_t length = varint_at(s.file, length_at);
+    for (const int64_t delta : {100, 7, -9}) {  // longer, shorter (the field keeps its size)
         std::vector<uint8_t> file = s.file;
-        put_u32(file, length_at, get_u32(file, length_at) + delta);
+        ASSERT_LT(int64_t(length) + delta, int64_t(1) << (7 * length_bytes)) << delta;
+        const std::vector<uint8_t> field =
+            varint_of(uint64_t(int64_t(length) + delta), length_bytes);
+        std::copy(field.begin(), field.end(), file.begin() + std::ptrdiff_t(length_at));
         const Decoded d = decode(file);
         // Frame 4 is predicted from 3; frame 5 is a key frame.
         expect_frames(d, {0, 1, 2, 5, 6, 7, 8, 9, 10, 11});
@@ -166,7 +197,10 @@ TEST(CodecRecovery, BadLengthInTheMiddleLosesThatFrameAndItsDependants) {
     }
     // A length past the end of the file: named as such.
     std::vector<uint8_t> file = s.file;
-    put_u32(file, length_at, 1u << 27);
+    const std::vector<uint8_t> far = varint_of(1u << 27, 4);
+    file.erase(file.begin() + std::ptrdiff_t(length_at),
+               file.begin() + std::ptrdiff_t(length_at + length_bytes));
+    file.insert(file.begin() + std::ptrdiff_t(length_at), far.begin(), far.end());
     const Decoded d = decode(file);
     expect_frames(d, {0, 1, 2, 5, 6, 7, 8, 9, 10, 11});
     ASSERT_EQ(d.report.damage.size(), 1u);
@@ -212,9 +246,8 @@ TEST(CodecRecovery, GarbageBetweenPacketsIsSkipped) {
     for (uint8_t& b : garbage) b = uint8_t(rng());
     // A false packet header in the garbage, with a length that fits the file.
     const uint8_t version = s.file[s.offsets[0] + 4];
-    std::vector<uint8_t> fake = {'R', 'P', 'K', 'T', version, 1, 0, 0};
+    const std::vector<uint8_t> fake = fake_header(version, 500);
     garbage.insert(garbage.begin() + 100, fake.begin(), fake.end());
-    put_u32(garbage, 100 + 24, 500);
     std::vector<uint8_t> file = s.file;
     file.insert(file.begin() + std::ptrdiff_t(s.offsets[7]), garbage.begin(), garbage.end());
     // And some before the first packet and after the last.
@@ -250,11 +283,11 @@ TEST(CodecRecovery, FalseHeadersCostBoundedWork) {
     const Stream s = make_stream();
     std::vector<uint8_t> file(s.file.begin(), s.file.begin() + 24);
     const uint8_t version = s.file[s.offsets[0] + 4];
-    std::vector<uint8_t> fake = {'R', 'P', 'K', 'T', version, 1, 0, 0};
-    fake.resize(32);
     const std::size_t count = (std::size_t(4) << 20) / 32;
-    for (std::size_t i = 0; i < count; ++i) {
-        put_u32(fake, 24, uint32_t((count - i - 1) * 32));
+    for (std::size_t i = 0; i < count; ++i) {  // 32 bytes each, the rest of the file its payload
+        std::vector<uint8_t> fake =
+            fake_header(version, uint32_t((count - i - 1) * 32 + 32 - 14 - 4));
+        fake.resize(32);
         file.insert(file.end(), fake.begin(), fake.end());
     }
     StreamInfo info;

@@ -216,9 +216,9 @@ struct Encoder::State {
         color = encode_color(fc, source_planes, pic.depth.view(), motion, qp_now,
                              options.skip_threshold, pic.planes, section, fs);
         append_section(payload, section);
-        // The packet header, key frame parameters and section lengths.
-        fs.header_bits = 8 * (kPacketHeaderSize + payload.size()) -
-                         (fs.camera_bits + fs.depth_bits + fs.motion_bits + fs.color_bits);
+        // The key frame parameters and section lengths (the packet header is added once written).
+        fs.header_bits =
+            8 * payload.size() - (fs.camera_bits + fs.depth_bits + fs.motion_bits + fs.color_bits);
         pic.camera = camera;
         pic.time = camera.time;
         pic.frame = next_frame;
@@ -363,19 +363,13 @@ Status Encoder::send_frame(const GBufferView& given) {
             --attempt;
             continue;
         }
-        const double bits = 8.0 * (payload.size() + kPacketHeaderSize);
+        const double bits = 8.0 * double(payload.size() + kMaxPacketHeader + 4);
         const double limit = target_bits * (ref < 0 ? 6.0 : 3.0);
         if (target_bits > 0 && bits > limit && qp < 51 && attempt < 3) {
             qp = std::min(51, qp + 6);
             continue;
         }
         break;
-    }
-    if (target_bits > 0) {
-        const double bits = 8.0 * (payload.size() + kPacketHeaderSize);
-        s.qp_state = std::clamp(
-            s.qp_state + 0.5 * 6.0 * std::log2(std::max(bits, 1.0) / target_bits), 4.0, 51.0);
-        s.qp = int(std::lround(s.qp_state));
     }
 
     const bool key = ref < 0;
@@ -389,6 +383,13 @@ Status Encoder::send_frame(const GBufferView& given) {
         header.kept = uint16_t(s.next_frame - s.refs[kept].frame);
     Packet packet;
     write_packet(header, payload, packet.data);
+    fs.header_bits += 8 * (packet.data.size() - payload.size());
+    if (target_bits > 0) {  // from the packet's size, as Encoder::resume replays it
+        const double bits = 8.0 * double(packet.data.size());
+        s.qp_state = std::clamp(
+            s.qp_state + 0.5 * 6.0 * std::log2(std::max(bits, 1.0) / target_bits), 4.0, 51.0);
+        s.qp = int(std::lround(s.qp_state));
+    }
     packet.frame = header.frame;
     packet.reference = header.reference;
     packet.type = header.type;

@@ -14,8 +14,9 @@ namespace reprise::codec {
 
 inline constexpr uint32_t kPacketMagic = 0x544B5052;  // "RPKT"
 inline constexpr uint32_t kFileMagic = 0x53525052;    // "RPRS"
-inline constexpr uint8_t kVersion = 15;
-inline constexpr std::size_t kPacketHeaderSize = 32;
+inline constexpr uint8_t kVersion = 16;
+// The longest packet header: magic, version, type and five varints (the CRC follows the payload).
+inline constexpr std::size_t kMaxPacketHeader = 6 + 5 + 5 + 3 + 10 + 5;
 inline constexpr std::size_t kMaxPayload = 256u << 20;
 inline constexpr int kMaxSide = 16384;
 inline constexpr int kMaxSlices = 64;
@@ -71,7 +72,7 @@ struct Picture {
     double time = 0.0;
 };
 
-// --- packet.cpp: the 32-byte packet header (docs/bitstream.md) and the key frame's parameters.
+// --- packet.cpp: the packet header and CRC (docs/bitstream.md) and the key frame's parameters.
 struct PacketHeader {
     PacketType type = PacketType::Key;
     uint32_t frame = 0, reference = 0;
@@ -82,6 +83,10 @@ void write_packet(const PacketHeader& header, std::span<const uint8_t> payload,
                   std::vector<uint8_t>& out);
 Status parse_packet(std::span<const uint8_t> packet, PacketHeader& header,
                     std::span<const uint8_t>& payload);
+// A packet whose bytes were changed, with its payload length and CRC made to fit again (tests,
+// fuzzing): the bytes between the header and the last four are the payload. False when the
+// header's fields do not read.
+bool reseal_packet(std::vector<uint8_t>& packet);
 void write_params(const SequenceParams& sp, std::vector<uint8_t>& out);
 Status read_params(ByteReader& r, SequenceParams& sp);
 int default_slices(int height);

@@ -15,38 +15,19 @@ int default_slices(int height) {
     return std::clamp((mb_rows + 23) / 24, 1, kMaxSlices);
 }
 
-void write_packet(const PacketHeader& h, std::span<const uint8_t> payload,
-                  std::vector<uint8_t>& out) {
-    out.clear();
-    ByteWriter w(out);
-    w.u32(kPacketMagic);
-    w.u8(kVersion);
-    w.u8(uint8_t(h.type));
-    w.u16(h.kept);
-    w.u32(h.frame);
-    w.u32(h.reference);
-    w.u64(uint64_t(h.timestamp_us));
-    w.u32(uint32_t(payload.size()));
-    w.bytes(payload);
-    const uint32_t crc = crc32c(std::span(out).first(28), 0);
-    const uint32_t full = crc32c(std::span(out).subspan(28), crc);
-    std::vector<uint8_t> tail;
-    ByteWriter(tail).u32(full);
-    out.insert(out.begin() + 28, tail.begin(), tail.end());
-}
+namespace {
 
-Status parse_packet(std::span<const uint8_t> packet, PacketHeader& h,
-                    std::span<const uint8_t>& payload) {
-    ByteReader r(packet, "packet header");
+uint64_t zigzag(int64_t v) { return (uint64_t(v) << 1) ^ uint64_t(v >> 63); }
+int64_t unzigzag(uint64_t u) { return int64_t(u >> 1) ^ -int64_t(u & 1); }
+
+// The header's fields up to the payload (docs/bitstream.md section 2); `length` is the payload's.
+Status read_header(ByteReader& r, PacketHeader& h, uint64_t& length) {
     const uint32_t magic = r.u32();
     const uint8_t version = r.u8();
     const uint8_t type = r.u8();
-    h.kept = r.u16();
-    h.frame = r.u32();
-    h.reference = r.u32();
-    h.timestamp_us = int64_t(r.u64());
-    const uint32_t length = r.u32();
-    const uint32_t crc = r.u32();
+    const uint64_t frame = r.varint(), distance = r.varint(), kept = r.varint();
+    h.timestamp_us = unzigzag(r.varint());
+    length = r.varint();
     if (!r.ok()) return Status::error(r.error());
     if (magic != kPacketMagic)
         return Status::error("packet header: bad magic (not a reprise packet)");
@@ -56,24 +37,84 @@ Status parse_packet(std::span<const uint8_t> packet, PacketHeader& h,
                              "; re-encode the stream)");
     if (type > uint8_t(PacketType::Inter))
         return Status::error("packet header: unknown type " + std::to_string(type));
+    if (frame > 0xFFFFFFFFu)
+        return Status::error("packet header: frame number " + std::to_string(frame) +
+                             " above 2^32 - 1");
+    h.type = PacketType(type);
+    h.frame = uint32_t(frame);
+    if (h.type == PacketType::Key ? distance != 0 : distance == 0 || distance > frame)
+        return Status::error("packet header: frame " + std::to_string(frame) +
+                             (h.type == PacketType::Key
+                                  ? " is a key frame and names a reference"
+                                  : " names reference distance " + std::to_string(distance)));
+    h.reference = uint32_t(frame - distance);
+    if (kept > 0 && (h.type == PacketType::Key || kept > frame || kept > 0xFFFF))
+        return Status::error(
+            "packet header: frame " + std::to_string(frame) + " keeps frame " +
+            std::to_string(int64_t(frame) - int64_t(std::min<uint64_t>(kept, 1u << 40))) +
+            (h.type == PacketType::Key ? " (a key frame keeps none)" : ""));
+    h.kept = uint16_t(kept);
     if (length > kMaxPayload)
         return Status::error("packet header: payload length " + std::to_string(length) +
                              " above the maximum");
-    if (length != r.remaining())
+    return {};
+}
+
+}  // namespace
+
+void write_packet(const PacketHeader& h, std::span<const uint8_t> payload,
+                  std::vector<uint8_t>& out) {
+    out.clear();
+    ByteWriter w(out);
+    w.u32(kPacketMagic);
+    w.u8(kVersion);
+    w.u8(uint8_t(h.type));
+    w.varint(h.frame);
+    w.varint(h.frame - h.reference);
+    w.varint(h.kept);
+    w.varint(zigzag(h.timestamp_us));
+    w.varint(payload.size());
+    w.bytes(payload);
+    w.u32(crc32c(out, 0));
+}
+
+bool reseal_packet(std::vector<uint8_t>& packet) {
+    ByteReader r(packet, "packet header");
+    const uint32_t magic = r.u32();
+    const uint8_t version = r.u8(), type = r.u8();
+    uint64_t fields[4];
+    for (uint64_t& f : fields) f = r.varint();
+    (void)r.varint();  // the payload length, written again
+    if (!r.ok()) return false;
+    const std::size_t end =
+        std::max(r.position(), packet.size() - std::min<std::size_t>(4, packet.size()));
+    const std::vector<uint8_t> payload(packet.begin() + std::ptrdiff_t(r.position()),
+                                       packet.begin() + std::ptrdiff_t(end));
+    packet.clear();
+    ByteWriter w(packet);
+    w.u32(magic);
+    w.u8(version);
+    w.u8(type);
+    for (uint64_t f : fields) w.varint(f);
+    w.varint(payload.size());
+    w.bytes(payload);
+    w.u32(crc32c(packet, 0));
+    return true;
+}
+
+Status parse_packet(std::span<const uint8_t> packet, PacketHeader& h,
+                    std::span<const uint8_t>& payload) {
+    ByteReader r(packet, "packet header");
+    uint64_t length = 0;
+    REPRISE_TRY(read_header(r, h, length));
+    if (r.remaining() < 4 || length != r.remaining() - 4)
         return Status::error("packet header: payload length " + std::to_string(length) + " but " +
-                             std::to_string(r.remaining()) + " bytes follow");
-    const uint32_t expected = crc32c(packet.subspan(28 + 4), crc32c(packet.first(28), 0));
-    if (crc != expected)
-        return Status::error("packet " + std::to_string(h.frame) + ": CRC mismatch");
-    h.type = PacketType(type);
-    if (h.type == PacketType::Key && h.reference != h.frame)
-        return Status::error("packet header: key frame " + std::to_string(h.frame) +
-                             " names a reference");
-    if (h.kept > 0 && (h.type == PacketType::Key || h.kept > h.frame))
-        return Status::error("packet header: frame " + std::to_string(h.frame) + " keeps frame " +
-                             std::to_string(int64_t(h.frame) - h.kept) +
-                             (h.type == PacketType::Key ? " (a key frame keeps none)" : ""));
+                             std::to_string(r.remaining() < 4 ? 0 : r.remaining() - 4) +
+                             " bytes follow before the CRC");
     payload = r.bytes(length);
+    const uint32_t crc = r.u32();
+    if (crc != crc32c(packet.first(packet.size() - 4), 0))
+        return Status::error("packet " + std::to_string(h.frame) + ": CRC mismatch");
     return {};
 }
 
@@ -169,22 +210,19 @@ std::string packet_at(std::span<const uint8_t> file, std::size_t at, std::size_t
     if (!std::equal(file.begin() + std::ptrdiff_t(at),
                     file.begin() + std::ptrdiff_t(at + std::min<std::size_t>(remaining, 4)), magic))
         return "no packet header (bad magic)";
-    if (remaining < kPacketHeaderSize)
-        return "the file ends inside a packet header (" + std::to_string(remaining) + " bytes)";
-    ByteReader r(file.subspan(at + 4, kPacketHeaderSize - 4), "packet header");
-    const uint8_t version = r.u8(), type = r.u8();
-    const uint16_t flags = r.u16();
-    const uint32_t frame = r.u32();
-    (void)r.u32();
-    (void)r.u64();
-    const uint32_t length = r.u32();
-    const std::string named = "packet header of frame " + std::to_string(frame);
-    if (version != kVersion || type > uint8_t(PacketType::Inter) || flags)
-        return named + ": version, type or flags out of range";
-    if (length > kMaxPayload || length > remaining - kPacketHeaderSize)
-        return named + ": runs past the end of the file (payload length " + std::to_string(length) +
-               ", " + std::to_string(remaining - kPacketHeaderSize) + " bytes follow)";
-    size = kPacketHeaderSize + length;
+    ByteReader r(file.subspan(at, std::min(remaining, kMaxPacketHeader)), "packet header");
+    PacketHeader header;
+    uint64_t length = 0;
+    if (const Status s = read_header(r, header, length); !s.ok())
+        return !r.ok() && remaining < kMaxPacketHeader ? "the file ends inside a packet header (" +
+                                                             std::to_string(remaining) + " bytes)"
+                                                       : s.message();
+    const std::size_t after = remaining - r.position();
+    if (after < 4 || length > after - 4)
+        return "packet header of frame " + std::to_string(header.frame) +
+               ": runs past the end of the file (payload length " + std::to_string(length) + ", " +
+               std::to_string(after < 4 ? 0 : after - 4) + " bytes follow before a CRC)";
+    size = r.position() + std::size_t(length) + 4;
     budget -= std::min(budget, size);
     PacketHeader h;
     std::span<const uint8_t> payload;

@@ -21,7 +21,8 @@ codec::EncoderOptions encoder_options(int qp, int bitrate_kbps, double fps, int 
                                       const std::string& chroma, const std::string& depth,
                                       float depth_error, float view_error_px,
                                       float view_displacement, float motion_error_px,
-                                      int skip_threshold, bool detect_cuts, bool bounds_follow_qp) {
+                                      int skip_threshold, bool detect_cuts, bool bounds_follow_qp,
+                                      int slices) {
     codec::EncoderOptions o{.qp = qp,
                             .bitrate_kbps = bitrate_kbps,
                             .fps = fps,
@@ -32,7 +33,8 @@ codec::EncoderOptions encoder_options(int qp, int bitrate_kbps, double fps, int 
                             .motion_error_px = motion_error_px,
                             .bounds_follow_qp = bounds_follow_qp,
                             .skip_threshold = skip_threshold,
-                            .detect_cuts = detect_cuts};
+                            .detect_cuts = detect_cuts,
+                            .slices = slices};
     if (chroma == "420")
         o.chroma = codec::Chroma::C420;
     else if (chroma == "444")
@@ -138,10 +140,12 @@ void bind_codec(py::module_& m) {
     auto options_init = [](int qp, int bitrate_kbps, double fps, int keyint,
                            const std::string& chroma, const std::string& depth, float depth_error,
                            float view_error_px, float view_displacement, float motion_error_px,
-                           int skip_threshold, bool detect_cuts, bool bounds_follow_qp) {
-        return std::make_unique<PyEncoder>(encoder_options(
-            qp, bitrate_kbps, fps, keyint, chroma, depth, depth_error, view_error_px,
-            view_displacement, motion_error_px, skip_threshold, detect_cuts, bounds_follow_qp));
+                           int skip_threshold, bool detect_cuts, bool bounds_follow_qp,
+                           int slices) {
+        return std::make_unique<PyEncoder>(
+            encoder_options(qp, bitrate_kbps, fps, keyint, chroma, depth, depth_error,
+                            view_error_px, view_displacement, motion_error_px, skip_threshold,
+                            detect_cuts, bounds_follow_qp, slices));
     };
     py::class_<PyEncoder>(m, "Encoder",
                           "Scene-aware predictive encoder: one packet (bytes) per frame "
@@ -151,7 +155,8 @@ void bind_codec(py::module_& m) {
              py::arg("depth") = "view", py::arg("depth_error") = 1e-4f,
              py::arg("view_error_px") = 0.25f, py::arg("view_displacement") = 0.164f,
              py::arg("motion_error_px") = 0.25f, py::arg("skip_threshold") = 2,
-             py::arg("detect_cuts") = true, py::arg("bounds_follow_qp") = true)
+             py::arg("detect_cuts") = true, py::arg("bounds_follow_qp") = true,
+             py::arg("slices") = 0)
         .def("encode", &PyEncoder::encode, py::arg("frame"), "The packet of the next frame.")
         .def("request_key_frame", [](PyEncoder& e) { e.encoder.request_key_frame(); })
         .def_property_readonly(
@@ -193,13 +198,13 @@ void bind_codec(py::module_& m) {
                        double fps, int keyint, const std::string& chroma, const std::string& depth,
                        float depth_error, float view_error_px, float view_displacement,
                        float motion_error_px, int skip_threshold, bool detect_cuts,
-                       bool bounds_follow_qp) {
+                       bool bounds_follow_qp, int slices) {
             if (frames.empty()) value_error("encode_stream: no frames");
             for (const Frame* f : frames)
                 if (!f) type_error("encode_stream: None in the frame list");
             auto encoder = options_init(qp, bitrate_kbps, fps, keyint, chroma, depth, depth_error,
                                         view_error_px, view_displacement, motion_error_px,
-                                        skip_threshold, detect_cuts, bounds_follow_qp);
+                                        skip_threshold, detect_cuts, bounds_follow_qp, slices);
             std::vector<uint8_t> file;
             const double stream_fps = frames[0]->fps > 0.0 ? frames[0]->fps : fps;
             check(codec::write_stream_header(file, frames[0]->width(), frames[0]->height(),
@@ -215,7 +220,7 @@ void bind_codec(py::module_& m) {
         py::arg("depth_error") = 1e-4f, py::arg("view_error_px") = 0.25f,
         py::arg("view_displacement") = 0.164f, py::arg("motion_error_px") = 0.25f,
         py::arg("skip_threshold") = 2, py::arg("detect_cuts") = true,
-        py::arg("bounds_follow_qp") = true,
+        py::arg("bounds_follow_qp") = true, py::arg("slices") = 0,
         "A whole .rps stream (file header + packets) of the frames.");
     m.def(
         "decode_stream",

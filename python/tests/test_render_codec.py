@@ -92,6 +92,15 @@ def test_codec_streams_and_bad_packets(pan_60):
         decoder.decode(np.zeros(4, np.float32))
     with pytest.raises(ValueError):
         reprise.Encoder(qp=99)
+    # Slices: by default one per 24 macroblock rows (one at 160x96); each more restarts the models.
+    one = reprise.encode_stream(pan_60[:2], qp=30)
+    assert reprise.encode_stream(pan_60[:2], qp=30, slices=1) == one
+    three = reprise.encode_stream(pan_60[:2], qp=30, slices=3)
+    assert len(three) > len(one)  # each slice: its length, its flush, its models from 1/2
+    assert len(reprise.decode_stream(three)) == 2
+    for slices in (-1, 65):
+        with pytest.raises(ValueError, match="slices"):
+            reprise.Encoder(slices=slices)
     # Above qp 34 the view and motion bounds follow the quantiser unless told not to.
     coarse = reprise.encode_stream(pan_60[:3], qp=46)
     fixed = reprise.encode_stream(pan_60[:3], qp=46, bounds_follow_qp=False)
@@ -112,12 +121,22 @@ def test_anti_aliasing_changes_color_only(renderer):
 
 
 def _packet_offsets(stream):
-    """Where each packet of a .rps file starts: a 24-byte file header, then 32-byte packet
-    headers with the payload length at byte 24."""
+    """Where each packet of a .rps file starts: a 24-byte file header, then packets of magic,
+    version, type, five varints (the last the payload length), the payload and a 4-byte CRC."""
     offsets, at = [], 24
-    while at + 32 <= len(stream):
+    while at + 6 < len(stream):
         offsets.append(at)
-        at += 32 + int.from_bytes(stream[at + 24:at + 28], "little")
+        pos, value = at + 6, 0
+        for _ in range(5):
+            value, shift = 0, 0
+            while True:
+                byte = stream[pos]
+                pos += 1
+                value |= (byte & 0x7F) << shift
+                shift += 7
+                if byte < 0x80:
+                    break
+        at = pos + value + 4
     return offsets
 
 
