@@ -23,8 +23,6 @@ namespace reprise::codec {
 
 namespace {
 
-constexpr uint32_t kInfCode = (1u << 30) + 1;
-constexpr uint32_t kInvalidCode = (1u << 30) + 2;
 constexpr int kBlock = 8;
 constexpr uint8_t kAllPredicted = 1;
 constexpr uint8_t kOwnStep = 2;  // view depth: this frame's 1/z step follows (f32)
@@ -32,7 +30,6 @@ constexpr float kMinViewStep = 1e-12f, kMaxViewStep = 1e6f;
 
 // View-mode codes are k = round(1/z / (q / 32)) in 0..2^30 (k = 0 decodes as half a code), for
 // the view step q; residuals count steps of 33 codes, so the nearest choice errs by at most q / 2.
-constexpr uint32_t kMaxViewCode = 1u << 30;
 constexpr int kViewResidualStep = kViewCodesPerStep + 1;
 
 struct Mapping {
@@ -364,6 +361,28 @@ inline uint64_t pixel_cost(const SliceJob& j, int x, int y, bool temporal, uint3
 }
 
 }  // namespace
+
+void view_code_row_reference(const ViewCodeRow& r, int i_begin, int i_end) {
+    for (int i = i_begin; i < i_end; ++i) {
+        const float z = r.depth[i];
+        r.out[i] = std::isnan(z)   ? kNoPrediction
+                   : z == INFINITY ? kInfCode
+                   : !(z > 0.0f && z < INFINITY)
+                       ? kInvalidCode
+                       : uint32_t(std::min(std::nearbyint(1.0 / double(z) / r.step),
+                                           double(kMaxViewCode)));
+    }
+}
+
+void view_depth_row_reference(const ViewDepthRow& r, int i_begin, int i_end) {
+    for (int i = i_begin; i < i_end; ++i) {
+        const uint32_t c = r.codes[i];
+        const float z = float(1.0 / (c == 0 ? 0.5 * r.step : double(c) * r.step));
+        r.out[i] = c <= kMaxViewCode ? z
+                   : c == kInfCode   ? std::numeric_limits<float>::infinity()
+                                     : std::numeric_limits<float>::quiet_NaN();
+    }
+}
 
 void view_keep_row_reference(const ViewKeepRow& r, int i_begin, int i_end) {
     for (int i = i_begin; i < i_end; ++i) {
@@ -750,11 +769,17 @@ void temporal_codes(const FrameContext& fc, const Camera& camera, const Mapping&
                     map.view ? surface_step(*fc.sp, map) : 0.0f);
     ensure_size(out, w, h);
     parallel_for(0, h, [&](int y0, int y1) {
-        for (int y = y0; y < y1; ++y)
+        for (int y = y0; y < y1; ++y) {
+            if (map.view) {
+                view_code_row(
+                    {.depth = &projected(0, y), .count = w, .step = map.step, .out = &out(0, y)});
+                continue;
+            }
             for (int x = 0; x < w; ++x) {
                 const float z = projected(x, y);
                 out(x, y) = std::isnan(z) ? kNoPrediction : map.code(z);
             }
+        }
     });
 }
 
@@ -776,16 +801,11 @@ void depth_from_codes(const Mapping& map, const Image<uint32_t>& codes, Image<fl
     ensure_size(out, codes.width(), codes.height());
     parallel_for(0, codes.height(), [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y) {
-            if (map.view) {  // map.depth without branches (most codes differ from their left)
-                const uint32_t* row = &codes(0, y);
-                float* o = &out(0, y);
-                for (int x = 0; x < codes.width(); ++x) {
-                    const uint32_t c = row[x];
-                    const float z = float(1.0 / (c == 0 ? 0.5 * map.step : double(c) * map.step));
-                    o[x] = c <= kMaxViewCode ? z
-                           : c == kInfCode   ? std::numeric_limits<float>::infinity()
-                                             : std::numeric_limits<float>::quiet_NaN();
-                }
+            if (map.view) {  // map.depth of each code (most differ from their left)
+                view_depth_row({.codes = &codes(0, y),
+                                .count = codes.width(),
+                                .step = map.step,
+                                .out = &out(0, y)});
                 continue;
             }
             uint32_t last = codes(0, y);

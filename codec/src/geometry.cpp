@@ -197,9 +197,9 @@ struct Landings {
 void fill_cracks(ImageView<float> depth, Image<float>& scratch, float step) {
     const int w = depth.width, h = depth.height;
     auto mean = [step](float a, float b) {
+        if (!(a < kInf && b < kInf)) return kNan;  // nothing landed there, or background
         const float va = 1.0f / a, vb = 1.0f / b;
-        return a < kInf && b < kInf &&
-                       std::abs(va - vb) <= std::max(kSameSurface * std::max(va, vb), 2.0f * step)
+        return std::abs(va - vb) <= std::max(kSameSurface * std::max(va, vb), 2.0f * step)
                    ? 2.0f / (va + vb)
                    : kNan;
     };

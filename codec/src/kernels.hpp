@@ -176,7 +176,34 @@ struct ViewKeepRow {
 };
 void view_keep_row_reference(const ViewKeepRow& row, int i_begin, int i_end);
 void view_keep_row(const ViewKeepRow& row);
-inline constexpr uint32_t kNoPrediction = 0xFFFFFFFFu;  // no depth code maps here
-inline constexpr int kViewCodesPerStep = 32;            // view-mode codes per step q of 1/z
+inline constexpr uint32_t kNoPrediction = 0xFFFFFFFFu;    // no depth code maps here
+inline constexpr int kViewCodesPerStep = 32;              // view-mode codes per step q of 1/z
+inline constexpr uint32_t kMaxViewCode = 1u << 30;        // view codes of surfaces: 0..2^30
+inline constexpr uint32_t kInfCode = (1u << 30) + 1;      // background (+inf)
+inline constexpr uint32_t kInvalidCode = (1u << 30) + 2;  // NaN, zero or negative depth
+
+// View-mode codes of one row of the reprojected reference's depth (depth.cpp, temporal_codes):
+// NaN (nothing landed) kNoPrediction, +inf kInfCode, other depth that is not finite and
+// positive kInvalidCode, else min(k, 2^30) with k = 1 / z / step rounded half to even, in
+// binary64.
+struct ViewCodeRow {
+    const float* depth;
+    int count;
+    double step;  // 1/z per code
+    uint32_t* out;
+};
+void view_code_row_reference(const ViewCodeRow& row, int i_begin, int i_end);
+void view_code_row(const ViewCodeRow& row);
+
+// The depth of view-mode codes (depth.cpp, depth_from_codes): float(1 / (c step)) in binary64
+// (c = 0: 1 / (step / 2)) for c <= 2^30, +inf for kInfCode, NaN for any other code.
+struct ViewDepthRow {
+    const uint32_t* codes;
+    int count;
+    double step;
+    float* out;
+};
+void view_depth_row_reference(const ViewDepthRow& row, int i_begin, int i_end);
+void view_depth_row(const ViewDepthRow& row);
 
 }  // namespace reprise::codec

@@ -336,9 +336,6 @@ const ObjectMotion* same_id(const std::vector<ObjectMotion>* reference, uint64_t
     return nullptr;
 }
 
-inline uint64_t zigzag(int64_t v) { return (uint64_t(v) << 1) ^ uint64_t(v >> 63); }
-inline int64_t unzigzag(uint64_t u) { return int64_t(u >> 1) ^ -int64_t(u & 1); }
-
 // The six floats of an object in order: rotation, translation.
 template <class O>
 auto floats(O& o) {

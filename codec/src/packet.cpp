@@ -17,9 +17,6 @@ int default_slices(int height) {
 
 namespace {
 
-uint64_t zigzag(int64_t v) { return (uint64_t(v) << 1) ^ uint64_t(v >> 63); }
-int64_t unzigzag(uint64_t u) { return int64_t(u >> 1) ^ -int64_t(u & 1); }
-
 // The header's fields up to the payload (docs/bitstream.md section 2); `length` is the payload's.
 Status read_header(ByteReader& r, PacketHeader& h, uint64_t& length) {
     const uint32_t magic = r.u32();
@@ -51,7 +48,7 @@ Status read_header(ByteReader& r, PacketHeader& h, uint64_t& length) {
     if (kept > 0 && (h.type == PacketType::Key || kept > frame || kept > 0xFFFF))
         return Status::error(
             "packet header: frame " + std::to_string(frame) + " keeps frame " +
-            std::to_string(int64_t(frame) - int64_t(std::min<uint64_t>(kept, 1u << 40))) +
+            std::to_string(int64_t(frame) - int64_t(std::min<uint64_t>(kept, uint64_t(1) << 40))) +
             (h.type == PacketType::Key ? " (a key frame keeps none)" : ""));
     h.kept = uint16_t(kept);
     if (length > kMaxPayload)

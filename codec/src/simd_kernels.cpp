@@ -482,6 +482,60 @@ void ViewKeepRowSimd(const ViewKeepRow& r) {
     view_keep_row_reference(r, i, r.count);
 }
 
+void ViewCodeRowSimd(const ViewCodeRow& r) {
+    const hn::ScalableTag<double> dd;
+    const hn::Rebind<float, decltype(dd)> df;
+    const hn::Rebind<int32_t, decltype(dd)> di;
+    using VD = hn::Vec<decltype(dd)>;
+    const int n = int(hn::Lanes(dd));
+    const VD one = hn::Set(dd, 1.0);
+    const VD step = hn::Set(dd, r.step), max_code = hn::Set(dd, double(kMaxViewCode));
+    const auto zero = hn::Zero(df), inf = hn::Set(df, HUGE_VALF), unit = hn::Set(df, 1.0f);
+    const auto none = hn::Set(di, int32_t(kNoPrediction));
+    const auto background = hn::Set(di, int32_t(kInfCode));
+    const auto invalid = hn::Set(di, int32_t(kInvalidCode));
+    int i = 0;
+    for (; i + n <= r.count; i += n) {
+        const auto z = hn::LoadU(df, r.depth + i);
+        const auto surface = hn::And(z > zero, z < inf);
+        // Lanes that are no surface divide 1 by 1; their code is replaced below.
+        const VD zd = hn::PromoteTo(dd, hn::IfThenElse(surface, z, unit));
+        const VD k = hn::Min(hn::Round(one / zd / step), max_code);
+        auto code = hn::IfThenElse(hn::RebindMask(di, surface), hn::DemoteTo(di, k), invalid);
+        code = hn::IfThenElse(hn::RebindMask(di, z == inf), background, code);
+        code = hn::IfThenElse(hn::RebindMask(di, hn::IsNaN(z)), none, code);
+        hn::StoreU(code, di, reinterpret_cast<int32_t*>(r.out) + i);
+    }
+    view_code_row_reference(r, i, r.count);
+}
+
+void ViewDepthRowSimd(const ViewDepthRow& r) {
+    const hn::ScalableTag<double> dd;
+    const hn::Rebind<float, decltype(dd)> df;
+    const hn::Rebind<int32_t, decltype(dd)> di;
+    const hn::Rebind<int64_t, decltype(dd)> di64;
+    using VD = hn::Vec<decltype(dd)>;
+    const int n = int(hn::Lanes(dd));
+    const VD zero = hn::Zero(dd), one = hn::Set(dd, 1.0);
+    const VD step = hn::Set(dd, r.step), half_step = hn::Set(dd, 0.5 * r.step);
+    const auto max_code = hn::Set(di, int32_t(kMaxViewCode)),
+               background = hn::Set(di, int32_t(kInfCode));
+    const auto inf = hn::Set(df, HUGE_VALF),
+               nan = hn::Set(df, std::numeric_limits<float>::quiet_NaN());
+    int i = 0;
+    for (; i + n <= r.count; i += n) {
+        // Codes above 2^31 read as negative int32: neither a surface's nor the background's.
+        const auto c = hn::LoadU(di, reinterpret_cast<const int32_t*>(r.codes) + i);
+        const VD cd = hn::ConvertTo(dd, hn::PromoteTo(di64, c));
+        const VD w = hn::IfThenElse(cd == zero, half_step, cd * step);
+        const auto surface = hn::Not(hn::Or(c<hn::Zero(di), c> max_code));
+        auto z = hn::IfThenElse(hn::RebindMask(df, surface), hn::DemoteTo(df, one / w), nan);
+        z = hn::IfThenElse(hn::RebindMask(df, c == background), inf, z);
+        hn::StoreU(z, df, r.out + i);
+    }
+    view_depth_row_reference(r, i, r.count);
+}
+
 }  // namespace reprise::codec::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
 
@@ -496,10 +550,16 @@ HWY_EXPORT(FromPlanesRowSimd);
 HWY_EXPORT(ForwardRowSimd);
 HWY_EXPORT(MotionResidualRowSimd);
 HWY_EXPORT(ViewKeepRowSimd);
+HWY_EXPORT(ViewCodeRowSimd);
+HWY_EXPORT(ViewDepthRowSimd);
 HWY_EXPORT(PlaneRowSimd);
 HWY_EXPORT(RevealRowSimd);
 
 void view_keep_row(const ViewKeepRow& row) { HWY_DYNAMIC_DISPATCH(ViewKeepRowSimd)(row); }
+
+void view_code_row(const ViewCodeRow& row) { HWY_DYNAMIC_DISPATCH(ViewCodeRowSimd)(row); }
+
+void view_depth_row(const ViewDepthRow& row) { HWY_DYNAMIC_DISPATCH(ViewDepthRowSimd)(row); }
 
 bool motion_residual_row(const MotionResidualRow& row) {
     return HWY_DYNAMIC_DISPATCH(MotionResidualRowSimd)(row);

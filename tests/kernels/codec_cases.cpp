@@ -540,6 +540,79 @@ private:
     std::vector<uint8_t> reference_, optimized_;
 };
 
+// View-mode codes of reprojected depth and the depth of codes. Random: depth of a scene (and
+// nothing landed one time in eight); codes near a depth's own and the background's; worst case:
+// NaN/Inf/zero/negative/denormal depths, codes around 2^30 and above 2^31, halfway quotients
+// (1 / z / step ties, which round to even).
+class ViewCodeCase final : public KernelCase {
+public:
+    void generate(int w, int h, KernelInputs inputs, uint32_t seed) override {
+        std::mt19937 rng(seed);
+        width_ = w, height_ = h;
+        const bool worst = inputs == KernelInputs::WorstCase;
+        step_ = seed % 3 == 0 ? 0x1p-12 : double(uniform(rng, 1e-6f, 1e-2f));
+        depth_.resize(std::size_t(w) * h);
+        codes_.resize(depth_.size());
+        for (std::size_t i = 0; i < depth_.size(); ++i) {
+            float z = rng() % 8 == 0 ? kNaN : random_depth(rng, 0.05f, 500.0f, worst);
+            if (worst && rng() % 8 == 0) {
+                const float extremes[] = {0.0f, -0.0f, -1.0f, 1e-45f, 1e-38f, 3e38f, -kInf};
+                z = extremes[rng() % std::size(extremes)];
+            }
+            if (step_ == 0x1p-12 && rng() % 4 == 0)  // 1 / z / step = k + 1/2 exactly
+                z = float(1.0 / ((double(rng() % 4096) + 0.5) * step_));
+            depth_[i] = z;
+            uint32_t c = rng() % 3 ? uint32_t(rng() % (1u << 20)) : kInfCode;
+            if (worst && rng() % 4 == 0) {
+                const uint32_t extremes[] = {0u,           1u,          kMaxViewCode, kInfCode,
+                                             kInvalidCode, 0x7FFFFFFFu, 0x80000000u,  0xFFFFFFFFu};
+                c = extremes[rng() % std::size(extremes)];
+            }
+            codes_[i] = c;
+        }
+    }
+    void run_reference() override {
+        run_into(
+            codes_reference_, depth_reference_,
+            [](const ViewCodeRow& r) { view_code_row_reference(r, 0, r.count); },
+            [](const ViewDepthRow& r) { view_depth_row_reference(r, 0, r.count); });
+    }
+    void run() override {
+        run_into(codes_optimized_, depth_optimized_, view_code_row, view_depth_row);
+    }
+    std::string compare() const override {
+        const std::string codes = compare_elements("code", codes_optimized_, codes_reference_);
+        return codes.empty() ? compare_floats("depth of a code", depth_optimized_, depth_reference_)
+                             : codes;
+    }
+
+private:
+    template <class CodeKernel, class DepthKernel>
+    void run_into(std::vector<uint32_t>& codes, std::vector<float>& depth, CodeKernel code_kernel,
+                  DepthKernel depth_kernel) {
+        codes.assign(depth_.size(), 7u);
+        depth.assign(depth_.size(), -7.0f);
+        parallel_for(0, height_, [&](int y0, int y1) {
+            for (int y = y0; y < y1; ++y) {
+                const std::size_t o = std::size_t(y) * width_;
+                code_kernel({.depth = depth_.data() + o,
+                             .count = width_,
+                             .step = step_,
+                             .out = codes.data() + o});
+                depth_kernel({.codes = codes_.data() + o,
+                              .count = width_,
+                              .step = step_,
+                              .out = depth.data() + o});
+            }
+        });
+    }
+
+    int width_ = 0, height_ = 0;
+    double step_ = 1e-4;
+    std::vector<float> depth_, depth_reference_, depth_optimized_;
+    std::vector<uint32_t> codes_, codes_reference_, codes_optimized_;
+};
+
 // The plane fit of depth reprojection. Random: landings of one tilted surface, stretched and
 // shifted, with holes (no landing) and a second object; worst case: NaN/Inf/zero/negative and
 // huge inverse depths, landings on a pixel's edge and degenerate planes (neighbours landing on
@@ -621,6 +694,7 @@ constexpr KernelEntry kEntries[] = {
     {"codec depth plane fit", "bit-exact", true, make<PlaneCase>},
     {"codec motion residual test", "bit-exact", true, make<MotionResidualCase>},
     {"codec view depth keeps its prediction", "bit-exact", true, make<ViewKeepCase>},
+    {"codec view depth codes and their depth", "bit-exact", true, make<ViewCodeCase>},
     {"codec colour to YCoCg-R", "bit-exact", true, make<ToPlanesCase>},
     {"codec YCoCg-R to colour", "bit-exact", true, make<FromPlanesCase>},
 };
