@@ -1167,16 +1167,32 @@ TEST(Codec, BadPacketsGiveAStatusAndTheDecoderResumes) {
         EXPECT_FALSE(s.message().empty());
     };
     rejected({}, "empty");
-    rejected(std::vector<uint8_t>(good.begin(), good.begin() + 20), "truncated header");
-    rejected(std::vector<uint8_t>(good.begin(), good.end() - 1), "truncated payload");
     const std::size_t start = payload_offset(good);
+    rejected(std::vector<uint8_t>(good.begin(), good.begin() + std::ptrdiff_t(start) - 1),
+             "truncated header");
+    rejected(std::vector<uint8_t>(good.begin(), good.end() - 1), "truncated payload");
     auto flipped = good;
     flipped[start + 8] ^= 0x10;
     rejected(flipped, "wrong CRC");
     std::vector<uint8_t> absurd(good.begin(), good.begin() + std::ptrdiff_t(start) - 1);
     for (uint8_t b : {0xFF, 0xFF, 0xFF, 0x7F}) absurd.push_back(b);  // a length above 2^34
     absurd.insert(absurd.end(), good.begin() + std::ptrdiff_t(start), good.end());
-    rejected(absurd, "absurd length");
+    EXPECT_NE(decoder.send_packet(absurd).message().find("above the maximum"), std::string::npos);
+    // The same fields as varints padded to 10 bytes each: a 56-byte header, refused.
+    std::vector<uint8_t> padded(good.begin(), good.begin() + 6);
+    std::size_t at = 6;
+    for (int field = 0; field < 5; ++field) {
+        uint64_t v = 0;
+        for (int shift = 0;; shift += 7)
+            if (v |= uint64_t(good[at] & 0x7F) << shift; !(good[at++] & 0x80)) break;
+        for (int i = 0; i < 10; ++i, v >>= 7)
+            padded.push_back(uint8_t((v & 0x7F) | (i < 9 ? 0x80 : 0)));
+    }
+    padded.insert(padded.end(), good.begin() + std::ptrdiff_t(at), good.end() - 4);
+    const uint32_t crc = crc32c(padded, 0);
+    for (int i = 0; i < 4; ++i) padded.push_back(uint8_t(crc >> (8 * i)));
+    EXPECT_NE(decoder.send_packet(padded).message().find("56 bytes (at most 34)"),
+              std::string::npos);
     auto version = good;
     version[4] = uint8_t(good[4] + 1);
     fix_crc(version);

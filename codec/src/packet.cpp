@@ -22,10 +22,8 @@ Status read_header(ByteReader& r, PacketHeader& h, uint64_t& length) {
     const uint32_t magic = r.u32();
     const uint8_t version = r.u8();
     const uint8_t type = r.u8();
-    const uint64_t frame = r.varint(), distance = r.varint(), kept = r.varint();
-    h.timestamp_us = unzigzag(r.varint());
-    length = r.varint();
     if (!r.ok()) return Status::error(r.error());
+    // Magic and version first: an older stream's fixed fields do not read as varints.
     if (magic != kPacketMagic)
         return Status::error("packet header: bad magic (not a reprise packet)");
     if (version != kVersion)
@@ -34,6 +32,13 @@ Status read_header(ByteReader& r, PacketHeader& h, uint64_t& length) {
                              "; re-encode the stream)");
     if (type > uint8_t(PacketType::Inter))
         return Status::error("packet header: unknown type " + std::to_string(type));
+    const uint64_t frame = r.varint(), distance = r.varint(), kept = r.varint();
+    h.timestamp_us = unzigzag(r.varint());
+    length = r.varint();
+    if (!r.ok()) return Status::error(r.error());
+    if (r.position() > kMaxPacketHeader)
+        return Status::error("packet header: " + std::to_string(r.position()) + " bytes (at most " +
+                             std::to_string(kMaxPacketHeader) + ")");
     if (frame > 0xFFFFFFFFu)
         return Status::error("packet header: frame number " + std::to_string(frame) +
                              " above 2^32 - 1");

@@ -550,7 +550,11 @@ public:
         std::mt19937 rng(seed);
         width_ = w, height_ = h;
         const bool worst = inputs == KernelInputs::WorstCase;
-        step_ = seed % 3 == 0 ? 0x1p-12 : double(uniform(rng, 1e-6f, 1e-2f));
+        // Every third seed: a step for which depth 1 is a halfway quotient, 1 / 1 / step = k + 1/2.
+        step_ = double(uniform(rng, 1e-6f, 1e-2f));
+        const bool ties = seed % 3 == 0;
+        for (int k = 1 + int(rng() % 4000); ties; ++k)
+            if (step_ = 2.0 / double(2 * k + 1); 1.0 / 1.0 / step_ - double(k) == 0.5) break;
         depth_.resize(std::size_t(w) * h);
         codes_.resize(depth_.size());
         for (std::size_t i = 0; i < depth_.size(); ++i) {
@@ -559,8 +563,7 @@ public:
                 const float extremes[] = {0.0f, -0.0f, -1.0f, 1e-45f, 1e-38f, 3e38f, -kInf};
                 z = extremes[rng() % std::size(extremes)];
             }
-            if (step_ == 0x1p-12 && rng() % 4 == 0)  // 1 / z / step = k + 1/2 exactly
-                z = float(1.0 / ((double(rng() % 4096) + 0.5) * step_));
+            if (ties && rng() % 4 == 0) z = 1.0f;  // rounds to the even neighbour
             depth_[i] = z;
             uint32_t c = rng() % 3 ? uint32_t(rng() % (1u << 20)) : kInfCode;
             if (worst && rng() % 4 == 0) {
