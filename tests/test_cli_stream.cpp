@@ -77,6 +77,31 @@ TEST(CliStream, ConnectExtrapolatesOnTheGpuBackend) {
     EXPECT_TRUE(fs::exists(out / "frame_00000.exr")) << connected.output;
 }
 
+// --backend gles --window without --out: the window's OpenGL ES context is the GPU's, each
+// extrapolated frame is drawn from its texture and nothing is downloaded (SDL's offscreen driver).
+TEST(CliStream, ConnectWindowDrawsTheGpusFramesWithoutDownloading) {
+    const std::string port = std::to_string(20000 + (getpid() + 13) % 20000);
+    ::setenv("SDL_VIDEODRIVER", "offscreen", 1);
+    Outcome served;
+    std::thread server([&] {
+        served = run_reprise(
+            "serve --pin 445566 --listen 127.0.0.1:" + port + " --size 96x64 --duration 5", 60);
+    });
+    const Outcome connected = run_reprise("connect 127.0.0.1:" + port +
+                                              " --pin 445566 --display-rate 30 --duration 2 "
+                                              "--backend gles --window",
+                                          60);
+    server.join();
+    ::unsetenv("SDL_VIDEODRIVER");
+    EXPECT_EQ(connected.status, 0) << connected.output;
+    EXPECT_EQ(served.status, 0) << served.output;
+    EXPECT_NE(connected.output.find("download 0.00 ms a frame; kept on the GPU and drawn from "
+                                    "there by the window"),
+              std::string::npos)
+        << connected.output;
+    EXPECT_EQ(connected.output.find("the GPU failed on"), std::string::npos) << connected.output;
+}
+
 TEST(CliStream, BadArgumentsAreRefused) {
     auto expect_refused = [](const std::string& args, const std::string& mention) {
         const Outcome r = run_reprise(args, 30);

@@ -3,6 +3,8 @@
 // the texture entry point.
 #include <gtest/gtest.h>
 
+#include <bit>
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
@@ -240,13 +242,13 @@ struct Textures {
 };
 
 // A GL_RGBA32F texture read back as the application would (through a framebuffer).
-Image<glm::vec4> read_rgba(GLuint texture) {
-    Image<glm::vec4> pixels(kWidth, kHeight);
+Image<glm::vec4> read_rgba(GLuint texture, int width = kWidth, int height = kHeight) {
+    Image<glm::vec4> pixels(width, height);
     GLuint framebuffer = 0;
     glGenFramebuffers(1, &framebuffer);
     glBindFramebuffer(GL_FRAMEBUFFER, framebuffer);
     glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, texture, 0);
-    glReadPixels(0, 0, kWidth, kHeight, GL_RGBA, GL_FLOAT, pixels.data());
+    glReadPixels(0, 0, width, height, GL_RGBA, GL_FLOAT, pixels.data());
     glBindFramebuffer(GL_FRAMEBUFFER, 0);
     glDeleteFramebuffers(1, &framebuffer);
     return pixels;
@@ -983,6 +985,66 @@ TEST(Gpu, ExtrapolationKeepsTheUploadOfTheSameFrameKey) {
                                  kSplatExtrapolation, 1.0f, 41)
                     .ok());
     EXPECT_FALSE(third.upload_kept);
+}
+
+// Left on the GPU: the textures hold the frame the CPU-image entry downloads; the backend kept
+// that way empties its output; any other call ends what made() names.
+TEST(Gpu, ExtrapolationKeptOnTheGpuIsTheFrameDownloaded) {
+    NonfiniteCounts spoiled;
+    const std::vector<Frame> frames = test::spoiled_sequence(2, spoiled);
+    const Camera& to = frames[0].camera;
+    gpu::Context& context = shared_gpu();
+    Frame downloaded;
+    gpu::ExtrapolateStats stats;
+    ASSERT_TRUE(context
+                    .extrapolate(frames[1], to.view, to.projection, 0.75f, downloaded, stats,
+                                 kSplatExtrapolation)
+                    .ok());
+    EXPECT_GT(stats.covered, 0u);
+    ASSERT_TRUE(context
+                    .extrapolate_on_gpu(frames[1], to.view, to.projection, 0.75f, stats,
+                                        kSplatExtrapolation)
+                    .ok());
+    EXPECT_EQ(context.timings().download_ms, 0.0);
+    context.make_current();
+    const gpu::MadeTextures made = context.made();
+    ASSERT_NE(made.color, 0u);
+    const int w = frames[1].width(), h = frames[1].height();
+    EXPECT_EQ(made.width, w);
+    EXPECT_EQ(made.height, h);
+    EXPECT_EQ(test::display_psnr(downloaded.color, read_rgba(made.color, w, h)), INFINITY);
+    const Image<glm::vec4> depth = read_rgba(made.depth, w, h);
+    const Image<glm::vec4> motion = read_rgba(made.motion, w, h);
+    int depth_differs = 0, motion_differs = 0;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            depth_differs += std::bit_cast<uint32_t>(depth(x, y).r) !=
+                             std::bit_cast<uint32_t>(downloaded.depth(x, y));
+            motion_differs += glm::vec2(motion(x, y)) != downloaded.motion(x, y);
+        }
+    EXPECT_EQ(depth_differs, 0);
+    EXPECT_EQ(motion_differs, 0);
+
+    gpu::FrucBackend backend(context);
+    backend.keep_extrapolated_on_gpu(true);
+    Frame out = frames[0];
+    warp::FrucCounters counters;
+    ASSERT_TRUE(backend
+                    .extrapolate(frames[1], to.view, to.projection, 0.75f, 1.0f,
+                                 kSplatExtrapolation, out, counters, 0)
+                    .ok());
+    EXPECT_TRUE(out.color.empty() && out.depth.empty() && out.motion.empty());
+    EXPECT_EQ(backend.total().download_ms, 0.0);
+    EXPECT_EQ(test::display_psnr(downloaded.color, read_rgba(backend.made().color, w, h)),
+              INFINITY);
+    Image<glm::vec4> color = downloaded.color;
+    Image<uint8_t> valid(w, h);
+    std::fill(valid.data(), valid.data() + valid.pixel_count(), uint8_t(1));
+    valid(3, 4) = 0;
+    warp::FillStats filled;
+    ASSERT_TRUE(context.fill(color.view(), valid.view(), {}, filled).ok());
+    EXPECT_EQ(filled.holes, 1u);
+    EXPECT_EQ(backend.made().color, 0u);
 }
 
 // The converter extrapolating at factor 3 through a cut: the CPU's frames, made on the GPU.

@@ -197,21 +197,8 @@ Status run_connect(const ConnectJob& job) {
             "': a name from the server's catalogue (1..32 of [a-z0-9_-]), never a path");
     o.scene = job.scene;
     o.extrapolate = !job.no_extrapolate;
-    // --backend gles: each display frame extrapolated on the GPU (warp splat, pull-push), a
-    // lowres stream's colour upsampled there.
     if (job.backend != "cpu" && job.backend != "gles")
         return Status::error("--backend '" + job.backend + "': expected cpu or gles");
-    std::unique_ptr<gpu::Context> gpu;
-    std::unique_ptr<gpu::FrucBackend> backend;
-    std::unique_ptr<gpu::Upsampler> upsampler;
-    if (job.backend == "gles") {
-        REPRISE_TRY(gpu::Context::create(gpu));
-        backend = std::make_unique<gpu::FrucBackend>(*gpu);
-        o.extrapolation.warp = warp::WarpMethod::Splat;
-        o.extrapolation.backend = backend.get();
-        REPRISE_TRY(gpu::Upsampler::create(*gpu, {}, upsampler));
-        o.upsampler = upsampler.get();
-    }
     if (job.loss > 0 || job.delay > 0 || job.jitter > 0) {
         if (!(job.loss >= 0 && job.loss <= 1)) return Status::error("--loss must be in [0, 1]");
         o.inject_faults = true;
@@ -232,13 +219,32 @@ Status run_connect(const ConnectJob& job) {
             REPRISE_TRY(server::parse_camera_spec(job.camera, scene, fallback, path));
         }
     }
+    // The window before the GPU: with --backend gles the GPU works in the window's OpenGL ES
+    // context (so the context outlives the GPU's objects), and the frames it extrapolates are
+    // drawn from their textures; without --out nothing is downloaded.
+    const bool gles = job.backend == "gles";
     std::unique_ptr<StreamWindow> window;
     if (job.window || job.interactive) {
         const glm::mat4 start =
             poses.empty() ? server::camera_view(path, scene, 0.0) : poses.front().second;
-        // The GPU's context is made current on this thread each display frame: SDL's window
-        // then draws without a GL context of its own.
-        REPRISE_TRY(StreamWindow::open(job.interactive, start, bool(backend), window));
+        REPRISE_TRY(StreamWindow::open(
+            job.interactive, start, gles ? StreamWindow::Drawing::GlEs : StreamWindow::Drawing::Sdl,
+            window));
+    }
+    // --backend gles: each display frame extrapolated on the GPU (warp splat, pull-push), a
+    // lowres stream's colour upsampled there.
+    std::unique_ptr<gpu::Context> gpu;
+    std::unique_ptr<gpu::FrucBackend> backend;
+    std::unique_ptr<gpu::Upsampler> upsampler;
+    const bool kept_on_gpu = gles && window && job.out.empty();
+    if (gles) {
+        REPRISE_TRY(window ? gpu::Context::adopt_current(gpu) : gpu::Context::create(gpu));
+        backend = std::make_unique<gpu::FrucBackend>(*gpu);
+        backend->keep_extrapolated_on_gpu(kept_on_gpu);
+        o.extrapolation.warp = warp::WarpMethod::Splat;
+        o.extrapolation.backend = backend.get();
+        REPRISE_TRY(gpu::Upsampler::create(*gpu, {}, upsampler));
+        o.upsampler = upsampler.get();
     }
     double last_t = 0.0;
     bool window_open = true;
@@ -283,7 +289,9 @@ Status run_connect(const ConnectJob& job) {
                     << ',' << latency << ',' << info.source_scene_time << ','
                     << (displayed_us - info.source_pose_us) / 1000.0 << ',' << int(written) << '\n';
             }
-            if (window) window->show(f);
+            // A frame the GPU extrapolated is drawn from its texture (kept there without --out).
+            if (window && !(backend && info.extrapolated && window->show(backend->made())))
+                window->show(f);
             ++index;
             return !g_stop.load() && window_open;
         }));
@@ -306,10 +314,11 @@ Status run_connect(const ConnectJob& job) {
         std::fprintf(stderr,
                      "[connect] %zu frames extrapolated on the GPU (%s; %zu from the frame "
                      "uploaded for the one before): upload %.2f, compute %.2f, download %.2f ms a "
-                     "frame\n",
+                     "frame%s\n",
                      backend->frames(), gpu->description().c_str(), backend->uploads_kept(),
                      backend->total().upload_ms / n, backend->total().compute_ms / n,
-                     backend->total().download_ms / n);
+                     backend->total().download_ms / n,
+                     kept_on_gpu ? "; kept on the GPU and drawn from there by the window" : "");
     }
     if (upsampler && upsampler->frames() > 0) {
         const double n = double(upsampler->frames());
@@ -395,7 +404,9 @@ int command_connect(int argc, char** argv) {
     args.flag("--no-extrapolate", &job.no_extrapolate, "show the newest decoded frame as it is");
     args.option("--backend", &job.backend,
                 "cpu | gles (default cpu); gles: each display frame extrapolated (warp splat, "
-                "pull-push) and\na lowres stream's colour upsampled by OpenGL ES compute shaders");
+                "pull-push) and\na lowres stream's colour upsampled by OpenGL ES compute shaders; "
+                "with --window the GPU works in\nthe window's context and draws its frames from "
+                "their textures (nothing downloaded unless --out)");
     args.option("--loss", &job.loss, "fault injector: random loss each way (0..1)");
     args.option("--delay", &job.delay, "fault injector: round-trip delay in ms");
     args.option("--jitter", &job.jitter, "fault injector: jitter in ms each way");

@@ -7,13 +7,47 @@
 #include <vector>
 
 #include "reprise/core/visualize.hpp"
+#include "reprise/gl/program.hpp"
 
 namespace reprise::cli {
+
+namespace {
+
+// A full-window triangle; each fragment takes the texel under it (nearest, row 0 at the top)
+// and shows its display value as visualize_color computes it.
+constexpr const char* kVertex = R"(#version 310 es
+void main() {
+    vec2 p = vec2(float((gl_VertexID & 1) << 2) - 1.0, float((gl_VertexID & 2) << 1) - 1.0);
+    gl_Position = vec4(p, 0.0, 1.0);
+}
+)";
+constexpr const char* kFragment = R"(#version 310 es
+precision highp float;
+uniform highp sampler2D colour;
+uniform vec2 window_size;
+out vec4 shown;
+float display(float c) {
+    if ((floatBitsToUint(c) & 0x7fffffffu) > 0x7f800000u) return 0.0;  // NaN
+    c = clamp(c, 0.0, 1.0);
+    return c <= 0.0031308 ? 12.92 * c : 1.055 * pow(c, 1.0 / 2.4) - 0.055;
+}
+void main() {
+    ivec2 size = textureSize(colour, 0);
+    vec2 at = vec2(gl_FragCoord.x, window_size.y - gl_FragCoord.y) / window_size;
+    ivec2 texel = min(ivec2(at * vec2(size)), size - 1);
+    vec3 c = texelFetch(colour, texel, 0).rgb;
+    shown = vec4(display(c.r), display(c.g), display(c.b), 1.0);
+}
+)";
+
+}  // namespace
 
 struct StreamWindow::State {
     SDL_Window* window = nullptr;
     SDL_Renderer* renderer = nullptr;
     SDL_Texture* texture = nullptr;
+    SDL_GLContext gl = nullptr;
+    GLuint program = 0, uploaded = 0;  // GlEs: the drawing program, CPU frames' texture
     int tw = 0, th = 0;
     bool interactive = false;
     glm::vec3 position{0.0f};
@@ -21,6 +55,12 @@ struct StreamWindow::State {
     Image<Rgb8> pixels;
 
     ~State() {
+        if (gl) {
+            SDL_GL_MakeCurrent(window, gl);
+            if (program) glDeleteProgram(program);
+            if (uploaded) glDeleteTextures(1, &uploaded);
+            SDL_GL_DeleteContext(gl);
+        }
         if (texture) SDL_DestroyTexture(texture);
         if (renderer) SDL_DestroyRenderer(renderer);
         if (window) SDL_DestroyWindow(window);
@@ -31,22 +71,56 @@ struct StreamWindow::State {
         m = glm::rotate(m, yaw, glm::vec3(0, 1, 0));
         return glm::rotate(m, pitch, glm::vec3(1, 0, 0));
     }
+    Status open_gl() {
+        SDL_GL_SetAttribute(SDL_GL_CONTEXT_PROFILE_MASK, SDL_GL_CONTEXT_PROFILE_ES);
+        SDL_GL_SetAttribute(SDL_GL_CONTEXT_MAJOR_VERSION, 3);
+        SDL_GL_SetAttribute(SDL_GL_CONTEXT_MINOR_VERSION, 1);
+        gl = SDL_GL_CreateContext(window);
+        if (!gl) return Status::error(std::string("SDL2 OpenGL ES 3.1 context: ") + SDL_GetError());
+        if (SDL_GL_MakeCurrent(window, gl) != 0)
+            return Status::error(std::string("SDL2 OpenGL ES context: ") + SDL_GetError());
+        SDL_GL_SetSwapInterval(0);  // the display loop keeps its own time
+        REPRISE_TRY(gl::link_program(kVertex, kFragment, "window", program));
+        glGenTextures(1, &uploaded);
+        return gl::check_errors("window");
+    }
+    // Draws `texture` (GL_RGBA32F, linear colour) over the window and presents it.
+    void draw(GLuint colour) {
+        int w = 0, h = 0;
+        SDL_GL_GetDrawableSize(window, &w, &h);
+        glBindFramebuffer(GL_FRAMEBUFFER, 0);
+        glViewport(0, 0, w, h);
+        glUseProgram(program);
+        glUniform2f(glGetUniformLocation(program, "window_size"), float(w), float(h));
+        glActiveTexture(GL_TEXTURE0);
+        glBindTexture(GL_TEXTURE_2D, colour);
+        glDrawArrays(GL_TRIANGLES, 0, 3);
+        glBindTexture(GL_TEXTURE_2D, 0);
+        glUseProgram(0);
+        SDL_GL_SwapWindow(window);
+    }
 };
 
 StreamWindow::StreamWindow() : state_(std::make_unique<State>()) {}
 StreamWindow::~StreamWindow() = default;
 
-Status StreamWindow::open(bool interactive, const glm::mat4& start_view, bool software,
+Status StreamWindow::open(bool interactive, const glm::mat4& start_view, Drawing drawing,
                           std::unique_ptr<StreamWindow>& window) {
     if (SDL_InitSubSystem(SDL_INIT_VIDEO) != 0)
         return Status::error(std::string("SDL2: ") + SDL_GetError());
     std::unique_ptr<StreamWindow> w(new StreamWindow());
     State& s = *w->state_;
+    const bool gles = drawing == Drawing::GlEs;
     s.window = SDL_CreateWindow("reprise connect", SDL_WINDOWPOS_UNDEFINED, SDL_WINDOWPOS_UNDEFINED,
-                                960, 540, SDL_WINDOW_RESIZABLE);
+                                960, 540, SDL_WINDOW_RESIZABLE | (gles ? SDL_WINDOW_OPENGL : 0));
     if (!s.window) return Status::error(std::string("SDL2 window: ") + SDL_GetError());
-    s.renderer = SDL_CreateRenderer(s.window, -1, software ? SDL_RENDERER_SOFTWARE : 0);
-    if (!s.renderer) return Status::error(std::string("SDL2 renderer: ") + SDL_GetError());
+    if (gles) {
+        REPRISE_TRY(s.open_gl());
+    } else {
+        s.renderer = SDL_CreateRenderer(
+            s.window, -1, drawing == Drawing::SdlSoftware ? SDL_RENDERER_SOFTWARE : 0);
+        if (!s.renderer) return Status::error(std::string("SDL2 renderer: ") + SDL_GetError());
+    }
     s.interactive = interactive;
     // The free camera starts where the path's camera is: position and heading of its inverse.
     const glm::mat4 to_world = glm::inverse(start_view);
@@ -92,6 +166,22 @@ glm::mat4 StreamWindow::view() const { return glm::inverse(state_->camera_to_wor
 void StreamWindow::show(const GBufferView& frame) {
     State& s = *state_;
     const int w = frame.width(), h = frame.height();
+    if (w <= 0 || h <= 0) return;
+    if (s.gl) {
+        if (s.tw != w || s.th != h) {
+            gl::allocate_texture(s.uploaded, GL_RGBA32F, w, h);
+            s.tw = w, s.th = h;
+        }
+        glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
+        glBindTexture(GL_TEXTURE_2D, s.uploaded);
+        glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+        glPixelStorei(GL_UNPACK_ROW_LENGTH, int(frame.color.stride));
+        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, w, h, GL_RGBA, GL_FLOAT, frame.color.data);
+        glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+        glBindTexture(GL_TEXTURE_2D, 0);
+        s.draw(s.uploaded);
+        return;
+    }
     if (!s.texture || s.tw != w || s.th != h) {
         if (s.texture) SDL_DestroyTexture(s.texture);
         s.texture =
@@ -106,6 +196,13 @@ void StreamWindow::show(const GBufferView& frame) {
     SDL_RenderClear(s.renderer);
     SDL_RenderCopy(s.renderer, s.texture, nullptr, nullptr);
     SDL_RenderPresent(s.renderer);
+}
+
+bool StreamWindow::show(const gpu::MadeTextures& frame) {
+    State& s = *state_;
+    if (!s.gl || !frame.color || frame.width <= 0 || frame.height <= 0) return false;
+    s.draw(frame.color);
+    return true;
 }
 
 }  // namespace reprise::cli

@@ -122,6 +122,26 @@ Status Context::extrapolate(const GBufferView& given, const glm::mat4& view,
                             const glm::mat4& projection, float periods, Frame& out,
                             ExtrapolateStats& stats, const warp::FrucOptions& options,
                             float motion_scale, uint64_t frame_key) {
+    REPRISE_TRY(extrapolate_on_gpu(given, view, projection, periods, stats, options, motion_scale,
+                                   frame_key));
+    out.normal.clear();
+    out.id.clear();
+    const int w = given.width(), h = given.height();
+    if (w <= 0 || h <= 0) return {};
+    ContextState& s = *state_;
+    auto t = std::chrono::steady_clock::now();
+    s.download_made(out);
+    out.motion.resize(w, h);
+    s.download_channels(s.made_motion, &out.motion.data()->x, 2, w);
+    REPRISE_TRY(gl::check_errors("gpu extrapolate download"));
+    timings_.download_ms = finish_ms(t);
+    return {};
+}
+
+Status Context::extrapolate_on_gpu(const GBufferView& given, const glm::mat4& view,
+                                   const glm::mat4& projection, float periods,
+                                   ExtrapolateStats& stats, const warp::FrucOptions& options,
+                                   float motion_scale, uint64_t frame_key) {
     timings_ = {};
     stats = {};
     REPRISE_TRY(check_options(options));
@@ -131,8 +151,7 @@ Status Context::extrapolate(const GBufferView& given, const glm::mat4& view,
     if (given.depth.width != w || given.depth.height != h || given.motion.width != w ||
         given.motion.height != h)
         return Status::error("gpu extrapolate: the frame needs depth and motion of its size");
-    out.normal.clear();
-    out.id.clear();
+    s.made_valid = false;
     if (w <= 0 || h <= 0) return {};
     REPRISE_TRY(s.gl->acquire());
     auto t = std::chrono::steady_clock::now();
@@ -157,12 +176,14 @@ Status Context::extrapolate(const GBufferView& given, const glm::mat4& view,
         view, projection, periods, motion_scale, options, s.color.name, s.depth.name,
         s.made_motion.name, stats));
     timings_.compute_ms = finish_ms(t);
-    s.download_made(out);
-    out.motion.resize(w, h);
-    s.download_channels(s.made_motion, &out.motion.data()->x, 2, w);
-    REPRISE_TRY(gl::check_errors("gpu extrapolate download"));
-    timings_.download_ms = finish_ms(t);
+    s.made_valid = true;
     return {};
+}
+
+MadeTextures Context::made() const {
+    const ContextState& s = *state_;
+    if (!s.made_valid) return {};
+    return {s.color.name, s.depth.name, s.made_motion.name, s.color.width, s.color.height};
 }
 
 Status Context::extrapolate(const GBufferTextures& frame, unsigned color, const glm::mat4& view,

@@ -52,8 +52,15 @@ Status FrucBackend::extrapolate(const GBufferView& f, const glm::mat4& view,
                                 const warp::FrucOptions& options, Frame& out,
                                 warp::FrucCounters& counters, uint64_t frame_key) {
     ExtrapolateStats stats;
-    REPRISE_TRY(context_.extrapolate(f, view, projection, periods, out, stats, options,
-                                     motion_scale, frame_key));
+    if (keep_on_gpu_) {
+        REPRISE_TRY(context_.extrapolate_on_gpu(f, view, projection, periods, stats, options,
+                                                motion_scale, frame_key));
+        out.color.clear(), out.depth.clear(), out.motion.clear(), out.normal.clear();
+        out.id.clear();
+    } else {
+        REPRISE_TRY(context_.extrapolate(f, view, projection, periods, out, stats, options,
+                                         motion_scale, frame_key));
+    }
     uploads_kept_ += stats.upload_kept;
     if (has_projection(f.camera))
         ++(stats.moving ? counters.dynamic_layers : counters.dynamic_skipped);

@@ -441,6 +441,7 @@ Status Context::interpolate(const GBufferView& given_a, const GBufferView& given
         s.upload_frame(*frames[f], *textures[3 * f], *textures[3 * f + 1], *textures[3 * f + 2]);
         k.key[f] = keys[f];
     }
+    s.made_valid = false;  // color and depth no longer hold an extrapolation
     s.color.ensure(GL_RGBA32F, w, h);
     s.depth.ensure(GL_R32F, w, h);
     k.made_motion.ensure(GL_RGBA32F, w, h);

@@ -343,6 +343,7 @@ Status Context::fill(ImageView<glm::vec4> color, ImageView<const uint8_t> valid,
     REPRISE_TRY(s.gl->acquire());
     using Clock = std::chrono::steady_clock;
     Clock::time_point t = Clock::now();
+    s.made_valid = false;  // color and depth no longer hold an extrapolation
     s.color.ensure(GL_RGBA32F, w, h);
     s.valid.ensure(GL_R8UI, w, h);
     s.out.ensure(GL_RGBA32F, w, h);

@@ -181,6 +181,7 @@ Status Context::reproject(const GBufferView& current, const GBufferView& previou
         warp::reproject_setup(current.camera, previous.camera, w, h, ids, options);
 
     Clock::time_point t = Clock::now();
+    s.made_valid = false;  // color and depth no longer hold an extrapolation
     s.depth.ensure(GL_R32F, w, h);
     s.motion.ensure(GL_RG32F, w, h);
     s.out.ensure(GL_RGBA32F, w, h);

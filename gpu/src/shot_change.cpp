@@ -126,6 +126,7 @@ Status Context::shot_change(const GBufferView& frame, const GBufferView& previou
     ContextState& s = *state_;
     REPRISE_TRY(s.gl->acquire());
     auto t = std::chrono::steady_clock::now();
+    s.made_valid = false;  // color and depth no longer hold an extrapolation
     s.upload_frame(frame, s.color, s.depth, s.motion);
     s.payload.ensure(GL_RGBA32F, pw, ph);
     s.previous_depth.ensure(GL_R32F, pw, ph);

@@ -353,6 +353,7 @@ Status Context::splat(const GBufferView& source, float factor, const warp::WarpT
     s.upload_frame(source, s.payload, s.previous_depth, s.motion);
     timings_.upload_ms = finish_ms(t);
     s.out.ensure(GL_RGBA32F, tw, th);
+    s.made_valid = false;  // color and depth no longer hold an extrapolation
     s.depth.ensure(GL_R32F, tw, th);
     s.hit.ensure(GL_R32UI, tw, th);
     const bool carry_motion = !target.motion.empty();

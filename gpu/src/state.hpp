@@ -263,6 +263,7 @@ struct ContextState {
     NonfiniteRepair extrapolate_repair;
     Texture source_color, source_depth, source_motion, made_motion;
     uint64_t extrapolate_key = 0;  // the frame key of what the source textures hold (0: none)
+    bool made_valid = false;       // color, depth and made_motion hold the last extrapolation
     NonfiniteCounts extrapolate_nonfinite;  // ... and what its repair found
 
     // Counters live in GPU memory (a buffer hinted for reading may be placed in the host's, where

@@ -315,6 +315,7 @@ Status Context::stereo_eye(const GBufferView& given, const Camera& target, Frame
         textures = {s.history_color.name, s.history_depth.name, motion ? s.history_motion.name : 0u,
                     history.camera};
     }
+    s.made_valid = false;  // color and depth no longer hold an extrapolation
     s.color.ensure(GL_RGBA32F, w, h);
     s.depth.ensure(GL_R32F, w, h);
     timings_.upload_ms = finish_ms(t);

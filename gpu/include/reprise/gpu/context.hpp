@@ -41,6 +41,13 @@ struct GBufferTextures {
     Camera camera;
 };
 
+// A frame made on the GPU and kept there: colour GL_RGBA32F (linear light), depth GL_R32F,
+// backward motion per period in the RG of a GL_RGBA32F texture.
+struct MadeTextures {
+    unsigned color = 0, depth = 0, motion = 0;
+    int width = 0, height = 0;
+};
+
 // What an in-between frame took: covered pixels of each side, pixels neither covered, the
 // fill's stats (all zero when there were no holes: no fill), and the NaN/Inf the CPU-image entry
 // repaired in its inputs (as the CPU converter does).
@@ -179,6 +186,15 @@ public:
                        float periods, Frame& out, ExtrapolateStats& stats,
                        const warp::FrucOptions& options, float motion_scale = 1.0f,
                        uint64_t frame_key = 0);
+    // The same with the made frame left on the GPU, nothing downloaded: made() names its
+    // textures (a display that draws them, `reprise connect --backend gles --window`).
+    Status extrapolate_on_gpu(const GBufferView& frame, const glm::mat4& view,
+                              const glm::mat4& projection, float periods, ExtrapolateStats& stats,
+                              const warp::FrucOptions& options, float motion_scale = 1.0f,
+                              uint64_t frame_key = 0);
+    // What the last extrapolate call on CPU images made, until the next call of any kind (the
+    // textures are the context's scratch); all 0 when that call failed or made nothing.
+    MadeTextures made() const;
     // The same on textures: `color` GL_RGBA32F beside frame's depth and motion; `out_color`
     // (GL_RGBA32F), `out_depth` (GL_R32F) and `out_motion` (GL_RGBA32F with the motion in RG, as
     // GL ES has no RG32F image format; 0: not written), all of the frame's size. No repair.

@@ -29,6 +29,12 @@ public:
                        float periods, float motion_scale, const warp::FrucOptions& options,
                        Frame& out, warp::FrucCounters& counters, uint64_t frame_key) override;
 
+    // Extrapolated frames left on the GPU for a display that draws them: `out` of extrapolate
+    // gets no colour, depth or motion (emptied) and made() names the textures that hold them,
+    // until the next call. Off by default (every frame downloaded).
+    void keep_extrapolated_on_gpu(bool keep) { keep_on_gpu_ = keep; }
+    MadeTextures made() const { return context_.made(); }
+
     // The phases of every frame made so far (interpolated or extrapolated), summed, and how many.
     const Timings& total() const { return total_; }
     std::size_t frames() const { return frames_; }
@@ -43,6 +49,7 @@ private:
     warp::SplatOptions splat_;
     Timings total_;
     std::size_t frames_ = 0, uploads_kept_ = 0;
+    bool keep_on_gpu_ = false;
 };
 
 }  // namespace reprise::gpu
