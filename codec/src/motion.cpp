@@ -158,6 +158,13 @@ bool code_slice(SliceJob& j, Coder& rc) {
 }
 
 // Motion the cameras explain (to the previous frame as this frame's camera records it).
+// A frame's owners before its motion models set them: 0 everywhere, in the buffer the picture
+// held before (a fresh one each frame cost its page faults).
+void clear_owners(Image<uint32_t>& owner, int w, int h) {
+    ensure_size(owner, w, h);
+    std::fill(owner.data(), owner.data() + owner.pixel_count(), 0u);
+}
+
 void base_motion(const Camera& camera, ImageView<const float> depth, int w, int h,
                  Image<glm::vec2>& base) {
     ensure_size(base, w, h);
@@ -271,13 +278,15 @@ void encode_motion(const FrameContext& fc, const Camera& camera, ImageView<const
                     any.store(true, std::memory_order_relaxed);
         });
     ByteWriter wr(bytes);
-    owner = {};
+    if (any && models && !fc.objects.empty())
+        clear_owners(owner, w, h);
+    else
+        owner = {};
     if (!any) {
         wr.u8(kNoResidual);
         std::swap(out, base);  // the camera motion is the motion (base is remade every frame)
     } else if (models) {
         const bool objects = !fc.objects.empty();
-        if (objects) ensure_size(owner, w, h);
         object_fields(camera, depth, fc.objects, fc.work->object_fields);
         const uint32_t all = uint32_t((uint64_t(1) << fc.objects.size()) - 1);
         const uint32_t predicting = predict_from_objects(
@@ -314,7 +323,10 @@ Status decode_motion(const FrameContext& fc, const Camera& camera, ImageView<con
     ByteReader r(in, "motion section");
     const uint8_t flags = r.u8();
     if (!r.ok()) return Status::error(r.error());
-    owner = {};
+    if (!(flags & kNoResidual) && sp.motion_error > 0.0f && !fc.objects.empty())
+        clear_owners(owner, w, h);
+    else
+        owner = {};
     if (flags & ~(kNoResidual | kPredictedObjects) || flags == (kNoResidual | kPredictedObjects))
         return Status::error("motion section: unknown flags " + std::to_string(flags));
     uint32_t predicting = 0;
@@ -339,7 +351,6 @@ Status decode_motion(const FrameContext& fc, const Camera& camera, ImageView<con
         if (!read_slices(r, sp.slices, slices)) return Status::error(r.error());
         if (sp.motion_error > 0.0f) {
             const bool objects = !fc.objects.empty();
-            if (objects) ensure_size(owner, w, h);
             object_fields(camera, depth, fc.objects, fc.work->object_fields);
             predict_from_objects(fc, camera, predicting, base, fc.work->object_fields,
                                  fc.work->predicted_owner);
