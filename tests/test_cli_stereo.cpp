@@ -51,6 +51,17 @@ TEST(CliStereo, RenderBothEyesSynthesizeAndExport) {
         EXPECT_GT(ours, 28.0);
         EXPECT_GT(ours, copy + 5.0);
     }
+    // The grid's colour fetch: bicubic by default, bilinear on request (another eye, as good).
+    const std::string bicubic = (dir / "bicubic").string(), bilinear = (dir / "bilinear").string();
+    for (const auto& [fetch, out] :
+         {std::pair{"grid-bicubic", bicubic}, {"grid-bilinear", bilinear}})
+        ASSERT_EQ(run_command(cli::command_stereo, {"--in", truth + "/left", "--ipd", "0.1",
+                                                    "--temporal", "--warp", fetch, "--out", out}),
+                  0);
+    const std::string right = frame_path(truth + "/right", 1);
+    EXPECT_EQ(psnr_of(frame_path(made + "/right", 1), frame_path(bicubic + "/right", 1)), INFINITY);
+    EXPECT_LT(psnr_of(frame_path(made + "/right", 1), frame_path(bilinear + "/right", 1)), 80.0);
+    EXPECT_GT(psnr_of(right, frame_path(bilinear + "/right", 1)), 28.0);
     const std::string sbs = (dir / "sbs.png").string();
     ASSERT_EQ(run_command(cli::command_export, {made, "--stereo", "sbs", "--png", sbs}), 0);
     cv::Mat picture = cv::imread(sbs);
@@ -68,6 +79,8 @@ TEST(CliStereo, BadArgumentsExitWithTwo) {
     EXPECT_EQ(run_command(cli::command_stereo, {"--in", "x", "--out", "y", "--convergence", "-1"}),
               2);
     EXPECT_EQ(run_command(cli::command_stereo, {"--in", "x", "--out", "y", "--ipd", "abc"}), 2);
+    EXPECT_EQ(run_command(cli::command_stereo, {"--in", "x", "--out", "y", "--warp", "grid-cubic"}),
+              2);
     EXPECT_EQ(run_command(cli::command_stereo, {"--out", "y"}), 2);
     EXPECT_EQ(run_command(cli::command_export, {"x", "--stereo", "3d", "--png", "a.png"}), 2);
     // A folder that holds no sequence is bad data: exit 1.

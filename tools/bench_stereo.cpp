@@ -250,6 +250,12 @@ std::vector<OurSetting> our_settings() {
                                        std::pair{"patch", stereo::StereoFill::Patch}})
             settings.push_back(
                 {std::string(warp_name) + "+" + fill_name, {.warp = warp, .fill = fill}});
+    // The other colour fetch of the grid (bicubic by default), with the default fill.
+    stereo::StereoOptions other_fetch;
+    other_fetch.grid.bicubic = !other_fetch.grid.bicubic;
+    settings.push_back(
+        {other_fetch.grid.bicubic ? "grid-bicubic+pullpush" : "grid-bilinear+pullpush",
+         other_fetch});
     settings.push_back({"grid+pullpush+history", {}, true});
     return settings;
 }

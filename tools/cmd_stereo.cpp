@@ -48,8 +48,10 @@ Status check(const StereoJob& j, stereo::StereoRig& rig, stereo::StereoOptions& 
         return Status::error("--rig: '" + j.rig + "' is not parallel or offaxis");
     if (j.eye != "left" && j.eye != "right")
         return Status::error("--eye: '" + j.eye + "' is not left or right");
-    if (j.warp != "grid" && j.warp != "splat")
-        return Status::error("--warp: '" + j.warp + "' is not grid or splat");
+    if (j.warp != "grid" && j.warp != "grid-bicubic" && j.warp != "grid-bilinear" &&
+        j.warp != "splat")
+        return Status::error("--warp: '" + j.warp +
+                             "' is not grid, grid-bicubic, grid-bilinear or splat");
     if (j.fill != "pullpush" && j.fill != "andreev" && j.fill != "patch" && j.fill != "none")
         return Status::error("--fill: '" + j.fill + "' is not pullpush, andreev, patch or none");
     if (j.backend != "cpu" && j.backend != "gles")
@@ -68,6 +70,8 @@ Status check(const StereoJob& j, stereo::StereoRig& rig, stereo::StereoOptions& 
                        : j.fill == "patch" ? stereo::StereoFill::Patch
                        : j.fill == "none"  ? stereo::StereoFill::None
                                            : stereo::StereoFill::PullPush};
+    if (j.warp == "grid-bicubic" || j.warp == "grid-bilinear")
+        options.grid.bicubic = j.warp == "grid-bicubic";
     options.widen_silhouettes = j.silhouettes == "widen";
     return {};
 }
@@ -193,7 +197,9 @@ int command_stereo(int argc, char** argv) {
                 "vertical field of view in degrees, for inputs without a camera");
     args.option("--rig", &job.rig, "parallel|offaxis (default parallel)");
     args.option("--eye", &job.eye, "which eye the input is: left|right (default left)");
-    args.option("--warp", &job.warp, "grid|splat (default grid)");
+    args.option("--warp", &job.warp,
+                "grid|splat (default grid; grid-bicubic, grid-bilinear pick its colour fetch, "
+                "grid is bicubic)");
     args.option("--fill", &job.fill,
                 "pullpush|andreev|patch|none (default pullpush; patch: frequency-selective "
                 "reconstruction, slow)");

@@ -36,10 +36,13 @@ stereo::StereoOptions make_options(const std::string& warp_method, const std::st
     o.widen_silhouettes = widen_silhouettes;
     if (warp_method == "grid")
         o.warp = stereo::StereoWarp::Grid;
+    else if (warp_method == "grid-bicubic" || warp_method == "grid-bilinear")
+        o.warp = stereo::StereoWarp::Grid, o.grid.bicubic = warp_method == "grid-bicubic";
     else if (warp_method == "splat")
         o.warp = stereo::StereoWarp::Splat;
     else
-        value_error("warp must be 'grid' or 'splat', got '" + warp_method + "'");
+        value_error("warp must be 'grid', 'grid-bicubic', 'grid-bilinear' or 'splat', got '" +
+                    warp_method + "'");
     if (fill == "pullpush")
         o.fill = stereo::StereoFill::PullPush;
     else if (fill == "andreev")

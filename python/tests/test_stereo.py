@@ -25,6 +25,14 @@ def test_synthesized_eye_is_close_to_the_rendered_one(renderer, pan_60):
     kept, _ = reprise.StereoSynthesizer().synthesize(left, right_camera, widen_silhouettes=False)
     print(f"silhouettes kept: {psnr(truth, kept):.2f} dB")
     assert not np.array_equal(kept.color, made.color)
+    bicubic, _ = reprise.StereoSynthesizer().synthesize(left, right_camera, warp="grid-bicubic")
+    assert np.array_equal(bicubic.color, made.color)  # the grid's default fetch
+    bilinear, _ = reprise.StereoSynthesizer().synthesize(left, right_camera, warp="grid-bilinear")
+    print(f"bilinear fetch: {psnr(truth, bilinear):.2f} dB")
+    assert not np.array_equal(bilinear.color, made.color)
+    assert psnr(truth, bilinear) > 28.0
+    with pytest.raises(ValueError, match="grid-bilinear"):
+        reprise.StereoSynthesizer().synthesize(left, right_camera, warp="grid-cubic")
 
 
 def test_the_gpu_backend_makes_the_cpus_splat_eye(pan_60):

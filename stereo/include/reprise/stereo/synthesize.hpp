@@ -23,8 +23,9 @@ struct StereoOptions {
     // stairs (the eye's edges are not blended with another side as an in-between frame's are).
     // Measured on bench stereo: +0.74 dB mean over the built-in scenes (pan +1.85, hud +1.88,
     // shadows +2.53, stroll +1.19; specular -0.59, crossing -0.27, courtyard -0.16), +0.2 to +0.8
-    // on the Blender renders, at the same time.
-    warp::GridOptions grid;
+    // on the Blender renders, at the same time. Colour fetched bicubically, as the in-between
+    // frame's (warp::FrucOptions::grid): docs/benchmarks.md has bench stereo with both fetches.
+    warp::GridOptions grid{.bicubic = true};
     warp::SplatOptions splat;
     // History and current warp show the same surface when their depths differ by less than this
     // fraction; the history (a view nearer the target, with its own view-dependent shading) then

@@ -125,7 +125,7 @@ struct FrucOptions {
     WarpMethod warp = WarpMethod::Grid;
     FillMethod fill = FillMethod::PullPush;
     // The grid fetches colour bicubically: on anti-aliased renders it measured 0.6-1.1 dB above the
-    // bilinear fetch (docs/benchmarks.md). The stereo eye keeps GridOptions' bilinear default.
+    // bilinear fetch (docs/benchmarks.md). The stereo eye fetches bicubically too (StereoOptions).
     GridOptions grid{.bicubic = true};
     // Edge pixels go with the nearer surface (widen_silhouettes, reprise/warp/silhouettes.hpp):
     // their blended colour travels with the silhouette instead of staying on the background as a
