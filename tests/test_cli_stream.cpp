@@ -79,27 +79,36 @@ TEST(CliStream, ConnectExtrapolatesOnTheGpuBackend) {
 
 // --backend gles --window without --out: the window's OpenGL ES context is the GPU's, each
 // extrapolated frame is drawn from its texture and nothing is downloaded (SDL's offscreen driver).
+// Where SDL offers no OpenGL (its dummy driver) the window falls back to SDL's software renderer
+// beside the GPU's own context, and says so.
 TEST(CliStream, ConnectWindowDrawsTheGpusFramesWithoutDownloading) {
     const std::string port = std::to_string(20000 + (getpid() + 13) % 20000);
-    ::setenv("SDL_VIDEODRIVER", "offscreen", 1);
     Outcome served;
     std::thread server([&] {
         served = run_reprise(
-            "serve --pin 445566 --listen 127.0.0.1:" + port + " --size 96x64 --duration 5", 60);
+            "serve --pin 445566 --listen 127.0.0.1:" + port + " --size 96x64 --duration 9", 60);
     });
-    const Outcome connected = run_reprise("connect 127.0.0.1:" + port +
-                                              " --pin 445566 --display-rate 30 --duration 2 "
-                                              "--backend gles --window",
-                                          60);
-    server.join();
+    const std::string connect = "connect 127.0.0.1:" + port +
+                                " --pin 445566 --display-rate 30 --duration 2 --backend gles "
+                                "--window";
+    ::setenv("SDL_VIDEODRIVER", "offscreen", 1);
+    const Outcome on_gl = run_reprise(connect, 60);
+    ::setenv("SDL_VIDEODRIVER", "dummy", 1);
+    const Outcome software = run_reprise(connect, 60);
     ::unsetenv("SDL_VIDEODRIVER");
-    EXPECT_EQ(connected.status, 0) << connected.output;
+    server.join();
     EXPECT_EQ(served.status, 0) << served.output;
-    EXPECT_NE(connected.output.find("download 0.00 ms a frame; kept on the GPU and drawn from "
-                                    "there by the window"),
+    EXPECT_EQ(on_gl.status, 0) << on_gl.output;
+    EXPECT_NE(on_gl.output.find("download 0.00 ms a frame; kept on the GPU and drawn from there "
+                                "by the window"),
               std::string::npos)
-        << connected.output;
-    EXPECT_EQ(connected.output.find("the GPU failed on"), std::string::npos) << connected.output;
+        << on_gl.output;
+    EXPECT_EQ(on_gl.output.find("the GPU failed on"), std::string::npos) << on_gl.output;
+    EXPECT_EQ(software.status, 0) << software.output;
+    EXPECT_NE(software.output.find("no OpenGL ES window"), std::string::npos) << software.output;
+    EXPECT_NE(software.output.find("extrapolated on the GPU"), std::string::npos)
+        << software.output;
+    EXPECT_EQ(software.output.find("kept on the GPU"), std::string::npos) << software.output;
 }
 
 TEST(CliStream, BadArgumentsAreRefused) {

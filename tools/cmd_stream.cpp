@@ -221,24 +221,39 @@ Status run_connect(const ConnectJob& job) {
     }
     // The window before the GPU: with --backend gles the GPU works in the window's OpenGL ES
     // context (so the context outlives the GPU's objects), and the frames it extrapolates are
-    // drawn from their textures; without --out nothing is downloaded.
+    // drawn from their textures; without --out nothing is downloaded. Where the window gets no
+    // such context, SDL's software renderer draws downloaded frames beside the GPU's own context.
     const bool gles = job.backend == "gles";
     std::unique_ptr<StreamWindow> window;
+    std::unique_ptr<gpu::Context> gpu;
     if (job.window || job.interactive) {
         const glm::mat4 start =
             poses.empty() ? server::camera_view(path, scene, 0.0) : poses.front().second;
-        REPRISE_TRY(StreamWindow::open(
-            job.interactive, start, gles ? StreamWindow::Drawing::GlEs : StreamWindow::Drawing::Sdl,
-            window));
+        if (gles) {
+            Status on_gl =
+                StreamWindow::open(job.interactive, start, StreamWindow::Drawing::GlEs, window);
+            if (on_gl.ok()) on_gl = gpu::Context::adopt_current(gpu);
+            if (!on_gl.ok()) {
+                gpu.reset();
+                window.reset();
+                std::fprintf(stderr,
+                             "[connect] no OpenGL ES window (%s): SDL's software renderer draws "
+                             "the downloaded frames\n",
+                             on_gl.message().c_str());
+            }
+        }
+        if (!window)
+            REPRISE_TRY(StreamWindow::open(
+                job.interactive, start,
+                gles ? StreamWindow::Drawing::SdlSoftware : StreamWindow::Drawing::Sdl, window));
     }
     // --backend gles: each display frame extrapolated on the GPU (warp splat, pull-push), a
     // lowres stream's colour upsampled there.
-    std::unique_ptr<gpu::Context> gpu;
     std::unique_ptr<gpu::FrucBackend> backend;
     std::unique_ptr<gpu::Upsampler> upsampler;
-    const bool kept_on_gpu = gles && window && job.out.empty();
+    const bool kept_on_gpu = gpu && job.out.empty();
     if (gles) {
-        REPRISE_TRY(window ? gpu::Context::adopt_current(gpu) : gpu::Context::create(gpu));
+        if (!gpu) REPRISE_TRY(gpu::Context::create(gpu));
         backend = std::make_unique<gpu::FrucBackend>(*gpu);
         backend->keep_extrapolated_on_gpu(kept_on_gpu);
         o.extrapolation.warp = warp::WarpMethod::Splat;
@@ -247,7 +262,7 @@ Status run_connect(const ConnectJob& job) {
         o.upsampler = upsampler.get();
     }
     double last_t = 0.0;
-    bool window_open = true;
+    bool window_open = true, window_error = false;
     client::PoseFunction pose = [&](double t) {
         if (window) {
             window_open = window->pump(t - last_t) && window_open;
@@ -290,8 +305,14 @@ Status run_connect(const ConnectJob& job) {
                     << (displayed_us - info.source_pose_us) / 1000.0 << ',' << int(written) << '\n';
             }
             // A frame the GPU extrapolated is drawn from its texture (kept there without --out).
-            if (window && !(backend && info.extrapolated && window->show(backend->made())))
-                window->show(f);
+            if (window) {
+                const bool texture = backend && info.extrapolated && window->draws_textures();
+                const Status shown = texture ? window->show(backend->made()) : window->show(f);
+                if (!shown.ok() && !window_error) {
+                    std::fprintf(stderr, "[connect] window: %s\n", shown.message().c_str());
+                    window_error = true;
+                }
+            }
             ++index;
             return !g_stop.load() && window_open;
         }));

@@ -72,9 +72,6 @@ struct StreamWindow::State {
         return glm::rotate(m, pitch, glm::vec3(1, 0, 0));
     }
     Status open_gl() {
-        SDL_GL_SetAttribute(SDL_GL_CONTEXT_PROFILE_MASK, SDL_GL_CONTEXT_PROFILE_ES);
-        SDL_GL_SetAttribute(SDL_GL_CONTEXT_MAJOR_VERSION, 3);
-        SDL_GL_SetAttribute(SDL_GL_CONTEXT_MINOR_VERSION, 1);
         gl = SDL_GL_CreateContext(window);
         if (!gl) return Status::error(std::string("SDL2 OpenGL ES 3.1 context: ") + SDL_GetError());
         if (SDL_GL_MakeCurrent(window, gl) != 0)
@@ -85,7 +82,7 @@ struct StreamWindow::State {
         return gl::check_errors("window");
     }
     // Draws `texture` (GL_RGBA32F, linear colour) over the window and presents it.
-    void draw(GLuint colour) {
+    Status draw(GLuint colour) {
         int w = 0, h = 0;
         SDL_GL_GetDrawableSize(window, &w, &h);
         glBindFramebuffer(GL_FRAMEBUFFER, 0);
@@ -98,6 +95,7 @@ struct StreamWindow::State {
         glBindTexture(GL_TEXTURE_2D, 0);
         glUseProgram(0);
         SDL_GL_SwapWindow(window);
+        return gl::check_errors("window");
     }
 };
 
@@ -111,6 +109,12 @@ Status StreamWindow::open(bool interactive, const glm::mat4& start_view, Drawing
     std::unique_ptr<StreamWindow> w(new StreamWindow());
     State& s = *w->state_;
     const bool gles = drawing == Drawing::GlEs;
+    if (gles) {  // an EGL context (the GPU adopts it), also under X11, where SDL prefers GLX
+        SDL_SetHint(SDL_HINT_VIDEO_X11_FORCE_EGL, "1");
+        SDL_GL_SetAttribute(SDL_GL_CONTEXT_PROFILE_MASK, SDL_GL_CONTEXT_PROFILE_ES);
+        SDL_GL_SetAttribute(SDL_GL_CONTEXT_MAJOR_VERSION, 3);
+        SDL_GL_SetAttribute(SDL_GL_CONTEXT_MINOR_VERSION, 1);
+    }
     s.window = SDL_CreateWindow("reprise connect", SDL_WINDOWPOS_UNDEFINED, SDL_WINDOWPOS_UNDEFINED,
                                 960, 540, SDL_WINDOW_RESIZABLE | (gles ? SDL_WINDOW_OPENGL : 0));
     if (!s.window) return Status::error(std::string("SDL2 window: ") + SDL_GetError());
@@ -163,24 +167,25 @@ bool StreamWindow::pump(double dt) {
 
 glm::mat4 StreamWindow::view() const { return glm::inverse(state_->camera_to_world()); }
 
-void StreamWindow::show(const GBufferView& frame) {
+bool StreamWindow::draws_textures() const { return state_->gl != nullptr; }
+
+Status StreamWindow::show(const GBufferView& frame) {
     State& s = *state_;
     const int w = frame.width(), h = frame.height();
-    if (w <= 0 || h <= 0) return;
+    if (w <= 0 || h <= 0) return {};
     if (s.gl) {
+        glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
         if (s.tw != w || s.th != h) {
             gl::allocate_texture(s.uploaded, GL_RGBA32F, w, h);
             s.tw = w, s.th = h;
         }
-        glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
         glBindTexture(GL_TEXTURE_2D, s.uploaded);
         glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
         glPixelStorei(GL_UNPACK_ROW_LENGTH, int(frame.color.stride));
         glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, w, h, GL_RGBA, GL_FLOAT, frame.color.data);
         glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
         glBindTexture(GL_TEXTURE_2D, 0);
-        s.draw(s.uploaded);
-        return;
+        return s.draw(s.uploaded);
     }
     if (!s.texture || s.tw != w || s.th != h) {
         if (s.texture) SDL_DestroyTexture(s.texture);
@@ -189,20 +194,22 @@ void StreamWindow::show(const GBufferView& frame) {
         s.tw = w, s.th = h;
         s.pixels = Image<Rgb8>(w, h);
     }
-    if (!s.texture) return;
+    if (!s.texture) return Status::error(std::string("SDL2 texture: ") + SDL_GetError());
     visualize_color(frame.color, s.pixels.view());
     SDL_UpdateTexture(s.texture, nullptr, s.pixels.data(),
                       int(s.pixels.view().stride * sizeof(Rgb8)));
     SDL_RenderClear(s.renderer);
     SDL_RenderCopy(s.renderer, s.texture, nullptr, nullptr);
     SDL_RenderPresent(s.renderer);
+    return {};
 }
 
-bool StreamWindow::show(const gpu::MadeTextures& frame) {
+Status StreamWindow::show(const gpu::MadeTextures& frame) {
     State& s = *state_;
-    if (!s.gl || !frame.color || frame.width <= 0 || frame.height <= 0) return false;
-    s.draw(frame.color);
-    return true;
+    if (!s.gl) return Status::error("window: textures are drawn only in an OpenGL ES window");
+    if (!frame.color || frame.width <= 0 || frame.height <= 0)
+        return Status::error("window: no texture to draw");
+    return s.draw(frame.color);
 }
 
 }  // namespace reprise::cli

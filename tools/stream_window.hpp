@@ -27,10 +27,12 @@ public:
     bool pump(double dt);
     glm::mat4 view() const;  // world -> camera of the interactive camera
     // Colour as display values (sRGB of linear colour clamped to [0, 1], NaN 0) scaled to the
-    // window, nearest pixel; then presented.
-    void show(const GBufferView& frame);
-    // GlEs: a frame on the GPU (its colour texture), the same way; false where there is none.
-    bool show(const gpu::MadeTextures& frame);
+    // window, nearest pixel; then presented. An error names what SDL or GL refused.
+    Status show(const GBufferView& frame);
+    // Whether the window draws in its own OpenGL ES context (Drawing::GlEs).
+    bool draws_textures() const;
+    // GlEs: a frame on the GPU (its colour texture), the same way; an error without one.
+    Status show(const gpu::MadeTextures& frame);
 
     struct State;
 

@@ -133,7 +133,11 @@ Status Context::extrapolate(const GBufferView& given, const glm::mat4& view,
     s.download_made(out);
     out.motion.resize(w, h);
     s.download_channels(s.made_motion, &out.motion.data()->x, 2, w);
-    REPRISE_TRY(gl::check_errors("gpu extrapolate download"));
+    const Status downloaded = gl::check_errors("gpu extrapolate download");
+    if (!downloaded.ok()) {
+        s.made_valid = false;
+        return downloaded;
+    }
     timings_.download_ms = finish_ms(t);
     return {};
 }
@@ -142,16 +146,16 @@ Status Context::extrapolate_on_gpu(const GBufferView& given, const glm::mat4& vi
                                    const glm::mat4& projection, float periods,
                                    ExtrapolateStats& stats, const warp::FrucOptions& options,
                                    float motion_scale, uint64_t frame_key) {
+    ContextState& s = *state_;
+    s.made_valid = false;
     timings_ = {};
     stats = {};
     REPRISE_TRY(check_options(options));
     REPRISE_TRY(check_periods(periods));
-    ContextState& s = *state_;
     const int w = given.width(), h = given.height();
     if (given.depth.width != w || given.depth.height != h || given.motion.width != w ||
         given.motion.height != h)
         return Status::error("gpu extrapolate: the frame needs depth and motion of its size");
-    s.made_valid = false;
     if (w <= 0 || h <= 0) return {};
     REPRISE_TRY(s.gl->acquire());
     auto t = std::chrono::steady_clock::now();
