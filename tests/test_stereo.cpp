@@ -151,9 +151,21 @@ TEST(StereoSynthesis, PlaneShiftsLeftByFocalTimesIpdOverDepth) {
                 ASSERT_NEAR(right.color(x, y).x, left.color(x + 3, y).x, 1e-3f) << x << "," << y;
                 ASSERT_NEAR(right.color(x, y).y, left.color(x + 3, y).y, 1e-3f) << x << "," << y;
             }
-        // The right eye's last three columns are unseen by the left eye: holes, filled.
+        // The right eye's last three columns are unseen by the left eye: holes, which the grid
+        // eye fills by continuing each row's last covered pixel, the splat eye by pull-push.
         EXPECT_EQ(stats.holes, std::size_t(3 * h));
-        EXPECT_EQ(stats.filled, stats.holes);
+        if (method == StereoWarp::Grid) {
+            EXPECT_EQ(stats.border, stats.holes);
+            EXPECT_EQ(stats.filled, 0u);
+            for (int y = 0; y < h; ++y)
+                for (int x = w - 3; x < w; ++x) {
+                    ASSERT_EQ(right.color(x, y), right.color(w - 4, y)) << x << "," << y;
+                    ASSERT_EQ(right.depth(x, y), right.depth(w - 4, y)) << x << "," << y;
+                }
+        } else {
+            EXPECT_EQ(stats.border, 0u);
+            EXPECT_EQ(stats.filled, stats.holes);
+        }
         EXPECT_TRUE(all_finite(right.color));
     }
 }

@@ -71,6 +71,7 @@ py::dict stats_dict(const stereo::StereoStats& s) {
     d["stretched"] = s.stretched;
     d["from_history"] = s.from_history;
     d["history_moving"] = s.history_moving;
+    d["border"] = s.border;
     d["filled"] = s.filled;
     d["unfilled"] = s.unfilled;
     d["cells"] = s.cells;

@@ -52,9 +52,12 @@ struct StereoStats {
     std::size_t stretched = 0;
     std::size_t from_history = 0;    // pixels taken from the history view
     std::size_t history_moving = 0;  // history pixels left out as moving (history_moving_tolerance)
-    std::size_t filled = 0;          // pixels invented by the hole filler
-    std::size_t unfilled = 0;        // holes left (no fill, or nothing to fill from): colour 0
-    std::size_t cells = 0;           // grid cells drawn (both warps)
+    // Grid eye: holes at the image's left and right edges that continue their row's outermost
+    // covered pixel (what the made eye sees beyond the rendered one's view).
+    std::size_t border = 0;
+    std::size_t filled = 0;    // pixels invented by the hole filler
+    std::size_t unfilled = 0;  // holes left (no fill, or nothing to fill from): colour 0
+    std::size_t cells = 0;     // grid cells drawn (both warps)
     // NaN/Inf in the rendered eye and the history, repaired before warping (colour: holes;
     // depth NaN/-inf and motion: unknown; see reprise/core/nonfinite.hpp).
     NonfiniteCounts nonfinite;
