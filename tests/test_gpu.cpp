@@ -27,6 +27,7 @@
 #include "reprise/warp/extrapolate.hpp"
 #include "reprise/warp/fill.hpp"
 #include "reprise/warp/fruc.hpp"
+#include "reprise/warp/grid_warp.hpp"
 #include "reprise/warp/reproject.hpp"
 #include "reprise/warp/shot_change.hpp"
 #include "reprise/warp/splat.hpp"
@@ -499,6 +500,64 @@ TEST(Gpu, SplatMatchesTheCpuOnEveryBuiltInScene) {
     }
 }
 
+// The grid's cells drawn by GL's rasteriser: the CPU's coverage, depth and colour.
+TEST(Gpu, GridWarpMatchesTheCpuOnEveryBuiltInScene) {
+    const std::size_t allowed = std::size_t(kWidth) * kHeight / 1000;
+    warp::GridWarper grid;
+    std::size_t exact = 0, compared = 0, stretched = 0;
+    for (const server::SceneInfo& info : server::builtin_scenes()) {
+        SCOPED_TRACE(info.name);
+        const Frame& f = scene_frames(info.name)[1];
+        for (bool bicubic : {false, true})
+            for (float factor : {-0.5f, 1.0f}) {
+                // Two-pixel cells draw stretched triangles (one-pixel ones tear instead).
+                const warp::GridOptions options{.min_cell = bicubic ? 1 : 2, .bicubic = bicubic};
+                Splatted cpu(kWidth, kHeight), gpu(kWidth, kHeight);
+                const warp::GridStats expected = grid.warp(f, factor, cpu.target(), options);
+                warp::GridStats stats;
+                const Status status =
+                    shared_gpu().grid_warp(f, factor, gpu.target(), options, stats);
+                ASSERT_TRUE(status.ok()) << status.message();
+                EXPECT_EQ(stats.cells, expected.cells);
+                EXPECT_GT(expected.covered, std::size_t(kWidth) * kHeight * 8 / 10);
+                EXPECT_LE(mask_differences(cpu.covered, gpu.covered), allowed);
+                EXPECT_LE(std::max(stats.covered, expected.covered) -
+                              std::min(stats.covered, expected.covered),
+                          allowed);
+                const double db = test::display_psnr(covered_color(cpu), covered_color(gpu));
+                EXPECT_GE(db, 50.0) << "bicubic " << bicubic << " factor " << factor;
+                std::size_t depth_off = 0, motion_off = 0;
+                for (std::size_t i = 0; i < gpu.color.pixel_count(); ++i) {
+                    if (!gpu.covered.data()[i] || !cpu.covered.data()[i]) continue;
+                    const float a = cpu.depth.data()[i], b = gpu.depth.data()[i];
+                    // Edge triangles drawn as slivers have steep planes whose large terms round
+                    // apart (the CPU steps along a span, the GPU evaluates each pixel): up to
+                    // 4e-4 of the depth on `fast`.
+                    depth_off += !(a == b || std::abs(a - b) <= 1e-3f * a);
+                    // Where two triangles tie in depth within an ulp the GPU may keep the other
+                    // (its depth test compares depth halved): up to 0.02 px apart on `fast`.
+                    motion_off += glm::length(cpu.motion.data()[i] - gpu.motion.data()[i]) > 0.05f;
+                    ++compared;
+                    exact += cpu.color.data()[i] == gpu.color.data()[i] && a == b;
+                    stretched += cpu.covered.data()[i] == warp::kCoveredStretched;
+                }
+                EXPECT_LE(depth_off, allowed);
+                EXPECT_LE(motion_off, allowed);
+                std::printf(
+                    "%-10s grid %s x%+.1f cells %zu covered cpu %zu gpu %zu, masks differ at %zu, "
+                    "%.1f dB\n",
+                    info.name, bicubic ? "bicubic" : "bilinear", factor, expected.cells,
+                    expected.covered, stats.covered, mask_differences(cpu.covered, gpu.covered),
+                    db);
+            }
+    }
+    std::printf(
+        "grid: %zu of %zu pixels covered on both sides have the CPU's colour and depth "
+        "to the bit; %zu stretched\n",
+        exact, compared, stretched);
+    EXPECT_GT(stretched, 50u);  // not vacuous: stretched triangles were drawn
+}
+
 const stereo::StereoOptions kSplatEye{.warp = stereo::StereoWarp::Splat};
 
 TEST(Gpu, StereoEyeMatchesTheCpuOnEveryBuiltInScene) {
@@ -524,6 +583,55 @@ TEST(Gpu, StereoEyeMatchesTheCpuOnEveryBuiltInScene) {
                     stats.holes, db);
     }
     EXPECT_GT(holes, 50u);  // not vacuous: pull-push had holes to fill (84 at 96x64)
+}
+
+// The default eye (the grid, bicubic, its border strip continued, pull-push) and the bilinear
+// grid without a fill.
+TEST(Gpu, GridEyeMatchesTheCpuOnEveryBuiltInScene) {
+    std::size_t stretched = 0, border = 0;
+    struct Setting {
+        stereo::StereoOptions options;
+        float ipd;
+    };
+    for (const Setting& setting :
+         {Setting{{}, 0.064f}, Setting{{.grid = {.min_cell = 2, .bicubic = true}}, 0.5f},
+          Setting{{.fill = stereo::StereoFill::None, .grid = {.bicubic = false}}, 0.064f}})
+        for (const server::SceneInfo& info : server::builtin_scenes()) {
+            SCOPED_TRACE(info.name);
+            const stereo::StereoOptions& options = setting.options;
+            const Frame& f = scene_frames(info.name)[1];
+            const Camera right =
+                stereo::eye_cameras(f.camera, {.ipd = setting.ipd}, stereo::Anchor::Left).right;
+            Frame cpu, gpu;
+            const stereo::StereoStats expected = stereo::synthesize_eye(f, right, options, cpu);
+            stereo::StereoStats stats;
+            const Status status = shared_gpu().stereo_eye(f, right, gpu, stats, options);
+            ASSERT_TRUE(status.ok()) << status.message();
+            const std::size_t allowed = cpu.color.pixel_count() / 1000;
+            EXPECT_EQ(stats.cells, expected.cells);
+            EXPECT_LE(std::max(stats.holes, expected.holes) - std::min(stats.holes, expected.holes),
+                      allowed);
+            EXPECT_LE(std::max(stats.stretched, expected.stretched) -
+                          std::min(stats.stretched, expected.stretched),
+                      allowed);
+            EXPECT_LE(
+                std::max(stats.border, expected.border) - std::min(stats.border, expected.border),
+                allowed);
+            EXPECT_EQ(stats.filled + stats.unfilled + stats.border,
+                      stats.holes + stats.stretched * (options.fill != stereo::StereoFill::None));
+            const double db = test::display_psnr(cpu.color, gpu.color);
+            EXPECT_GE(db, 50.0);
+            stretched += expected.stretched;
+            border += expected.border;
+            std::printf(
+                "%-10s grid eye (%s, ipd %.3f) holes cpu %zu gpu %zu, stretched %zu / %zu, "
+                "border %zu / %zu, %.1f dB\n",
+                info.name, options.fill == stereo::StereoFill::None ? "no fill" : "default",
+                setting.ipd, expected.holes, stats.holes, expected.stretched, stats.stretched,
+                expected.border, stats.border, db);
+        }
+    EXPECT_GT(stretched, 50u);  // not vacuous: stretched pixels and border strips were made
+    EXPECT_GT(border, 50u);
 }
 
 // Every source pixel onto one target pixel: more candidates than the shader sorts, taken by the
@@ -587,8 +695,12 @@ TEST(Gpu, StereoEyeOnTexturesAndOptionsTheGpuLacks) {
 
     Frame unused;
     stereo::StereoStats s;
-    const Status grid = context.stereo_eye(f, right, unused, s, {});
-    EXPECT_NE(grid.message().find("grid warp is not on the GPU"), std::string::npos);
+    const Status grid = context.stereo_eye(rendered, color, right, out, depth, s, {});
+    EXPECT_NE(grid.message().find("the grid eye takes CPU images"), std::string::npos);
+    const GBufferView history = f;
+    const Status grid_history = context.stereo_eye(f, right, unused, s, {}, &history);
+    EXPECT_NE(grid_history.message().find("the grid eye with a history is not on the GPU yet"),
+              std::string::npos);
     const Status andreev = context.stereo_eye(
         f, right, unused, s,
         {.warp = stereo::StereoWarp::Splat, .fill = stereo::StereoFill::Andreev});

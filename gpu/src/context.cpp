@@ -306,6 +306,7 @@ Context::~Context() {
     glDeleteBuffers(1, &state_->readback_buffer);
     glDeleteFramebuffers(1, &state_->read_framebuffer);
     glDeleteProgram(state_->reproject_program);
+    destroy_grid(state_->grid);
 }
 
 Status Context::create(std::unique_ptr<Context>& context) {

@@ -12,6 +12,7 @@
 #include "reprise/gl/context.hpp"
 #include "reprise/gl/program.hpp"
 #include "reprise/gpu/context.hpp"
+#include "reprise/warp/grid_warp.hpp"
 
 namespace reprise::gpu {
 
@@ -194,6 +195,33 @@ void dispatch(int w, int h);
 // glFinish, then the milliseconds since `since`, which moves to now.
 double finish_ms(std::chrono::steady_clock::time_point& since);
 
+// The grid warp's GL objects (made on first use: the cells are read in a vertex shader, which
+// GL ES 3.1 does not promise) and the CPU's side: the cells and the eye's displacement.
+struct GridRaster {
+    GLuint program = 0, finish_program = 0, eye_valid_program = 0, border_program = 0;
+    GLuint framebuffer = 0, depth_buffer = 0, cells = 0, counts = 0;
+    int depth_width = 0, depth_height = 0;
+    std::size_t cells_bytes = 0;
+    warp::GridWarper warper;
+    std::vector<warp::GridCell> cells_cpu;
+    Image<glm::vec2> displacement;
+    Image<float> target_depth;
+};
+void destroy_grid(GridRaster& grid);
+
+// Where grid_passes draws: colour GL_RGBA32F, depth GL_R32F, covered GL_R32UI (1, or 2 where a
+// stretched triangle won), motion GL_RGBA32F (RG; 0: none), all width x height.
+struct GridOutput {
+    GLuint color = 0, depth = 0, covered = 0, motion = 0;
+    int width = 0, height = 0;
+};
+// `cells` (warp::GridWarper::cells) drawn over source colour `source_color` (sw x sh) into `out`
+// as warp::GridWarper::warp draws them; stats' cells, covered and nonfinite set, `stretched`
+// the covered pixels marked 2.
+Status grid_passes(ContextState& s, GLuint source_color, int sw, int sh,
+                   const std::vector<warp::GridCell>& cells, bool bicubic, const GridOutput& out,
+                   warp::GridStats& stats, std::size_t& stretched);
+
 // The in-between frame's inputs (a, b) and intermediates.
 struct Interpolation {
     Texture a_color, a_depth, a_motion, b_color, b_depth, b_motion;
@@ -249,6 +277,7 @@ struct ContextState {
     Texture display_table, shot_reprojected, shot_hit;
     std::size_t invert_bytes = 0;
     Interpolation interpolation;
+    GridRaster grid;
     Texture displacement, target_depth, eye_color;
     // The eye's history: its displacement and depth, warped colour, depth and coverage, the merge.
     GLuint merge_program = 0, eye_counts = 0;

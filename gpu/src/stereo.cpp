@@ -1,7 +1,9 @@
-// The second eye on the GPU: stereo::StereoSynthesizer with StereoWarp::Splat. Each pixel's
-// displacement to the target camera through its depth (warp/'s displacement_row_reference, same
-// arithmetic), the splat; with a history, its warp merged into the holes; pull-push over what is
-// left, and non-finite colour to 0 on the way into the output.
+// The second eye on the GPU: stereo::StereoSynthesizer. Splat: each pixel's displacement to the
+// target camera through its depth (warp/'s displacement_row_reference, same arithmetic), the
+// splat; with a history, its warp merged into the holes. Grid (CPU images, no history yet): the
+// displacement and the grid's cells on the CPU, drawn on the GPU (grid.cpp), pixels of stretched
+// triangles left to the fill, the border strip continued. Then pull-push over what is left, and
+// non-finite colour to 0 on the way into the output.
 #include <chrono>
 #include <string>
 
@@ -110,18 +112,76 @@ void main() {
 }
 )";
 
+// The grid eye's valid mask in place: a pixel only a stretched triangle covered (2) is a hole
+// where pull-push refills it, as StereoSynthesizer's.
+constexpr const char* kGridValid = R"(
+layout(binding = 0, r32ui) uniform highp uimage2D covered;
+uniform ivec2 size;
+uniform bool refill;
+void main() {
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    if (p.x >= size.x || p.y >= size.y) return;
+    uint c = imageLoad(covered, p).r;
+    imageStore(covered, p, uvec4(c == 2u && refill ? 0u : min(c, 1u)));
+}
+)";
+
+// StereoSynthesizer's continue_border_rows, a row per invocation: the holes between an image
+// edge and the row's outermost valid pixel take its colour and depth and become valid; counted.
+// The colour is read through a sampler at the valid pixels and written at the holes only.
+constexpr const char* kBorderRows = R"(
+layout(binding = 0) uniform highp sampler2D color_in;
+layout(binding = 0, rgba32f) writeonly uniform highp image2D color;
+layout(binding = 1, r32f) uniform highp image2D depth;
+layout(binding = 2, r32ui) uniform highp uimage2D valid;
+uniform ivec2 size;
+void continue_row(int y) {
+    int left = 0;
+    while (left < size.x && imageLoad(valid, ivec2(left, y)).r == 0u) ++left;
+    if (left == size.x) return;
+    int right = size.x - 1;
+    while (imageLoad(valid, ivec2(right, y)).r == 0u) --right;
+    highp vec4 lc = texelFetch(color_in, ivec2(left, y), 0), rc = texelFetch(color_in, ivec2(right, y), 0);
+    highp vec4 lz = imageLoad(depth, ivec2(left, y)), rz = imageLoad(depth, ivec2(right, y));
+    for (int x = 0; x < left; ++x) {
+        imageStore(color, ivec2(x, y), lc);
+        imageStore(depth, ivec2(x, y), lz);
+        imageStore(valid, ivec2(x, y), uvec4(1u));
+    }
+    for (int x = right + 1; x < size.x; ++x) {
+        imageStore(color, ivec2(x, y), rc);
+        imageStore(depth, ivec2(x, y), rz);
+        imageStore(valid, ivec2(x, y), uvec4(1u));
+    }
+    atomicAdd(group_counts[0], uint(left + size.x - 1 - right));
+}
+void main() {
+    count_begin();
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    if (p.x == 0 && p.y < size.y) continue_row(p.y);
+    count_end();
+}
+)";
+
 void run(GLuint program, int w, int h) {
     glUniform2i(glGetUniformLocation(program, "size"), w, h);
     dispatch(w, h);
 }
 
-Status check_options(const stereo::StereoOptions& o) {
-    if (o.warp != stereo::StereoWarp::Splat)
+Status check_options(const stereo::StereoOptions& o, bool on_textures, bool history) {
+    if (o.warp == stereo::StereoWarp::Grid && on_textures)
         return Status::error(
-            "gpu stereo eye: the grid warp is not on the GPU yet (StereoWarp::Splat is)");
-    if (o.fill == stereo::StereoFill::Andreev)
+            "gpu stereo eye: the grid eye takes CPU images (its cells are grown on the CPU); on "
+            "textures StereoWarp::Splat");
+    if (o.warp == stereo::StereoWarp::Grid && history)
         return Status::error(
-            "gpu stereo eye: Andreev's fill is not on the GPU yet (PullPush and None are)");
+            "gpu stereo eye: the grid eye with a history is not on the GPU yet (StereoWarp::Splat "
+            "with a history is)");
+    if (o.fill != stereo::StereoFill::PullPush && o.fill != stereo::StereoFill::None)
+        return Status::error(
+            "gpu stereo eye: Andreev's and the patch fill are not on the GPU yet (PullPush and "
+            "None "
+            "are)");
     return {};
 }
 
@@ -133,6 +193,10 @@ Status create_stereo_programs(ContextState& s) {
                                  "stereo displacement", s.displacement_program));
     REPRISE_TRY(gl::link_compute((header + kGroupCounts + kMerge).c_str(), "stereo merge",
                                  s.merge_program));
+    REPRISE_TRY(gl::link_compute((header + kGridValid).c_str(), "stereo grid valid",
+                                 s.grid.eye_valid_program));
+    REPRISE_TRY(gl::link_compute((header + kGroupCounts + kBorderRows).c_str(),
+                                 "stereo border rows", s.grid.border_program));
     s.eye_counts = s.make_counters(4 * sizeof(GLuint));
     return gl::link_compute((header + kFinish).c_str(), "stereo finish", s.finish_program);
 }
@@ -171,14 +235,70 @@ std::size_t displace(ContextState& s, GLuint depth, GLuint motion, int w, int h,
     return moving;
 }
 
+// Pull-push over the holes of `warped` (valid mask s.hit), non-finite colour to 0, into
+// `out_color`.
+Status fill_and_finish(ContextState& s, GLuint warped, int w, int h, const stereo::StereoOptions& o,
+                       GLuint out_color, GLuint out_depth, stereo::StereoStats& stats,
+                       std::size_t history_holes_filled) {
+    warp::FillStats filled;
+    if (o.fill == stereo::StereoFill::PullPush)
+        REPRISE_TRY(fill_passes(s, warped, s.hit.name, out_depth, w, h, s.out.name, filled));
+    else
+        filled.holes = filled.unfilled = stats.holes - history_holes_filled;
+    stats.filled = filled.holes - filled.unfilled;
+    stats.unfilled = filled.unfilled;
+
+    glUseProgram(s.finish_program);
+    s.bind_inputs({stats.filled ? s.out.name : warped});
+    glBindImageTexture(0, out_color, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    run(s.finish_program, w, h);
+    ContextState::unbind_inputs();
+    glUseProgram(0);
+    return gl::check_errors("gpu stereo eye");
+}
+
+// The grid eye's warp of `color` (w x h) by the cells in s.grid (grown on the CPU): colour into
+// s.eye_color, depth into `out_depth`, the valid mask into s.hit, the border strip continued.
+Status grid_eye_passes(ContextState& s, GLuint color, int w, int h, const stereo::StereoOptions& o,
+                       GLuint out_depth, stereo::StereoStats& stats) {
+    warp::GridStats grid;
+    REPRISE_TRY(grid_passes(s, color, w, h, s.grid.cells_cpu, o.grid.bicubic,
+                            {s.eye_color.name, out_depth, s.hit.name, 0, w, h}, grid,
+                            stats.stretched));
+    stats.cells = grid.cells;
+    stats.covered = grid.covered;
+    stats.holes = std::size_t(w) * std::size_t(h) - grid.covered;
+    glUseProgram(s.grid.eye_valid_program);
+    glBindImageTexture(0, s.hit.name, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
+    glUniform1i(glGetUniformLocation(s.grid.eye_valid_program, "refill"),
+                o.fill == stereo::StereoFill::PullPush);
+    run(s.grid.eye_valid_program, w, h);
+    if (o.fill == stereo::StereoFill::None) return {};
+    glUseProgram(s.grid.border_program);
+    s.bind_inputs({s.eye_color.name});
+    glBindImageTexture(0, s.eye_color.name, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glBindImageTexture(1, out_depth, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32F);
+    glBindImageTexture(2, s.hit.name, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
+    ContextState::reset_counters(s.eye_counts, 4);
+    glUniform2i(glGetUniformLocation(s.grid.border_program, "size"), w, h);
+    dispatch(1, h);
+    GLuint border = 0;
+    s.read_counters(s.eye_counts, &border, sizeof border);
+    stats.border = border;
+    return {};
+}
+
 // Colour `color` and depth `depth` (w x h) seen from `target` into out_color / out_depth; with
-// `history`, its warp fills the rendered eye's holes first.
+// `history`, its warp fills the rendered eye's holes first. The grid eye's cells are grown
+// beforehand, on the CPU.
 Status eye_passes(ContextState& s, GLuint color, GLuint depth, int w, int h, const Camera& from,
                   const Camera& target, const stereo::StereoOptions& o, GLuint out_color,
                   GLuint out_depth, stereo::StereoStats& stats, const EyeHistory* history) {
+    // The splat's displacement is made on the GPU, for axis-aligned projections.
     const StaticReprojection to_target(from, target.view, target.projection, w, h);
-    if (!to_target.unprojector().axis_aligned() ||
-        (history && !Unprojector(history->camera.projection, w, h).axis_aligned()))
+    if (o.warp == stereo::StereoWarp::Splat &&
+        (!to_target.unprojector().axis_aligned() ||
+         (history && !Unprojector(history->camera.projection, w, h).axis_aligned())))
         return Status::error("gpu stereo eye: the rendered camera's projection is skewed");
     s.displacement.ensure(GL_RGBA32F, w, h);
     s.target_depth.ensure(GL_R32F, w, h);
@@ -194,15 +314,19 @@ Status eye_passes(ContextState& s, GLuint color, GLuint depth, int w, int h, con
         s.merged.ensure(GL_RGBA32F, w, h);
     }
 
+    const std::size_t n = std::size_t(w) * std::size_t(h);
+    GLuint warped = s.eye_color.name;
+    std::size_t history_holes_filled = 0;
+    if (o.warp == stereo::StereoWarp::Grid) {
+        REPRISE_TRY(grid_eye_passes(s, color, w, h, o, out_depth, stats));
+        return fill_and_finish(s, warped, w, h, o, out_color, out_depth, stats, 0);
+    }
     displace(s, depth, 0, w, h, from, target, INFINITY, s.displacement.name, s.target_depth.name);
     std::size_t covered = 0;
     REPRISE_TRY(splat_passes(s, {color, s.target_depth.name, s.displacement.name, w, h}, 1.0f,
                              o.splat, w, h, s.eye_color.name, out_depth, s.hit.name, 0, covered));
-    const std::size_t n = std::size_t(w) * std::size_t(h);
     stats.covered = covered;
     stats.holes = n - covered;
-    GLuint warped = s.eye_color.name;
-    std::size_t history_holes_filled = 0;
     if (history) {
         stats.history_moving = displace(s, history->depth, history->motion, w, h, history->camera,
                                         target, o.history_moving_tolerance,
@@ -234,21 +358,7 @@ Status eye_passes(ContextState& s, GLuint color, GLuint depth, int w, int h, con
         history_holes_filled = taken[2];
         warped = s.merged.name;
     }
-    warp::FillStats filled;
-    if (o.fill == stereo::StereoFill::PullPush)
-        REPRISE_TRY(fill_passes(s, warped, s.hit.name, out_depth, w, h, s.out.name, filled));
-    else
-        filled.holes = filled.unfilled = stats.holes - history_holes_filled;
-    stats.filled = filled.holes - filled.unfilled;
-    stats.unfilled = filled.unfilled;
-
-    glUseProgram(s.finish_program);
-    s.bind_inputs({stats.filled ? s.out.name : warped});
-    glBindImageTexture(0, out_color, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-    run(s.finish_program, w, h);
-    ContextState::unbind_inputs();
-    glUseProgram(0);
-    return gl::check_errors("gpu stereo eye");
+    return fill_and_finish(s, warped, w, h, o, out_color, out_depth, stats, history_holes_filled);
 }
 
 Status Context::stereo_eye(const GBufferView& given, const Camera& target, Frame& out,
@@ -256,7 +366,7 @@ Status Context::stereo_eye(const GBufferView& given, const Camera& target, Frame
                            const GBufferView* given_history) {
     timings_ = {};
     stats = {};
-    REPRISE_TRY(check_options(options));
+    REPRISE_TRY(check_options(options, false, given_history != nullptr));
     const int w = given.width(), h = given.height();
     REPRISE_ASSERT(given.depth.width == w && given.depth.height == h);
     ContextState& s = *state_;
@@ -299,10 +409,22 @@ Status Context::stereo_eye(const GBufferView& given, const Camera& target, Frame
         if (with_history)
             history = warp::widen_silhouettes(history, s.wide_history_depth, s.wide_history_motion);
     }
+    if (options.warp == stereo::StereoWarp::Grid) {  // the displacement and the cells on the CPU
+        GridRaster& g = s.grid;
+        g.displacement.resize(w, h);
+        g.target_depth.resize(w, h);
+        stereo::stereo_displacement(rendered, target, g.displacement.view(), g.target_depth.view());
+        const GBufferView moved{.color = rendered.color,
+                                .depth = g.target_depth.view(),
+                                .motion = g.displacement.view(),
+                                .camera = rendered.camera};
+        g.warper.cells(moved, 1.0f, options.grid, g.cells_cpu);
+    }
     s.payload.ensure(GL_RGBA32F, w, h);
     s.previous_depth.ensure(GL_R32F, w, h);
     s.upload(s.payload, rendered.color.data, rendered.color.stride);
-    s.upload(s.previous_depth, rendered.depth.data, rendered.depth.stride);
+    if (options.warp == stereo::StereoWarp::Splat)
+        s.upload(s.previous_depth, rendered.depth.data, rendered.depth.stride);
     EyeHistory textures;
     if (with_history) {
         const bool motion = history.motion.width == w && history.motion.height == h;
@@ -335,7 +457,7 @@ Status Context::stereo_eye(const GBufferTextures& rendered, unsigned color, cons
                            unsigned history_color) {
     timings_ = {};
     stats = {};
-    REPRISE_TRY(check_options(options));
+    REPRISE_TRY(check_options(options, true, history != nullptr));
     ContextState& s = *state_;
     REPRISE_TRY(s.gl->acquire());
     const int w = rendered.width, h = rendered.height;

@@ -11,21 +11,8 @@
 
 namespace reprise::warp::grid {
 
-struct Vertex {
-    int32_t x, y;  // target position, 1/256 pixel
-    float sx, sy;  // source position, pixels
-    float z;       // depth (background: a huge finite stand-in)
-    float mx, my;  // motion
-};
-struct Cell {
-    Vertex v[4];  // top-left, top-right, bottom-right, bottom-left
-    // Passed the smoothness test: depth is interpolated as 1/z (perspective-correct). Else (the
-    // smallest cells across an edge) linearly, so that background never pulls geometry along.
-    bool perspective;
-    // Per triangle (v0 v1 v2, v0 v2 v3), what `covered` becomes where it is drawn: 1, or
-    // kCoveredStretched for an edge triangle across a depth edge stretched over a disocclusion.
-    uint8_t coverage[2];
-};
+using Vertex = GridVertex;
+using Cell = GridCell;
 struct Row {  // the cells grown from one row of starting cells
     std::vector<Cell> cells;
     int y_lo = 0, y_hi = -1;  // target rows they may touch
@@ -61,10 +48,11 @@ struct Scratch {  // one thread's: the tests of a row of starting cells, the gri
 
 inline constexpr float kInf = std::numeric_limits<float>::infinity();
 inline constexpr float kBackgroundDepth = 1e30f;  // background in the depth test
-inline constexpr float kBackgroundFrom = 1e29f;   // depths from here on count as background
-inline constexpr float kHugeMotion = 1e30f;       // motion this large (or NaN/Inf) is invalid
-inline constexpr int kSubpixelBits = 8;           // target positions in 1/256 px
+inline constexpr float kBackgroundFrom = kGridBackgroundFrom;
+inline constexpr float kHugeMotion = 1e30f;  // motion this large (or NaN/Inf) is invalid
+inline constexpr int kSubpixelBits = 8;      // target positions in 1/256 px
 inline constexpr int kSubpixel = 1 << kSubpixelBits;
+static_assert(kSubpixel == kGridSubpixel);
 inline constexpr int kOverlap = kSubpixel / 16;  // edges pushed out by 1/16 px (grid_raster.cpp)
 inline constexpr int kMaxCell = 64;
 

@@ -30,27 +30,22 @@ GridWarper::~GridWarper() = default;
 GridWarper::GridWarper(GridWarper&&) noexcept = default;
 GridWarper& GridWarper::operator=(GridWarper&&) noexcept = default;
 
-GridStats GridWarper::run(const GBufferView& source, float factor, const WarpTarget& target,
-                          const GridOptions& options, bool threaded) {
-    check(source, target);
+int GridWarper::build(const GBufferView& source, float factor, const GridOptions& options,
+                      bool threaded, int bands, int target_width, bool motion) {
     const grid::Params params = grid::make_params(options, factor);
-    GridStats stats;
-    if (target.color.empty()) return stats;
-
     const int top_rows =
         source.color.empty() ? 0 : (source.height() + params.cell - 1) / params.cell;
     if (!state_) state_ = std::make_unique<State>();  // moved from
     State& st = *state_;
     if (int(st.rows.size()) < top_rows) st.rows.resize(std::size_t(top_rows));
-    const int height = target.color.height, bands = (height + kBandRows - 1) / kBandRows;
     const int workers =
         threaded ? std::max(1, std::min(thread_count(), std::max(top_rows, bands))) : 1;
     if (int(st.scratch.size()) < workers) st.scratch.resize(std::size_t(workers));
     // Sized here, not on first use: which worker gets work depends on scheduling, and a worker
     // that first gets some in a later frame must not allocate then.
     for (int k = 0; k < workers; ++k)
-        grid::size_scratch(st.scratch[std::size_t(k)], params, source.width(), target.color.width,
-                           kBandRows, !target.motion.empty());
+        grid::size_scratch(st.scratch[std::size_t(k)], params, source.width(), target_width,
+                           kBandRows, motion);
     if (threaded) {
         std::atomic<int> next{0};
         parallel_for(
@@ -65,6 +60,33 @@ GridStats GridWarper::run(const GBufferView& source, float factor, const WarpTar
     } else {
         grid::build_rows(source, params, 0, top_rows, false, st.scratch[0], st.rows.data());
     }
+    return top_rows;
+}
+
+void GridWarper::cells(const GBufferView& source, float factor, const GridOptions& options,
+                       std::vector<GridCell>& cells) {
+    REPRISE_ASSERT(source.depth.width == source.width() && source.depth.height == source.height());
+    REPRISE_ASSERT(source.motion.width == source.width() &&
+                   source.motion.height == source.height());
+    cells.clear();
+    const int top_rows = build(source, factor, options, true, 1, 1, false);
+    for (int r = 0; r < top_rows; ++r) {
+        const grid::Row& row = state_->rows[std::size_t(r)];
+        cells.insert(cells.end(), row.cells.begin(), row.cells.end());
+    }
+}
+
+GridStats GridWarper::run(const GBufferView& source, float factor, const WarpTarget& target,
+                          const GridOptions& options, bool threaded) {
+    check(source, target);
+    GridStats stats;
+    if (target.color.empty()) return stats;
+    const int height = target.color.height, bands = (height + kBandRows - 1) / kBandRows;
+    const int top_rows =
+        build(source, factor, options, threaded, bands, target.color.width, !target.motion.empty());
+    State& st = *state_;
+    const int workers =
+        threaded ? std::max(1, std::min(thread_count(), std::max(top_rows, bands))) : 1;
     for (int r = 0; r < top_rows; ++r) stats.cells += st.rows[std::size_t(r)].cells.size();
 
     const ImageView<const glm::vec4> color = source.color;

@@ -14,6 +14,7 @@
 #include "reprise/stereo/synthesize.hpp"
 #include "reprise/warp/fill.hpp"
 #include "reprise/warp/fruc.hpp"
+#include "reprise/warp/grid_warp.hpp"
 #include "reprise/warp/reproject.hpp"
 #include "reprise/warp/shot_change.hpp"
 #include "reprise/warp/splat.hpp"
@@ -130,6 +131,11 @@ public:
     Status splat(const GBufferView& source, float factor, const warp::WarpTarget& target,
                  const warp::SplatOptions& options, std::size_t& covered);
 
+    // warp::GridWarper::warp on the GPU: its cells grown on the CPU (GridWarper::cells), drawn by
+    // GL's rasteriser with the CPU's edge functions, attribute planes, clamps and depth test.
+    // Needs storage buffers in vertex shaders and float colour attachments (an error says so).
+    Status grid_warp(const GBufferView& source, float factor, const warp::WarpTarget& target,
+                     const warp::GridOptions& options, warp::GridStats& stats);
     // stereo::StereoSynthesizer::synthesize for StereoWarp::Splat and StereoFill::PullPush or
     // None (others are an error): displacement through depth, the splat, the `history` (e.g. the
     // previous frame's other eye, its moving pixels left out) warped the same way into the

@@ -2,7 +2,9 @@
 // Adaptive-grid image warping (Didyk et al. 2010): a coarse grid refined at depth and motion
 // discontinuities, its vertices moved along the motion, rasterised with a depth test.
 #include <cstddef>
+#include <cstdint>
 #include <memory>
+#include <vector>
 
 #include "reprise/warp/splat.hpp"
 
@@ -28,6 +30,26 @@ struct GridOptions {
     // takes the other side there where that side saw the surface (+inf: none marked). 0.5 px^2
     // measured best of 0, 0.5, 1, 2, 3 (docs/benchmarks.md).
     float stretched_area = 0.5f;
+};
+
+// A cell as the raster draws it (GridWarper::cells: the GPU's mesh). Target positions are in
+// 1/kGridSubpixel px; depth at or beyond kGridBackgroundFrom is background (+inf once drawn).
+inline constexpr int kGridSubpixel = 256;
+inline constexpr float kGridBackgroundFrom = 1e29f;
+struct GridVertex {
+    int32_t x, y;  // target position, 1/kGridSubpixel px
+    float sx, sy;  // source position, pixels
+    float z;       // depth (background: a huge finite stand-in)
+    float mx, my;  // motion
+};
+struct GridCell {
+    GridVertex v[4];  // top-left, top-right, bottom-right, bottom-left
+    // Passed the smoothness test: depth is interpolated as 1/z (perspective-correct). Else (the
+    // smallest cells across an edge) linearly, so that background never pulls geometry along.
+    bool perspective;
+    // Per triangle (v0 v1 v2, v0 v2 v3), what `covered` becomes where it is drawn: 1, or
+    // kCoveredStretched for an edge triangle across a depth edge stretched over a disocclusion.
+    uint8_t coverage[2];
 };
 
 struct GridStats {
@@ -61,6 +83,10 @@ class GridWarper {
 public:
     GridStats warp(const GBufferView& source, float factor, const WarpTarget& target,
                    const GridOptions& options = {});
+    // The cells warp() would draw, in its drawing order (later cells lose depth ties), into
+    // `cells`; the GPU draws them (gpu/src/grid.cpp).
+    void cells(const GBufferView& source, float factor, const GridOptions& options,
+               std::vector<GridCell>& cells);
     // The single-threaded scalar reference.
     GridStats warp_reference(const GBufferView& source, float factor, const WarpTarget& target,
                              const GridOptions& options = {});
@@ -73,6 +99,10 @@ public:
     struct State;  // cells and per-thread scratch (grid_internal.hpp)
 
 private:
+    // Grows the cells into the state's rows, its scratch sized for `bands` bands of a target
+    // `target_width` wide; returns how many rows of starting cells.
+    int build(const GBufferView& source, float factor, const GridOptions& options, bool threaded,
+              int bands, int target_width, bool motion);
     GridStats run(const GBufferView& source, float factor, const WarpTarget& target,
                   const GridOptions& options, bool threaded);
     std::unique_ptr<State> state_;
