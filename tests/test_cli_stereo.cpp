@@ -128,8 +128,8 @@ TEST(CliStereo, InputWithoutACameraNeedsTheFieldOfView) {
 }
 
 // --backend gles: the same eyes as the CPU's splat (bit-identical on llvmpipe; the bar is
-// 50 dB), and the options the GPU lacks named.
-TEST(CliStereo, TheGpuBackendMakesTheCpusSplatEye) {
+// 50 dB) and grid, and the options the GPU lacks named.
+TEST(CliStereo, TheGpuBackendMakesTheCpusEyes) {
     const fs::path dir =
         fs::temp_directory_path() / ("reprise_cli_stereo_gles_" + std::to_string(::getpid()));
     fs::remove_all(dir);
@@ -145,8 +145,19 @@ TEST(CliStereo, TheGpuBackendMakesTheCpusSplatEye) {
               0);
     for (int i = 0; i < 2; ++i)
         EXPECT_GE(psnr_of(frame_path(cpu + "/right", i), frame_path(gles + "/right", i)), 50.0);
-    EXPECT_EQ(run_command(cli::command_stereo, {"--in", truth, "--out", gles, "--backend", "gles"}),
-              2);  // the grid warp
+    // The default eye (the grid): its cells grown on the CPU, drawn by the GPU.
+    const std::string grid_cpu = (dir / "grid_cpu").string(),
+                      grid_gles = (dir / "grid_gles").string();
+    ASSERT_EQ(run_command(cli::command_stereo, {"--in", truth, "--out", grid_cpu}), 0);
+    ASSERT_EQ(
+        run_command(cli::command_stereo, {"--in", truth, "--backend", "gles", "--out", grid_gles}),
+        0);
+    for (int i = 0; i < 2; ++i)
+        EXPECT_GE(psnr_of(frame_path(grid_cpu + "/right", i), frame_path(grid_gles + "/right", i)),
+                  50.0);
+    EXPECT_EQ(run_command(cli::command_stereo,
+                          {"--in", truth, "--out", gles, "--backend", "gles", "--temporal"}),
+              2);  // the grid eye with a history
     // --temporal: the previous frame fills the holes first, on the GPU as on the CPU.
     const std::string cpu_temporal = (dir / "cpu_temporal").string(),
                       gles_temporal = (dir / "gles_temporal").string();

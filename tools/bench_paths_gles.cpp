@@ -1,5 +1,5 @@
 // reprise bench paths --backend gles: the stages the GPU backend has (reverse reprojection,
-// pull-push, the forward splat, the stereo eye and the in-between frame by splat), each beside its
+// pull-push, the forward splat, the stereo eye by splat and by the grid, the in-between frame by splat), each beside its
 // CPU reference on the same frames in the same run; the GPU's upload, compute and download apart,
 // the texture entry point on textures already on the GPU, and how far the GPU's result is from the
 // CPU's.
@@ -131,10 +131,10 @@ Status bench_gles_stages(const std::vector<Frame>& frames, const std::string& si
     Image<glm::vec4> cpu_out(w, h), gpu_out(w, h), cpu_filled(w, h), gpu_filled(w, h);
     Image<uint8_t> cpu_hit(w, h), gpu_hit(w, h);
     warp::PullPush pull_push;
-    StageTimes stages[7] = {{"reproject RGBA"},       {"pull-push (depth)"},
+    StageTimes stages[8] = {{"reproject RGBA"},       {"pull-push (depth)"},
                             {"splat x-0.5"},          {"stereo-eye splat+pp"},
                             {"interpolate splat+pp"}, {"extrapolate splat+pp"},
-                            {"upsample 1/4 Herzog"}};
+                            {"upsample 1/4 Herzog"},  {"stereo-eye grid+pp"}};
     // Herzog upsampling of every other pixel of every other row (jitter -0.5 px: the low pixel
     // (u, v) is the full pixel (2u, 2v)), guided by the frame's full G-buffer, with history.
     warp::SpatioTemporalUpsampler cpu_upsampler;
@@ -228,6 +228,17 @@ Status bench_gles_stages(const std::vector<Frame>& frames, const std::string& si
         if (timing) record(stages[3], context->timings(), eye_total.ms[0]);
         stages[3].worst_db =
             std::min(stages[3].worst_db, display_psnr(cpu_eye.color, gpu_eye.color));
+
+        // The default eye: the grid (cells grown on the CPU, counted as upload), pull-push.
+        Timing& cpu_grid_eye = timing ? stages[7].cpu : scratch;
+        time_once(cpu_grid_eye, [&] { synthesizer.synthesize(current, right, cpu_eye, {}); });
+        Timing grid_eye_total;
+        time_once(grid_eye_total,
+                  [&] { status = context->stereo_eye(current, right, gpu_eye, eye_stats, {}); });
+        REPRISE_TRY(status);
+        if (timing) record(stages[7], context->timings(), grid_eye_total.ms[0]);
+        stages[7].worst_db =
+            std::min(stages[7].worst_db, display_psnr(cpu_eye.color, gpu_eye.color));
 
         // The frame halfway between the previous and the current one: the converter gets the
         // current frame (it holds the previous) and gives the made frame, then the input.

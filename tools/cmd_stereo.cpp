@@ -58,10 +58,14 @@ Status check(const StereoJob& j, stereo::StereoRig& rig, stereo::StereoOptions& 
         return Status::error("--backend: '" + j.backend + "' is not cpu or gles");
     if (j.silhouettes != "widen" && j.silhouettes != "keep")
         return Status::error("--silhouettes: '" + j.silhouettes + "' is not widen or keep");
-    if (j.backend == "gles" && (j.warp != "splat" || j.fill == "andreev" || j.fill == "patch"))
+    if (j.backend == "gles" && (j.fill == "andreev" || j.fill == "patch"))
         return Status::error(
-            "--backend gles: the GPU makes the eye with --warp splat and --fill pullpush or "
-            "none (the grid warp, Andreev's and the patch fill are not on the GPU yet)");
+            "--backend gles: the GPU fills with --fill pullpush or none (Andreev's and the patch "
+            "fill are not on the GPU yet)");
+    if (j.backend == "gles" && j.temporal && j.warp != "splat")
+        return Status::error(
+            "--backend gles --temporal: the GPU fills from the previous frame with --warp splat "
+            "(the grid eye with a history is not on the GPU yet)");
     rig = {.ipd = float(j.ipd),
            .convergence = float(j.convergence),
            .rig = j.rig == "offaxis" ? stereo::Rig::OffAxis : stereo::Rig::Parallel};
@@ -204,7 +208,8 @@ int command_stereo(int argc, char** argv) {
                 "pullpush|andreev|patch|none (default pullpush; patch: frequency-selective "
                 "reconstruction, slow)");
     args.option("--backend", &job.backend,
-                "cpu|gles (default cpu); gles: OpenGL ES compute shaders, with --warp splat");
+                "cpu|gles (default cpu); gles: OpenGL ES (the grid's cells grown on the CPU, drawn "
+                "by the GPU)");
     args.option("--silhouettes", &job.silhouettes,
                 "widen|keep (default widen): pixels beside a nearer surface warp with it");
     args.flag("--temporal", &job.temporal, "fill disocclusions from the previous frame first");

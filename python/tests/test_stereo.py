@@ -35,7 +35,7 @@ def test_synthesized_eye_is_close_to_the_rendered_one(renderer, pan_60):
         reprise.StereoSynthesizer().synthesize(left, right_camera, warp="grid-cubic")
 
 
-def test_the_gpu_backend_makes_the_cpus_splat_eye(pan_60):
+def test_the_gpu_backend_makes_the_cpus_eyes(pan_60):
     left = pan_60[2]
     _, right_camera = reprise.eye_cameras(left.camera, ipd=0.064, anchor="left")
     cpu, cpu_stats = reprise.StereoSynthesizer().synthesize(left, right_camera, warp="splat")
@@ -44,8 +44,15 @@ def test_the_gpu_backend_makes_the_cpus_splat_eye(pan_60):
     # The bar for the GPU backend; on llvmpipe the eyes are bit-identical.
     assert reprise.psnr(reprise.to_display(gpu.color), reprise.to_display(cpu.color)) >= 50.0
     assert gpu_stats["holes"] == cpu_stats["holes"] and gpu_stats["holes"] > 0
-    with pytest.raises(ValueError, match="grid warp is not on the GPU"):
-        gles.synthesize(left, right_camera)
+    # The default eye, the grid: its cells grown on the CPU, drawn by the GPU.
+    cpu_grid, cpu_grid_stats = reprise.StereoSynthesizer().synthesize(left, right_camera)
+    gpu_grid, gpu_grid_stats = gles.synthesize(left, right_camera)
+    assert reprise.psnr(reprise.to_display(gpu_grid.color),
+                        reprise.to_display(cpu_grid.color)) >= 50.0
+    assert gpu_grid_stats["cells"] == cpu_grid_stats["cells"] > 0
+    assert gpu_grid_stats["border"] == cpu_grid_stats["border"] > 0
+    with pytest.raises(ValueError, match="the grid eye with a history is not on the GPU"):
+        gles.synthesize(left, right_camera, history=pan_60[3])
     # With the previous frame as history, filling the holes first: the CPU's eye too.
     cpu, cpu_stats = reprise.StereoSynthesizer().synthesize(left, right_camera, warp="splat",
                                                             history=pan_60[3])
