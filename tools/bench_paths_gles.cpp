@@ -1,8 +1,8 @@
 // reprise bench paths --backend gles: the stages the GPU backend has (reverse reprojection,
-// pull-push, the forward splat, the stereo eye by splat and by the grid, the in-between frame by splat), each beside its
-// CPU reference on the same frames in the same run; the GPU's upload, compute and download apart,
-// the texture entry point on textures already on the GPU, and how far the GPU's result is from the
-// CPU's.
+// pull-push, the forward splat, the stereo eye by splat and by the grid, the in-between frame by
+// splat), each beside its CPU reference on the same frames in the same run; the GPU's upload,
+// compute and download apart, the texture entry point on textures already on the GPU, and how far
+// the GPU's result is from the CPU's.
 #include <cstdio>
 #include <memory>
 #include <string>

@@ -1,4 +1,5 @@
-// Extrapolation on the GPU: warp's extrapolate_to_camera for the splat. The static-layer test
+// Extrapolation on the GPU: warp's extrapolate_to_camera for the splat (and, on CPU images, the
+// grid: its displacement and cells on the CPU, drawn by grid.cpp). The static-layer test
 // (warp's static_layer_row_reference: a pixel is static when the camera alone explains its
 // motion) gives each pixel its displacement, to where the target camera sees it or `periods`
 // along its own motion; one splat carries colour, depth and that displacement; pull-push fills
@@ -6,6 +7,9 @@
 #include <chrono>
 #include <cmath>
 #include <string>
+#include <utility>
+
+#include "reprise/warp/extrapolate.hpp"
 
 #include "state.hpp"
 
@@ -38,13 +42,18 @@ void main() {
 }
 )";
 
-Status check_options(const warp::FrucOptions& o) {
-    if (o.warp != warp::WarpMethod::Splat && o.warp != warp::WarpMethod::Reverse)
+Status check_options(const warp::FrucOptions& o, bool on_textures) {
+    const bool grid = o.warp == warp::WarpMethod::Grid;
+    if (grid && on_textures)
         return Status::error(
-            "gpu extrapolate: the GPU warps with warp splat or reverse only (docs/gpu.md)");
+            "gpu extrapolate: the grid takes CPU images (its cells are grown on the CPU); on "
+            "textures warp splat or reverse");
+    if (!grid && o.warp != warp::WarpMethod::Splat && o.warp != warp::WarpMethod::Reverse)
+        return Status::error(
+            "gpu extrapolate: the GPU warps with warp grid, splat or reverse only (docs/gpu.md)");
     if (o.fill != warp::FillMethod::PullPush && o.fill != warp::FillMethod::None)
         return Status::error("gpu extrapolate: the GPU fills with pullpush or none only");
-    if (o.splat.footprint != 1 && o.splat.footprint != 2)
+    if (!grid && o.splat.footprint != 1 && o.splat.footprint != 2)
         return Status::error("gpu extrapolate: splat footprint " +
                              std::to_string(o.splat.footprint) + ": expected 1 or 2");
     return {};
@@ -63,6 +72,21 @@ Status create_extrapolate_programs(ContextState& s) {
     return gl::link_compute(
         (std::string(kComputeHeader) + kViewPoint + kStillTest + kStaticLayer).c_str(),
         "static layer", s.static_layer_program);
+}
+
+// After the warp into s.eye_color, out_depth, s.hit (covered) and s.splat_motion (the
+// displacement carried): pull-push over the holes into out_color, the motion per period.
+Status fill_and_scale(ContextState& s, int w, int h, const warp::FrucOptions& options,
+                      GLuint out_color, GLuint out_depth, GLuint out_motion, float to_backward,
+                      ExtrapolateStats& stats) {
+    stats.holes = std::size_t(w) * std::size_t(h) - stats.covered;
+    if (stats.holes && options.fill == warp::FillMethod::PullPush)
+        REPRISE_TRY(
+            fill_passes(s, s.eye_color.name, s.hit.name, out_depth, w, h, out_color, stats.fill));
+    else
+        copy_scaled(s, s.eye_color.name, out_color, w, h, 1.0f);
+    if (out_motion) copy_scaled(s, s.splat_motion.name, out_motion, w, h, to_backward);
+    return gl::check_errors("gpu extrapolate");
 }
 
 Status extrapolate_passes(ContextState& s, const SplatTextures& frame, const Camera& camera,
@@ -108,14 +132,43 @@ Status extrapolate_passes(ContextState& s, const SplatTextures& frame, const Cam
     if (reverse)
         REPRISE_TRY(refetch_pass(s, along, factor, s.splat_motion.name, s.hit.name, w, h,
                                  s.eye_color.name));
-    stats.holes = pixels - stats.covered;
-    if (stats.holes && options.fill == warp::FillMethod::PullPush)
-        REPRISE_TRY(
-            fill_passes(s, s.eye_color.name, s.hit.name, out_depth, w, h, out_color, stats.fill));
-    else
-        copy_scaled(s, s.eye_color.name, out_color, w, h, 1.0f);
-    if (out_motion) copy_scaled(s, s.splat_motion.name, out_motion, w, h, to_backward);
-    return gl::check_errors("gpu extrapolate");
+    return fill_and_scale(s, w, h, options, out_color, out_depth, out_motion, to_backward, stats);
+}
+
+// The grid's extrapolation of `frame` (CPU images, repaired; its colour uploaded as
+// s.source_color): the displacement and the cells on the CPU, drawn by the GPU.
+Status grid_extrapolation(ContextState& s, const GBufferView& frame, const glm::mat4& view,
+                          const glm::mat4& projection, float periods, float motion_scale,
+                          const warp::FrucOptions& options, GLuint out_color, GLuint out_depth,
+                          GLuint out_motion, ExtrapolateStats& stats) {
+    const int w = frame.width(), h = frame.height();
+    GridRaster& g = s.grid;
+    GBufferView along = frame;
+    float factor = 1.0f, to_backward = periods > 1e-6f ? -motion_scale / periods : 0.0f;
+    if (has_projection(frame.camera)) {
+        g.target_depth.resize(w, h);
+        g.displacement.resize(w, h);
+        stats.moving = warp::extrapolation_displacement(
+            frame, view, projection, periods, options.static_tolerance, g.target_depth.view(),
+            g.displacement.view());
+        along.motion = std::as_const(g.displacement).view();
+    } else {
+        // Without a camera nothing tells static from moving: every pixel follows its motion.
+        stats.moving = std::size_t(w) * std::size_t(h);
+        factor = -periods;
+        to_backward = motion_scale;
+    }
+    g.warper.cells(along, factor, options.grid, g.cells_cpu);
+    s.eye_color.ensure(GL_RGBA32F, w, h);
+    s.hit.ensure(GL_R32UI, w, h);
+    s.splat_motion.ensure(GL_RGBA32F, w, h);
+    warp::GridStats grid;
+    std::size_t stretched = 0;  // kept as covered, as the CPU's extrapolation keeps them
+    REPRISE_TRY(grid_passes(s, s.source_color.name, w, h, g.cells_cpu, options.grid.bicubic,
+                            {s.eye_color.name, out_depth, s.hit.name, s.splat_motion.name, w, h},
+                            grid, stretched));
+    stats.covered = grid.covered;
+    return fill_and_scale(s, w, h, options, out_color, out_depth, out_motion, to_backward, stats);
 }
 
 Status Context::extrapolate(const GBufferView& given, const glm::mat4& view,
@@ -150,7 +203,7 @@ Status Context::extrapolate_on_gpu(const GBufferView& given, const glm::mat4& vi
     s.made_valid = false;
     timings_ = {};
     stats = {};
-    REPRISE_TRY(check_options(options));
+    REPRISE_TRY(check_options(options, false));
     REPRISE_TRY(check_periods(periods));
     const int w = given.width(), h = given.height();
     if (given.depth.width != w || given.depth.height != h || given.motion.width != w ||
@@ -162,11 +215,15 @@ Status Context::extrapolate_on_gpu(const GBufferView& given, const glm::mat4& vi
     // The same frame as the last call's: its repaired pixels are uploaded already.
     const bool kept = frame_key != 0 && frame_key == s.extrapolate_key &&
                       s.source_color.width == w && s.source_color.height == h;
+    const bool grid = options.warp == warp::WarpMethod::Grid;
+    GBufferView frame;  // repaired; the grid's cells are grown from it on the CPU
     if (kept) {
         stats.nonfinite = s.extrapolate_nonfinite;
         stats.upload_kept = true;
+        NonfiniteCounts again;
+        if (grid) frame = s.extrapolate_repair.clean(given, again);
     } else {
-        const GBufferView frame = s.extrapolate_repair.clean(given, stats.nonfinite);
+        frame = s.extrapolate_repair.clean(given, stats.nonfinite);
         s.upload_frame(frame, s.source_color, s.source_depth, s.source_motion);
         s.extrapolate_key = frame_key;
         s.extrapolate_nonfinite = stats.nonfinite;
@@ -175,10 +232,14 @@ Status Context::extrapolate_on_gpu(const GBufferView& given, const glm::mat4& vi
     s.depth.ensure(GL_R32F, w, h);
     s.made_motion.ensure(GL_RGBA32F, w, h);
     timings_.upload_ms = finish_ms(t);
-    REPRISE_TRY(extrapolate_passes(
-        s, {s.source_color.name, s.source_depth.name, s.source_motion.name, w, h}, given.camera,
-        view, projection, periods, motion_scale, options, s.color.name, s.depth.name,
-        s.made_motion.name, stats));
+    if (grid)
+        REPRISE_TRY(grid_extrapolation(s, frame, view, projection, periods, motion_scale, options,
+                                       s.color.name, s.depth.name, s.made_motion.name, stats));
+    else
+        REPRISE_TRY(extrapolate_passes(
+            s, {s.source_color.name, s.source_depth.name, s.source_motion.name, w, h}, given.camera,
+            view, projection, periods, motion_scale, options, s.color.name, s.depth.name,
+            s.made_motion.name, stats));
     timings_.compute_ms = finish_ms(t);
     s.made_valid = true;
     return {};
@@ -196,7 +257,7 @@ Status Context::extrapolate(const GBufferTextures& frame, unsigned color, const 
                             const warp::FrucOptions& options, float motion_scale) {
     timings_ = {};
     stats = {};
-    REPRISE_TRY(check_options(options));
+    REPRISE_TRY(check_options(options, true));
     REPRISE_TRY(check_periods(periods));
     ContextState& s = *state_;
     REPRISE_TRY(s.gl->acquire());

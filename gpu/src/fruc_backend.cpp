@@ -11,17 +11,19 @@ Status FrucBackend::check(const warp::FrucOptions& o, const warp::SplatOptions& 
     auto need = [&](bool ok, const char* what) {
         if (!ok) unsupported += std::string(unsupported.empty() ? "" : ", ") + what;
     };
-    need(o.warp == warp::WarpMethod::Splat || o.warp == warp::WarpMethod::Reverse,
-         "warp splat or reverse");
-    if (o.mode == warp::FrucMode::Interpolate) {
+    const bool extrapolate = o.mode != warp::FrucMode::Interpolate;
+    need(o.warp == warp::WarpMethod::Splat || o.warp == warp::WarpMethod::Reverse ||
+             (extrapolate && o.warp == warp::WarpMethod::Grid),
+         extrapolate ? "warp grid, splat or reverse" : "warp splat or reverse");
+    if (!extrapolate) {
         need(o.fill == warp::FillMethod::PullPush, "fill pullpush");
         need(!o.refine.enabled, "refine off");
     } else {
         need(o.fill == warp::FillMethod::PullPush || o.fill == warp::FillMethod::None,
              "fill pullpush or none");
     }
-    need(o.warp == warp::WarpMethod::Reverse || (o.splat.footprint == splat.footprint &&
-                                                 o.splat.depth_tolerance == splat.depth_tolerance),
+    need(o.warp != warp::WarpMethod::Splat || (o.splat.footprint == splat.footprint &&
+                                               o.splat.depth_tolerance == splat.depth_tolerance),
          "the backend's splat options");
     if (unsupported.empty()) return {};
     return Status::error(std::string("gpu: the GPU makes ") +

@@ -177,7 +177,7 @@ bool inside(ivec2 p, ivec2 q, ivec2 at) {
     return edge_inside(dx, at.y - p.y, dy, at.x - p.x, 16 * max(abs(dx), abs(dy)));
 }
 )"
-                                 R"(
+                                  R"(
 int floor_small(highp float v) {
     int i = int(v);
     return i - (v < float(i) ? 1 : 0);
@@ -305,9 +305,9 @@ public:
 
 private:
     static constexpr int kCaps = 8;
-    static constexpr GLenum kCap[kCaps] = {GL_DEPTH_TEST,   GL_BLEND,
-                                           GL_SCISSOR_TEST, GL_CULL_FACE,
-                                           GL_STENCIL_TEST, GL_RASTERIZER_DISCARD,
+    static constexpr GLenum kCap[kCaps] = {GL_DEPTH_TEST,      GL_BLEND,
+                                           GL_SCISSOR_TEST,    GL_CULL_FACE,
+                                           GL_STENCIL_TEST,    GL_RASTERIZER_DISCARD,
                                            GL_SAMPLE_COVERAGE, GL_SAMPLE_ALPHA_TO_COVERAGE};
     GLboolean enabled_[kCaps];
     GLint viewport_[4], depth_func_ = GL_LESS;
@@ -317,14 +317,15 @@ private:
 
 Status create_grid_programs(ContextState& s) {
     GridRaster& g = s.grid;
-    if (g.counts) return {};  // made last: everything before it is ready
+    if (g.counts) return {};     // made last: everything before it is ready
     glDeleteProgram(g.program);  // a failed try's
     g.program = 0;
     GLint blocks = 0;
     glGetIntegerv(GL_MAX_VERTEX_SHADER_STORAGE_BLOCKS, &blocks);
     if (blocks < 1)
-        return Status::error("gpu grid warp: " + s.gl->description() +
-                             " offers no storage buffer in vertex shaders (the cells are read there)");
+        return Status::error(
+            "gpu grid warp: " + s.gl->description() +
+            " offers no storage buffer in vertex shaders (the cells are read there)");
     const std::string header = kGraphicsHeader;
     REPRISE_TRY(gl::link_program((header + kVertex).c_str(), (header + kFragment).c_str(),
                                  "grid warp", g.program));
@@ -465,10 +466,10 @@ Status Context::grid_warp(const GBufferView& source, float factor, const warp::W
     const bool motion = !target.motion.empty();
     if (motion) s.splat_motion.ensure(GL_RGBA32F, tw, th);
     std::size_t stretched = 0;
-    REPRISE_TRY(grid_passes(s, s.payload.name, sw, sh, s.grid.cells_cpu, options.bicubic,
-                            {s.out.name, s.depth.name, s.hit.name,
-                             motion ? s.splat_motion.name : 0u, tw, th},
-                            stats, stretched));
+    REPRISE_TRY(grid_passes(
+        s, s.payload.name, sw, sh, s.grid.cells_cpu, options.bicubic,
+        {s.out.name, s.depth.name, s.hit.name, motion ? s.splat_motion.name : 0u, tw, th}, stats,
+        stretched));
     timings_.compute_ms = finish_ms(t);
     s.download(s.out, target.color.data, target.color.stride);
     s.download_channels(s.depth, target.depth.data, 1, target.depth.stride);
@@ -476,7 +477,8 @@ Status Context::grid_warp(const GBufferView& source, float factor, const warp::W
     for (int y = 0; y < th; ++y)
         for (int x = 0; x < tw; ++x)
             target.covered(x, y) = uint8_t(s.hit_readback[std::size_t(y) * tw + x].x);
-    if (motion) s.download_channels(s.splat_motion, &target.motion.data->x, 2, target.motion.stride);
+    if (motion)
+        s.download_channels(s.splat_motion, &target.motion.data->x, 2, target.motion.stride);
     REPRISE_TRY(gl::check_errors("gpu grid warp download"));
     timings_.download_ms = finish_ms(t);
     return {};

@@ -160,6 +160,26 @@ std::size_t static_layer(const GBufferView& f, const glm::mat4& to_view,
     return dynamic.load();
 }
 
+std::size_t extrapolation_displacement(const GBufferView& f, const glm::mat4& view,
+                                       const glm::mat4& projection, float periods,
+                                       float static_tolerance, ImageView<float> layer_depth,
+                                       ImageView<glm::vec2> displacement) {
+    const int w = f.width(), h = f.height();
+    const std::size_t moving =
+        static_layer(f, view, projection, static_tolerance, layer_depth, displacement);
+    if (moving)
+        parallel_for(0, h, [&](int y0, int y1) {
+            for (int y = y0; y < y1; ++y) {
+                const float* still = layer_depth.row(y);
+                const glm::vec2* own = f.motion.row(y);
+                glm::vec2* d = displacement.row(y);
+                for (int x = 0; x < w; ++x)
+                    if (std::isnan(still[x])) d[x] = -periods * own[x];
+            }
+        });
+    return moving;
+}
+
 Status extrapolate_frame(const GBufferView& f, float s, float motion_scale,
                          const FrucOptions& options, FrucScratch& scratch, Frame& out,
                          FrucCounters& counters) {
@@ -197,19 +217,9 @@ Status extrapolate_to_camera(const GBufferView& given, const glm::mat4& future_v
     scratch.layer_depth.resize(w, h);
     scratch.layer_motion.resize(w, h);
     const std::size_t moving_pixels =
-        static_layer(f, future_view, future_projection, options.static_tolerance,
-                     scratch.layer_depth.view(), scratch.layer_motion.view());
+        extrapolation_displacement(f, future_view, future_projection, s, options.static_tolerance,
+                                   scratch.layer_depth.view(), scratch.layer_motion.view());
     ++(moving_pixels ? counters.dynamic_layers : counters.dynamic_skipped);
-    if (moving_pixels)
-        parallel_for(0, h, [&](int y0, int y1) {
-            for (int y = y0; y < y1; ++y) {
-                const float* still = &scratch.layer_depth(0, y);
-                const glm::vec2* own = f.motion.row(y);
-                glm::vec2* displacement = &scratch.layer_motion(0, y);
-                for (int x = 0; x < w; ++x)
-                    if (std::isnan(still[x])) displacement[x] = -s * own[x];
-            }
-        });
     const GBufferView along{.color = f.color,
                             .depth = f.depth,
                             .motion = std::as_const(scratch.layer_motion).view(),

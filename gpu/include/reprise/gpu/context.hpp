@@ -177,9 +177,10 @@ public:
                        unsigned out_motion = 0);
 
     // warp::PoseExtrapolator (and the converter's extrapolation) for FrucOptions with warp Splat
-    // or Reverse and fill PullPush or None (others are an error): `frame` as seen by (view,
-    // projection) `periods` frame periods after it. Static pixels (their motion within
-    // options.static_tolerance px of the camera's alone) go where that camera sees them, the
+    // or Reverse (on CPU images also Grid: warp::extrapolation_displacement and the grid's cells
+    // on the CPU, drawn by the GPU) and fill PullPush or None (others are an error): `frame` as
+    // seen by (view, projection) `periods` frame periods after it. Static pixels (their motion
+    // within options.static_tolerance px of the camera's alone) go where that camera sees them, the
     // others `periods` along their own motion, in one splat; pull-push over what nothing covers.
     // A frame without a projection goes along its motion alone (view and projection unused).
     // out gets colour, depth and backward motion per period times motion_scale (0 at periods

@@ -9,6 +9,16 @@
 
 namespace reprise::warp {
 
+// Where extrapolation moves each pixel of `f` (with a projection): a static pixel (its camera
+// alone explains its motion within `static_tolerance` px) to where (view, projection) sees it, the
+// others `periods` along their own motion, as `displacement` in pixels (NaN: invalid);
+// `layer_depth` is scratch of f's size. Returns how many pixels moved on their own. The grid or
+// splat of `f` with this as its motion, by 1, is the extrapolated frame before its fill.
+std::size_t extrapolation_displacement(const GBufferView& f, const glm::mat4& view,
+                                       const glm::mat4& projection, float periods,
+                                       float static_tolerance, ImageView<float> layer_depth,
+                                       ImageView<glm::vec2> displacement);
+
 class PoseExtrapolator {
 public:
     explicit PoseExtrapolator(const FrucOptions& options = {.mode = FrucMode::Extrapolate});
