@@ -155,9 +155,20 @@ TEST(CliStereo, TheGpuBackendMakesTheCpusEyes) {
     for (int i = 0; i < 2; ++i)
         EXPECT_GE(psnr_of(frame_path(grid_cpu + "/right", i), frame_path(grid_gles + "/right", i)),
                   50.0);
+    const std::string grid_temporal = (dir / "grid_temporal").string(),
+                      grid_gles_temporal = (dir / "grid_gles_temporal").string();
+    ASSERT_EQ(
+        run_command(cli::command_stereo, {"--in", truth, "--temporal", "--out", grid_temporal}), 0);
+    ASSERT_EQ(run_command(cli::command_stereo, {"--in", truth, "--temporal", "--backend", "gles",
+                                                "--out", grid_gles_temporal}),
+              0);
+    for (int i = 0; i < 2; ++i)
+        EXPECT_GE(psnr_of(frame_path(grid_temporal + "/right", i),
+                          frame_path(grid_gles_temporal + "/right", i)),
+                  50.0);
     EXPECT_EQ(run_command(cli::command_stereo,
-                          {"--in", truth, "--out", gles, "--backend", "gles", "--temporal"}),
-              2);  // the grid eye with a history
+                          {"--in", truth, "--out", gles, "--backend", "gles", "--fill", "andreev"}),
+              2);
     // --temporal: the previous frame fills the holes first, on the GPU as on the CPU.
     const std::string cpu_temporal = (dir / "cpu_temporal").string(),
                       gles_temporal = (dir / "gles_temporal").string();

@@ -697,10 +697,6 @@ TEST(Gpu, StereoEyeOnTexturesAndOptionsTheGpuLacks) {
     stereo::StereoStats s;
     const Status grid = context.stereo_eye(rendered, color, right, out, depth, s, {});
     EXPECT_NE(grid.message().find("the grid eye takes CPU images"), std::string::npos);
-    const GBufferView history = f;
-    const Status grid_history = context.stereo_eye(f, right, unused, s, {}, &history);
-    EXPECT_NE(grid_history.message().find("the grid eye with a history is not on the GPU yet"),
-              std::string::npos);
     const Status andreev = context.stereo_eye(
         f, right, unused, s,
         {.warp = stereo::StereoWarp::Splat, .fill = stereo::StereoFill::Andreev});
@@ -1419,7 +1415,7 @@ TEST(Gpu, UpsamplingOptionsAndNonFiniteSamples) {
 // --- The eye with history: the previous frame warped into the rendered eye's holes.
 
 TEST(Gpu, StereoEyeWithHistoryMatchesTheCpuOnEveryBuiltInScene) {
-    std::size_t from_history = 0, moving = 0;
+    std::size_t from_history = 0, moving = 0, grid_from_history = 0;
     for (const server::SceneInfo& info : server::builtin_scenes()) {
         SCOPED_TRACE(info.name);
         const std::vector<Frame>& frames = scene_frames(info.name);
@@ -1429,7 +1425,8 @@ TEST(Gpu, StereoEyeWithHistoryMatchesTheCpuOnEveryBuiltInScene) {
              {stereo::StereoOptions{.warp = stereo::StereoWarp::Splat},
               stereo::StereoOptions{.warp = stereo::StereoWarp::Splat,
               .fill = stereo::StereoFill::None,
-              .history_replaces = true}}) {
+              .history_replaces = true},
+              stereo::StereoOptions{}, stereo::StereoOptions{.grid = {.min_cell = 2}}}) {
             Frame cpu, gpu;
             stereo::StereoSynthesizer synthesizer;
             const GBufferView history = frames[0].view();
@@ -1440,17 +1437,25 @@ TEST(Gpu, StereoEyeWithHistoryMatchesTheCpuOnEveryBuiltInScene) {
                 shared_gpu().stereo_eye(frames[1], right, gpu, b, options, &history);
             ASSERT_TRUE(status.ok()) << status.message();
             EXPECT_GE(test::display_psnr(cpu.color, gpu.color), 50.0);
-            EXPECT_EQ(b.from_history, a.from_history);
             EXPECT_EQ(b.history_moving, a.history_moving);
-            EXPECT_EQ(b.holes, a.holes);
-            EXPECT_EQ(b.filled, a.filled);
-            EXPECT_EQ(b.unfilled, a.unfilled);
+            // The grid's draws agree on coverage within the 0.1 % (here: exactly).
+            const std::size_t allowed =
+                options.warp == stereo::StereoWarp::Grid ? cpu.color.pixel_count() / 1000 : 0;
+            for (auto [x, y] : {std::pair{a.from_history, b.from_history},
+                                {a.holes, b.holes},
+                                {a.filled, b.filled},
+                                {a.unfilled, b.unfilled},
+                                {a.stretched, b.stretched},
+                                {a.border, b.border}})
+                EXPECT_LE(std::max(x, y) - std::min(x, y), allowed);
             from_history += b.from_history;
             moving += b.history_moving;
+            grid_from_history += options.warp == stereo::StereoWarp::Grid ? b.from_history : 0;
         }
     }
     EXPECT_GT(from_history, 0u);  // not vacuous: holes were filled from the history
     EXPECT_GT(moving, 0u);        // ... and moving history pixels left out
+    EXPECT_GT(grid_from_history, 0u);
 }
 
 TEST(Gpu, StereoEyeWithHistoryOnTexturesIsTheImageEntrys) {

@@ -62,10 +62,6 @@ Status check(const StereoJob& j, stereo::StereoRig& rig, stereo::StereoOptions& 
         return Status::error(
             "--backend gles: the GPU fills with --fill pullpush or none (Andreev's and the patch "
             "fill are not on the GPU yet)");
-    if (j.backend == "gles" && j.temporal && j.warp != "splat")
-        return Status::error(
-            "--backend gles --temporal: the GPU fills from the previous frame with --warp splat "
-            "(the grid eye with a history is not on the GPU yet)");
     rig = {.ipd = float(j.ipd),
            .convergence = float(j.convergence),
            .rig = j.rig == "offaxis" ? stereo::Rig::OffAxis : stereo::Rig::Parallel};

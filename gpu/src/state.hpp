@@ -203,9 +203,9 @@ struct GridRaster {
     int depth_width = 0, depth_height = 0;
     std::size_t cells_bytes = 0;
     warp::GridWarper warper;
-    std::vector<warp::GridCell> cells_cpu;
-    Image<glm::vec2> displacement;
-    Image<float> target_depth;
+    std::vector<warp::GridCell> cells_cpu, history_cells;
+    Image<glm::vec2> displacement, history_displacement;
+    Image<float> target_depth, history_target_depth;
 };
 void destroy_grid(GridRaster& grid);
 

@@ -1,8 +1,9 @@
 // The second eye on the GPU: stereo::StereoSynthesizer. Splat: each pixel's displacement to the
 // target camera through its depth (warp/'s displacement_row_reference, same arithmetic), the
-// splat; with a history, its warp merged into the holes. Grid (CPU images, no history yet): the
-// displacement and the grid's cells on the CPU, drawn on the GPU (grid.cpp), pixels of stretched
-// triangles left to the fill, the border strip continued. Then pull-push over what is left, and
+// splat; with a history, its warp merged into the holes. Grid (CPU images): the displacements and
+// the grid's cells on the CPU, drawn on the GPU (grid.cpp), the history's merged into the holes
+// and stretched pixels, the pixels of stretched triangles left to the fill, the border strip
+// continued. Then pull-push over what is left, and
 // non-finite colour to 0 on the way into the output.
 #include <chrono>
 #include <string>
@@ -59,7 +60,8 @@ void main() {
 )";
 
 // The history warped to the target where the rendered eye left a hole (or, history_replaces and
-// the history's camera nearer, where both see one surface): colour into `merged`, depth and
+// the history's camera nearer, where both see one surface; or, grid eye, where only a stretched
+// triangle (2) covered it and the history saw it unstretched): colour into `merged`, depth and
 // coverage in place; counts taken pixels and the holes among them.
 constexpr const char* kMerge = R"(
 layout(binding = 0) uniform highp sampler2D eye;
@@ -75,12 +77,15 @@ uniform highp float tolerance;
 
 void merge(ivec2 p) {
     highp vec4 c = texelFetch(eye, p, 0);
-    if (texelFetch(history_covered, p, 0).r != 0u) {
+    uint seen = texelFetch(history_covered, p, 0).r;
+    if (seen != 0u) {
         highp float zh = texelFetch(history_depth, p, 0).r, zc = imageLoad(depth, p).r;
-        bool hole = imageLoad(covered, p).r == 0u;
+        uint mine = imageLoad(covered, p).r;
+        bool hole = mine == 0u;
+        bool better = hole || (mine == 2u && seen != 2u);
         PRECISE highp float gap = abs(zh - zc), allowed = tolerance * min(zh, zc);
         bool same = zh == zc || gap <= allowed;
-        if (hole || (closer && same)) {
+        if (better || (closer && same)) {
             c = texelFetch(history, p, 0);
             imageStore(depth, p, vec4(zh));
             imageStore(covered, p, uvec4(1u));
@@ -168,20 +173,15 @@ void run(GLuint program, int w, int h) {
     dispatch(w, h);
 }
 
-Status check_options(const stereo::StereoOptions& o, bool on_textures, bool history) {
+Status check_options(const stereo::StereoOptions& o, bool on_textures) {
     if (o.warp == stereo::StereoWarp::Grid && on_textures)
         return Status::error(
             "gpu stereo eye: the grid eye takes CPU images (its cells are grown on the CPU); on "
             "textures StereoWarp::Splat");
-    if (o.warp == stereo::StereoWarp::Grid && history)
-        return Status::error(
-            "gpu stereo eye: the grid eye with a history is not on the GPU yet (StereoWarp::Splat "
-            "with a history is)");
     if (o.fill != stereo::StereoFill::PullPush && o.fill != stereo::StereoFill::None)
         return Status::error(
             "gpu stereo eye: Andreev's and the patch fill are not on the GPU yet (PullPush and "
-            "None "
-            "are)");
+            "None are)");
     return {};
 }
 
@@ -235,6 +235,33 @@ std::size_t displace(ContextState& s, GLuint depth, GLuint motion, int w, int h,
     return moving;
 }
 
+// The history's warp (s.history_warped, its depth and coverage) merged into the eye's
+// (s.eye_color, `out_depth`, s.hit): colour into s.merged.
+Status merge_history(ContextState& s, int w, int h, const stereo::StereoOptions& o,
+                     const Camera& from, const Camera& target, const Camera& history_camera,
+                     GLuint out_depth, stereo::StereoStats& stats,
+                     std::size_t& history_holes_filled) {
+    auto distance = [](const Camera& a, const Camera& b) {
+        return glm::length(glm::vec3(glm::inverse(a.view)[3]) - glm::vec3(glm::inverse(b.view)[3]));
+    };
+    glUseProgram(s.merge_program);
+    s.bind_inputs({s.eye_color.name, s.history_warped.name, s.history_warped_depth.name,
+                   s.history_covered.name});
+    glBindImageTexture(0, s.merged.name, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glBindImageTexture(1, out_depth, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32F);
+    glBindImageTexture(2, s.hit.name, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
+    ContextState::reset_counters(s.eye_counts, 4);
+    glUniform1i(glGetUniformLocation(s.merge_program, "closer"),
+                o.history_replaces && distance(history_camera, target) < distance(from, target));
+    glUniform1f(glGetUniformLocation(s.merge_program, "tolerance"), o.history_depth_tolerance);
+    run(s.merge_program, w, h);
+    GLuint taken[3] = {0, 0, 0};
+    s.read_counters(s.eye_counts, taken, sizeof taken);
+    stats.from_history = taken[1];
+    history_holes_filled = taken[2];
+    return gl::check_errors("gpu stereo eye merge");
+}
+
 // Pull-push over the holes of `warped` (valid mask s.hit), non-finite colour to 0, into
 // `out_color`.
 Status fill_and_finish(ContextState& s, GLuint warped, int w, int h, const stereo::StereoOptions& o,
@@ -258,9 +285,12 @@ Status fill_and_finish(ContextState& s, GLuint warped, int w, int h, const stere
 }
 
 // The grid eye's warp of `color` (w x h) by the cells in s.grid (grown on the CPU): colour into
-// s.eye_color, depth into `out_depth`, the valid mask into s.hit, the border strip continued.
+// `warped` (s.eye_color, or s.merged with a history, whose cells are s.grid.history_cells),
+// depth into `out_depth`, the valid mask into s.hit, the border strip continued.
 Status grid_eye_passes(ContextState& s, GLuint color, int w, int h, const stereo::StereoOptions& o,
-                       GLuint out_depth, stereo::StereoStats& stats) {
+                       const Camera& from, const Camera& target, const EyeHistory* history,
+                       GLuint out_depth, stereo::StereoStats& stats, GLuint& warped,
+                       std::size_t& history_holes_filled) {
     warp::GridStats grid;
     REPRISE_TRY(grid_passes(s, color, w, h, s.grid.cells_cpu, o.grid.bicubic,
                             {s.eye_color.name, out_depth, s.hit.name, 0, w, h}, grid,
@@ -268,6 +298,19 @@ Status grid_eye_passes(ContextState& s, GLuint color, int w, int h, const stereo
     stats.cells = grid.cells;
     stats.covered = grid.covered;
     stats.holes = std::size_t(w) * std::size_t(h) - grid.covered;
+    warped = s.eye_color.name;
+    if (history) {
+        warp::GridStats seen;
+        std::size_t unused = 0;
+        REPRISE_TRY(grid_passes(
+            s, history->color, w, h, s.grid.history_cells, o.grid.bicubic,
+            {s.history_warped.name, s.history_warped_depth.name, s.history_covered.name, 0, w, h},
+            seen, unused));
+        stats.cells += seen.cells;
+        REPRISE_TRY(merge_history(s, w, h, o, from, target, history->camera, out_depth, stats,
+                                  history_holes_filled));
+        warped = s.merged.name;
+    }
     glUseProgram(s.grid.eye_valid_program);
     glBindImageTexture(0, s.hit.name, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
     glUniform1i(glGetUniformLocation(s.grid.eye_valid_program, "refill"),
@@ -275,8 +318,8 @@ Status grid_eye_passes(ContextState& s, GLuint color, int w, int h, const stereo
     run(s.grid.eye_valid_program, w, h);
     if (o.fill == stereo::StereoFill::None) return {};
     glUseProgram(s.grid.border_program);
-    s.bind_inputs({s.eye_color.name});
-    glBindImageTexture(0, s.eye_color.name, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    s.bind_inputs({warped});
+    glBindImageTexture(0, warped, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     glBindImageTexture(1, out_depth, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32F);
     glBindImageTexture(2, s.hit.name, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
     ContextState::reset_counters(s.eye_counts, 4);
@@ -318,8 +361,10 @@ Status eye_passes(ContextState& s, GLuint color, GLuint depth, int w, int h, con
     GLuint warped = s.eye_color.name;
     std::size_t history_holes_filled = 0;
     if (o.warp == stereo::StereoWarp::Grid) {
-        REPRISE_TRY(grid_eye_passes(s, color, w, h, o, out_depth, stats));
-        return fill_and_finish(s, warped, w, h, o, out_color, out_depth, stats, 0);
+        REPRISE_TRY(grid_eye_passes(s, color, w, h, o, from, target, history, out_depth, stats,
+                                    warped, history_holes_filled));
+        return fill_and_finish(s, warped, w, h, o, out_color, out_depth, stats,
+                               history_holes_filled);
     }
     displace(s, depth, 0, w, h, from, target, INFINITY, s.displacement.name, s.target_depth.name);
     std::size_t covered = 0;
@@ -336,26 +381,8 @@ Status eye_passes(ContextState& s, GLuint color, GLuint depth, int w, int h, con
             s, {history->color, s.history_target_depth.name, s.history_displacement.name, w, h},
             1.0f, o.splat, w, h, s.history_warped.name, s.history_warped_depth.name,
             s.history_covered.name, 0, seen));
-        auto distance = [](const Camera& a, const Camera& b) {
-            return glm::length(glm::vec3(glm::inverse(a.view)[3]) -
-                               glm::vec3(glm::inverse(b.view)[3]));
-        };
-        glUseProgram(s.merge_program);
-        s.bind_inputs({s.eye_color.name, s.history_warped.name, s.history_warped_depth.name,
-                       s.history_covered.name});
-        glBindImageTexture(0, s.merged.name, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-        glBindImageTexture(1, out_depth, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32F);
-        glBindImageTexture(2, s.hit.name, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
-        ContextState::reset_counters(s.eye_counts, 4);
-        glUniform1i(
-            glGetUniformLocation(s.merge_program, "closer"),
-            o.history_replaces && distance(history->camera, target) < distance(from, target));
-        glUniform1f(glGetUniformLocation(s.merge_program, "tolerance"), o.history_depth_tolerance);
-        run(s.merge_program, w, h);
-        GLuint taken[3] = {0, 0, 0};
-        s.read_counters(s.eye_counts, taken, sizeof taken);
-        stats.from_history = taken[1];
-        history_holes_filled = taken[2];
+        REPRISE_TRY(merge_history(s, w, h, o, from, target, history->camera, out_depth, stats,
+                                  history_holes_filled));
         warped = s.merged.name;
     }
     return fill_and_finish(s, warped, w, h, o, out_color, out_depth, stats, history_holes_filled);
@@ -366,7 +393,7 @@ Status Context::stereo_eye(const GBufferView& given, const Camera& target, Frame
                            const GBufferView* given_history) {
     timings_ = {};
     stats = {};
-    REPRISE_TRY(check_options(options, false, given_history != nullptr));
+    REPRISE_TRY(check_options(options, false));
     const int w = given.width(), h = given.height();
     REPRISE_ASSERT(given.depth.width == w && given.depth.height == h);
     ContextState& s = *state_;
@@ -419,6 +446,19 @@ Status Context::stereo_eye(const GBufferView& given, const Camera& target, Frame
                                 .motion = g.displacement.view(),
                                 .camera = rendered.camera};
         g.warper.cells(moved, 1.0f, options.grid, g.cells_cpu);
+        if (with_history) {  // its moving pixels left out, as StereoSynthesizer does
+            g.history_displacement.resize(w, h);
+            g.history_target_depth.resize(w, h);
+            stereo::stereo_displacement(history, target, g.history_displacement.view(),
+                                        g.history_target_depth.view());
+            stats.history_moving = stereo::drop_moving(history, options.history_moving_tolerance,
+                                                       g.history_displacement.view());
+            const GBufferView history_moved{.color = history.color,
+                                            .depth = g.history_target_depth.view(),
+                                            .motion = g.history_displacement.view(),
+                                            .camera = history.camera};
+            g.warper.cells(history_moved, 1.0f, options.grid, g.history_cells);
+        }
     }
     s.payload.ensure(GL_RGBA32F, w, h);
     s.previous_depth.ensure(GL_R32F, w, h);
@@ -432,8 +472,10 @@ Status Context::stereo_eye(const GBufferView& given, const Camera& target, Frame
         s.history_depth.ensure(GL_R32F, w, h);
         s.history_motion.ensure(GL_RG32F, motion ? w : 1, motion ? h : 1);
         s.upload(s.history_color, history.color.data, history.color.stride);
-        s.upload(s.history_depth, history.depth.data, history.depth.stride);
-        if (motion) s.upload(s.history_motion, history.motion.data, history.motion.stride);
+        if (options.warp == stereo::StereoWarp::Splat) {  // the grid's was read on the CPU
+            s.upload(s.history_depth, history.depth.data, history.depth.stride);
+            if (motion) s.upload(s.history_motion, history.motion.data, history.motion.stride);
+        }
         textures = {s.history_color.name, s.history_depth.name, motion ? s.history_motion.name : 0u,
                     history.camera};
     }
@@ -457,7 +499,7 @@ Status Context::stereo_eye(const GBufferTextures& rendered, unsigned color, cons
                            unsigned history_color) {
     timings_ = {};
     stats = {};
-    REPRISE_TRY(check_options(options, true, history != nullptr));
+    REPRISE_TRY(check_options(options, true));
     ContextState& s = *state_;
     REPRISE_TRY(s.gl->acquire());
     const int w = rendered.width, h = rendered.height;

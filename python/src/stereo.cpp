@@ -93,7 +93,7 @@ py::tuple made_eye(const Frame& rendered, Make&& make) {
 }
 
 // backend "gles": the eye made by OpenGL ES (gpu::Context::stereo_eye: fill pullpush or none;
-// the grid's cells grown on the CPU, without a history), the CPU's eye within 50 dB.
+// the grid's cells grown on the CPU), the CPU's eye within 50 dB.
 struct Synthesizer {
     explicit Synthesizer(const std::string& backend = "cpu") {
         if (backend == "gles")
@@ -165,7 +165,7 @@ void bind_stereo(py::module_& m) {
                             "frames of one size.")
         .def(py::init<const std::string&>(), py::arg("backend") = "cpu",
              "backend 'gles': eyes made by OpenGL ES (fill 'pullpush' or 'none'; the grid's "
-             "cells grown on the CPU and without a history)")
+             "cells grown on the CPU)")
         .def("synthesize", &Synthesizer::synthesize, py::arg("rendered"), py::arg("target"),
              py::arg("warp") = "grid", py::arg("fill") = "pullpush", py::arg("history") = nullptr,
              py::arg("widen_silhouettes") = true,

@@ -51,8 +51,14 @@ def test_the_gpu_backend_makes_the_cpus_eyes(pan_60):
                         reprise.to_display(cpu_grid.color)) >= 50.0
     assert gpu_grid_stats["cells"] == cpu_grid_stats["cells"] > 0
     assert gpu_grid_stats["border"] == cpu_grid_stats["border"] > 0
-    with pytest.raises(ValueError, match="the grid eye with a history is not on the GPU"):
-        gles.synthesize(left, right_camera, history=pan_60[3])
+    cpu_grid, cpu_grid_stats = reprise.StereoSynthesizer().synthesize(left, right_camera,
+                                                                      history=pan_60[3])
+    gpu_grid, gpu_grid_stats = gles.synthesize(left, right_camera, history=pan_60[3])
+    assert reprise.psnr(reprise.to_display(gpu_grid.color),
+                        reprise.to_display(cpu_grid.color)) >= 50.0
+    assert gpu_grid_stats["from_history"] == cpu_grid_stats["from_history"]
+    with pytest.raises(ValueError, match="Andreev"):
+        gles.synthesize(left, right_camera, fill="andreev")
     # With the previous frame as history, filling the holes first: the CPU's eye too.
     cpu, cpu_stats = reprise.StereoSynthesizer().synthesize(left, right_camera, warp="splat",
                                                             history=pan_60[3])

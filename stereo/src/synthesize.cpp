@@ -44,8 +44,8 @@ float distance_between(const Camera& a, const Camera& b) {
     return glm::length(glm::vec3(glm::inverse(a.view)[3]) - glm::vec3(glm::inverse(b.view)[3]));
 }
 
-// Leaves out of the warp (NaN displacement) the pixels of `source` whose motion its camera does
-// not explain within `tolerance` px; returns how many. Without motion, none.
+}  // namespace
+
 std::size_t drop_moving(const GBufferView& source, float tolerance,
                         ImageView<glm::vec2> displacement) {
     const int w = source.width(), h = source.height();
@@ -78,8 +78,6 @@ std::size_t drop_moving(const GBufferView& source, float tolerance,
     });
     return dropped.load();
 }
-
-}  // namespace
 
 std::size_t StereoSynthesizer::warp_into(const GBufferView& given, const Camera& target,
                                          const StereoOptions& o, const warp::WarpTarget& into,

@@ -122,4 +122,10 @@ StereoStats synthesize_eye(const GBufferView& rendered, const Camera& target,
 void stereo_displacement(const GBufferView& source, const Camera& target,
                          ImageView<glm::vec2> displacement, ImageView<float> target_depth);
 
+// Leaves out of a history's warp (NaN displacement) the pixels of `source` whose motion its
+// camera does not explain within `tolerance` px: they are not where they were. Returns how many;
+// without motion, none.
+std::size_t drop_moving(const GBufferView& source, float tolerance,
+                        ImageView<glm::vec2> displacement);
+
 }  // namespace reprise::stereo
