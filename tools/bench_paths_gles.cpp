@@ -31,11 +31,12 @@ namespace {
 // One stage's timings on both backends, and the GPU result's distance from the CPU's.
 struct StageTimes {
     const char* name;
-    Timing cpu, upload, compute, download, total, textures;
+    Timing cpu, prep, upload, compute, download, total, textures;
     double worst_db = INFINITY;
 };
 
 void record(StageTimes& stage, const gpu::Timings& t, double total_ms) {
+    stage.prep.ms.push_back(t.cpu_ms);
     stage.upload.ms.push_back(t.upload_ms);
     stage.compute.ms.push_back(t.compute_ms);
     stage.download.ms.push_back(t.download_ms);
@@ -71,6 +72,8 @@ struct Textures {
 const warp::FrucOptions kExtrapolation{.mode = warp::FrucMode::Extrapolate,
                                        .warp = warp::WarpMethod::Splat,
                                        .widen_silhouettes = false};
+const warp::FrucOptions kGridExtrapolation{.mode = warp::FrucMode::Extrapolate,
+                                           .widen_silhouettes = false};
 
 // Both stages on textures already on the GPU (the last pair of frames), `runs` times each:
 // compute alone, as an application that keeps its frames on the GPU pays it.
@@ -131,10 +134,10 @@ Status bench_gles_stages(const std::vector<Frame>& frames, const std::string& si
     Image<glm::vec4> cpu_out(w, h), gpu_out(w, h), cpu_filled(w, h), gpu_filled(w, h);
     Image<uint8_t> cpu_hit(w, h), gpu_hit(w, h);
     warp::PullPush pull_push;
-    StageTimes stages[8] = {{"reproject RGBA"},       {"pull-push (depth)"},
-                            {"splat x-0.5"},          {"stereo-eye splat+pp"},
-                            {"interpolate splat+pp"}, {"extrapolate splat+pp"},
-                            {"upsample 1/4 Herzog"},  {"stereo-eye grid+pp"}};
+    StageTimes stages[9] = {
+        {"reproject RGBA"},      {"pull-push (depth)"},    {"splat x-0.5"},
+        {"stereo-eye splat+pp"}, {"interpolate splat+pp"}, {"extrapolate splat+pp"},
+        {"upsample 1/4 Herzog"}, {"stereo-eye grid+pp"},   {"extrapolate grid+pp"}};
     // Herzog upsampling of every other pixel of every other row (jitter -0.5 px: the low pixel
     // (u, v) is the full pixel (2u, 2v)), guided by the frame's full G-buffer, with history.
     warp::SpatioTemporalUpsampler cpu_upsampler;
@@ -142,7 +145,7 @@ Status bench_gles_stages(const std::vector<Frame>& frames, const std::string& si
     REPRISE_TRY(gpu::Upsampler::create(*context, {}, gpu_upsampler));
     Image<glm::vec4> low((w + 1) / 2, (h + 1) / 2), cpu_up(w, h), gpu_up(w, h);
     // The previous frame one period on, seen by the current camera.
-    warp::PoseExtrapolator extrapolator(kExtrapolation);
+    warp::PoseExtrapolator extrapolator(kExtrapolation), grid_extrapolator(kGridExtrapolation);
     Frame cpu_ahead, gpu_ahead;
     // The CPU's in-between frame with the same method (both sides splatted, blended, pull-push),
     // its inputs' silhouettes as they are (a backend gets them widened by the converter).
@@ -279,6 +282,23 @@ Status bench_gles_stages(const std::vector<Frame>& frames, const std::string& si
         stages[5].worst_db =
             std::min(stages[5].worst_db, display_psnr(cpu_ahead.color, gpu_ahead.color));
 
+        // The default extrapolation: the grid (displacement and cells on the CPU), pull-push.
+        Timing& cpu_grid_ahead = timing ? stages[8].cpu : scratch;
+        time_once(cpu_grid_ahead, [&] {
+            status =
+                grid_extrapolator.extrapolate(previous, to.view, to.projection, 1.0f, cpu_ahead);
+        });
+        REPRISE_TRY(status);
+        Timing grid_ahead_total;
+        time_once(grid_ahead_total, [&] {
+            status = context->extrapolate(previous, to.view, to.projection, 1.0f, gpu_ahead,
+                                          ahead_stats, kGridExtrapolation);
+        });
+        REPRISE_TRY(status);
+        if (timing) record(stages[8], context->timings(), grid_ahead_total.ms[0]);
+        stages[8].worst_db =
+            std::min(stages[8].worst_db, display_psnr(cpu_ahead.color, gpu_ahead.color));
+
         for (int v = 0; v < low.height(); ++v)
             for (int u = 0; u < low.width(); ++u) low(u, v) = current.color(2 * u, 2 * v);
         const glm::vec2 jitter(-0.5f);
@@ -297,17 +317,18 @@ Status bench_gles_stages(const std::vector<Frame>& frames, const std::string& si
                                   int(frames.size()) - 2, stages[0].textures, stages[1].textures,
                                   stages[3].textures, stages[4].textures, stages[5].textures));
     std::printf(
-        "gles: %s; GPU columns are medians; textures: the texture entry point on "
+        "gles: %s; GPU columns are medians; gles cpu: the work left on the CPU (widened "
+        "silhouettes, the grid's displacement and cells); textures: the texture entry point on "
         "textures already on the GPU (compute alone)\n",
         context->description().c_str());
-    std::printf("%-10s %-20s %9s %9s %9s %9s %9s %9s %9s %9s %8s\n", "size", "stage", "cpu best",
-                "cpu med", "upload", "compute", "download", "gles med", "textures", "tex/cpu",
-                "dB vs cpu");
+    std::printf("%-10s %-20s %9s %9s %9s %9s %9s %9s %9s %9s %9s %8s\n", "size", "stage",
+                "cpu best", "cpu med", "gles cpu", "upload", "compute", "download", "gles med",
+                "textures", "tex/cpu", "dB vs cpu");
     for (const StageTimes& s : stages)
-        std::printf("%-10s %-20s %9.2f %9.2f %9.2f %9.2f %9.2f %9.2f %9.3f %8.3fx %8.1f\n",
-                    size.c_str(), s.name, s.cpu.best(), s.cpu.median(), s.upload.median(),
-                    s.compute.median(), s.download.median(), s.total.median(), s.textures.median(),
-                    s.textures.median() / s.cpu.median(), s.worst_db);
+        std::printf("%-10s %-20s %9.2f %9.2f %9.2f %9.2f %9.2f %9.2f %9.2f %9.3f %8.3fx %8.1f\n",
+                    size.c_str(), s.name, s.cpu.best(), s.cpu.median(), s.prep.median(),
+                    s.upload.median(), s.compute.median(), s.download.median(), s.total.median(),
+                    s.textures.median(), s.textures.median() / s.cpu.median(), s.worst_db);
     return {};
 }
 

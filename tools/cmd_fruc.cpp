@@ -191,9 +191,9 @@ Status run_fruc(const FrucJob& job) {
     if (backend && backend->frames() > 0) {
         const double n_gpu = double(backend->frames());
         std::printf(
-            "  gles: %zu frames on the GPU, upload %.2f, compute %.2f, download %.2f ms "
+            "  gles: %zu frames on the GPU, cpu %.2f, upload %.2f, compute %.2f, download %.2f ms "
             "each\n",
-            backend->frames(), backend->total().upload_ms / n_gpu,
+            backend->frames(), backend->total().cpu_ms / n_gpu, backend->total().upload_ms / n_gpu,
             backend->total().compute_ms / n_gpu, backend->total().download_ms / n_gpu);
     }
     std::printf(

@@ -19,12 +19,16 @@ Status create_interpolate_programs(ContextState& state);
 Status create_extrapolate_programs(ContextState& state);
 Status create_shot_change_program(ContextState& state);
 
-double finish_ms(std::chrono::steady_clock::time_point& since) {
-    glFinish();
+double ms_since(std::chrono::steady_clock::time_point& since) {
     const auto now = std::chrono::steady_clock::now();
     const double ms = std::chrono::duration<double, std::milli>(now - since).count();
     since = now;
     return ms;
+}
+
+double finish_ms(std::chrono::steady_clock::time_point& since) {
+    glFinish();
+    return ms_since(since);
 }
 
 void Texture::ensure(GLenum new_format, int w, int h) {

@@ -140,7 +140,8 @@ Status extrapolate_passes(ContextState& s, const SplatTextures& frame, const Cam
 Status grid_extrapolation(ContextState& s, const GBufferView& frame, const glm::mat4& view,
                           const glm::mat4& projection, float periods, float motion_scale,
                           const warp::FrucOptions& options, GLuint out_color, GLuint out_depth,
-                          GLuint out_motion, ExtrapolateStats& stats) {
+                          GLuint out_motion, ExtrapolateStats& stats, double& cpu_ms) {
+    auto start = std::chrono::steady_clock::now();
     const int w = frame.width(), h = frame.height();
     GridRaster& g = s.grid;
     GBufferView along = frame;
@@ -159,6 +160,7 @@ Status grid_extrapolation(ContextState& s, const GBufferView& frame, const glm::
         to_backward = motion_scale;
     }
     g.warper.cells(along, factor, options.grid, g.cells_cpu);
+    cpu_ms = ms_since(start);
     s.eye_color.ensure(GL_RGBA32F, w, h);
     s.hit.ensure(GL_R32UI, w, h);
     s.splat_motion.ensure(GL_RGBA32F, w, h);
@@ -234,13 +236,14 @@ Status Context::extrapolate_on_gpu(const GBufferView& given, const glm::mat4& vi
     timings_.upload_ms = finish_ms(t);
     if (grid)
         REPRISE_TRY(grid_extrapolation(s, frame, view, projection, periods, motion_scale, options,
-                                       s.color.name, s.depth.name, s.made_motion.name, stats));
+                                       s.color.name, s.depth.name, s.made_motion.name, stats,
+                                       timings_.cpu_ms));
     else
         REPRISE_TRY(extrapolate_passes(
             s, {s.source_color.name, s.source_depth.name, s.source_motion.name, w, h}, given.camera,
             view, projection, periods, motion_scale, options, s.color.name, s.depth.name,
             s.made_motion.name, stats));
-    timings_.compute_ms = finish_ms(t);
+    timings_.compute_ms = finish_ms(t) - timings_.cpu_ms;
     s.made_valid = true;
     return {};
 }

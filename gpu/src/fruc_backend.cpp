@@ -72,6 +72,7 @@ Status FrucBackend::extrapolate(const GBufferView& f, const glm::mat4& view,
 
 void FrucBackend::count(std::size_t holes, bool filled, warp::FrucCounters& counters) {
     const Timings& t = context_.timings();
+    total_.cpu_ms += t.cpu_ms;
     total_.upload_ms += t.upload_ms;
     total_.compute_ms += t.compute_ms;
     total_.download_ms += t.download_ms;

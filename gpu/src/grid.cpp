@@ -456,6 +456,7 @@ Status Context::grid_warp(const GBufferView& source, float factor, const warp::W
     REPRISE_TRY(s.gl->acquire());
     auto t = std::chrono::steady_clock::now();
     s.grid.warper.cells(source, factor, options, s.grid.cells_cpu);
+    timings_.cpu_ms = ms_since(t);
     s.payload.ensure(GL_RGBA32F, sw, sh);
     s.upload(s.payload, source.color.data, source.color.stride);
     timings_.upload_ms = finish_ms(t);

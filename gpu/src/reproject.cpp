@@ -158,6 +158,7 @@ Status Context::reproject(const GBufferView& current, const GBufferView& previou
                           warp::ConstPayload previous_payload, warp::Payload out,
                           ImageView<uint8_t> hit, const warp::ReprojectOptions& options,
                           warp::ReprojectCounts& counts) {
+    timings_ = {};
     const int w = current.depth.width, h = current.depth.height;
     const int pw = previous.depth.width, ph = previous.depth.height;
     if (previous_payload.channels != 4 || out.channels != 4)
@@ -243,8 +244,8 @@ Status Context::reproject(const GBufferTextures& current, const GBufferTextures&
     if (payload == out) return Status::error("gpu reproject: the output is the payload texture");
     const warp::ReprojectSetup k =
         warp::reproject_setup(current.camera, previous.camera, w, h, ids, options);
+    timings_ = {};
     Clock::time_point t = Clock::now();
-    timings_.upload_ms = 0.0;
     REPRISE_TRY(reproject_pass(s, current.depth, current.motion, ids ? current.id : 0,
                                previous.depth, ids ? previous.id : 0, payload, out, hit, w, h, pw,
                                ph, k, std::max(1, options.step), counts));

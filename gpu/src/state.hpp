@@ -194,6 +194,8 @@ void dispatch(int w, int h);
 
 // glFinish, then the milliseconds since `since`, which moves to now.
 double finish_ms(std::chrono::steady_clock::time_point& since);
+// The milliseconds since `since` (CPU work), which moves to now.
+double ms_since(std::chrono::steady_clock::time_point& since);
 
 // The grid warp's GL objects (made on first use: the cells are read in a vertex shader, which
 // GL ES 3.1 does not promise) and the CPU's side: the cells and the eye's displacement.

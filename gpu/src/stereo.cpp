@@ -430,7 +430,7 @@ Status Context::stereo_eye(const GBufferView& given, const Camera& target, Frame
     if (w <= 0 || h <= 0) return {};
     REPRISE_TRY(s.gl->acquire());
     auto t = std::chrono::steady_clock::now();
-    // The silhouettes widened on the CPU, as StereoSynthesizer does (counted as upload time).
+    // The silhouettes widened on the CPU, as StereoSynthesizer does.
     if (options.widen_silhouettes) {
         rendered = warp::widen_silhouettes(rendered, s.wide_depth, s.wide_motion);
         if (with_history)
@@ -460,6 +460,7 @@ Status Context::stereo_eye(const GBufferView& given, const Camera& target, Frame
             g.warper.cells(history_moved, 1.0f, options.grid, g.history_cells);
         }
     }
+    timings_.cpu_ms = ms_since(t);
     s.payload.ensure(GL_RGBA32F, w, h);
     s.previous_depth.ensure(GL_R32F, w, h);
     s.upload(s.payload, rendered.color.data, rendered.color.stride);

@@ -26,7 +26,10 @@ class Context;
 namespace reprise::gpu {
 
 // What the last call spent, in milliseconds, each phase finished (glFinish) before the next.
+// `cpu_ms`: the work a path leaves on the CPU (widened silhouettes; the grid's displacement and
+// cells), apart from the transfers and the GPU's compute.
 struct Timings {
+    double cpu_ms = 0.0;
     double upload_ms = 0.0;
     double compute_ms = 0.0;
     double download_ms = 0.0;
