@@ -166,7 +166,7 @@ Status grid_extrapolation(ContextState& s, const GBufferView& frame, const glm::
     s.splat_motion.ensure(GL_RGBA32F, w, h);
     warp::GridStats grid;
     std::size_t stretched = 0;  // kept as covered, as the CPU's extrapolation keeps them
-    REPRISE_TRY(grid_passes(s, s.source_color.name, w, h, g.cells_cpu, options.grid.bicubic,
+    REPRISE_TRY(grid_passes(s, s.source_color.name, w, h, {&g.cells_cpu}, options.grid.bicubic,
                             {s.eye_color.name, out_depth, s.hit.name, s.splat_motion.name, w, h},
                             grid, stretched));
     stats.covered = grid.covered;

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstring>
 #include <string>
 
 #include "state.hpp"
@@ -28,16 +29,17 @@ constexpr const char* kGraphicsHeader = R"(#version 310 es
 precision highp float;
 precision highp int;
 bool finite(highp float v) { return (floatBitsToUint(v) & 0x7f800000u) != 0x7f800000u; }
-// x * y - z * w + e >= 0, exactly (64-bit products).
+// x * y - z * w + 16 * e >= 0 (e >= 0), exactly: 64-bit products and sums.
 bool edge_inside(int x, int y, int z, int w, int e) {
-    int h1, l1, h2, l2;
+    int h1, l1, h2, l2, h3, l3;
     imulExtended(x, y, h1, l1);
     imulExtended(z, w, h2, l2);
+    imulExtended(16, e, h3, l3);
     uint borrow, carry;
     uint lo = usubBorrow(uint(l1), uint(l2), borrow);
     uint hi = uint(h1) - uint(h2) - borrow;
-    uaddCarry(lo, uint(e), carry);
-    hi += carry;
+    lo = uaddCarry(lo, uint(l3), carry);
+    hi += uint(h3) + carry;
     return (hi & 0x80000000u) == 0u;
 }
 )";
@@ -174,7 +176,7 @@ highp float clamp_like_sse(highp float v, highp float lo, highp float hi) {
 }
 bool inside(ivec2 p, ivec2 q, ivec2 at) {
     int dx = q.x - p.x, dy = q.y - p.y;
-    return edge_inside(dx, at.y - p.y, dy, at.x - p.x, 16 * max(abs(dx), abs(dy)));
+    return edge_inside(dx, at.y - p.y, dy, at.x - p.x, max(abs(dx), abs(dy)));
 }
 )"
                                   R"(
@@ -217,8 +219,9 @@ void main() {
     PRECISE highp float z = z_plane.x + z_plane.y * o.x + z_plane.z * o.y;
     highp float zc = clamp_like_sse(z, z_plane.w, z_more.x);
     if ((flags & 1) != 0) zc = clamp_like_sse(1.0 / zc, z_more.y, z_more.z);
-    // Positive depths order as their bits; halved, they stay within the depth buffer's [0, 1].
-    gl_FragDepth = uintBitsToFloat(floatBitsToUint(zc) >> 1u);
+    // Scaled by a power of two: exact, in order, and within the depth buffer's [0, 1] (the
+    // background stand-in 1e30 is 0.79); the test keeps the nearer, ties to the first drawn.
+    gl_FragDepth = ldexp(abs(zc), -100);
     uint covered = 1u;
     if ((flags & 2) != 0) {
         PRECISE highp float from_near = (zc - z_plane.w) * z_more.w;
@@ -281,8 +284,10 @@ void main() {
 // Sets the rasteriser state the draw needs and puts the application's back when it goes.
 class RasterState {
 public:
-    RasterState() {
+    explicit RasterState(GLuint vertex_array) {
         for (int k = 0; k < kCaps; ++k) enabled_[k] = glIsEnabled(kCap[k]);
+        glGetBooleanv(GL_COLOR_WRITEMASK, color_mask_);
+        glGetIntegerv(GL_VERTEX_ARRAY_BINDING, &vertex_array_);
         glGetIntegerv(GL_VIEWPORT, viewport_);
         glGetIntegerv(GL_DEPTH_FUNC, &depth_func_);
         glGetBooleanv(GL_DEPTH_WRITEMASK, &depth_mask_);
@@ -292,6 +297,8 @@ public:
         glDepthFunc(GL_LESS);
         glDepthMask(GL_TRUE);
         glDepthRangef(0.0f, 1.0f);
+        glColorMask(GL_TRUE, GL_TRUE, GL_TRUE, GL_TRUE);
+        glBindVertexArray(vertex_array);  // an empty one: the application's may hold arrays
     }
     ~RasterState() {
         for (int k = 0; k < kCaps; ++k) (enabled_[k] ? glEnable : glDisable)(kCap[k]);
@@ -299,6 +306,8 @@ public:
         glDepthFunc(GLenum(depth_func_));
         glDepthMask(depth_mask_);
         glDepthRangef(depth_range_[0], depth_range_[1]);
+        glColorMask(color_mask_[0], color_mask_[1], color_mask_[2], color_mask_[3]);
+        glBindVertexArray(GLuint(vertex_array_));
     }
     RasterState(const RasterState&) = delete;
     RasterState& operator=(const RasterState&) = delete;
@@ -310,7 +319,8 @@ private:
                                            GL_STENCIL_TEST,    GL_RASTERIZER_DISCARD,
                                            GL_SAMPLE_COVERAGE, GL_SAMPLE_ALPHA_TO_COVERAGE};
     GLboolean enabled_[kCaps];
-    GLint viewport_[4], depth_func_ = GL_LESS;
+    GLint viewport_[4], depth_func_ = GL_LESS, vertex_array_ = 0;
+    GLboolean color_mask_[4];
     GLboolean depth_mask_ = GL_TRUE;
     GLfloat depth_range_[2];
 };
@@ -319,7 +329,8 @@ Status create_grid_programs(ContextState& s) {
     GridRaster& g = s.grid;
     if (g.counts) return {};     // made last: everything before it is ready
     glDeleteProgram(g.program);  // a failed try's
-    g.program = 0;
+    glDeleteProgram(g.finish_program);
+    g.program = g.finish_program = 0;
     GLint blocks = 0;
     glGetIntegerv(GL_MAX_VERTEX_SHADER_STORAGE_BLOCKS, &blocks);
     if (blocks < 1)
@@ -334,6 +345,7 @@ Status create_grid_programs(ContextState& s) {
     glGenFramebuffers(1, &g.framebuffer);
     glGenRenderbuffers(1, &g.depth_buffer);
     glGenBuffers(1, &g.cells);
+    glGenVertexArrays(1, &g.vertex_array);
     g.counts = s.make_counters(4 * sizeof(GLuint));
     return gl::check_errors("gpu grid warp programs");
 }
@@ -347,11 +359,18 @@ void destroy_grid(GridRaster& g) {
     glDeleteRenderbuffers(1, &g.depth_buffer);
     glDeleteBuffers(1, &g.cells);
     glDeleteBuffers(1, &g.counts);
+    glDeleteProgram(g.cells_program);
+    glDeleteProgram(g.offsets_program);
+    glDeleteProgram(g.eye_valid_program);
+    glDeleteProgram(g.border_program);
+    glDeleteBuffers(1, &g.offsets);
+    glDeleteBuffers(2, g.grown);
+    glDeleteVertexArrays(1, &g.vertex_array);
 }
 
-Status grid_passes(ContextState& s, GLuint source_color, int sw, int sh,
-                   const std::vector<warp::GridCell>& cells, bool bicubic, const GridOutput& out,
-                   warp::GridStats& stats, std::size_t& stretched) {
+Status grid_passes(ContextState& s, GLuint source_color, int sw, int sh, const GridCells& cells,
+                   bool bicubic, const GridOutput& out, warp::GridStats& stats,
+                   std::size_t& stretched) {
     REPRISE_TRY(create_grid_programs(s));
     GridRaster& g = s.grid;
     const int tw = out.width, th = out.height;
@@ -381,7 +400,7 @@ Status grid_passes(ContextState& s, GLuint source_color, int sw, int sh,
                              std::to_string(complete) + "; EXT_color_buffer_float)");
     }
     {
-        RasterState raster;
+        RasterState raster(g.vertex_array);
         glViewport(0, 0, tw, th);
         const GLfloat zero[4] = {0.0f, 0.0f, 0.0f, 0.0f};
         const GLfloat far[4] = {INFINITY, 0.0f, 0.0f, 0.0f};
@@ -397,24 +416,30 @@ Status grid_passes(ContextState& s, GLuint source_color, int sw, int sh,
         glUniform2i(glGetUniformLocation(g.program, "target_size"), tw, th);
         glUniform2i(glGetUniformLocation(g.program, "source_size"), sw, sh);
         glUniform1i(glGetUniformLocation(g.program, "bicubic_fetch"), bicubic);
-        // In batches that fit a storage buffer; GL draws them in order.
-        GLint64 max_bytes = 0;
-        glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &max_bytes);
-        const std::size_t batch = std::max<std::size_t>(
-            1, std::min<std::size_t>(std::size_t(1) << 18,
-                                     std::size_t(max_bytes) / sizeof(warp::GridCell)));
-        glBindBuffer(GL_SHADER_STORAGE_BUFFER, g.cells);
-        const std::size_t bytes = std::min(cells.size(), batch) * sizeof(warp::GridCell);
-        if (g.cells_bytes < bytes) {
-            glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(bytes), nullptr, GL_STREAM_DRAW);
-            g.cells_bytes = bytes;
-        }
-        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, g.cells);
-        for (std::size_t first = 0; first < cells.size(); first += batch) {
-            const std::size_t n = std::min(batch, cells.size() - first);
-            glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, GLsizeiptr(n * sizeof(warp::GridCell)),
-                            &cells[first]);
-            glDrawArrays(GL_TRIANGLES, 0, GLsizei(12 * n));
+        const GLuint buffer = cells.cpu ? g.cells : g.grown[cells.slot];
+        glBindBuffer(GL_SHADER_STORAGE_BUFFER, buffer);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, buffer);
+        if (cells.cpu) {
+            // In batches that fit a storage buffer; GL draws them in order.
+            const std::vector<warp::GridCell>& cpu = *cells.cpu;
+            GLint64 max_bytes = 0;
+            glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &max_bytes);
+            const std::size_t batch = std::max<std::size_t>(
+                1, std::min<std::size_t>(std::size_t(1) << 18,
+                                         std::size_t(max_bytes) / sizeof(warp::GridCell)));
+            const std::size_t bytes = std::min(cpu.size(), batch) * sizeof(warp::GridCell);
+            if (g.cells_bytes < bytes) {
+                glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(bytes), nullptr, GL_STREAM_DRAW);
+                g.cells_bytes = bytes;
+            }
+            for (std::size_t first = 0; first < cpu.size(); first += batch) {
+                const std::size_t n = std::min(batch, cpu.size() - first);
+                glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, GLsizeiptr(n * sizeof(warp::GridCell)),
+                                &cpu[first]);
+                glDrawArrays(GL_TRIANGLES, 0, GLsizei(12 * n));
+            }
+        } else if (cells.grown) {
+            glDrawArrays(GL_TRIANGLES, 0, GLsizei(12 * cells.grown));
         }
         glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, 0);
         glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
@@ -435,11 +460,47 @@ Status grid_passes(ContextState& s, GLuint source_color, int sw, int sh,
     dispatch(tw, th);
     GLuint counts[3] = {0, 0, 0};
     s.read_counters(g.counts, counts, sizeof counts);
-    stats.cells = cells.size();
+    stats.cells = cells.cpu ? cells.cpu->size() : cells.grown;
     stats.covered = counts[0];
     stats.nonfinite = counts[1];
     stretched = counts[2];
+    ContextState::unbind_inputs();
+    glUseProgram(0);
     return gl::check_errors("gpu grid warp");
+}
+
+Status Context::grid_cells(const GBufferView& source, float factor,
+                           const warp::GridOptions& options, std::vector<warp::GridCell>& cells) {
+    timings_ = {};
+    cells.clear();
+    const int w = source.width(), h = source.height();
+    REPRISE_ASSERT(source.depth.width == w && source.motion.width == w);
+    if (!std::isfinite(factor)) return Status::error("gpu grid cells: the factor is not finite");
+    if (w <= 0 || h <= 0) return {};
+    ContextState& s = *state_;
+    REPRISE_TRY(s.gl->acquire());
+    auto t = std::chrono::steady_clock::now();
+    s.previous_depth.ensure(GL_R32F, w, h);
+    s.motion.ensure(GL_RG32F, w, h);
+    s.upload(s.previous_depth, source.depth.data, source.depth.stride);
+    s.upload(s.motion, source.motion.data, source.motion.stride);
+    timings_.upload_ms = finish_ms(t);
+    std::size_t grown = 0;
+    REPRISE_TRY(
+        grow_cells(s, s.previous_depth.name, s.motion.name, w, h, options, factor, 0, grown));
+    timings_.compute_ms = finish_ms(t);
+    cells.resize(grown);
+    if (grown) {
+        glBindBuffer(GL_COPY_READ_BUFFER, s.grid.grown[0]);
+        const void* mapped = glMapBufferRange(
+            GL_COPY_READ_BUFFER, 0, GLsizeiptr(grown * sizeof(warp::GridCell)), GL_MAP_READ_BIT);
+        if (mapped) std::memcpy(cells.data(), mapped, grown * sizeof(warp::GridCell));
+        glUnmapBuffer(GL_COPY_READ_BUFFER);
+        glBindBuffer(GL_COPY_READ_BUFFER, 0);
+        if (!mapped) return Status::error("gpu grid cells: the cells could not be read back");
+    }
+    timings_.download_ms = finish_ms(t);
+    return gl::check_errors("gpu grid cells");
 }
 
 Status Context::grid_warp(const GBufferView& source, float factor, const warp::WarpTarget& target,
@@ -448,17 +509,27 @@ Status Context::grid_warp(const GBufferView& source, float factor, const warp::W
     stats = {};
     const int sw = source.width(), sh = source.height();
     const int tw = target.color.width, th = target.color.height;
-    REPRISE_ASSERT(source.depth.width == sw && source.motion.width == sw);
-    REPRISE_ASSERT(target.depth.width == tw && target.covered.width == tw);
+    REPRISE_ASSERT(source.depth.width == sw && source.depth.height == sh);
+    REPRISE_ASSERT(source.motion.width == sw && source.motion.height == sh);
+    REPRISE_ASSERT(target.depth.width == tw && target.depth.height == th);
+    REPRISE_ASSERT(target.covered.width == tw && target.covered.height == th);
+    REPRISE_ASSERT(target.motion.empty() ||
+                   (target.motion.width == tw && target.motion.height == th));
     if (!std::isfinite(factor)) return Status::error("gpu grid warp: the factor is not finite");
-    if (sw <= 0 || sh <= 0 || tw <= 0 || th <= 0) return {};
+    if (tw <= 0 || th <= 0) return {};
+    if (sw <= 0 || sh <= 0) {  // nothing lands, as the CPU's warp leaves it
+        for (int y = 0; y < th; ++y) {
+            std::fill_n(target.color.row(y), tw, glm::vec4(0.0f));
+            std::fill_n(target.depth.row(y), tw, INFINITY);
+            std::fill_n(target.covered.row(y), tw, uint8_t(0));
+            if (!target.motion.empty()) std::fill_n(target.motion.row(y), tw, glm::vec2(0.0f));
+        }
+        return {};
+    }
     ContextState& s = *state_;
     REPRISE_TRY(s.gl->acquire());
     auto t = std::chrono::steady_clock::now();
-    s.grid.warper.cells(source, factor, options, s.grid.cells_cpu);
-    timings_.cpu_ms = ms_since(t);
-    s.payload.ensure(GL_RGBA32F, sw, sh);
-    s.upload(s.payload, source.color.data, source.color.stride);
+    s.upload_frame(source, s.payload, s.previous_depth, s.motion);
     timings_.upload_ms = finish_ms(t);
     s.made_valid = false;  // color and depth no longer hold an extrapolation
     s.out.ensure(GL_RGBA32F, tw, th);
@@ -466,9 +537,11 @@ Status Context::grid_warp(const GBufferView& source, float factor, const warp::W
     s.hit.ensure(GL_R32UI, tw, th);
     const bool motion = !target.motion.empty();
     if (motion) s.splat_motion.ensure(GL_RGBA32F, tw, th);
-    std::size_t stretched = 0;
+    std::size_t grown = 0, stretched = 0;
+    REPRISE_TRY(
+        grow_cells(s, s.previous_depth.name, s.motion.name, sw, sh, options, factor, 0, grown));
     REPRISE_TRY(grid_passes(
-        s, s.payload.name, sw, sh, s.grid.cells_cpu, options.bicubic,
+        s, s.payload.name, sw, sh, {nullptr, grown}, options.bicubic,
         {s.out.name, s.depth.name, s.hit.name, motion ? s.splat_motion.name : 0u, tw, th}, stats,
         stretched));
     timings_.compute_ms = finish_ms(t);

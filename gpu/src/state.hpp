@@ -201,9 +201,11 @@ double ms_since(std::chrono::steady_clock::time_point& since);
 // GL ES 3.1 does not promise) and the CPU's side: the cells and the eye's displacement.
 struct GridRaster {
     GLuint program = 0, finish_program = 0, eye_valid_program = 0, border_program = 0;
-    GLuint framebuffer = 0, depth_buffer = 0, cells = 0, counts = 0;
+    GLuint cells_program = 0, offsets_program = 0;  // growing the cells (grid_cells.cpp)
+    GLuint framebuffer = 0, depth_buffer = 0, cells = 0, counts = 0, offsets = 0, vertex_array = 0;
+    GLuint grown[2] = {0, 0};  // cells grown on the GPU: the eye's or the frame's, the history's
     int depth_width = 0, depth_height = 0;
-    std::size_t cells_bytes = 0;
+    std::size_t cells_bytes = 0, offsets_bytes = 0, grown_bytes[2] = {0, 0};
     warp::GridWarper warper;
     std::vector<warp::GridCell> cells_cpu, history_cells;
     Image<glm::vec2> displacement, history_displacement;
@@ -217,12 +219,24 @@ struct GridOutput {
     GLuint color = 0, depth = 0, covered = 0, motion = 0;
     int width = 0, height = 0;
 };
-// `cells` (warp::GridWarper::cells) drawn over source colour `source_color` (sw x sh) into `out`
-// as warp::GridWarper::warp draws them; stats' cells, covered and nonfinite set, `stretched`
-// the covered pixels marked 2.
-Status grid_passes(ContextState& s, GLuint source_color, int sw, int sh,
-                   const std::vector<warp::GridCell>& cells, bool bicubic, const GridOutput& out,
-                   warp::GridStats& stats, std::size_t& stretched);
+// The cells to draw: `cpu` (warp::GridWarper::cells, uploaded in batches), else the `grown`
+// cells grow_cells left in s.grid.grown[slot].
+struct GridCells {
+    const std::vector<warp::GridCell>* cpu = nullptr;
+    std::size_t grown = 0;
+    int slot = 0;
+};
+// `cells` drawn over source colour `source_color` (sw x sh) into `out` as
+// warp::GridWarper::warp draws them; stats' cells, covered and nonfinite set, `stretched` the
+// covered pixels marked 2.
+Status grid_passes(ContextState& s, GLuint source_color, int sw, int sh, const GridCells& cells,
+                   bool bicubic, const GridOutput& out, warp::GridStats& stats,
+                   std::size_t& stretched);
+// warp::GridWarper::cells on the GPU: the cells of a source whose depth (GL_R32F) and motion (RG
+// of a float texture) are w x h, warped by `factor`, into s.grid.grown[slot] in the CPU's order;
+// `count` gets how many. An error where they exceed one storage buffer.
+Status grow_cells(ContextState& s, GLuint depth, GLuint motion, int w, int h,
+                  const warp::GridOptions& options, float factor, int slot, std::size_t& count);
 
 // The in-between frame's inputs (a, b) and intermediates.
 struct Interpolation {

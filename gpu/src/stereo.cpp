@@ -1,9 +1,9 @@
 // The second eye on the GPU: stereo::StereoSynthesizer. Splat: each pixel's displacement to the
 // target camera through its depth (warp/'s displacement_row_reference, same arithmetic), the
-// splat; with a history, its warp merged into the holes. Grid (CPU images): the displacements and
-// the grid's cells on the CPU, drawn on the GPU (grid.cpp), the history's merged into the holes
-// and stretched pixels, the pixels of stretched triangles left to the fill, the border strip
-// continued. Then pull-push over what is left, and
+// splat; with a history, its warp merged into the holes. Grid: the displacements, the grid's
+// cells grown (grid_cells.cpp; on the CPU for skewed projections) and drawn (grid.cpp), the
+// history's merged into the holes and stretched pixels, the pixels of stretched triangles left to
+// the fill, the border strip continued. Then pull-push over what is left, and
 // non-finite colour to 0 on the way into the output.
 #include <chrono>
 #include <string>
@@ -173,11 +173,7 @@ void run(GLuint program, int w, int h) {
     dispatch(w, h);
 }
 
-Status check_options(const stereo::StereoOptions& o, bool on_textures) {
-    if (o.warp == stereo::StereoWarp::Grid && on_textures)
-        return Status::error(
-            "gpu stereo eye: the grid eye takes CPU images (its cells are grown on the CPU); on "
-            "textures StereoWarp::Splat");
+Status check_options(const stereo::StereoOptions& o) {
     if (o.fill != stereo::StereoFill::PullPush && o.fill != stereo::StereoFill::None)
         return Status::error(
             "gpu stereo eye: Andreev's and the patch fill are not on the GPU yet (PullPush and "
@@ -284,15 +280,16 @@ Status fill_and_finish(ContextState& s, GLuint warped, int w, int h, const stere
     return gl::check_errors("gpu stereo eye");
 }
 
-// The grid eye's warp of `color` (w x h) by the cells in s.grid (grown on the CPU): colour into
-// `warped` (s.eye_color, or s.merged with a history, whose cells are s.grid.history_cells),
-// depth into `out_depth`, the valid mask into s.hit, the border strip continued.
+// The grid eye's warp of `color` (w x h) by `cells` (and the history's by `history_cells`):
+// colour into `warped` (s.eye_color, or s.merged with a history), depth into `out_depth`, the
+// valid mask into s.hit, the border strip continued.
 Status grid_eye_passes(ContextState& s, GLuint color, int w, int h, const stereo::StereoOptions& o,
                        const Camera& from, const Camera& target, const EyeHistory* history,
-                       GLuint out_depth, stereo::StereoStats& stats, GLuint& warped,
+                       const GridCells& cells, const GridCells& history_cells, GLuint out_depth,
+                       stereo::StereoStats& stats, GLuint& warped,
                        std::size_t& history_holes_filled) {
     warp::GridStats grid;
-    REPRISE_TRY(grid_passes(s, color, w, h, s.grid.cells_cpu, o.grid.bicubic,
+    REPRISE_TRY(grid_passes(s, color, w, h, cells, o.grid.bicubic,
                             {s.eye_color.name, out_depth, s.hit.name, 0, w, h}, grid,
                             stats.stretched));
     stats.cells = grid.cells;
@@ -303,7 +300,7 @@ Status grid_eye_passes(ContextState& s, GLuint color, int w, int h, const stereo
         warp::GridStats seen;
         std::size_t unused = 0;
         REPRISE_TRY(grid_passes(
-            s, history->color, w, h, s.grid.history_cells, o.grid.bicubic,
+            s, history->color, w, h, history_cells, o.grid.bicubic,
             {s.history_warped.name, s.history_warped_depth.name, s.history_covered.name, 0, w, h},
             seen, unused));
         stats.cells += seen.cells;
@@ -331,17 +328,21 @@ Status grid_eye_passes(ContextState& s, GLuint color, int w, int h, const stereo
     return {};
 }
 
+// Whether the GPU makes the eye's displacement (for axis-aligned projections only).
+bool displaced_on_gpu(const Camera& from, const Camera* history, int w, int h) {
+    return Unprojector(from.projection, w, h).axis_aligned() &&
+           (!history || Unprojector(history->projection, w, h).axis_aligned());
+}
+
 // Colour `color` and depth `depth` (w x h) seen from `target` into out_color / out_depth; with
-// `history`, its warp fills the rendered eye's holes first. The grid eye's cells are grown
-// beforehand, on the CPU.
+// `history`, its warp fills the rendered eye's holes first. The grid's cells are grown here on
+// the GPU, or, `cpu_cells`, were grown on the CPU into s.grid (skewed projections).
 Status eye_passes(ContextState& s, GLuint color, GLuint depth, int w, int h, const Camera& from,
                   const Camera& target, const stereo::StereoOptions& o, GLuint out_color,
-                  GLuint out_depth, stereo::StereoStats& stats, const EyeHistory* history) {
-    // The splat's displacement is made on the GPU, for axis-aligned projections.
-    const StaticReprojection to_target(from, target.view, target.projection, w, h);
-    if (o.warp == stereo::StereoWarp::Splat &&
-        (!to_target.unprojector().axis_aligned() ||
-         (history && !Unprojector(history->camera.projection, w, h).axis_aligned())))
+                  GLuint out_depth, stereo::StereoStats& stats, const EyeHistory* history,
+                  bool cpu_cells = false) {
+    const bool grid = o.warp == stereo::StereoWarp::Grid;
+    if (!(grid && cpu_cells) && !displaced_on_gpu(from, history ? &history->camera : nullptr, w, h))
         return Status::error("gpu stereo eye: the rendered camera's projection is skewed");
     s.displacement.ensure(GL_RGBA32F, w, h);
     s.target_depth.ensure(GL_R32F, w, h);
@@ -360,9 +361,26 @@ Status eye_passes(ContextState& s, GLuint color, GLuint depth, int w, int h, con
     const std::size_t n = std::size_t(w) * std::size_t(h);
     GLuint warped = s.eye_color.name;
     std::size_t history_holes_filled = 0;
-    if (o.warp == stereo::StereoWarp::Grid) {
-        REPRISE_TRY(grid_eye_passes(s, color, w, h, o, from, target, history, out_depth, stats,
-                                    warped, history_holes_filled));
+    if (grid) {
+        GridCells cells{&s.grid.cells_cpu}, history_cells{&s.grid.history_cells};
+        if (!cpu_cells) {
+            cells = {nullptr, 0, 0};
+            history_cells = {nullptr, 0, 1};
+            displace(s, depth, 0, w, h, from, target, INFINITY, s.displacement.name,
+                     s.target_depth.name);
+            REPRISE_TRY(grow_cells(s, s.target_depth.name, s.displacement.name, w, h, o.grid, 1.0f,
+                                   0, cells.grown));
+            if (history) {
+                stats.history_moving =
+                    displace(s, history->depth, history->motion, w, h, history->camera, target,
+                             o.history_moving_tolerance, s.history_displacement.name,
+                             s.history_target_depth.name);
+                REPRISE_TRY(grow_cells(s, s.history_target_depth.name, s.history_displacement.name,
+                                       w, h, o.grid, 1.0f, 1, history_cells.grown));
+            }
+        }
+        REPRISE_TRY(grid_eye_passes(s, color, w, h, o, from, target, history, cells, history_cells,
+                                    out_depth, stats, warped, history_holes_filled));
         return fill_and_finish(s, warped, w, h, o, out_color, out_depth, stats,
                                history_holes_filled);
     }
@@ -393,7 +411,7 @@ Status Context::stereo_eye(const GBufferView& given, const Camera& target, Frame
                            const GBufferView* given_history) {
     timings_ = {};
     stats = {};
-    REPRISE_TRY(check_options(options, false));
+    REPRISE_TRY(check_options(options));
     const int w = given.width(), h = given.height();
     REPRISE_ASSERT(given.depth.width == w && given.depth.height == h);
     ContextState& s = *state_;
@@ -436,7 +454,11 @@ Status Context::stereo_eye(const GBufferView& given, const Camera& target, Frame
         if (with_history)
             history = warp::widen_silhouettes(history, s.wide_history_depth, s.wide_history_motion);
     }
-    if (options.warp == stereo::StereoWarp::Grid) {  // the displacement and the cells on the CPU
+    // The grid's displacement and cells on the CPU where the GPU's displacement cannot be made.
+    const bool cpu_cells =
+        options.warp == stereo::StereoWarp::Grid &&
+        !displaced_on_gpu(rendered.camera, with_history ? &history.camera : nullptr, w, h);
+    if (cpu_cells) {
         GridRaster& g = s.grid;
         g.displacement.resize(w, h);
         g.target_depth.resize(w, h);
@@ -464,8 +486,7 @@ Status Context::stereo_eye(const GBufferView& given, const Camera& target, Frame
     s.payload.ensure(GL_RGBA32F, w, h);
     s.previous_depth.ensure(GL_R32F, w, h);
     s.upload(s.payload, rendered.color.data, rendered.color.stride);
-    if (options.warp == stereo::StereoWarp::Splat)
-        s.upload(s.previous_depth, rendered.depth.data, rendered.depth.stride);
+    if (!cpu_cells) s.upload(s.previous_depth, rendered.depth.data, rendered.depth.stride);
     EyeHistory textures;
     if (with_history) {
         const bool motion = history.motion.width == w && history.motion.height == h;
@@ -473,7 +494,7 @@ Status Context::stereo_eye(const GBufferView& given, const Camera& target, Frame
         s.history_depth.ensure(GL_R32F, w, h);
         s.history_motion.ensure(GL_RG32F, motion ? w : 1, motion ? h : 1);
         s.upload(s.history_color, history.color.data, history.color.stride);
-        if (options.warp == stereo::StereoWarp::Splat) {  // the grid's was read on the CPU
+        if (!cpu_cells) {  // else the history's cells were grown on the CPU
             s.upload(s.history_depth, history.depth.data, history.depth.stride);
             if (motion) s.upload(s.history_motion, history.motion.data, history.motion.stride);
         }
@@ -486,7 +507,7 @@ Status Context::stereo_eye(const GBufferView& given, const Camera& target, Frame
     timings_.upload_ms = finish_ms(t);
     REPRISE_TRY(eye_passes(s, s.payload.name, s.previous_depth.name, w, h, rendered.camera, target,
                            options, s.color.name, s.depth.name, stats,
-                           with_history ? &textures : nullptr));
+                           with_history ? &textures : nullptr, cpu_cells));
     timings_.compute_ms = finish_ms(t);
     s.download_made(out);
     REPRISE_TRY(gl::check_errors("gpu stereo eye download"));
@@ -500,7 +521,7 @@ Status Context::stereo_eye(const GBufferTextures& rendered, unsigned color, cons
                            unsigned history_color) {
     timings_ = {};
     stats = {};
-    REPRISE_TRY(check_options(options, true));
+    REPRISE_TRY(check_options(options));
     ContextState& s = *state_;
     REPRISE_TRY(s.gl->acquire());
     const int w = rendered.width, h = rendered.height;

@@ -394,23 +394,31 @@ private:
 
 }  // namespace
 
-Params make_params(const GridOptions& o, float factor) {
+}  // namespace reprise::warp::grid
+
+namespace reprise::warp {
+
+GridParameters grid_parameters(const GridOptions& o, float factor) {
     REPRISE_ASSERT(std::isfinite(factor));
-    Params p{};
+    GridParameters p{};
     p.min_cell = std::clamp(o.min_cell, 1, 2);
     p.cell = p.min_cell;
-    while (p.cell * 2 <= std::min(o.cell, kMaxCell)) p.cell *= 2;
+    while (p.cell * 2 <= std::min(o.cell, grid::kMaxCell)) p.cell *= 2;
     // NaN thresholds count as 0; the relative depth tolerance stays below 1 so that zero and
     // negative depths always fail it.
     p.depth_tolerance = o.depth_threshold > 0.0f ? std::min(o.depth_threshold, 0.5f) : 0.0f;
     const float motion = o.motion_threshold > 0.0f ? o.motion_threshold : 0.0f;
-    p.motion_limit = factor != 0.0f ? motion / std::fabs(factor) : kInf;
+    p.motion_limit = factor != 0.0f ? motion / std::fabs(factor) : grid::kInf;
     p.vertex_z_ratio = 1.0f + 2.0f * p.depth_tolerance;
     p.vertex_motion = 2.0f * p.motion_limit;
     p.stretched_area = o.stretched_area >= 0.0f ? o.stretched_area : 0.0f;  // NaN: 0
     p.factor = factor;
     return p;
 }
+
+}  // namespace reprise::warp
+
+namespace reprise::warp::grid {
 
 void size_scratch(Scratch& scratch, const Params& params, int source_width, int target_width,
                   int band_rows, bool motion) {

@@ -56,16 +56,10 @@ static_assert(kSubpixel == kGridSubpixel);
 inline constexpr int kOverlap = kSubpixel / 16;  // edges pushed out by 1/16 px (grid_raster.cpp)
 inline constexpr int kMaxCell = 64;
 
-struct Params {
-    float depth_tolerance;  // depth_threshold: allowed |1 - predicted(1/z) * z|
-    float motion_limit;     // motion_threshold / |factor|: allowed motion error, source pixels
-    float vertex_z_ratio;   // 1 + 2 depth_tolerance: 2x2 pixels that share a vertex
-    float vertex_motion;    // 2 motion_limit: their motion range
-    float stretched_area;   // stretched_area: px^2 an edge triangle grows by to be stretched
-    int cell, min_cell;
-    float factor;
-};
-Params make_params(const GridOptions& options, float factor);
+using Params = GridParameters;
+inline Params make_params(const GridOptions& options, float factor) {
+    return grid_parameters(options, factor);
+}
 
 // The first and last pixel whose centre (i + 0.5) lies at or after / at or before a fixed-point
 // coordinate (arithmetic shifts round towards -inf).

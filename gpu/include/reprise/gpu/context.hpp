@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "reprise/core/gbuffer.hpp"
 #include "reprise/core/nonfinite.hpp"
@@ -134,11 +135,15 @@ public:
     Status splat(const GBufferView& source, float factor, const warp::WarpTarget& target,
                  const warp::SplatOptions& options, std::size_t& covered);
 
-    // warp::GridWarper::warp on the GPU: its cells grown on the CPU (GridWarper::cells), drawn by
-    // GL's rasteriser with the CPU's edge functions, attribute planes, clamps and depth test.
-    // Needs storage buffers in vertex shaders and float colour attachments (an error says so).
+    // warp::GridWarper::warp on the GPU: its cells grown by a compute shader (the CPU's
+    // GridWarper::cells, the same cells in the same order), drawn by GL's rasteriser with the
+    // CPU's edge functions, attribute planes, clamps and depth test. Needs storage buffers in
+    // vertex shaders and float colour attachments (an error says so).
     Status grid_warp(const GBufferView& source, float factor, const warp::WarpTarget& target,
                      const warp::GridOptions& options, warp::GridStats& stats);
+    // The cells grid_warp grows, read back (what GridWarper::cells gives on the CPU).
+    Status grid_cells(const GBufferView& source, float factor, const warp::GridOptions& options,
+                      std::vector<warp::GridCell>& cells);
     // stereo::StereoSynthesizer::synthesize for StereoWarp::Splat and StereoFill::PullPush or
     // None (others are an error): displacement through depth, the splat, the `history` (e.g. the
     // previous frame's other eye, its moving pixels left out) warped the same way into the

@@ -52,6 +52,19 @@ struct GridCell {
     uint8_t coverage[2];
 };
 
+// The thresholds a cell's growth uses, from GridOptions and the warp's factor (shared with the
+// GPU's cell growth, gpu/src/grid_cells.cpp).
+struct GridParameters {
+    float depth_tolerance;  // depth_threshold: allowed |1 - predicted(1/z) * z|
+    float motion_limit;     // motion_threshold / |factor|: allowed motion error, source pixels
+    float vertex_z_ratio;   // 1 + 2 depth_tolerance: 2x2 pixels that share a vertex
+    float vertex_motion;    // 2 motion_limit: their motion range
+    float stretched_area;   // stretched_area: px^2 an edge triangle grows by to be stretched
+    int cell, min_cell;     // the starting and the smallest cell, pixels
+    float factor;
+};
+GridParameters grid_parameters(const GridOptions& options, float factor);
+
 struct GridStats {
     std::size_t cells = 0;      // cells drawn
     std::size_t covered = 0;    // covered output pixels (stretched ones too)
