@@ -245,6 +245,20 @@ TEST(CliStereo, FrucOnTheGpuBackendMakesTheCpusSplatFrames) {
     ASSERT_TRUE(read_frame(frame_path(gles_ahead, 2), made).ok());
     ASSERT_FALSE(made.motion.empty());
     EXPECT_EQ(made.motion(80, 45), cpu_made.motion(80, 45));
+    // The default extrapolation, the grid: its cells grown and drawn on the GPU.
+    const std::vector<std::string> grid_ahead = {"--in",        in,         "--mode",
+                                                 "extrapolate", "--factor", "3"};
+    const std::string cpu_grid = (dir / "cpu_grid").string(),
+                      gles_grid = (dir / "gles_grid").string();
+    args = grid_ahead;
+    args.insert(args.end(), {"--out", cpu_grid});
+    ASSERT_EQ(run_command(cli::command_fruc, args), 0);
+    args = grid_ahead;
+    args.insert(args.end(), {"--backend", "gles", "--out", gles_grid});
+    ASSERT_EQ(run_command(cli::command_fruc, args), 0);
+    for (int i = 0; i < 9; ++i)
+        EXPECT_GE(psnr_of(frame_path(cpu_grid, i), frame_path(gles_grid, i)), 50.0)
+            << "extrapolated by the grid, frame " << i;
     const std::string refused = (dir / "refused").string();
     EXPECT_EQ(run_command(cli::command_fruc,
                           {"--in", in, "--backend", "gles", "--warp", "splat", "--out", refused}),

@@ -1345,19 +1345,31 @@ TEST(Gpu, ExtrapolationOnTexturesAndBadArguments) {
     unresolved.warp = warp::WarpMethod::Auto;
     EXPECT_NE(message(unresolved, 1.0f, frames[0]).find("warp grid, splat or reverse only"),
               std::string::npos);
+    // The grid (its cells grown on the GPU) on textures: the CPU-image entry's frame.
     warp::FrucOptions grid = kSplatExtrapolation;
     grid.warp = warp::WarpMethod::Grid;
-    EXPECT_NE(context
-                  .extrapolate(frame, color, to.view, to.projection, 1.0f, out, depth, motion,
-                               texture_stats, grid)
-                  .message()
-                  .find("the grid takes CPU images"),
-              std::string::npos);
+    ASSERT_TRUE(
+        context.extrapolate(frames[0], to.view, to.projection, 1.0f, from_images, image_stats, grid)
+            .ok());
+    context.make_current();
+    ASSERT_TRUE(context
+                    .extrapolate(frame, color, to.view, to.projection, 1.0f, out, depth, motion,
+                                 texture_stats, grid)
+                    .ok());
+    EXPECT_EQ(texture_stats.holes, image_stats.holes);
+    EXPECT_EQ(test::display_psnr(read_rgba(out), from_images.color), INFINITY);
+    const Image<glm::vec4> grid_motion = read_rgba(motion);
+    for (std::size_t i = 0; i < grid_motion.pixel_count(); ++i)
+        ASSERT_EQ(glm::vec2(grid_motion.data()[i]), from_images.motion.data()[i]) << "pixel " << i;
     EXPECT_NE(message(kSplatExtrapolation, -1.0f, frames[0]).find("periods"), std::string::npos);
     Frame skewed = frames[0];
     skewed.camera.projection[1][0] = 0.1f;
     skewed.camera.prev_projection = skewed.camera.projection;
     EXPECT_NE(message(kSplatExtrapolation, 1.0f, skewed).find("skewed"), std::string::npos);
+    // The grid takes a skewed projection: its displacement and cells made on the CPU.
+    gpu::ExtrapolateStats skewed_stats;
+    expect_extrapolation_matches(skewed, to, 1.0f, skewed_stats, warp::WarpMethod::Grid);
+    EXPECT_GT(context.timings().cpu_ms, 0.0);
     EXPECT_NE(context
                   .extrapolate(frame, color, to.view, to.projection, 1.0f, color, depth, motion,
                                texture_stats, kSplatExtrapolation)

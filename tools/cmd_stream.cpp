@@ -247,8 +247,8 @@ Status run_connect(const ConnectJob& job) {
                 job.interactive, start,
                 gles ? StreamWindow::Drawing::SdlSoftware : StreamWindow::Drawing::Sdl, window));
     }
-    // --backend gles: each display frame extrapolated on the GPU (warp splat, pull-push), a
-    // lowres stream's colour upsampled there.
+    // --backend gles: each display frame extrapolated on the GPU (the CPU's method: the grid,
+    // pull-push), a lowres stream's colour upsampled there.
     std::unique_ptr<gpu::FrucBackend> backend;
     std::unique_ptr<gpu::Upsampler> upsampler;
     const bool kept_on_gpu = gpu && job.out.empty();
@@ -256,7 +256,6 @@ Status run_connect(const ConnectJob& job) {
         if (!gpu) REPRISE_TRY(gpu::Context::create(gpu));
         backend = std::make_unique<gpu::FrucBackend>(*gpu);
         backend->keep_extrapolated_on_gpu(kept_on_gpu);
-        o.extrapolation.warp = warp::WarpMethod::Splat;
         o.extrapolation.backend = backend.get();
         REPRISE_TRY(gpu::Upsampler::create(*gpu, {}, upsampler));
         o.upsampler = upsampler.get();
@@ -424,8 +423,8 @@ int command_connect(int argc, char** argv) {
               "window with a free camera: WASD, Q/E, arrows, mouse drag");
     args.flag("--no-extrapolate", &job.no_extrapolate, "show the newest decoded frame as it is");
     args.option("--backend", &job.backend,
-                "cpu | gles (default cpu); gles: each display frame extrapolated (warp splat, "
-                "pull-push) and\na lowres stream's colour upsampled by OpenGL ES compute shaders; "
+                "cpu | gles (default cpu); gles: each display frame extrapolated (the grid, "
+                "pull-push) and\na lowres stream's colour upsampled by OpenGL ES; "
                 "with --window the GPU works in\nthe window's context and draws its frames from "
                 "their textures (nothing downloaded unless --out)");
     args.option("--loss", &job.loss, "fault injector: random loss each way (0..1)");

@@ -1,5 +1,6 @@
-// Extrapolation on the GPU: warp's extrapolate_to_camera for the splat (and, on CPU images, the
-// grid: its displacement and cells on the CPU, drawn by grid.cpp). The static-layer test
+// Extrapolation on the GPU: warp's extrapolate_to_camera for the splat and the grid (its cells
+// grown by grid_cells.cpp and drawn by grid.cpp; for a skewed projection on CPU images, the
+// displacement and cells are made on the CPU). The static-layer test
 // (warp's static_layer_row_reference: a pixel is static when the camera alone explains its
 // motion) gives each pixel its displacement, to where the target camera sees it or `periods`
 // along its own motion; one splat carries colour, depth and that displacement; pull-push fills
@@ -42,12 +43,8 @@ void main() {
 }
 )";
 
-Status check_options(const warp::FrucOptions& o, bool on_textures) {
+Status check_options(const warp::FrucOptions& o) {
     const bool grid = o.warp == warp::WarpMethod::Grid;
-    if (grid && on_textures)
-        return Status::error(
-            "gpu extrapolate: the grid takes CPU images (its cells are grown on the CPU); on "
-            "textures warp splat or reverse");
     if (!grid && o.warp != warp::WarpMethod::Splat && o.warp != warp::WarpMethod::Reverse)
         return Status::error(
             "gpu extrapolate: the GPU warps with warp grid, splat or reverse only (docs/gpu.md)");
@@ -122,6 +119,19 @@ Status extrapolate_passes(ContextState& s, const SplatTextures& frame, const Cam
         factor = -periods;
         to_backward = motion_scale;
     }
+    if (options.warp == warp::WarpMethod::Grid) {  // its cells grown here, carrying the motion
+        if (out_motion) s.splat_motion.ensure(GL_RGBA32F, w, h);
+        std::size_t grown = 0, stretched = 0;
+        REPRISE_TRY(grow_cells(s, frame.depth, along.motion, w, h, options.grid, factor, 0, grown));
+        warp::GridStats grid;
+        REPRISE_TRY(grid_passes(
+            s, frame.color, w, h, {nullptr, grown, 0}, options.grid.bicubic,
+            {s.eye_color.name, out_depth, s.hit.name, out_motion ? s.splat_motion.name : 0u, w, h},
+            grid, stretched));
+        stats.covered = grid.covered;
+        return fill_and_scale(s, w, h, options, out_color, out_depth, out_motion, to_backward,
+                              stats);
+    }
     // The reverse warp: a footprint-2 splat, each covered pixel's colour then refetched.
     const bool reverse = options.warp == warp::WarpMethod::Reverse;
     const bool carry = out_motion || reverse;
@@ -136,7 +146,8 @@ Status extrapolate_passes(ContextState& s, const SplatTextures& frame, const Cam
 }
 
 // The grid's extrapolation of `frame` (CPU images, repaired; its colour uploaded as
-// s.source_color): the displacement and the cells on the CPU, drawn by the GPU.
+// s.source_color) for a skewed projection: the displacement and the cells on the CPU, drawn by
+// the GPU.
 Status grid_extrapolation(ContextState& s, const GBufferView& frame, const glm::mat4& view,
                           const glm::mat4& projection, float periods, float motion_scale,
                           const warp::FrucOptions& options, GLuint out_color, GLuint out_depth,
@@ -205,7 +216,7 @@ Status Context::extrapolate_on_gpu(const GBufferView& given, const glm::mat4& vi
     s.made_valid = false;
     timings_ = {};
     stats = {};
-    REPRISE_TRY(check_options(options, false));
+    REPRISE_TRY(check_options(options));
     REPRISE_TRY(check_periods(periods));
     const int w = given.width(), h = given.height();
     if (given.depth.width != w || given.depth.height != h || given.motion.width != w ||
@@ -217,8 +228,11 @@ Status Context::extrapolate_on_gpu(const GBufferView& given, const glm::mat4& vi
     // The same frame as the last call's: its repaired pixels are uploaded already.
     const bool kept = frame_key != 0 && frame_key == s.extrapolate_key &&
                       s.source_color.width == w && s.source_color.height == h;
-    const bool grid = options.warp == warp::WarpMethod::Grid;
-    GBufferView frame;  // repaired; the grid's cells are grown from it on the CPU
+    // A skewed projection: no static-layer test on the GPU; the grid's displacement and cells
+    // are made on the CPU instead.
+    const bool grid = options.warp == warp::WarpMethod::Grid && has_projection(given.camera) &&
+                      !Unprojector(given.camera.projection, w, h).axis_aligned();
+    GBufferView frame;  // repaired; the CPU grid's cells are grown from it
     if (kept) {
         stats.nonfinite = s.extrapolate_nonfinite;
         stats.upload_kept = true;
@@ -260,7 +274,7 @@ Status Context::extrapolate(const GBufferTextures& frame, unsigned color, const 
                             const warp::FrucOptions& options, float motion_scale) {
     timings_ = {};
     stats = {};
-    REPRISE_TRY(check_options(options, true));
+    REPRISE_TRY(check_options(options));
     REPRISE_TRY(check_periods(periods));
     ContextState& s = *state_;
     REPRISE_TRY(s.gl->acquire());

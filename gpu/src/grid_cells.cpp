@@ -270,8 +270,8 @@ Status create_grid_cell_programs(ContextState& s) {
     GridRaster& g = s.grid;
     const std::string header = kComputeHeader;
     REPRISE_TRY(gl::link_compute((header + kCells).c_str(), "grid cells", g.cells_program));
-    REPRISE_TRY(gl::link_compute((header + kOffsets).c_str(), "grid cell offsets",
-                                 g.offsets_program));
+    REPRISE_TRY(
+        gl::link_compute((header + kOffsets).c_str(), "grid cell offsets", g.offsets_program));
     glGenBuffers(1, &g.offsets);
     glGenBuffers(2, g.grown);
     return gl::check_errors("gpu grid cell programs");
@@ -316,8 +316,7 @@ Status grow_cells(ContextState& s, GLuint depth, GLuint motion, int w, int h,
     glBindBuffer(GL_COPY_WRITE_BUFFER, s.readback_buffer);
     glCopyBufferSubData(GL_COPY_READ_BUFFER, GL_COPY_WRITE_BUFFER,
                         GLintptr(starting * sizeof(GLuint)), 0, sizeof(GLuint));
-    const void* mapped =
-        glMapBufferRange(GL_COPY_WRITE_BUFFER, 0, sizeof(GLuint), GL_MAP_READ_BIT);
+    const void* mapped = glMapBufferRange(GL_COPY_WRITE_BUFFER, 0, sizeof(GLuint), GL_MAP_READ_BIT);
     if (mapped) std::memcpy(&total, mapped, sizeof total);
     glUnmapBuffer(GL_COPY_WRITE_BUFFER);
     glBindBuffer(GL_COPY_READ_BUFFER, 0);
