@@ -1532,7 +1532,7 @@ TEST(Gpu, StereoEyeWithHistoryMatchesTheCpuOnEveryBuiltInScene) {
             ASSERT_TRUE(status.ok()) << status.message();
             EXPECT_GE(test::display_psnr(cpu.color, gpu.color), 50.0);
             EXPECT_EQ(b.history_moving, a.history_moving);
-            // The grid's draws agree on coverage within the 0.1 % (here: exactly).
+            // The grid's counts within the 0.1 % of the pixels; the splat's exactly.
             const std::size_t allowed =
                 options.warp == stereo::StereoWarp::Grid ? cpu.color.pixel_count() / 1000 : 0;
             for (auto [x, y] : {std::pair{a.from_history, b.from_history},

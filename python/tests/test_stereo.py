@@ -49,14 +49,17 @@ def test_the_gpu_backend_makes_the_cpus_eyes(pan_60):
     gpu_grid, gpu_grid_stats = gles.synthesize(left, right_camera)
     assert reprise.psnr(reprise.to_display(gpu_grid.color),
                         reprise.to_display(cpu_grid.color)) >= 50.0
+    # The bar: the same holes within 0.1 % of the pixels (on llvmpipe: the same).
+    allowed = left.color.shape[0] * left.color.shape[1] // 1000
     assert gpu_grid_stats["cells"] == cpu_grid_stats["cells"] > 0
-    assert gpu_grid_stats["border"] == cpu_grid_stats["border"] > 0
+    assert cpu_grid_stats["border"] > 0
+    assert abs(gpu_grid_stats["border"] - cpu_grid_stats["border"]) <= allowed
     cpu_grid, cpu_grid_stats = reprise.StereoSynthesizer().synthesize(left, right_camera,
                                                                       history=pan_60[3])
     gpu_grid, gpu_grid_stats = gles.synthesize(left, right_camera, history=pan_60[3])
     assert reprise.psnr(reprise.to_display(gpu_grid.color),
                         reprise.to_display(cpu_grid.color)) >= 50.0
-    assert gpu_grid_stats["from_history"] == cpu_grid_stats["from_history"]
+    assert abs(gpu_grid_stats["from_history"] - cpu_grid_stats["from_history"]) <= allowed
     with pytest.raises(ValueError, match="Andreev"):
         gles.synthesize(left, right_camera, fill="andreev")
     # With the previous frame as history, filling the holes first: the CPU's eye too.

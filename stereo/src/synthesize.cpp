@@ -202,7 +202,7 @@ StereoStats StereoSynthesizer::synthesize(const GBufferView& given, const Camera
 
     // What the made eye sees past the rendered eye's view at the left and right edges continues
     // the row (the fills, which prefer the farthest samples, pulled the sky down across that
-    // strip; docs/benchmarks.md). The splat eye, the GPU's, keeps the fill's.
+    // strip; docs/benchmarks.md). The splat eye keeps the fill's, on the CPU and the GPU.
     if (o.warp == StereoWarp::Grid && o.fill != StereoFill::None)
         stats.border = continue_border_rows(out.color.view(), out.depth.view(), valid_.view());
     warp::FillStats filled;

@@ -144,10 +144,12 @@ public:
     // The cells grid_warp grows, read back (what GridWarper::cells gives on the CPU).
     Status grid_cells(const GBufferView& source, float factor, const warp::GridOptions& options,
                       std::vector<warp::GridCell>& cells);
-    // stereo::StereoSynthesizer::synthesize for StereoWarp::Splat and StereoFill::PullPush or
-    // None (others are an error): displacement through depth, the splat, the `history` (e.g. the
-    // previous frame's other eye, its moving pixels left out) warped the same way into the
-    // holes, pull-push, non-finite colour to 0. Cameras without jitter, projections without skew.
+    // stereo::StereoSynthesizer::synthesize for StereoFill::PullPush or None (others are an
+    // error): displacement through depth, the splat or the grid (its cells grown on the GPU), the
+    // `history` (e.g. the previous frame's other eye, its moving pixels left out) warped the same
+    // way into the holes (and the grid's stretched pixels), the grid's border strip continued,
+    // pull-push, non-finite colour to 0. Cameras without jitter; a skewed projection only for
+    // the grid on CPU images (its displacement and cells then made on the CPU).
     Status stereo_eye(const GBufferView& rendered, const Camera& target, Frame& out,
                       stereo::StereoStats& stats, const stereo::StereoOptions& options = {},
                       const GBufferView* history = nullptr);
