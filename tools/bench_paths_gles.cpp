@@ -68,7 +68,7 @@ struct Textures {
     ~Textures() { glDeleteTextures(GLsizei(names.size()), names.data()); }
 };
 
-// Extrapolation as the GPU makes it (warp splat, pull-push), the silhouettes as they are.
+// Extrapolation by the splat and by the grid (pull-push), the silhouettes as they are.
 const warp::FrucOptions kExtrapolation{.mode = warp::FrucMode::Extrapolate,
                                        .warp = warp::WarpMethod::Splat,
                                        .widen_silhouettes = false};

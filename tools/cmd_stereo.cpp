@@ -204,8 +204,8 @@ int command_stereo(int argc, char** argv) {
                 "pullpush|andreev|patch|none (default pullpush; patch: frequency-selective "
                 "reconstruction, slow)");
     args.option("--backend", &job.backend,
-                "cpu|gles (default cpu); gles: OpenGL ES (the grid's cells grown on the CPU, drawn "
-                "by the GPU)");
+                "cpu|gles (default cpu); gles: OpenGL ES (compute shaders, and the rasteriser for "
+                "the grid), with --fill pullpush or none");
     args.option("--silhouettes", &job.silhouettes,
                 "widen|keep (default widen): pixels beside a nearer surface warp with it");
     args.flag("--temporal", &job.temporal, "fill disocclusions from the previous frame first");

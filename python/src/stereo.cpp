@@ -92,8 +92,8 @@ py::tuple made_eye(const Frame& rendered, Make&& make) {
     return py::make_tuple(std::move(out), stats_dict(stats));
 }
 
-// backend "gles": the eye made by OpenGL ES (gpu::Context::stereo_eye: fill pullpush or none;
-// the grid's cells grown on the CPU), the CPU's eye within 50 dB.
+// backend "gles": the eye made by OpenGL ES (gpu::Context::stereo_eye: fill pullpush or none),
+// the CPU's eye within 50 dB.
 struct Synthesizer {
     explicit Synthesizer(const std::string& backend = "cpu") {
         if (backend == "gles")
@@ -164,8 +164,7 @@ void bind_stereo(py::module_& m) {
                             "Makes another view from a rendered one; keeps its scratch between "
                             "frames of one size.")
         .def(py::init<const std::string&>(), py::arg("backend") = "cpu",
-             "backend 'gles': eyes made by OpenGL ES (fill 'pullpush' or 'none'; the grid's "
-             "cells grown on the CPU)")
+             "backend 'gles': eyes made by OpenGL ES (fill 'pullpush' or 'none')")
         .def("synthesize", &Synthesizer::synthesize, py::arg("rendered"), py::arg("target"),
              py::arg("warp") = "grid", py::arg("fill") = "pullpush", py::arg("history") = nullptr,
              py::arg("widen_silhouettes") = true,
