@@ -145,7 +145,7 @@ TEST(CliStereo, TheGpuBackendMakesTheCpusEyes) {
               0);
     for (int i = 0; i < 2; ++i)
         EXPECT_GE(psnr_of(frame_path(cpu + "/right", i), frame_path(gles + "/right", i)), 50.0);
-    // The default eye (the grid): its cells grown on the CPU, drawn by the GPU.
+    // The default eye (the grid): its cells grown and drawn on the GPU.
     const std::string grid_cpu = (dir / "grid_cpu").string(),
                       grid_gles = (dir / "grid_gles").string();
     ASSERT_EQ(run_command(cli::command_stereo, {"--in", truth, "--out", grid_cpu}), 0);

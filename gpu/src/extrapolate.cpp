@@ -230,8 +230,9 @@ Status Context::extrapolate_on_gpu(const GBufferView& given, const glm::mat4& vi
                       s.source_color.width == w && s.source_color.height == h;
     // A skewed projection: no static-layer test on the GPU; the grid's displacement and cells
     // are made on the CPU instead.
-    const bool grid = options.warp == warp::WarpMethod::Grid && has_projection(given.camera) &&
-                      !Unprojector(given.camera.projection, w, h).axis_aligned();
+    const bool grid = options.warp == warp::WarpMethod::Grid;
+    const bool cpu_grid = grid && has_projection(given.camera) &&
+                          !Unprojector(given.camera.projection, w, h).axis_aligned();
     GBufferView frame;  // repaired; the CPU grid's cells are grown from it
     if (kept) {
         stats.nonfinite = s.extrapolate_nonfinite;
@@ -248,15 +249,18 @@ Status Context::extrapolate_on_gpu(const GBufferView& given, const glm::mat4& vi
     s.depth.ensure(GL_R32F, w, h);
     s.made_motion.ensure(GL_RGBA32F, w, h);
     timings_.upload_ms = finish_ms(t);
-    if (grid)
-        REPRISE_TRY(grid_extrapolation(s, frame, view, projection, periods, motion_scale, options,
-                                       s.color.name, s.depth.name, s.made_motion.name, stats,
-                                       timings_.cpu_ms));
-    else
-        REPRISE_TRY(extrapolate_passes(
+    Status made;
+    if (!cpu_grid)
+        made = extrapolate_passes(
             s, {s.source_color.name, s.source_depth.name, s.source_motion.name, w, h}, given.camera,
             view, projection, periods, motion_scale, options, s.color.name, s.depth.name,
-            s.made_motion.name, stats));
+            s.made_motion.name, stats);
+    // A skewed projection, or more cells than a storage buffer holds: the CPU grows them.
+    if (cpu_grid || (!made.ok() && grid && s.grid.overflowed))
+        made = grid_extrapolation(s, frame, view, projection, periods, motion_scale, options,
+                                  s.color.name, s.depth.name, s.made_motion.name, stats,
+                                  timings_.cpu_ms);
+    REPRISE_TRY(made);
     timings_.compute_ms = finish_ms(t) - timings_.cpu_ms;
     s.made_valid = true;
     return {};

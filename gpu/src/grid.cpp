@@ -1,5 +1,5 @@
-// The adaptive grid warp on the GPU: warp::GridWarper's cells (grown on the CPU, where the
-// smoothness test reads the source) drawn by GL's rasteriser. Each triangle is drawn as its
+// The adaptive grid warp on the GPU: warp::GridWarper's cells (grown by grid_cells.cpp, or on
+// the CPU) drawn by GL's rasteriser. Each triangle is drawn as its
 // pixel bounding box; the fragment shader keeps the pixel centres inside the CPU's integer edge
 // functions (1/256-px vertices, edges pushed out by 1/16 px, products in 64 bits through
 // imulExtended), evaluates the CPU's attribute planes at the centre with its clamps, and the
@@ -20,8 +20,11 @@ static_assert(sizeof(warp::GridCell) == 116, "the shader reads a cell as 29 word
 constexpr int kCellWords = 29;
 
 constexpr const char* kGraphicsHeader = R"(#version 310 es
-#ifdef GL_EXT_gpu_shader5
+#if defined(GL_EXT_gpu_shader5)
 #extension GL_EXT_gpu_shader5 : enable
+#define PRECISE precise
+#elif defined(GL_OES_gpu_shader5)
+#extension GL_OES_gpu_shader5 : enable
 #define PRECISE precise
 #else
 #define PRECISE
@@ -491,6 +494,7 @@ Status Context::grid_cells(const GBufferView& source, float factor,
     timings_.compute_ms = finish_ms(t);
     cells.resize(grown);
     if (grown) {
+        glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
         glBindBuffer(GL_COPY_READ_BUFFER, s.grid.grown[0]);
         const void* mapped = glMapBufferRange(
             GL_COPY_READ_BUFFER, 0, GLsizeiptr(grown * sizeof(warp::GridCell)), GL_MAP_READ_BIT);
@@ -538,10 +542,19 @@ Status Context::grid_warp(const GBufferView& source, float factor, const warp::W
     const bool motion = !target.motion.empty();
     if (motion) s.splat_motion.ensure(GL_RGBA32F, tw, th);
     std::size_t grown = 0, stretched = 0;
-    REPRISE_TRY(
-        grow_cells(s, s.previous_depth.name, s.motion.name, sw, sh, options, factor, 0, grown));
+    GridCells cells{nullptr, 0, 0};
+    const Status on_gpu =
+        grow_cells(s, s.previous_depth.name, s.motion.name, sw, sh, options, factor, 0, grown);
+    cells.grown = grown;
+    if (!on_gpu.ok()) {
+        if (!s.grid.overflowed) return on_gpu;
+        auto cpu = std::chrono::steady_clock::now();  // more cells than a buffer: the CPU's
+        s.grid.warper.cells(source, factor, options, s.grid.cells_cpu);
+        timings_.cpu_ms = ms_since(cpu);
+        cells.cpu = &s.grid.cells_cpu;
+    }
     REPRISE_TRY(grid_passes(
-        s, s.payload.name, sw, sh, {nullptr, grown}, options.bicubic,
+        s, s.payload.name, sw, sh, cells, options.bicubic,
         {s.out.name, s.depth.name, s.hit.name, motion ? s.splat_motion.name : 0u, tw, th}, stats,
         stretched));
     timings_.compute_ms = finish_ms(t);

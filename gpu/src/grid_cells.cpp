@@ -4,6 +4,9 @@
 // starting cell's cells, one invocation turns the counts into offsets in the CPU's order (rows of
 // starting cells, left to right), and a second pass writes the cells there: the same cells, in
 // the same order, as warp::GridWarper::cells, which grid.cpp draws.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <string>
 
@@ -21,8 +24,10 @@ layout(std430, binding = 2) writeonly buffer Cells { uint words[]; };
 uniform ivec2 size;  // the source's
 uniform ivec2 starting;  // starting cells in a row, rows of them
 uniform int cell, min_cell;
-uniform highp float depth_tolerance, motion_limit, vertex_z_ratio, vertex_motion, stretched_area,
-    factor;
+uniform highp float depth_tolerance, motion_limit, vertex_z_ratio, vertex_motion, factor;
+// 131072 * stretched_area rounded down, 64 bits (hi, lo); never: +inf (nothing stretched).
+uniform uvec2 stretch_limit;
+uniform bool never_stretched;
 uniform bool write_cells;  // else count them
 
 const highp float kHugeMotion = 1e30, kBackgroundFrom = 1e29, kBackgroundDepth = 1e30;
@@ -122,8 +127,9 @@ bool fits(int x, int y, int x1, int y1) {
 // |v| <= 2^20, where v * 256 is exact and, from 2^23 on, already whole.
 int to_fixed(highp float v) {
     PRECISE highp float scaled = v * 256.0;
-    if (abs(scaled) >= 8388608.0) return int(scaled);
-    return int(floor(scaled + 0.5));
+    highp float whole = floor(scaled);
+    PRECISE highp float part = scaled - whole;  // exact
+    return int(whole) + (part >= 0.5 ? 1 : 0);
 }
 
 struct Vertex {
@@ -160,24 +166,31 @@ bool vertex(int cx, int cy, int ix, int iy, out Vertex v) {
                  motion_at(ix, iy), v);
 }
 
-// 2 where an edge triangle across a depth edge grew by more than stretched_area px^2.
+// 2 where an edge triangle across a depth edge grew by more than stretched_area px^2: exactly,
+// in integers (twice the target area in 1/65536 px^2, less twice the source's, a whole number
+// of px^2 as source positions are grid points, against 131072 stretched_area).
 uint coverage(Vertex a, Vertex b, Vertex c) {
     highp float z_lo = min(a.z, min(b.z, c.z)), z_hi = max(a.z, max(b.z, c.z));
     PRECISE highp float far = z_lo * vertex_z_ratio;
-    if (!(z_hi > far)) return 1u;
+    if (!(z_hi > far) || never_stretched) return 1u;
     PRECISE highp float source = abs((b.sx - a.sx) * (c.sy - a.sy) - (b.sy - a.sy) * (c.sx - a.sx));
     int h1, l1, h2, l2;
     imulExtended(b.x - a.x, c.y - a.y, h1, l1);
     imulExtended(b.y - a.y, c.x - a.x, h2, l2);
-    uint borrow;
+    uint borrow, carry;
     uint lo = usubBorrow(uint(l1), uint(l2), borrow);
-    int hi = int(uint(h1) - uint(h2) - borrow);
-    highp float target = abs(float(hi) * 4294967296.0 + float(lo)) / 65536.0;
-    PRECISE highp float grown = (target - source) * 0.5;
-    return grown > stretched_area ? 2u : 1u;
+    uint hi = uint(h1) - uint(h2) - borrow;
+    if ((hi & 0x80000000u) != 0u) {  // |.|: two's complement negation
+        lo = uaddCarry(~lo, 1u, carry);
+        hi = ~hi + carry;
+    }
+    lo = usubBorrow(lo, uint(source) * 65536u, borrow);
+    if (hi < borrow) return 1u;  // grew by less than nothing
+    hi -= borrow;
+    return hi > stretch_limit.x || (hi == stretch_limit.x && lo > stretch_limit.y) ? 2u : 1u;
 }
 
-uint emitted = 0u, first_cell = 0u;
+uint emitted = 0u, first_cell = 0u, end_cell = 0u;
 void put(uint at, Vertex v) {
     words[at] = uint(v.x);
     words[at + 1u] = uint(v.y);
@@ -192,7 +205,7 @@ void emit(int x, int y, int x1, int y1, bool fitted) {
     if (!vertex(x, y, x, y, v0) || !vertex(x1, y, x1 - 1, y, v1) ||
         !vertex(x1, y1, x1 - 1, y1 - 1, v2) || !vertex(x, y1, x, y1 - 1, v3))
         return;
-    if (write_cells) {
+    if (write_cells && first_cell + emitted < end_cell) {  // never past its counted range
         uint at = (first_cell + emitted) * 29u;
         put(at, v0);
         put(at + 7u, v1);
@@ -242,7 +255,10 @@ void main() {
     ivec2 id = ivec2(gl_GlobalInvocationID.xy);
     if (id.x >= starting.x || id.y >= starting.y) return;
     uint index = uint(id.y * starting.x + id.x);
-    if (write_cells) first_cell = offsets[index];
+    if (write_cells) {
+        first_cell = offsets[index];
+        end_cell = offsets[index + 1u];
+    }
     grow(id.x * cell, id.y * cell);
     if (!write_cells) offsets[index] = emitted;
 }
@@ -268,19 +284,23 @@ void main() {
 
 Status create_grid_cell_programs(ContextState& s) {
     GridRaster& g = s.grid;
+    glDeleteProgram(g.cells_program);  // a failed try's
+    glDeleteProgram(g.offsets_program);
+    g.cells_program = g.offsets_program = 0;
     const std::string header = kComputeHeader;
     REPRISE_TRY(gl::link_compute((header + kCells).c_str(), "grid cells", g.cells_program));
     REPRISE_TRY(
         gl::link_compute((header + kOffsets).c_str(), "grid cell offsets", g.offsets_program));
-    glGenBuffers(1, &g.offsets);
     glGenBuffers(2, g.grown);
+    glGenBuffers(1, &g.offsets);  // made last: everything before it is ready
     return gl::check_errors("gpu grid cell programs");
 }
 
 Status grow_cells(ContextState& s, GLuint depth, GLuint motion, int w, int h,
                   const warp::GridOptions& options, float factor, int slot, std::size_t& count) {
     GridRaster& g = s.grid;
-    if (!g.cells_program) REPRISE_TRY(create_grid_cell_programs(s));
+    g.overflowed = false;
+    if (!g.offsets) REPRISE_TRY(create_grid_cell_programs(s));
     const warp::GridParameters p = warp::grid_parameters(options, factor);
     const int columns = (w + p.cell - 1) / p.cell, rows = (h + p.cell - 1) / p.cell;
     const std::size_t starting = std::size_t(columns) * std::size_t(rows);
@@ -302,7 +322,12 @@ Status grow_cells(ContextState& s, GLuint depth, GLuint motion, int w, int h,
     glUniform1f(glGetUniformLocation(program, "motion_limit"), p.motion_limit);
     glUniform1f(glGetUniformLocation(program, "vertex_z_ratio"), p.vertex_z_ratio);
     glUniform1f(glGetUniformLocation(program, "vertex_motion"), p.vertex_motion);
-    glUniform1f(glGetUniformLocation(program, "stretched_area"), p.stretched_area);
+    const double stretch = std::floor(131072.0 * double(p.stretched_area));
+    const bool never = !(stretch < 1.8e19);  // +inf, or more than 64 bits hold
+    const uint64_t limit = never ? 0 : uint64_t(stretch);
+    glUniform2ui(glGetUniformLocation(program, "stretch_limit"), GLuint(limit >> 32),
+                 GLuint(limit & 0xffffffffu));
+    glUniform1i(glGetUniformLocation(program, "never_stretched"), never);
     glUniform1f(glGetUniformLocation(program, "factor"), factor);
     glUniform1i(glGetUniformLocation(program, "write_cells"), 0);
     dispatch(columns, rows);
@@ -311,6 +336,13 @@ Status grow_cells(ContextState& s, GLuint depth, GLuint motion, int w, int h,
     glUniform1ui(glGetUniformLocation(g.offsets_program, "count"), GLuint(starting));
     glDispatchCompute(1, 1, 1);
     glMemoryBarrier(GL_SHADER_STORAGE_BARRIER_BIT | GL_BUFFER_UPDATE_BARRIER_BIT);
+    auto unbind = [&] {
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, 0);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, 0);
+        glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
+        ContextState::unbind_inputs();
+        glUseProgram(0);
+    };
     GLuint total = 0;
     glBindBuffer(GL_COPY_READ_BUFFER, g.offsets);
     glBindBuffer(GL_COPY_WRITE_BUFFER, s.readback_buffer);
@@ -321,29 +353,34 @@ Status grow_cells(ContextState& s, GLuint depth, GLuint motion, int w, int h,
     glUnmapBuffer(GL_COPY_WRITE_BUFFER);
     glBindBuffer(GL_COPY_READ_BUFFER, 0);
     glBindBuffer(GL_COPY_WRITE_BUFFER, 0);
-    if (!mapped) return Status::error("gpu grid cells: the cell count could not be read back");
-
+    if (!mapped) {
+        unbind();
+        return Status::error("gpu grid cells: the cell count could not be read back");
+    }
+    // One storage buffer holds them (and 32-bit word offsets reach them all).
     GLint64 max_bytes = 0;
     glGetInteger64v(GL_MAX_SHADER_STORAGE_BLOCK_SIZE, &max_bytes);
+    max_bytes = std::min<GLint64>(max_bytes, GLint64(1) << 31);
     const std::size_t bytes = std::size_t(total) * sizeof(warp::GridCell);
-    if (bytes > std::size_t(max_bytes))
+    g.overflowed = bytes > std::size_t(max_bytes);
+    if (g.overflowed) {
+        unbind();
         return Status::error("gpu grid cells: " + std::to_string(total) +
                              " cells exceed one storage buffer (" + std::to_string(max_bytes) +
                              " bytes)");
-    glBindBuffer(GL_SHADER_STORAGE_BUFFER, g.grown[slot]);
-    if (g.grown_bytes[slot] < bytes) {
-        glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(bytes), nullptr, GL_DYNAMIC_COPY);
-        g.grown_bytes[slot] = bytes;
     }
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, g.grown[slot]);
-    glUseProgram(program);
-    glUniform1i(glGetUniformLocation(program, "write_cells"), 1);
-    dispatch(columns, rows);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, 0);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, 0);
-    glBindBuffer(GL_SHADER_STORAGE_BUFFER, 0);
-    ContextState::unbind_inputs();
-    glUseProgram(0);
+    if (total) {
+        glBindBuffer(GL_SHADER_STORAGE_BUFFER, g.grown[slot]);
+        if (g.grown_bytes[slot] < bytes) {
+            glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(bytes), nullptr, GL_DYNAMIC_COPY);
+            g.grown_bytes[slot] = bytes;
+        }
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, g.grown[slot]);
+        glUseProgram(program);
+        glUniform1i(glGetUniformLocation(program, "write_cells"), 1);
+        dispatch(columns, rows);
+    }
+    unbind();
     count = total;
     return gl::check_errors("gpu grid cells");
 }

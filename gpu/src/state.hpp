@@ -29,11 +29,14 @@ struct Texture {
 Status check_texture(unsigned name, GLenum format, int w, int h, const char* what);
 
 // The first lines of every compute shader: GLSL ES 3.10, 8x8 work groups, and PRECISE
-// (GL_EXT_gpu_shader5's `precise` where offered) on what must not be fused into multiply-adds,
-// so that the GPU repeats the CPU reference's arithmetic.
+// (GL_EXT_gpu_shader5's or GL_OES_gpu_shader5's `precise` where offered) on what must not be
+// fused into multiply-adds, so that the GPU repeats the CPU reference's arithmetic.
 inline constexpr const char* kComputeHeader = R"(#version 310 es
-#ifdef GL_EXT_gpu_shader5
+#if defined(GL_EXT_gpu_shader5)
 #extension GL_EXT_gpu_shader5 : enable
+#define PRECISE precise
+#elif defined(GL_OES_gpu_shader5)
+#extension GL_OES_gpu_shader5 : enable
 #define PRECISE precise
 #else
 #define PRECISE
@@ -198,7 +201,8 @@ double finish_ms(std::chrono::steady_clock::time_point& since);
 double ms_since(std::chrono::steady_clock::time_point& since);
 
 // The grid warp's GL objects (made on first use: the cells are read in a vertex shader, which
-// GL ES 3.1 does not promise) and the CPU's side: the cells and the eye's displacement.
+// GL ES 3.1 does not promise) and the CPU's side for skewed projections and for more cells than
+// a storage buffer holds: the cells and the displacements.
 struct GridRaster {
     GLuint program = 0, finish_program = 0, eye_valid_program = 0, border_program = 0;
     GLuint cells_program = 0, offsets_program = 0;  // growing the cells (grid_cells.cpp)
@@ -206,6 +210,7 @@ struct GridRaster {
     GLuint grown[2] = {0, 0};  // cells grown on the GPU: the eye's or the frame's, the history's
     int depth_width = 0, depth_height = 0;
     std::size_t cells_bytes = 0, offsets_bytes = 0, grown_bytes[2] = {0, 0};
+    bool overflowed = false;  // the last grow_cells had more cells than a storage buffer holds
     warp::GridWarper warper;
     std::vector<warp::GridCell> cells_cpu, history_cells;
     Image<glm::vec2> displacement, history_displacement;

@@ -343,7 +343,9 @@ Status eye_passes(ContextState& s, GLuint color, GLuint depth, int w, int h, con
                   bool cpu_cells = false) {
     const bool grid = o.warp == stereo::StereoWarp::Grid;
     if (!(grid && cpu_cells) && !displaced_on_gpu(from, history ? &history->camera : nullptr, w, h))
-        return Status::error("gpu stereo eye: the rendered camera's projection is skewed");
+        return Status::error(
+            "gpu stereo eye: the rendered or the history camera's projection is skewed (the grid "
+            "takes it on CPU images)");
     s.displacement.ensure(GL_RGBA32F, w, h);
     s.target_depth.ensure(GL_R32F, w, h);
     s.eye_color.ensure(GL_RGBA32F, w, h);
@@ -454,12 +456,10 @@ Status Context::stereo_eye(const GBufferView& given, const Camera& target, Frame
         if (with_history)
             history = warp::widen_silhouettes(history, s.wide_history_depth, s.wide_history_motion);
     }
-    // The grid's displacement and cells on the CPU where the GPU's displacement cannot be made.
-    const bool cpu_cells =
-        options.warp == stereo::StereoWarp::Grid &&
-        !displaced_on_gpu(rendered.camera, with_history ? &history.camera : nullptr, w, h);
-    if (cpu_cells) {
-        GridRaster& g = s.grid;
+    // The grid's displacement and cells on the CPU where the GPU's displacement cannot be made
+    // (and, below, where more cells grow than a storage buffer holds).
+    GridRaster& g = s.grid;
+    auto grow_on_cpu = [&] {
         g.displacement.resize(w, h);
         g.target_depth.resize(w, h);
         stereo::stereo_displacement(rendered, target, g.displacement.view(), g.target_depth.view());
@@ -481,7 +481,11 @@ Status Context::stereo_eye(const GBufferView& given, const Camera& target, Frame
                                             .camera = history.camera};
             g.warper.cells(history_moved, 1.0f, options.grid, g.history_cells);
         }
-    }
+    };
+    const bool cpu_cells =
+        options.warp == stereo::StereoWarp::Grid &&
+        !displaced_on_gpu(rendered.camera, with_history ? &history.camera : nullptr, w, h);
+    if (cpu_cells) grow_on_cpu();
     timings_.cpu_ms = ms_since(t);
     s.payload.ensure(GL_RGBA32F, w, h);
     s.previous_depth.ensure(GL_R32F, w, h);
@@ -505,9 +509,18 @@ Status Context::stereo_eye(const GBufferView& given, const Camera& target, Frame
     s.color.ensure(GL_RGBA32F, w, h);
     s.depth.ensure(GL_R32F, w, h);
     timings_.upload_ms = finish_ms(t);
-    REPRISE_TRY(eye_passes(s, s.payload.name, s.previous_depth.name, w, h, rendered.camera, target,
-                           options, s.color.name, s.depth.name, stats,
-                           with_history ? &textures : nullptr, cpu_cells));
+    Status made = eye_passes(s, s.payload.name, s.previous_depth.name, w, h, rendered.camera,
+                             target, options, s.color.name, s.depth.name, stats,
+                             with_history ? &textures : nullptr, cpu_cells);
+    if (!made.ok() && !cpu_cells && g.overflowed) {
+        auto cpu = std::chrono::steady_clock::now();
+        grow_on_cpu();
+        timings_.cpu_ms += ms_since(cpu);
+        made = eye_passes(s, s.payload.name, s.previous_depth.name, w, h, rendered.camera, target,
+                          options, s.color.name, s.depth.name, stats,
+                          with_history ? &textures : nullptr, true);
+    }
+    REPRISE_TRY(made);
     timings_.compute_ms = finish_ms(t);
     s.download_made(out);
     REPRISE_TRY(gl::check_errors("gpu stereo eye download"));

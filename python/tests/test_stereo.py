@@ -44,7 +44,7 @@ def test_the_gpu_backend_makes_the_cpus_eyes(pan_60):
     # The bar for the GPU backend; on llvmpipe the eyes are bit-identical.
     assert reprise.psnr(reprise.to_display(gpu.color), reprise.to_display(cpu.color)) >= 50.0
     assert gpu_stats["holes"] == cpu_stats["holes"] and gpu_stats["holes"] > 0
-    # The default eye, the grid: its cells grown on the CPU, drawn by the GPU.
+    # The default eye, the grid: its cells grown and drawn on the GPU.
     cpu_grid, cpu_grid_stats = reprise.StereoSynthesizer().synthesize(left, right_camera)
     gpu_grid, gpu_grid_stats = gles.synthesize(left, right_camera)
     assert reprise.psnr(reprise.to_display(gpu_grid.color),

@@ -16,7 +16,7 @@ public:
     explicit FrucBackend(Context& context, const warp::SplatOptions& splat = {})
         : context_(context), splat_(splat) {}
     // Warp splat with these splat options (or reverse); interpolation with fill pull-push and
-    // refinement off, extrapolation also with warp grid (its cells grown on the CPU) and fill
+    // refinement off, extrapolation also with warp grid and fill
     // pull-push or none: what the GPU makes the CPU's frames for.
     static Status check(const warp::FrucOptions& options, const warp::SplatOptions& splat = {});
     Status supports(const warp::FrucOptions& options) const override {
