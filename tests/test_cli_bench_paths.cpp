@@ -15,9 +15,9 @@ namespace {
 // Each GPU stage's row: size, stage (two words), 10 figures, the last the GPU's PSNR against the
 // CPU's (inf on llvmpipe for all but the grid's).
 void expect_gles_rows(const std::string& output) {
-    for (const char* stage :
-         {"reproject RGBA", "pull-push (depth)", "stereo-eye splat+pp", "interpolate splat+pp",
-          "extrapolate splat+pp", "stereo-eye grid+pp", "extrapolate grid+pp"}) {
+    for (const char* stage : {"reproject RGBA", "pull-push (depth)", "stereo-eye splat+pp",
+                              "interpolate splat+pp", "extrapolate splat+pp", "stereo-eye grid+pp",
+                              "extrapolate grid+pp", "interpolate grid+pp"}) {
         const std::size_t at = output.find(std::string("96x64      ") + stage);
         ASSERT_NE(at, std::string::npos) << stage << "\n" << output;
         std::istringstream row(output.substr(at, output.find('\n', at) - at));

@@ -214,6 +214,18 @@ TEST(CliStereo, FrucOnTheGpuBackendMakesTheCpusSplatFrames) {
     ASSERT_TRUE(read_frame(frame_path(cpu, 1), cpu_made).ok());
     ASSERT_FALSE(made.motion.empty());  // per output period, as the CPU's
     EXPECT_EQ(made.motion(80, 45), cpu_made.motion(80, 45));
+    // The default warp, the grid (refinement off): both sides' cells grown and drawn on the GPU.
+    const std::string cpu_grid_between = (dir / "cpu_grid_between").string(),
+                      gles_grid_between = (dir / "gles_grid_between").string();
+    ASSERT_EQ(
+        run_command(cli::command_fruc, {"--in", in, "--refine", "off", "--out", cpu_grid_between}),
+        0);
+    ASSERT_EQ(run_command(cli::command_fruc, {"--in", in, "--refine", "off", "--backend", "gles",
+                                              "--out", gles_grid_between}),
+              0);
+    for (int i = 0; i < 5; ++i)
+        EXPECT_GE(psnr_of(frame_path(cpu_grid_between, i), frame_path(gles_grid_between, i)), 50.0)
+            << "in-between by the grid, frame " << i;
     // With true motion (the default) too.
     const std::string cpu_true = (dir / "cpu_true").string(),
                       gles_true = (dir / "gles_true").string();

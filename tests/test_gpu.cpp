@@ -822,15 +822,12 @@ Differences differences(const Frame& cpu, const Frame& gpu) {
 const warp::FrucOptions kSplatInterpolation{
     .warp = warp::WarpMethod::Splat, .true_motion = false, .refine = {.enabled = false}};
 
-// The frame the CPU makes halfway between `a` and `b` from the inputs as they are (the converter
-// widens their silhouettes before it hands them to a backend; Context::interpolate does not).
-Frame cpu_between(const Frame& a, const Frame& b, bool true_motion = false,
-                  warp::FrucCounters* counters = nullptr,
-                  warp::WarpMethod method = warp::WarpMethod::Splat) {
-    warp::FrucOptions options = kSplatInterpolation;
+// The frame the CPU makes halfway between `a` and `b` with `options` from the inputs as they are
+// (the converter widens their silhouettes before it hands them to a backend; Context::interpolate
+// does not).
+Frame cpu_between_with(const Frame& a, const Frame& b, warp::FrucOptions options,
+                       warp::FrucCounters* counters = nullptr) {
     options.widen_silhouettes = false;
-    options.true_motion = true_motion;
-    options.warp = method;
     warp::FrameRateConverter converter;
     EXPECT_TRUE(warp::FrameRateConverter::create(2, options, converter).ok());
     std::vector<Frame> outputs;
@@ -843,6 +840,54 @@ Frame cpu_between(const Frame& a, const Frame& b, bool true_motion = false,
     EXPECT_EQ(outputs.size(), 3u);  // a, the made frame, b
     if (counters) *counters = converter.counters();
     return outputs.size() == 3 ? outputs[1] : Frame{};
+}
+
+Frame cpu_between(const Frame& a, const Frame& b, bool true_motion = false,
+                  warp::FrucCounters* counters = nullptr,
+                  warp::WarpMethod method = warp::WarpMethod::Splat) {
+    warp::FrucOptions options = kSplatInterpolation;
+    options.true_motion = true_motion;
+    options.warp = method;
+    return cpu_between_with(a, b, options, counters);
+}
+
+// The in-between frame by the grid (refinement off): both sides' cells grown and drawn on the
+// GPU, blended with the stretched sides' rule.
+TEST(Gpu, GridInterpolationMatchesTheCpuOnEveryBuiltInScene) {
+    std::size_t holes = 0;
+    for (const server::SceneInfo& info : server::builtin_scenes()) {
+        const std::vector<Frame>& frames = scene_frames(info.name);
+        for (const int min_cell : {1, 2})
+            for (const bool follow : {false, true}) {
+                SCOPED_TRACE(std::string(info.name) + ", cells " + std::to_string(min_cell) +
+                             (follow ? ", true motion" : ""));
+                const warp::FrucOptions options{.warp = warp::WarpMethod::Grid,
+                                                .grid = {.min_cell = min_cell, .bicubic = true},
+                                                .true_motion = follow,
+                                                .refine = {.enabled = false}};
+                const Frame cpu = cpu_between_with(frames[0], frames[1], options);
+                Frame gpu;
+                gpu::InterpolateStats stats;
+                ASSERT_TRUE(shared_gpu()
+                                .interpolate(frames[0], frames[1], 0.5f, gpu, stats,
+                                             {.grid = true,
+                                              .grid_options = options.grid,
+                                              .true_motion = follow,
+                                              .motion_scale = 0.5f})
+                                .ok());
+                const double db = test::display_psnr(cpu.color, gpu.color);
+                EXPECT_GE(db, 50.0);
+                std::size_t motion_off = 0;
+                for (std::size_t i = 0; i < cpu.motion.pixel_count(); ++i)
+                    motion_off += glm::length(cpu.motion.data()[i] - gpu.motion.data()[i]) > 0.05f;
+                EXPECT_LE(motion_off, cpu.motion.pixel_count() / 1000);
+                holes += stats.holes;
+                std::printf("%-10s between by the grid (%d-px cells%s): holes %zu, %.1f dB\n",
+                            info.name, min_cell, stats.true_motion ? ", true motion" : "",
+                            stats.holes, db);
+            }
+    }
+    EXPECT_GT(holes, 0u);  // not vacuous: some holes filled
 }
 
 TEST(Gpu, InterpolationMatchesTheCpuOnEveryBuiltInScene) {
@@ -948,11 +993,13 @@ TEST(Gpu, TheConverterWithTheGpuBackendMakesTheCpusFrames) {
     EXPECT_EQ(gpu_counters.fills + gpu_counters.fills_skipped,
               cpu_counters.fills + cpu_counters.fills_skipped);
 
-    warp::FrucOptions grid;
-    grid.backend = &backend;
+    // The defaults (the grid with refinement, Andreev's fill absent): refinement refused, named.
+    warp::FrucOptions defaults;
+    defaults.backend = &backend;
+    defaults.fill = warp::FillMethod::Andreev;
     warp::FrameRateConverter refused;
-    const Status status = warp::FrameRateConverter::create(2, grid, refused);
-    EXPECT_NE(status.message().find("warp splat or reverse, refine off"), std::string::npos)
+    const Status status = warp::FrameRateConverter::create(2, defaults, refused);
+    EXPECT_NE(status.message().find("fill pullpush, refine off"), std::string::npos)
         << status.message();
 }
 

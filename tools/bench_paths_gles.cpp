@@ -78,7 +78,7 @@ const warp::FrucOptions kGridExtrapolation{.mode = warp::FrucMode::Extrapolate,
 // The stages on textures already on the GPU (the last pair of frames), `runs` times each:
 // compute alone, as an application that keeps its frames on the GPU pays it.
 struct TextureTimings {
-    Timing &reproject, &fill, &eye, &between, &ahead, &grid_eye, &grid_ahead;
+    Timing &reproject, &fill, &eye, &between, &ahead, &grid_eye, &grid_ahead, &grid_between;
 };
 Status time_texture_path(gpu::Context& context, const Frame& current, const Frame& previous,
                          const Image<uint8_t>& hit_mask, int runs, const TextureTimings& timed) {
@@ -114,6 +114,9 @@ Status time_texture_path(gpu::Context& context, const Frame& current, const Fram
         REPRISE_TRY(context.interpolate(before, previous_color, now, color, 0.5f, filled, eye_depth,
                                         between_stats));
         if (i) timed.between.ms.push_back(context.timings().compute_ms);
+        REPRISE_TRY(context.interpolate(before, previous_color, now, color, 0.5f, filled, eye_depth,
+                                        between_stats, {.grid = true}));
+        if (i) timed.grid_between.ms.push_back(context.timings().compute_ms);
         gpu::ExtrapolateStats ahead_stats;
         REPRISE_TRY(context.extrapolate(before, previous_color, current.camera.view,
                                         current.camera.projection, 1.0f, filled, eye_depth, out,
@@ -143,10 +146,11 @@ Status bench_gles_stages(const std::vector<Frame>& frames, const std::string& si
     Image<glm::vec4> cpu_out(w, h), gpu_out(w, h), cpu_filled(w, h), gpu_filled(w, h);
     Image<uint8_t> cpu_hit(w, h), gpu_hit(w, h);
     warp::PullPush pull_push;
-    StageTimes stages[9] = {
-        {"reproject RGBA"},      {"pull-push (depth)"},    {"splat x-0.5"},
-        {"stereo-eye splat+pp"}, {"interpolate splat+pp"}, {"extrapolate splat+pp"},
-        {"upsample 1/4 Herzog"}, {"stereo-eye grid+pp"},   {"extrapolate grid+pp"}};
+    StageTimes stages[10] = {{"reproject RGBA"},       {"pull-push (depth)"},
+                             {"splat x-0.5"},          {"stereo-eye splat+pp"},
+                             {"interpolate splat+pp"}, {"extrapolate splat+pp"},
+                             {"upsample 1/4 Herzog"},  {"stereo-eye grid+pp"},
+                             {"extrapolate grid+pp"},  {"interpolate grid+pp"}};
     // Herzog upsampling of every other pixel of every other row (jitter -0.5 px: the low pixel
     // (u, v) is the full pixel (2u, 2v)), guided by the frame's full G-buffer, with history.
     warp::SpatioTemporalUpsampler cpu_upsampler;
@@ -162,8 +166,11 @@ Status bench_gles_stages(const std::vector<Frame>& frames, const std::string& si
                                             .widen_silhouettes = false,
                                             .true_motion = false,
                                             .refine = {.enabled = false}};
-    warp::FrameRateConverter converter;
+    warp::FrameRateConverter converter, grid_converter;
     REPRISE_TRY(warp::FrameRateConverter::create(2, between_options, converter));
+    const warp::FrucOptions grid_between_options{
+        .widen_silhouettes = false, .true_motion = false, .refine = {.enabled = false}};
+    REPRISE_TRY(warp::FrameRateConverter::create(2, grid_between_options, grid_converter));
     Frame between_in, gpu_between;
     warp::SplatOptions splat_options;
     const stereo::StereoOptions eye_options{.warp = stereo::StereoWarp::Splat};
@@ -254,25 +261,33 @@ Status bench_gles_stages(const std::vector<Frame>& frames, const std::string& si
 
         // The frame halfway between the previous and the current one: the converter gets the
         // current frame (it holds the previous) and gives the made frame, then the input.
-        Timing& cpu_between = timing ? stages[4].cpu : scratch;
-        between_in = current;
-        Frame received[2];
-        int count = 0;
-        time_once(cpu_between, [&] {
-            status = converter.send(std::move(between_in));
-            while (count < 2 && converter.receive(received[count])) ++count;
-        });
-        REPRISE_TRY(status);
-        Timing between_total;
-        gpu::InterpolateStats between_stats;
-        time_once(between_total, [&] {
-            status = context->interpolate(previous, current, 0.5f, gpu_between, between_stats);
-        });
-        REPRISE_TRY(status);
-        if (timing) record(stages[4], context->timings(), between_total.ms[0]);
-        if (count == 2)
-            stages[4].worst_db =
-                std::min(stages[4].worst_db, display_psnr(received[0].color, gpu_between.color));
+        auto between = [&](StageTimes& stage, warp::FrameRateConverter& cpu_converter,
+                           const gpu::InterpolateOptions& gpu_options) {
+            Timing& cpu_between = timing ? stage.cpu : scratch;
+            between_in = current;
+            Frame received[2];
+            int count = 0;
+            time_once(cpu_between, [&] {
+                status = cpu_converter.send(std::move(between_in));
+                while (count < 2 && cpu_converter.receive(received[count])) ++count;
+            });
+            REPRISE_TRY(status);
+            Timing between_total;
+            gpu::InterpolateStats between_stats;
+            time_once(between_total, [&] {
+                status = context->interpolate(previous, current, 0.5f, gpu_between, between_stats,
+                                              gpu_options);
+            });
+            REPRISE_TRY(status);
+            if (timing) record(stage, context->timings(), between_total.ms[0]);
+            if (count == 2)
+                stage.worst_db =
+                    std::min(stage.worst_db, display_psnr(received[0].color, gpu_between.color));
+            return Status{};
+        };
+        REPRISE_TRY(between(stages[4], converter, {}));
+        REPRISE_TRY(between(stages[9], grid_converter,
+                            {.grid = true, .grid_options = grid_between_options.grid}));
 
         const Camera& to = current.camera;
         Timing& cpu_ahead_time = timing ? stages[5].cpu : scratch;
@@ -325,7 +340,7 @@ Status bench_gles_stages(const std::vector<Frame>& frames, const std::string& si
     REPRISE_TRY(time_texture_path(
         *context, frames.back(), frames[frames.size() - 2], cpu_hit, int(frames.size()) - 2,
         {stages[0].textures, stages[1].textures, stages[3].textures, stages[4].textures,
-         stages[5].textures, stages[7].textures, stages[8].textures}));
+         stages[5].textures, stages[7].textures, stages[8].textures, stages[9].textures}));
     std::printf(
         "gles: %s; GPU columns are medians; gles cpu: the work left on the CPU (widened "
         "silhouettes, the grid's displacement and cells); textures: the texture entry point on "

@@ -257,9 +257,9 @@ int command_fruc(int argc, char** argv) {
                 "widen | keep (default widen): pixels beside a nearer surface warp with it, so "
                 "the colour\nanti-aliasing blended into them travels with the silhouette");
     args.option("--backend", &job.backend,
-                "cpu | gles (default cpu); gles: the made frames on OpenGL ES; interpolated with "
-                "--warp splat or\nreverse, --fill pullpush --refine off; extrapolated with --warp "
-                "grid, splat or reverse,\n--fill pullpush or none");
+                "cpu | gles (default cpu); gles: the made frames on OpenGL ES (--warp grid, splat "
+                "or reverse);\ninterpolated with --fill pullpush --refine off, extrapolated with "
+                "--fill pullpush or none");
     args.option("--warp", &job.warp,
                 "reverse | splat | grid | auto (default grid; grid-bicubic, grid-bilinear pick "
                 "its colour\nfetch; auto: chosen per frame)");

@@ -13,8 +13,8 @@ Status FrucBackend::check(const warp::FrucOptions& o, const warp::SplatOptions& 
     };
     const bool extrapolate = o.mode != warp::FrucMode::Interpolate;
     need(o.warp == warp::WarpMethod::Splat || o.warp == warp::WarpMethod::Reverse ||
-             (extrapolate && o.warp == warp::WarpMethod::Grid),
-         extrapolate ? "warp grid, splat or reverse" : "warp splat or reverse");
+             o.warp == warp::WarpMethod::Grid,
+         "warp grid, splat or reverse");
     if (!extrapolate) {
         need(o.fill == warp::FillMethod::PullPush, "fill pullpush");
         need(!o.refine.enabled, "refine off");
@@ -38,6 +38,8 @@ Status FrucBackend::interpolate(const GBufferView& a, const GBufferView& b, floa
     REPRISE_TRY(context_.interpolate(a, b, s, out, stats,
                                      {.splat = splat_,
                                       .reverse = options.warp == warp::WarpMethod::Reverse,
+                                      .grid = options.warp == warp::WarpMethod::Grid,
+                                      .grid_options = options.grid,
                                       .true_motion = options.true_motion,
                                       .static_tolerance = options.static_tolerance,
                                       .motion_scale = motion_scale},

@@ -1,6 +1,6 @@
-// The in-between frame on the GPU: warp's interpolate_frame for the splat or the reverse warp
-// without refinement (FrucOptions{.warp = Splat or Reverse, .refine = off}): b splatted by
-// 1 - s, a by -s (along their true motion when asked), the two blended where both see one
+// The in-between frame on the GPU: warp's interpolate_frame for the splat, the reverse warp or the
+// grid without refinement (FrucOptions{.warp = Splat, Reverse or Grid, .refine = off}): b warped
+// by 1 - s, a by -s (along their true motion when asked), the two blended where both see one
 // surface, pull-push over what neither covers.
 #include <chrono>
 #include <string>
@@ -32,11 +32,12 @@ uniform ivec2 size;
 uniform highp float s, motion_scale;
 uniform bool write_motion;
 
-// Whether pixel p is a hole. blend_row_reference's rule (kSameSurface 0.15); the splat marks no
-// pixel kCoveredStretched, so its rule for stretched sides never applies here. The motion is b's
-// (0 where nothing landed) unless a alone is taken.
+// Whether pixel p is a hole. blend_row_reference's rule (kSameSurface 0.15): where only one side
+// was drawn by a grid triangle stretched over a disocclusion (2), the other side's; the motion
+// is b's (0 where nothing landed) unless a alone is taken.
 bool blend(ivec2 p) {
-    bool ca = texelFetch(covered_a, p, 0).r != 0u, cb = texelFetch(covered_b, p, 0).r != 0u;
+    uint mark_a = texelFetch(covered_a, p, 0).r, mark_b = texelFetch(covered_b, p, 0).r;
+    bool ca = mark_a != 0u, cb = mark_b != 0u;
     highp float za = texelFetch(depth_a, p, 0).r, zb = texelFetch(depth_b, p, 0).r;
     highp vec4 a = texelFetch(color_a, p, 0), c = texelFetch(color_b, p, 0);
     highp float z = zb;
@@ -44,7 +45,13 @@ bool blend(ivec2 p) {
     if (ca) {
         PRECISE highp float gap = abs(za - zb), allowed = 0.15 * min(za, zb);
         bool both_background = positive_inf(za) && positive_inf(zb);
-        if (cb && (both_background || (!positive_inf(za) && !positive_inf(zb) && gap <= allowed))) {
+        if (cb && (mark_a == 2u) != (mark_b == 2u)) {
+            if (mark_b == 2u) {
+                c = a;
+                z = za;
+                take_a = true;
+            }
+        } else if (cb && (both_background || (!positive_inf(za) && !positive_inf(zb) && gap <= allowed))) {
             PRECISE highp vec4 mixed = (1.0 - s) * a + s * c;
             c = mixed;
             z = min(za, zb);
@@ -294,16 +301,41 @@ Status interpolate_passes(ContextState& s, const SplatTextures& given_a,
     const float motion_scale = options.motion_scale;
     k.side_a_motion.ensure(GL_RGBA32F, carry ? w : 1, carry ? h : 1);
     k.side_b_motion.ensure(GL_RGBA32F, carry ? w : 1, carry ? h : 1);
-    // The reverse warp: a footprint-2 splat, each covered pixel's colour then refetched.
-    const warp::SplatOptions splat =
-        options.reverse ? warp::SplatOptions{.footprint = 2} : options.splat;
-    REPRISE_TRY(splat_passes(s, b, 1.0f - s_between, splat, w, h, k.side_b_color.name,
-                             k.side_b_depth.name, k.side_b_covered.name,
-                             carry ? k.side_b_motion.name : 0, stats.covered_b));
-    REPRISE_TRY(splat_passes(s, a, -s_between, splat, w, h, k.side_a_color.name,
-                             k.side_a_depth.name, k.side_a_covered.name,
-                             carry ? k.side_a_motion.name : 0, stats.covered_a));
-    if (options.reverse) {
+    if (options.grid) {  // each side's cells grown (slots 1 and 0) and drawn
+        struct Side {
+            const SplatTextures& in;
+            float factor;
+            int slot;
+            Texture &color, &depth, &covered, &motion;
+            std::size_t& count;
+        };
+        for (const Side& side : {Side{b, 1.0f - s_between, 1, k.side_b_color, k.side_b_depth,
+                                      k.side_b_covered, k.side_b_motion, stats.covered_b},
+                                 Side{a, -s_between, 0, k.side_a_color, k.side_a_depth,
+                                      k.side_a_covered, k.side_a_motion, stats.covered_a}}) {
+            std::size_t grown = 0, stretched = 0;
+            REPRISE_TRY(grow_cells(s, side.in.depth, side.in.motion, w, h, options.grid_options,
+                                   side.factor, side.slot, grown));
+            warp::GridStats drawn;
+            REPRISE_TRY(grid_passes(s, side.in.color, w, h, {nullptr, grown, side.slot},
+                                    options.grid_options.bicubic,
+                                    {side.color.name, side.depth.name, side.covered.name,
+                                     carry ? side.motion.name : 0u, w, h},
+                                    drawn, stretched));
+            side.count = drawn.covered;
+        }
+    } else {
+        // The reverse warp: a footprint-2 splat, each covered pixel's colour then refetched.
+        const warp::SplatOptions splat =
+            options.reverse ? warp::SplatOptions{.footprint = 2} : options.splat;
+        REPRISE_TRY(splat_passes(s, b, 1.0f - s_between, splat, w, h, k.side_b_color.name,
+                                 k.side_b_depth.name, k.side_b_covered.name,
+                                 carry ? k.side_b_motion.name : 0, stats.covered_b));
+        REPRISE_TRY(splat_passes(s, a, -s_between, splat, w, h, k.side_a_color.name,
+                                 k.side_a_depth.name, k.side_a_covered.name,
+                                 carry ? k.side_a_motion.name : 0, stats.covered_a));
+    }
+    if (options.reverse && !options.grid) {
         REPRISE_TRY(refetch_pass(s, b, 1.0f - s_between, k.side_b_motion.name,
                                  k.side_b_covered.name, w, h, k.side_b_color.name));
         REPRISE_TRY(refetch_pass(s, a, -s_between, k.side_a_motion.name, k.side_a_covered.name, w,

@@ -116,10 +116,10 @@ void bind_fruc(py::module_& m) {
         "the frame, then K-1 frames beyond it. refine: optical flow where the "
         "rendered motion is not what is seen (moving shadows, reflections). "
         "true_motion: each side goes where it truly is at the in-between "
-        "instant (off: linearly). backend 'gles': the in-between frames on the "
-        "GPU (OpenGL ES), with warp 'splat', fill 'pullpush', refine and "
-        "true_motion off; its made frames carry no motion, and it is used from the thread "
-        "that made it (another thread gets an error). widen_silhouettes: pixels beside a nearer "
+        "instant (off: linearly). backend 'gles': the made frames on the "
+        "GPU (OpenGL ES), with warp 'grid', 'splat' or 'reverse', fill 'pullpush' (extrapolation "
+        "also 'none') and refine off, as the CPU's; it is used from the thread that made it "
+        "(another thread gets an error). widen_silhouettes: pixels beside a nearer "
         "surface warp with it, so the anti-aliasing blended into them travels with the "
         "silhouette.")
         .def(py::init<int, const std::string&, const std::string&, const std::string&, bool, bool,

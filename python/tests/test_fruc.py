@@ -102,6 +102,11 @@ def test_gpu_backend_makes_the_cpus_splat_frames(pan_60):
                                      backend="gles").convert(inputs)
     for k in range(5):
         assert reprise.psnr(reprise.to_display(gpu[k].color), reprise.to_display(cpu[k].color)) >= 50.0
+    # The default warp, the grid, without refinement: both sides' cells grown and drawn there.
+    cpu = reprise.FrameRateConverter(factor=2, refine=False).convert(inputs)
+    gpu = reprise.FrameRateConverter(factor=2, refine=False, backend="gles").convert(inputs)
+    for k in range(5):
+        assert reprise.psnr(reprise.to_display(gpu[k].color), reprise.to_display(cpu[k].color)) >= 50.0
     with pytest.raises(ValueError, match="refine off"):
         reprise.FrameRateConverter(factor=2, warp="splat", refine=True, backend="gles")
     with pytest.raises(ValueError, match="expected cpu or gles"):

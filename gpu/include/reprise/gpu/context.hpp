@@ -79,6 +79,8 @@ struct ExtrapolateStats {
 struct InterpolateOptions {
     warp::SplatOptions splat;
     bool reverse = false;  // WarpMethod::Reverse: a footprint-2 splat whose colour is refetched
+    bool grid = false;     // WarpMethod::Grid: each side by the adaptive grid (`grid_options`)
+    warp::GridOptions grid_options;
     // Each side along its true motion (static pixels through depth to the in-between camera,
     // a's moving ones along b's motion inverted) unless warp's survey finds it linear (on
     // textures, its sampled pixels are gathered and read back: 1/64 of the depth and motion).
@@ -166,10 +168,11 @@ public:
                       const GBufferTextures* history = nullptr, unsigned history_color = 0);
 
     // The frame at `s` in [0, 1] between a (0) and b (1) with b's backward motion: warp's
-    // interpolate_frame for FrucOptions{.warp = Splat, .refine off} and pull-push: b splatted by
-    // 1 - s, a by -s (along their true motion with options.true_motion), blended by s where both
-    // land on one surface (depths within 15 %), the nearer or the only one elsewhere, pull-push
-    // over what neither covers. Colour, depth and motion out: the motion the winning side
+    // interpolate_frame for FrucOptions{.warp = Splat, Reverse or Grid, .refine off} and
+    // pull-push: b warped by 1 - s, a by -s (along their true motion with options.true_motion),
+    // blended by s where both land on one surface (depths within 15 %; where only one side was
+    // drawn by a stretched grid triangle, the other), the nearer or the only one elsewhere,
+    // pull-push over what neither covers. Colour, depth and motion out: the motion the winning side
     // carried (b's where both are blended) times motion_scale, as the CPU's (normal and id
     // cleared; out.camera is b's).
     // NaN/Inf in a and b are repaired first, as the CPU converter does; the texture entry does

@@ -15,9 +15,9 @@ public:
     // `context` must outlive the backend.
     explicit FrucBackend(Context& context, const warp::SplatOptions& splat = {})
         : context_(context), splat_(splat) {}
-    // Warp splat with these splat options (or reverse); interpolation with fill pull-push and
-    // refinement off, extrapolation also with warp grid and fill
-    // pull-push or none: what the GPU makes the CPU's frames for.
+    // Warp grid, reverse or splat with these splat options; interpolation with fill pull-push
+    // and refinement off, extrapolation with fill pull-push or none: what the GPU makes the
+    // CPU's frames for.
     static Status check(const warp::FrucOptions& options, const warp::SplatOptions& splat = {});
     Status supports(const warp::FrucOptions& options) const override {
         return check(options, splat_);
