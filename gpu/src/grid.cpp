@@ -19,16 +19,7 @@ namespace {
 static_assert(sizeof(warp::GridCell) == 116, "the shader reads a cell as 29 words");
 constexpr int kCellWords = 29;
 
-constexpr const char* kGraphicsHeader = R"(#version 310 es
-#if defined(GL_EXT_gpu_shader5)
-#extension GL_EXT_gpu_shader5 : enable
-#define PRECISE precise
-#elif defined(GL_OES_gpu_shader5)
-#extension GL_OES_gpu_shader5 : enable
-#define PRECISE precise
-#else
-#define PRECISE
-#endif
+constexpr const char* kGraphicsHeader = R"(
 precision highp float;
 precision highp int;
 bool finite(highp float v) { return (floatBitsToUint(v) & 0x7f800000u) != 0x7f800000u; }
@@ -181,38 +172,8 @@ bool inside(ivec2 p, ivec2 q, ivec2 at) {
     int dx = q.x - p.x, dy = q.y - p.y;
     return edge_inside(dx, at.y - p.y, dy, at.x - p.x, max(abs(dx), abs(dy)));
 }
-)"
-                                  R"(
-int floor_small(highp float v) {
-    int i = int(v);
-    return i - (v < float(i) ? 1 : 0);
-}
-void weights(highp float t, out highp vec4 w) {
-    PRECISE highp float t2 = t * t, t3 = t2 * t;
-    PRECISE highp float w0 = 0.5 * (-t3 + 2.0 * t2 - t);
-    PRECISE highp float w1 = 0.5 * (3.0 * t3 - 5.0 * t2 + 2.0);
-    PRECISE highp float w2 = 0.5 * (-3.0 * t3 + 4.0 * t2 + t);
-    PRECISE highp float w3 = 0.5 * (t3 - t2);
-    w = vec4(w0, w1, w2, w3);
-}
-highp vec4 bicubic(highp vec2 p) {
-    PRECISE highp float sx = p.x - 0.5, sy = p.y - 0.5;
-    int ix = floor_small(sx), iy = floor_small(sy);
-    PRECISE highp float tx = sx - float(ix), ty = sy - float(iy);
-    highp vec4 wx, wy;
-    weights(tx, wx);
-    weights(ty, wy);
-    PRECISE highp vec4 sum = vec4(0.0);
-    for (int j = 0; j < 4; ++j) {
-        int y = clamp(iy - 1 + j, 0, source_size.y - 1);
-        PRECISE highp vec4 line = vec4(0.0);
-        for (int i = 0; i < 4; ++i)
-            line = line + wx[i] * texelFetch(source_color, ivec2(clamp(ix - 1 + i, 0, source_size.x - 1), y), 0);
-        sum = sum + wy[j] * line;
-    }
-    return sum;
-}
-
+)";
+constexpr const char* kFragmentMain = R"(
 void main() {
     ivec2 pixel = ivec2(gl_FragCoord.xy);
     ivec2 at = pixel * 256 + 128;
@@ -340,8 +301,9 @@ Status create_grid_programs(ContextState& s) {
         return Status::error(
             "gpu grid warp: " + s.gl->description() +
             " offers no storage buffer in vertex shaders (the cells are read there)");
-    const std::string header = kGraphicsHeader;
-    REPRISE_TRY(gl::link_program((header + kVertex).c_str(), (header + kFragment).c_str(),
+    const std::string header = std::string(kShaderPrelude) + kGraphicsHeader;
+    REPRISE_TRY(gl::link_program((header + kVertex).c_str(),
+                                 (header + kFragment + kBicubicFetch + kFragmentMain).c_str(),
                                  "grid warp", g.program));
     REPRISE_TRY(gl::link_compute((std::string(kComputeHeader) + kGroupCounts + kFinish).c_str(),
                                  "grid finish", g.finish_program));

@@ -198,36 +198,8 @@ layout(binding = 3) uniform highp usampler2D covered;
 layout(binding = 0, rgba32f) writeonly uniform highp image2D out_color;
 uniform ivec2 source_size, target_size;
 uniform highp float factor;
-
-int floor_small(highp float v) {
-    int i = int(v);
-    return i - (v < float(i) ? 1 : 0);
-}
-void weights(highp float t, out highp vec4 w) {
-    PRECISE highp float t2 = t * t, t3 = t2 * t;
-    PRECISE highp float w0 = 0.5 * (-t3 + 2.0 * t2 - t);
-    PRECISE highp float w1 = 0.5 * (3.0 * t3 - 5.0 * t2 + 2.0);
-    PRECISE highp float w2 = 0.5 * (-3.0 * t3 + 4.0 * t2 + t);
-    PRECISE highp float w3 = 0.5 * (t3 - t2);
-    w = vec4(w0, w1, w2, w3);
-}
-highp vec4 bicubic(highp vec2 p) {
-    PRECISE highp float sx = p.x - 0.5, sy = p.y - 0.5;
-    int ix = floor_small(sx), iy = floor_small(sy);
-    PRECISE highp float tx = sx - float(ix), ty = sy - float(iy);
-    highp vec4 wx, wy;
-    weights(tx, wx);
-    weights(ty, wy);
-    PRECISE highp vec4 sum = vec4(0.0);
-    for (int j = 0; j < 4; ++j) {
-        int y = clamp(iy - 1 + j, 0, source_size.y - 1);
-        PRECISE highp vec4 line = vec4(0.0);
-        for (int i = 0; i < 4; ++i)
-            line = line + wx[i] * texelFetch(source_color, ivec2(clamp(ix - 1 + i, 0, source_size.x - 1), y), 0);
-        sum = sum + wy[j] * line;
-    }
-    return sum;
-}
+)";
+constexpr const char* kRefetchMain = R"(
 void main() {
     ivec2 t = ivec2(gl_GlobalInvocationID.xy);
     if (t.x >= target_size.x || t.y >= target_size.y) return;
@@ -274,8 +246,8 @@ Status refetch_pass(ContextState& s, const SplatTextures& source, float factor, 
 }
 
 Status create_splat_programs(ContextState& s) {
-    REPRISE_TRY(gl::link_compute((std::string(kComputeHeader) + kRefetch).c_str(), "refetch",
-                                 s.refetch_program));
+    REPRISE_TRY(gl::link_compute((kComputeHeader + kRefetch + kBicubicFetch + kRefetchMain).c_str(),
+                                 "refetch", s.refetch_program));
     const std::string landing = std::string(kComputeHeader) + kLanding;
     REPRISE_TRY(
         gl::link_compute((landing + kScatter).c_str(), "splat scatter", s.splat_scatter_program));

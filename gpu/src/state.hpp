@@ -3,6 +3,7 @@
 #include <chrono>
 #include <initializer_list>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include <glm/vec4.hpp>
@@ -28,10 +29,10 @@ struct Texture {
 // An error naming `what` unless texture `name` is a 2D texture of `format` and w x h.
 Status check_texture(unsigned name, GLenum format, int w, int h, const char* what);
 
-// The first lines of every compute shader: GLSL ES 3.10, 8x8 work groups, and PRECISE
+// The first lines of every shader here (compute and the grid's draw): GLSL ES 3.10 and PRECISE
 // (GL_EXT_gpu_shader5's or GL_OES_gpu_shader5's `precise` where offered) on what must not be
 // fused into multiply-adds, so that the GPU repeats the CPU reference's arithmetic.
-inline constexpr const char* kComputeHeader = R"(#version 310 es
+inline constexpr const char* kShaderPrelude = R"(#version 310 es
 #if defined(GL_EXT_gpu_shader5)
 #extension GL_EXT_gpu_shader5 : enable
 #define PRECISE precise
@@ -41,6 +42,9 @@ inline constexpr const char* kComputeHeader = R"(#version 310 es
 #else
 #define PRECISE
 #endif
+)";
+// Then, in compute shaders, 8x8 work groups and the helpers below.
+inline const std::string kComputeHeader = std::string(kShaderPrelude) + R"(
 layout(local_size_x = 8, local_size_y = 8) in;
 // Tested by bits: a shader compiler may assume that no float is NaN or infinite.
 bool finite(highp float v) { return (floatBitsToUint(v) & 0x7f800000u) != 0x7f800000u; }
@@ -65,10 +69,44 @@ shared uint group_flags[64];
     }
 )";
 
-// A pixel's view-space point through its depth and where a camera sees it, in warp/'s arithmetic
-// (reproject_setup's Unprojector for an axis-aligned projection P, transform_row's sums): the
-// stereo eye's displacement and extrapolation's static-layer test. Background (+inf) is the
-// direction (background_zv, background_w).
+// Warp's bicubic_fetch (Catmull-Rom, taps clamped to the border) of `source_color` (a sampler the
+// shader declares, `source_size` its size) at position p in pixels.
+inline constexpr const char* kBicubicFetch = R"(
+int floor_small(highp float v) {
+    int i = int(v);
+    return i - (v < float(i) ? 1 : 0);
+}
+void weights(highp float t, out highp vec4 w) {
+    PRECISE highp float t2 = t * t, t3 = t2 * t;
+    PRECISE highp float w0 = 0.5 * (-t3 + 2.0 * t2 - t);
+    PRECISE highp float w1 = 0.5 * (3.0 * t3 - 5.0 * t2 + 2.0);
+    PRECISE highp float w2 = 0.5 * (-3.0 * t3 + 4.0 * t2 + t);
+    PRECISE highp float w3 = 0.5 * (t3 - t2);
+    w = vec4(w0, w1, w2, w3);
+}
+highp vec4 bicubic(highp vec2 p) {
+    PRECISE highp float sx = p.x - 0.5, sy = p.y - 0.5;
+    int ix = floor_small(sx), iy = floor_small(sy);
+    PRECISE highp float tx = sx - float(ix), ty = sy - float(iy);
+    highp vec4 wx, wy;
+    weights(tx, wx);
+    weights(ty, wy);
+    PRECISE highp vec4 sum = vec4(0.0);
+    for (int j = 0; j < 4; ++j) {
+        int y = clamp(iy - 1 + j, 0, source_size.y - 1);
+        PRECISE highp vec4 line = vec4(0.0);
+        for (int i = 0; i < 4; ++i)
+            line = line + wx[i] * texelFetch(source_color, ivec2(clamp(ix - 1 + i, 0, source_size.x - 1), y), 0);
+        sum = sum + wy[j] * line;
+    }
+    return sum;
+}
+)";
+
+// A pixel's view-space point through its depth and where a camera sees it, in warp/'s
+// arithmetic (reproject_setup's Unprojector for an axis-aligned projection P, transform_row's
+// sums): the stereo eye's displacement and extrapolation's static-layer test. Background (+inf)
+// is the direction (background_zv, background_w).
 inline constexpr const char* kViewPoint = R"(
 uniform highp mat4 P;
 uniform highp float background_zv, background_w;
