@@ -187,8 +187,8 @@ TEST(CliStereo, TheGpuBackendMakesTheCpusEyes) {
     fs::remove_all(dir);
 }
 
-// `reprise fruc --backend gles`: the CPU's splat frames, motion included, and the
-// options the GPU lacks named before anything is written.
+// `reprise fruc --backend gles`: the CPU's frames (splat, grid, refinement), motion included,
+// and the options the GPU lacks named before anything is written.
 TEST(CliStereo, FrucOnTheGpuBackendMakesTheCpusSplatFrames) {
     const fs::path dir =
         fs::temp_directory_path() / ("reprise_cli_fruc_gles_" + std::to_string(::getpid()));
@@ -214,18 +214,17 @@ TEST(CliStereo, FrucOnTheGpuBackendMakesTheCpusSplatFrames) {
     ASSERT_TRUE(read_frame(frame_path(cpu, 1), cpu_made).ok());
     ASSERT_FALSE(made.motion.empty());  // per output period, as the CPU's
     EXPECT_EQ(made.motion(80, 45), cpu_made.motion(80, 45));
-    // The default warp, the grid (refinement off): both sides' cells grown and drawn on the GPU.
+    // The defaults (the grid, true motion, refinement): both sides' cells grown and drawn on the
+    // GPU, refinement's survey and choices there, its flow on the CPU.
     const std::string cpu_grid_between = (dir / "cpu_grid_between").string(),
                       gles_grid_between = (dir / "gles_grid_between").string();
-    ASSERT_EQ(
-        run_command(cli::command_fruc, {"--in", in, "--refine", "off", "--out", cpu_grid_between}),
-        0);
-    ASSERT_EQ(run_command(cli::command_fruc, {"--in", in, "--refine", "off", "--backend", "gles",
-                                              "--out", gles_grid_between}),
+    ASSERT_EQ(run_command(cli::command_fruc, {"--in", in, "--out", cpu_grid_between}), 0);
+    ASSERT_EQ(run_command(cli::command_fruc,
+                          {"--in", in, "--backend", "gles", "--out", gles_grid_between}),
               0);
     for (int i = 0; i < 5; ++i)
         EXPECT_GE(psnr_of(frame_path(cpu_grid_between, i), frame_path(gles_grid_between, i)), 50.0)
-            << "in-between by the grid, frame " << i;
+            << "the default in-between frame, frame " << i;
     // With true motion (the default) too.
     const std::string cpu_true = (dir / "cpu_true").string(),
                       gles_true = (dir / "gles_true").string();
@@ -273,8 +272,8 @@ TEST(CliStereo, FrucOnTheGpuBackendMakesTheCpusSplatFrames) {
             << "extrapolated by the grid, frame " << i;
     const std::string refused = (dir / "refused").string();
     EXPECT_EQ(run_command(cli::command_fruc,
-                          {"--in", in, "--backend", "gles", "--warp", "splat", "--out", refused}),
-              1);  // refinement on
+                          {"--in", in, "--backend", "gles", "--fill", "andreev", "--out", refused}),
+              1);  // Andreev's fill: the CPU's alone
     EXPECT_EQ(run_command(cli::command_fruc, with({"--backend", "vulkan", "--out", refused})), 1);
     EXPECT_EQ(
         run_command(cli::command_fruc, {"--in", in, "--true-motion", "maybe", "--out", refused}),

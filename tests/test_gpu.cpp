@@ -890,6 +890,54 @@ TEST(Gpu, GridInterpolationMatchesTheCpuOnEveryBuiltInScene) {
     EXPECT_GT(holes, 0u);  // not vacuous: some holes filled
 }
 
+// The default in-between frame (the grid, true motion, refinement): the survey, the crops, the
+// flow's evaluation and the choice on the GPU, the flow on the CPU from the GPU's crops.
+TEST(Gpu, RefinedInterpolationMatchesTheCpuOnEveryBuiltInScene) {
+    std::size_t refined = 0, skipped = 0;
+    for (const server::SceneInfo& info : server::builtin_scenes()) {
+        const std::vector<Frame>& frames = scene_frames(info.name);
+        // The defaults, and a survey that flags more (smaller tiles, a lower threshold).
+        for (const bool eager : {false, true}) {
+            SCOPED_TRACE(std::string(info.name) + (eager ? ", eager" : ""));
+            warp::FrucOptions options;
+            if (eager) options.refine = {.tile = 8, .threshold = 0.02f};
+            warp::FrucCounters counters;
+            const Frame cpu = cpu_between_with(frames[0], frames[1], options, &counters);
+            if (counters.copied_still) continue;  // a still pair whose pictures agree: copied
+            Frame gpu;
+            gpu::InterpolateStats stats;
+            const Status status =
+                shared_gpu().interpolate(frames[0], frames[1], 0.5f, gpu, stats,
+                                         {.grid = options.warp == warp::WarpMethod::Grid,
+                                          .grid_options = options.grid,
+                                          .true_motion = options.true_motion,
+                                          .static_tolerance = options.static_tolerance,
+                                          .motion_scale = 0.5f,
+                                          .refine = options.refine});
+            ASSERT_TRUE(status.ok()) << status.message();
+            EXPECT_EQ(std::size_t(stats.refine_skipped), counters.refine_skipped);
+            EXPECT_EQ(stats.refine_tiles, counters.refine_tiles);
+            EXPECT_EQ(stats.flow_pixels, counters.flow_pixels);
+            const std::size_t pixels = cpu.color.pixel_count();
+            const std::size_t apart = stats.refined_pixels > counters.refined_pixels
+                                          ? stats.refined_pixels - counters.refined_pixels
+                                          : counters.refined_pixels - stats.refined_pixels;
+            EXPECT_LE(apart, pixels / 1000);
+            const double db = test::display_psnr(cpu.color, gpu.color);
+            EXPECT_GE(db, 50.0);
+            refined += stats.refined_pixels;
+            skipped += stats.refine_skipped;
+            std::printf(
+                "%-10s refined%s: tiles %zu, flow over %zu px, refined CPU %zu GPU %zu, "
+                "%.1f dB\n",
+                info.name, eager ? " (eager)" : "", stats.refine_tiles, stats.flow_pixels,
+                counters.refined_pixels, stats.refined_pixels, db);
+        }
+    }
+    EXPECT_GT(refined, 0u);  // not vacuous: some pixels took the flow's colour
+    EXPECT_GT(skipped, 0u);  // ... and some frames needed no flow
+}
+
 TEST(Gpu, InterpolationMatchesTheCpuOnEveryBuiltInScene) {
     std::size_t holes = 0, true_motion = 0;
     for (const server::SceneInfo& info : server::builtin_scenes()) {
@@ -993,14 +1041,23 @@ TEST(Gpu, TheConverterWithTheGpuBackendMakesTheCpusFrames) {
     EXPECT_EQ(gpu_counters.fills + gpu_counters.fills_skipped,
               cpu_counters.fills + cpu_counters.fills_skipped);
 
-    // The defaults (the grid with refinement, Andreev's fill absent): refinement refused, named.
-    warp::FrucOptions defaults;
-    defaults.backend = &backend;
-    defaults.fill = warp::FillMethod::Andreev;
+    // The defaults (the grid with refinement): the CPU's frames, refinement counted alike.
+    warp::FrucOptions defaults, defaults_on_gpu;
+    defaults_on_gpu.backend = &backend;
+    const std::vector<Frame> cpu_defaults = convert(frames, 3, defaults, cpu_counters);
+    const std::vector<Frame> gpu_defaults = convert(frames, 3, defaults_on_gpu, gpu_counters);
+    ASSERT_EQ(gpu_defaults.size(), cpu_defaults.size());
+    for (std::size_t i = 0; i < cpu_defaults.size(); ++i)
+        EXPECT_GE(test::display_psnr(cpu_defaults[i].color, gpu_defaults[i].color), 50.0) << i;
+    EXPECT_EQ(gpu_counters.refined_frames + gpu_counters.refine_skipped,
+              cpu_counters.refined_frames + cpu_counters.refine_skipped);
+    EXPECT_EQ(gpu_counters.refined_frames, cpu_counters.refined_frames);
+    EXPECT_EQ(gpu_counters.refined_pixels, cpu_counters.refined_pixels);
+    // Andreev's fill: refused, named.
+    defaults_on_gpu.fill = warp::FillMethod::Andreev;
     warp::FrameRateConverter refused;
-    const Status status = warp::FrameRateConverter::create(2, defaults, refused);
-    EXPECT_NE(status.message().find("fill pullpush, refine off"), std::string::npos)
-        << status.message();
+    const Status status = warp::FrameRateConverter::create(2, defaults_on_gpu, refused);
+    EXPECT_NE(status.message().find("fill pullpush only"), std::string::npos) << status.message();
 }
 
 // A context serves one thread at a time: another thread gets an error, not a crash.
@@ -1048,6 +1105,31 @@ TEST(Gpu, InterpolationOnTexturesAndBadArguments) {
                   .message()
                   .find("s must lie in [0, 1]"),
               std::string::npos);
+}
+
+// Refinement on textures: the same survey, flow and choices as from CPU images (mirror's
+// reflection moves against its surface: 874 pixels take the flow's colour at 96x64).
+TEST(Gpu, RefinementOnTexturesIsTheImageEntrys) {
+    const std::vector<Frame>& frames = scene_frames("mirror");
+    gpu::Context& context = shared_gpu();
+    const gpu::InterpolateOptions options{.grid = true, .refine = {}};
+    Frame from_images;
+    gpu::InterpolateStats image_stats, texture_stats;
+    ASSERT_TRUE(
+        context.interpolate(frames[0], frames[1], 0.5f, from_images, image_stats, options).ok());
+    EXPECT_GT(image_stats.refined_pixels, 0u);
+    context.make_current();
+    Textures t;
+    const gpu::GBufferTextures a = t.gbuffer(frames[0]), b = t.gbuffer(frames[1]);
+    const GLuint a_color = t.color(frames[0]), b_color = t.color(frames[1]);
+    const GLuint out = t.rgba(), depth = t.r32f();
+    const Status status =
+        context.interpolate(a, a_color, b, b_color, 0.5f, out, depth, texture_stats, options);
+    ASSERT_TRUE(status.ok()) << status.message();
+    EXPECT_EQ(texture_stats.refine_tiles, image_stats.refine_tiles);
+    EXPECT_EQ(texture_stats.refined_pixels, image_stats.refined_pixels);
+    EXPECT_EQ(test::display_psnr(read_rgba(out), from_images.color), INFINITY);
+    EXPECT_GT(context.timings().cpu_ms, 0.0);  // the flow's, on the CPU
 }
 
 // True motion on textures: the linearity survey reads back the sampled pixels alone and decides

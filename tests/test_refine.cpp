@@ -10,6 +10,7 @@
 #include "reprise/server/builtin_scenes.hpp"
 #include "reprise/server/renderer.hpp"
 #include "reprise/warp/fruc.hpp"
+#include "reprise/warp/refine.hpp"
 #include "support/frames.hpp"
 #include "support/renderer.hpp"
 
@@ -172,4 +173,42 @@ TEST(Refine, FlowBudgetLeavesTilesOut) {
     for (int y = 0; y < kHeight; ++y)
         for (int x = 0; x < kWidth; ++x)
             ASSERT_EQ(none.frame.color(x, y), off.frame.color(x, y)) << x << "," << y;
+}
+
+// One box's flow is the same whatever the refiner estimated before (an OpenCV DIS object kept
+// across calls gave another flow for the same pictures after a smaller box's).
+TEST(Refine, FlowDoesNotDependOnEarlierFlows) {
+    struct Pictures {
+        Image<uint8_t> grey_a, grey_b;
+        Image<glm::vec2> seed;
+    };
+    // The w x h at (x0, y0), as a box's crop.
+    auto pictures = [](const std::vector<Frame>& f, int x0, int y0, int w, int h) {
+        Pictures p{Image<uint8_t>(w, h), Image<uint8_t>(w, h), Image<glm::vec2>(w, h)};
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                p.grey_a(x, y) = MotionRefiner::grey(f[0].color(x0 + x, y0 + y));
+                p.grey_b(x, y) = MotionRefiner::grey(f[1].color(x0 + x, y0 + y));
+                p.seed(x, y) = f[1].motion(x0 + x, y0 + y);
+            }
+        return p;
+    };
+    // Boxes the converter met on these scenes at 96x64: a smaller one, then a whole frame.
+    const Pictures pan = pictures(test::render_scene("pan", 2, 96, 64, 30.0, 3), 16, 8, 80, 56);
+    const Pictures fence = pictures(test::render_scene("fence", 2, 96, 64, 30.0, 3), 0, 0, 96, 64);
+    auto flow = [](MotionRefiner& refiner, const Pictures& p, Image<glm::vec2>& out) {
+        refiner.flow(p.grey_b.view(), p.grey_a.view(), p.seed.view(), out);
+    };
+    MotionRefiner fresh, used;
+    Image<glm::vec2> expected, other, got;
+    flow(fresh, fence, expected);
+    flow(used, pan, other);
+    flow(used, fence, got);
+    std::size_t moved = 0;
+    for (int y = 0; y < expected.height(); ++y)
+        for (int x = 0; x < expected.width(); ++x) {
+            ASSERT_EQ(got(x, y), expected(x, y)) << x << "," << y;
+            moved += glm::length(expected(x, y)) > 0.05f;
+        }
+    EXPECT_GT(moved, std::size_t(96 * 64 / 4));  // a flow that moves, not all zero
 }

@@ -1,8 +1,8 @@
 // reprise bench paths --backend gles: the stages the GPU backend has (reverse reprojection,
 // pull-push, the forward splat, the stereo eye by splat and by the grid, the in-between frame by
-// splat), each beside its CPU reference on the same frames in the same run; the GPU's upload,
-// compute and download apart, the texture entry point on textures already on the GPU, and how far
-// the GPU's result is from the CPU's.
+// splat, by the grid and the default one with refinement), each beside its CPU reference on the
+// same frames in the same run; the GPU's upload, compute and download apart, the texture entry
+// point on textures already on the GPU, and how far the GPU's result is from the CPU's.
 #include <cstdio>
 #include <memory>
 #include <string>
@@ -75,10 +75,15 @@ const warp::FrucOptions kExtrapolation{.mode = warp::FrucMode::Extrapolate,
 const warp::FrucOptions kGridExtrapolation{.mode = warp::FrucMode::Extrapolate,
                                            .widen_silhouettes = false};
 
+// The default in-between frame on the GPU: the grid, true motion, refinement.
+const gpu::InterpolateOptions kRefinedBetween{
+    .grid = true, .grid_options = warp::FrucOptions{}.grid, .true_motion = true, .refine = {}};
+
 // The stages on textures already on the GPU (the last pair of frames), `runs` times each:
 // compute alone, as an application that keeps its frames on the GPU pays it.
 struct TextureTimings {
-    Timing &reproject, &fill, &eye, &between, &ahead, &grid_eye, &grid_ahead, &grid_between;
+    Timing &reproject, &fill, &eye, &between, &ahead, &grid_eye, &grid_ahead, &grid_between,
+        &refined_between;
 };
 Status time_texture_path(gpu::Context& context, const Frame& current, const Frame& previous,
                          const Image<uint8_t>& hit_mask, int runs, const TextureTimings& timed) {
@@ -117,6 +122,11 @@ Status time_texture_path(gpu::Context& context, const Frame& current, const Fram
         REPRISE_TRY(context.interpolate(before, previous_color, now, color, 0.5f, filled, eye_depth,
                                         between_stats, {.grid = true}));
         if (i) timed.grid_between.ms.push_back(context.timings().compute_ms);
+        REPRISE_TRY(context.interpolate(before, previous_color, now, color, 0.5f, filled, eye_depth,
+                                        between_stats, kRefinedBetween));
+        if (i)
+            timed.refined_between.ms.push_back(context.timings().compute_ms +
+                                               context.timings().cpu_ms);
         gpu::ExtrapolateStats ahead_stats;
         REPRISE_TRY(context.extrapolate(before, previous_color, current.camera.view,
                                         current.camera.projection, 1.0f, filled, eye_depth, out,
@@ -146,11 +156,11 @@ Status bench_gles_stages(const std::vector<Frame>& frames, const std::string& si
     Image<glm::vec4> cpu_out(w, h), gpu_out(w, h), cpu_filled(w, h), gpu_filled(w, h);
     Image<uint8_t> cpu_hit(w, h), gpu_hit(w, h);
     warp::PullPush pull_push;
-    StageTimes stages[10] = {{"reproject RGBA"},       {"pull-push (depth)"},
-                             {"splat x-0.5"},          {"stereo-eye splat+pp"},
-                             {"interpolate splat+pp"}, {"extrapolate splat+pp"},
-                             {"upsample 1/4 Herzog"},  {"stereo-eye grid+pp"},
-                             {"extrapolate grid+pp"},  {"interpolate grid+pp"}};
+    StageTimes stages[11] = {
+        {"reproject RGBA"},      {"pull-push (depth)"},    {"splat x-0.5"},
+        {"stereo-eye splat+pp"}, {"interpolate splat+pp"}, {"extrapolate splat+pp"},
+        {"upsample 1/4 Herzog"}, {"stereo-eye grid+pp"},   {"extrapolate grid+pp"},
+        {"interpolate grid+pp"}, {"interpolate default"}};
     // Herzog upsampling of every other pixel of every other row (jitter -0.5 px: the low pixel
     // (u, v) is the full pixel (2u, 2v)), guided by the frame's full G-buffer, with history.
     warp::SpatioTemporalUpsampler cpu_upsampler;
@@ -166,11 +176,14 @@ Status bench_gles_stages(const std::vector<Frame>& frames, const std::string& si
                                             .widen_silhouettes = false,
                                             .true_motion = false,
                                             .refine = {.enabled = false}};
-    warp::FrameRateConverter converter, grid_converter;
+    warp::FrameRateConverter converter, grid_converter, default_converter;
     REPRISE_TRY(warp::FrameRateConverter::create(2, between_options, converter));
     const warp::FrucOptions grid_between_options{
         .widen_silhouettes = false, .true_motion = false, .refine = {.enabled = false}};
     REPRISE_TRY(warp::FrameRateConverter::create(2, grid_between_options, grid_converter));
+    // The default: the grid, true motion, refinement (its flow on the CPU on both backends).
+    REPRISE_TRY(
+        warp::FrameRateConverter::create(2, {.widen_silhouettes = false}, default_converter));
     Frame between_in, gpu_between;
     warp::SplatOptions splat_options;
     const stereo::StereoOptions eye_options{.warp = stereo::StereoWarp::Splat};
@@ -288,6 +301,7 @@ Status bench_gles_stages(const std::vector<Frame>& frames, const std::string& si
         REPRISE_TRY(between(stages[4], converter, {}));
         REPRISE_TRY(between(stages[9], grid_converter,
                             {.grid = true, .grid_options = grid_between_options.grid}));
+        REPRISE_TRY(between(stages[10], default_converter, kRefinedBetween));
 
         const Camera& to = current.camera;
         Timing& cpu_ahead_time = timing ? stages[5].cpu : scratch;
@@ -337,14 +351,16 @@ Status bench_gles_stages(const std::vector<Frame>& frames, const std::string& si
         if (timing) record(stages[6], gpu_upsampler->timings(), up_total.ms[0]);
         stages[6].worst_db = std::min(stages[6].worst_db, display_psnr(cpu_up, gpu_up));
     }
-    REPRISE_TRY(time_texture_path(
-        *context, frames.back(), frames[frames.size() - 2], cpu_hit, int(frames.size()) - 2,
-        {stages[0].textures, stages[1].textures, stages[3].textures, stages[4].textures,
-         stages[5].textures, stages[7].textures, stages[8].textures, stages[9].textures}));
+    REPRISE_TRY(time_texture_path(*context, frames.back(), frames[frames.size() - 2], cpu_hit,
+                                  int(frames.size()) - 2,
+                                  {stages[0].textures, stages[1].textures, stages[3].textures,
+                                   stages[4].textures, stages[5].textures, stages[7].textures,
+                                   stages[8].textures, stages[9].textures, stages[10].textures}));
     std::printf(
         "gles: %s; GPU columns are medians; gles cpu: the work left on the CPU (widened "
-        "silhouettes, the grid's displacement and cells); textures: the texture entry point on "
-        "textures already on the GPU (compute alone)\n",
+        "silhouettes, the grid's displacement and cells, refinement's optical flow); textures: the "
+        "texture entry point on textures already on the GPU (compute alone; with the flow for "
+        "the default in-between frame)\n",
         context->description().c_str());
     std::printf("%-10s %-20s %9s %9s %9s %9s %9s %9s %9s %9s %9s %8s\n", "size", "stage",
                 "cpu best", "cpu med", "gles cpu", "upload", "compute", "download", "gles med",

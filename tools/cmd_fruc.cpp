@@ -258,8 +258,8 @@ int command_fruc(int argc, char** argv) {
                 "the colour\nanti-aliasing blended into them travels with the silhouette");
     args.option("--backend", &job.backend,
                 "cpu | gles (default cpu); gles: the made frames on OpenGL ES (--warp grid, splat "
-                "or reverse);\ninterpolated with --fill pullpush --refine off, extrapolated with "
-                "--fill pullpush or none");
+                "or reverse);\ninterpolated with --fill pullpush (refinement's optical flow on "
+                "the CPU), extrapolated\nwith --fill pullpush or none");
     args.option("--warp", &job.warp,
                 "reverse | splat | grid | auto (default grid; grid-bicubic, grid-bilinear pick "
                 "its colour\nfetch; auto: chosen per frame)");

@@ -17,6 +17,7 @@ Status create_splat_programs(ContextState& state);
 Status create_stereo_programs(ContextState& state);
 Status create_interpolate_programs(ContextState& state);
 Status create_extrapolate_programs(ContextState& state);
+Status create_refine_programs(ContextState& state);
 Status create_shot_change_program(ContextState& state);
 
 double ms_since(std::chrono::steady_clock::time_point& since) {
@@ -286,6 +287,9 @@ Context::~Context() {
                        &state_->shot_hit})
         glDeleteTextures(1, &t->name);
     for (Texture* t : state_->interpolation.all) glDeleteTextures(1, &t->name);
+    for (Texture* t : state_->refinement.all) glDeleteTextures(1, &t->name);
+    for (GLuint program : state_->refine_programs) glDeleteProgram(program);
+    glDeleteBuffers(1, &state_->refinement.won);
     for (auto* chain :
          {&state_->pulled, &state_->pulled_depth, &state_->filled, &state_->filled_depth})
         for (Texture& t : *chain) glDeleteTextures(1, &t.name);
@@ -351,6 +355,7 @@ Status Context::create_on(std::unique_ptr<gl::Context> gl, std::unique_ptr<Conte
     REPRISE_TRY(create_stereo_programs(s));
     REPRISE_TRY(create_interpolate_programs(s));
     REPRISE_TRY(create_extrapolate_programs(s));
+    REPRISE_TRY(create_refine_programs(s));
     s.counts_buffer = s.make_counters(8 * sizeof(GLuint));
     glGenBuffers(1, &s.readback_buffer);
     glBindBuffer(GL_COPY_WRITE_BUFFER, s.readback_buffer);

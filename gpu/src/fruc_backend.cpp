@@ -17,7 +17,6 @@ Status FrucBackend::check(const warp::FrucOptions& o, const warp::SplatOptions& 
          "warp grid, splat or reverse");
     if (!extrapolate) {
         need(o.fill == warp::FillMethod::PullPush, "fill pullpush");
-        need(!o.refine.enabled, "refine off");
     } else {
         need(o.fill == warp::FillMethod::PullPush || o.fill == warp::FillMethod::None,
              "fill pullpush or none");
@@ -42,9 +41,17 @@ Status FrucBackend::interpolate(const GBufferView& a, const GBufferView& b, floa
                                       .grid_options = options.grid,
                                       .true_motion = options.true_motion,
                                       .static_tolerance = options.static_tolerance,
-                                      .motion_scale = motion_scale},
+                                      .motion_scale = motion_scale,
+                                      .refine = options.refine},
                                      a_key, b_key));
     uploads_kept_ += stats.uploads_kept;
+    if (options.refine.enabled) {
+        ++(stats.refine_skipped ? counters.refine_skipped : counters.refined_frames);
+        counters.refine_tiles += stats.refine_tiles;
+        counters.refine_tiles_left_out += stats.refine_tiles_left_out;
+        counters.flow_pixels += stats.flow_pixels;
+        counters.refined_pixels += stats.refined_pixels;
+    }
     counters.true_motion += stats.true_motion;
     counters.linear_motion += stats.linear_motion;
     count(stats.holes, stats.holes > 0, counters);

@@ -1,7 +1,7 @@
 // The in-between frame on the GPU: warp's interpolate_frame for the splat, the reverse warp or the
-// grid without refinement (FrucOptions{.warp = Splat, Reverse or Grid, .refine = off}): b warped
-// by 1 - s, a by -s (along their true motion when asked), the two blended where both see one
-// surface, pull-push over what neither covers.
+// grid (FrucOptions{.warp = Splat, Reverse or Grid}): b warped by 1 - s, a by -s (along their
+// true motion when asked), refinement's choices found (refine.cpp), the two blended where both
+// see one surface, pull-push over what neither covers, the refined colours written over.
 #include <chrono>
 #include <string>
 #include <utility>
@@ -279,7 +279,8 @@ void true_motion_passes(ContextState& s, const SplatTextures& a, const SplatText
 Status interpolate_passes(ContextState& s, const SplatTextures& given_a,
                           const SplatTextures& given_b, float s_between, int w, int h,
                           const InterpolateOptions& options, GLuint out_color, GLuint out_depth,
-                          GLuint out_motion, InterpolateStats& stats, const TrueMotion& plan) {
+                          GLuint out_motion, InterpolateStats& stats, const TrueMotion& plan,
+                          double& cpu_ms) {
     Interpolation& k = s.interpolation;
     SplatTextures a = given_a, b = given_b;
     if (plan.follow) {
@@ -342,6 +343,11 @@ Status interpolate_passes(ContextState& s, const SplatTextures& given_a,
                                  h, k.side_a_color.name));
     }
 
+    bool refined = false;
+    if (options.refine.enabled)
+        REPRISE_TRY(refine_passes(s, given_a, given_b, s_between, w, h, options.refine, stats,
+                                  cpu_ms, refined));
+
     glUseProgram(s.blend_program);
     s.bind_inputs({k.side_a_color.name, k.side_a_depth.name, k.side_a_covered.name,
                    k.side_b_color.name, k.side_b_depth.name, k.side_b_covered.name,
@@ -368,6 +374,7 @@ Status interpolate_passes(ContextState& s, const SplatTextures& given_a,
             fill_passes(s, k.blended.name, k.valid.name, out_depth, w, h, out_color, stats.fill));
     else
         copy_scaled(s, k.blended.name, out_color, w, h, 1.0f);
+    if (refined) refine_apply(s, w, h, options.refine, out_color);
     return gl::check_errors("gpu interpolate");
 }
 
@@ -481,8 +488,8 @@ Status Context::interpolate(const GBufferView& given_a, const GBufferView& given
     REPRISE_TRY(interpolate_passes(s, {k.a_color.name, k.a_depth.name, k.a_motion.name, w, h},
                                    {k.b_color.name, k.b_depth.name, k.b_motion.name, w, h},
                                    s_between, w, h, options, s.color.name, s.depth.name,
-                                   k.made_motion.name, stats, plan));
-    timings_.compute_ms = finish_ms(t);
+                                   k.made_motion.name, stats, plan, timings_.cpu_ms));
+    timings_.compute_ms = finish_ms(t) - timings_.cpu_ms;
     s.download_made(out);
     out.motion.resize(w, h);
     s.download_channels(k.made_motion, &out.motion.data()->x, 2, w);
@@ -530,8 +537,8 @@ Status Context::interpolate(const GBufferTextures& a, unsigned a_color, const GB
             },
             plan, stats));
     REPRISE_TRY(interpolate_passes(s, sides[0], sides[1], s_between, w, h, options, out_color,
-                                   out_depth, out_motion, stats, plan));
-    timings_.compute_ms = finish_ms(t);
+                                   out_depth, out_motion, stats, plan, timings_.cpu_ms));
+    timings_.compute_ms = finish_ms(t) - timings_.cpu_ms;
     return {};
 }
 

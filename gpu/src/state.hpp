@@ -14,6 +14,7 @@
 #include "reprise/gl/program.hpp"
 #include "reprise/gpu/context.hpp"
 #include "reprise/warp/grid_warp.hpp"
+#include "reprise/warp/refine.hpp"
 
 namespace reprise::gpu {
 
@@ -212,7 +213,7 @@ struct TrueMotion {
 Status interpolate_passes(ContextState& s, const SplatTextures& a, const SplatTextures& b,
                           float s_between, int w, int h, const InterpolateOptions& options,
                           GLuint out_color, GLuint out_depth, GLuint out_motion,
-                          InterpolateStats& stats, const TrueMotion& plan);
+                          InterpolateStats& stats, const TrueMotion& plan, double& cpu_ms);
 // `out_motion` (GL_RGBA32F, motion in RG; 0: none) gets the motion each winner carried.
 Status splat_passes(ContextState& s, const SplatTextures& in, float factor,
                     const warp::SplatOptions& options, int tw, int th, GLuint out_color,
@@ -298,6 +299,30 @@ struct Interpolation {
                         &survey};
 };
 
+// Motion refinement: the tiles' counts and boxes (warp::MotionRefiner plans them and runs the
+// flow), each box's crop, flow, errors and flow colour, and the chosen colours over the frame.
+struct Refinement {
+    warp::MotionRefiner refiner;
+    Texture counts, labels, crop, flow, errors, flow_color, refined, mask;
+    Texture* all[8] = {&counts, &labels, &crop, &flow, &errors, &flow_color, &refined, &mask};
+    GLuint won = 0;  // the winners' counter
+    std::vector<int> surveyed, disagreeing;
+    std::vector<uint32_t> label_codes;  // per tile: its box + 1, 0 where none
+    Image<glm::vec4> crop_pixels;
+    Image<uint8_t> grey_a, grey_b;
+    Image<glm::vec2> seed, flow_field;
+};
+
+// After the in-between frame's sides are warped (Interpolation's side textures) and before
+// the blend: where they disagree, the flow's colour per pixel found (into Refinement::refined);
+// `refined` says whether any pixel took it. The flow's CPU time goes to `cpu_ms`.
+Status refine_passes(ContextState& s, const SplatTextures& a, const SplatTextures& b,
+                     float s_between, int w, int h, const warp::RefineOptions& options,
+                     InterpolateStats& stats, double& cpu_ms, bool& refined);
+// ... written over the made frame's colour.
+void refine_apply(ContextState& s, int w, int h, const warp::RefineOptions& options,
+                  GLuint out_color);
+
 struct ContextState {
     std::unique_ptr<gl::Context> gl;
     GLuint reproject_program = 0;
@@ -336,6 +361,8 @@ struct ContextState {
     Texture display_table, shot_reprojected, shot_hit;
     std::size_t invert_bytes = 0;
     Interpolation interpolation;
+    GLuint refine_programs[5] = {0, 0, 0, 0, 0};  // survey, crop, evaluate, decide, apply
+    Refinement refinement;
     GridRaster grid;
     Texture displacement, target_depth, eye_color;
     // The eye's history: its displacement and depth, warped colour, depth and coverage, the merge.

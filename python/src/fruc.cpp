@@ -117,8 +117,9 @@ void bind_fruc(py::module_& m) {
         "rendered motion is not what is seen (moving shadows, reflections). "
         "true_motion: each side goes where it truly is at the in-between "
         "instant (off: linearly). backend 'gles': the made frames on the "
-        "GPU (OpenGL ES), with warp 'grid', 'splat' or 'reverse', fill 'pullpush' (extrapolation "
-        "also 'none') and refine off, as the CPU's; it is used from the thread that made it "
+        "GPU (OpenGL ES), with warp 'grid', 'splat' or 'reverse' and fill 'pullpush' "
+        "(extrapolation also 'none'), as the CPU's (refinement's optical flow runs on the CPU); "
+        "it is used from the thread that made it "
         "(another thread gets an error). widen_silhouettes: pixels beside a nearer "
         "surface warp with it, so the anti-aliasing blended into them travels with the "
         "silhouette.")

@@ -5,39 +5,10 @@
 
 #include "reprise/core/gbuffer.hpp"
 #include "reprise/warp/fruc.hpp"
+#include "reprise/warp/refine.hpp"
 #include "reprise/warp/shot_change.hpp"
 
 namespace reprise::warp {
-
-// One side of an in-between frame as warped: colour, depth and which pixels it covers.
-struct WarpedSide {
-    ImageView<const glm::vec4> color;
-    ImageView<const float> depth;
-    ImageView<const uint8_t> covered;
-};
-
-// Motion refinement (refine.cpp, RefineOptions): found before the blend, applied after it.
-class MotionRefiner {
-public:
-    MotionRefiner();
-    ~MotionRefiner();
-    // Surveys where the warped sides disagree at instant s between a and b and, where they do,
-    // estimates flow there and keeps the better colour per pixel. False: nothing to apply.
-    bool prepare(const GBufferView& a, const GBufferView& b, float s, const WarpedSide& side_a,
-                 const WarpedSide& side_b, const RefineOptions& options, FrucCounters& counters);
-    // Writes the kept colours over the blended frame.
-    void apply(ImageView<glm::vec4> color) const;
-    // Whether the colours of a and b themselves (a still pair) disagree anywhere as prepare()
-    // would find.
-    bool pictures_differ(const GBufferView& a, const GBufferView& b, const RefineOptions& options);
-    // 1 on the pixels of the tiles the last survey found disagreeing, 0 elsewhere.
-    void region(Image<uint8_t>& mask, int width, int height) const;
-    void forget_region();
-
-private:
-    struct State;
-    std::unique_ptr<State> state_;
-};
 
 // A warp's output images, sized once per frame size.
 struct WarpBuffers {

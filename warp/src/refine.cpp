@@ -9,8 +9,8 @@
 #include <opencv2/video/tracking.hpp>
 #include <utility>
 
-#include "fruc_stages.hpp"
 #include "reprise/core/parallel.hpp"
+#include "reprise/warp/refine.hpp"
 #include "reprise/warp/sample.hpp"
 
 namespace reprise::warp {
@@ -46,16 +46,7 @@ bool same_surface(float za, float zb) {
     return std::abs(za - zb) <= 0.02f * std::min(za, zb);
 }
 
-uint8_t grey(glm::vec4 c) {
-    const float luma = display(0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b);
-    return uint8_t(luma * 255.0f + 0.5f);
-}
-
-struct Box {
-    int x0, y0, x1, y1;  // pixels [x0, x1) x [y0, y1)
-    int area() const { return (x1 - x0) * (y1 - y0); }
-    bool overlaps(const Box& o) const { return x0 < o.x1 && o.x0 < x1 && y0 < o.y1 && o.y0 < y1; }
-};
+using Box = RefineBox;
 
 // Both candidates' colour and error at one output pixel, or +inf error where a side falls
 // outside its frame.
@@ -79,7 +70,6 @@ Candidate along(const GBufferView& a, const GBufferView& b, glm::vec2 q, glm::ve
 }  // namespace
 
 struct MotionRefiner::State {
-    cv::Ptr<cv::DISOpticalFlow> flow = cv::DISOpticalFlow::create(cv::DISOpticalFlow::PRESET_FAST);
     int tile = 16, tiles_x = 0, tiles_y = 0;
     std::vector<uint8_t> flagged;            // tiles whose sides disagree
     std::vector<int> surveyed, disagreeing;  // per tile: pixels surveyed, those that disagree
@@ -100,27 +90,36 @@ struct MotionRefiner::State {
     std::vector<float> error_rendered, error_flow;
     std::vector<glm::vec4> color_flow;
 
-    void size_tiles(int w, int h, int t) {
-        tile = std::max(t, 4);
-        tiles_x = (w + tile - 1) / tile;
-        tiles_y = (h + tile - 1) / tile;
-        flagged.assign(std::size_t(tiles_x) * tiles_y, 0);
+    void size_tiles(int w, int h, const RefineOptions& options) {
+        const RefineTiles t = RefineTiles::of(w, h, options);
+        tile = t.size, tiles_x = t.x, tiles_y = t.y;
+        flagged.assign(t.count(), 0);
     }
 
-    // Flags the tiles where the sides show one surface in different colours; returns how many.
+    // Flags the tiles whose counts say the sides show one surface in different colours; returns
+    // how many.
+    std::size_t flag(const RefineOptions& options) {
+        std::size_t total = 0;
+        for (std::size_t t = 0; t < flagged.size(); ++t) {
+            flagged[t] = disagreeing[t] >= kMinDisagreeing &&
+                         float(disagreeing[t]) >= options.tile_share * float(surveyed[t]);
+            total += flagged[t];
+        }
+        return total;
+    }
+
+    // Counts each tile's surveyed and disagreeing pixels (MotionRefiner::plan), then flags.
     std::size_t survey(ImageView<const glm::vec4> ca, ImageView<const float> za,
                        ImageView<const uint8_t> covered_a, ImageView<const glm::vec4> cb,
                        ImageView<const float> zb, ImageView<const uint8_t> covered_b,
                        const RefineOptions& options) {
         const int w = ca.width, h = ca.height;
-        size_tiles(w, h, options.tile);
-        std::atomic<std::size_t> total{0};
+        size_tiles(w, h, options);
         surveyed.assign(flagged.size(), 0);
         disagreeing.assign(flagged.size(), 0);
         parallel_for(
             0, tiles_y,
             [&](int t0, int t1) {
-                std::size_t local = 0;
                 for (int ty = t0; ty < t1; ++ty) {
                     int* surveyed_row = surveyed.data() + std::size_t(ty) * tiles_x;
                     int* disagreeing_row = disagreeing.data() + std::size_t(ty) * tiles_x;
@@ -135,18 +134,10 @@ struct MotionRefiner::State {
                             disagreeing_row[tx] +=
                                 largest_difference(ca(x, y), cb(x, y)) > options.threshold;
                         }
-                    for (int tx = 0; tx < tiles_x; ++tx) {
-                        const bool disagree = disagreeing_row[tx] >= kMinDisagreeing &&
-                                              float(disagreeing_row[tx]) >=
-                                                  options.tile_share * float(surveyed_row[tx]);
-                        flagged[std::size_t(ty) * tiles_x + tx] = disagree;
-                        local += disagree;
-                    }
                 }
-                total += local;
             },
             1);
-        return total;
+        return flag(options);
     }
 
     // Flagged tiles (and their neighbours), in boxes (connected groups, with margin, merged
@@ -243,12 +234,33 @@ struct MotionRefiner::State {
         return left_out;
     }
 
+    // From the flagged tiles: the boxes and the tiles they decide; false where none is flagged.
+    bool plan(int w, int h, std::size_t flagged_tiles, const RefineOptions& options,
+              FrucCounters& counters) {
+        decided.clear();
+        if (flagged_tiles == 0) {
+            boxes.clear();
+            label.assign(flagged.size(), -1);
+            ++counters.refine_skipped;
+            return false;
+        }
+        ++counters.refined_frames;
+        counters.refine_tiles += flagged_tiles;
+        make_boxes(w, h, std::max(options.margin, 0), options.neighbours);
+        const double share = std::clamp(double(options.max_flow_share), 0.0, 1.0);
+        counters.refine_tiles_left_out += keep_within(std::size_t(share * double(w) * h));
+        for (int t = 0; t < tiles_x * tiles_y; ++t)
+            if (label[t] >= 0) decided.push_back(t);
+        for (const Box& box : boxes) counters.flow_pixels += std::size_t(box.area());
+        return true;
+    }
+
     void grey_crop(const GBufferView& f, const Box& box, cv::Mat& out) {
         out.create(box.y1 - box.y0, box.x1 - box.x0, CV_8U);
         for (int y = box.y0; y < box.y1; ++y) {
             uint8_t* row = out.ptr<uint8_t>(y - box.y0);
             const glm::vec4* c = f.color.row(y);
-            for (int x = box.x0; x < box.x1; ++x) row[x - box.x0] = grey(c[x]);
+            for (int x = box.x0; x < box.x1; ++x) row[x - box.x0] = MotionRefiner::grey(c[x]);
         }
     }
 
@@ -265,7 +277,10 @@ struct MotionRefiner::State {
                 row[x - box.x0] = cv::Vec2f(m.x, m.y);
             }
         }
-        flow->calc(from, to, flow_out);
+        // A new DIS each time: one kept across calls gave flows that depend on the calls before
+        // (OpenCV 4.6: a 96x64 box after an 80x56 one), so a frame's refinement depended on the
+        // frames refined before it.
+        cv::DISOpticalFlow::create(cv::DISOpticalFlow::PRESET_FAST)->calc(from, to, flow_out);
     }
 
     // Errors of the rendered motion and the flow, and the flow's colour, over a box.
@@ -352,21 +367,9 @@ bool MotionRefiner::prepare(const GBufferView& a, const GBufferView& b, float s,
         if (!apply) st.decided.clear();
         return apply;
     };
-    const int w = b.width(), h = b.height();
     const std::size_t flagged = st.survey(side_a.color, side_a.depth, side_a.covered, side_b.color,
                                           side_b.depth, side_b.covered, options);
-    if (flagged == 0) {
-        ++counters.refine_skipped;
-        return finish(false);
-    }
-    ++counters.refined_frames;
-    counters.refine_tiles += flagged;
-    st.make_boxes(w, h, std::max(options.margin, 0), options.neighbours);
-    const double share = std::clamp(double(options.max_flow_share), 0.0, 1.0);
-    counters.refine_tiles_left_out += st.keep_within(std::size_t(share * double(w) * h));
-    st.decided.clear();
-    for (int t = 0; t < st.tiles_x * st.tiles_y; ++t)
-        if (st.label[t] >= 0) st.decided.push_back(t);
+    if (!st.plan(b.width(), b.height(), flagged, options, counters)) return finish(false);
     const std::size_t tile_area = std::size_t(st.tile) * st.tile;
     st.chosen.resize(st.decided.size() * tile_area);
     st.chosen_color.resize(st.decided.size() * tile_area);
@@ -374,7 +377,6 @@ bool MotionRefiner::prepare(const GBufferView& a, const GBufferView& b, float s,
     for (std::size_t i = 0; i < st.boxes.size(); ++i) {
         const Box& box = st.boxes[i];
         if (box.area() == 0) continue;
-        counters.flow_pixels += std::size_t(box.area());
         st.grey_crop(a, box, st.grey_a);
         st.grey_crop(b, box, st.grey_b);
         // b(p) ~ a(p + flow): b's backward motion, followed from the in-between instant.
@@ -419,6 +421,49 @@ void MotionRefiner::region(Image<uint8_t>& mask, int width, int height) const {
             if (tx < st.tiles_x && ty < st.tiles_y)
                 mask(x, y) = st.flagged[std::size_t(ty) * st.tiles_x + tx];
         }
+}
+
+RefineTiles RefineTiles::of(int width, int height, const RefineOptions& options) {
+    const int size = std::max(options.tile, 4);
+    return {size, (std::max(width, 0) + size - 1) / size, (std::max(height, 0) + size - 1) / size};
+}
+
+uint8_t MotionRefiner::grey(glm::vec4 c) {
+    const float luma = display(0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b);
+    return uint8_t(luma * 255.0f + 0.5f);
+}
+
+const std::vector<RefineBox>& MotionRefiner::plan(int width, int height,
+                                                  std::span<const int> surveyed,
+                                                  std::span<const int> disagreeing,
+                                                  const RefineOptions& options,
+                                                  FrucCounters& counters) {
+    State& st = *state_;
+    st.size_tiles(width, height, options);
+    REPRISE_ASSERT(surveyed.size() == st.flagged.size() && disagreeing.size() == st.flagged.size());
+    st.surveyed.assign(surveyed.begin(), surveyed.end());
+    st.disagreeing.assign(disagreeing.begin(), disagreeing.end());
+    st.plan(width, height, st.flag(options), options, counters);
+    return st.boxes;
+}
+
+std::span<const int> MotionRefiner::tile_boxes() const { return state_->label; }
+
+void MotionRefiner::flow(ImageView<const uint8_t> grey_b, ImageView<const uint8_t> grey_a,
+                         ImageView<const glm::vec2> seed, Image<glm::vec2>& flow) {
+    State& st = *state_;
+    const int w = grey_b.width, h = grey_b.height;
+    REPRISE_ASSERT(grey_a.width == w && grey_a.height == h && seed.width == w && seed.height == h);
+    const auto wrap = [](ImageView<const uint8_t> v) {
+        return cv::Mat(v.height, v.width, CV_8U, const_cast<uint8_t*>(v.data),
+                       std::size_t(v.stride));
+    };
+    st.estimate(wrap(grey_b), wrap(grey_a), seed, 1.0f, Box{0, 0, w, h}, st.flow_field);
+    flow.resize(w, h);
+    for (int y = 0; y < h; ++y) {
+        const cv::Vec2f* row = st.flow_field.ptr<cv::Vec2f>(y);
+        for (int x = 0; x < w; ++x) flow(x, y) = glm::vec2(row[x][0], row[x][1]);
+    }
 }
 
 void MotionRefiner::forget_region() {

@@ -63,6 +63,10 @@ struct InterpolateStats {
     warp::FillStats fill;
     NonfiniteCounts nonfinite;
     int uploads_kept = 0;  // inputs whose key matched: an earlier call's upload reused (0-2)
+    // Motion refinement (InterpolateOptions::refine): FrucCounters' fields of the same names for
+    // this frame; refine_skipped where nothing disagreed.
+    bool refine_skipped = false;
+    std::size_t refine_tiles = 0, refine_tiles_left_out = 0, flow_pixels = 0, refined_pixels = 0;
 };
 
 // What an extrapolated frame took: pixels its camera does not explain (carried along their own
@@ -87,6 +91,10 @@ struct InterpolateOptions {
     bool true_motion = false;
     float static_tolerance = 0.25f;
     float motion_scale = 1.0f;  // the made frame's motion: per output period
+    // Motion refinement, off unless asked (FrucOptions' is on): the survey, the flow's grey
+    // crops, its evaluation and the choice on the GPU, the flow itself (OpenCV's DIS over the
+    // boxes around the disagreeing tiles) on the CPU: the crops come back, the flow goes up.
+    warp::RefineOptions refine{.enabled = false};
 };
 
 struct ContextState;  // GL objects and scratch (private)
@@ -168,11 +176,12 @@ public:
                       const GBufferTextures* history = nullptr, unsigned history_color = 0);
 
     // The frame at `s` in [0, 1] between a (0) and b (1) with b's backward motion: warp's
-    // interpolate_frame for FrucOptions{.warp = Splat, Reverse or Grid, .refine off} and
-    // pull-push: b warped by 1 - s, a by -s (along their true motion with options.true_motion),
-    // blended by s where both land on one surface (depths within 15 %; where only one side was
-    // drawn by a stretched grid triangle, the other), the nearer or the only one elsewhere,
-    // pull-push over what neither covers. Colour, depth and motion out: the motion the winning side
+    // interpolate_frame for FrucOptions{.warp = Splat, Reverse or Grid} and pull-push: b warped
+    // by 1 - s, a by -s (along their true motion with options.true_motion), blended by s where
+    // both land on one surface (depths within 15 %; where only one side was drawn by a
+    // stretched grid triangle, the other), the nearer or the only one elsewhere, pull-push over
+    // what neither covers, and with options.refine the flow's colour where it wins (the flow
+    // on the CPU: Timings::cpu_ms). Colour, depth and motion out: the motion the winning side
     // carried (b's where both are blended) times motion_scale, as the CPU's (normal and id
     // cleared; out.camera is b's).
     // NaN/Inf in a and b are repaired first, as the CPU converter does; the texture entry does
