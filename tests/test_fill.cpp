@@ -656,3 +656,40 @@ TEST(PatchFill, NoHolesAllHolesOnePixelAndNonFiniteColour) {
     EXPECT_TRUE(all_finite(img));
     EXPECT_EQ(img(30, 20).r, 7.0f);
 }
+
+// The border strip: up to max_run holes beside each row's outermost valid pixel take its colour
+// and depth; holes farther in, rows without a valid pixel and valid pixels stay as they were.
+TEST(BorderRows, ContinueUpToTheRunFromTheOutermostValidPixel) {
+    const int w = 24, h = 3;
+    Image<vec4> color(w, h, vec4(0.0f));
+    Image<float> depth(w, h, kInf);
+    Image<uint8_t> valid(w, h, 0);
+    for (int x = 10; x < 14; ++x) {  // row 0: valid at 10..13, holes 10 to the left, 10 right
+        color(x, 0) = vec4(float(x), 1.0f, 2.0f, 1.0f);
+        depth(x, 0) = float(x);
+        valid(x, 0) = 1;
+    }
+    valid(0, 1) = 1, color(0, 1) = vec4(7.0f), depth(0, 1) = 3.0f;  // row 1: valid at 0 only
+    const Image<vec4> before = color;
+    EXPECT_EQ(reprise::warp::continue_border_rows(color.view(), depth.view(), valid.view(), 8),
+              8u + 8u + 8u);
+    for (int x = 0; x < w; ++x) {
+        const bool left_run = x >= 2 && x < 10, right_run = x >= 14 && x < 22;
+        if (left_run || right_run) {
+            const int from = left_run ? 10 : 13;
+            EXPECT_EQ(color(x, 0), before(from, 0)) << x;
+            EXPECT_EQ(depth(x, 0), float(from)) << x;
+            EXPECT_EQ(valid(x, 0), 1) << x;
+        } else if (x < 10 || x >= 14) {
+            EXPECT_EQ(valid(x, 0), 0) << x;  // past the run: left to the fill
+            EXPECT_EQ(color(x, 0), before(x, 0)) << x;
+        }
+        // Row 1: its only valid pixel is at the left edge: 8 to its right.
+        EXPECT_EQ(valid(x, 1), x <= 8 ? 1 : 0) << x;
+        if (x <= 8) EXPECT_EQ(depth(x, 1), 3.0f) << x;
+        EXPECT_EQ(valid(x, 2), 0) << x;  // row 2: nothing to continue
+    }
+    // Without depth, and a run as wide as the picture: every hole of rows with a valid pixel.
+    Image<uint8_t> all = valid;
+    EXPECT_EQ(reprise::warp::continue_border_rows(color.view(), {}, all.view(), w), 2u + 2u + 15u);
+}

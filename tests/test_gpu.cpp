@@ -957,6 +957,7 @@ TEST(Gpu, InterpolationMatchesTheCpuOnEveryBuiltInScene) {
                     {.reverse = reverse, .true_motion = follow, .motion_scale = 0.5f});
                 ASSERT_TRUE(status.ok()) << status.message();
                 if (counters.copied_still == 0) {  // (shadows: a still pair, the CPU copies it)
+                    EXPECT_EQ(stats.border, counters.border_pixels);
                     EXPECT_EQ(std::size_t(stats.true_motion), counters.true_motion);
                     EXPECT_EQ(std::size_t(stats.linear_motion), counters.linear_motion);
                 }
@@ -1238,22 +1239,27 @@ void expect_extrapolation_matches(const Frame& frame, const Camera& to, float pe
         EXPECT_LE(std::max(stats.holes, extrapolator.counters().hole_pixels) -
                       std::min(stats.holes, extrapolator.counters().hole_pixels),
                   allowed);
+        EXPECT_LE(std::max(stats.border, extrapolator.counters().border_pixels) -
+                      std::min(stats.border, extrapolator.counters().border_pixels),
+                  allowed);
     } else {
         EXPECT_LE(d.depth, allowed);
         EXPECT_LE(d.motion, 1e-4f);
         EXPECT_EQ(stats.holes, extrapolator.counters().hole_pixels);
+        EXPECT_EQ(stats.border, extrapolator.counters().border_pixels);
     }
     if (has_projection(frame.camera)) {
         EXPECT_EQ(stats.moving > 0, extrapolator.counters().dynamic_layers == 1);
     }
     std::printf(
-        "  %.2f periods on: moving %zu, covered %zu, holes %zu, %.1f dB, depth %zu "
+        "  %.2f periods on: moving %zu, covered %zu, border %zu, holes %zu, %.1f dB, depth %zu "
         "differ, motion within %g\n",
-        periods, stats.moving, stats.covered, stats.holes, db, d.depth, double(d.motion));
+        periods, stats.moving, stats.covered, stats.border, stats.holes, db, d.depth,
+        double(d.motion));
 }
 
 TEST(Gpu, ExtrapolationMatchesTheCpuOnEveryBuiltInScene) {
-    std::size_t moving = 0, holes = 0, grid_holes = 0;
+    std::size_t moving = 0, holes = 0, grid_holes = 0, border = 0;
     for (const server::SceneInfo& info : server::builtin_scenes()) {
         SCOPED_TRACE(info.name);
         std::printf("%s\n", info.name);
@@ -1265,6 +1271,7 @@ TEST(Gpu, ExtrapolationMatchesTheCpuOnEveryBuiltInScene) {
                                          warp::WarpMethod::Reverse);
             moving += stats.moving;
             holes += stats.holes;
+            border += stats.border;
             expect_extrapolation_matches(frames[0], frames[1].camera, periods, stats,
                                          warp::WarpMethod::Grid);
             grid_holes += stats.holes;
@@ -1273,6 +1280,7 @@ TEST(Gpu, ExtrapolationMatchesTheCpuOnEveryBuiltInScene) {
     EXPECT_GT(moving, 0u);  // not vacuous: objects moved on their own and holes were filled
     EXPECT_GT(holes, 0u);
     EXPECT_GT(grid_holes, 0u);
+    EXPECT_GT(border, 0u);  // ... and border strips continued
 }
 
 TEST(Gpu, ExtrapolationWithoutACameraAndOnNonFiniteInput) {

@@ -27,6 +27,7 @@ struct FrucJob {
     std::string silhouettes = "widen";
     std::string backend = "cpu";
     double refine_share = 1.0;
+    int border_run = warp::kMadeFrameBorderRun;
     std::string ui;             // a UI sequence beside the input (its colour: premultiplied RGBA)
     bool ui_composite = false;  // draw the UI into the output colour
     double budget_db = 0.0;     // auto: the PSNR to reach (0: within slack of the best expected)
@@ -64,6 +65,8 @@ Status run_fruc(const FrucJob& job) {
     if (!(job.refine_share >= 0.0 && job.refine_share <= 1.0))
         return Status::error("--refine-share must be in 0..1");
     options.refine.max_flow_share = float(job.refine_share);
+    if (job.border_run < 0) return Status::error("--border-run must be >= 0");
+    options.border_run = job.border_run;
     if (job.true_motion != "on" && job.true_motion != "off")
         return Status::error("--true-motion '" + job.true_motion + "': expected on or off");
     options.true_motion = job.true_motion == "on";
@@ -202,10 +205,11 @@ Status run_fruc(const FrucJob& job) {
         "%zu true-motion passes (linear motion), %zu cut tests (the camera said)\n",
         c.copied_still, c.fills_skipped, c.dynamic_skipped, c.linear_motion, c.cut_tests_skipped);
     std::printf(
-        "  done: %zu fills (%zu hole pixels), %zu dynamic layers, %zu grid cells, %zu cuts, "
-        "%zu true-motion frames, %zu input pixels with a nearer neighbour's surface\n",
-        c.fills, c.hole_pixels, c.dynamic_layers, c.grid_cells, c.cuts, c.true_motion,
-        c.silhouette_pixels);
+        "  done: %zu fills (%zu hole pixels, %zu border pixels continued first), %zu dynamic "
+        "layers, %zu grid cells, %zu cuts, %zu true-motion frames, %zu input pixels with a "
+        "nearer neighbour's surface\n",
+        c.fills, c.hole_pixels, c.border_pixels, c.dynamic_layers, c.grid_cells, c.cuts,
+        c.true_motion, c.silhouette_pixels);
     if (options.mode == warp::FrucMode::Interpolate && options.refine.enabled)
         std::printf(
             "  refinement: %zu frames refined, %zu skipped (sides agree), %zu tiles (%zu left out "
@@ -250,6 +254,10 @@ int command_fruc(int argc, char** argv) {
     args.option("--refine-share", &job.refine_share,
                 "refinement: largest share of the frame's pixels the flow runs on (default 1); "
                 "the\ntiles past it are left out, those that disagree most per pixel go first");
+    args.option("--border-run", &job.border_run,
+                "px of each row's border strip a made frame continues from the row before its "
+                "fill\n(default " +
+                    std::to_string(warp::kMadeFrameBorderRun) + "; 0: the fill alone)");
     args.option("--true-motion", &job.true_motion,
                 "on | off (default on): interpolation moves each side where it truly is at the "
                 "in-between\ninstant (off: each follows its motion linearly)");

@@ -290,6 +290,8 @@ Context::~Context() {
     for (Texture* t : state_->refinement.all) glDeleteTextures(1, &t->name);
     for (GLuint program : state_->refine_programs) glDeleteProgram(program);
     glDeleteBuffers(1, &state_->refinement.won);
+    glDeleteProgram(state_->border_program);
+    glDeleteBuffers(1, &state_->border_counts);
     for (auto* chain :
          {&state_->pulled, &state_->pulled_depth, &state_->filled, &state_->filled_depth})
         for (Texture& t : *chain) glDeleteTextures(1, &t.name);

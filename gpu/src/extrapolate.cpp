@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "reprise/warp/extrapolate.hpp"
+#include "reprise/warp/fill.hpp"
 
 #include "state.hpp"
 
@@ -72,11 +73,17 @@ Status create_extrapolate_programs(ContextState& s) {
 }
 
 // After the warp into s.eye_color, out_depth, s.hit (covered) and s.splat_motion (the
-// displacement carried): pull-push over the holes into out_color, the motion per period.
+// displacement carried): the border strips continued, pull-push over the other holes into
+// out_color, the motion per period.
 Status fill_and_scale(ContextState& s, int w, int h, const warp::FrucOptions& options,
                       GLuint out_color, GLuint out_depth, GLuint out_motion, float to_backward,
                       ExtrapolateStats& stats) {
     stats.holes = std::size_t(w) * std::size_t(h) - stats.covered;
+    if (stats.holes && options.fill == warp::FillMethod::PullPush && options.border_run > 0) {
+        stats.border =
+            border_rows_pass(s, s.eye_color.name, out_depth, s.hit.name, w, h, options.border_run);
+        stats.holes -= std::min(stats.holes, stats.border);
+    }
     if (stats.holes && options.fill == warp::FillMethod::PullPush)
         REPRISE_TRY(
             fill_passes(s, s.eye_color.name, s.hit.name, out_depth, w, h, out_color, stats.fill));

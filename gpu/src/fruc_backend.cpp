@@ -42,9 +42,11 @@ Status FrucBackend::interpolate(const GBufferView& a, const GBufferView& b, floa
                                       .true_motion = options.true_motion,
                                       .static_tolerance = options.static_tolerance,
                                       .motion_scale = motion_scale,
-                                      .refine = options.refine},
+                                      .refine = options.refine,
+                                      .border_run = options.border_run},
                                      a_key, b_key));
     uploads_kept_ += stats.uploads_kept;
+    counters.border_pixels += stats.border;
     if (options.refine.enabled) {
         ++(stats.refine_skipped ? counters.refine_skipped : counters.refined_frames);
         counters.refine_tiles += stats.refine_tiles;
@@ -73,6 +75,7 @@ Status FrucBackend::extrapolate(const GBufferView& f, const glm::mat4& view,
                                          motion_scale, frame_key));
     }
     uploads_kept_ += stats.upload_kept;
+    counters.border_pixels += stats.border;
     if (has_projection(f.camera))
         ++(stats.moving ? counters.dynamic_layers : counters.dynamic_skipped);
     count(stats.holes, stats.holes > 0 && options.fill != warp::FillMethod::None, counters);

@@ -327,7 +327,6 @@ void destroy_grid(GridRaster& g) {
     glDeleteProgram(g.cells_program);
     glDeleteProgram(g.offsets_program);
     glDeleteProgram(g.eye_valid_program);
-    glDeleteProgram(g.border_program);
     glDeleteBuffers(1, &g.offsets);
     glDeleteBuffers(2, g.grown);
     glDeleteVertexArrays(1, &g.vertex_array);

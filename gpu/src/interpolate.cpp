@@ -1,11 +1,13 @@
 // The in-between frame on the GPU: warp's interpolate_frame for the splat, the reverse warp or the
 // grid (FrucOptions{.warp = Splat, Reverse or Grid}): b warped by 1 - s, a by -s (along their
 // true motion when asked), refinement's choices found (refine.cpp), the two blended where both
-// see one surface, pull-push over what neither covers, the refined colours written over.
+// see one surface, the border strips continued, pull-push over the other holes, the refined
+// colours written over.
 #include <chrono>
 #include <string>
 #include <utility>
 
+#include "reprise/warp/fill.hpp"
 #include "reprise/warp/true_motion.hpp"
 #include "state.hpp"
 
@@ -368,8 +370,13 @@ Status interpolate_passes(ContextState& s, const SplatTextures& given_a,
     s.read_counters(s.blend_counts, &holes, sizeof holes);
     stats.holes = holes;
     stats.fill = {};
+    if (holes && options.border_run > 0) {
+        stats.border =
+            border_rows_pass(s, k.blended.name, out_depth, k.valid.name, w, h, options.border_run);
+        stats.holes -= std::min(stats.holes, stats.border);
+    }
     // No holes, no fill: the blend as it is (the fill's last pass writes every pixel).
-    if (holes)
+    if (stats.holes)
         REPRISE_TRY(
             fill_passes(s, k.blended.name, k.valid.name, out_depth, w, h, out_color, stats.fill));
     else

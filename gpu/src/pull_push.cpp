@@ -317,6 +317,63 @@ Status fill_passes(ContextState& s, GLuint color, GLuint valid, GLuint depth, in
     return {};
 }
 
+// warp::continue_border_rows, a row per invocation: up to max_run holes between an image edge
+// and the row's outermost valid pixel take its colour and depth and become valid; counted. The
+// colour is read through a sampler at the valid pixels and written at the holes only.
+constexpr const char* kBorderRows = R"(
+layout(binding = 0) uniform highp sampler2D color_in;
+layout(binding = 0, rgba32f) writeonly uniform highp image2D color;
+layout(binding = 1, r32f) uniform highp image2D depth;
+layout(binding = 2, r32ui) uniform highp uimage2D valid;
+uniform ivec2 size;
+uniform int max_run;
+void continue_row(int y) {
+    int left = 0;
+    while (left < size.x && imageLoad(valid, ivec2(left, y)).r == 0u) ++left;
+    if (left == size.x) return;
+    int right = size.x - 1;
+    while (imageLoad(valid, ivec2(right, y)).r == 0u) --right;
+    highp vec4 lc = texelFetch(color_in, ivec2(left, y), 0), rc = texelFetch(color_in, ivec2(right, y), 0);
+    highp vec4 lz = imageLoad(depth, ivec2(left, y)), rz = imageLoad(depth, ivec2(right, y));
+    int x0 = left - min(left, max_run), x1 = right + 1 + min(size.x - 1 - right, max_run);
+    for (int x = x0; x < left; ++x) {
+        imageStore(color, ivec2(x, y), lc);
+        imageStore(depth, ivec2(x, y), lz);
+        imageStore(valid, ivec2(x, y), uvec4(1u));
+    }
+    for (int x = right + 1; x < x1; ++x) {
+        imageStore(color, ivec2(x, y), rc);
+        imageStore(depth, ivec2(x, y), rz);
+        imageStore(valid, ivec2(x, y), uvec4(1u));
+    }
+    atomicAdd(group_counts[0], uint(left - x0 + x1 - right - 1));
+}
+void main() {
+    count_begin();
+    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
+    if (p.x == 0 && p.y < size.y) continue_row(p.y);
+    count_end();
+}
+)";
+
+std::size_t border_rows_pass(ContextState& s, GLuint color, GLuint depth, GLuint valid, int w,
+                             int h, int max_run) {
+    glUseProgram(s.border_program);
+    s.bind_inputs({color});
+    glBindImageTexture(0, color, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
+    glBindImageTexture(1, depth, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32F);
+    glBindImageTexture(2, valid, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
+    ContextState::reset_counters(s.border_counts, 4);
+    glUniform2i(glGetUniformLocation(s.border_program, "size"), w, h);
+    glUniform1i(glGetUniformLocation(s.border_program, "max_run"), std::max(max_run, 0));
+    dispatch(1, h);
+    ContextState::unbind_inputs();
+    glUseProgram(0);
+    GLuint border = 0;
+    s.read_counters(s.border_counts, &border, sizeof border);
+    return border;
+}
+
 Status create_fill_programs(ContextState& s) {
     const std::string prelude = std::string(kComputeHeader) + kPrelude;
     REPRISE_TRY(gl::link_compute(
@@ -328,6 +385,9 @@ Status create_fill_programs(ContextState& s) {
     REPRISE_TRY(gl::link_compute((prelude + kPush).c_str(), "push", s.push_program));
     REPRISE_TRY(gl::link_compute((prelude + kFinal).c_str(), "fill", s.final_program));
     s.fill_counts = s.make_counters((kMaxLevels + 2) * sizeof(GLuint));
+    REPRISE_TRY(gl::link_compute((std::string(kComputeHeader) + kGroupCounts + kBorderRows).c_str(),
+                                 "border rows", s.border_program));
+    s.border_counts = s.make_counters(4 * sizeof(GLuint));
     return {};
 }
 

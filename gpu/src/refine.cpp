@@ -352,8 +352,7 @@ Status create_refine_programs(ContextState& s) {
                             "refine apply"};
     const char* bodies[5] = {kSurvey, kCrop, kEvaluate, kDecide, kApply};
     for (int i = 0; i < 5; ++i)
-        REPRISE_TRY(
-            gl::link_compute((header + bodies[i]).c_str(), names[i], s.refine_programs[i]));
+        REPRISE_TRY(gl::link_compute((header + bodies[i]).c_str(), names[i], s.refine_programs[i]));
     s.refinement.won = s.make_counters(sizeof(GLuint));
     return {};
 }

@@ -200,6 +200,11 @@ Status reproject_pass(ContextState& s, GLuint depth, GLuint motion, GLuint id,
                       GLuint hit, int width, int height, int previous_width, int previous_height,
                       const warp::ReprojectSetup& k, int step, warp::ReprojectCounts& counts);
 
+// warp::continue_border_rows on textures: `color` (GL_RGBA32F), `depth` (GL_R32F) and `valid`
+// (GL_R32UI), w x h, changed in place; returns how many pixels it made valid.
+std::size_t border_rows_pass(ContextState& s, GLuint color, GLuint depth, GLuint valid, int w,
+                             int h, int max_run);
+
 // The passes of each path over textures, shared by its CPU-image and texture entry points.
 Status fill_passes(ContextState& s, GLuint color, GLuint valid, GLuint depth, int w, int h,
                    GLuint out, warp::FillStats& stats);
@@ -243,7 +248,7 @@ double ms_since(std::chrono::steady_clock::time_point& since);
 // GL ES 3.1 does not promise) and the CPU's side for skewed projections and for more cells than
 // a storage buffer holds: the cells and the displacements.
 struct GridRaster {
-    GLuint program = 0, finish_program = 0, eye_valid_program = 0, border_program = 0;
+    GLuint program = 0, finish_program = 0, eye_valid_program = 0;
     GLuint cells_program = 0, offsets_program = 0;  // growing the cells (grid_cells.cpp)
     GLuint framebuffer = 0, depth_buffer = 0, cells = 0, counts = 0, offsets = 0, vertex_array = 0;
     GLuint grown[2] = {0, 0};  // cells grown on the GPU: the eye's or the frame's, the history's
@@ -333,7 +338,8 @@ struct ContextState {
     Texture depth, motion, id, previous_depth, previous_id, payload, out, hit;
     // Pull-push: the image's colour and valid mask, the pulled levels and the filled ones.
     GLuint pull_image_program = 0, pull_level_program = 0, push_program = 0, final_program = 0;
-    GLuint fill_counts = 0;  // holes, then the empty pixels of each level
+    GLuint fill_counts = 0;                        // holes, then the empty pixels of each level
+    GLuint border_program = 0, border_counts = 0;  // border_rows_pass
     Texture color, valid;
     std::vector<Texture> pulled, pulled_depth, filled, filled_depth;
     std::vector<glm::uvec4> hit_readback;   // integer downloads come as RGBA

@@ -131,43 +131,6 @@ void main() {
 }
 )";
 
-// StereoSynthesizer's continue_border_rows, a row per invocation: the holes between an image
-// edge and the row's outermost valid pixel take its colour and depth and become valid; counted.
-// The colour is read through a sampler at the valid pixels and written at the holes only.
-constexpr const char* kBorderRows = R"(
-layout(binding = 0) uniform highp sampler2D color_in;
-layout(binding = 0, rgba32f) writeonly uniform highp image2D color;
-layout(binding = 1, r32f) uniform highp image2D depth;
-layout(binding = 2, r32ui) uniform highp uimage2D valid;
-uniform ivec2 size;
-void continue_row(int y) {
-    int left = 0;
-    while (left < size.x && imageLoad(valid, ivec2(left, y)).r == 0u) ++left;
-    if (left == size.x) return;
-    int right = size.x - 1;
-    while (imageLoad(valid, ivec2(right, y)).r == 0u) --right;
-    highp vec4 lc = texelFetch(color_in, ivec2(left, y), 0), rc = texelFetch(color_in, ivec2(right, y), 0);
-    highp vec4 lz = imageLoad(depth, ivec2(left, y)), rz = imageLoad(depth, ivec2(right, y));
-    for (int x = 0; x < left; ++x) {
-        imageStore(color, ivec2(x, y), lc);
-        imageStore(depth, ivec2(x, y), lz);
-        imageStore(valid, ivec2(x, y), uvec4(1u));
-    }
-    for (int x = right + 1; x < size.x; ++x) {
-        imageStore(color, ivec2(x, y), rc);
-        imageStore(depth, ivec2(x, y), rz);
-        imageStore(valid, ivec2(x, y), uvec4(1u));
-    }
-    atomicAdd(group_counts[0], uint(left + size.x - 1 - right));
-}
-void main() {
-    count_begin();
-    ivec2 p = ivec2(gl_GlobalInvocationID.xy);
-    if (p.x == 0 && p.y < size.y) continue_row(p.y);
-    count_end();
-}
-)";
-
 void run(GLuint program, int w, int h) {
     glUniform2i(glGetUniformLocation(program, "size"), w, h);
     dispatch(w, h);
@@ -191,8 +154,6 @@ Status create_stereo_programs(ContextState& s) {
                                  s.merge_program));
     REPRISE_TRY(gl::link_compute((header + kGridValid).c_str(), "stereo grid valid",
                                  s.grid.eye_valid_program));
-    REPRISE_TRY(gl::link_compute((header + kGroupCounts + kBorderRows).c_str(),
-                                 "stereo border rows", s.grid.border_program));
     s.eye_counts = s.make_counters(4 * sizeof(GLuint));
     return gl::link_compute((header + kFinish).c_str(), "stereo finish", s.finish_program);
 }
@@ -314,17 +275,7 @@ Status grid_eye_passes(ContextState& s, GLuint color, int w, int h, const stereo
                 o.fill == stereo::StereoFill::PullPush);
     run(s.grid.eye_valid_program, w, h);
     if (o.fill == stereo::StereoFill::None) return {};
-    glUseProgram(s.grid.border_program);
-    s.bind_inputs({warped});
-    glBindImageTexture(0, warped, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
-    glBindImageTexture(1, out_depth, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32F);
-    glBindImageTexture(2, s.hit.name, 0, GL_FALSE, 0, GL_READ_WRITE, GL_R32UI);
-    ContextState::reset_counters(s.eye_counts, 4);
-    glUniform2i(glGetUniformLocation(s.grid.border_program, "size"), w, h);
-    dispatch(1, h);
-    GLuint border = 0;
-    s.read_counters(s.eye_counts, &border, sizeof border);
-    stats.border = border;
+    stats.border = border_rows_pass(s, warped, out_depth, s.hit.name, w, h, w);
     return {};
 }
 

@@ -72,6 +72,7 @@ struct Converter {
         d["fills"] = c.fills;
         d["fills_skipped"] = c.fills_skipped;
         d["hole_pixels"] = c.hole_pixels;
+        d["border_pixels"] = c.border_pixels;
         d["dynamic_layers"] = c.dynamic_layers;
         d["dynamic_skipped"] = c.dynamic_skipped;
         d["cuts"] = c.cuts;

@@ -15,27 +15,6 @@ namespace {
 
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 
-// Each row's holes between an image edge and the row's outermost valid pixel take that pixel's
-// colour and depth and become valid; rows without a valid pixel are left. Returns how many.
-std::size_t continue_border_rows(ImageView<glm::vec4> color, ImageView<float> depth,
-                                 ImageView<uint8_t> valid) {
-    std::size_t filled = 0;
-    const int w = color.width;
-    for (int y = 0; y < color.height; ++y) {
-        uint8_t* v = valid.row(y);
-        int left = 0, right = w - 1;
-        while (left < w && !v[left]) ++left;
-        if (left == w) continue;
-        while (!v[right]) --right;
-        for (int x = 0; x < left; ++x)
-            color(x, y) = color(left, y), depth(x, y) = depth(left, y), v[x] = 1;
-        for (int x = right + 1; x < w; ++x)
-            color(x, y) = color(right, y), depth(x, y) = depth(right, y), v[x] = 1;
-        filled += std::size_t(left) + std::size_t(w - 1 - right);
-    }
-    return filled;
-}
-
 bool same_camera(const Camera& a, const Camera& b) {
     return a.view == b.view && a.projection == b.projection;
 }
@@ -204,7 +183,8 @@ StereoStats StereoSynthesizer::synthesize(const GBufferView& given, const Camera
     // the row (the fills, which prefer the farthest samples, pulled the sky down across that
     // strip; docs/benchmarks.md). The splat eye keeps the fill's, on the CPU and the GPU.
     if (o.warp == StereoWarp::Grid && o.fill != StereoFill::None)
-        stats.border = continue_border_rows(out.color.view(), out.depth.view(), valid_.view());
+        stats.border = warp::continue_border_rows(out.color.view(), out.depth.view(), valid_.view(),
+                                                  out.color.width());
     warp::FillStats filled;
     if (o.fill == StereoFill::PullPush)
         filled = pull_push_.fill(out.color.view(), valid, out.depth.view());

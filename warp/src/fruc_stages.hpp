@@ -60,10 +60,12 @@ GBufferView warp_input(const GBufferView& f, int slot, const FrucOptions& option
                        FrucScratch& scratch, FrucCounters& counters);
 
 // Fills the holes of `color` (valid = 0; `holes` of them, counted by the caller) as options.fill
-// says, using depth for the side to prefer; counts what it did or skipped.
-void fill_holes(ImageView<glm::vec4> color, ImageView<const uint8_t> valid,
-                ImageView<const float> depth, std::size_t holes, const FrucOptions& options,
-                FrucScratch& scratch, FrucCounters& counters);
+// says, using depth for the side to prefer, after each row's border strip is continued (up to
+// options.border_run px: those pixels become valid, with their depth); counts what it did or
+// skipped.
+void fill_holes(ImageView<glm::vec4> color, ImageView<uint8_t> valid, ImageView<float> depth,
+                std::size_t holes, const FrucOptions& options, FrucScratch& scratch,
+                FrucCounters& counters);
 
 // Frame at fraction s in (0, 1) between a (earlier) and b (later) into out (colour, depth, and
 // motion times motion_scale). Without use_a (a's motion is not trustworthy, e.g. it starts a

@@ -123,9 +123,14 @@ GBufferView warp_input(const GBufferView& f, int slot, const FrucOptions& option
     return widened;
 }
 
-void fill_holes(ImageView<glm::vec4> color, ImageView<const uint8_t> valid,
-                ImageView<const float> depth, std::size_t holes, const FrucOptions& options,
-                FrucScratch& scratch, FrucCounters& counters) {
+void fill_holes(ImageView<glm::vec4> color, ImageView<uint8_t> valid, ImageView<float> depth,
+                std::size_t holes, const FrucOptions& options, FrucScratch& scratch,
+                FrucCounters& counters) {
+    if (holes && options.fill != FillMethod::None && options.border_run > 0) {
+        const std::size_t border = continue_border_rows(color, depth, valid, options.border_run);
+        counters.border_pixels += border;
+        holes -= std::min(holes, border);
+    }
     counters.hole_pixels += holes;
     if (holes == 0 || options.fill == FillMethod::None) {
         counters.fills_skipped += holes == 0;

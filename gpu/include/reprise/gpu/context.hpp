@@ -57,7 +57,9 @@ struct MadeTextures {
 // fill's stats (all zero when there were no holes: no fill), and the NaN/Inf the CPU-image entry
 // repaired in its inputs (as the CPU converter does).
 struct InterpolateStats {
-    std::size_t covered_a = 0, covered_b = 0, holes = 0;
+    // holes: those the fill was given, after `border` of them were continued from their row
+    // (warp::continue_border_rows, kMadeFrameBorderRun), as the CPU counts them.
+    std::size_t covered_a = 0, covered_b = 0, holes = 0, border = 0;
     bool true_motion = false;    // the sides followed their true motion
     bool linear_motion = false;  // ... had it been asked for, but a survey found it linear
     warp::FillStats fill;
@@ -73,7 +75,8 @@ struct InterpolateStats {
 // motion; every pixel when the frame has no camera), covered pixels, pixels nothing covered, the
 // fill's stats (zero when nothing was a hole) and the NaN/Inf the CPU-image entry repaired.
 struct ExtrapolateStats {
-    std::size_t moving = 0, covered = 0, holes = 0;
+    std::size_t moving = 0, covered = 0, holes = 0,
+                border = 0;  // holes, border: as interpolation's
     warp::FillStats fill;
     NonfiniteCounts nonfinite;
     bool upload_kept = false;  // the frame key matched: the last call's upload was reused
@@ -95,6 +98,7 @@ struct InterpolateOptions {
     // crops, its evaluation and the choice on the GPU, the flow itself (OpenCV's DIS over the
     // boxes around the disagreeing tiles) on the CPU: the crops come back, the flow goes up.
     warp::RefineOptions refine{.enabled = false};
+    int border_run = warp::kMadeFrameBorderRun;  // FrucOptions::border_run
 };
 
 struct ContextState;  // GL objects and scratch (private)

@@ -89,4 +89,16 @@ private:
 FillStats inpaint_andreev(ImageView<glm::vec4> color, ImageView<const uint8_t> valid,
                           ImageView<const float> depth = {}, int max_passes = 64);
 
+// Each row's holes between an image edge and the row's outermost valid pixel, up to `max_run`
+// of them beside that pixel, take its colour and depth (when given) and become valid; rows
+// without a valid pixel are left. What a camera uncovers at the border continues what is beside
+// it, where a fill that prefers the farthest samples pulls the background across it. Returns
+// how many pixels it made valid.
+std::size_t continue_border_rows(ImageView<glm::vec4> color, ImageView<float> depth,
+                                 ImageView<uint8_t> valid, int max_run);
+// Made frames (interpolated and extrapolated) continue this many pixels of each row's border
+// strip before their fill by default (FrucOptions::border_run; docs/benchmarks.md: all of a wider
+// strip fills worse where it crosses textured ground or posts).
+inline constexpr int kMadeFrameBorderRun = 8;
+
 }  // namespace reprise::warp

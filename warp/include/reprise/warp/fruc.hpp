@@ -154,6 +154,10 @@ struct FrucOptions {
     AutoOptions auto_choice;  // warp or fill Auto
     // Not owned; null: the CPU. It must outlive the converter.
     WarpBackend* backend = nullptr;
+    // Before a made frame's fill, up to this many holes beside each row's outermost covered pixel
+    // take its colour and depth (warp::continue_border_rows): what a panning camera uncovers at
+    // the border continues the row. 0: the fill alone. Not with FillMethod::None.
+    int border_run = kMadeFrameBorderRun;
 };
 
 // What was done and what was left out because the frame did not need it.
@@ -163,7 +167,8 @@ struct FrucCounters {
     std::size_t copied_still = 0;   // zero motion: exact copy, nothing warped
     std::size_t fills = 0;          // frames whose holes were filled
     std::size_t fills_skipped = 0;  // no holes: no fill
-    std::size_t hole_pixels = 0;
+    std::size_t hole_pixels = 0;    // holes the fill was given (after the border strips)
+    std::size_t border_pixels = 0;  // holes at the border continued from their row first
     std::size_t dynamic_layers =
         0;  // extrapolation: frames with pixels the camera does not explain
     std::size_t dynamic_skipped = 0;    // ... without: every pixel follows the camera
