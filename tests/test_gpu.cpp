@@ -915,9 +915,13 @@ TEST(Gpu, RefinedInterpolationMatchesTheCpuOnEveryBuiltInScene) {
                                           .motion_scale = 0.5f,
                                           .refine = options.refine});
             ASSERT_TRUE(status.ok()) << status.message();
+            // The survey's threshold may flip a tile where a GPU's sqrt rounds otherwise.
             EXPECT_EQ(std::size_t(stats.refine_skipped), counters.refine_skipped);
-            EXPECT_EQ(stats.refine_tiles, counters.refine_tiles);
-            EXPECT_EQ(stats.flow_pixels, counters.flow_pixels);
+            EXPECT_LE(std::max(stats.refine_tiles, counters.refine_tiles) -
+                          std::min(stats.refine_tiles, counters.refine_tiles),
+                      1u);
+            if (stats.refine_tiles == counters.refine_tiles)
+                EXPECT_EQ(stats.flow_pixels, counters.flow_pixels);
             const std::size_t pixels = cpu.color.pixel_count();
             const std::size_t apart = stats.refined_pixels > counters.refined_pixels
                                           ? stats.refined_pixels - counters.refined_pixels
@@ -1052,8 +1056,12 @@ TEST(Gpu, TheConverterWithTheGpuBackendMakesTheCpusFrames) {
         EXPECT_GE(test::display_psnr(cpu_defaults[i].color, gpu_defaults[i].color), 50.0) << i;
     EXPECT_EQ(gpu_counters.refined_frames + gpu_counters.refine_skipped,
               cpu_counters.refined_frames + cpu_counters.refine_skipped);
+    // Within 0.1 % of the pixels: llvmpipe's are the CPU's; a GPU's sqrt and division need not
+    // round as the CPU's, and a grey one step off changes the flow a little.
     EXPECT_EQ(gpu_counters.refined_frames, cpu_counters.refined_frames);
-    EXPECT_EQ(gpu_counters.refined_pixels, cpu_counters.refined_pixels);
+    EXPECT_LE(std::max(gpu_counters.refined_pixels, cpu_counters.refined_pixels) -
+                  std::min(gpu_counters.refined_pixels, cpu_counters.refined_pixels),
+              frames[0].color.pixel_count() / 1000);
     // Andreev's fill: refused, named.
     defaults_on_gpu.fill = warp::FillMethod::Andreev;
     warp::FrameRateConverter refused;

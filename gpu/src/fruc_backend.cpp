@@ -53,6 +53,7 @@ Status FrucBackend::interpolate(const GBufferView& a, const GBufferView& b, floa
         counters.refine_tiles_left_out += stats.refine_tiles_left_out;
         counters.flow_pixels += stats.flow_pixels;
         counters.refined_pixels += stats.refined_pixels;
+        counters.refine_ms += stats.refine_ms;
     }
     counters.true_motion += stats.true_motion;
     counters.linear_motion += stats.linear_motion;

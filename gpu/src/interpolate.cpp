@@ -346,9 +346,12 @@ Status interpolate_passes(ContextState& s, const SplatTextures& given_a,
     }
 
     bool refined = false;
-    if (options.refine.enabled)
+    if (options.refine.enabled) {
+        auto refine_start = std::chrono::steady_clock::now();
         REPRISE_TRY(refine_passes(s, given_a, given_b, s_between, w, h, options.refine, stats,
                                   cpu_ms, refined));
+        stats.refine_ms = finish_ms(refine_start);
+    }
 
     glUseProgram(s.blend_program);
     s.bind_inputs({k.side_a_color.name, k.side_a_depth.name, k.side_a_covered.name,

@@ -30,8 +30,9 @@ highp float mean_difference(highp vec4 a, highp vec4 b) {
     PRECISE highp float m = (d.r + d.g + d.b) * (1.0 / 3.0);
     return m;
 }
+bool infinite(highp float v) { return (floatBitsToUint(v) & 0x7fffffffu) == 0x7f800000u; }
 bool same_surface(highp float za, highp float zb) {
-    if (positive_inf(za) && positive_inf(zb)) return true;
+    if (infinite(za) && infinite(zb)) return true;
     PRECISE highp float gap = abs(za - zb), allowed = 0.02 * min(za, zb);
     return gap <= allowed;
 }

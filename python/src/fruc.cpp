@@ -25,9 +25,11 @@ warp::FrucOptions fruc_options(const std::string& mode, const std::string& warp_
 struct Converter {
     Converter(int factor, const std::string& mode, const std::string& warp_method,
               const std::string& fill, bool refine, bool true_motion, const std::string& backend,
-              bool widen_silhouettes) {
+              bool widen_silhouettes, int border_run) {
         warp::FrucOptions options =
             fruc_options(mode, warp_method, fill, refine, true_motion, widen_silhouettes);
+        if (border_run < 0) value_error("border_run must be >= 0");
+        options.border_run = border_run;
         if (backend == "gles") {
             if (const Status s = gpu::FrucBackend::check(options, options.splat); !s.ok())
                 value_error("backend gles: " + s.message());
@@ -123,12 +125,14 @@ void bind_fruc(py::module_& m) {
         "it is used from the thread that made it "
         "(another thread gets an error). widen_silhouettes: pixels beside a nearer "
         "surface warp with it, so the anti-aliasing blended into them travels with the "
-        "silhouette.")
+        "silhouette. border_run: px of each row's border strip a made frame continues from "
+        "the row before its fill (0: the fill alone).")
         .def(py::init<int, const std::string&, const std::string&, const std::string&, bool, bool,
-                      const std::string&, bool>(),
+                      const std::string&, bool, int>(),
              py::arg("factor") = 2, py::arg("mode") = "interpolate", py::arg("warp") = "grid",
              py::arg("fill") = "pullpush", py::arg("refine") = true, py::arg("true_motion") = true,
-             py::arg("backend") = "cpu", py::arg("widen_silhouettes") = true)
+             py::arg("backend") = "cpu", py::arg("widen_silhouettes") = true,
+             py::arg("border_run") = warp::kMadeFrameBorderRun)
         .def("send", &Converter::send, py::arg("frame"), "Feeds the next rendered frame.")
         .def("receive", &Converter::receive, "The next output frame, or None.")
         .def("convert", &Converter::convert, py::arg("frames"),

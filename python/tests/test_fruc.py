@@ -28,13 +28,21 @@ def test_interpolated_frames_beat_repetition(pan_60):
     assert kept.counters["silhouette_pixels"] == 0
 
 
-def test_extrapolation_and_receive(pan_60):
+def test_extrapolation_and_receive(pan_60, renderer):
     converter = reprise.FrameRateConverter(2, mode="extrapolate", fill="andreev")
     converter.send(pan_60[0])
     first = converter.receive()
     beyond = converter.receive()
     assert first is not None and beyond is not None and converter.receive() is None
     assert beyond.color.shape == pan_60[0].color.shape
+    # The panning camera uncovers a strip at the border: continued before the fill, or not at all.
+    inputs = renderer.render_sequence(reprise.Scene("pan"), frames=3, fps=30.0, width=160, height=90)
+    for run in (8, 0):
+        ahead = reprise.FrameRateConverter(2, mode="extrapolate", border_run=run)
+        ahead.convert(inputs)
+        assert (ahead.counters["border_pixels"] > 0) == (run > 0)
+    with pytest.raises(ValueError, match="border_run"):
+        reprise.FrameRateConverter(2, border_run=-1)
 
 
 def test_bad_arguments_raise(pan_60):

@@ -444,6 +444,7 @@ const std::vector<RefineBox>& MotionRefiner::plan(int width, int height,
     st.surveyed.assign(surveyed.begin(), surveyed.end());
     st.disagreeing.assign(disagreeing.begin(), disagreeing.end());
     st.plan(width, height, st.flag(options), options, counters);
+    st.decided.clear();  // apply() follows prepare() alone: the caller decides these boxes
     return st.boxes;
 }
 

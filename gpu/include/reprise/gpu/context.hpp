@@ -58,7 +58,7 @@ struct MadeTextures {
 // repaired in its inputs (as the CPU converter does).
 struct InterpolateStats {
     // holes: those the fill was given, after `border` of them were continued from their row
-    // (warp::continue_border_rows, kMadeFrameBorderRun), as the CPU counts them.
+    // (warp::continue_border_rows, InterpolateOptions::border_run), as the CPU counts them.
     std::size_t covered_a = 0, covered_b = 0, holes = 0, border = 0;
     bool true_motion = false;    // the sides followed their true motion
     bool linear_motion = false;  // ... had it been asked for, but a survey found it linear
@@ -69,6 +69,7 @@ struct InterpolateStats {
     // this frame; refine_skipped where nothing disagreed.
     bool refine_skipped = false;
     std::size_t refine_tiles = 0, refine_tiles_left_out = 0, flow_pixels = 0, refined_pixels = 0;
+    double refine_ms = 0.0;  // the survey, the flow and the choice, wall clock
 };
 
 // What an extrapolated frame took: pixels its camera does not explain (carried along their own
@@ -183,8 +184,9 @@ public:
     // interpolate_frame for FrucOptions{.warp = Splat, Reverse or Grid} and pull-push: b warped
     // by 1 - s, a by -s (along their true motion with options.true_motion), blended by s where
     // both land on one surface (depths within 15 %; where only one side was drawn by a
-    // stretched grid triangle, the other), the nearer or the only one elsewhere, pull-push over
-    // what neither covers, and with options.refine the flow's colour where it wins (the flow
+    // stretched grid triangle, the other), the nearer or the only one elsewhere, each row's
+    // border strip continued (options.border_run px), pull-push over the other holes, and with
+    // options.refine the flow's colour where it wins (the flow
     // on the CPU: Timings::cpu_ms). Colour, depth and motion out: the motion the winning side
     // carried (b's where both are blended) times motion_scale, as the CPU's (normal and id
     // cleared; out.camera is b's).
@@ -207,7 +209,8 @@ public:
     // on the CPU, drawn by the GPU) and fill PullPush or None (others are an error): `frame` as
     // seen by (view, projection) `periods` frame periods after it. Static pixels (their motion
     // within options.static_tolerance px of the camera's alone) go where that camera sees them, the
-    // others `periods` along their own motion, in one splat; pull-push over what nothing covers.
+    // others `periods` along their own motion, in one splat; each row's border strip continued
+    // (FrucOptions::border_run px), pull-push over the other holes.
     // A frame without a projection goes along its motion alone (view and projection unused).
     // out gets colour, depth and backward motion per period times motion_scale (0 at periods
     // 0); out.normal and id cleared, out.camera untouched. NaN/Inf are repaired first, as the

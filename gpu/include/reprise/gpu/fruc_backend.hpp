@@ -16,7 +16,7 @@ public:
     explicit FrucBackend(Context& context, const warp::SplatOptions& splat = {})
         : context_(context), splat_(splat) {}
     // Warp grid, reverse or splat with these splat options; interpolation with fill pull-push
-    // and refinement off, extrapolation with fill pull-push or none: what the GPU makes the
+    // (refinement on or off), extrapolation with fill pull-push or none: what the GPU makes the
     // CPU's frames for.
     static Status check(const warp::FrucOptions& options, const warp::SplatOptions& splat = {});
     Status supports(const warp::FrucOptions& options) const override {

@@ -247,7 +247,8 @@ public:
 
     const FrucCounters& counters() const;
     // The region refinement surveyed as disagreeing for the last in-between frame made (1 on the
-    // pixels of its tiles, 0 elsewhere; all 0 when none or refinement is off), sized like it.
+    // pixels of its tiles, 0 elsewhere; all 0 when none or refinement is off, and with a backend,
+    // which surveys on its own), sized like it.
     void refine_region(Image<uint8_t>& mask) const;
 
 private:

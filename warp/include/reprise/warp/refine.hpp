@@ -44,7 +44,7 @@ public:
     // estimates flow there and keeps the better colour per pixel. False: nothing to apply.
     bool prepare(const GBufferView& a, const GBufferView& b, float s, const WarpedSide& side_a,
                  const WarpedSide& side_b, const RefineOptions& options, FrucCounters& counters);
-    // Writes the kept colours over the blended frame.
+    // Writes the colours the last prepare() kept over the blended frame (nothing after plan()).
     void apply(ImageView<glm::vec4> color) const;
     // Whether the colours of a and b themselves (a still pair) disagree anywhere as prepare()
     // would find.
@@ -54,8 +54,8 @@ public:
     void forget_region();
 
     // prepare()'s steps for a backend that surveys, evaluates and decides elsewhere (a GPU).
-    // The survey's pixels: in each tile, every 2nd pixel from (1, 1) of every 2nd row from its
-    // first row + 1, where both sides cover one surface (depths within 2 %, or both +inf);
+    // The survey's pixels: the odd columns of the image, in each tile's rows from its first + 1
+    // every 2nd, where both sides cover one surface (depths within 2 %, or both +inf);
     // disagreeing where a channel's display values differ by more than the threshold. From those
     // counts per tile (row by row), the disagreeing tiles and the boxes the flow runs over (their
     // ring of tiles too with RefineOptions::neighbours, with the margin, merged, the most
