@@ -138,11 +138,13 @@ void ContextState::read_counters(GLuint buffer, void* counts, std::size_t bytes)
     glBindBuffer(GL_COPY_WRITE_BUFFER, 0);
 }
 
-void ContextState::upload(const Texture& texture, const void* data, std::ptrdiff_t stride) {
+void ContextState::upload(const Texture& texture, const void* data, std::ptrdiff_t stride,
+                          int width, int height) {
     GLenum format = 0, type = 0;
     gl::transfer_format(texture.format, format, type);
-    const std::size_t row = texel_bytes(texture.format) * std::size_t(texture.width);
-    const std::size_t bytes = row * std::size_t(texture.height);
+    const int w = width > 0 ? width : texture.width, h = height > 0 ? height : texture.height;
+    const std::size_t row = texel_bytes(texture.format) * std::size_t(w);
+    const std::size_t bytes = row * std::size_t(h);
     const std::size_t source_row = texel_bytes(texture.format) * std::size_t(stride);
     glBindTexture(GL_TEXTURE_2D, texture.name);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
@@ -153,20 +155,19 @@ void ContextState::upload(const Texture& texture, const void* data, std::ptrdiff
         GL_MAP_WRITE_BIT | GL_MAP_INVALIDATE_BUFFER_BIT | GL_MAP_UNSYNCHRONIZED_BIT));
     const auto* source = static_cast<const unsigned char*>(data);
     if (mapped) {
-        parallel_for(0, texture.height, [&](int y0, int y1) {
+        parallel_for(0, h, [&](int y0, int y1) {
             for (int y = y0; y < y1; ++y)
                 std::memcpy(mapped + std::size_t(y) * row, source + std::size_t(y) * source_row,
                             row);
         });
         glUnmapBuffer(GL_PIXEL_UNPACK_BUFFER);
-        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, texture.width, texture.height, format, type,
-                        nullptr);
+        glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, w, h, format, type, nullptr);
         glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);
         return;
     }
     glBindBuffer(GL_PIXEL_UNPACK_BUFFER, 0);  // the driver would not map: from client memory
     glPixelStorei(GL_UNPACK_ROW_LENGTH, GLint(stride));
-    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, texture.width, texture.height, format, type, data);
+    glTexSubImage2D(GL_TEXTURE_2D, 0, 0, 0, w, h, format, type, data);
     glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
 }
 
@@ -211,19 +212,20 @@ void ContextState::upload_frame(const GBufferView& frame, Texture& color_texture
     upload(motion_texture, frame.motion.data, frame.motion.stride);
 }
 
-void ContextState::download(const Texture& texture, void* data, std::ptrdiff_t stride) {
+void ContextState::download(const Texture& texture, void* data, std::ptrdiff_t stride, int width,
+                            int height) {
+    const int w = width > 0 ? width : texture.width, h = height > 0 ? height : texture.height;
     // Shader image stores become visible to reads through a framebuffer only after this.
     glMemoryBarrier(GL_FRAMEBUFFER_BARRIER_BIT | GL_TEXTURE_UPDATE_BARRIER_BIT);
     glBindFramebuffer(GL_FRAMEBUFFER, read_framebuffer);
     glFramebufferTexture2D(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_TEXTURE_2D, texture.name, 0);
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
     if (texture.format == GL_R32UI) {
-        hit_readback.resize(std::size_t(texture.width) * std::size_t(texture.height));
-        glReadPixels(0, 0, texture.width, texture.height, GL_RGBA_INTEGER, GL_UNSIGNED_INT,
-                     hit_readback.data());
+        hit_readback.resize(std::size_t(w) * std::size_t(h));
+        glReadPixels(0, 0, w, h, GL_RGBA_INTEGER, GL_UNSIGNED_INT, hit_readback.data());
     } else {
         glPixelStorei(GL_PACK_ROW_LENGTH, GLint(stride));
-        glReadPixels(0, 0, texture.width, texture.height, GL_RGBA, GL_FLOAT, data);
+        glReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, data);
         glPixelStorei(GL_PACK_ROW_LENGTH, 0);
     }
     glBindFramebuffer(GL_FRAMEBUFFER, 0);

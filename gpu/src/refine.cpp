@@ -225,14 +225,14 @@ void box_flow(ContextState& s, const SplatTextures& a, const SplatTextures& b,
               const warp::RefineBox& box, double& cpu_ms) {
     Refinement& r = s.refinement;
     const int bw = box.width(), bh = box.height();
-    r.crop.ensure(GL_RGBA32F, bw, bh);
+    r.crop.ensure_at_least(GL_RGBA32F, bw, bh);
     glUseProgram(s.refine_programs[1]);
     s.bind_inputs({a.color, b.color, b.motion});
     glBindImageTexture(0, r.crop.name, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA32F);
     set_box(s.refine_programs[1], box);
     dispatch(bw, bh);
     r.crop_pixels.resize(bw, bh);
-    s.download(r.crop, r.crop_pixels.data(), r.crop_pixels.view().stride);
+    s.download(r.crop, r.crop_pixels.data(), r.crop_pixels.view().stride, bw, bh);
     auto t = std::chrono::steady_clock::now();
     r.grey_a.resize(bw, bh), r.grey_b.resize(bw, bh), r.seed.resize(bw, bh);
     for (int y = 0; y < bh; ++y)
@@ -244,8 +244,8 @@ void box_flow(ContextState& s, const SplatTextures& a, const SplatTextures& b,
     r.refiner.flow(std::as_const(r.grey_b).view(), std::as_const(r.grey_a).view(),
                    std::as_const(r.seed).view(), r.flow_field);
     cpu_ms += ms_since(t);
-    r.flow.ensure(GL_RG32F, bw, bh);
-    s.upload(r.flow, r.flow_field.data(), r.flow_field.view().stride);
+    r.flow.ensure_at_least(GL_RG32F, bw, bh);
+    s.upload(r.flow, r.flow_field.data(), r.flow_field.view().stride, bw, bh);
 }
 
 }  // namespace
@@ -299,8 +299,8 @@ Status refine_passes(ContextState& s, const SplatTextures& a, const SplatTexture
         const warp::RefineBox& box = boxes[i];
         if (box.area() == 0) continue;
         box_flow(s, a, b, box, cpu_ms);
-        r.errors.ensure(GL_RGBA32F, box.width(), box.height());
-        r.flow_color.ensure(GL_RGBA32F, box.width(), box.height());
+        r.errors.ensure_at_least(GL_RGBA32F, box.width(), box.height());
+        r.flow_color.ensure_at_least(GL_RGBA32F, box.width(), box.height());
         GLuint program = s.refine_programs[2];
         glUseProgram(program);
         s.bind_inputs({a.color, b.color, k.side_a_color.name, k.side_a_depth.name,

@@ -1,5 +1,6 @@
 #pragma once
 // What a gpu::Context owns: the GL context, programs, and textures sized once per frame size.
+#include <algorithm>
 #include <chrono>
 #include <initializer_list>
 #include <memory>
@@ -25,6 +26,11 @@ struct Texture {
     int width = 0;
     int height = 0;
     void ensure(GLenum new_format, int w, int h);
+    // At least w x h: grown (to the larger of each side) only when it is smaller.
+    void ensure_at_least(GLenum new_format, int w, int h) {
+        ensure(new_format, format == new_format ? std::max(width, w) : w,
+               format == new_format ? std::max(height, h) : h);
+    }
 };
 
 // An error naming `what` unless texture `name` is a 2D texture of `format` and w x h.
@@ -404,14 +410,17 @@ struct ContextState {
     GLuint make_counters(std::size_t bytes);
     // The first `bytes` of counters buffer `buffer` (the shaders that wrote it finished).
     void read_counters(GLuint buffer, void* counts, std::size_t bytes);
-    // Uploads the texture's rows, `stride` pixels apart, into `texture` (already sized).
-    void upload(const Texture& texture, const void* data, std::ptrdiff_t stride);
+    // Uploads the texture's rows, `stride` pixels apart, into `texture` (already sized), or into
+    // its top-left width x height.
+    void upload(const Texture& texture, const void* data, std::ptrdiff_t stride, int width = 0,
+                int height = 0);
     // A frame's colour, depth and motion into `color` (RGBA32F), `depth` (R32F) and `motion`
     // (RG32F), sized to the frame.
     void upload_frame(const GBufferView& frame, Texture& color, Texture& depth, Texture& motion);
     // Reads `texture` (GL_RGBA32F into floats, GL_R32UI into hit_readback) through the
-    // framebuffer; `stride` in pixels for float targets.
-    void download(const Texture& texture, void* data, std::ptrdiff_t stride);
+    // framebuffer, or its top-left width x height; `stride` in pixels for float targets.
+    void download(const Texture& texture, void* data, std::ptrdiff_t stride, int width = 0,
+                  int height = 0);
     // The first `channels` of each pixel of a float texture into floats, `stride` pixels apart.
     void download_channels(const Texture& texture, float* data, int channels,
                            std::ptrdiff_t stride);
