@@ -854,7 +854,7 @@ Frame cpu_between(const Frame& a, const Frame& b, bool true_motion = false,
 // The in-between frame by the grid (refinement off): both sides' cells grown and drawn on the
 // GPU, blended with the stretched sides' rule.
 TEST(Gpu, GridInterpolationMatchesTheCpuOnEveryBuiltInScene) {
-    std::size_t holes = 0;
+    std::size_t holes = 0, cells = 0;
     for (const server::SceneInfo& info : server::builtin_scenes()) {
         const std::vector<Frame>& frames = scene_frames(info.name);
         for (const int min_cell : {1, 2})
@@ -865,7 +865,8 @@ TEST(Gpu, GridInterpolationMatchesTheCpuOnEveryBuiltInScene) {
                                                 .grid = {.min_cell = min_cell, .bicubic = true},
                                                 .true_motion = follow,
                                                 .refine = {.enabled = false}};
-                const Frame cpu = cpu_between_with(frames[0], frames[1], options);
+                warp::FrucCounters counters;
+                const Frame cpu = cpu_between_with(frames[0], frames[1], options, &counters);
                 Frame gpu;
                 gpu::InterpolateStats stats;
                 ASSERT_TRUE(shared_gpu()
@@ -875,6 +876,9 @@ TEST(Gpu, GridInterpolationMatchesTheCpuOnEveryBuiltInScene) {
                                               .true_motion = follow,
                                               .motion_scale = 0.5f})
                                 .ok());
+                if (counters.copied_still == 0)  // both sides' cells, as the CPU counts them
+                    EXPECT_EQ(stats.grid_cells, counters.grid_cells);
+                cells += stats.grid_cells;
                 const double db = test::display_psnr(cpu.color, gpu.color);
                 EXPECT_GE(db, 50.0);
                 std::size_t motion_off = 0;
@@ -888,6 +892,7 @@ TEST(Gpu, GridInterpolationMatchesTheCpuOnEveryBuiltInScene) {
             }
     }
     EXPECT_GT(holes, 0u);  // not vacuous: some holes filled
+    EXPECT_GT(cells, 0u);
 }
 
 // The default in-between frame (the grid, true motion, refinement): the survey, the crops, the
@@ -1250,6 +1255,8 @@ void expect_extrapolation_matches(const Frame& frame, const Camera& to, float pe
         EXPECT_LE(std::max(stats.border, extrapolator.counters().border_pixels) -
                       std::min(stats.border, extrapolator.counters().border_pixels),
                   allowed);
+        EXPECT_EQ(stats.grid_cells, extrapolator.counters().grid_cells);
+        EXPECT_GT(stats.grid_cells, 0u);
     } else {
         EXPECT_LE(d.depth, allowed);
         EXPECT_LE(d.motion, 1e-4f);

@@ -136,6 +136,7 @@ Status extrapolate_passes(ContextState& s, const SplatTextures& frame, const Cam
             {s.eye_color.name, out_depth, s.hit.name, out_motion ? s.splat_motion.name : 0u, w, h},
             grid, stretched));
         stats.covered = grid.covered;
+        stats.grid_cells = grid.cells;
         return fill_and_scale(s, w, h, options, out_color, out_depth, out_motion, to_backward,
                               stats);
     }
@@ -188,6 +189,7 @@ Status grid_extrapolation(ContextState& s, const GBufferView& frame, const glm::
                             {s.eye_color.name, out_depth, s.hit.name, s.splat_motion.name, w, h},
                             grid, stretched));
     stats.covered = grid.covered;
+    stats.grid_cells = grid.cells;
     return fill_and_scale(s, w, h, options, out_color, out_depth, out_motion, to_backward, stats);
 }
 

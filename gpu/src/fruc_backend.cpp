@@ -47,6 +47,7 @@ Status FrucBackend::interpolate(const GBufferView& a, const GBufferView& b, floa
                                      a_key, b_key));
     uploads_kept_ += stats.uploads_kept;
     counters.border_pixels += stats.border;
+    counters.grid_cells += stats.grid_cells;
     if (options.refine.enabled) {
         ++(stats.refine_skipped ? counters.refine_skipped : counters.refined_frames);
         counters.refine_tiles += stats.refine_tiles;
@@ -77,6 +78,7 @@ Status FrucBackend::extrapolate(const GBufferView& f, const glm::mat4& view,
     }
     uploads_kept_ += stats.upload_kept;
     counters.border_pixels += stats.border;
+    counters.grid_cells += stats.grid_cells;
     if (has_projection(f.camera))
         ++(stats.moving ? counters.dynamic_layers : counters.dynamic_skipped);
     count(stats.holes, stats.holes > 0 && options.fill != warp::FillMethod::None, counters);

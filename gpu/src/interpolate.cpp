@@ -326,6 +326,7 @@ Status interpolate_passes(ContextState& s, const SplatTextures& given_a,
                                      carry ? side.motion.name : 0u, w, h},
                                     drawn, stretched));
             side.count = drawn.covered;
+            stats.grid_cells += drawn.cells;
         }
     } else {
         // The reverse warp: a footprint-2 splat, each covered pixel's colour then refetched.

@@ -213,8 +213,6 @@ void main() {
 }
 )";
 
-constexpr float kWinMargin = 0.01f;  // refine.cpp's: the flow must beat the rendered error by this
-
 void set_box(GLuint program, const warp::RefineBox& box) {
     glUniform2i(glGetUniformLocation(program, "origin"), box.x0, box.y0);
     glUniform2i(glGetUniformLocation(program, "box_size"), box.width(), box.height());
@@ -321,7 +319,7 @@ Status refine_passes(ContextState& s, const SplatTextures& a, const SplatTexture
         set_box(program, box);
         glUniform1i(glGetUniformLocation(program, "tile"), tiles.size);
         glUniform1i(glGetUniformLocation(program, "box"), int(i));
-        glUniform1f(glGetUniformLocation(program, "margin"), kWinMargin);
+        glUniform1f(glGetUniformLocation(program, "margin"), warp::kRefineWinMargin);
         dispatch(box.width(), box.height());
     }
     ContextState::unbind_inputs();

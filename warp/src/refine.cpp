@@ -17,9 +17,8 @@ namespace reprise::warp {
 
 namespace {
 
-constexpr int kSurveyStep = 2;       // the survey looks at every 2nd pixel of every 2nd row
-constexpr int kMinDisagreeing = 4;   // surveyed pixels a tile needs besides its share
-constexpr float kWinMargin = 0.01f;  // a flow candidate must beat the rendered error by this
+constexpr int kSurveyStep = 2;      // the survey looks at every 2nd pixel of every 2nd row
+constexpr int kMinDisagreeing = 4;  // surveyed pixels a tile needs besides its share
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
 // sRGB display value within about 1 % (NaN -> 0): what a viewer sees, cheaply.
@@ -341,7 +340,8 @@ struct MotionRefiner::State {
                             flowed += error_flow[j];
                             ++count;
                         }
-                    if (!(flowed / float(count) + kWinMargin < rendered / float(count))) continue;
+                    if (!(flowed / float(count) + kRefineWinMargin < rendered / float(count)))
+                        continue;
                     const std::size_t k = std::size_t(y - ty0) * tile + std::size_t(x - tx0);
                     pick[k] = 1;
                     flow_color[k] = color_flow[i];

@@ -60,6 +60,7 @@ struct InterpolateStats {
     // holes: those the fill was given, after `border` of them were continued from their row
     // (warp::continue_border_rows, InterpolateOptions::border_run), as the CPU counts them.
     std::size_t covered_a = 0, covered_b = 0, holes = 0, border = 0;
+    std::size_t grid_cells = 0;  // cells the grid drew, both sides (FrucCounters::grid_cells)
     bool true_motion = false;    // the sides followed their true motion
     bool linear_motion = false;  // ... had it been asked for, but a survey found it linear
     warp::FillStats fill;
@@ -77,7 +78,8 @@ struct InterpolateStats {
 // fill's stats (zero when nothing was a hole) and the NaN/Inf the CPU-image entry repaired.
 struct ExtrapolateStats {
     std::size_t moving = 0, covered = 0, holes = 0,
-                border = 0;  // holes, border: as interpolation's
+                border = 0;      // holes, border: as interpolation's
+    std::size_t grid_cells = 0;  // cells the grid drew
     warp::FillStats fill;
     NonfiniteCounts nonfinite;
     bool upload_kept = false;  // the frame key matched: the last call's upload was reused

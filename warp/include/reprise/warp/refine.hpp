@@ -18,6 +18,10 @@ struct WarpedSide {
     ImageView<const uint8_t> covered;
 };
 
+// A pixel takes the flow's colour where the 3x3 mean of its sides' error beats the rendered
+// motion's by this.
+inline constexpr float kRefineWinMargin = 0.01f;
+
 // Pixels [x0, x1) x [y0, y1).
 struct RefineBox {
     int x0 = 0, y0 = 0, x1 = 0, y1 = 0;
