@@ -312,6 +312,8 @@ Context::~Context() {
     glDeleteBuffers(1, &state_->splat_counts);
     glDeleteBuffers(1, &state_->splat_lists);
     glDeleteBuffers(1, &state_->fill_counts);
+    glDeleteBuffers(1, &state_->small_levels);
+    glDeleteProgram(state_->small_levels_program);
     glDeleteSamplers(1, &state_->nearest_sampler);
     glDeleteBuffers(1, &state_->counts_buffer);
     glDeleteBuffers(1, &state_->unpack_buffer);

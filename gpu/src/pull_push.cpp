@@ -1,7 +1,9 @@
 // warp::PullPush on the GPU as a mip chain: one compute pass per level down (pull), one per level
-// back up (push), one into the output. Every level down to 1x1 is pulled (no read-back to stop
-// early): below the first level without an empty pixel every weight is 1 and the push leaves
-// those pixels alone, so the result is the CPU's. The arithmetic is pull_push.cpp's, in its order.
+// back up (push), one into the output; the levels of at most 32x32 pixels pulled and pushed in
+// one work group (small_levels), as each dispatch costs a GPU tens of microseconds. Every level
+// down to 1x1 is pulled (no read-back to stop early): below the first level without an empty
+// pixel every weight is 1 and the push leaves those pixels alone, so the result is the CPU's.
+// The arithmetic is pull_push.cpp's, in its order.
 #include <algorithm>
 #include <cstring>
 #include <string>
@@ -64,37 +66,50 @@ void taps(int x, int n, out int i0, out int i1, out highp float w0, out highp fl
     }
 }
 
-// The filled coarse level upsampled at fine pixel p, dropping taps nearer than the farthest.
-highp vec3 upsample(highp sampler2D c, highp sampler2D d, ivec2 p, out highp float depth) {
+// The four taps of fine pixel p on a coarse level of `coarse` pixels and their weights.
+void upsample_taps(ivec2 p, ivec2 coarse, out ivec2 t[4], out highp float w[4]) {
     int x0, x1, y0, y1;
     highp float ax, bx, ay, by;
-    taps(p.x, coarse_size.x, x0, x1, ax, bx);
-    taps(p.y, coarse_size.y, y0, y1, ay, by);
-    ivec2 t[4] = ivec2[4](ivec2(x0, y0), ivec2(x1, y0), ivec2(x0, y1), ivec2(x1, y1));
-    highp float w[4] = float[4](ax * ay, bx * ay, ax * by, bx * by);
+    taps(p.x, coarse.x, x0, x1, ax, bx);
+    taps(p.y, coarse.y, y0, y1, ay, by);
+    t = ivec2[4](ivec2(x0, y0), ivec2(x1, y0), ivec2(x0, y1), ivec2(x1, y1));
+    w = float[4](ax * ay, bx * ay, ax * by, bx * by);
+}
+
+// The taps' filled colours and depths upsampled, dropping taps nearer than the farthest.
+highp vec3 upsample_of(highp vec4 cs[4], highp float dk[4], highp float w[4],
+                       out highp float depth) {
     depth = 0.0;
     if (use_depth) {
-        highp float dk[4];
-        for (int k = 0; k < 4; ++k) dk[k] = texelFetch(d, t[k], 0).r;
         depth = max(max(dk[0], dk[1]), max(dk[2], dk[3]));
         for (int k = 0; k < 4; ++k)
             if (!(dk[k] * ratio >= depth)) w[k] = 0.0;
     }
-    highp vec4 c0 = texelFetch(c, t[0], 0), c1 = texelFetch(c, t[1], 0);
-    highp vec4 c2 = texelFetch(c, t[2], 0), c3 = texelFetch(c, t[3], 0);
     if (w[0] > 0.0 && w[1] > 0.0 && w[2] > 0.0 && w[3] > 0.0) {
-        PRECISE highp vec4 s = vec4(0.0) + c0 * w[0] + c1 * w[1] + c2 * w[2] + c3 * w[3];
+        PRECISE highp vec4 s = vec4(0.0) + cs[0] * w[0] + cs[1] * w[1] + cs[2] * w[2] + cs[3] * w[3];
         return s.rgb;
     }
     PRECISE highp vec3 acc = vec3(0.0);
     PRECISE highp float sum = 0.0;
-    highp vec4 cs[4] = vec4[4](c0, c1, c2, c3);
     for (int k = 0; k < 4; ++k)
         if (w[k] > 0.0) {
             acc += cs[k].rgb * w[k];
             sum += w[k];
         }
     return acc / sum;
+}
+
+// The filled coarse level (textures c and d, coarse_size) upsampled at fine pixel p.
+highp vec3 upsample(highp sampler2D c, highp sampler2D d, ivec2 p, out highp float depth) {
+    ivec2 t[4];
+    highp float w[4], dk[4];
+    highp vec4 cs[4];
+    upsample_taps(p, coarse_size, t, w);
+    for (int k = 0; k < 4; ++k) {
+        cs[k] = texelFetch(c, t[k], 0);
+        dk[k] = use_depth ? texelFetch(d, t[k], 0).r : 0.0;
+    }
+    return upsample_of(cs, dk, w, depth);
 }
 )";
 
@@ -200,6 +215,116 @@ void main() {
 }
 )";
 
+// Levels first..last (each at most kSmallLevel pixels a side) in one work group: pulled from
+// level first - 1 (textures of fine_size), each kept in the buffer, then pushed back up in place
+// to level first, which is written out with the top level as pulled (the final pass reads it).
+constexpr const char* kSmallLevels = R"(
+layout(binding = 0) uniform highp sampler2D fine;
+layout(binding = 2) uniform highp sampler2D fine_depth;
+layout(binding = 0, rgba32f) writeonly uniform highp image2D out_color;
+layout(binding = 1, r32f) writeonly uniform highp image2D out_depth;
+layout(binding = 2, rgba32f) writeonly uniform highp image2D top_pulled;
+struct Pixel {
+    highp vec4 color;
+    highp float depth;
+};
+layout(std430, binding = 1) buffer Small { Pixel small[]; };
+uniform int first, last;
+const int kInvocations = 64;
+ivec2 sizes[MAX_LEVELS];
+int offsets[MAX_LEVELS];
+void pull_level(int l, ivec2 fsz, int from) {
+    ivec2 sz = sizes[l - first];
+    uint empty = 0u;
+    for (int i = int(gl_LocalInvocationIndex); i < sz.x * sz.y; i += kInvocations) {
+        ivec2 q = ivec2(i % sz.x, i / sz.x);
+        highp vec3 p[4];
+        highp float w[4], d[4];
+        int n = 0;
+        for (int dy = 0; dy < 2; ++dy)
+            for (int dx = 0; dx < 2; ++dx) {
+                ivec2 f = 2 * q + ivec2(dx, dy);
+                if (f.x >= fsz.x || f.y >= fsz.y) continue;
+                highp vec4 c;
+                highp float z;
+                if (l == first) {
+                    c = texelFetch(fine, f, 0);
+                    z = use_depth ? texelFetch(fine_depth, f, 0).r : 0.0;
+                } else {
+                    c = small[from + f.y * fsz.x + f.x].color;
+                    z = use_depth ? small[from + f.y * fsz.x + f.x].depth : 0.0;
+                }
+                p[n] = c.rgb;
+                w[n] = c.a;
+                d[n] = z;
+                ++n;
+            }
+        highp vec4 result;
+        highp float depth;
+        pull_pixel(p, w, d, n, result, depth);
+        small[offsets[l - first] + i] = Pixel(result, depth);
+        if (l == last) imageStore(top_pulled, q, result);
+        if (result.a < 1.0) ++empty;
+    }
+    if (empty != 0u) atomicAdd(counts[1 + l], empty);
+}
+void push_level(int l) {
+    ivec2 sz = sizes[l - first];
+    int at = offsets[l - first];
+    for (int i = int(gl_LocalInvocationIndex); i < sz.x * sz.y; i += kInvocations) {
+        ivec2 q = ivec2(i % sz.x, i / sz.x);
+        highp vec4 px = small[at + i].color;
+        highp float d = use_depth ? small[at + i].depth : 0.0;
+        if (l == last) {
+            if (px.a > 0.0 && px.a < 1.0) px = vec4(px.rgb / px.a, 1.0);
+        } else if (px.a < 1.0) {
+            ivec2 t[4];
+            highp float w[4], dk[4];
+            highp vec4 cs[4];
+            upsample_taps(q, sizes[l + 1 - first], t, w);
+            int up = offsets[l + 1 - first], up_width = sizes[l + 1 - first].x;
+            for (int k = 0; k < 4; ++k) {
+                cs[k] = small[up + t[k].y * up_width + t[k].x].color;
+                dk[k] = use_depth ? small[up + t[k].y * up_width + t[k].x].depth : 0.0;
+            }
+            highp float ud;
+            highp vec3 filled = upsample_of(cs, dk, w, ud);
+            if (use_depth && px.a == 0.0) d = ud;
+            PRECISE highp vec3 mixed = px.rgb + (1.0 - px.a) * filled;
+            px = vec4(mixed, 1.0);
+        }
+        small[at + i] = Pixel(px, d);
+        if (l == first) {
+            imageStore(out_color, q, px);
+            if (use_depth) imageStore(out_depth, q, vec4(d));
+        }
+    }
+}
+void main() {
+    ivec2 sz = fine_size;
+    int at = 0;
+    for (int l = first; l <= last; ++l) {
+        sz = (sz + 1) / 2;
+        sizes[l - first] = sz;
+        offsets[l - first] = at;
+        at += sz.x * sz.y;
+    }
+    for (int l = first; l <= last; ++l) {
+        pull_level(l, l == first ? fine_size : sizes[l - 1 - first],
+                   l == first ? 0 : offsets[l - 1 - first]);
+        memoryBarrierBuffer();
+        barrier();
+    }
+    for (int l = last; l >= first; --l) {
+        push_level(l);
+        memoryBarrierBuffer();
+        barrier();
+    }
+}
+)";
+
+constexpr int kSmallLevel = 32;
+
 void set_sizes(GLuint program, int fw, int fh, int cw, int ch) {
     glUniform2i(glGetUniformLocation(program, "fine_size"), fw, fh);
     glUniform2i(glGetUniformLocation(program, "coarse_size"), cw, ch);
@@ -250,8 +375,15 @@ Status fill_passes(ContextState& s, GLuint color, GLuint valid, GLuint depth, in
         return use_depth ? chain[std::size_t(l)].name : 0u;
     };
 
+    // The first level of at most kSmallLevel pixels a side (never level 0, read from the image):
+    // it and those below in one work group.
+    int small = 1;
+    while (small < levels && (s.pulled[std::size_t(small)].width > kSmallLevel ||
+                              s.pulled[std::size_t(small)].height > kSmallLevel))
+        ++small;
+
     // Pull.
-    for (int l = 0; l < levels; ++l) {
+    for (int l = 0; l < small && l < levels; ++l) {
         const Texture& target = s.pulled[std::size_t(l)];
         const GLuint program = l == 0 ? s.pull_image_program : s.pull_level_program;
         common_uniforms(program, use_depth, l);
@@ -268,8 +400,33 @@ Status fill_passes(ContextState& s, GLuint color, GLuint valid, GLuint depth, in
                                GL_WRITE_ONLY, GL_R32F);
         dispatch(target.width, target.height);
     }
-    // Push, from the top.
-    for (int l = levels - 1; l >= 0; --l) {
+    if (small < levels) {
+        std::size_t pixels = 0;
+        for (int l = small; l < levels; ++l)
+            pixels += std::size_t(s.pulled[std::size_t(l)].width) * s.pulled[std::size_t(l)].height;
+        const std::size_t bytes = pixels * 8 * sizeof(float);  // std430: vec4, float, padding
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, s.small_levels);
+        if (s.small_levels_bytes < bytes) {
+            glBufferData(GL_SHADER_STORAGE_BUFFER, GLsizeiptr(bytes), nullptr, GL_DYNAMIC_COPY);
+            s.small_levels_bytes = bytes;
+        }
+        const Texture& fine = s.pulled[std::size_t(small) - 1];
+        common_uniforms(s.small_levels_program, use_depth, small);
+        set_sizes(s.small_levels_program, fine.width, fine.height, 1, 1);
+        glUniform1i(glGetUniformLocation(s.small_levels_program, "first"), small);
+        glUniform1i(glGetUniformLocation(s.small_levels_program, "last"), levels - 1);
+        s.bind_inputs({fine.name, 0, depth_of(s.pulled_depth, small - 1)});
+        glBindImageTexture(0, s.filled[std::size_t(small)].name, 0, GL_FALSE, 0, GL_WRITE_ONLY,
+                           GL_RGBA32F);
+        if (use_depth)
+            glBindImageTexture(1, s.filled_depth[std::size_t(small)].name, 0, GL_FALSE, 0,
+                               GL_WRITE_ONLY, GL_R32F);
+        glBindImageTexture(2, s.pulled[std::size_t(levels) - 1].name, 0, GL_FALSE, 0, GL_WRITE_ONLY,
+                           GL_RGBA32F);
+        dispatch(1, 1);  // one work group
+    }
+    // Push, from the top (or from above the small levels).
+    for (int l = std::min(small, levels) - 1; l >= 0; --l) {
         const Texture& target = s.filled[std::size_t(l)];
         const bool top = l == levels - 1;
         common_uniforms(s.push_program, use_depth, l);
@@ -385,6 +542,11 @@ Status create_fill_programs(ContextState& s) {
     REPRISE_TRY(gl::link_compute((prelude + kPush).c_str(), "push", s.push_program));
     REPRISE_TRY(gl::link_compute((prelude + kFinal).c_str(), "fill", s.final_program));
     s.fill_counts = s.make_counters((kMaxLevels + 2) * sizeof(GLuint));
+    REPRISE_TRY(gl::link_compute((std::string(kComputeHeader) + "#define MAX_LEVELS " +
+                                  std::to_string(kMaxLevels) + "\n" + kPrelude + kSmallLevels)
+                                     .c_str(),
+                                 "pull-push small levels", s.small_levels_program));
+    glGenBuffers(1, &s.small_levels);
     REPRISE_TRY(gl::link_compute((std::string(kComputeHeader) + kGroupCounts + kBorderRows).c_str(),
                                  "border rows", s.border_program));
     s.border_counts = s.make_counters(4 * sizeof(GLuint));

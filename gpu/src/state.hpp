@@ -344,7 +344,9 @@ struct ContextState {
     Texture depth, motion, id, previous_depth, previous_id, payload, out, hit;
     // Pull-push: the image's colour and valid mask, the pulled levels and the filled ones.
     GLuint pull_image_program = 0, pull_level_program = 0, push_program = 0, final_program = 0;
-    GLuint fill_counts = 0;                        // holes, then the empty pixels of each level
+    GLuint fill_counts = 0;  // holes, then the empty pixels of each level
+    GLuint small_levels_program = 0, small_levels = 0;  // the levels of one work group, a buffer
+    std::size_t small_levels_bytes = 0;
     GLuint border_program = 0, border_counts = 0;  // border_rows_pass
     Texture color, valid;
     std::vector<Texture> pulled, pulled_depth, filled, filled_depth;
