@@ -18,6 +18,7 @@
 
 #include "frame_writer.hpp"
 #include "reprise/codec/codec.hpp"
+#include "reprise/core/exr.hpp"
 #include "support/cli.hpp"
 
 namespace fs = std::filesystem;
@@ -51,7 +52,10 @@ TEST(CliStream, ServeAndConnectWriteDisplayedFrames) {
 }
 
 // --backend gles on a lowres stream: every display frame extrapolated and every frame's colour
-// upsampled by the GPU (llvmpipe here), none left to the CPU because the GPU failed.
+// upsampled by the GPU (llvmpipe here), none left to the CPU because the GPU failed; the
+// upsampled colour goes to the extrapolation as a texture (nothing downloaded for it), and the
+// frames written show the scene (the CPU's copy of that colour is never filled: warping it would
+// write black frames).
 TEST(CliStream, ConnectExtrapolatesOnTheGpuBackend) {
     const fs::path out =
         reprise::test::fresh_directory(fs::temp_directory_path() / "reprise-cli-stream-gles");
@@ -72,9 +76,18 @@ TEST(CliStream, ConnectExtrapolatesOnTheGpuBackend) {
     EXPECT_EQ(served.status, 0) << served.output;
     EXPECT_NE(connected.output.find("extrapolated on the GPU"), std::string::npos)
         << connected.output;
-    EXPECT_NE(connected.output.find("upsampled on the GPU"), std::string::npos) << connected.output;
+    EXPECT_NE(connected.output.find("download 0.00 ms a frame; the colour handed to the "
+                                    "extrapolation as a texture"),
+              std::string::npos)
+        << connected.output;
     EXPECT_EQ(connected.output.find("the GPU failed on"), std::string::npos) << connected.output;
-    EXPECT_TRUE(fs::exists(out / "frame_00000.exr")) << connected.output;
+    ASSERT_TRUE(fs::exists(out / "frame_00003.exr")) << connected.output;
+    reprise::Frame shown;
+    ASSERT_TRUE(reprise::read_frame((out / "frame_00003.exr").string(), shown).ok());
+    double sum = 0.0;
+    for (std::size_t i = 0; i < shown.color.pixel_count(); ++i)
+        sum += shown.color.data()[i].r + shown.color.data()[i].g + shown.color.data()[i].b;
+    EXPECT_GT(sum / double(shown.color.pixel_count()), 0.1);  // the scene, not black
 }
 
 // --backend gles --window without --out: the window's OpenGL ES context is the GPU's, each

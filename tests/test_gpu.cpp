@@ -1659,6 +1659,56 @@ TEST(Gpu, UpsamplingOptionsAndNonFiniteSamples) {
         std::string::npos);
 }
 
+// The lowres client's hand-off (Upsampler::keep_output, FrucBackend::colour_from): the kept
+// colour never comes to the CPU image it was asked for, and the frames extrapolated from the
+// texture are those extrapolated from the downloaded colour, to the bit.
+TEST(Gpu, UpsampledColourKeptForTheExtrapolationIsTheDownloadedOne) {
+    const Lowres r = render_lowres("crossing", 3, 2);
+    std::unique_ptr<gpu::Upsampler> downloading, keeping;
+    ASSERT_TRUE(gpu::Upsampler::create(shared_gpu(), {}, downloading).ok());
+    ASSERT_TRUE(gpu::Upsampler::create(shared_gpu(), {}, keeping).ok());
+    keeping->keep_output(true);
+    gpu::FrucBackend uploading(shared_gpu()), handed(shared_gpu());
+    handed.colour_from(keeping.get());
+    const warp::FrucOptions options{.mode = warp::FrucMode::Extrapolate};
+    const Camera& to = r.full[2].camera;
+    Image<glm::vec4> upsampled(kWidth, kHeight), kept(kWidth, kHeight);
+    for (std::size_t i = 0; i < r.full.size(); ++i) {
+        SCOPED_TRACE("frame " + std::to_string(i));
+        ASSERT_TRUE(
+            downloading->upsample(r.low[i].view(), r.jitter[i], r.full[i], upsampled.view()).ok());
+        kept.fill(glm::vec4(NAN));
+        ASSERT_TRUE(keeping->upsample(r.low[i].view(), r.jitter[i], r.full[i], kept.view()).ok());
+        EXPECT_TRUE(keeping->output_kept());
+        EXPECT_TRUE(std::isnan(kept(3, 3).r));               // left unwritten
+        EXPECT_EQ(keeping->kept_for(upsampled.view()), 0u);  // another image: nothing kept for it
+        GBufferView frame = r.full[i];
+        frame.color = upsampled.view();
+        Frame expected, got;
+        warp::FrucCounters c1, c2;
+        ASSERT_TRUE(
+            uploading
+                .extrapolate(frame, to.view, to.projection, 0.5f, 1.0f, options, expected, c1, 0)
+                .ok());
+        frame.color = kept.view();  // NaN on the CPU: the texture must be what is warped
+        ASSERT_TRUE(
+            handed.extrapolate(frame, to.view, to.projection, 0.5f, 1.0f, options, got, c2, 0)
+                .ok());
+        ASSERT_EQ(got.color.width(), kWidth);
+        EXPECT_EQ(test::display_psnr(expected.color, got.color), INFINITY);
+        EXPECT_EQ(std::memcmp(expected.depth.data(), got.depth.data(),
+                              expected.depth.pixel_count() * sizeof(float)),
+                  0);
+        EXPECT_EQ(c1.hole_pixels, c2.hole_pixels);
+        ASSERT_TRUE(keeping->download_kept(kept.view()).ok());
+        EXPECT_EQ(
+            std::memcmp(kept.data(), upsampled.data(), kept.pixel_count() * sizeof(glm::vec4)), 0);
+        EXPECT_FALSE(keeping->output_kept());  // downloaded: the CPU image holds it now
+        EXPECT_NE(keeping->download_kept(kept.view()).message().find("nothing kept"),
+                  std::string::npos);
+    }
+}
+
 // --- The eye with history: the previous frame warped into the rendered eye's holes.
 
 TEST(Gpu, StereoEyeWithHistoryMatchesTheCpuOnEveryBuiltInScene) {

@@ -248,7 +248,8 @@ Status run_connect(const ConnectJob& job) {
                 gles ? StreamWindow::Drawing::SdlSoftware : StreamWindow::Drawing::Sdl, window));
     }
     // --backend gles: each display frame extrapolated on the GPU (the CPU's method: the grid,
-    // pull-push), a lowres stream's colour upsampled there.
+    // pull-push), a lowres stream's colour upsampled there and handed to the extrapolation as a
+    // texture (downloaded only for a reader on the CPU).
     std::unique_ptr<gpu::FrucBackend> backend;
     std::unique_ptr<gpu::Upsampler> upsampler;
     const bool kept_on_gpu = gpu && job.out.empty();
@@ -259,6 +260,11 @@ Status run_connect(const ConnectJob& job) {
         o.extrapolation.backend = backend.get();
         REPRISE_TRY(gpu::Upsampler::create(*gpu, {}, upsampler));
         o.upsampler = upsampler.get();
+        if (o.extrapolate) {
+            upsampler->keep_output(true);
+            backend->colour_from(upsampler.get());
+            o.upsampled_colour_stays = true;
+        }
     }
     double last_t = 0.0;
     bool window_open = true, window_error = false;
@@ -344,9 +350,12 @@ Status run_connect(const ConnectJob& job) {
         const double n = double(upsampler->frames());
         std::fprintf(stderr,
                      "[connect] %zu frames upsampled on the GPU: upload %.2f, compute %.2f, "
-                     "download %.2f ms a frame\n",
+                     "download %.2f ms a frame%s\n",
                      upsampler->frames(), upsampler->total().upload_ms / n,
-                     upsampler->total().compute_ms / n, upsampler->total().download_ms / n);
+                     upsampler->total().compute_ms / n, upsampler->total().download_ms / n,
+                     o.upsampled_colour_stays
+                         ? "; the colour handed to the extrapolation as a texture"
+                         : "");
     }
     if (st.backend_errors > 0)
         std::fprintf(stderr,

@@ -54,6 +54,7 @@ struct StreamClient::State {
     Frame displayed;
     GBufferView shown;
     bool have_decoded = false;
+    bool decoded_colour_kept = false;  // its colour is still the upsampler's (on its device)
     int64_t decoded_pose_us = 0;
     uint32_t decoded_frame = 0;
     uint64_t decoded_count = 0;  // frames decoded: the extrapolator's key for the one shown
@@ -130,6 +131,18 @@ struct StreamClient::State {
         stats.frames_lost += frames.size();
     }
 
+    // The decoded frame's colour on the CPU: where the upsampler kept it, downloaded now.
+    void bring_colour() {
+        if (!decoded_colour_kept) return;
+        decoded_colour_kept = false;
+        const Status s = options.upsampler->download_kept(decoded.color.view());
+        if (!s.ok()) {  // shown black rather than another frame's pixels
+            ++stats.backend_errors;
+            stats.backend_error = s.message();
+            decoded.color.fill(glm::vec4(0.0f));
+        }
+    }
+
     void request_key(int64_t now) {
         if (now - last_key_request_us < kKeyRequestIntervalUs) return;
         last_key_request_us = now;
@@ -197,6 +210,7 @@ struct StreamClient::State {
         }
         consecutive_decode_errors = 0;
         std::swap(decoded, scratch_decoded);
+        decoded_colour_kept = lowres && options.upsampler && options.upsampler->output_kept();
         have_decoded = true;
         decoded_pose_us = packet.pose_time_us;
         decoded_frame = packet.frame;
@@ -445,6 +459,7 @@ const GBufferView* StreamClient::display(const glm::mat4& view, double scene_tim
     info.source_scene_time = f.camera.time;
     info.source_frame = s.decoded_frame;
     info.extrapolated = s.options.extrapolate;
+    if (!s.options.extrapolate || !s.options.upsampled_colour_stays) s.bring_colour();
     if (!s.options.extrapolate) {
         s.shown = f.view();
         return &s.shown;
@@ -456,6 +471,7 @@ const GBufferView* StreamClient::display(const glm::mat4& view, double scene_tim
     if (!made.ok()) {  // the backend failed: the decoded frame as it is
         ++s.stats.backend_errors;
         s.stats.backend_error = made.message();
+        s.bring_colour();
         info.extrapolated = false;
         s.shown = f.view();
         return &s.shown;
@@ -473,6 +489,7 @@ const net::StreamInfoMessage* StreamClient::stream_info() const {
 const StreamClientStats& StreamClient::stats() const { return state_->stats; }
 const net::ResumptionTicket& StreamClient::ticket() const { return state_->ticket; }
 const codec::DecodedFrame* StreamClient::newest_decoded() const {
+    state_->bring_colour();
     return state_->have_decoded ? &state_->decoded : nullptr;
 }
 

@@ -196,9 +196,9 @@ Status grid_extrapolation(ContextState& s, const GBufferView& frame, const glm::
 Status Context::extrapolate(const GBufferView& given, const glm::mat4& view,
                             const glm::mat4& projection, float periods, Frame& out,
                             ExtrapolateStats& stats, const warp::FrucOptions& options,
-                            float motion_scale, uint64_t frame_key) {
+                            float motion_scale, uint64_t frame_key, unsigned color) {
     REPRISE_TRY(extrapolate_on_gpu(given, view, projection, periods, stats, options, motion_scale,
-                                   frame_key));
+                                   frame_key, color));
     out.normal.clear();
     out.id.clear();
     const int w = given.width(), h = given.height();
@@ -220,7 +220,7 @@ Status Context::extrapolate(const GBufferView& given, const glm::mat4& view,
 Status Context::extrapolate_on_gpu(const GBufferView& given, const glm::mat4& view,
                                    const glm::mat4& projection, float periods,
                                    ExtrapolateStats& stats, const warp::FrucOptions& options,
-                                   float motion_scale, uint64_t frame_key) {
+                                   float motion_scale, uint64_t frame_key, unsigned color) {
     ContextState& s = *state_;
     s.made_valid = false;
     timings_ = {};
@@ -233,7 +233,11 @@ Status Context::extrapolate_on_gpu(const GBufferView& given, const glm::mat4& vi
         return Status::error("gpu extrapolate: the frame needs depth and motion of its size");
     if (w <= 0 || h <= 0) return {};
     REPRISE_TRY(s.gl->acquire());
+    if (color) REPRISE_TRY(check_texture(color, GL_RGBA32F, w, h, "frame colour"));
     auto t = std::chrono::steady_clock::now();
+    // The colour from a texture: only the depth and motion are repaired and uploaded.
+    GBufferView geometry = given;
+    if (color) geometry.color = {};
     // The same frame as the last call's: its repaired pixels are uploaded already.
     const bool kept = frame_key != 0 && frame_key == s.extrapolate_key &&
                       s.source_color.width == w && s.source_color.height == h;
@@ -247,13 +251,23 @@ Status Context::extrapolate_on_gpu(const GBufferView& given, const glm::mat4& vi
         stats.nonfinite = s.extrapolate_nonfinite;
         stats.upload_kept = true;
         NonfiniteCounts again;
-        if (grid) frame = s.extrapolate_repair.clean(given, again);
+        if (grid) frame = s.extrapolate_repair.clean(geometry, again);
     } else {
-        frame = s.extrapolate_repair.clean(given, stats.nonfinite);
-        s.upload_frame(frame, s.source_color, s.source_depth, s.source_motion);
+        frame = s.extrapolate_repair.clean(geometry, stats.nonfinite);
+        if (color) {
+            s.source_color.ensure(GL_RGBA32F, w, h);
+            s.source_depth.ensure(GL_R32F, w, h);
+            s.source_motion.ensure(GL_RG32F, w, h);
+            s.upload(s.source_depth, frame.depth.data, frame.depth.stride);
+            s.upload(s.source_motion, frame.motion.data, frame.motion.stride);
+            copy_scaled(s, color, s.source_color.name, w, h, 1.0f);
+        } else {
+            s.upload_frame(frame, s.source_color, s.source_depth, s.source_motion);
+        }
         s.extrapolate_key = frame_key;
         s.extrapolate_nonfinite = stats.nonfinite;
     }
+    if (color) frame.color = given.color;  // sizes the CPU grid's cells (colour: s.source_color)
     s.color.ensure(GL_RGBA32F, w, h);
     s.depth.ensure(GL_R32F, w, h);
     s.made_motion.ensure(GL_RGBA32F, w, h);

@@ -67,14 +67,15 @@ Status FrucBackend::extrapolate(const GBufferView& f, const glm::mat4& view,
                                 const warp::FrucOptions& options, Frame& out,
                                 warp::FrucCounters& counters, uint64_t frame_key) {
     ExtrapolateStats stats;
+    const unsigned kept_color = colour_from_ ? colour_from_->kept_for(f.color) : 0u;
     if (keep_on_gpu_) {
         REPRISE_TRY(context_.extrapolate_on_gpu(f, view, projection, periods, stats, options,
-                                                motion_scale, frame_key));
+                                                motion_scale, frame_key, kept_color));
         out.color.clear(), out.depth.clear(), out.motion.clear(), out.normal.clear();
         out.id.clear();
     } else {
         REPRISE_TRY(context_.extrapolate(f, view, projection, periods, out, stats, options,
-                                         motion_scale, frame_key));
+                                         motion_scale, frame_key, kept_color));
     }
     uploads_kept_ += stats.upload_kept;
     counters.border_pixels += stats.border;

@@ -441,6 +441,8 @@ struct Upsampler::State {
     NonfiniteRepair guide_repair;
     Timings timings, total;
     std::size_t frames = 0;
+    bool keep = false;                    // keep_output
+    ImageView<const glm::vec4> kept_for;  // the `out` the last call kept its result for
 
     void count_frame() {
         total.upload_ms += timings.upload_ms;
@@ -492,6 +494,30 @@ Status Upsampler::create(Context& context, const warp::UpsampleOptions& options,
 }
 
 void Upsampler::reset() { state_->has_history = false; }
+
+void Upsampler::keep_output(bool keep) {
+    state_->keep = keep;
+    state_->kept_for = {};
+}
+
+bool Upsampler::output_kept() const { return !state_->kept_for.empty(); }
+
+unsigned Upsampler::kept_for(ImageView<const glm::vec4> out) const {
+    const ImageView<const glm::vec4>& k = state_->kept_for;
+    const bool same = !k.empty() && k.data == out.data && k.width == out.width &&
+                      k.height == out.height && k.stride == out.stride;
+    return same ? state_->out.name : 0u;
+}
+
+Status Upsampler::download_kept(ImageView<glm::vec4> out) {
+    State& u = *state_;
+    if (!kept_for(out)) return Status::error("gpu upsample: nothing kept for this image");
+    ContextState& s = *u.context->state_;
+    REPRISE_TRY(s.gl->acquire());
+    s.download(u.out, out.data, out.stride);
+    u.kept_for = {};
+    return gl::check_errors("gpu upsample download");
+}
 
 const Timings& Upsampler::timings() const { return state_->timings; }
 const Timings& Upsampler::total() const { return state_->total; }
@@ -648,6 +674,7 @@ Status Upsampler::upsample(ImageView<const glm::vec4> low_color, glm::vec2 jitte
     State& u = *state_;
     ContextState& s = *u.context->state_;
     u.timings = {};
+    u.kept_for = {};
     GBufferView guides = given;
     guides.color = {};
     NonfiniteCounts input_nonfinite;
@@ -695,9 +722,13 @@ Status Upsampler::upsample(ImageView<const glm::vec4> low_color, glm::vec2 jitte
                                  .jitter = jitter_px},
                                 u.out.name, counted));
     u.timings.compute_ms = finish_ms(t);
-    s.download(u.out, out.data, out.stride);
-    REPRISE_TRY(gl::check_errors("gpu upsample download"));
-    u.timings.download_ms = finish_ms(t);
+    if (u.keep) {
+        u.kept_for = out;
+    } else {
+        s.download(u.out, out.data, out.stride);
+        REPRISE_TRY(gl::check_errors("gpu upsample download"));
+        u.timings.download_ms = finish_ms(t);
+    }
     u.count_frame();
     counted.nonfinite = input_nonfinite;
     if (stats) *stats = counted;
@@ -710,6 +741,7 @@ Status Upsampler::upsample(unsigned low_color, int low_width, int low_height, gl
     State& u = *state_;
     ContextState& s = *u.context->state_;
     u.timings = {};
+    u.kept_for = {};
     REPRISE_TRY(s.gl->acquire());
     const int w = full.width, h = full.height;
     if (w <= 0 || h <= 0 || low_width <= 0 || low_height <= 0 || low_width > w || low_height > h)

@@ -30,6 +30,11 @@ struct StreamClientOptions {
     // Lowres streams: where the colour is upsampled (null: the CPU; gpu::Upsampler, not owned,
     // used from the thread that calls poll()).
     warp::UpsampleBackend* upsampler = nullptr;
+    // The upsampler keeps its output on its device (UpsampleBackend::output_kept) and the
+    // extrapolation's backend takes it from there (gpu::Upsampler::keep_output with
+    // gpu::FrucBackend::colour_from): a decoded frame's colour comes to the CPU only for a reader
+    // there (no extrapolation, a failed one, newest_decoded()). False: it always comes.
+    bool upsampled_colour_stays = false;
     bool inject_faults = false;  // put the in-process fault injector on both directions
     net::FaultOptions uplink, downlink;
     double reconnect_after_s = 2.0;  // silence from the server that ends the connection

@@ -219,17 +219,19 @@ public:
     // converter does (PoseExtrapolator does not: on such input the GPU makes the CPU's frame of
     // the repaired input); the silhouettes are warped as they are (the CPU widens them first).
     // A non-zero `frame_key` equal to the last call's reuses that call's upload (and its repair
-    // counts): the caller promises the same frame, pixels unchanged.
+    // counts): the caller promises the same frame, pixels unchanged. A non-zero `color`
+    // (GL_RGBA32F of the frame's size, finite: gpu::Upsampler's kept output) is the frame's
+    // colour, copied on the GPU; frame.color is then neither read nor repaired.
     Status extrapolate(const GBufferView& frame, const glm::mat4& view, const glm::mat4& projection,
                        float periods, Frame& out, ExtrapolateStats& stats,
                        const warp::FrucOptions& options, float motion_scale = 1.0f,
-                       uint64_t frame_key = 0);
+                       uint64_t frame_key = 0, unsigned color = 0);
     // The same with the made frame left on the GPU, nothing downloaded: made() names its
     // textures (a display that draws them, `reprise connect --backend gles --window`).
     Status extrapolate_on_gpu(const GBufferView& frame, const glm::mat4& view,
                               const glm::mat4& projection, float periods, ExtrapolateStats& stats,
                               const warp::FrucOptions& options, float motion_scale = 1.0f,
-                              uint64_t frame_key = 0);
+                              uint64_t frame_key = 0, unsigned color = 0);
     // What the last extrapolate call on CPU images made, until the next call of any kind (the
     // textures are the context's scratch); all 0 when that call failed or made nothing.
     MadeTextures made() const;

@@ -6,6 +6,7 @@
 #include <cstddef>
 
 #include "reprise/gpu/context.hpp"
+#include "reprise/gpu/upsampler.hpp"
 #include "reprise/warp/fruc.hpp"
 
 namespace reprise::gpu {
@@ -34,6 +35,9 @@ public:
     // gets no colour, depth or motion (emptied) and made() names the textures that hold them,
     // until the next call. Off by default (every frame downloaded).
     void keep_extrapolated_on_gpu(bool keep) { keep_on_gpu_ = keep; }
+    // Extrapolated frames whose colour `upsampler` (on the same context) kept on the GPU
+    // (Upsampler::keep_output) take it from there, nothing uploaded; null: none. Not owned.
+    void colour_from(const Upsampler* upsampler) { colour_from_ = upsampler; }
     MadeTextures made() const { return context_.made(); }
 
     // The phases of every frame made so far (interpolated or extrapolated), summed, and how many.
@@ -51,6 +55,7 @@ private:
     Timings total_;
     std::size_t frames_ = 0, uploads_kept_ = 0;
     bool keep_on_gpu_ = false;
+    const Upsampler* colour_from_ = nullptr;
 };
 
 }  // namespace reprise::gpu

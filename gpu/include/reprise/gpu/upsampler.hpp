@@ -31,6 +31,17 @@ public:
                     warp::UpsampleStats* stats = nullptr);
     void reset() override;  // forgets the history (a cut, a new stream)
 
+    // The CPU-image upsample() leaves `out` unwritten and keeps the result in a texture: a
+    // gpu::FrucBackend on the same context joined by colour_from() extrapolates a frame whose
+    // colour is that `out` (the same pixels, size and stride) from the texture, nothing
+    // downloaded or uploaded; download_kept() writes it for a reader on the CPU. Until the next
+    // call; a failed call keeps nothing. Off by default.
+    void keep_output(bool keep);
+    bool output_kept() const override;
+    Status download_kept(ImageView<glm::vec4> out) override;
+    // The texture (GL_RGBA32F) kept for `out`, or 0 when the last call kept nothing for it.
+    unsigned kept_for(ImageView<const glm::vec4> out) const;
+
     const Timings& timings() const;  // the last call's
     const Timings& total() const;    // every call's, summed, and how many
     std::size_t frames() const;

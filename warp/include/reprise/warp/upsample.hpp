@@ -87,6 +87,13 @@ public:
                             const GBufferView& full, ImageView<glm::vec4> out,
                             UpsampleStats* stats = nullptr) = 0;
     virtual void reset() = 0;
+    // Whether the last successful upsample() left `out` unwritten and kept its result on the
+    // backend's device (for a warp backend there: gpu::Upsampler::keep_output); download_kept()
+    // then writes it into `out` for a reader on the CPU.
+    virtual bool output_kept() const { return false; }
+    virtual Status download_kept(ImageView<glm::vec4> /*out*/) {
+        return Status::error("upsample: this backend keeps no output");
+    }
 };
 
 class SpatioTemporalUpsampler {
