@@ -1062,6 +1062,8 @@ TEST(Gpu, TheConverterWithTheGpuBackendMakesTheCpusFrames) {
         EXPECT_GE(test::display_psnr(cpu_defaults[i].color, gpu_defaults[i].color), 50.0) << i;
     EXPECT_EQ(gpu_counters.refined_frames + gpu_counters.refine_skipped,
               cpu_counters.refined_frames + cpu_counters.refine_skipped);
+    EXPECT_EQ(gpu_counters.grid_cells, cpu_counters.grid_cells);  // the backend adds them up
+    EXPECT_GT(cpu_counters.grid_cells, 0u);
     // Within 0.1 % of the pixels: llvmpipe's are the CPU's; a GPU's sqrt and division need not
     // round as the CPU's, and a grey one step off changes the flow a little.
     EXPECT_EQ(gpu_counters.refined_frames, cpu_counters.refined_frames);
@@ -1669,7 +1671,7 @@ TEST(Gpu, UpsampledColourKeptForTheExtrapolationIsTheDownloadedOne) {
     ASSERT_TRUE(gpu::Upsampler::create(shared_gpu(), {}, keeping).ok());
     keeping->keep_output(true);
     gpu::FrucBackend uploading(shared_gpu()), handed(shared_gpu());
-    handed.colour_from(keeping.get());
+    ASSERT_TRUE(handed.colour_from(keeping.get()).ok());
     const warp::FrucOptions options{.mode = warp::FrucMode::Extrapolate};
     const Camera& to = r.full[2].camera;
     Image<glm::vec4> upsampled(kWidth, kHeight), kept(kWidth, kHeight);

@@ -189,7 +189,9 @@ uniform ivec2 size;
 uniform highp float scale;
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
-    if (p.x < size.x && p.y < size.y) imageStore(to, p, texelFetch(from, p, 0) * scale);
+    if (p.x >= size.x || p.y >= size.y) return;
+    highp vec4 v = texelFetch(from, p, 0);  // scale 1: a plain copy (no denormal flushed)
+    imageStore(to, p, scale == 1.0 ? v : v * scale);
 }
 )";
 

@@ -218,7 +218,7 @@ void main() {
 // Levels first..last (each at most kSmallLevel pixels a side) in one work group: pulled from
 // level first - 1 (textures of fine_size), each kept in the buffer, then pushed back up in place
 // to level first, which is written out with the top level as pulled (the final pass reads it).
-constexpr const char* kSmallLevels = R"(
+constexpr const char* kSmallLevelsPass = R"(
 layout(binding = 0) uniform highp sampler2D fine;
 layout(binding = 2) uniform highp sampler2D fine_depth;
 layout(binding = 0, rgba32f) writeonly uniform highp image2D out_color;
@@ -228,13 +228,18 @@ struct Pixel {
     highp vec4 color;
     highp float depth;
 };
-layout(std430, binding = 1) buffer Small { Pixel small[]; };
-uniform int first, last;
-const int kInvocations = 64;
-ivec2 sizes[MAX_LEVELS];
-int offsets[MAX_LEVELS];
-void pull_level(int l, ivec2 fsz, int from) {
-    ivec2 sz = sizes[l - first];
+layout(std430, binding = 1) coherent buffer Small { Pixel small[]; };
+uniform int first, last;  // at most SMALL_LEVELS levels
+const int kInvocations = int(gl_WorkGroupSize.x * gl_WorkGroupSize.y);
+ivec2 sizes[SMALL_LEVELS];
+int offsets[SMALL_LEVELS];
+// Level first + k pulled from the level above it (none past `last`).
+void pull_level(int k) {
+    int l = first + k;
+    if (l > last) return;
+    ivec2 fsz = k == 0 ? fine_size : sizes[k - 1];
+    int from = k == 0 ? 0 : offsets[k - 1];
+    ivec2 sz = sizes[k];
     uint empty = 0u;
     for (int i = int(gl_LocalInvocationIndex); i < sz.x * sz.y; i += kInvocations) {
         ivec2 q = ivec2(i % sz.x, i / sz.x);
@@ -262,13 +267,16 @@ void pull_level(int l, ivec2 fsz, int from) {
         highp vec4 result;
         highp float depth;
         pull_pixel(p, w, d, n, result, depth);
-        small[offsets[l - first] + i] = Pixel(result, depth);
+        small[offsets[k] + i] = Pixel(result, depth);
         if (l == last) imageStore(top_pulled, q, result);
         if (result.a < 1.0) ++empty;
     }
     if (empty != 0u) atomicAdd(counts[1 + l], empty);
 }
-void push_level(int l) {
+// Level last - k filled from the filled level below it (none above `first`).
+void push_level(int k) {
+    int l = last - k;
+    if (l < first) return;
     ivec2 sz = sizes[l - first];
     int at = offsets[l - first];
     for (int i = int(gl_LocalInvocationIndex); i < sz.x * sz.y; i += kInvocations) {
@@ -300,6 +308,8 @@ void push_level(int l) {
         }
     }
 }
+// barrier() may not sit in control flow: the steps are written out, SMALL_LEVELS of each.
+#define STEP(call) call; memoryBarrierBuffer(); barrier();
 void main() {
     ivec2 sz = fine_size;
     int at = 0;
@@ -309,21 +319,16 @@ void main() {
         offsets[l - first] = at;
         at += sz.x * sz.y;
     }
-    for (int l = first; l <= last; ++l) {
-        pull_level(l, l == first ? fine_size : sizes[l - 1 - first],
-                   l == first ? 0 : offsets[l - 1 - first]);
-        memoryBarrierBuffer();
-        barrier();
-    }
-    for (int l = last; l >= first; --l) {
-        push_level(l);
-        memoryBarrierBuffer();
-        barrier();
-    }
+    STEP(pull_level(0)) STEP(pull_level(1)) STEP(pull_level(2))
+    STEP(pull_level(3)) STEP(pull_level(4)) STEP(pull_level(5))
+    STEP(push_level(0)) STEP(push_level(1)) STEP(push_level(2))
+    STEP(push_level(3)) STEP(push_level(4)) STEP(push_level(5))
 }
 )";
 
-constexpr int kSmallLevel = 32;
+// Levels of at most kSmallLevel pixels a side are one work group's (kSmallLevelsPass): at most
+// kSmallLevels of them (32, 16, 8, 4, 2, 1), as many steps as the shader writes out.
+constexpr int kSmallLevel = 32, kSmallLevels = 6;
 
 void set_sizes(GLuint program, int fw, int fh, int cw, int ch) {
     glUniform2i(glGetUniformLocation(program, "fine_size"), fw, fh);
@@ -401,6 +406,7 @@ Status fill_passes(ContextState& s, GLuint color, GLuint valid, GLuint depth, in
         dispatch(target.width, target.height);
     }
     if (small < levels) {
+        REPRISE_ASSERT(levels - small <= kSmallLevels);
         std::size_t pixels = 0;
         for (int l = small; l < levels; ++l)
             pixels += std::size_t(s.pulled[std::size_t(l)].width) * s.pulled[std::size_t(l)].height;
@@ -542,8 +548,8 @@ Status create_fill_programs(ContextState& s) {
     REPRISE_TRY(gl::link_compute((prelude + kPush).c_str(), "push", s.push_program));
     REPRISE_TRY(gl::link_compute((prelude + kFinal).c_str(), "fill", s.final_program));
     s.fill_counts = s.make_counters((kMaxLevels + 2) * sizeof(GLuint));
-    REPRISE_TRY(gl::link_compute((std::string(kComputeHeader) + "#define MAX_LEVELS " +
-                                  std::to_string(kMaxLevels) + "\n" + kPrelude + kSmallLevels)
+    REPRISE_TRY(gl::link_compute((std::string(kComputeHeader) + "#define SMALL_LEVELS " +
+                                  std::to_string(kSmallLevels) + "\n" + kPrelude + kSmallLevelsPass)
                                      .c_str(),
                                  "pull-push small levels", s.small_levels_program));
     glGenBuffers(1, &s.small_levels);

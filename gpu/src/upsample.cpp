@@ -493,12 +493,18 @@ Status Upsampler::create(Context& context, const warp::UpsampleOptions& options,
     return {};
 }
 
-void Upsampler::reset() { state_->has_history = false; }
+void Upsampler::reset() {
+    state_->has_history = false;
+    state_->kept_for = {};
+}
 
 void Upsampler::keep_output(bool keep) {
+    if (keep == state_->keep) return;
     state_->keep = keep;
     state_->kept_for = {};
 }
+
+const Context& Upsampler::context() const { return *state_->context; }
 
 bool Upsampler::output_kept() const { return !state_->kept_for.empty(); }
 
@@ -514,9 +520,12 @@ Status Upsampler::download_kept(ImageView<glm::vec4> out) {
     if (!kept_for(out)) return Status::error("gpu upsample: nothing kept for this image");
     ContextState& s = *u.context->state_;
     REPRISE_TRY(s.gl->acquire());
+    auto t = std::chrono::steady_clock::now();
     s.download(u.out, out.data, out.stride);
     u.kept_for = {};
-    return gl::check_errors("gpu upsample download");
+    REPRISE_TRY(gl::check_errors("gpu upsample download"));
+    u.total.download_ms += finish_ms(t);  // the frame's download, made late
+    return {};
 }
 
 const Timings& Upsampler::timings() const { return state_->timings; }

@@ -33,7 +33,8 @@ struct StreamClientOptions {
     // The upsampler keeps its output on its device (UpsampleBackend::output_kept) and the
     // extrapolation's backend takes it from there (gpu::Upsampler::keep_output with
     // gpu::FrucBackend::colour_from): a decoded frame's colour comes to the CPU only for a reader
-    // there (no extrapolation, a failed one, newest_decoded()). False: it always comes.
+    // there (no extrapolation, a failed one, newest_decoded()). False: it always comes. Set before
+    // streaming, with the two joined; otherwise the never-written CPU colour is warped.
     bool upsampled_colour_stays = false;
     bool inject_faults = false;  // put the in-process fault injector on both directions
     net::FaultOptions uplink, downlink;
@@ -94,6 +95,8 @@ public:
     const StreamClientStats& stats() const;
     // The newest resumption ticket the server sent (valid once a session was admitted).
     const net::ResumptionTicket& ticket() const;
+    // The newest decoded frame, its colour on the CPU (one the upsampler kept is downloaded
+    // here: call it from the thread that calls poll(), and again after poll()).
     const codec::DecodedFrame* newest_decoded() const;
 
     struct State;

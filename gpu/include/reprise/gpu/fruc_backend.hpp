@@ -35,9 +35,14 @@ public:
     // gets no colour, depth or motion (emptied) and made() names the textures that hold them,
     // until the next call. Off by default (every frame downloaded).
     void keep_extrapolated_on_gpu(bool keep) { keep_on_gpu_ = keep; }
-    // Extrapolated frames whose colour `upsampler` (on the same context) kept on the GPU
-    // (Upsampler::keep_output) take it from there, nothing uploaded; null: none. Not owned.
-    void colour_from(const Upsampler* upsampler) { colour_from_ = upsampler; }
+    // Extrapolated frames whose colour `upsampler` kept on the GPU (Upsampler::keep_output) take
+    // it from there, nothing uploaded; null: none. Not owned; an error on another context.
+    Status colour_from(const Upsampler* upsampler) {
+        if (upsampler && &upsampler->context() != &context_)
+            return Status::error("gpu fruc backend: the upsampler works on another GPU context");
+        colour_from_ = upsampler;
+        return {};
+    }
     MadeTextures made() const { return context_.made(); }
 
     // The phases of every frame made so far (interpolated or extrapolated), summed, and how many.

@@ -35,13 +35,15 @@ public:
     // gpu::FrucBackend on the same context joined by colour_from() extrapolates a frame whose
     // colour is that `out` (the same pixels, size and stride) from the texture, nothing
     // downloaded or uploaded; download_kept() writes it for a reader on the CPU. Until the next
-    // call; a failed call keeps nothing. Off by default.
+    // call; a failed call and reset() keep nothing. Off by default; the time of download_kept
+    // counts in total().download_ms.
     void keep_output(bool keep);
     bool output_kept() const override;
     Status download_kept(ImageView<glm::vec4> out) override;
     // The texture (GL_RGBA32F) kept for `out`, or 0 when the last call kept nothing for it.
     unsigned kept_for(ImageView<const glm::vec4> out) const;
 
+    const Context& context() const;
     const Timings& timings() const;  // the last call's
     const Timings& total() const;    // every call's, summed, and how many
     std::size_t frames() const;
