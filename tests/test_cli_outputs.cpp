@@ -9,6 +9,7 @@
 #include <string>
 #include <thread>
 
+#include "reprise/core/exr.hpp"
 #include "support/cli.hpp"
 
 namespace fs = std::filesystem;
@@ -196,6 +197,17 @@ TEST(CliOutputs, KilledEncodeResumesToTheSameBytes) {
     const fs::path in = dir / "in";
     ASSERT_EQ(
         run("render --scene crossing --frames 24 --size 320x180 --aa 1 --out " + q(in)).status, 0);
+    // Frames 4.. at 15 fps (a server stepping down): rate control divides the bitrate by each
+    // frame's rate, which a resumed encode takes from the frames' headers.
+    for (int i = 4; i < 24; ++i) {
+        const std::string file =
+            (in / ("frame_" + std::string(i < 10 ? "0000" : "000") + std::to_string(i) + ".exr"))
+                .string();
+        reprise::Frame f;
+        ASSERT_TRUE(reprise::read_frame(file, f).ok()) << file;
+        f.fps = 15.0;
+        ASSERT_TRUE(reprise::write_frame(file, f).ok()) << file;
+    }
     for (const std::string options : {"--qp 30", "--bitrate 400"}) {
         const std::string encode = "encode --in " + q(in) + " " + options;
         const fs::path whole = dir / "whole.rps", killed = dir / "killed.rps";

@@ -169,9 +169,11 @@ Status encoder_options(const EncodeJob& job, codec::EncoderOptions& o) {
 }
 
 // --resume: the packets a killed encode left in `partial` (whole ones; a torn last one is
-// dropped) are decoded into the encoder's state, and `prefix` keeps their bytes.
-Status resume_stream(const EncodeJob& job, const std::string& partial, codec::Encoder& encoder,
-                     std::vector<uint8_t>& prefix, codec::StreamInfo& info, std::size_t& frames) {
+// dropped) are decoded into the encoder's state, with their frames' rates from the sequence's
+// headers (rate control's, which the stream does not hold), and `prefix` keeps their bytes.
+Status resume_stream(const EncodeJob& job, const std::string& partial, const Sequence& sequence,
+                     double fps, codec::Encoder& encoder, std::vector<uint8_t>& prefix,
+                     codec::StreamInfo& info, std::size_t& frames) {
     std::error_code ec;
     if (!std::filesystem::exists(partial, ec)) return {};
     const std::string recorded = read_text(partial + ".run");
@@ -185,7 +187,16 @@ Status resume_stream(const EncodeJob& job, const std::string& partial, codec::En
         prefix.clear();
         return {};
     }
-    REPRISE_TRY(encoder.resume(packets));
+    if (packets.size() > sequence.files.size())
+        return Status::error("--resume: " + partial + " holds " + std::to_string(packets.size()) +
+                             " frames, more than " + job.in + " has");
+    std::vector<double> rates(packets.size());
+    for (std::size_t i = 0; i < packets.size(); ++i) {
+        FrameHeader header;
+        REPRISE_TRY(read_frame_header(sequence.files[i], header));
+        rates[i] = header.fps > 0 ? header.fps : fps;  // as run_encode sends them
+    }
+    REPRISE_TRY(encoder.resume(packets, rates));
     prefix.resize(std::size_t(packets.back().data() + packets.back().size() - prefix.data()));
     frames = packets.size();
     std::fprintf(stderr, "[encode] resuming after %zu whole packets%s\n", frames,
@@ -216,7 +227,9 @@ Status run_encode(const EncodeJob& job, const codec::EncoderOptions& o) {
     std::vector<uint8_t> prefix;
     codec::StreamInfo resumed;
     std::size_t first = 0;
-    if (job.resume) REPRISE_TRY(resume_stream(job, partial, encoder, prefix, resumed, first));
+    const double fps = sequence.fps > 0 ? sequence.fps : 30.0;
+    if (job.resume)
+        REPRISE_TRY(resume_stream(job, partial, sequence, fps, encoder, prefix, resumed, first));
     std::ofstream(partial + ".run", std::ios::trunc) << job.line;
     std::ofstream stream(partial, std::ios::binary | std::ios::trunc);
     std::size_t bytes = prefix.size();
@@ -225,7 +238,6 @@ Status run_encode(const EncodeJob& job, const codec::EncoderOptions& o) {
     prefix = {};
     Frame frame;
     double busy_ms = 0.0;
-    double fps = sequence.fps > 0 ? sequence.fps : 30.0;
     const std::size_t n = sequence.files.size();
     for (std::size_t i = first; i < n; ++i) {
         REPRISE_TRY(read_frame(sequence, i, frame));

@@ -425,10 +425,14 @@ Status Encoder::send_frame(const GBufferView& given) {
     return {};
 }
 
-Status Encoder::resume(std::span<const std::span<const uint8_t>> packets) {
+Status Encoder::resume(std::span<const std::span<const uint8_t>> packets,
+                       std::span<const double> fps) {
     State& s = *state_;
     if (s.started || s.next_frame != 0)
         return Status::error("resume: the encoder has already encoded frames");
+    if (!fps.empty() && fps.size() != packets.size())
+        return Status::error("resume: " + std::to_string(fps.size()) + " frame rates for " +
+                             std::to_string(packets.size()) + " packets");
     Decoder decoder;
     DecodedFrame decoded;
     std::vector<uint32_t> reference_of(packets.size());
@@ -445,10 +449,11 @@ Status Encoder::resume(std::span<const std::span<const uint8_t>> packets) {
         }
         reference_of[n] = info.reference;
         if (info.type == PacketType::Key) s.last_key = n;
-        // Rate control as send_frame ran it, from the packet's size.
+        // Rate control as send_frame ran it, from the packet's size and the frame's rate.
         const Decoder::State& d = *decoder.state_;
+        const double rate = fps.empty() ? d.sp.fps : fps[n] > 0.0 ? fps[n] : s.options.fps;
         const double target_bits = s.options.bitrate_kbps > 0
-                                       ? s.options.bitrate_kbps * 1000.0 / std::max(1.0, d.sp.fps)
+                                       ? s.options.bitrate_kbps * 1000.0 / std::max(1.0, rate)
                                        : 0.0;
         if (target_bits > 0) {
             const double bits = 8.0 * double(packets[n].size());

@@ -154,7 +154,11 @@ public:
     // them into the references and rate-control state this encoder would hold after them, so
     // that the next send_frame writes what one encoder over the whole sequence would have.
     // Only on an encoder that has encoded nothing; every packet must decode, frames 0, 1, ...
-    Status resume(std::span<const std::span<const uint8_t>> packets);
+    // `fps`: the rate each of those frames was sent with (GBufferView::fps; 0: the options'),
+    // which rate control divides the bitrate by and the stream does not hold; empty: every
+    // frame at the stream's (its key frame's), exact for a constant rate only.
+    Status resume(std::span<const std::span<const uint8_t>> packets,
+                  std::span<const double> fps = {});
     // Changes the rate-control target from the next frame on (0 = constant quality at qp); no
     // key frame is forced.
     void set_bitrate(int kbps);
