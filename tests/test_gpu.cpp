@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <map>
 #include <memory>
 #include <random>
@@ -30,6 +31,7 @@
 #include "reprise/warp/grid_warp.hpp"
 #include "reprise/warp/reproject.hpp"
 #include "reprise/warp/shot_change.hpp"
+#include "reprise/warp/silhouettes.hpp"
 #include "reprise/warp/splat.hpp"
 #include "reprise/warp/true_motion.hpp"
 #include "reprise/warp/upsample.hpp"
@@ -727,6 +729,91 @@ TEST(Gpu, SplatOfTheWholeImageOntoOnePixel) {
     EXPECT_EQ(gpu.depth(40, 30), 5.0f);
 }
 
+// warp::widen_silhouettes on textures, bit for bit: NaN, zeros, negatives, infinities, denormals
+// and depths from 1e-30 to 1e30 beside each other, odd and one-pixel sizes, with and without
+// motion, and a rendered frame.
+TEST(Gpu, WidenedSilhouettesAreTheCpusOnExtremeDepths) {
+    const float nan = std::numeric_limits<float>::quiet_NaN(), inf = INFINITY;
+    const float extremes[] = {nan,    -nan,  0.0f, -0.0f, -1.0f, inf,   -inf,   1e-42f,
+                              1e-30f, 1e30f, 1.0f, 0.86f, 0.85f, 1.17f, 3.4e38f};
+    std::mt19937 random(7);
+    auto frame_of = [&](int w, int h) {
+        Frame f;
+        f.color.resize(w, h);
+        f.depth.resize(w, h);
+        f.motion.resize(w, h);
+        for (int y = 0; y < h; ++y)
+            for (int x = 0; x < w; ++x) {
+                const unsigned pick = random() % 24;
+                f.depth(x, y) = pick < std::size(extremes)
+                                    ? extremes[pick]
+                                    : std::ldexp(1.0f + float(random() % 1000) / 1000.0f,
+                                                 int(random() % 8) - 2);
+                f.motion(x, y) = {float(int(random() % 200) - 100) / 8.0f,
+                                  pick == 3 ? nan : float(y)};
+            }
+        return f;
+    };
+    gpu::Context& context = shared_gpu();
+    std::size_t widened = 0;
+    std::vector<Frame> frames;
+    for (const glm::ivec2 size : {glm::ivec2(1, 1), glm::ivec2(1, 7), glm::ivec2(9, 1),
+                                  glm::ivec2(37, 23), glm::ivec2(64, 64)})
+        frames.push_back(frame_of(size.x, size.y));
+    frames.push_back(scene_frames("fence")[1]);
+    for (const Frame& f : frames)
+        for (const bool moves : {true, false}) {
+            const int w = f.width(), h = f.height();
+            SCOPED_TRACE(std::to_string(w) + "x" + std::to_string(h) +
+                         (moves ? "" : ", no motion"));
+            GBufferView view = f.view();
+            if (!moves) view.motion = {};
+            Image<float> cpu_depth;
+            Image<glm::vec2> cpu_motion;
+            std::size_t cpu_changed = 0;
+            warp::widen_silhouettes(view, cpu_depth, cpu_motion, &cpu_changed);
+            context.make_current();
+            Textures t;
+            gpu::GBufferTextures in = t.gbuffer(f);
+            in.width = w, in.height = h;
+            if (!moves) in.motion = 0;
+            const GLuint depth = t.make(GL_R32F, w, h, GL_RED, GL_FLOAT, nullptr);
+            const GLuint motion = t.make(GL_RGBA32F, w, h, GL_RGBA, GL_FLOAT, nullptr);
+            std::size_t changed = 0;
+            const Status status = context.widen_silhouettes(in, depth, motion, changed);
+            ASSERT_TRUE(status.ok()) << status.message();
+            EXPECT_EQ(changed, cpu_changed);
+            widened += changed;
+            const Image<glm::vec4> gpu_depth = read_rgba(depth, w, h);
+            const Image<glm::vec4> gpu_motion = read_rgba(motion, w, h);
+            for (int y = 0; y < h; ++y)
+                for (int x = 0; x < w; ++x) {
+                    ASSERT_EQ(std::bit_cast<uint32_t>(gpu_depth(x, y).x),
+                              std::bit_cast<uint32_t>(cpu_depth(x, y)))
+                        << x << "," << y << ": " << f.depth(x, y);
+                    if (!moves) continue;
+                    for (int k = 0; k < 2; ++k)
+                        ASSERT_EQ(std::bit_cast<uint32_t>(gpu_motion(x, y)[k]),
+                                  std::bit_cast<uint32_t>(cpu_motion(x, y)[k]))
+                            << x << "," << y;
+                }
+        }
+    EXPECT_GT(widened, 1000u);  // not vacuous
+
+    context.make_current();
+    Textures t;
+    const Frame& f = scene_frames("fence")[1];
+    const gpu::GBufferTextures in = t.gbuffer(f);
+    std::size_t changed = 0;
+    EXPECT_NE(context.widen_silhouettes(in, in.depth, t.rgba(), changed)
+                  .message()
+                  .find("the output depth is the input depth"),
+              std::string::npos);
+    EXPECT_NE(
+        context.widen_silhouettes(in, t.r32f(), t.r32f(), changed).message().find("output motion"),
+        std::string::npos);
+}
+
 TEST(Gpu, StereoEyeRepairsNonFiniteInputAsTheCpu) {
     NonfiniteCounts spoiled;
     const std::vector<Frame> frames = test::spoiled_sequence(1, spoiled);
@@ -749,10 +836,9 @@ TEST(Gpu, StereoEyeOnTexturesAndOptionsTheGpuLacks) {
     Frame from_images;
     stereo::StereoStats image_stats, texture_stats;
     gpu::Context& context = shared_gpu();
-    // The texture entry warps the depth texture as it is: no widened silhouettes.
-    stereo::StereoOptions as_is = kSplatEye;
-    as_is.widen_silhouettes = false;
-    ASSERT_TRUE(context.stereo_eye(f, right, from_images, image_stats, as_is).ok());
+    // Both entries widen the silhouettes on the GPU.
+    const stereo::StereoOptions& splat = kSplatEye;
+    ASSERT_TRUE(context.stereo_eye(f, right, from_images, image_stats, splat).ok());
     context.make_current();
     Textures t;
     const gpu::GBufferTextures rendered = t.gbuffer(f);
@@ -760,7 +846,7 @@ TEST(Gpu, StereoEyeOnTexturesAndOptionsTheGpuLacks) {
     const GLuint out = t.rgba();
     const GLuint depth = t.r32f();
     const Status status =
-        context.stereo_eye(rendered, color, right, out, depth, texture_stats, as_is);
+        context.stereo_eye(rendered, color, right, out, depth, texture_stats, splat);
     ASSERT_TRUE(status.ok()) << status.message();
     EXPECT_EQ(texture_stats.holes, image_stats.holes);
     EXPECT_EQ(context.timings().upload_ms, 0.0);
@@ -768,11 +854,10 @@ TEST(Gpu, StereoEyeOnTexturesAndOptionsTheGpuLacks) {
     EXPECT_EQ(test::display_psnr(read, from_images.color), INFINITY);
 
     // The grid eye (its cells grown on the GPU) on textures: the CPU-image entry's eye.
-    const stereo::StereoOptions grid_as_is{.widen_silhouettes = false};
-    ASSERT_TRUE(context.stereo_eye(f, right, from_images, image_stats, grid_as_is).ok());
+    const stereo::StereoOptions grid;
+    ASSERT_TRUE(context.stereo_eye(f, right, from_images, image_stats, grid).ok());
     context.make_current();
-    ASSERT_TRUE(
-        context.stereo_eye(rendered, color, right, out, depth, texture_stats, grid_as_is).ok());
+    ASSERT_TRUE(context.stereo_eye(rendered, color, right, out, depth, texture_stats, grid).ok());
     EXPECT_EQ(texture_stats.cells, image_stats.cells);
     EXPECT_EQ(texture_stats.border, image_stats.border);
     EXPECT_GT(texture_stats.border, 0u);
@@ -823,12 +908,10 @@ Differences differences(const Frame& cpu, const Frame& gpu) {
 const warp::FrucOptions kSplatInterpolation{
     .warp = warp::WarpMethod::Splat, .true_motion = false, .refine = {.enabled = false}};
 
-// The frame the CPU makes halfway between `a` and `b` with `options` from the inputs as they are
-// (the converter widens their silhouettes before it hands them to a backend; Context::interpolate
-// does not).
-Frame cpu_between_with(const Frame& a, const Frame& b, warp::FrucOptions options,
+// The frame the CPU makes halfway between `a` and `b` with `options` (their silhouettes widened
+// on the CPU, as Context::interpolate widens them on the GPU).
+Frame cpu_between_with(const Frame& a, const Frame& b, const warp::FrucOptions& options,
                        warp::FrucCounters* counters = nullptr) {
-    options.widen_silhouettes = false;
     warp::FrameRateConverter converter;
     EXPECT_TRUE(warp::FrameRateConverter::create(2, options, converter).ok());
     std::vector<Frame> outputs;
@@ -949,7 +1032,7 @@ TEST(Gpu, RefinedInterpolationMatchesTheCpuOnEveryBuiltInScene) {
 }
 
 TEST(Gpu, InterpolationMatchesTheCpuOnEveryBuiltInScene) {
-    std::size_t holes = 0, true_motion = 0;
+    std::size_t holes = 0, true_motion = 0, widened = 0;
     for (const server::SceneInfo& info : server::builtin_scenes()) {
         const std::vector<Frame>& frames = scene_frames(info.name);
         for (const bool reverse : {false, true}) {
@@ -968,6 +1051,8 @@ TEST(Gpu, InterpolationMatchesTheCpuOnEveryBuiltInScene) {
                 ASSERT_TRUE(status.ok()) << status.message();
                 if (counters.copied_still == 0) {  // (shadows: a still pair, the CPU copies it)
                     EXPECT_EQ(stats.border, counters.border_pixels);
+                    EXPECT_EQ(stats.silhouette_a + stats.silhouette_b, counters.silhouette_pixels);
+                    widened += stats.silhouette_a + stats.silhouette_b;
                     EXPECT_EQ(std::size_t(stats.true_motion), counters.true_motion);
                     EXPECT_EQ(std::size_t(stats.linear_motion), counters.linear_motion);
                 }
@@ -990,6 +1075,7 @@ TEST(Gpu, InterpolationMatchesTheCpuOnEveryBuiltInScene) {
     }
     EXPECT_GT(holes, 0u);        // not vacuous: some holes filled
     EXPECT_GT(true_motion, 0u);  // ... and some pairs followed their true motion
+    EXPECT_GT(widened, 0u);      // ... and some silhouettes widened on the GPU
 }
 
 TEST(Gpu, InterpolationRepairsNonFiniteInputAsTheCpu) {
@@ -1049,6 +1135,8 @@ TEST(Gpu, TheConverterWithTheGpuBackendMakesTheCpusFrames) {
               cpu[1].motion.pixel_count() / 1000);  // per output period, as the CPU's
     EXPECT_EQ(gpu_counters.cuts, 1u);
     EXPECT_EQ(gpu_counters.hole_pixels, cpu_counters.hole_pixels);
+    // Widened on the GPU once per upload, as the CPU widens once per input.
+    EXPECT_EQ(gpu_counters.silhouette_pixels, cpu_counters.silhouette_pixels);
     EXPECT_EQ(gpu_counters.fills + gpu_counters.fills_skipped,
               cpu_counters.fills + cpu_counters.fills_skipped);
 
@@ -1215,8 +1303,7 @@ TEST(Gpu, LinearitySurveyOfSamplesIsTheSurveyOfTheFrame) {
 // --- Extrapolation against warp::PoseExtrapolator and the converter with the same options.
 
 const warp::FrucOptions kSplatExtrapolation{.mode = warp::FrucMode::Extrapolate,
-                                            .warp = warp::WarpMethod::Splat,
-                                            .widen_silhouettes = false};
+                                            .warp = warp::WarpMethod::Splat};
 
 // `frame` seen by the next frame's camera `periods` on, on the CPU and on the GPU: colour within
 // 50 dB, depth in bits on all but 0.1 % of the pixels, motion within 1e-4 px.
@@ -1269,6 +1356,7 @@ void expect_extrapolation_matches(const Frame& frame, const Camera& to, float pe
     if (has_projection(frame.camera)) {
         EXPECT_EQ(stats.moving > 0, extrapolator.counters().dynamic_layers == 1);
     }
+    EXPECT_EQ(stats.silhouette_pixels, extrapolator.counters().silhouette_pixels);
     std::printf(
         "  %.2f periods on: moving %zu, covered %zu, border %zu, holes %zu, %.1f dB, depth %zu "
         "differ, motion within %g\n",
@@ -1431,8 +1519,7 @@ TEST(Gpu, ExtrapolationKeptOnTheGpuIsTheFrameDownloaded) {
 TEST(Gpu, TheExtrapolatingConverterWithTheGpuBackendMakesTheCpusFrames) {
     std::vector<Frame> frames = test::render_scene("crossing", 3, kWidth, kHeight, 30.0, 3);
     frames[2].camera.cut = Cut::Yes;
-    warp::FrucOptions cpu_options = kSplatExtrapolation;
-    cpu_options.widen_silhouettes = true;
+    const warp::FrucOptions& cpu_options = kSplatExtrapolation;
     gpu::FrucBackend backend(shared_gpu());
     warp::FrucOptions gpu_options = cpu_options;
     gpu_options.backend = &backend;
@@ -1450,6 +1537,8 @@ TEST(Gpu, TheExtrapolatingConverterWithTheGpuBackendMakesTheCpusFrames) {
     EXPECT_EQ(backend.frames(), 4u);        // the cut's two are copies
     EXPECT_EQ(backend.uploads_kept(), 2u);  // each input's second frame warps its first upload
     EXPECT_EQ(gpu_counters.hole_pixels, cpu_counters.hole_pixels);
+    EXPECT_EQ(gpu_counters.silhouette_pixels, cpu_counters.silhouette_pixels);
+    EXPECT_GT(gpu_counters.silhouette_pixels, 0u);
     EXPECT_EQ(gpu_counters.dynamic_layers, cpu_counters.dynamic_layers);
     EXPECT_EQ(gpu_counters.fills, cpu_counters.fills);
 
@@ -1484,6 +1573,8 @@ TEST(Gpu, ExtrapolationOnTexturesAndBadArguments) {
     ASSERT_TRUE(status.ok()) << status.message();
     EXPECT_EQ(texture_stats.holes, image_stats.holes);
     EXPECT_EQ(texture_stats.moving, image_stats.moving);
+    EXPECT_EQ(texture_stats.silhouette_pixels, image_stats.silhouette_pixels);
+    EXPECT_GT(texture_stats.silhouette_pixels, 0u);
     EXPECT_EQ(test::display_psnr(read_rgba(out), from_images.color), INFINITY);
     const Image<glm::vec4> read_motion = read_rgba(motion);
     for (std::size_t i = 0; i < read_motion.pixel_count(); ++i)
@@ -1661,9 +1752,10 @@ TEST(Gpu, UpsamplingOptionsAndNonFiniteSamples) {
         std::string::npos);
 }
 
-// The lowres client's hand-off (Upsampler::keep_output, FrucBackend::colour_from): the kept
-// colour never comes to the CPU image it was asked for, and the frames extrapolated from the
-// texture are those extrapolated from the downloaded colour, to the bit.
+// The lowres client's hand-off (Upsampler::keep_output, FrucBackend::inputs_from): the kept
+// colour never comes to the CPU image it was asked for, the depth and motion that guided the
+// upsampler are not uploaded again, and the frames extrapolated from the textures are those
+// extrapolated from the downloaded colour and the uploaded depth and motion, to the bit.
 TEST(Gpu, UpsampledColourKeptForTheExtrapolationIsTheDownloadedOne) {
     const Lowres r = render_lowres("crossing", 3, 2);
     std::unique_ptr<gpu::Upsampler> downloading, keeping;
@@ -1671,7 +1763,7 @@ TEST(Gpu, UpsampledColourKeptForTheExtrapolationIsTheDownloadedOne) {
     ASSERT_TRUE(gpu::Upsampler::create(shared_gpu(), {}, keeping).ok());
     keeping->keep_output(true);
     gpu::FrucBackend uploading(shared_gpu()), handed(shared_gpu());
-    ASSERT_TRUE(handed.colour_from(keeping.get()).ok());
+    ASSERT_TRUE(handed.inputs_from(keeping.get()).ok());
     const warp::FrucOptions options{.mode = warp::FrucMode::Extrapolate};
     const Camera& to = r.full[2].camera;
     Image<glm::vec4> upsampled(kWidth, kHeight), kept(kWidth, kHeight);
@@ -1680,7 +1772,8 @@ TEST(Gpu, UpsampledColourKeptForTheExtrapolationIsTheDownloadedOne) {
         ASSERT_TRUE(
             downloading->upsample(r.low[i].view(), r.jitter[i], r.full[i], upsampled.view()).ok());
         kept.fill(glm::vec4(NAN));
-        ASSERT_TRUE(keeping->upsample(r.low[i].view(), r.jitter[i], r.full[i], kept.view()).ok());
+        Frame guides = r.full[i];
+        ASSERT_TRUE(keeping->upsample(r.low[i].view(), r.jitter[i], guides, kept.view()).ok());
         EXPECT_TRUE(keeping->output_kept());
         EXPECT_TRUE(std::isnan(kept(3, 3).r));               // left unwritten
         EXPECT_EQ(keeping->kept_for(upsampled.view()), 0u);  // another image: nothing kept for it
@@ -1692,9 +1785,19 @@ TEST(Gpu, UpsampledColourKeptForTheExtrapolationIsTheDownloadedOne) {
             uploading
                 .extrapolate(frame, to.view, to.projection, 0.5f, 1.0f, options, expected, c1, 0)
                 .ok());
-        frame.color = kept.view();  // NaN on the CPU: the texture must be what is warped
+        // NaN colour, flat depth and no motion on the CPU: the textures must be what is warped.
+        guides.depth.fill(1.0f);
+        guides.motion.fill(glm::vec2(0.0f));
+        GBufferView handed_frame = guides.view();
+        handed_frame.color = kept.view();
+        const gpu::FrameOnGpu on_gpu = keeping->on_gpu(handed_frame);
+        EXPECT_NE(on_gpu.color, 0u);
+        EXPECT_NE(on_gpu.depth, 0u);
+        EXPECT_NE(on_gpu.motion, 0u);
+        EXPECT_EQ(keeping->on_gpu(frame).depth, 0u);  // other images: not these
         ASSERT_TRUE(
-            handed.extrapolate(frame, to.view, to.projection, 0.5f, 1.0f, options, got, c2, 0)
+            handed
+                .extrapolate(handed_frame, to.view, to.projection, 0.5f, 1.0f, options, got, c2, 0)
                 .ok());
         ASSERT_EQ(got.color.width(), kWidth);
         EXPECT_EQ(test::display_psnr(expected.color, got.color), INFINITY);
@@ -1702,6 +1805,8 @@ TEST(Gpu, UpsampledColourKeptForTheExtrapolationIsTheDownloadedOne) {
                               expected.depth.pixel_count() * sizeof(float)),
                   0);
         EXPECT_EQ(c1.hole_pixels, c2.hole_pixels);
+        EXPECT_EQ(c1.silhouette_pixels, c2.silhouette_pixels);  // widened on the GPU alike
+        EXPECT_GT(c1.silhouette_pixels, 0u);
         ASSERT_TRUE(keeping->download_kept(kept.view()).ok());
         EXPECT_EQ(
             std::memcmp(kept.data(), upsampled.data(), kept.pixel_count() * sizeof(glm::vec4)), 0);
@@ -1762,9 +1867,8 @@ TEST(Gpu, StereoEyeWithHistoryOnTexturesIsTheImageEntrys) {
     const std::vector<Frame>& frames = scene_frames("mirror");
     const Camera right =
         stereo::eye_cameras(frames[1].camera, {.ipd = 0.2f}, stereo::Anchor::Left).right;
-    // The texture entry warps the depth as it is: silhouettes not widened on either.
-    const stereo::StereoOptions options{.warp = stereo::StereoWarp::Splat,
-                                        .widen_silhouettes = false};
+    // Silhouettes widened on the GPU by both entries.
+    const stereo::StereoOptions options{.warp = stereo::StereoWarp::Splat};
     gpu::Context& context = shared_gpu();
     Frame from_images;
     stereo::StereoStats image_stats, texture_stats;

@@ -68,12 +68,10 @@ struct Textures {
     ~Textures() { glDeleteTextures(GLsizei(names.size()), names.data()); }
 };
 
-// Extrapolation by the splat and by the grid (pull-push), the silhouettes as they are.
+// Extrapolation by the splat and by the grid (pull-push).
 const warp::FrucOptions kExtrapolation{.mode = warp::FrucMode::Extrapolate,
-                                       .warp = warp::WarpMethod::Splat,
-                                       .widen_silhouettes = false};
-const warp::FrucOptions kGridExtrapolation{.mode = warp::FrucMode::Extrapolate,
-                                           .widen_silhouettes = false};
+                                       .warp = warp::WarpMethod::Splat};
+const warp::FrucOptions kGridExtrapolation{.mode = warp::FrucMode::Extrapolate};
 
 // The default in-between frame on the GPU: the grid, true motion, refinement.
 const gpu::InterpolateOptions kRefinedBetween{
@@ -112,8 +110,7 @@ Status time_texture_path(gpu::Context& context, const Frame& current, const Fram
         REPRISE_TRY(context.stereo_eye(now, color, right, filled, eye_depth, eye_stats,
                                        {.warp = stereo::StereoWarp::Splat}));
         if (i) timed.eye.ms.push_back(context.timings().compute_ms);
-        REPRISE_TRY(context.stereo_eye(now, color, right, filled, eye_depth, eye_stats,
-                                       {.widen_silhouettes = false}));
+        REPRISE_TRY(context.stereo_eye(now, color, right, filled, eye_depth, eye_stats, {}));
         if (i) timed.grid_eye.ms.push_back(context.timings().compute_ms);
         gpu::InterpolateStats between_stats;
         REPRISE_TRY(context.interpolate(before, previous_color, now, color, 0.5f, filled, eye_depth,
@@ -170,20 +167,16 @@ Status bench_gles_stages(const std::vector<Frame>& frames, const std::string& si
     // The previous frame one period on, seen by the current camera.
     warp::PoseExtrapolator extrapolator(kExtrapolation), grid_extrapolator(kGridExtrapolation);
     Frame cpu_ahead, gpu_ahead;
-    // The CPU's in-between frame with the same method (both sides splatted, blended, pull-push),
-    // its inputs' silhouettes as they are (a backend gets them widened by the converter).
-    const warp::FrucOptions between_options{.warp = warp::WarpMethod::Splat,
-                                            .widen_silhouettes = false,
-                                            .true_motion = false,
-                                            .refine = {.enabled = false}};
+    // The CPU's in-between frame with the same method (both sides splatted, blended, pull-push).
+    const warp::FrucOptions between_options{
+        .warp = warp::WarpMethod::Splat, .true_motion = false, .refine = {.enabled = false}};
     warp::FrameRateConverter converter, grid_converter, default_converter;
     REPRISE_TRY(warp::FrameRateConverter::create(2, between_options, converter));
-    const warp::FrucOptions grid_between_options{
-        .widen_silhouettes = false, .true_motion = false, .refine = {.enabled = false}};
+    const warp::FrucOptions grid_between_options{.true_motion = false,
+                                                 .refine = {.enabled = false}};
     REPRISE_TRY(warp::FrameRateConverter::create(2, grid_between_options, grid_converter));
     // The default: the grid, true motion, refinement (its flow on the CPU on both backends).
-    REPRISE_TRY(
-        warp::FrameRateConverter::create(2, {.widen_silhouettes = false}, default_converter));
+    REPRISE_TRY(warp::FrameRateConverter::create(2, {}, default_converter));
     Frame between_in, gpu_between;
     warp::SplatOptions splat_options;
     const stereo::StereoOptions eye_options{.warp = stereo::StereoWarp::Splat};
@@ -357,8 +350,8 @@ Status bench_gles_stages(const std::vector<Frame>& frames, const std::string& si
                                    stages[4].textures, stages[5].textures, stages[7].textures,
                                    stages[8].textures, stages[9].textures, stages[10].textures}));
     std::printf(
-        "gles: %s; GPU columns are medians; gles cpu: the work left on the CPU (widened "
-        "silhouettes, the grid's displacement and cells, refinement's optical flow); textures: the "
+        "gles: %s; GPU columns are medians; gles cpu: the work left on the CPU (refinement's "
+        "optical flow; for a skewed projection the grid's displacement and cells); textures: the "
         "texture entry point on textures already on the GPU (compute alone; with the flow for "
         "the default in-between frame)\n",
         context->description().c_str());

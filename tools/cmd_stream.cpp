@@ -262,7 +262,7 @@ Status run_connect(const ConnectJob& job) {
         o.upsampler = upsampler.get();
         if (o.extrapolate) {
             upsampler->keep_output(true);
-            REPRISE_TRY(backend->colour_from(upsampler.get()));
+            REPRISE_TRY(backend->inputs_from(upsampler.get()));
             o.upsampled_colour_stays = true;
         }
     }

@@ -19,6 +19,7 @@ Status create_interpolate_programs(ContextState& state);
 Status create_extrapolate_programs(ContextState& state);
 Status create_refine_programs(ContextState& state);
 Status create_shot_change_program(ContextState& state);
+Status create_silhouette_program(ContextState& state);
 
 double ms_since(std::chrono::steady_clock::time_point& since) {
     const auto now = std::chrono::steady_clock::now();
@@ -284,6 +285,11 @@ Context::~Context() {
                        &state_->history_warped_depth,
                        &state_->history_covered,
                        &state_->merged,
+                       &state_->eye_wide_depth,
+                       &state_->history_wide_depth,
+                       &state_->history_wide_motion,
+                       &state_->source_wide_depth,
+                       &state_->source_wide_motion,
                        &state_->display_table,
                        &state_->shot_reprojected,
                        &state_->shot_hit})
@@ -294,6 +300,8 @@ Context::~Context() {
     glDeleteBuffers(1, &state_->refinement.won);
     glDeleteProgram(state_->border_program);
     glDeleteBuffers(1, &state_->border_counts);
+    glDeleteProgram(state_->widen_program);
+    glDeleteBuffers(1, &state_->widen_counts);
     for (auto* chain :
          {&state_->pulled, &state_->pulled_depth, &state_->filled, &state_->filled_depth})
         for (Texture& t : *chain) glDeleteTextures(1, &t.name);
@@ -362,6 +370,7 @@ Status Context::create_on(std::unique_ptr<gl::Context> gl, std::unique_ptr<Conte
     REPRISE_TRY(create_interpolate_programs(s));
     REPRISE_TRY(create_extrapolate_programs(s));
     REPRISE_TRY(create_refine_programs(s));
+    REPRISE_TRY(create_silhouette_program(s));
     s.counts_buffer = s.make_counters(8 * sizeof(GLuint));
     glGenBuffers(1, &s.readback_buffer);
     glBindBuffer(GL_COPY_WRITE_BUFFER, s.readback_buffer);

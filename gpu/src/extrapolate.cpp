@@ -12,6 +12,7 @@
 
 #include "reprise/warp/extrapolate.hpp"
 #include "reprise/warp/fill.hpp"
+#include "reprise/warp/silhouettes.hpp"
 
 #include "state.hpp"
 
@@ -196,9 +197,9 @@ Status grid_extrapolation(ContextState& s, const GBufferView& frame, const glm::
 Status Context::extrapolate(const GBufferView& given, const glm::mat4& view,
                             const glm::mat4& projection, float periods, Frame& out,
                             ExtrapolateStats& stats, const warp::FrucOptions& options,
-                            float motion_scale, uint64_t frame_key, unsigned color) {
+                            float motion_scale, uint64_t frame_key, const FrameOnGpu& on_gpu) {
     REPRISE_TRY(extrapolate_on_gpu(given, view, projection, periods, stats, options, motion_scale,
-                                   frame_key, color));
+                                   frame_key, on_gpu));
     out.normal.clear();
     out.id.clear();
     const int w = given.width(), h = given.height();
@@ -220,7 +221,8 @@ Status Context::extrapolate(const GBufferView& given, const glm::mat4& view,
 Status Context::extrapolate_on_gpu(const GBufferView& given, const glm::mat4& view,
                                    const glm::mat4& projection, float periods,
                                    ExtrapolateStats& stats, const warp::FrucOptions& options,
-                                   float motion_scale, uint64_t frame_key, unsigned color) {
+                                   float motion_scale, uint64_t frame_key,
+                                   const FrameOnGpu& on_gpu) {
     ContextState& s = *state_;
     s.made_valid = false;
     timings_ = {};
@@ -233,11 +235,17 @@ Status Context::extrapolate_on_gpu(const GBufferView& given, const glm::mat4& vi
         return Status::error("gpu extrapolate: the frame needs depth and motion of its size");
     if (w <= 0 || h <= 0) return {};
     REPRISE_TRY(s.gl->acquire());
-    if (color) REPRISE_TRY(check_texture(color, GL_RGBA32F, w, h, "frame colour"));
+    const bool color_on_gpu = on_gpu.color != 0;
+    const bool geometry_on_gpu = on_gpu.depth != 0 || on_gpu.motion != 0;
+    if (color_on_gpu) REPRISE_TRY(check_texture(on_gpu.color, GL_RGBA32F, w, h, "frame colour"));
+    if (geometry_on_gpu) {
+        REPRISE_TRY(check_texture(on_gpu.depth, GL_R32F, w, h, "frame depth"));
+        REPRISE_TRY(check_texture(on_gpu.motion, GL_RG32F, w, h, "frame motion"));
+    }
     auto t = std::chrono::steady_clock::now();
-    // The colour from a texture: only the depth and motion are repaired and uploaded.
+    // The colour from a texture: only the depth and motion are repaired (and uploaded).
     GBufferView geometry = given;
-    if (color) geometry.color = {};
+    if (color_on_gpu) geometry.color = {};
     // The same frame as the last call's: its repaired pixels are uploaded already.
     const bool kept = frame_key != 0 && frame_key == s.extrapolate_key &&
                       s.source_color.width == w && s.source_color.height == h;
@@ -253,21 +261,39 @@ Status Context::extrapolate_on_gpu(const GBufferView& given, const glm::mat4& vi
         NonfiniteCounts again;
         if (grid) frame = s.extrapolate_repair.clean(geometry, again);
     } else {
+        s.source_wide = SourceWide::Nothing;
         frame = s.extrapolate_repair.clean(geometry, stats.nonfinite);
-        if (color) {
-            s.source_color.ensure(GL_RGBA32F, w, h);
-            s.source_depth.ensure(GL_R32F, w, h);
-            s.source_motion.ensure(GL_RG32F, w, h);
+        s.source_color.ensure(GL_RGBA32F, w, h);
+        s.source_depth.ensure(GL_R32F, w, h);
+        s.source_motion.ensure(GL_RG32F, w, h);
+        if (color_on_gpu)
+            copy_scaled(s, on_gpu.color, s.source_color.name, w, h, 1.0f);
+        else
+            s.upload(s.source_color, frame.color.data, frame.color.stride);
+        if (!geometry_on_gpu) {
             s.upload(s.source_depth, frame.depth.data, frame.depth.stride);
             s.upload(s.source_motion, frame.motion.data, frame.motion.stride);
-            copy_scaled(s, color, s.source_color.name, w, h, 1.0f);
-        } else {
-            s.upload_frame(frame, s.source_color, s.source_depth, s.source_motion);
         }
         s.extrapolate_key = frame_key;
         s.extrapolate_nonfinite = stats.nonfinite;
     }
-    if (color) frame.color = given.color;  // sizes the CPU grid's cells (colour: s.source_color)
+    if (color_on_gpu) frame.color = given.color;  // sizes the CPU grid's cells
+    // The depth and motion warped: the silhouettes widened on the GPU once per upload (the CPU
+    // grid widens its own), or the textures handed over copied (they may change before the
+    // frame key does).
+    const bool widen = options.widen_silhouettes && !cpu_grid;
+    const SourceWide wanted = widen             ? SourceWide::Widened
+                              : geometry_on_gpu ? SourceWide::Copied
+                                                : SourceWide::Nothing;
+    if (wanted != SourceWide::Nothing && s.source_wide != wanted) {
+        const std::size_t changed =
+            widen_pass(s, geometry_on_gpu ? on_gpu.depth : s.source_depth.name,
+                       geometry_on_gpu ? on_gpu.motion : s.source_motion.name, w, h,
+                       s.source_wide_depth, &s.source_wide_motion, widen);
+        if (!kept) stats.silhouette_pixels = changed;
+        s.source_wide = wanted;
+    }
+    const bool from_wide = wanted != SourceWide::Nothing;
     s.color.ensure(GL_RGBA32F, w, h);
     s.depth.ensure(GL_R32F, w, h);
     s.made_motion.ensure(GL_RGBA32F, w, h);
@@ -275,14 +301,25 @@ Status Context::extrapolate_on_gpu(const GBufferView& given, const glm::mat4& vi
     Status made;
     if (!cpu_grid)
         made = extrapolate_passes(
-            s, {s.source_color.name, s.source_depth.name, s.source_motion.name, w, h}, given.camera,
-            view, projection, periods, motion_scale, options, s.color.name, s.depth.name,
-            s.made_motion.name, stats);
+            s,
+            {s.source_color.name, from_wide ? s.source_wide_depth.name : s.source_depth.name,
+             from_wide ? s.source_wide_motion.name : s.source_motion.name, w, h},
+            given.camera, view, projection, periods, motion_scale, options, s.color.name,
+            s.depth.name, s.made_motion.name, stats);
     // A skewed projection, or more cells than a storage buffer holds: the CPU grows them.
-    if (cpu_grid || (!made.ok() && grid && s.grid.overflowed))
+    if (cpu_grid || (!made.ok() && grid && s.grid.overflowed)) {
+        if (options.widen_silhouettes) {
+            auto cpu = std::chrono::steady_clock::now();
+            std::size_t changed = 0;
+            frame = warp::widen_silhouettes(frame, s.wide_depth, s.wide_motion, &changed);
+            if (!kept) stats.silhouette_pixels = changed;
+            timings_.cpu_ms += ms_since(cpu);
+        }
+        double grid_ms = 0.0;
         made = grid_extrapolation(s, frame, view, projection, periods, motion_scale, options,
-                                  s.color.name, s.depth.name, s.made_motion.name, stats,
-                                  timings_.cpu_ms);
+                                  s.color.name, s.depth.name, s.made_motion.name, stats, grid_ms);
+        timings_.cpu_ms += grid_ms;
+    }
     REPRISE_TRY(made);
     timings_.compute_ms = finish_ms(t) - timings_.cpu_ms;
     s.made_valid = true;
@@ -318,9 +355,16 @@ Status Context::extrapolate(const GBufferTextures& frame, unsigned color, const 
     if (out_color == color || out_depth == frame.depth)
         return Status::error("gpu extrapolate: an output is an input (colour or depth)");
     auto t = std::chrono::steady_clock::now();
-    REPRISE_TRY(extrapolate_passes(s, {color, frame.depth, frame.motion, w, h}, frame.camera, view,
-                                   projection, periods, motion_scale, options, out_color, out_depth,
-                                   out_motion, stats));
+    SplatTextures source{color, frame.depth, frame.motion, w, h};
+    if (options.widen_silhouettes) {
+        s.source_wide = SourceWide::Nothing;  // no longer the CPU-image entry's source
+        stats.silhouette_pixels = widen_pass(s, frame.depth, frame.motion, w, h,
+                                             s.source_wide_depth, &s.source_wide_motion);
+        source.depth = s.source_wide_depth.name;
+        source.motion = s.source_wide_motion.name;
+    }
+    REPRISE_TRY(extrapolate_passes(s, source, frame.camera, view, projection, periods, motion_scale,
+                                   options, out_color, out_depth, out_motion, stats));
     timings_.compute_ms = finish_ms(t);
     return {};
 }

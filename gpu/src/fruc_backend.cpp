@@ -1,5 +1,7 @@
 #include "reprise/gpu/fruc_backend.hpp"
 
+#include <algorithm>
+#include <iterator>
 #include <string>
 
 #include "reprise/core/camera_math.hpp"
@@ -43,9 +45,12 @@ Status FrucBackend::interpolate(const GBufferView& a, const GBufferView& b, floa
                                       .static_tolerance = options.static_tolerance,
                                       .motion_scale = motion_scale,
                                       .refine = options.refine,
-                                      .border_run = options.border_run},
+                                      .border_run = options.border_run,
+                                      .widen_silhouettes = options.widen_silhouettes},
                                      a_key, b_key));
     uploads_kept_ += stats.uploads_kept;
+    count_silhouettes(a_key, stats.silhouette_a, counters);
+    count_silhouettes(b_key, stats.silhouette_b, counters);
     counters.border_pixels += stats.border;
     counters.grid_cells += stats.grid_cells;
     if (options.refine.enabled) {
@@ -67,23 +72,37 @@ Status FrucBackend::extrapolate(const GBufferView& f, const glm::mat4& view,
                                 const warp::FrucOptions& options, Frame& out,
                                 warp::FrucCounters& counters, uint64_t frame_key) {
     ExtrapolateStats stats;
-    const unsigned kept_color = colour_from_ ? colour_from_->kept_for(f.color) : 0u;
+    const FrameOnGpu on_gpu = inputs_from_ ? inputs_from_->on_gpu(f) : FrameOnGpu{};
     if (keep_on_gpu_) {
         REPRISE_TRY(context_.extrapolate_on_gpu(f, view, projection, periods, stats, options,
-                                                motion_scale, frame_key, kept_color));
+                                                motion_scale, frame_key, on_gpu));
         out.color.clear(), out.depth.clear(), out.motion.clear(), out.normal.clear();
         out.id.clear();
     } else {
         REPRISE_TRY(context_.extrapolate(f, view, projection, periods, out, stats, options,
-                                         motion_scale, frame_key, kept_color));
+                                         motion_scale, frame_key, on_gpu));
     }
     uploads_kept_ += stats.upload_kept;
+    count_silhouettes(frame_key, stats.silhouette_pixels, counters);
     counters.border_pixels += stats.border;
     counters.grid_cells += stats.grid_cells;
     if (has_projection(f.camera))
         ++(stats.moving ? counters.dynamic_layers : counters.dynamic_skipped);
     count(stats.holes, stats.holes > 0 && options.fill != warp::FillMethod::None, counters);
     return {};
+}
+
+void FrucBackend::count_silhouettes(uint64_t key, std::size_t pixels,
+                                    warp::FrucCounters& counters) {
+    if (key != 0) {
+        if (std::find(std::begin(widened_keys_), std::end(widened_keys_), key) !=
+            std::end(widened_keys_))
+            return;
+        std::rotate(std::begin(widened_keys_), std::end(widened_keys_) - 1,
+                    std::end(widened_keys_));
+        widened_keys_[0] = key;
+    }
+    counters.silhouette_pixels += pixels;
 }
 
 void FrucBackend::count(std::size_t holes, bool filled, warp::FrucCounters& counters) {

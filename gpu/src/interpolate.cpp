@@ -463,15 +463,6 @@ Status Context::interpolate(const GBufferView& given_a, const GBufferView& given
     out.id.clear();
     out.camera = b.camera;
     if (w <= 0 || h <= 0) return {};
-    TrueMotion plan;
-    if (options.true_motion)
-        REPRISE_TRY(plan_true_motion(
-            a.camera, b.camera, s_between, w, h,
-            [&](int side, float factor) {
-                return warp::motion_is_linear(side ? b : a, plan.at, factor,
-                                              options.static_tolerance);
-            },
-            plan, stats));
     REPRISE_TRY(s.gl->acquire());
     auto t = std::chrono::steady_clock::now();
     // The last pair's b as this pair's a: its textures change sides instead of uploading again.
@@ -479,29 +470,58 @@ Status Context::interpolate(const GBufferView& given_a, const GBufferView& given
         std::swap(k.a_color, k.b_color);
         std::swap(k.a_depth, k.b_depth);
         std::swap(k.a_motion, k.b_motion);
+        std::swap(k.a_wide_depth, k.b_wide_depth);
+        std::swap(k.a_wide_motion, k.b_wide_motion);
+        std::swap(k.widened[0], k.widened[1]);
         std::swap(k.key[0], k.key[1]);
     }
     Texture* textures[6] = {&k.a_color, &k.a_depth, &k.a_motion,
                             &k.b_color, &k.b_depth, &k.b_motion};
+    Texture* wide[4] = {&k.a_wide_depth, &k.a_wide_motion, &k.b_wide_depth, &k.b_wide_motion};
     const GBufferView* frames[2] = {&a, &b};
     const uint64_t keys[2] = {a_key, b_key};
+    SplatTextures sides[2];
     for (int f = 0; f < 2; ++f) {
         const bool kept = keys[f] != 0 && keys[f] == k.key[f] && textures[3 * f]->width == w &&
                           textures[3 * f]->height == h;
         stats.uploads_kept += kept;
-        if (kept) continue;
-        s.upload_frame(*frames[f], *textures[3 * f], *textures[3 * f + 1], *textures[3 * f + 2]);
-        k.key[f] = keys[f];
+        if (!kept) {
+            s.upload_frame(*frames[f], *textures[3 * f], *textures[3 * f + 1],
+                           *textures[3 * f + 2]);
+            k.key[f] = keys[f];
+            k.widened[f] = false;
+        }
+        // Widened once per upload, kept with it.
+        if (options.widen_silhouettes && !k.widened[f]) {
+            (f ? stats.silhouette_b : stats.silhouette_a) =
+                widen_pass(s, textures[3 * f + 1]->name, textures[3 * f + 2]->name, w, h,
+                           *wide[2 * f], wide[2 * f + 1]);
+            k.widened[f] = true;
+        }
+        const bool widened = options.widen_silhouettes;
+        sides[f] = {textures[3 * f]->name, (widened ? wide[2 * f] : textures[3 * f + 1])->name,
+                    (widened ? wide[2 * f + 1] : textures[3 * f + 2])->name, w, h};
     }
     s.made_valid = false;  // color and depth no longer hold an extrapolation
     s.color.ensure(GL_RGBA32F, w, h);
     s.depth.ensure(GL_R32F, w, h);
     k.made_motion.ensure(GL_RGBA32F, w, h);
     timings_.upload_ms = finish_ms(t);
-    REPRISE_TRY(interpolate_passes(s, {k.a_color.name, k.a_depth.name, k.a_motion.name, w, h},
-                                   {k.b_color.name, k.b_depth.name, k.b_motion.name, w, h},
-                                   s_between, w, h, options, s.color.name, s.depth.name,
-                                   k.made_motion.name, stats, plan, timings_.cpu_ms));
+    // The linearity survey on what is warped: the widened textures' samples, else the images.
+    TrueMotion plan;
+    if (options.true_motion)
+        REPRISE_TRY(plan_true_motion(
+            a.camera, b.camera, s_between, w, h,
+            [&](int side, float factor) {
+                if (options.widen_silhouettes)
+                    return motion_is_linear(s, sides[side], side ? b.camera : a.camera, plan.at,
+                                            factor, options.static_tolerance);
+                return warp::motion_is_linear(side ? b : a, plan.at, factor,
+                                              options.static_tolerance);
+            },
+            plan, stats));
+    REPRISE_TRY(interpolate_passes(s, sides[0], sides[1], s_between, w, h, options, s.color.name,
+                                   s.depth.name, k.made_motion.name, stats, plan, timings_.cpu_ms));
     timings_.compute_ms = finish_ms(t) - timings_.cpu_ms;
     s.download_made(out);
     out.motion.resize(w, h);
@@ -538,8 +558,19 @@ Status Context::interpolate(const GBufferTextures& a, unsigned a_color, const GB
     if (out_color == a_color || out_color == b_color)
         return Status::error("gpu interpolate: the output is an input colour");
     auto t = std::chrono::steady_clock::now();
-    const SplatTextures sides[2] = {{a_color, a.depth, a.motion, w, h},
-                                    {b_color, b.depth, b.motion, w, h}};
+    SplatTextures sides[2] = {{a_color, a.depth, a.motion, w, h},
+                              {b_color, b.depth, b.motion, w, h}};
+    if (options.widen_silhouettes) {
+        Interpolation& k = s.interpolation;
+        Texture* wide[4] = {&k.a_wide_depth, &k.a_wide_motion, &k.b_wide_depth, &k.b_wide_motion};
+        for (int f = 0; f < 2; ++f) {
+            (f ? stats.silhouette_b : stats.silhouette_a) =
+                widen_pass(s, sides[f].depth, sides[f].motion, w, h, *wide[2 * f], wide[2 * f + 1]);
+            k.widened[f] = false;  // no longer the CPU-image entry's uploads widened
+            sides[f].depth = wide[2 * f]->name;
+            sides[f].motion = wide[2 * f + 1]->name;
+        }
+    }
     TrueMotion plan;
     if (options.true_motion)
         REPRISE_TRY(plan_true_motion(

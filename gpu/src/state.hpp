@@ -211,6 +211,16 @@ Status reproject_pass(ContextState& s, GLuint depth, GLuint motion, GLuint id,
 std::size_t border_rows_pass(ContextState& s, GLuint color, GLuint depth, GLuint valid, int w,
                              int h, int max_run);
 
+// warp::widen_silhouettes on textures: `depth` (GL_R32F) and `motion` (RG of a float texture; 0:
+// none) of w x h into `wide_depth` (GL_R32F) and, with motion, `wide_motion` (GL_RGBA32F, the
+// motion in RG); returns how many pixels took a neighbour's surface. `widen` false: copied as
+// they are.
+std::size_t widen_pass(ContextState& s, GLuint depth, GLuint motion, int w, int h,
+                       GLuint wide_depth, GLuint wide_motion, bool widen = true);
+// The same into scratch textures, sized here.
+std::size_t widen_pass(ContextState& s, GLuint depth, GLuint motion, int w, int h,
+                       Texture& wide_depth, Texture* wide_motion, bool widen = true);
+
 // The passes of each path over textures, shared by its CPU-image and texture entry points.
 Status fill_passes(ContextState& s, GLuint color, GLuint valid, GLuint depth, int w, int h,
                    GLuint out, warp::FillStats& stats);
@@ -299,15 +309,18 @@ struct Interpolation {
     Texture side_a_color, side_a_depth, side_a_covered, side_a_motion, side_b_color, side_b_depth,
         side_b_covered, side_b_motion, blended, valid, made_motion, true_a, true_b, inverted,
         survey;
+    // a's and b's silhouettes widened (widen_pass), and whether they hold the uploaded inputs'.
+    Texture a_wide_depth, a_wide_motion, b_wide_depth, b_wide_motion;
+    bool widened[2] = {false, false};
     NonfiniteRepair repair_a, repair_b;  // each keeps its repaired copy until the next call
     Image<glm::vec4> survey_samples;     // the linearity survey's samples, read back
     uint64_t key[2] = {0, 0};            // the frame keys a's and b's textures hold (0: none)
-    Texture* all[21] = {&a_color,        &a_depth,       &a_motion,     &b_color,
-                        &b_depth,        &b_motion,      &side_a_color, &side_a_depth,
-                        &side_a_covered, &side_a_motion, &side_b_color, &side_b_depth,
-                        &side_b_covered, &side_b_motion, &blended,      &valid,
-                        &made_motion,    &true_a,        &true_b,       &inverted,
-                        &survey};
+    Texture* all[25] = {
+        &a_color,      &a_depth,      &a_motion,       &b_color,        &b_depth,
+        &b_motion,     &side_a_color, &side_a_depth,   &side_a_covered, &side_a_motion,
+        &side_b_color, &side_b_depth, &side_b_covered, &side_b_motion,  &blended,
+        &valid,        &made_motion,  &true_a,         &true_b,         &inverted,
+        &survey,       &a_wide_depth, &a_wide_motion,  &b_wide_depth,   &b_wide_motion};
 };
 
 // Motion refinement: the tiles' counts and boxes (warp::MotionRefiner plans them and runs the
@@ -334,6 +347,9 @@ Status refine_passes(ContextState& s, const SplatTextures& a, const SplatTexture
 void refine_apply(ContextState& s, int w, int h, const warp::RefineOptions& options,
                   GLuint out_color);
 
+// What the extrapolation's source_wide_* textures hold of the frame its source textures hold.
+enum class SourceWide { Nothing, Copied, Widened };
+
 struct ContextState {
     std::unique_ptr<gl::Context> gl;
     GLuint reproject_program = 0;
@@ -348,6 +364,7 @@ struct ContextState {
     GLuint small_levels_program = 0, small_levels = 0;  // the levels of one work group, a buffer
     std::size_t small_levels_bytes = 0;
     GLuint border_program = 0, border_counts = 0;  // border_rows_pass
+    GLuint widen_program = 0, widen_counts = 0;    // widen_pass
     Texture color, valid;
     std::vector<Texture> pulled, pulled_depth, filled, filled_depth;
     std::vector<glm::uvec4> hit_readback;   // integer downloads come as RGBA
@@ -383,6 +400,8 @@ struct ContextState {
     GLuint merge_program = 0, eye_counts = 0;
     Texture history_color, history_depth, history_motion, history_displacement,
         history_target_depth, history_warped, history_warped_depth, history_covered, merged;
+    // The eye's and its history's silhouettes widened (widen_pass).
+    Texture eye_wide_depth, history_wide_depth, history_wide_motion;
     NonfiniteRepair eye_history_repair;
     Image<float> wide_history_depth;
     Image<glm::vec2> wide_history_motion;
@@ -391,8 +410,10 @@ struct ContextState {
     GLuint static_layer_program = 0, extrapolate_counts = 0;
     NonfiniteRepair extrapolate_repair;
     Texture source_color, source_depth, source_motion, made_motion;
+    Texture source_wide_depth, source_wide_motion;  // the source's silhouettes widened
     uint64_t extrapolate_key = 0;  // the frame key of what the source textures hold (0: none)
-    bool made_valid = false;       // color, depth and made_motion hold the last extrapolation
+    SourceWide source_wide = SourceWide::Nothing;  // what source_wide_* hold
+    bool made_valid = false;  // color, depth and made_motion hold the last extrapolation
     NonfiniteCounts extrapolate_nonfinite;  // ... and what its repair found
 
     // Counters live in GPU memory (a buffer hinted for reading may be placed in the host's, where

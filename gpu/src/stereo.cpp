@@ -286,17 +286,33 @@ bool displaced_on_gpu(const Camera& from, const Camera* history, int w, int h) {
 }
 
 // Colour `color` and depth `depth` (w x h) seen from `target` into out_color / out_depth; with
-// `history`, its warp fills the rendered eye's holes first. The grid's cells are grown here on
-// the GPU, or, `cpu_cells`, were grown on the CPU into s.grid (skewed projections).
+// `history`, its warp fills the rendered eye's holes first. Silhouettes are widened here
+// (o.widen_silhouettes) and the grid's cells grown on the GPU, or, `cpu_cells`, both were done on
+// the CPU into s.grid (skewed projections).
 Status eye_passes(ContextState& s, GLuint color, GLuint depth, int w, int h, const Camera& from,
                   const Camera& target, const stereo::StereoOptions& o, GLuint out_color,
-                  GLuint out_depth, stereo::StereoStats& stats, const EyeHistory* history,
+                  GLuint out_depth, stereo::StereoStats& stats, const EyeHistory* given_history,
                   bool cpu_cells = false) {
     const bool grid = o.warp == stereo::StereoWarp::Grid;
-    if (!(grid && cpu_cells) && !displaced_on_gpu(from, history ? &history->camera : nullptr, w, h))
+    if (!(grid && cpu_cells) &&
+        !displaced_on_gpu(from, given_history ? &given_history->camera : nullptr, w, h))
         return Status::error(
             "gpu stereo eye: the rendered or the history camera's projection is skewed (the grid "
             "takes it on CPU images)");
+    EyeHistory widened_history;
+    const EyeHistory* history = given_history;
+    if (o.widen_silhouettes && !(grid && cpu_cells)) {
+        widen_pass(s, depth, 0, w, h, s.eye_wide_depth, nullptr);
+        depth = s.eye_wide_depth.name;
+        if (history) {
+            widened_history = *history;
+            widen_pass(s, history->depth, history->motion, w, h, s.history_wide_depth,
+                       &s.history_wide_motion);
+            widened_history.depth = s.history_wide_depth.name;
+            if (history->motion) widened_history.motion = s.history_wide_motion.name;
+            history = &widened_history;
+        }
+    }
     s.displacement.ensure(GL_RGBA32F, w, h);
     s.target_depth.ensure(GL_R32F, w, h);
     s.eye_color.ensure(GL_RGBA32F, w, h);
@@ -401,16 +417,17 @@ Status Context::stereo_eye(const GBufferView& given, const Camera& target, Frame
     if (w <= 0 || h <= 0) return {};
     REPRISE_TRY(s.gl->acquire());
     auto t = std::chrono::steady_clock::now();
-    // The silhouettes widened on the CPU, as StereoSynthesizer does.
-    if (options.widen_silhouettes) {
-        rendered = warp::widen_silhouettes(rendered, s.wide_depth, s.wide_motion);
-        if (with_history)
-            history = warp::widen_silhouettes(history, s.wide_history_depth, s.wide_history_motion);
-    }
     // The grid's displacement and cells on the CPU where the GPU's displacement cannot be made
-    // (and, below, where more cells grow than a storage buffer holds).
+    // (and, below, where more cells grow than a storage buffer holds), from silhouettes widened
+    // on the CPU, as StereoSynthesizer widens them (elsewhere the GPU widens them).
     GridRaster& g = s.grid;
     auto grow_on_cpu = [&] {
+        if (options.widen_silhouettes) {
+            rendered = warp::widen_silhouettes(rendered, s.wide_depth, s.wide_motion);
+            if (with_history)
+                history =
+                    warp::widen_silhouettes(history, s.wide_history_depth, s.wide_history_motion);
+        }
         g.displacement.resize(w, h);
         g.target_depth.resize(w, h);
         stereo::stereo_displacement(rendered, target, g.displacement.view(), g.target_depth.view());

@@ -443,6 +443,7 @@ struct Upsampler::State {
     std::size_t frames = 0;
     bool keep = false;                    // keep_output
     ImageView<const glm::vec4> kept_for;  // the `out` the last call kept its result for
+    GBufferView guides;                   // the depth and motion the last call uploaded
 
     void count_frame() {
         total.upload_ms += timings.upload_ms;
@@ -496,6 +497,7 @@ Status Upsampler::create(Context& context, const warp::UpsampleOptions& options,
 void Upsampler::reset() {
     state_->has_history = false;
     state_->kept_for = {};
+    state_->guides = {};
 }
 
 void Upsampler::keep_output(bool keep) {
@@ -513,6 +515,20 @@ unsigned Upsampler::kept_for(ImageView<const glm::vec4> out) const {
     const bool same = !k.empty() && k.data == out.data && k.width == out.width &&
                       k.height == out.height && k.stride == out.stride;
     return same ? state_->out.name : 0u;
+}
+
+FrameOnGpu Upsampler::on_gpu(const GBufferView& frame) const {
+    const State& u = *state_;
+    auto same = [](const auto& a, const auto& b) {
+        return !a.empty() && a.data == b.data && a.width == b.width && a.height == b.height &&
+               a.stride == b.stride;
+    };
+    FrameOnGpu held{.color = kept_for(frame.color)};
+    if (same(u.guides.depth, frame.depth) && same(u.guides.motion, frame.motion)) {
+        held.depth = u.depth.name;
+        held.motion = u.motion.name;
+    }
+    return held;
 }
 
 Status Upsampler::download_kept(ImageView<glm::vec4> out) {
@@ -684,6 +700,7 @@ Status Upsampler::upsample(ImageView<const glm::vec4> low_color, glm::vec2 jitte
     ContextState& s = *u.context->state_;
     u.timings = {};
     u.kept_for = {};
+    u.guides = {};
     GBufferView guides = given;
     guides.color = {};
     NonfiniteCounts input_nonfinite;
@@ -731,6 +748,7 @@ Status Upsampler::upsample(ImageView<const glm::vec4> low_color, glm::vec2 jitte
                                  .jitter = jitter_px},
                                 u.out.name, counted));
     u.timings.compute_ms = finish_ms(t);
+    if (!given.motion.empty()) u.guides = {.depth = given.depth, .motion = given.motion};
     if (u.keep) {
         u.kept_for = out;
     } else {
@@ -751,6 +769,7 @@ Status Upsampler::upsample(unsigned low_color, int low_width, int low_height, gl
     ContextState& s = *u.context->state_;
     u.timings = {};
     u.kept_for = {};
+    u.guides = {};
     REPRISE_TRY(s.gl->acquire());
     const int w = full.width, h = full.height;
     if (w <= 0 || h <= 0 || low_width <= 0 || low_height <= 0 || low_width > w || low_height > h)

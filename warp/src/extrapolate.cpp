@@ -201,7 +201,7 @@ Status extrapolate_to_camera(const GBufferView& given, const glm::mat4& future_v
                              const FrucOptions& options, FrucScratch& scratch, Frame& out,
                              FrucCounters& counters) {
     if (options.backend)
-        return options.backend->extrapolate(warp_input(given, 0, options, scratch, counters),
+        return options.backend->extrapolate(backend_input(given, 0, options, scratch, counters),
                                             future_view, future_projection, s, motion_scale,
                                             options, out, counters, scratch.input_key[0]);
     if (!has_projection(given.camera)) {

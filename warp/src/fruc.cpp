@@ -393,8 +393,8 @@ Status FrameRateConverter::send_frame(const Frame& given, Frame* owned) {
                     if (st.options.backend && a_warpable) {
                         // The inputs the CPU's warps would take.
                         REPRISE_TRY(undone_unless(st.options.backend->interpolate(
-                            warp_input(a, 0, st.options, st.scratch, st.counters),
-                            warp_input(frame, 1, st.options, st.scratch, st.counters), s, scale,
+                            backend_input(a, 0, st.options, st.scratch, st.counters),
+                            backend_input(frame, 1, st.options, st.scratch, st.counters), s, scale,
                             st.options, out, st.counters, st.scratch.input_key[0],
                             st.scratch.input_key[1])));
                     } else {

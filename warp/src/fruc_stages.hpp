@@ -52,12 +52,15 @@ struct FrucScratch {
 std::size_t warp_into(const GBufferView& source, float factor, const FrucOptions& options,
                       FrucScratch& scratch, const WarpTarget& out, FrucCounters& counters);
 
-// `f` with its silhouettes widened into scratch slot `slot` (0 or 1) when options ask for it.
 // A frame key no other frame of this process has had (never 0).
 uint64_t next_frame_key();
 
+// `f` with its silhouettes widened into scratch slot `slot` (0 or 1) when options ask for it.
 GBufferView warp_input(const GBufferView& f, int slot, const FrucOptions& options,
                        FrucScratch& scratch, FrucCounters& counters);
+// What options.backend is handed: warp_input's, or `f` as it is for a backend that widens.
+GBufferView backend_input(const GBufferView& f, int slot, const FrucOptions& options,
+                          FrucScratch& scratch, FrucCounters& counters);
 
 // Fills the holes of `color` (valid = 0; `holes` of them, counted by the caller) as options.fill
 // says, using depth for the side to prefer, after each row's border strip is continued (up to

@@ -123,6 +123,12 @@ GBufferView warp_input(const GBufferView& f, int slot, const FrucOptions& option
     return widened;
 }
 
+GBufferView backend_input(const GBufferView& f, int slot, const FrucOptions& options,
+                          FrucScratch& scratch, FrucCounters& counters) {
+    if (options.backend->widens_silhouettes()) return f;
+    return warp_input(f, slot, options, scratch, counters);
+}
+
 void fill_holes(ImageView<glm::vec4> color, ImageView<uint8_t> valid, ImageView<float> depth,
                 std::size_t holes, const FrucOptions& options, FrucScratch& scratch,
                 FrucCounters& counters) {

@@ -8,13 +8,11 @@ namespace reprise::warp {
 
 GBufferView widen_silhouettes(const GBufferView& f, Image<float>& depth, Image<glm::vec2>& motion,
                               std::size_t* changed) {
-    constexpr float ratio = 0.15f;
     if (f.depth.empty()) return f;
     const int w = f.width(), h = f.height();
     const bool moves = !f.motion.empty();
     depth.resize(w, h);
     if (moves) motion.resize(w, h);
-    const float keep = 1.0f - ratio;
     std::atomic<std::size_t> total{0};
     parallel_for(0, h, [&](int y0, int y1) {
         std::size_t count = 0;
@@ -28,8 +26,8 @@ GBufferView widen_silhouettes(const GBufferView& f, Image<float>& depth, Image<g
             for (int x = 0; x < w; ++x) {
                 z_out[x] = z[x];
                 if (moves) m_out[x] = m[x];
-                // Nearer than keep * z, and a real depth (NaN and <= 0 fail both tests).
-                float nearest = z[x] * keep;
+                // Nearer than kSilhouetteKeep * z, and a real depth (NaN and <= 0 fail both tests).
+                float nearest = z[x] * kSilhouetteKeep;
                 int nx = -1, ny = 0;
                 auto consider = [&](float candidate, int cx, int cy) {
                     if (candidate > 0.0f && candidate < nearest) {

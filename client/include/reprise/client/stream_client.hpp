@@ -32,7 +32,8 @@ struct StreamClientOptions {
     warp::UpsampleBackend* upsampler = nullptr;
     // The upsampler keeps its output on its device (UpsampleBackend::output_kept) and the
     // extrapolation's backend takes it from there (gpu::Upsampler::keep_output with
-    // gpu::FrucBackend::colour_from): a decoded frame's colour comes to the CPU only for a reader
+    // gpu::FrucBackend::inputs_from, which takes the depth and motion that guided the upsampler
+    // too): a decoded frame's colour comes to the CPU only for a reader
     // there (no extrapolation, a failed one, newest_decoded()). False: it always comes. Set before
     // streaming, with the two joined; otherwise the never-written CPU colour is warped.
     bool upsampled_colour_stays = false;

@@ -27,8 +27,9 @@ class Context;
 namespace reprise::gpu {
 
 // What the last call spent, in milliseconds, each phase finished (glFinish) before the next.
-// `cpu_ms`: the work a path leaves on the CPU (widened silhouettes; the grid's displacement and
-// cells), apart from the transfers and the GPU's compute.
+// `cpu_ms`: the work a path leaves on the CPU (the flow of motion refinement; for skewed
+// projections the grid's displacement and cells, and the widened silhouettes they start from),
+// apart from the transfers and the GPU's compute.
 struct Timings {
     double cpu_ms = 0.0;
     double upload_ms = 0.0;
@@ -46,6 +47,14 @@ struct GBufferTextures {
     Camera camera;
 };
 
+// A frame's planes already on the GPU, each 0 where not (gpu::Upsampler's kept output and its
+// guides, FrucBackend::inputs_from): colour GL_RGBA32F (finite), depth GL_R32F and motion
+// GL_RG32F (both or neither, NaN/Inf repaired as the CPU-image entries repair them), all of the
+// frame's size and holding its pixels.
+struct FrameOnGpu {
+    unsigned color = 0, depth = 0, motion = 0;
+};
+
 // A frame made on the GPU and kept there: colour GL_RGBA32F (linear light), depth GL_R32F,
 // backward motion per period in the RG of a GL_RGBA32F texture.
 struct MadeTextures {
@@ -61,6 +70,9 @@ struct InterpolateStats {
     // (warp::continue_border_rows, InterpolateOptions::border_run), as the CPU counts them.
     std::size_t covered_a = 0, covered_b = 0, holes = 0, border = 0;
     std::size_t grid_cells = 0;  // cells the grid drew, both sides (FrucCounters::grid_cells)
+    // Pixels of a and of b given a nearer neighbour's surface (InterpolateOptions::
+    // widen_silhouettes), counted when the input is uploaded (0 where its upload was kept).
+    std::size_t silhouette_a = 0, silhouette_b = 0;
     bool true_motion = false;    // the sides followed their true motion
     bool linear_motion = false;  // ... had it been asked for, but a survey found it linear
     warp::FillStats fill;
@@ -80,6 +92,9 @@ struct ExtrapolateStats {
     std::size_t moving = 0, covered = 0, holes = 0,
                 border = 0;      // holes, border: as interpolation's
     std::size_t grid_cells = 0;  // cells the grid drew
+    // Pixels given a nearer neighbour's surface (FrucOptions::widen_silhouettes), counted when
+    // the frame is uploaded (0 when the upload was kept).
+    std::size_t silhouette_pixels = 0;
     warp::FillStats fill;
     NonfiniteCounts nonfinite;
     bool upload_kept = false;  // the frame key matched: the last call's upload was reused
@@ -102,6 +117,7 @@ struct InterpolateOptions {
     // boxes around the disagreeing tiles) on the CPU: the crops come back, the flow goes up.
     warp::RefineOptions refine{.enabled = false};
     int border_run = warp::kMadeFrameBorderRun;  // FrucOptions::border_run
+    bool widen_silhouettes = true;               // FrucOptions::widen_silhouettes
 };
 
 struct ContextState;  // GL objects and scratch (private)
@@ -145,6 +161,14 @@ public:
     Status fill(unsigned color, unsigned valid, unsigned depth, int width, int height, unsigned out,
                 warp::FillStats& stats);
 
+    // warp::widen_silhouettes on textures (the paths below widen their inputs themselves, as
+    // their options say): `frame.depth` (GL_R32F) and `frame.motion` (GL_RG32F; 0: none, depth
+    // alone widened) into `out_depth` (GL_R32F) and `out_motion` (GL_RGBA32F, the motion in RG;
+    // unused without motion), all of the frame's size; `changed` gets the pixels that took a
+    // nearer neighbour's depth and motion.
+    Status widen_silhouettes(const GBufferTextures& frame, unsigned out_depth, unsigned out_motion,
+                             std::size_t& changed);
+
     // warp::splat on the GPU. Among the candidates within the depth tolerance of a pixel's
     // nearest one, the one landing nearest its centre wins, ties to the first in source order
     // (the CPU z-tests in source order against the one stored: the same where candidates do not
@@ -173,8 +197,8 @@ public:
     // The same on textures: `rendered.depth` and `color` (GL_RGBA32F) in, `out_color`
     // (GL_RGBA32F) and `out_depth` (GL_R32F) written, all of the rendered size. No repair of
     // NaN/Inf input here (the CPU-image entry repairs as the CPU does): pixels with NaN depth are
-    // left out, colour with a non-finite channel comes out 0. The depth texture is warped as it
-    // is (StereoOptions::widen_silhouettes is the CPU-image entry's, done on the CPU). A
+    // left out, colour with a non-finite channel comes out 0. Silhouettes are widened on the GPU
+    // by both entries (StereoOptions::widen_silhouettes; on the CPU for a skewed grid's). A
     // `history` (its depth, motion (0: none, nothing left out) and camera, colour
     // `history_color`, of the rendered size) fills the holes as in the CPU-image entry.
     Status stereo_eye(const GBufferTextures& rendered, unsigned color, const Camera& target,
@@ -192,9 +216,10 @@ public:
     // on the CPU: Timings::cpu_ms). Colour, depth and motion out: the motion the winning side
     // carried (b's where both are blended) times motion_scale, as the CPU's (normal and id
     // cleared; out.camera is b's).
-    // NaN/Inf in a and b are repaired first, as the CPU converter does; the texture entry does
-    // not repair. Non-zero keys equal to the last call's a or b key reuse that input's upload
-    // (b's becoming a's when the next pair starts): the caller promises the same frame.
+    // NaN/Inf in a and b are repaired first, as the CPU converter does (the texture entry does
+    // not repair); then their silhouettes are widened on the GPU (options.widen_silhouettes).
+    // Non-zero keys equal to the last call's a or b key reuse that input's upload (b's becoming a's
+    // when the next pair starts): the caller promises the same frame.
     Status interpolate(const GBufferView& a, const GBufferView& b, float s, Frame& out,
                        InterpolateStats& stats, const InterpolateOptions& options = {},
                        uint64_t a_key = 0, uint64_t b_key = 0);
@@ -217,27 +242,29 @@ public:
     // out gets colour, depth and backward motion per period times motion_scale (0 at periods
     // 0); out.normal and id cleared, out.camera untouched. NaN/Inf are repaired first, as the
     // converter does (PoseExtrapolator does not: on such input the GPU makes the CPU's frame of
-    // the repaired input); the silhouettes are warped as they are (the CPU widens them first).
+    // the repaired input); the silhouettes widened on the GPU (options.widen_silhouettes).
     // A non-zero `frame_key` equal to the last call's reuses that call's upload (and its repair
-    // counts): the caller promises the same frame, pixels unchanged. A non-zero `color`
-    // (GL_RGBA32F of the frame's size, finite: gpu::Upsampler's kept output) is the frame's
-    // colour, copied on the GPU; frame.color is then neither read nor repaired.
+    // counts): the caller promises the same frame, pixels unchanged. Planes `on_gpu` names are
+    // copied (or widened) on the GPU instead of uploaded; frame.color is then not read, frame's
+    // depth and motion only repaired to count what was repaired (and for the grid's cells on the
+    // CPU, skewed projections).
     Status extrapolate(const GBufferView& frame, const glm::mat4& view, const glm::mat4& projection,
                        float periods, Frame& out, ExtrapolateStats& stats,
                        const warp::FrucOptions& options, float motion_scale = 1.0f,
-                       uint64_t frame_key = 0, unsigned color = 0);
+                       uint64_t frame_key = 0, const FrameOnGpu& on_gpu = {});
     // The same with the made frame left on the GPU, nothing downloaded: made() names its
     // textures (a display that draws them, `reprise connect --backend gles --window`).
     Status extrapolate_on_gpu(const GBufferView& frame, const glm::mat4& view,
                               const glm::mat4& projection, float periods, ExtrapolateStats& stats,
                               const warp::FrucOptions& options, float motion_scale = 1.0f,
-                              uint64_t frame_key = 0, unsigned color = 0);
+                              uint64_t frame_key = 0, const FrameOnGpu& on_gpu = {});
     // What the last extrapolate call on CPU images made, until the next call of any kind (the
     // textures are the context's scratch); all 0 when that call failed or made nothing.
     MadeTextures made() const;
     // The same on textures: `color` GL_RGBA32F beside frame's depth and motion; `out_color`
     // (GL_RGBA32F), `out_depth` (GL_R32F) and `out_motion` (GL_RGBA32F with the motion in RG, as
-    // GL ES has no RG32F image format; 0: not written), all of the frame's size. No repair.
+    // GL ES has no RG32F image format; 0: not written), all of the frame's size. No repair;
+    // silhouettes widened as options say.
     Status extrapolate(const GBufferTextures& frame, unsigned color, const glm::mat4& view,
                        const glm::mat4& projection, float periods, unsigned out_color,
                        unsigned out_depth, unsigned out_motion, ExtrapolateStats& stats,

@@ -4,6 +4,7 @@
 // Converter(backend="gles")): the caller keeps order, cuts, still pairs, repair and UI on the
 // CPU; each in-between frame is Context::interpolate, each extrapolated one Context::extrapolate.
 #include <cstddef>
+#include <cstdint>
 
 #include "reprise/gpu/context.hpp"
 #include "reprise/gpu/upsampler.hpp"
@@ -23,6 +24,8 @@ public:
     Status supports(const warp::FrucOptions& options) const override {
         return check(options, splat_);
     }
+    // On the GPU, once per upload (FrucCounters::silhouette_pixels counted there).
+    bool widens_silhouettes() const override { return true; }
     // Colour, depth and motion, as the CPU's.
     Status interpolate(const GBufferView& a, const GBufferView& b, float s, float motion_scale,
                        const warp::FrucOptions& options, Frame& out, warp::FrucCounters& counters,
@@ -35,12 +38,13 @@ public:
     // gets no colour, depth or motion (emptied) and made() names the textures that hold them,
     // until the next call. Off by default (every frame downloaded).
     void keep_extrapolated_on_gpu(bool keep) { keep_on_gpu_ = keep; }
-    // Extrapolated frames whose colour `upsampler` kept on the GPU (Upsampler::keep_output) take
-    // it from there, nothing uploaded; null: none. Not owned; an error on another context.
-    Status colour_from(const Upsampler* upsampler) {
+    // Extrapolated frames take what `upsampler` holds of them on the GPU (Upsampler::on_gpu: the
+    // colour it kept, Upsampler::keep_output, and the depth and motion that guided it), nothing
+    // of that uploaded; null: none. Not owned; an error on another context.
+    Status inputs_from(const Upsampler* upsampler) {
         if (upsampler && &upsampler->context() != &context_)
             return Status::error("gpu fruc backend: the upsampler works on another GPU context");
-        colour_from_ = upsampler;
+        inputs_from_ = upsampler;
         return {};
     }
     MadeTextures made() const { return context_.made(); }
@@ -55,12 +59,16 @@ public:
 private:
     // Adds the last call's timings and what its frame took.
     void count(std::size_t holes, bool filled, warp::FrucCounters& counters);
+    // Adds an input's widened pixels once per frame key (an input both interpolated and
+    // extrapolated is uploaded, and widened, by each), as the CPU counts them once per input.
+    void count_silhouettes(uint64_t key, std::size_t pixels, warp::FrucCounters& counters);
     Context& context_;
     warp::SplatOptions splat_;
     Timings total_;
     std::size_t frames_ = 0, uploads_kept_ = 0;
     bool keep_on_gpu_ = false;
-    const Upsampler* colour_from_ = nullptr;
+    const Upsampler* inputs_from_ = nullptr;
+    uint64_t widened_keys_[3] = {0, 0, 0};  // the inputs whose widened pixels were counted last
 };
 
 }  // namespace reprise::gpu

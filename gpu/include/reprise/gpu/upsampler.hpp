@@ -32,7 +32,7 @@ public:
     void reset() override;  // forgets the history (a cut, a new stream)
 
     // The CPU-image upsample() leaves `out` unwritten and keeps the result in a texture: a
-    // gpu::FrucBackend on the same context joined by colour_from() extrapolates a frame whose
+    // gpu::FrucBackend on the same context joined by inputs_from() extrapolates a frame whose
     // colour is that `out` (the same pixels, size and stride) from the texture, nothing
     // downloaded or uploaded; download_kept() writes it for a reader on the CPU. Until the next
     // call; a failed call and reset() keep nothing. Off by default; the time of download_kept
@@ -42,6 +42,10 @@ public:
     Status download_kept(ImageView<glm::vec4> out) override;
     // The texture (GL_RGBA32F) kept for `out`, or 0 when the last call kept nothing for it.
     unsigned kept_for(ImageView<const glm::vec4> out) const;
+    // What of `frame` is on the GPU here: its colour where it is the kept output (kept_for), its
+    // depth and motion (repaired) where they are those the last CPU-image upsample() was guided
+    // by (the same pixels, size and stride; until the next call or reset()).
+    FrameOnGpu on_gpu(const GBufferView& frame) const;
 
     const Context& context() const;
     const Timings& timings() const;  // the last call's

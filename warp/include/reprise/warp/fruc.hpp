@@ -91,7 +91,8 @@ struct FrucOptions;
 
 // Makes the warped frames of a FrameRateConverter or a PoseExtrapolator elsewhere than on the
 // CPU (a GPU: gpu::FrucBackend). The caller keeps the rest — order, cuts, still pairs, repair,
-// widened silhouettes, UI — and hands the backend the inputs its own warps would take. An error
+// widened silhouettes (unless the backend widens them), UI — and hands the backend the inputs its
+// own warps would take. An error
 // from it ends send() (or extrapolate()) with that error and leaves the converter as it was
 // before that send().
 class WarpBackend {
@@ -99,6 +100,9 @@ public:
     virtual ~WarpBackend() = default;
     // The options the backend makes the same frames for as the CPU; an error says why not.
     virtual Status supports(const FrucOptions& options) const = 0;
+    // Whether the backend widens its inputs' silhouettes itself (FrucOptions::widen_silhouettes,
+    // counted into FrucCounters::silhouette_pixels): then it is handed them as they are.
+    virtual bool widens_silhouettes() const { return false; }
     // What interpolate_frame makes with both sides warpable: the frame at s between a and b,
     // colour, depth and motion times motion_scale (its motion may stay empty). Non-zero keys,
     // the same for the same frame, say which frames a and b are (the converter's input keys: a

@@ -8,6 +8,9 @@
 
 namespace reprise::warp {
 
+// A neighbour nearer than this fraction of a pixel's depth gives it its surface.
+inline constexpr float kSilhouetteKeep = 1.0f - 0.15f;
+
 // `f` with its depth and motion replaced by `depth` and `motion` (sized here): a pixel with a
 // 4-neighbour nearer by more than 15 % of its own depth (background: any geometry; the in-between
 // frame's one-surface tolerance) takes the depth and motion of the nearest such neighbour, so a
