@@ -1165,6 +1165,29 @@ TEST(Gpu, TheConverterWithTheGpuBackendMakesTheCpusFrames) {
     EXPECT_NE(status.message().find("fill pullpush only"), std::string::npos) << status.message();
 }
 
+// After a cut the converter makes the next frame on the CPU (from the new shot's first frame,
+// widened there); the GPU then uploads that frame as its next pair's a: its widened pixels are
+// counted once, as the CPU converter counts them.
+TEST(Gpu, EachInputsWidenedPixelsAreCountedOnceAcrossACut) {
+    std::vector<Frame> frames = test::render_scene("crossing", 5, kWidth, kHeight, 30.0, 3);
+    frames[2].camera.cut = Cut::Yes;
+    gpu::FrucBackend backend(shared_gpu());
+    const warp::FrucOptions cpu_options{.warp = warp::WarpMethod::Splat,
+                                        .refine = {.enabled = false}};
+    warp::FrucOptions gpu_options = cpu_options;
+    gpu_options.backend = &backend;
+    warp::FrucCounters cpu_counters, gpu_counters;
+    const std::vector<Frame> cpu = convert(frames, 2, cpu_options, cpu_counters);
+    const std::vector<Frame> gpu = convert(frames, 2, gpu_options, gpu_counters);
+    ASSERT_EQ(gpu.size(), cpu.size());
+    EXPECT_EQ(gpu_counters.cuts, 1u);
+    EXPECT_EQ(backend.frames(), 3u);  // pairs 0-1, 2-3 and 3-4; the cut's frame on the CPU
+    EXPECT_GT(cpu_counters.silhouette_pixels, 0u);
+    EXPECT_EQ(gpu_counters.silhouette_pixels, cpu_counters.silhouette_pixels);
+    for (std::size_t i = 0; i < cpu.size(); ++i)
+        EXPECT_GE(test::display_psnr(cpu[i].color, gpu[i].color), 50.0) << i;
+}
+
 // A context serves one thread at a time: another thread gets an error, not a crash.
 TEST(Gpu, AnotherThreadGetsAnErrorWhileTheContextIsHeld) {
     const std::vector<Frame>& frames = scene_frames("crossing");
@@ -1814,6 +1837,33 @@ TEST(Gpu, UpsampledColourKeptForTheExtrapolationIsTheDownloadedOne) {
         EXPECT_NE(keeping->download_kept(kept.view()).message().find("nothing kept"),
                   std::string::npos);
     }
+    // A frame key extrapolated from the handed-over depth and motion, then again with nothing
+    // handed over (the upsampler reset, its colour on the CPU): uploaded then, not warped from
+    // source textures the first call never filled (widening off: the copy of the handed-over
+    // textures is not what the second call warps).
+    const warp::FrucOptions as_they_are{.mode = warp::FrucMode::Extrapolate,
+                                        .widen_silhouettes = false};
+    Frame guides = r.full[0];
+    ASSERT_TRUE(keeping->upsample(r.low[0].view(), r.jitter[0], guides, kept.view()).ok());
+    GBufferView frame = guides.view();
+    frame.color = kept.view();
+    Frame first, again;
+    warp::FrucCounters counters;
+    ASSERT_TRUE(handed
+                    .extrapolate(frame, to.view, to.projection, 0.5f, 1.0f, as_they_are, first,
+                                 counters, 77)
+                    .ok());
+    ASSERT_TRUE(keeping->download_kept(kept.view()).ok());
+    keeping->reset();
+    EXPECT_EQ(keeping->on_gpu(frame).depth, 0u);
+    ASSERT_TRUE(handed
+                    .extrapolate(frame, to.view, to.projection, 0.5f, 1.0f, as_they_are, again,
+                                 counters, 77)
+                    .ok());
+    EXPECT_EQ(test::display_psnr(first.color, again.color), INFINITY);
+    EXPECT_EQ(std::memcmp(first.depth.data(), again.depth.data(),
+                          first.depth.pixel_count() * sizeof(float)),
+              0);
 }
 
 // --- The eye with history: the previous frame warped into the rendered eye's holes.

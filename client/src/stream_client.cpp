@@ -211,10 +211,10 @@ struct StreamClient::State {
         consecutive_decode_errors = 0;
         std::swap(decoded, scratch_decoded);
         decoded_colour_kept = lowres && options.upsampler && options.upsampler->output_kept();
-        // A frame not upsampled there (a full-resolution stream now): the upsampler's kept
-        // output, named by the image it was made for, must not outlive that image's reuse.
-        if (!lowres && options.upsampler && options.upsampler->output_kept())
-            options.upsampler->reset();
+        // A frame not upsampled there (a full-resolution stream now): what the upsampler keeps
+        // of a frame (its output, its guides), named by the images it was made for, must not
+        // outlive those images' reuse by the decoder.
+        if (!lowres && options.upsampler) options.upsampler->reset();
         have_decoded = true;
         decoded_pose_us = packet.pose_time_us;
         decoded_frame = packet.frame;

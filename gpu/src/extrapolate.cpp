@@ -246,9 +246,11 @@ Status Context::extrapolate_on_gpu(const GBufferView& given, const glm::mat4& vi
     // The colour from a texture: only the depth and motion are repaired (and uploaded).
     GBufferView geometry = given;
     if (color_on_gpu) geometry.color = {};
-    // The same frame as the last call's: its repaired pixels are uploaded already.
+    // The same frame as the last call's: its repaired pixels are uploaded already (its depth and
+    // motion only if they were not handed over then, or are handed over again now).
     const bool kept = frame_key != 0 && frame_key == s.extrapolate_key &&
-                      s.source_color.width == w && s.source_color.height == h;
+                      s.source_color.width == w && s.source_color.height == h &&
+                      (geometry_on_gpu || s.source_geometry_uploaded);
     // A skewed projection: no static-layer test on the GPU; the grid's displacement and cells
     // are made on the CPU instead.
     const bool grid = options.warp == warp::WarpMethod::Grid;
@@ -274,10 +276,15 @@ Status Context::extrapolate_on_gpu(const GBufferView& given, const glm::mat4& vi
             s.upload(s.source_depth, frame.depth.data, frame.depth.stride);
             s.upload(s.source_motion, frame.motion.data, frame.motion.stride);
         }
+        s.source_geometry_uploaded = !geometry_on_gpu;
         s.extrapolate_key = frame_key;
         s.extrapolate_nonfinite = stats.nonfinite;
     }
     if (color_on_gpu) frame.color = given.color;  // sizes the CPU grid's cells
+    s.color.ensure(GL_RGBA32F, w, h);
+    s.depth.ensure(GL_R32F, w, h);
+    s.made_motion.ensure(GL_RGBA32F, w, h);
+    timings_.upload_ms = finish_ms(t);
     // The depth and motion warped: the silhouettes widened on the GPU once per upload (the CPU
     // grid widens its own), or the textures handed over copied (they may change before the
     // frame key does).
@@ -294,10 +301,6 @@ Status Context::extrapolate_on_gpu(const GBufferView& given, const glm::mat4& vi
         s.source_wide = wanted;
     }
     const bool from_wide = wanted != SourceWide::Nothing;
-    s.color.ensure(GL_RGBA32F, w, h);
-    s.depth.ensure(GL_R32F, w, h);
-    s.made_motion.ensure(GL_RGBA32F, w, h);
-    timings_.upload_ms = finish_ms(t);
     Status made;
     if (!cpu_grid)
         made = extrapolate_passes(

@@ -92,17 +92,19 @@ Status FrucBackend::extrapolate(const GBufferView& f, const glm::mat4& view,
     return {};
 }
 
+bool FrucBackend::remember_counted(uint64_t key) {
+    if (key == 0) return false;
+    if (std::find(std::begin(counted_keys_), std::end(counted_keys_), key) !=
+        std::end(counted_keys_))
+        return true;
+    std::rotate(std::begin(counted_keys_), std::end(counted_keys_) - 1, std::end(counted_keys_));
+    counted_keys_[0] = key;
+    return false;
+}
+
 void FrucBackend::count_silhouettes(uint64_t key, std::size_t pixels,
                                     warp::FrucCounters& counters) {
-    if (key != 0) {
-        if (std::find(std::begin(widened_keys_), std::end(widened_keys_), key) !=
-            std::end(widened_keys_))
-            return;
-        std::rotate(std::begin(widened_keys_), std::end(widened_keys_) - 1,
-                    std::end(widened_keys_));
-        widened_keys_[0] = key;
-    }
-    counters.silhouette_pixels += pixels;
+    if (!remember_counted(key)) counters.silhouette_pixels += pixels;
 }
 
 void FrucBackend::count(std::size_t holes, bool filled, warp::FrucCounters& counters) {

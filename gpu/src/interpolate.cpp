@@ -480,17 +480,22 @@ Status Context::interpolate(const GBufferView& given_a, const GBufferView& given
     Texture* wide[4] = {&k.a_wide_depth, &k.a_wide_motion, &k.b_wide_depth, &k.b_wide_motion};
     const GBufferView* frames[2] = {&a, &b};
     const uint64_t keys[2] = {a_key, b_key};
-    SplatTextures sides[2];
     for (int f = 0; f < 2; ++f) {
         const bool kept = keys[f] != 0 && keys[f] == k.key[f] && textures[3 * f]->width == w &&
                           textures[3 * f]->height == h;
         stats.uploads_kept += kept;
-        if (!kept) {
-            s.upload_frame(*frames[f], *textures[3 * f], *textures[3 * f + 1],
-                           *textures[3 * f + 2]);
-            k.key[f] = keys[f];
-            k.widened[f] = false;
-        }
+        if (kept) continue;
+        s.upload_frame(*frames[f], *textures[3 * f], *textures[3 * f + 1], *textures[3 * f + 2]);
+        k.key[f] = keys[f];
+        k.widened[f] = false;
+    }
+    s.made_valid = false;  // color and depth no longer hold an extrapolation
+    s.color.ensure(GL_RGBA32F, w, h);
+    s.depth.ensure(GL_R32F, w, h);
+    k.made_motion.ensure(GL_RGBA32F, w, h);
+    timings_.upload_ms = finish_ms(t);
+    SplatTextures sides[2];
+    for (int f = 0; f < 2; ++f) {
         // Widened once per upload, kept with it.
         if (options.widen_silhouettes && !k.widened[f]) {
             (f ? stats.silhouette_b : stats.silhouette_a) =
@@ -502,11 +507,6 @@ Status Context::interpolate(const GBufferView& given_a, const GBufferView& given
         sides[f] = {textures[3 * f]->name, (widened ? wide[2 * f] : textures[3 * f + 1])->name,
                     (widened ? wide[2 * f + 1] : textures[3 * f + 2])->name, w, h};
     }
-    s.made_valid = false;  // color and depth no longer hold an extrapolation
-    s.color.ensure(GL_RGBA32F, w, h);
-    s.depth.ensure(GL_R32F, w, h);
-    k.made_motion.ensure(GL_RGBA32F, w, h);
-    timings_.upload_ms = finish_ms(t);
     // The linearity survey on what is warped: the widened textures' samples, else the images.
     TrueMotion plan;
     if (options.true_motion)

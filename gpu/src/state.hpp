@@ -413,6 +413,7 @@ struct ContextState {
     Texture source_wide_depth, source_wide_motion;  // the source's silhouettes widened
     uint64_t extrapolate_key = 0;  // the frame key of what the source textures hold (0: none)
     SourceWide source_wide = SourceWide::Nothing;  // what source_wide_* hold
+    bool source_geometry_uploaded = false;  // source_depth and _motion hold the frame (not handed)
     bool made_valid = false;  // color, depth and made_motion hold the last extrapolation
     NonfiniteCounts extrapolate_nonfinite;  // ... and what its repair found
 

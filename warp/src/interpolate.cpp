@@ -120,6 +120,7 @@ GBufferView warp_input(const GBufferView& f, int slot, const FrucOptions& option
         widen_silhouettes(f, scratch.wide_depth[buffer], scratch.wide_motion[buffer], &changed);
     scratch.wide_key[buffer] = key;
     counters.silhouette_pixels += changed;
+    if (options.backend && key != 0) options.backend->silhouettes_counted(key);
     return widened;
 }
 

@@ -71,7 +71,9 @@ struct InterpolateStats {
     std::size_t covered_a = 0, covered_b = 0, holes = 0, border = 0;
     std::size_t grid_cells = 0;  // cells the grid drew, both sides (FrucCounters::grid_cells)
     // Pixels of a and of b given a nearer neighbour's surface (InterpolateOptions::
-    // widen_silhouettes), counted when the input is uploaded (0 where its upload was kept).
+    // widen_silhouettes), counted when the input is widened: after its upload, or again where
+    // a texture-entry call or widening off came between (0 where a kept upload's widening was
+    // kept too).
     std::size_t silhouette_a = 0, silhouette_b = 0;
     bool true_motion = false;    // the sides followed their true motion
     bool linear_motion = false;  // ... had it been asked for, but a survey found it linear

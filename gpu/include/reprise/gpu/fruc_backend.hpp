@@ -24,8 +24,9 @@ public:
     Status supports(const warp::FrucOptions& options) const override {
         return check(options, splat_);
     }
-    // On the GPU, once per upload (FrucCounters::silhouette_pixels counted there).
+    // On the GPU, once per upload (FrucCounters::silhouette_pixels counted there, once per key).
     bool widens_silhouettes() const override { return true; }
+    void silhouettes_counted(uint64_t frame_key) override { remember_counted(frame_key); }
     // Colour, depth and motion, as the CPU's.
     Status interpolate(const GBufferView& a, const GBufferView& b, float s, float motion_scale,
                        const warp::FrucOptions& options, Frame& out, warp::FrucCounters& counters,
@@ -62,13 +63,15 @@ private:
     // Adds an input's widened pixels once per frame key (an input both interpolated and
     // extrapolated is uploaded, and widened, by each), as the CPU counts them once per input.
     void count_silhouettes(uint64_t key, std::size_t pixels, warp::FrucCounters& counters);
+    // Whether `key` was counted lately; remembers it either way (0: never counted).
+    bool remember_counted(uint64_t key);
     Context& context_;
     warp::SplatOptions splat_;
     Timings total_;
     std::size_t frames_ = 0, uploads_kept_ = 0;
     bool keep_on_gpu_ = false;
     const Upsampler* inputs_from_ = nullptr;
-    uint64_t widened_keys_[3] = {0, 0, 0};  // the inputs whose widened pixels were counted last
+    uint64_t counted_keys_[4] = {0, 0, 0, 0};  // the inputs whose widened pixels were counted last
 };
 
 }  // namespace reprise::gpu

@@ -44,7 +44,9 @@ public:
     unsigned kept_for(ImageView<const glm::vec4> out) const;
     // What of `frame` is on the GPU here: its colour where it is the kept output (kept_for), its
     // depth and motion (repaired) where they are those the last CPU-image upsample() was guided
-    // by (the same pixels, size and stride; until the next call or reset()).
+    // by (the same pixels, size and stride; until the next call or reset()). Images are known
+    // by their address: a caller that reuses them for frames not upsampled here resets the
+    // upsampler first (the streaming client does after each full-resolution frame).
     FrameOnGpu on_gpu(const GBufferView& frame) const;
 
     const Context& context() const;

@@ -101,8 +101,11 @@ public:
     // The options the backend makes the same frames for as the CPU; an error says why not.
     virtual Status supports(const FrucOptions& options) const = 0;
     // Whether the backend widens its inputs' silhouettes itself (FrucOptions::widen_silhouettes,
-    // counted into FrucCounters::silhouette_pixels): then it is handed them as they are.
+    // counted into FrucCounters::silhouette_pixels): then it is handed them as they are, and told
+    // of an input the converter widened and counted on the CPU (a frame it made there, after a
+    // cut), so that each input is counted once.
     virtual bool widens_silhouettes() const { return false; }
+    virtual void silhouettes_counted(uint64_t /*frame_key*/) {}
     // What interpolate_frame makes with both sides warpable: the frame at s between a and b,
     // colour, depth and motion times motion_scale (its motion may stay empty). Non-zero keys,
     // the same for the same frame, say which frames a and b are (the converter's input keys: a
