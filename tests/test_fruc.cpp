@@ -1,6 +1,8 @@
 // Frame-rate upconversion end to end on rendered scenes, plus its skips, cuts and bad values.
 #include <gtest/gtest.h>
 
+#include <bit>
+
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -539,6 +541,16 @@ TEST(FrucSilhouettes, APixelTakesItsNearestNeighboursSurfaceAndBadDepthsNeitherT
     expect(3, 2, 4.0f, {3, 2});
     EXPECT_EQ(changed, 5u);
     EXPECT_EQ(wide.color.data, f.color.data()) << "colour is the frame's";
+    // One pixel alone (the GPU's linearity survey widens only the pixels it samples): the same.
+    for (int y = 0; y < 3; ++y)
+        for (int x = 0; x < 4; ++x) {
+            float z = 0.0f;
+            glm::vec2 m{0.0f};
+            widened_pixel(f, x, y, z, m);
+            EXPECT_EQ(std::bit_cast<uint32_t>(z), std::bit_cast<uint32_t>(wide.depth(x, y)))
+                << x << "," << y;
+            EXPECT_EQ(m, wide.motion(x, y)) << x << "," << y;
+        }
     // Without motion only depth is widened; without depth nothing is.
     Frame bare = f;
     bare.motion.clear();

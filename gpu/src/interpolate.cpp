@@ -8,7 +8,9 @@
 #include <utility>
 
 #include "reprise/warp/fill.hpp"
+#include "reprise/warp/silhouettes.hpp"
 #include "reprise/warp/true_motion.hpp"
+
 #include "state.hpp"
 
 namespace reprise::gpu {
@@ -414,6 +416,19 @@ bool motion_is_linear(ContextState& s, const SplatTextures& f, const Camera& cam
                                   to, factor, tolerance);
 }
 
+// The samples warp's linearity survey looks at, of `f` with its silhouettes widened.
+void widened_samples(const GBufferView& f, Image<glm::vec4>& samples) {
+    constexpr int kStep = warp::kLinearSurveyStep;
+    samples.resize(warp::linear_survey_samples(f.width()), warp::linear_survey_samples(f.height()));
+    for (int j = 0; j < samples.height(); ++j)
+        for (int i = 0; i < samples.width(); ++i) {
+            float z = 0.0f;
+            glm::vec2 m{0.0f};
+            warp::widened_pixel(f, kStep / 2 + kStep * i, kStep / 2 + kStep * j, z, m);
+            samples(i, j) = {z, m.x, m.y, 0.0f};
+        }
+}
+
 // warp's interpolate_frame's choice (both sides warpable): through the cameras unless the survey
 // finds the motion linear (`linear(side, factor)`, side 0 a, 1 b); without b's camera, a along
 // b's motion inverted.
@@ -507,17 +522,20 @@ Status Context::interpolate(const GBufferView& given_a, const GBufferView& given
         sides[f] = {textures[3 * f]->name, (widened ? wide[2 * f] : textures[3 * f + 1])->name,
                     (widened ? wide[2 * f + 1] : textures[3 * f + 2])->name, w, h};
     }
-    // The linearity survey on what is warped: the widened textures' samples, else the images.
+    // The linearity survey on what is warped, on the CPU (no read-back): where the silhouettes
+    // are widened, each sampled pixel widened as the GPU widened it.
     TrueMotion plan;
     if (options.true_motion)
         REPRISE_TRY(plan_true_motion(
             a.camera, b.camera, s_between, w, h,
             [&](int side, float factor) {
-                if (options.widen_silhouettes)
-                    return motion_is_linear(s, sides[side], side ? b.camera : a.camera, plan.at,
-                                            factor, options.static_tolerance);
-                return warp::motion_is_linear(side ? b : a, plan.at, factor,
-                                              options.static_tolerance);
+                const GBufferView& f = side ? b : a;
+                if (!options.widen_silhouettes)
+                    return warp::motion_is_linear(f, plan.at, factor, options.static_tolerance);
+                widened_samples(f, k.survey_samples);
+                return warp::motion_is_linear(f.camera, w, h,
+                                              std::as_const(k.survey_samples).view(), plan.at,
+                                              factor, options.static_tolerance);
             },
             plan, stats));
     REPRISE_TRY(interpolate_passes(s, sides[0], sides[1], s_between, w, h, options, s.color.name,

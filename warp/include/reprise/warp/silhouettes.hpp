@@ -25,4 +25,7 @@ inline constexpr float kSilhouetteKeep = 1.0f - 0.15f;
 GBufferView widen_silhouettes(const GBufferView& f, Image<float>& depth, Image<glm::vec2>& motion,
                               std::size_t* changed = nullptr);
 
+// The depth and motion widen_silhouettes gives pixel (x, y) of `f` (which has both), alone.
+void widened_pixel(const GBufferView& f, int x, int y, float& depth, glm::vec2& motion);
+
 }  // namespace reprise::warp
