@@ -150,10 +150,13 @@ void ContextState::upload(const Texture& texture, const void* data, std::ptrdiff
     glBindTexture(GL_TEXTURE_2D, texture.name);
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
     glBindBuffer(GL_PIXEL_UNPACK_BUFFER, unpack_buffer);
-    glBufferData(GL_PIXEL_UNPACK_BUFFER, GLsizeiptr(bytes), nullptr, GL_STREAM_DRAW);
-    auto* mapped = static_cast<unsigned char*>(glMapBufferRange(
-        GL_PIXEL_UNPACK_BUFFER, 0, GLsizeiptr(bytes),
-        GL_MAP_WRITE_BIT | GL_MAP_INVALIDATE_BUFFER_BIT | GL_MAP_UNSYNCHRONIZED_BIT));
+    if (bytes > unpack_bytes) {
+        glBufferData(GL_PIXEL_UNPACK_BUFFER, GLsizeiptr(bytes), nullptr, GL_STREAM_DRAW);
+        unpack_bytes = bytes;
+    }
+    auto* mapped = static_cast<unsigned char*>(
+        glMapBufferRange(GL_PIXEL_UNPACK_BUFFER, 0, GLsizeiptr(bytes),
+                         GL_MAP_WRITE_BIT | GL_MAP_INVALIDATE_BUFFER_BIT));
     const auto* source = static_cast<const unsigned char*>(data);
     if (mapped) {
         parallel_for(0, h, [&](int y0, int y1) {
