@@ -293,10 +293,10 @@ Status Context::extrapolate_on_gpu(const GBufferView& given, const glm::mat4& vi
                               : geometry_on_gpu ? SourceWide::Copied
                                                 : SourceWide::Nothing;
     if (wanted != SourceWide::Nothing && s.source_wide != wanted) {
-        const std::size_t changed =
-            widen_pass(s, geometry_on_gpu ? on_gpu.depth : s.source_depth.name,
-                       geometry_on_gpu ? on_gpu.motion : s.source_motion.name, w, h,
-                       s.source_wide_depth, &s.source_wide_motion, widen);
+        const std::size_t changed = widen_pass(
+            s, geometry_on_gpu ? on_gpu.depth : s.source_depth.name,
+            geometry_on_gpu ? on_gpu.motion : s.source_motion.name, w, h, s.source_wide_depth,
+            &s.source_wide_motion, widen ? Widening::Counted : Widening::Copy);
         if (!kept) stats.silhouette_pixels = changed;
         s.source_wide = wanted;
     }

@@ -66,7 +66,7 @@ Status create_silhouette_program(ContextState& s) {
 }
 
 std::size_t widen_pass(ContextState& s, GLuint depth, GLuint motion, int w, int h,
-                       GLuint wide_depth, GLuint wide_motion, bool widen) {
+                       GLuint wide_depth, GLuint wide_motion, Widening how) {
     const GLuint program = s.widen_program;
     glUseProgram(program);
     s.bind_inputs({depth, motion});
@@ -75,23 +75,23 @@ std::size_t widen_pass(ContextState& s, GLuint depth, GLuint motion, int w, int 
     glUniform2i(glGetUniformLocation(program, "size"), w, h);
     glUniform1f(glGetUniformLocation(program, "keep"), warp::kSilhouetteKeep);
     glUniform1i(glGetUniformLocation(program, "moves"), motion ? 1 : 0);
-    glUniform1i(glGetUniformLocation(program, "widen"), widen ? 1 : 0);
+    glUniform1i(glGetUniformLocation(program, "widen"), how != Widening::Copy ? 1 : 0);
     ContextState::reset_counters(s.widen_counts, 1);
     dispatch(w, h);
     ContextState::unbind_inputs();
     glUseProgram(0);
     GLuint changed = 0;
-    s.read_counters(s.widen_counts, &changed, sizeof changed);
+    if (how == Widening::Counted) s.read_counters(s.widen_counts, &changed, sizeof changed);
     return changed;
 }
 
 std::size_t widen_pass(ContextState& s, GLuint depth, GLuint motion, int w, int h,
-                       Texture& wide_depth, Texture* wide_motion, bool widen) {
+                       Texture& wide_depth, Texture* wide_motion, Widening how) {
     REPRISE_ASSERT(!motion || wide_motion);
     wide_depth.ensure(GL_R32F, w, h);
     if (motion) wide_motion->ensure(GL_RGBA32F, w, h);
     return widen_pass(s, depth, motion, w, h, wide_depth.name, motion ? wide_motion->name : 0u,
-                      widen);
+                      how);
 }
 
 Status Context::widen_silhouettes(const GBufferTextures& frame, unsigned out_depth,

@@ -211,15 +211,17 @@ Status reproject_pass(ContextState& s, GLuint depth, GLuint motion, GLuint id,
 std::size_t border_rows_pass(ContextState& s, GLuint color, GLuint depth, GLuint valid, int w,
                              int h, int max_run);
 
+// What widen_pass does: widen and count (the count read back: a synchronisation), widen alone
+// (returns 0), or copy the depth and motion as they are (returns 0).
+enum class Widening { Counted, Uncounted, Copy };
 // warp::widen_silhouettes on textures: `depth` (GL_R32F) and `motion` (RG of a float texture; 0:
 // none) of w x h into `wide_depth` (GL_R32F) and, with motion, `wide_motion` (GL_RGBA32F, the
-// motion in RG); returns how many pixels took a neighbour's surface. `widen` false: copied as
-// they are.
+// motion in RG); returns how many pixels took a neighbour's surface.
 std::size_t widen_pass(ContextState& s, GLuint depth, GLuint motion, int w, int h,
-                       GLuint wide_depth, GLuint wide_motion, bool widen = true);
+                       GLuint wide_depth, GLuint wide_motion, Widening how = Widening::Counted);
 // The same into scratch textures, sized here.
 std::size_t widen_pass(ContextState& s, GLuint depth, GLuint motion, int w, int h,
-                       Texture& wide_depth, Texture* wide_motion, bool widen = true);
+                       Texture& wide_depth, Texture* wide_motion, Widening how = Widening::Counted);
 
 // The passes of each path over textures, shared by its CPU-image and texture entry points.
 Status fill_passes(ContextState& s, GLuint color, GLuint valid, GLuint depth, int w, int h,

@@ -302,12 +302,12 @@ Status eye_passes(ContextState& s, GLuint color, GLuint depth, int w, int h, con
     EyeHistory widened_history;
     const EyeHistory* history = given_history;
     if (o.widen_silhouettes && !(grid && cpu_cells)) {
-        widen_pass(s, depth, 0, w, h, s.eye_wide_depth, nullptr);
+        widen_pass(s, depth, 0, w, h, s.eye_wide_depth, nullptr, Widening::Uncounted);
         depth = s.eye_wide_depth.name;
         if (history) {
             widened_history = *history;
             widen_pass(s, history->depth, history->motion, w, h, s.history_wide_depth,
-                       &s.history_wide_motion);
+                       &s.history_wide_motion, Widening::Uncounted);
             widened_history.depth = s.history_wide_depth.name;
             if (history->motion) widened_history.motion = s.history_wide_motion.name;
             history = &widened_history;
