@@ -79,6 +79,8 @@ void ContextState::unbind_inputs() {
 void ContextState::reset_counters(GLuint buffer, std::size_t count) {
     const GLuint zeros[64] = {};
     REPRISE_ASSERT(count <= 64);
+    // After the shader atomics of a pass whose count nobody read back.
+    glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 0, buffer);
     glBufferSubData(GL_SHADER_STORAGE_BUFFER, 0, GLsizeiptr(count * sizeof(GLuint)), zeros);
 }
@@ -148,7 +150,11 @@ void ContextState::upload(const Texture& texture, const void* data, std::ptrdiff
     const std::size_t bytes = row * std::size_t(h);
     const std::size_t source_row = texel_bytes(texture.format) * std::size_t(stride);
     glBindTexture(GL_TEXTURE_2D, texture.name);
+    // Tightly packed rows from the start (an adopted context's application may have set these).
     glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+    glPixelStorei(GL_UNPACK_SKIP_ROWS, 0);
+    glPixelStorei(GL_UNPACK_SKIP_PIXELS, 0);
     glBindBuffer(GL_PIXEL_UNPACK_BUFFER, unpack_buffer);
     if (bytes > unpack_bytes) {
         glBufferData(GL_PIXEL_UNPACK_BUFFER, GLsizeiptr(bytes), nullptr, GL_STREAM_DRAW);
@@ -158,6 +164,7 @@ void ContextState::upload(const Texture& texture, const void* data, std::ptrdiff
         glMapBufferRange(GL_PIXEL_UNPACK_BUFFER, 0, GLsizeiptr(bytes),
                          GL_MAP_WRITE_BIT | GL_MAP_INVALIDATE_BUFFER_BIT));
     const auto* source = static_cast<const unsigned char*>(data);
+    if (!mapped) unpack_bytes = 0;  // allocated again next time (it may have failed)
     if (mapped) {
         parallel_for(0, h, [&](int y0, int y1) {
             for (int y = y0; y < y1; ++y)

@@ -424,7 +424,7 @@ struct ContextState {
     // 0.32 ms with them in GPU memory) and are copied into this one to be read.
     GLuint readback_buffer = 0;
     GLuint unpack_buffer = 0;  // uploads go through it: the GPU lays the texels out, not the CPU
-    std::size_t unpack_bytes = 0;  // its size
+    std::size_t unpack_bytes = 0;  // its size: the largest upload so far (kept until destroyed)
 
     // Binds `textures` to units 0, 1, ... for texelFetch through the nearest sampler (0: none).
     static constexpr unsigned kInputUnits = 16;  // GL ES 3.1's least for compute shaders
