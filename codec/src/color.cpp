@@ -152,24 +152,30 @@ void linear_from_planes(const Planes& planes, const SequenceParams& sp,
                 if (sub) {
                     // 9 c(x, y) + 3 c(nx, y) + 3 c(x, ny) + c(nx, ny) = 3 v(x) + v(nx) with
                     // v = 3 c(., y) + c(., ny), the vertical pass made once per chroma column.
-                    const int c_lo = std::max(0, x0 / 2 - 1);
-                    const int c_hi = std::min(cw - 1, (x0 + n - 1) / 2 + 1);
-                    for (int c = c_lo; c <= c_hi; ++c) {
-                        co_column[c - c_lo] = 3 * co_plane(c, cy) + co_plane(c, ny);
-                        cg_column[c - c_lo] = 3 * cg_plane(c, cy) + cg_plane(c, ny);
+                    // column[k] holds chroma column c0 - 1 + k, the two ends clamped to the plane
+                    // (chroma_taps): pixels 2c and 2c + 1 take c's and their left or right
+                    // neighbour's. x0 is even.
+                    const int c0 = x0 / 2, m = (n + 1) / 2;
+                    const int16_t* co_near = co_plane.data() + std::size_t(cy) * co_plane.width();
+                    const int16_t* co_far = co_plane.data() + std::size_t(ny) * co_plane.width();
+                    const int16_t* cg_near = cg_plane.data() + std::size_t(cy) * cg_plane.width();
+                    const int16_t* cg_far = cg_plane.data() + std::size_t(ny) * cg_plane.width();
+                    for (int k = 0; k < m; ++k) {
+                        co_column[k + 1] = 3 * co_near[c0 + k] + co_far[c0 + k];
+                        cg_column[k + 1] = 3 * cg_near[c0 + k] + cg_far[c0 + k];
                     }
-                    // Pixels 2c and 2c + 1 share column c; their other taps are c - 1 and c + 1
-                    // (chroma_taps), clamped to the plane. x0 is even.
-                    for (int i = 0; i < n; i += 2) {
-                        const int c = (x0 + i) / 2, k = c - c_lo;
-                        const int left = std::max(c - 1, 0) - c_lo;
-                        const int right = std::min(c + 1, cw - 1) - c_lo;
-                        const int co3 = 3 * co_column[k] + 8, cg3 = 3 * cg_column[k] + 8;
-                        co[i] = int16_t((co3 + co_column[left]) >> 4);
-                        cg[i] = int16_t((cg3 + cg_column[left]) >> 4);
-                        if (i + 1 == n) break;
-                        co[i + 1] = int16_t((co3 + co_column[right]) >> 4);
-                        cg[i + 1] = int16_t((cg3 + cg_column[right]) >> 4);
+                    const int left = std::max(c0 - 1, 0), right = std::min(c0 + m, cw - 1);
+                    co_column[0] = 3 * co_near[left] + co_far[left];
+                    cg_column[0] = 3 * cg_near[left] + cg_far[left];
+                    co_column[m + 1] = 3 * co_near[right] + co_far[right];
+                    cg_column[m + 1] = 3 * cg_near[right] + cg_far[right];
+                    // An odd last chunk writes one value past n, inside the buffers (n < kChunk).
+                    for (int k = 0; k < m; ++k) {
+                        const int co3 = 3 * co_column[k + 1] + 8, cg3 = 3 * cg_column[k + 1] + 8;
+                        co[2 * k] = int16_t((co3 + co_column[k]) >> 4);
+                        co[2 * k + 1] = int16_t((co3 + co_column[k + 2]) >> 4);
+                        cg[2 * k] = int16_t((cg3 + cg_column[k]) >> 4);
+                        cg[2 * k + 1] = int16_t((cg3 + cg_column[k + 2]) >> 4);
                     }
                     pco = co, pcg = cg;
                 }

@@ -191,10 +191,15 @@ struct Landings {
     }
 };
 
+// A run of up to kWidestGap pixels across where nothing landed, between two landings, takes the
+// farther one's depth: where the camera or an object moved, what comes into view lies behind.
+constexpr int kWidestGap = 8;
+
 // A pixel no landing reached between two on one surface, across, down or diagonally (a crack
 // where the reference was stretched, or where two cracks cross), takes their mean inverse depth:
-// exact on a plane, as both are values at pixel centres.
-void fill_cracks(ImageView<float> depth, Image<float>& scratch, float step) {
+// exact on a plane, as both are values at pixel centres. Then the gaps left in each row are
+// filled (kWidestGap).
+void fill_cracks_and_gaps(ImageView<float> depth, Image<float>& scratch, float step) {
     const int w = depth.width, h = depth.height;
     auto mean = [step](float a, float b) {
         if (!(a < kInf && b < kInf)) return kNan;  // nothing landed there, or background
@@ -203,34 +208,32 @@ void fill_cracks(ImageView<float> depth, Image<float>& scratch, float step) {
                    ? 2.0f / (va + vb)
                    : kNan;
     };
-    // Only the pixels nothing landed on are read or written twice (scratch holds their values).
+    // The cracks' values go to scratch first: a filled pixel is not the neighbour of another.
     parallel_for(1, h - 1, [&](int y0, int y1) {
-        for (int y = y0; y < y1; ++y)
+        for (int y = y0; y < y1; ++y) {
+            const float *up = depth.row(y - 1), *row = depth.row(y), *down = depth.row(y + 1);
+            float* crack = &scratch(0, y);
             for (int x = 1; x + 1 < w; ++x) {
-                if (!std::isnan(depth(x, y))) continue;
+                if (!std::isnan(row[x])) continue;
                 float v = kNan;
-                for (const auto& [dx, dy] : {std::pair{1, 0}, {0, 1}, {1, 1}, {1, -1}}) {
-                    v = mean(depth(x - dx, y - dy), depth(x + dx, y + dy));
+                for (const auto& [a, b] : {std::pair{row[x - 1], row[x + 1]},
+                                           {up[x], down[x]},
+                                           {up[x - 1], down[x + 1]},
+                                           {down[x - 1], up[x + 1]}}) {
+                    v = mean(a, b);
                     if (!std::isnan(v)) break;
                 }
-                scratch(x, y) = v;
+                crack[x] = v;
             }
+        }
     });
-    parallel_for(1, h - 1, [&](int y0, int y1) {
-        for (int y = y0; y < y1; ++y)
-            for (int x = 1; x + 1 < w; ++x)
-                if (std::isnan(depth(x, y))) depth(x, y) = scratch(x, y);
-    });
-}
-
-// A run of up to kWidestGap pixels across where nothing landed, between two landings, takes the
-// farther one's depth: where the camera or an object moved, what comes into view lies behind.
-constexpr int kWidestGap = 8;
-void fill_gaps(ImageView<float> depth) {
-    const int w = depth.width;
-    parallel_for(0, depth.height, [&](int y0, int y1) {
+    parallel_for(0, h, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y) {
             float* row = depth.row(y);
+            if (y >= 1 && y + 1 < h) {
+                const float* crack = &scratch(0, y);
+                for (int x = 1; x + 1 < w; ++x) row[x] = std::isnan(row[x]) ? crack[x] : row[x];
+            }
             for (int x = 1; x < w; ++x) {
                 if (!std::isnan(row[x])) continue;
                 int end = x;
@@ -381,8 +384,7 @@ void reproject_depth(const Camera& from, ImageView<const float> depth, const Cam
             }
         });
     if (plane_fit) {
-        fill_cracks(out, landings.held, plane_step);
-        fill_gaps(out);
+        fill_cracks_and_gaps(out, landings.held, plane_step);
     }
 }
 
