@@ -175,9 +175,10 @@ namespace {
 struct Landings {
     Image<int32_t> slot;
     Image<float> z, px, py, held;
-    Image<float> inverse;               // 1 / z of each landing (plane fit only)
-    Image<int> object;                  // index into the objects, -1: none
-    std::vector<Image<float>> nearest;  // bands beyond the first: their nearest landings
+    Image<float> inverse;  // 1 / z of each landing (plane fit only)
+    Image<int> object;     // index into the objects, -1: none
+    // Per reference row, the smallest and largest slot its landings reach (first > last: none).
+    std::vector<int32_t> first_slot, last_slot;
     // The plane's span in pixels (plane_row): 6 at a height of 360, the best of 3 to 18 there, as
     // 12 was at 720.
     int span = 1;
@@ -186,6 +187,8 @@ struct Landings {
         span = std::max(2, int(std::lround(double(h) / 60.0)));
         for (Image<float>* i : {&z, &px, &py, &held, &inverse}) ensure_size(*i, w, h);
         ensure_size(slot, w, h);
+        first_slot.resize(std::size_t(h));
+        last_slot.resize(std::size_t(h));
         if (object.width() != w || object.height() != h) no_objects = false;
         ensure_size(object, w, h);
     }
@@ -323,6 +326,14 @@ void reproject_depth(const Camera& from, ImageView<const float> depth, const Cam
             if (plane_fit)
                 for (int x = 0; x < w; ++x)
                     landings.inverse(x, y) = row.slot[x] >= 0 ? 1.0f / row.z[x] : 0.0f;
+            int32_t first = std::numeric_limits<int32_t>::max(), last = -1;
+            for (int x = 0; x < w; ++x) {
+                const int32_t slot = row.slot[x];
+                first = std::min(first, slot < 0 ? first : slot);
+                last = std::max(last, slot);
+            }
+            landings.first_slot[std::size_t(y)] = first;
+            landings.last_slot[std::size_t(y)] = last;
         }
     });
     landings.no_objects = objects.empty();
@@ -345,44 +356,28 @@ void reproject_depth(const Camera& from, ImageView<const float> depth, const Cam
         });
     const Image<float>& value = plane_fit ? landings.held : landings.z;
     // Each pixel keeps the nearest landing (NaN: none), whatever order they land in. Landings
-    // never come out NaN, and the nearest of several is the same in any order: each band of
-    // source rows (groups of 8 rows dealt out in turn, so that the bands' work is alike) keeps
-    // its own nearest landings, without atomics, and the bands' nearest are merged. At most
-    // kLandingBands: each band beyond the first holds a picture of floats.
-    constexpr int kLandingBands = 4;
-    const int bands = std::clamp(thread_count(), 1, std::min(kLandingBands, std::max(1, h / 8)));
-    landings.nearest.resize(std::size_t(bands - 1));
-    for (Image<float>& i : landings.nearest) ensure_size(i, w, h);
-    auto band_image = [&](int b) {
-        return b == 0 ? out.data : landings.nearest[std::size_t(b - 1)].data();
-    };
-    parallel_for(0, h, [&](int y0, int y1) {
-        for (int b = 0; b < bands; ++b)
-            std::fill(band_image(b) + std::size_t(y0) * w, band_image(b) + std::size_t(y1) * w,
-                      kNan);
-    });
+    // never come out NaN, and the nearest of several is the same in any order: each worker takes
+    // a band of the picture's rows and the landings in it, from the reference rows that reach it
+    // (without atomics; a row's landings mostly stay within a few rows).
+    const int bands = std::max(1, 2 * thread_count());
     parallel_for(
-        0, bands,
-        [&](int b0, int b1) {
-            for (int b = b0; b < b1; ++b) {
-                float* nearest = band_image(b);
-                for (int group = b; group * 8 < h; group += bands)
-                    for (int y = group * 8; y < std::min(h, group * 8 + 8); ++y)
-                        for (int x = 0; x < w; ++x)
-                            if (const int32_t slot = landings.slot(x, y);
-                                slot >= 0 && !(value(x, y) >= nearest[slot]))
-                                nearest[slot] = value(x, y);
+        0, h,
+        [&](int t0, int t1) {
+            const int32_t lo = t0 * w, hi = t1 * w;
+            std::fill(out.data + lo, out.data + hi, kNan);
+            for (int y = 0; y < h; ++y) {
+                if (landings.last_slot[std::size_t(y)] < lo ||
+                    landings.first_slot[std::size_t(y)] >= hi)
+                    continue;
+                const int32_t* slots = &landings.slot(0, y);
+                const float* values = &value(0, y);
+                for (int x = 0; x < w; ++x)
+                    if (const int32_t slot = slots[x];
+                        slot >= lo && slot < hi && !(values[x] >= out.data[slot]))
+                        out.data[slot] = values[x];
             }
         },
-        1);
-    if (bands > 1)
-        parallel_for(0, h, [&](int y0, int y1) {
-            for (int b = 1; b < bands; ++b) {
-                const float* other = band_image(b);
-                for (std::size_t i = std::size_t(y0) * w; i < std::size_t(y1) * w; ++i)
-                    if (other[i] < out.data[i] || std::isnan(out.data[i])) out.data[i] = other[i];
-            }
-        });
+        (h + bands - 1) / bands);
     if (plane_fit) {
         fill_cracks_and_gaps(out, landings.held, plane_step);
     }
