@@ -654,6 +654,26 @@ void encode_slice(SliceJob& j, std::vector<uint8_t>& bytes, std::vector<uint8_t>
     rc.finish();
 }
 
+// Codes x0..x1 - 1 of row y are their predictions (a block without residuals, not a plane): as
+// predict() gives them, with the left code carried along the run (the spatial median of a left
+// and a top code that are equal is that code, as in the background).
+void predict_run(SliceJob& j, int x0, int x1, int y, bool temporal) {
+    std::fill(&j.residuals(x0, y), &j.residuals(x0, y) + (x1 - x0), 0u);
+    uint32_t* codes = &j.codes(0, y);
+    if (x0 == 0 || y == j.y0 || j.map->lossless) {
+        for (int x = x0; x < x1; ++x) codes[x] = predict(j, x, y, temporal);
+        return;
+    }
+    const uint32_t* top = &j.codes(0, y - 1);
+    const uint32_t* reprojected = temporal ? &j.temporal(0, y) : nullptr;
+    uint32_t left = codes[x0 - 1];
+    for (int x = x0; x < x1; ++x) {
+        uint32_t p = reprojected ? reprojected[x] : kNoPrediction;
+        if (p == kNoPrediction) p = top[x] == left ? left : median_edge(left, top[x], top[x - 1]);
+        codes[x] = left = p;
+    }
+}
+
 bool decode_slice(SliceJob& j, std::span<const uint8_t> bytes) {
     RangeDecoder rc(bytes);
     Models m;
@@ -701,6 +721,12 @@ bool decode_slice(SliceJob& j, std::span<const uint8_t> bytes) {
                     continue;
                 }
                 const bool temporal = flags[b] & kTemporalBlock;
+                if ((flags[b] & (kZeroBlock | kPlaneBlock)) == kZeroBlock) {
+                    const int end = std::min(j.width, (b + 1) * kBlock);
+                    predict_run(j, x, end, y, temporal);
+                    x = end - 1;
+                    continue;
+                }
                 const uint32_t p = (flags[b] & kPlaneBlock)
                                        ? plane_code(planes[std::size_t(b)], x - b * kBlock, y - by)
                                        : predict(j, x, y, temporal);
