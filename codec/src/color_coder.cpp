@@ -420,8 +420,10 @@ bool code_slice(SliceJob& j, Coder& rc) {
                     ++j.blocks;
                     ++block;
                     if (skip) {
-                        load(j.predicted->p[k], bx, by, pred);
-                        store(j.out->p[k], bx, by, pred, nullptr, lo, 255);
+                        if (j.predicted != j.out) {  // the decoder predicts into its output
+                            load(j.predicted->p[k], bx, by, pred);
+                            store(j.out->p[k], bx, by, pred, nullptr, lo, 255);
+                        }
                         j.mark(k, bx, by, false);
                         ++j.skipped;
                         continue;
@@ -581,16 +583,15 @@ Status decode_color(const FrameContext& fc, ImageView<const float> depth,
         return Status::error("colour section: unknown flags " + std::to_string(flags));
     if ((flags & kAllSkipped) && fc.key)
         return Status::error("colour section: a key frame cannot skip its blocks");
-    Planes& predicted = fc.work->predicted;
+    // The prediction goes to the output, where skipped blocks keep it (a decoded block reads
+    // only its own prediction; intra blocks read the decoded blocks beside them).
+    Planes& predicted = out;
     if (!fc.key) predict(fc, depth, motion, predicted, stats);
     const StageTimer timer(stats.ms.color);
     const std::size_t blocks =
         std::size_t(sp.mb_cols()) * sp.mb_rows() * (4 + 2 * (sp.chroma == Chroma::C420 ? 1 : 4));
     if (flags & kAllSkipped) {
         if (r.remaining()) return Status::error("colour section: bytes after an all-skipped flag");
-        for (int k = 0; k < 3; ++k)
-            std::copy(predicted.p[k].data(), predicted.p[k].data() + predicted.p[k].pixel_count(),
-                      out.p[k].data());
         stats.blocks += blocks;
         stats.blocks_skipped += blocks;
     } else {
