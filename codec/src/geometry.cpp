@@ -300,7 +300,8 @@ void reproject_depth(const Camera& from, ImageView<const float> depth, const Cam
                            .slot = &landings.slot(0, y),
                            .z = &landings.z(0, y),
                            .px = &landings.px(0, y),
-                           .py = &landings.py(0, y)};
+                           .py = &landings.py(0, y),
+                           .inverse = plane_fit ? &landings.inverse(0, y) : nullptr};
             int* object = &landings.object(0, y);
             bool moved = false;
             if (!objects.empty())
@@ -323,16 +324,14 @@ void reproject_depth(const Camera& from, ImageView<const float> depth, const Cam
                     forward_row_reference(one, x, x + 1);
                 }
             }
-            if (plane_fit)
-                for (int x = 0; x < w; ++x)
-                    landings.inverse(x, y) = row.slot[x] >= 0 ? 1.0f / row.z[x] : 0.0f;
-            int32_t first = std::numeric_limits<int32_t>::max(), last = -1;
+            // -1 (nowhere) is the largest slot as unsigned.
+            uint32_t first = std::numeric_limits<uint32_t>::max();
+            int32_t last = -1;
             for (int x = 0; x < w; ++x) {
-                const int32_t slot = row.slot[x];
-                first = std::min(first, slot < 0 ? first : slot);
-                last = std::max(last, slot);
+                first = std::min(first, uint32_t(row.slot[x]));
+                last = std::max(last, row.slot[x]);
             }
-            landings.first_slot[std::size_t(y)] = first;
+            landings.first_slot[std::size_t(y)] = int32_t(std::min<uint32_t>(first, INT32_MAX));
             landings.last_slot[std::size_t(y)] = last;
         }
     });
@@ -404,6 +403,7 @@ void forward_row_reference(const ForwardRow& r, int i_begin, int i_end) {
         r.z[i] = tz;
         r.px[i] = px;
         r.py[i] = py;
+        if (r.inverse) r.inverse[i] = 1.0f / tz;
     }
 }
 

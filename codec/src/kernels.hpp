@@ -109,8 +109,9 @@ void from_planes_row(const FromPlanesRow& row);
 
 // Forward projection of `count` pixels from (x0, y) into another camera (reproject_depth): where
 // pixel x0 + i lands (slot[i]: row-major pixel index, -1 for nowhere), its depth there (z[i]) and
-// the point it lands on (px[i], py[i], in pixels; set where it lands). Depth +inf, NaN or below 0
-// lands nowhere. Perspective or not, through `projection`.
+// the point it lands on (px[i], py[i], in pixels; set where it lands), and 1 / z[i] there where
+// `inverse` is given. Depth +inf, NaN or below 0 lands nowhere. Perspective or not, through
+// `projection`.
 struct ForwardRow {
     glm::mat4 projection, to_clip, to_camera;
     int x0, y, count, width, height;
@@ -119,6 +120,7 @@ struct ForwardRow {
     float* z;
     float* px;
     float* py;
+    float* inverse = nullptr;
 };
 // The reference does pixels [i_begin, i_end) of the row.
 void forward_row_reference(const ForwardRow& row, int i_begin, int i_end);

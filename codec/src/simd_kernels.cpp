@@ -287,11 +287,16 @@ void ForwardRowSimd(const ForwardRow& r) {
         const VF tz = hn::Neg(times(C, 2, vx, vy, zv));
         const auto inside = hn::And(hn::And(px >= zero, py >= zero), hn::And(px < fw, py < fh));
         const auto lands = hn::And(hn::And(has_point, cw > zero), hn::And(inside, tz > zero));
+        if (hn::AllFalse(df, lands)) {  // background, say: nothing else is read where -1
+            hn::StoreU(none, di, r.slot + i);
+            continue;
+        }
         const auto slot = hn::ConvertTo(di, py) * width_i + hn::ConvertTo(di, px);
         hn::StoreU(hn::IfThenElse(hn::RebindMask(di, lands), slot, none), di, r.slot + i);
         hn::StoreU(tz, df, r.z + i);
         hn::StoreU(px, df, r.px + i);
         hn::StoreU(py, df, r.py + i);
+        if (r.inverse) hn::StoreU(one / tz, df, r.inverse + i);
     }
     forward_row_reference(r, i, r.count);
 }

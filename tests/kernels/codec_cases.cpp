@@ -364,6 +364,9 @@ public:
                 (std::memcmp(&optimized_.px[i], &reference_.px[i], sizeof(float)) != 0 ||
                  std::memcmp(&optimized_.py[i], &reference_.py[i], sizeof(float)) != 0))
                 return "pixel " + std::to_string(i) + ": landing point differs";
+            if (reference_.slot[i] >= 0 && i / width_ % 2 == 1 &&
+                std::memcmp(&optimized_.inverse[i], &reference_.inverse[i], sizeof(float)) != 0)
+                return "pixel " + std::to_string(i) + ": inverse depth differs";
         }
         return {};
     }
@@ -371,7 +374,7 @@ public:
 private:
     struct Output {
         std::vector<int32_t> slot;
-        std::vector<float> z, px, py;
+        std::vector<float> z, px, py, inverse;
     };
     template <class Kernel>
     void run_into(Output& out, Kernel kernel) {
@@ -379,6 +382,7 @@ private:
         out.z.assign(depth_.size(), 0.0f);
         out.px.assign(depth_.size(), 0.0f);
         out.py.assign(depth_.size(), 0.0f);
+        out.inverse.assign(depth_.size(), 0.0f);
         parallel_for(0, height_, [&](int y0, int y1) {
             for (int y = y0; y < y1; ++y) {
                 const std::size_t o = std::size_t(y) * width_;
@@ -394,7 +398,8 @@ private:
                         .slot = out.slot.data() + o,
                         .z = out.z.data() + o,
                         .px = out.px.data() + o,
-                        .py = out.py.data() + o});
+                        .py = out.py.data() + o,
+                        .inverse = y % 2 ? out.inverse.data() + o : nullptr});
             }
         });
     }
