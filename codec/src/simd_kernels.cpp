@@ -18,6 +18,13 @@ HWY_BEFORE_NAMESPACE();
 namespace reprise::codec::HWY_NAMESPACE {
 namespace hn = hwy::HWY_NAMESPACE;
 
+// first, first + 1, ...: Highway 1.0's Iota(d, first) stores the lanes and loads them back, a
+// stall in every loop that makes one; the lanes' offsets are made once per call and added.
+template <class D, class T>
+hn::Vec<D> counting_from(D d, hn::Vec<D> offsets, T first) {
+    return offsets + hn::Set(d, hn::TFromD<D>(first));
+}
+
 void PredictRowSimd(const PredictRow& r) {
     if constexpr (std::endian::native != std::endian::little) {
         predict_row_reference(r, 0, r.width);
@@ -29,6 +36,8 @@ void PredictRowSimd(const PredictRow& r) {
     using VF = hn::Vec<decltype(df)>;
     using VI = hn::Vec<decltype(di)>;
     const int n = int(hn::Lanes(df));
+    const auto lane = hn::Iota(df, 0.0f);
+    const auto lane_i = hn::Iota(di, 0);
     const VF zero = hn::Zero(df), half = hn::Set(df, 0.5f), eighth = hn::Set(df, 0.125f);
     const VF phases = hn::Set(df, 64.0f);
     const VF x_low = hn::Set(df, -4.0f * 64), x_high = hn::Set(df, float(r.width + 4) * 64);
@@ -68,7 +77,7 @@ void PredictRowSimd(const PredictRow& r) {
             mx = (((ax + bx) + cx) + dx) * eighth;
             my = (((ay + by) + cy2) + dy) * eighth;
         }
-        const VF centre = hn::Iota(df, float(x)) + half;
+        const VF centre = counting_from(df, lane, x) + half;
         const VI qx = fixed_position(centre, mx, x_low, x_high);
         const VI qy = fixed_position(cy, my, y_low, y_high);
         const VI ix = hn::ShiftRight<6>(qx), iy = hn::ShiftRight<6>(qy);
@@ -93,7 +102,8 @@ void PredictRowSimd(const PredictRow& r) {
                           hn::And(hn::ShiftRight<24>(packed_y), byte) - bias};
         VI sum = zero_i;
         const int ix0 = hn::GetLane(ix), iy0 = hn::GetLane(iy);
-        if (hn::AllTrue(di, hn::And(ix == hn::Iota(di, ix0), iy == hn::Set(di, iy0)))) {
+        if (hn::AllTrue(di,
+                        hn::And(ix == counting_from(di, lane_i, ix0), iy == hn::Set(di, iy0)))) {
             // Adjacent windows (the usual case: motion changes slowly along a row): each tap's
             // samples are one contiguous load.
             const int16_t* row = r.reference + std::size_t(iy0 - 1) * r.width + (ix0 - 1);
@@ -135,6 +145,7 @@ void CameraMotionRowSimd(const CameraMotionRow& r) {
     const hn::ScalableTag<float> df;
     using VF = hn::Vec<decltype(df)>;
     const int n = int(hn::Lanes(df));
+    const auto lane = hn::Iota(df, 0.0f);
     auto splat = [&](float v) { return hn::Set(df, v); };
     const VF a0x = splat(r.a0.x), a0y = splat(r.a0.y), a0w = splat(r.a0.w);
     const VF a1x = splat(r.a1.x), a1y = splat(r.a1.y), a1w = splat(r.a1.w);
@@ -162,7 +173,7 @@ void CameraMotionRowSimd(const CameraMotionRow& r) {
         const VF d = hn::LoadU(df, r.depth + x);
         const auto finite = hn::And(d >= zero, d < inf);
         const auto background = d == inf;
-        const VF fx = hn::Iota(df, float(x));
+        const VF fx = counting_from(df, lane, x);
         VF cx = (a0x + fx * a1x) + d * (b0x + fx * b1x);
         VF cyc = (a0y + fx * a1y) + d * (b0y + fx * b1y);
         VF cw = (a0w + fx * a1w) + d * (b0w + fx * b1w);
@@ -256,6 +267,7 @@ void ForwardRowSimd(const ForwardRow& r) {
     const hn::RebindToSigned<decltype(df)> di;
     using VF = hn::Vec<decltype(df)>;
     const int n = int(hn::Lanes(df));
+    const auto lane = hn::Iota(df, 0.0f);
     auto splat = [&](float v) { return hn::Set(df, v); };
     const glm::mat4& P = r.projection;
     const glm::mat4& M = r.to_clip;
@@ -274,7 +286,7 @@ void ForwardRowSimd(const ForwardRow& r) {
     for (; i + n <= r.count; i += n) {
         const VF z = hn::LoadU(df, r.depth + i);
         const auto has_point = hn::And(z < inf, z >= zero);
-        const VF fx = hn::Iota(df, float(r.x0 + i));
+        const VF fx = counting_from(df, lane, r.x0 + i);
         const VF x_ndc = two * (fx + half) / fw - one;
         const VF zv = hn::Neg(z);
         const VF wc = splat(P[2][3]) * zv + splat(P[3][3]);
@@ -398,6 +410,7 @@ std::size_t RevealRowSimd(const RevealRow& r) {
     using VF = hn::Vec<decltype(df)>;
     using VI = hn::Vec<decltype(di)>;
     const int n = int(hn::Lanes(df));
+    const auto lane = hn::Iota(df, 0.0f);
     const VF zero = hn::Zero(df), half = hn::Set(df, 0.5f), margin = hn::Set(df, 1.04f);
     const VF width = hn::Set(df, float(r.width)), height = hn::Set(df, float(r.height));
     const VF fy_base = hn::Set(df, float(r.y) + 0.5f);
@@ -407,7 +420,7 @@ std::size_t RevealRowSimd(const RevealRow& r) {
     for (; x + n <= r.width; x += n) {
         VF mx, my;
         hn::LoadInterleaved2(df, &r.motion[x].x, mx, my);
-        const VF fx = (hn::Iota(df, float(x)) + half) + mx, fy = fy_base + my;
+        const VF fx = (counting_from(df, lane, x) + half) + mx, fy = fy_base + my;
         const auto inside =
             hn::And(hn::And(fx >= zero, fy >= zero), hn::And(fx < width, fy < height));
         // Lanes outside (NaN among them) convert 0 and read pixel 0; they are masked out below.
