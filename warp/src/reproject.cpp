@@ -293,6 +293,8 @@ void reproject_rows(const Kernel& kernel, int y_begin, int y_end, int step, std:
         using VI = hn::Vec<decltype(di)>;
         const int lanes = int(hn::Lanes(df));
         const VF zero = hn::Zero(df), inf = hn::Set(df, kInf), half = hn::Set(df, 0.5f);
+        // Iota(d, x) in the loop would store its lanes and load them back (Highway 1.0): a stall.
+        const VF lane_numbers = hn::Iota(df, 0.0f);
         const VF v_kx = hn::Set(df, s.kx), v_kz = hn::Set(df, s.kz), v_k1 = hn::Set(df, s.k1);
         const VF v_wz = hn::Set(df, s.wz), v_w1 = hn::Set(df, s.w1), v_row = hn::Set(df, row);
         const VF v_px0 = hn::Set(df, s.px0), v_qx0 = hn::Set(df, s.qx0), v_qy = hn::Set(df, qy_row);
@@ -314,7 +316,7 @@ void reproject_rows(const Kernel& kernel, int y_begin, int y_end, int step, std:
         alignas(64) float FX[HWY_MAX_BYTES / 4], FY[HWY_MAX_BYTES / 4];
         alignas(64) int32_t DEPTH_OK[HWY_MAX_BYTES / 4], IDS_OK[HWY_MAX_BYTES / 4];
         for (; x + lanes <= width; x += lanes) {
-            const VF xf = hn::ConvertTo(df, hn::Iota(di, x));
+            const VF xf = lane_numbers + hn::Set(df, float(x));
             const VF z = hn::LoadU(df, zr + x);
             VF mx, my;
             hn::LoadInterleaved2(df, &mr[x].x, mx, my);

@@ -330,6 +330,7 @@ void RefetchRowSimd(const RefetchRow& r) {
     const int sw = r.color.width, sh = r.color.height;
     auto splat = [&](float v) { return hn::Set(df, v); };
     const VF zero = hn::Zero(df), half = splat(0.5f);
+    const VF lane_numbers = hn::Iota(df, 0.0f);  // Iota(df, x) in the loop stalls (Highway 1.0)
     const VF fsw = splat(float(sw)), fsh = splat(float(sh)), factor = splat(r.factor);
     const VF qy = splat(float(r.y) + 0.5f);
     const VI zero_i = hn::Zero(di), one_i = hn::Set(di, 1);
@@ -348,7 +349,7 @@ void RefetchRowSimd(const RefetchRow& r) {
         if (hn::AllFalse(df, covered)) continue;
         VF mx, my;
         hn::LoadInterleaved2(df, &r.target_motion[x].x, mx, my);
-        const VF qx = hn::Iota(df, float(x)) + half;
+        const VF qx = (lane_numbers + splat(float(x))) + half;
         VF px = qx - factor * mx, py = qy - factor * my;
         auto go = hn::And(covered,
                           hn::And(hn::And(px >= zero, py >= zero), hn::And(px <= fsw, py <= fsh)));
