@@ -1241,10 +1241,10 @@ TEST(Codec, BadPacketsGiveAStatusAndTheDecoderResumes) {
     for (int trial = 0; trial < 300; ++trial) {
         auto damaged = coded.packets[1 + trial % 3].data;
         const int flips = 1 + int(rng() % 8);
-        const std::size_t at = payload_offset(damaged), end = damaged.size() - 4;
+        const std::size_t from = payload_offset(damaged), end = damaged.size() - 4;
         for (int f = 0; f < flips; ++f)
-            damaged[at + rng() % (end - at)] ^= uint8_t(1 + rng() % 255);
-        if (trial % 5 == 0) damaged.resize(at + rng() % (end - at) + 4);
+            damaged[from + rng() % (end - from)] ^= uint8_t(1 + rng() % 255);
+        if (trial % 5 == 0) damaged.resize(from + rng() % (end - from) + 4);
         fix_crc(damaged);
         Decoder fresh;
         ASSERT_TRUE(fresh.send_packet(coded.packets[0].data).ok());

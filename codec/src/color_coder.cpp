@@ -188,7 +188,7 @@ void store(Image<int16_t>& p, int bx, int by, const Block& pred, const Block* re
 struct SliceJob {
     const Geometry* g;
     const Planes* source;     // encoder
-    const Planes* predicted;  // null on key frames
+    const Planes* predicted;  // null on key frames; else the output, predicted into
     Planes* out;
     int qp, skip_threshold;
     int mb_y0, mb_y1;
@@ -419,11 +419,7 @@ bool code_slice(SliceJob& j, Coder& rc) {
                     const int bx = mx * 8 * n + (b % n) * 8, by = my * 8 * n + (b / n) * 8;
                     ++j.blocks;
                     ++block;
-                    if (skip) {
-                        if (j.predicted != j.out) {  // the decoder predicts into its output
-                            load(j.predicted->p[k], bx, by, pred);
-                            store(j.out->p[k], bx, by, pred, nullptr, lo, 255);
-                        }
+                    if (skip) {  // the output holds the prediction already
                         j.mark(k, bx, by, false);
                         ++j.skipped;
                         continue;
@@ -532,7 +528,9 @@ ColorEncodeResult encode_color(const FrameContext& fc, const Planes& source,
                                StreamStats& stats) {
     const SequenceParams& sp = *fc.sp;
     prepare(sp, out, *fc.work);
-    Planes& predicted = fc.work->predicted;
+    // Predicted into the output, as the decoder does: a macroblock's decisions read its own
+    // blocks' prediction before they are reconstructed, skipped blocks keep it.
+    Planes& predicted = out;
     if (!fc.key) predict(fc, depth, motion, predicted, stats);
     const StageTimer timer(stats.ms.color);
     const std::size_t start = bytes.size();
@@ -583,8 +581,8 @@ Status decode_color(const FrameContext& fc, ImageView<const float> depth,
         return Status::error("colour section: unknown flags " + std::to_string(flags));
     if ((flags & kAllSkipped) && fc.key)
         return Status::error("colour section: a key frame cannot skip its blocks");
-    // The prediction goes to the output, where skipped blocks keep it (a decoded block reads
-    // only its own prediction; intra blocks read the decoded blocks beside them).
+    // The prediction goes to the output, where skipped blocks keep it (a block reads only its
+    // own prediction; intra blocks read the decoded blocks beside them).
     Planes& predicted = out;
     if (!fc.key) predict(fc, depth, motion, predicted, stats);
     const StageTimer timer(stats.ms.color);

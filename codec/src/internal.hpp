@@ -200,8 +200,7 @@ struct Workspace {
     MotionModelScratch motion_models;
     std::vector<ObjectField> object_fields;
     Image<uint32_t> predicted_owner;  // empty when no pixel is predicted to move with an object
-    Planes predicted;
-    Image<uint8_t> revealed;               // per luma pixel: the reference did not see it
+    Image<uint8_t> revealed;          // per luma pixel: the reference did not see it
     std::vector<uint8_t> coded_blocks[3];  // per 8x8 block of each plane: intra or with a residual
     std::vector<std::vector<uint8_t>> slice_bytes;
     std::vector<std::vector<uint8_t>> slice_flags;  // per slice: a block row's flags
