@@ -37,15 +37,15 @@ void forward_dct(const Block& in, Block& out) {
     int32_t tmp[64];
     for (int k = 0; k < 8; ++k)  // tmp = T X
         for (int j = 0; j < 8; ++j) {
-            int64_t s = 0;
-            for (int i = 0; i < 8; ++i) s += int64_t(kT[k][i]) * in[i * 8 + j];
-            tmp[k * 8 + j] = int32_t(s);
+            int32_t s = 0;
+            for (int i = 0; i < 8; ++i) s += kT[k][i] * in[i * 8 + j];
+            tmp[k * 8 + j] = s;
         }
     for (int k = 0; k < 8; ++k)  // out = tmp T^T
         for (int l = 0; l < 8; ++l) {
-            int64_t s = 0;
-            for (int j = 0; j < 8; ++j) s += int64_t(tmp[k * 8 + j]) * kT[l][j];
-            out[k * 8 + l] = round_shift(s, 10);
+            int32_t s = 0;
+            for (int j = 0; j < 8; ++j) s += tmp[k * 8 + j] * kT[l][j];
+            out[k * 8 + l] = (s + (1 << 9)) >> 10;
         }
 }
 
@@ -72,10 +72,12 @@ int32_t quant_scale(int qp) {
 
 int quantize(const Block& c, int32_t scale, int32_t deadzone16, Block& levels) {
     int nonzero = 0;
-    const int64_t offset = int64_t(scale) * deadzone16 / 16;
+    // forward_dct's coefficients are below 2^17 (130,560), the offset below a step (2^17):
+    // the sums stay within int32.
+    const int32_t offset = int32_t(int64_t(scale) * deadzone16 / 16);
     for (int i = 0; i < 64; ++i) {
-        const int64_t a = std::abs(int64_t(c[i])) * 16;
-        const int32_t level = int32_t((a + offset) / scale);
+        const int32_t a = std::abs(c[i]) * 16;
+        const int32_t level = (a + offset) / scale;
         levels[i] = c[i] < 0 ? -level : level;
         nonzero += level != 0;
     }
