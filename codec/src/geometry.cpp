@@ -211,6 +211,15 @@ void fill_cracks_and_gaps(ImageView<float> depth, Image<float>& scratch, float s
                    ? 2.0f / (va + vb)
                    : kNan;
     };
+    // The first pair of landings across pixel c that lie on one surface: their mean.
+    auto across = [&](const float* up, const float* row, const float* down, int c) {
+        for (const auto& [a, b] : {std::pair{row[c - 1], row[c + 1]},
+                                   {up[c], down[c]},
+                                   {up[c - 1], down[c + 1]},
+                                   {down[c - 1], up[c + 1]}})
+            if (const float v = mean(a, b); !std::isnan(v)) return v;
+        return kNan;
+    };
     // The cracks' values go to scratch first: a filled pixel is not the neighbour of another.
     parallel_for(1, h - 1, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y) {
@@ -218,15 +227,15 @@ void fill_cracks_and_gaps(ImageView<float> depth, Image<float>& scratch, float s
             float* crack = &scratch(0, y);
             for (int x = 1; x + 1 < w; ++x) {
                 if (!std::isnan(row[x])) continue;
-                float v = kNan;
-                for (const auto& [a, b] : {std::pair{row[x - 1], row[x + 1]},
-                                           {up[x], down[x]},
-                                           {up[x - 1], down[x + 1]},
-                                           {down[x - 1], up[x + 1]}}) {
-                    v = mean(a, b);
-                    if (!std::isnan(v)) break;
-                }
-                crack[x] = v;
+                int end = x + 1;  // the run of pixels without a landing, within the interior
+                while (end + 1 < w && std::isnan(row[end])) ++end;
+                // A run of two or more (background, say) with no landing above or below it has
+                // no pair of landings across any of its pixels.
+                bool beside = end - x < 2;
+                for (int k = x - 1; k <= end && !beside; ++k)
+                    beside = up[k] < kInf || down[k] < kInf;
+                for (int c = x; c < end; ++c) crack[c] = beside ? across(up, row, down, c) : kNan;
+                x = end - 1;
             }
         }
     });
