@@ -50,6 +50,24 @@ void PredictRowSimd(const PredictRow& r) {
     const VI lo = hn::Set(di, r.lo), hi = hn::Set(di, r.hi), zero_i = hn::Zero(di);
     const int32_t* weights = reinterpret_cast<const int32_t*>(&catmull_rom_packed()[0]);
     const int32_t* base = reinterpret_cast<const int32_t*>(r.reference);
+    // With 16 lanes the 64 packed weights are four vectors, looked up by permutes (a gather
+    // each otherwise).
+    const bool permute = n == 16;
+    VI table[4] = {zero_i, zero_i, zero_i, zero_i};
+    if (permute)
+        for (int k = 0; k < 4; ++k) table[k] = hn::LoadU(di, weights + 16 * k);
+    const VI fifteen = hn::Set(di, 15), sixteen = hn::Set(di, 16), thirty_two = hn::Set(di, 32);
+    auto packed_weights = [&](VI phase) {
+        if (!permute) return hn::GatherIndex(di, weights, phase);
+        const auto index = hn::IndicesFromVec(di, hn::And(phase, fifteen));
+        const auto odd_table = hn::RebindMask(di, hn::And(phase, sixteen) != zero_i);
+        const auto upper_tables = hn::RebindMask(di, hn::And(phase, thirty_two) != zero_i);
+        const VI low = hn::IfThenElse(odd_table, hn::TableLookupLanes(table[1], index),
+                                      hn::TableLookupLanes(table[0], index));
+        const VI high = hn::IfThenElse(odd_table, hn::TableLookupLanes(table[3], index),
+                                       hn::TableLookupLanes(table[2], index));
+        return hn::IfThenElse(upper_tables, high, low);
+    };
 
     auto usable = [&](VF& mx, VF& my) {  // non-finite motion counts as 0
         const auto finite = hn::And((mx - mx) == zero, (my - my) == zero);
@@ -88,9 +106,8 @@ void PredictRowSimd(const PredictRow& r) {
             continue;
         }
         const VI px = hn::And(qx, mask63), py = hn::And(qy, mask63);
-        // One gather per axis fetches a lane's four taps, a biased byte each.
-        const VI packed_x = hn::GatherIndex(di, weights, px);
-        const VI packed_y = hn::GatherIndex(di, weights, py);
+        // One lookup per axis fetches a lane's four taps, a biased byte each.
+        const VI packed_x = packed_weights(px), packed_y = packed_weights(py);
         const VI byte = hn::Set(di, 255), bias = hn::Set(di, kPackedWeightBias);
         const VI wx[4] = {hn::And(packed_x, byte) - bias,
                           hn::And(hn::ShiftRight<8>(packed_x), byte) - bias,
