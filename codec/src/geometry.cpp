@@ -386,9 +386,7 @@ void reproject_depth(const Camera& from, ImageView<const float> depth, const Cam
             }
         },
         (h + bands - 1) / bands);
-    if (plane_fit) {
-        fill_cracks_and_gaps(out, landings.held, plane_step);
-    }
+    if (plane_fit) fill_cracks_and_gaps(out, landings.held, plane_step);
 }
 
 void forward_row_reference(const ForwardRow& r, int i_begin, int i_end) {

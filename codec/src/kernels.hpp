@@ -108,10 +108,10 @@ void from_planes_row_reference(const FromPlanesRow& row, int x_begin, int x_end)
 void from_planes_row(const FromPlanesRow& row);
 
 // Forward projection of `count` pixels from (x0, y) into another camera (reproject_depth): where
-// pixel x0 + i lands (slot[i]: row-major pixel index, -1 for nowhere), its depth there (z[i]) and
-// the point it lands on (px[i], py[i], in pixels; set where it lands), and 1 / z[i] there where
-// `inverse` is given. Depth +inf, NaN or below 0 lands nowhere. Perspective or not, through
-// `projection`.
+// pixel x0 + i lands (slot[i]: row-major pixel index, -1 for nowhere), its depth there (z[i]),
+// the point it lands on (px[i], py[i], in pixels) and, where `inverse` is given, 1 / z[i]; those
+// four are set only where it lands. Depth +inf, NaN or below 0 lands nowhere. Perspective or not,
+// through `projection`.
 struct ForwardRow {
     glm::mat4 projection, to_clip, to_camera;
     int x0, y, count, width, height;

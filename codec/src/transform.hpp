@@ -15,8 +15,8 @@ void inverse_dct(const Block& in, Block& out);
 
 // Quantiser step of qp (0..51) in sixteenths of a transform unit: 2^((qp - 4) / 6) * 32 * 16.
 int32_t quant_scale(int qp);
-// Levels from forward_dct's coefficients, rounding offset `deadzone` (fraction of a step, in
-// 1/16 units: 16/3 for intra, 16/6 for inter). Returns the number of non-zero levels.
+// Levels from forward_dct's coefficients, rounding offset `deadzone16` (a fraction of a step, in
+// 1/16 units). Returns the number of non-zero levels.
 int quantize(const Block& coefficients, int32_t scale, int32_t deadzone16, Block& levels);
 void dequantize(const Block& levels, int32_t scale, Block& coefficients);
 
