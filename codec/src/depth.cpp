@@ -443,7 +443,12 @@ uint64_t block_cost(SliceJob& j, int bx, int by, int bw, int bh, int mode) {
     for (int y = by; y < by + bh; ++y)
         for (int x = bx; x < bx + bw; ++x) {
             const uint32_t p = block_prediction(j, x, y, mode);
-            if (j.map->view) j.codes(x, y) = choose_view_code(j, x, y, temporal, p);
+            if (j.map->view) {
+                // Background (or no source) is its flag's code: choose_view_code's first answer.
+                const bool background = j.source.empty() || j.source(x, y) == INFINITY;
+                j.codes(x, y) = background ? kInfCode : choose_view_code(j, x, y, temporal, p);
+                if (background && p == kInfCode) continue;  // pixel_cost: the prediction, 0
+            }
             cost += pixel_cost(j, x, y, temporal, p);
         }
     return cost;
