@@ -203,13 +203,19 @@ void set_cells(const Job& j, const Node& n, const MotionModel* model, bool zero)
 }
 
 void apply_zero(Job& j, const Node& n) {
-    for (int y = n.y; y < n.y + n.h; ++y)
-        for (int x = n.x; x < n.x + n.w; ++x) {
-            j.out(x, y) = j.base(x, y);
-            j.set_owner(x, y, nullptr);
-            j.kind(x, y) = kZeroPixel;
-            j.value(x, y) = {0, 0};
+    // Row by row as copies and fills (a node is a tile: the rows' loads miss the caches, and
+    // pixel by pixel each waited on the last through the byte stores' aliasing).
+    for (int y = n.y; y < n.y + n.h; ++y) {
+        std::copy_n(&j.base(n.x, y), n.w, &j.out(n.x, y));
+        if (!j.owner.empty()) {
+            if (j.predicted.empty())
+                std::fill_n(&j.owner(n.x, y), n.w, 0u);
+            else
+                std::copy_n(&j.predicted(n.x, y), n.w, &j.owner(n.x, y));
         }
+        std::fill_n(&j.kind(n.x, y), n.w, uint8_t(kZeroPixel));
+        std::fill_n(&j.value(n.x, y), n.w, glm::ivec2(0));
+    }
     set_cells(j, n, nullptr, true);
 }
 
