@@ -98,13 +98,16 @@ struct Job {
             if (fields[k].id == id) return int(k);
         return !fields.empty() && fields.back().id == 0 ? int(fields.size()) - 1 : -1;
     }
-    // m == nullptr: the pixel took its base.
-    void set_owner(int x, int y, const MotionModel* m) const {
+    // The owners of `count` pixels from (x, y) that took model m (nullptr: their base).
+    void set_owners(int x, int y, int count, const MotionModel* m) const {
         if (owner.empty()) return;
+        uint32_t* row = &owner(x, y);
         if (m)
-            owner(x, y) = m->object >= 0 ? fields[std::size_t(m->object)].id : 0;
+            std::fill_n(row, count, m->object >= 0 ? fields[std::size_t(m->object)].id : 0u);
+        else if (predicted.empty())
+            std::fill_n(row, count, 0u);
         else
-            owner(x, y) = predicted.empty() ? 0 : predicted(x, y);
+            std::copy_n(&predicted(x, y), count, row);
     }
 };
 
@@ -207,12 +210,7 @@ void apply_zero(Job& j, const Node& n) {
     // pixel by pixel each waited on the last through the byte stores' aliasing).
     for (int y = n.y; y < n.y + n.h; ++y) {
         std::copy_n(&j.base(n.x, y), n.w, &j.out(n.x, y));
-        if (!j.owner.empty()) {
-            if (j.predicted.empty())
-                std::fill_n(&j.owner(n.x, y), n.w, 0u);
-            else
-                std::copy_n(&j.predicted(n.x, y), n.w, &j.owner(n.x, y));
-        }
+        j.set_owners(n.x, y, n.w, nullptr);
         std::fill_n(&j.kind(n.x, y), n.w, uint8_t(kZeroPixel));
         std::fill_n(&j.value(n.x, y), n.w, glm::ivec2(0));
     }
@@ -220,13 +218,14 @@ void apply_zero(Job& j, const Node& n) {
 }
 
 void apply_model(Job& j, const Node& n, const MotionModel& m) {
-    for (int y = n.y; y < n.y + n.h; ++y)
+    for (int y = n.y; y < n.y + n.h; ++y) {
+        j.set_owners(n.x, y, n.w, &m);
         for (int x = n.x; x < n.x + n.w; ++x) {
             j.out(x, y) = j.output(m, x, y);
-            j.set_owner(x, y, &m);
             j.kind(x, y) = kModelPixel;
             j.value(x, y) = j.model_value(m, x, y);
         }
+    }
     j.pixels += std::size_t(n.w) * n.h;
     set_cells(j, n, &m, false);
 }
@@ -311,7 +310,7 @@ bool code_pixels(Job& j, Models& m, const Node& n, const MotionModel* const (&ca
                 ++j.own_pixels;
             }
             j.out(x, y) = out;
-            j.set_owner(x, y, kind == kModelPixel ? cands[which] : nullptr);
+            j.set_owners(x, y, 1, kind == kModelPixel ? cands[which] : nullptr);
             j.kind(x, y) = kind;
             j.value(x, y) = value;
             j.pixels += kind != kZeroPixel;
