@@ -113,6 +113,11 @@ inline int magnitude_class(uint32_t left, uint32_t top) {
     return s == 0 ? 0 : s <= 8 ? 1 : s <= 256 ? 2 : 3;
 }
 
+// Two codes further apart than one residual step: an edge, where residuals gather.
+inline bool step_between(const Mapping& map, uint32_t a, uint32_t b) {
+    return std::abs(int64_t(a) - int64_t(b)) > int64_t(map.residual_step);
+}
+
 // Block flags: bit 0 temporal, bit 1 zero (no residuals), bit 2 plane (view mode).
 constexpr uint8_t kTemporalBlock = 1, kZeroBlock = 2, kPlaneBlock = 4;
 
@@ -138,12 +143,13 @@ inline uint32_t plane_code(const Plane& q, int dx, int dy) {
 
 struct Models {
     BitModel temporal[3][3];
-    BitModel plane[3];
+    BitModel plane[3][3];  // [what the block shows][neighbours]
     BitModel zero_block[3][3][3];
-    BitModel background[4];
+    BitModel background[32];  // version 17 (4 before)
     IntModel<24> residual[2][16];
     BitModel other[2];
-    BitModel across[2];  // version 14
+    IntModel<24> other_residual[2];  // version 17: a residual from the other prediction
+    BitModel across[2];              // version 14
     IntModel<24> plane_offset[2], plane_slope[2][2];
 };
 
@@ -210,7 +216,8 @@ inline uint32_t block_prediction(const SliceJob& j, int x, int y, int mode) {
 }
 
 // A plane block's parameters are predicted from the plane blocks to its left and above (the
-// surface continued), else flat at the code above the block's middle.
+// surface continued), else from the two rows above the block: the surface at the pixel above its
+// middle, or the nearest surface pixel to that in the row above, continued with its slopes.
 Plane predicted_plane(const SliceJob& j, int b, int by, const std::vector<uint8_t>& row,
                       const std::vector<uint8_t>& above, const std::vector<Plane>& planes,
                       const std::vector<Plane>& above_planes) {
@@ -226,16 +233,43 @@ Plane predicted_plane(const SliceJob& j, int b, int by, const std::vector<uint8_
     if (up)
         return {above_planes[b].c + kBlock * above_planes[b].gy, above_planes[b].gx,
                 above_planes[b].gy};
-    if (by > j.y0) {
-        const uint32_t m = j.codes(std::min(b * kBlock + kBlock / 2, j.width - 1), by - 1);
-        if (m <= kMaxViewCode) return {int64_t(m), 0, 0};
+    for (const int d : {-1, 1}) {  // above-left, then above-right
+        const int n = b + d;
+        if (above.empty() || n < 0 || n >= int(above.size()) || !(above[n] & kPlaneBlock)) continue;
+        const Plane& a = above_planes[std::size_t(n)];
+        return {a.c - d * kBlock * a.gx + kBlock * a.gy, a.gx, a.gy};
     }
-    return {};
+    if (by == j.y0) return {};
+    const int x0 = b * kBlock, mid = std::min(x0 + kBlock / 2, j.width - 1);
+    int at = -1;
+    for (int d = 0; d < kBlock && at < 0; ++d)
+        for (const int x : {mid - d, mid + d})
+            if (at < 0 && x >= 0 && x < j.width && j.codes(x, by - 1) <= kMaxViewCode) at = x;
+    if (at < 0) return {};
+    const int64_t m = j.codes(at, by - 1);
+    auto same = [&](int x, int y) {  // a code of the same surface
+        return x >= 0 && x < j.width && y >= j.y0 && j.codes(x, y) <= kMaxViewCode &&
+               !step_between(*j.map, j.codes(x, y), uint32_t(m));
+    };
+    Plane q{m, 0, 0};
+    if (same(at - 1, by - 1) && same(at + 1, by - 1))
+        q.gx = (int64_t(j.codes(at + 1, by - 1)) - int64_t(j.codes(at - 1, by - 1))) >> 1;
+    else if (same(at + 1, by - 1))
+        q.gx = int64_t(j.codes(at + 1, by - 1)) - m;
+    else if (same(at - 1, by - 1))
+        q.gx = m - int64_t(j.codes(at - 1, by - 1));
+    if (same(at, by - 2)) q.gy = m - int64_t(j.codes(at, by - 2));
+    q.c = m + ((q.gx * (2 * (x0 - at) + 7) + q.gy * 9) >> 1);  // at the block's centre
+    return plane_in_range(q) ? q : Plane{m, 0, 0};
 }
 
 inline int plane_context(const std::vector<uint8_t>& row, const std::vector<uint8_t>& above,
                          int b) {
-    return (b > 0 && (row[b - 1] & kPlaneBlock)) + (!above.empty() && (above[b] & kPlaneBlock));
+    const int n =
+        (b > 0 && (row[b - 1] & kPlaneBlock)) + (!above.empty() && (above[b] & kPlaneBlock));
+    if (n > 0 || above.empty()) return n;
+    return (b > 0 && (above[b - 1] & kPlaneBlock)) ||
+           (b + 1 < int(above.size()) && (above[b + 1] & kPlaneBlock));
 }
 
 // In a block with residuals, a pixel is first said to be background or not; a surface pixel whose
@@ -254,11 +288,6 @@ inline uint32_t surface_prediction(const SliceJob& j, int x, int y, uint32_t p) 
     return p;
 }
 
-// Two codes further apart than one residual step: an edge, where residuals gather.
-inline bool step_between(const Mapping& map, uint32_t a, uint32_t b) {
-    return std::abs(int64_t(a) - int64_t(b)) > int64_t(map.residual_step);
-}
-
 // A pixel the block's prediction misses may take the other prediction instead, for one flag. In
 // an inter frame that is the temporal one in a spatial or plane block and the spatial one in a
 // temporal block (a silhouette the reprojection put a pixel off, a surface the spatial prediction
@@ -269,12 +298,27 @@ inline uint32_t other_prediction(const SliceJob& j, int x, int y, bool temporal,
     if (j.temporal.empty()) {
         if (!j.map->view || x == 0 || y == j.y0) return p;
         const uint32_t a = j.codes(x - 1, y), b = j.codes(x, y - 1);
-        const uint32_t q =
-            std::abs(int64_t(p) - int64_t(a)) <= std::abs(int64_t(p) - int64_t(b)) ? b : a;
+        uint32_t q = std::abs(int64_t(p) - int64_t(a)) <= std::abs(int64_t(p) - int64_t(b)) ? b : a;
+        const bool above_right =
+            x + 1 < j.width && ((x + 1) % kBlock != 0 || (y - j.y0) % kBlock == 0);
+        if (above_right) {
+            const uint32_t d = j.codes(x + 1, y - 1);
+            if (j.map->surface(d) &&
+                std::abs(int64_t(p) - int64_t(d)) > std::abs(int64_t(p) - int64_t(q)))
+                q = d;
+        }
         return j.map->surface(q) && step_between(*j.map, q, p) ? q : p;
     }
     const uint32_t q = predict(j, x, y, !temporal);
     return j.map->surface(q) ? q : p;
+}
+
+// Whether the encoder codes c from the other prediction o rather than from p' (version 17): where
+// c lies a whole number of residual steps s from o, and nearer it than p' or not a whole number
+// of steps from p'.
+inline bool from_other(uint32_t c, uint32_t base, uint32_t other, uint32_t s) {
+    const int64_t ro = int32_t(c - other), rb = int32_t(c - base);
+    return ro % int64_t(s) == 0 && (rb % int64_t(s) != 0 || std::abs(ro) < std::abs(rb));
 }
 
 // A third prediction in inter frames in view mode, for a pixel both others miss: of its four
@@ -295,10 +339,15 @@ inline uint32_t across_prediction(const SliceJob& j, int x, int y, uint32_t p) {
     return step_between(*j.map, q, p) ? q : p;
 }
 
+// Which of the prediction and the left, above, above-left and above-right codes are background:
+// a silhouette against the background continues its slope from the row above.
 inline int background_context(const SliceJob& j, int x, int y, uint32_t p) {
     const uint32_t empty = j.map->empty();
-    return (p == empty) + (x > 0 && j.codes(x - 1, y) == empty) +
-           (y > j.y0 && j.codes(x, y - 1) == empty);
+    const bool top = y > j.y0;
+    return 16 * (p == empty) + 8 * (x > 0 && j.codes(x - 1, y) == empty) +
+           4 * (top && j.codes(x, y - 1) == empty) +
+           2 * (top && x > 0 && j.codes(x - 1, y - 1) == empty) +
+           (top && x + 1 < j.width && j.codes(x + 1, y - 1) == empty);
 }
 
 // A residual's class: at an edge (p no surface, or a step from the left or above code) or not,
@@ -307,7 +356,9 @@ inline int background_context(const SliceJob& j, int x, int y, uint32_t p) {
 inline int residual_context(const SliceJob& j, int x, int y, uint32_t p) {
     const bool edge = !j.map->surface(p) || (x > 0 && step_between(*j.map, j.codes(x - 1, y), p)) ||
                       (y > j.y0 && step_between(*j.map, j.codes(x, y - 1), p));
-    const bool across = across_prediction(j, x, y, p) != p;
+    const bool across = j.temporal.empty() ? y > j.y0 && x + 1 < j.width &&
+                                                 step_between(*j.map, j.codes(x + 1, y - 1), p)
+                                           : across_prediction(j, x, y, p) != p;
     return 4 * (edge + 2 * across) +
            magnitude_class(x > 0 ? j.residuals(x - 1, y) : 0, y > j.y0 ? j.residuals(x, y - 1) : 0);
 }
@@ -325,9 +376,25 @@ inline int zero_context(const std::vector<uint8_t>& row, const std::vector<uint8
 
 // What the temporal prediction shows of a block, known to both sides before its flags: 0 no
 // step between neighbouring codes, 1 a step (a silhouette, where residuals gather), 2 a pixel
-// nothing landed on, or no temporal prediction (key frames).
+// nothing landed on. Key frames (version 17): what the row above the block shows, 0 one
+// surface, 1 an edge or background beside a surface, 2 background only (or no row above).
 inline int reprojection_class(const SliceJob& j, int bx, int by, int bw, int bh) {
-    if (j.temporal.empty()) return 2;
+    if (j.temporal.empty()) {
+        if (by == j.y0) return 2;
+        bool surface = false, background = false, step = false;
+        uint32_t last = 0;
+        for (int x = std::max(bx - 1, 0); x < std::min(bx + bw + 1, j.width); ++x) {
+            const uint32_t c = j.codes(x, by - 1);
+            if (c == j.map->empty()) {
+                background = true;
+                continue;
+            }
+            step |= surface && step_between(*j.map, c, last);
+            surface = true;
+            last = c;
+        }
+        return !surface ? 2 : (background || step) ? 1 : 0;
+    }
     int step = 0;
     for (int y = by; y < by + bh; ++y)
         for (int x = bx; x < bx + bw; ++x) {
@@ -351,13 +418,13 @@ inline uint64_t pixel_cost(const SliceJob& j, int x, int y, bool temporal, uint3
     if (c == p) return 0;
     if (c == j.map->empty()) return 1;
     const uint32_t other = other_prediction(j, x, y, temporal, p);
-    if (other != p && c == other) return 3;
+    const uint32_t base = surface_prediction(j, x, y, p), s = j.map->residual_step;
+    if (other != p && from_other(c, base, other, s))
+        return 3 + residual_cost(int32_t(c - other) / int32_t(s));
     const uint32_t across = across_prediction(j, x, y, p);
     const bool has_across = across != p && across != other;
     if (has_across && c == across) return 3 + (other != p);
-    return 1 + (other != p) + has_across +
-           residual_cost(int32_t(c - surface_prediction(j, x, y, p)) /
-                         int32_t(j.map->residual_step));
+    return 1 + (other != p) + has_across + residual_cost(int32_t(c - base) / int32_t(s));
 }
 
 }  // namespace
@@ -416,8 +483,8 @@ uint32_t choose_view_code(const SliceJob& j, int x, int y, bool temporal, uint32
     if (k != kInvalidCode && p <= kMaxViewCode &&
         view_code_within(1.0 / double(z), p, map.step, map.displacement, share))
         return p;
+    const uint32_t other = other_prediction(j, x, y, temporal, p);
     if (k != kInvalidCode) {
-        const uint32_t other = other_prediction(j, x, y, temporal, p);
         if (other != p && other <= kMaxViewCode &&
             view_code_within(1.0 / double(z), other, map.step, map.displacement, share))
             return other;
@@ -429,9 +496,17 @@ uint32_t choose_view_code(const SliceJob& j, int x, int y, bool temporal, uint32
     const int64_t base = surface_prediction(j, x, y, p), s = kViewResidualStep;
     if (k == kInvalidCode)  // NaN: any code above 2^30 + 1
         return uint32_t(base + std::max<int64_t>(0, (kInvalidCode - base + s - 1) / s) * s);
-    int64_t c = base + (int64_t(k) - base + (k >= base ? s / 2 : -(s / 2))) / s * s;
-    if (c < 0) c += s;  // the nearest code of 0..2^30 instead
-    if (c > kMaxViewCode) c -= s;
+    auto nearest = [&](int64_t from) {  // whole steps from `from`, nearest the truth
+        int64_t c = from + (int64_t(k) - from + (k >= from ? s / 2 : -(s / 2))) / s * s;
+        if (c < 0) c += s;  // the nearest code of 0..2^30 instead
+        if (c > kMaxViewCode) c -= s;
+        return c;
+    };
+    int64_t c = nearest(base);
+    if (other != p && other <= kMaxViewCode) {  // fewer steps from the other prediction
+        const int64_t stepped = nearest(other);
+        if (std::abs(stepped - int64_t(other)) < std::abs(c - base)) c = stepped;
+    }
     return uint32_t(c);
 }
 
@@ -600,7 +675,7 @@ void encode_slice(SliceJob& j, std::vector<uint8_t>& bytes, std::vector<uint8_t>
                 rc.bit(m.temporal[shows][temporal_context(block_flags, above, b)],
                        mode == kTemporalMode);
             if (j.map->view && mode != kTemporalMode) {
-                rc.bit(m.plane[plane_context(block_flags, above, b)], mode == kPlaneMode);
+                rc.bit(m.plane[shows][plane_context(block_flags, above, b)], mode == kPlaneMode);
                 if (mode == kPlaneMode)
                     encode_plane(rc, m, fitted, predicted,
                                  plane_context(block_flags, above, b) > 0);
@@ -636,9 +711,13 @@ void encode_slice(SliceJob& j, std::vector<uint8_t>& bytes, std::vector<uint8_t>
                     if (c == base) continue;
                     const uint32_t other = other_prediction(j, x, y, flags & 1, p);
                     if (other != p) {
-                        rc.bit(m.other[flags & 1], c == other);
-                        if (c == other) {
-                            j.residuals(x, y) = 1;  // for the contexts: a pixel that missed
+                        const bool use = from_other(c, base, other, j.map->residual_step);
+                        rc.bit(m.other[flags & 1], use);
+                        if (use) {
+                            const int32_t r = int32_t(c - other) / int32_t(j.map->residual_step);
+                            encode_int(rc, m.other_residual[flags & 1], r);
+                            // For the contexts: a pixel that missed.
+                            j.residuals(x, y) = r == 0 ? 1u : uint32_t(r);
                             continue;
                         }
                     }
@@ -700,7 +779,7 @@ bool decode_slice(SliceJob& j, std::span<const uint8_t> bytes) {
             const bool temporal =
                 inter && rc.bit(m.temporal[shows][temporal_context(flags, above, b)]);
             const int context = plane_context(flags, above, b);
-            const bool plane = j.map->view && !temporal && rc.bit(m.plane[context]);
+            const bool plane = j.map->view && !temporal && rc.bit(m.plane[shows][context]);
             planes[std::size_t(b)] = {};
             if (plane &&
                 !decode_plane(rc, m, predicted_plane(j, b, by, flags, above, planes, above_planes),
@@ -752,8 +831,10 @@ bool decode_slice(SliceJob& j, std::span<const uint8_t> bytes) {
                 if (!rc.bit(model.zero)) continue;
                 const uint32_t other = other_prediction(j, x, y, temporal, p);
                 if (other != p && rc.bit(m.other[temporal])) {
-                    j.residuals(x, y) = 1;
-                    j.codes(x, y) = other;
+                    int64_t r = 0;
+                    if (!decode_int(rc, m.other_residual[temporal], r)) return false;
+                    j.residuals(x, y) = r == 0 ? 1u : uint32_t(r);
+                    j.codes(x, y) = other + uint32_t(r) * j.map->residual_step;
                     continue;
                 }
                 const uint32_t across = across_prediction(j, x, y, p);
