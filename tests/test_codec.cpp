@@ -14,6 +14,7 @@
 #include "../codec/src/range_coder.hpp"
 #include "../codec/src/transform.hpp"
 #include "reprise/codec/codec.hpp"
+#include "reprise/core/memory_limit.hpp"
 #include "reprise/core/nonfinite.hpp"
 #include "reprise/core/simd.hpp"
 #include "reprise/server/builtin_scenes.hpp"
@@ -1373,6 +1374,14 @@ TEST(Codec, ViewDepthKeepsExtremeRangesFinite) {
 
 TEST(Codec, EightKFrame) {
     const int w = 8192, h = 4320;
+    // The encoder's estimate for 8192x4320 is 4.7 GiB (144 bytes a pixel, docs/memory.md), above
+    // the 4 GiB default: a caller raises the limit, as `--max-memory 6G` does.
+    const std::uint64_t limit = memory_limit();
+    set_memory_limit(std::uint64_t(6) << 30);
+    struct Restore {
+        std::uint64_t bytes;
+        ~Restore() { set_memory_limit(bytes); }
+    } restore{limit};
     Frame f = test::constant_frame(w, h, 5.0f, {0.0f, 0.0f});
     for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x)

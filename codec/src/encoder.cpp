@@ -286,9 +286,10 @@ Status Encoder::send_frame(const GBufferView& given) {
     State& s = *state_;
     const int w = given.color.width, h = given.color.height;
     REPRISE_TRY(check_image_size(w, h, "encoder input frame " + std::to_string(s.next_frame)));
-    // References, predictions and residuals: `reprise encode` peaked at 120 bytes a pixel (RSS at
-    // 1920x1080 minus 960x540), 44 of them the caller's input frame.
-    REPRISE_TRY(check_image_memory(w, h, 80, "encode"));
+    // References, predictions, residuals and the stages' scratch: the encoder's own peak RSS was
+    // 137 bytes a pixel at 1920x1080 and 143 for 1920x1080 minus 960x540 (8 frames of pan, the
+    // input read beforehand, version 17); the caller's frames come on top.
+    REPRISE_TRY(check_image_memory(w, h, 144, "encode"));
     if (!given.depth.empty() && (given.depth.width != w || given.depth.height != h))
         return Status::error("encoder input frame " + std::to_string(s.next_frame) +
                              ": depth size differs from colour");
