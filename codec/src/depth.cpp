@@ -291,9 +291,10 @@ inline uint32_t surface_prediction(const SliceJob& j, int x, int y, uint32_t p) 
 // A pixel the block's prediction misses may take the other prediction instead, for one flag. In
 // an inter frame that is the temporal one in a spatial or plane block and the spatial one in a
 // temporal block (a silhouette the reprojection put a pixel off, a surface the spatial prediction
-// drifted from); in a key frame's view depth, of the left and above codes the one farther from p
-// when it is a step away (an edge the median or the plane put on the wrong side). Returns p where
-// that prediction is the same or no surface.
+// drifted from); in a key frame's view depth, of the left, above and (where the encoder knows it)
+// above-right codes the one farther from p when it is a step away (an edge the median or the plane
+// put on the wrong side, a silhouette coming down from the right). Returns p where that
+// prediction is the same or no surface. Version 17: a residual from it may follow.
 inline uint32_t other_prediction(const SliceJob& j, int x, int y, bool temporal, uint32_t p) {
     if (j.temporal.empty()) {
         if (!j.map->view || x == 0 || y == j.y0) return p;
@@ -465,14 +466,15 @@ namespace {
 
 // View mode: the code sent for the source depth at (x, y) predicted by p. Any code whose inverse
 // depth is close enough to the truth keeps the reprojection error within the bound: p itself
-// when it is such a code, else the surface prediction plus the residual steps that come nearest
-// the truth (within q / 2). The allowance shrinks by (1 - B/z)^2 for points near the camera
-// (docs/bitstream.md). A key frame keeps p only within 4/5 of the allowance: every later frame
-// transports its depth, and values left at the edge of the bound would leave it at the first
-// noise of that transport, a residual each. The other prediction, then the third (inter frames),
-// when it is close enough, costs less than a residual. A pixel may be allowed a multiple of the
-// bound (`SliceJob::share`); its residual still takes it nearest the truth (the smallest residual
-// within the wider bound left the next frames' predictions farther off: key depth +4 %).
+// when it is such a code, else the surface prediction, or the other prediction where that takes
+// fewer steps, plus the residual steps that come nearest the truth (within q / 2). The allowance
+// shrinks by (1 - B/z)^2 for points near the camera (docs/bitstream.md). A key frame keeps p only
+// within 4/5 of the allowance: every later frame transports its depth, and values left at the edge
+// of the bound would leave it at the first noise of that transport, a residual each. The other
+// prediction, then the third (inter frames), when it is close enough, costs less than a residual. A
+// pixel may be allowed a multiple of the bound (`SliceJob::share`); its residual still takes it
+// nearest the truth (the smallest residual within the wider bound left the next frames' predictions
+// farther off: key depth +4 %).
 uint32_t choose_view_code(const SliceJob& j, int x, int y, bool temporal, uint32_t p) {
     const Mapping& map = *j.map;
     const float z = j.source.empty() ? INFINITY : j.source(x, y);
