@@ -287,9 +287,9 @@ Status Encoder::send_frame(const GBufferView& given) {
     const int w = given.color.width, h = given.color.height;
     REPRISE_TRY(check_image_size(w, h, "encoder input frame " + std::to_string(s.next_frame)));
     // References, predictions, residuals and the stages' scratch: the encoder's own peak RSS was
-    // 137 bytes a pixel at 1920x1080 and 143 for 1920x1080 minus 960x540 (8 frames of pan, the
-    // input read beforehand, version 17); the caller's frames come on top.
-    REPRISE_TRY(check_image_memory(w, h, 144, "encode"));
+    // 113 bytes a pixel at 1920x1080 and 119 for 1920x1080 minus 960x540 (8 frames of pan, the
+    // input read beforehand); the caller's frames come on top.
+    REPRISE_TRY(check_image_memory(w, h, 120, "encode"));
     if (!given.depth.empty() && (given.depth.width != w || given.depth.height != h))
         return Status::error("encoder input frame " + std::to_string(s.next_frame) +
                              ": depth size differs from colour");
@@ -410,6 +410,9 @@ Status Encoder::send_frame(const GBufferView& given) {
     s.reference_of[slot] = header.reference;
     s.tainted[slot] = !key && s.tainted[ref];
     std::swap(s.refs[slot], pic);
+    // Only the newest picture's motion is read again (reconstruction()): the one before hands its
+    // buffer to the next frame's picture, so two motion buffers exist instead of five.
+    if (s.newest >= 0 && s.newest != slot) pic.motion = std::move(s.refs[s.newest].motion);
     s.newest = slot;
     s.after_loss = false;
     s.started = true;
