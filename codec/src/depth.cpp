@@ -272,6 +272,12 @@ inline int plane_context(const std::vector<uint8_t>& row, const std::vector<uint
            (b + 1 < int(above.size()) && (above[b + 1] & kPlaneBlock));
 }
 
+// Whether (x + 1, y - 1) is a code the encoder, which decides block by block, already knows when
+// it predicts (x, y): in the band above or in the same 8-pixel block.
+inline bool above_right_known(const SliceJob& j, int x, int y) {
+    return y > j.y0 && x + 1 < j.width && ((x + 1) % kBlock != 0 || (y - j.y0) % kBlock == 0);
+}
+
 // In a block with residuals, a pixel is first said to be background or not; a surface pixel whose
 // prediction is not a surface (a silhouette the prediction missed) is predicted from its nearest
 // surface neighbour instead, so an edge one pixel off costs a flag, not a jump across 2^30.
@@ -280,10 +286,8 @@ inline uint32_t surface_prediction(const SliceJob& j, int x, int y, uint32_t p) 
     const bool left = x > 0, top = y > j.y0;
     if (left && j.map->surface(j.codes(x - 1, y))) return j.codes(x - 1, y);
     if (top && j.map->surface(j.codes(x, y - 1))) return j.codes(x, y - 1);
-    // Above right only where the encoder, which decides block by block, knows it already.
-    const bool above_right =
-        top && x + 1 < j.width && ((x + 1) % kBlock != 0 || (y - j.y0) % kBlock == 0);
-    if (above_right && j.map->surface(j.codes(x + 1, y - 1))) return j.codes(x + 1, y - 1);
+    if (above_right_known(j, x, y) && j.map->surface(j.codes(x + 1, y - 1)))
+        return j.codes(x + 1, y - 1);
     if (left && top && j.map->surface(j.codes(x - 1, y - 1))) return j.codes(x - 1, y - 1);
     return p;
 }
@@ -300,9 +304,7 @@ inline uint32_t other_prediction(const SliceJob& j, int x, int y, bool temporal,
         if (!j.map->view || x == 0 || y == j.y0) return p;
         const uint32_t a = j.codes(x - 1, y), b = j.codes(x, y - 1);
         uint32_t q = std::abs(int64_t(p) - int64_t(a)) <= std::abs(int64_t(p) - int64_t(b)) ? b : a;
-        const bool above_right =
-            x + 1 < j.width && ((x + 1) % kBlock != 0 || (y - j.y0) % kBlock == 0);
-        if (above_right) {
+        if (above_right_known(j, x, y)) {
             const uint32_t d = j.codes(x + 1, y - 1);
             if (j.map->surface(d) &&
                 std::abs(int64_t(p) - int64_t(d)) > std::abs(int64_t(p) - int64_t(q)))
