@@ -905,8 +905,11 @@ Differences differences(const Frame& cpu, const Frame& gpu) {
 
 // --- The in-between frame against the CPU converter with the same options.
 
-const warp::FrucOptions kSplatInterpolation{
-    .warp = warp::WarpMethod::Splat, .true_motion = false, .refine = {.enabled = false}};
+// (The GPU blends in linear light: FrucOptions::perceptual is the CPU's alone.)
+const warp::FrucOptions kSplatInterpolation{.warp = warp::WarpMethod::Splat,
+                                            .perceptual = false,
+                                            .true_motion = false,
+                                            .refine = {.enabled = false}};
 
 // The frame the CPU makes halfway between `a` and `b` with `options` (their silhouettes widened
 // on the CPU, as Context::interpolate widens them on the GPU).
@@ -947,6 +950,7 @@ TEST(Gpu, GridInterpolationMatchesTheCpuOnEveryBuiltInScene) {
                              (follow ? ", true motion" : ""));
                 const warp::FrucOptions options{.warp = warp::WarpMethod::Grid,
                                                 .grid = {.min_cell = min_cell, .bicubic = true},
+                                                .perceptual = false,
                                                 .true_motion = follow,
                                                 .refine = {.enabled = false}};
                 warp::FrucCounters counters;
@@ -989,6 +993,7 @@ TEST(Gpu, RefinedInterpolationMatchesTheCpuOnEveryBuiltInScene) {
         for (const bool eager : {false, true}) {
             SCOPED_TRACE(std::string(info.name) + (eager ? ", eager" : ""));
             warp::FrucOptions options;
+            options.perceptual = false;
             if (eager) options.refine = {.tile = 8, .threshold = 0.02f};
             warp::FrucCounters counters;
             const Frame cpu = cpu_between_with(frames[0], frames[1], options, &counters);
@@ -1142,6 +1147,7 @@ TEST(Gpu, TheConverterWithTheGpuBackendMakesTheCpusFrames) {
 
     // The defaults (the grid with refinement): the CPU's frames, refinement counted alike.
     warp::FrucOptions defaults, defaults_on_gpu;
+    defaults.perceptual = false;
     defaults_on_gpu.backend = &backend;
     const std::vector<Frame> cpu_defaults = convert(frames, 3, defaults, cpu_counters);
     const std::vector<Frame> gpu_defaults = convert(frames, 3, defaults_on_gpu, gpu_counters);
@@ -1325,8 +1331,8 @@ TEST(Gpu, LinearitySurveyOfSamplesIsTheSurveyOfTheFrame) {
 
 // --- Extrapolation against warp::PoseExtrapolator and the converter with the same options.
 
-const warp::FrucOptions kSplatExtrapolation{.mode = warp::FrucMode::Extrapolate,
-                                            .warp = warp::WarpMethod::Splat};
+const warp::FrucOptions kSplatExtrapolation{
+    .mode = warp::FrucMode::Extrapolate, .warp = warp::WarpMethod::Splat, .perceptual = false};
 
 // `frame` seen by the next frame's camera `periods` on, on the CPU and on the GPU: colour within
 // 50 dB, depth in bits on all but 0.1 % of the pixels, motion within 1e-4 px.

@@ -97,8 +97,15 @@ std::vector<Setting> fruc_settings(bool quick) {
         off.options.refine.enabled = false;
         settings.push_back(off);
     };
+    // The default in linear light (FrucOptions::perceptual off), beside it.
+    auto add_linear = [&](const std::string& mode) {
+        add(mode, "grid", "pullpush");
+        settings.back().setting += "-linear";
+        settings.back().options.perceptual = false;
+    };
     if (quick) {
         add_refine_pair();
+        add_linear("interpolate");
         // The grid's other colour fetch, beside the default one.
         add("interpolate", warp::FrucOptions{}.grid.bicubic ? "grid-bilinear" : "grid-bicubic",
             "pullpush");
@@ -106,6 +113,7 @@ std::vector<Setting> fruc_settings(bool quick) {
         add("interpolate", "grid", "patch");
         add("interpolate", "splat", "none");
         add("extrapolate", "grid", "pullpush");
+        add_linear("extrapolate");
         add("interpolate", "auto", "auto");
         add("extrapolate", "auto", "auto");
         return settings;
@@ -119,6 +127,7 @@ std::vector<Setting> fruc_settings(bool quick) {
                 else
                     add(mode, warp_name, fill);
             }
+        add_linear(mode);
         add(mode, "grid", "patch");
         add(mode, "auto", "auto");
     }

@@ -25,6 +25,7 @@ struct FrucJob {
     std::string refine = "on";
     std::string true_motion = "on";
     std::string silhouettes = "widen";
+    std::string blend = "perceptual";
     std::string backend = "cpu";
     double refine_share = 1.0;
     int border_run = warp::kMadeFrameBorderRun;
@@ -73,6 +74,9 @@ Status run_fruc(const FrucJob& job) {
     if (job.silhouettes != "widen" && job.silhouettes != "keep")
         return Status::error("--silhouettes '" + job.silhouettes + "': expected widen or keep");
     options.widen_silhouettes = job.silhouettes == "widen";
+    if (job.blend != "perceptual" && job.blend != "linear")
+        return Status::error("--blend '" + job.blend + "': expected perceptual or linear");
+    options.perceptual = job.blend == "perceptual";
     if (job.backend != "cpu" && job.backend != "gles")
         return Status::error("--backend '" + job.backend + "': expected cpu or gles");
     std::unique_ptr<gpu::Context> gpu;
@@ -264,6 +268,10 @@ int command_fruc(int argc, char** argv) {
     args.option("--silhouettes", &job.silhouettes,
                 "widen | keep (default widen): pixels beside a nearer surface warp with it, so "
                 "the colour\nanti-aliasing blended into them travels with the silhouette");
+    args.option("--blend", &job.blend,
+                "perceptual | linear (default perceptual): colour warped, blended and filled as "
+                "the square\nroot of linear light (close to the display's scale), or in linear "
+                "light");
     args.option("--backend", &job.backend,
                 "cpu | gles (default cpu); gles: the made frames on OpenGL ES (--warp grid, splat "
                 "or reverse);\ninterpolated with --fill pullpush (refinement's optical flow on "

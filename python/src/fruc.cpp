@@ -25,11 +25,12 @@ warp::FrucOptions fruc_options(const std::string& mode, const std::string& warp_
 struct Converter {
     Converter(int factor, const std::string& mode, const std::string& warp_method,
               const std::string& fill, bool refine, bool true_motion, const std::string& backend,
-              bool widen_silhouettes, int border_run) {
+              bool widen_silhouettes, int border_run, bool perceptual) {
         warp::FrucOptions options =
             fruc_options(mode, warp_method, fill, refine, true_motion, widen_silhouettes);
         if (border_run < 0) value_error("border_run must be >= 0");
         options.border_run = border_run;
+        options.perceptual = perceptual;
         if (backend == "gles") {
             if (const Status s = gpu::FrucBackend::check(options, options.splat); !s.ok())
                 value_error("backend gles: " + s.message());
@@ -126,13 +127,15 @@ void bind_fruc(py::module_& m) {
         "(another thread gets an error). widen_silhouettes: pixels beside a nearer "
         "surface warp with it, so the anti-aliasing blended into them travels with the "
         "silhouette. border_run: px of each row's border strip a made frame continues from "
-        "the row before its fill (0: the fill alone).")
+        "the row before its fill (0: the fill alone). perceptual: colour warped, blended and "
+        "filled as the square root of linear light (close to the display's scale; off: in "
+        "linear light).")
         .def(py::init<int, const std::string&, const std::string&, const std::string&, bool, bool,
-                      const std::string&, bool, int>(),
+                      const std::string&, bool, int, bool>(),
              py::arg("factor") = 2, py::arg("mode") = "interpolate", py::arg("warp") = "grid",
              py::arg("fill") = "pullpush", py::arg("refine") = true, py::arg("true_motion") = true,
              py::arg("backend") = "cpu", py::arg("widen_silhouettes") = true,
-             py::arg("border_run") = warp::kMadeFrameBorderRun)
+             py::arg("border_run") = warp::kMadeFrameBorderRun, py::arg("perceptual") = true)
         .def("send", &Converter::send, py::arg("frame"), "Feeds the next rendered frame.")
         .def("receive", &Converter::receive, "The next output frame, or None.")
         .def("convert", &Converter::convert, py::arg("frames"),

@@ -26,6 +26,11 @@ def test_interpolated_frames_beat_repetition(pan_60):
     kept = reprise.FrameRateConverter(factor=2, widen_silhouettes=False)
     kept.convert(inputs)
     assert kept.counters["silhouette_pixels"] == 0
+    # Blended in linear light instead of on the display's scale: another frame, inputs as given.
+    linear = reprise.FrameRateConverter(factor=2, perceptual=False).convert(inputs)
+    assert not np.array_equal(linear[1].color, out[1].color)
+    assert psnr(pan_60[1], linear[1]) > psnr(pan_60[1], pan_60[0]) + 2.0
+    assert np.array_equal(linear[2].color, pan_60[2].color)
 
 
 def test_extrapolation_and_receive(pan_60, renderer):

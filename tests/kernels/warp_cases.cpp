@@ -687,6 +687,56 @@ private:
 
 // ---------------------------------------------------------------------------------------------
 
+// FrucOptions::perceptual: colour encoded, and the encoded colour decoded back.
+class PerceptualCase final : public KernelCase {
+public:
+    void generate(int w, int h, KernelInputs inputs, uint32_t seed) override {
+        std::mt19937 rng(seed);
+        const bool worst = inputs == KernelInputs::WorstCase;
+        width_ = w, height_ = h;
+        color_.resize(std::size_t(w) * std::size_t(h));
+        for (glm::vec4& c : color_)
+            for (int k = 0; k < 4; ++k)
+                c[k] = worst && rng() % 5 == 0 ? worst_value(rng) : uniform(rng, -0.5f, 4.0f);
+    }
+    void run_reference() override {
+        run_into(reference_, perceptual_encode_row_reference, perceptual_decode_row_reference);
+    }
+    void run() override { run_into(optimized_, perceptual_encode_row, perceptual_decode_row); }
+    std::string compare() const override {
+        std::string d =
+            compare_floats("encoded", optimized_.encoded, reference_.encoded, /*any_nan=*/true);
+        if (d.empty()) d = compare_floats("decoded", optimized_.decoded, reference_.decoded, true);
+        return d;
+    }
+
+private:
+    struct Output {
+        std::vector<glm::vec4> encoded, decoded;
+    };
+    template <class Encode, class Decode>
+    void run_into(Output& out, Encode encode, Decode decode) {
+        out.encoded.resize(color_.size());
+        const int w = width_;
+        parallel_for(0, height_, [&](int y0, int y1) {
+            for (int y = y0; y < y1; ++y) {
+                const std::size_t o = std::size_t(y) * std::size_t(w);
+                encode(color_.data() + o, out.encoded.data() + o, w);
+            }
+        });
+        out.decoded = out.encoded;
+        parallel_for(0, height_, [&](int y0, int y1) {
+            for (int y = y0; y < y1; ++y) decode(out.decoded.data() + std::size_t(y) * w, w);
+        });
+    }
+
+    int width_ = 0, height_ = 0;
+    std::vector<glm::vec4> color_;
+    Output reference_, optimized_;
+};
+
+// ---------------------------------------------------------------------------------------------
+
 // The forward splat (banded, threaded, its row kernels at the current level) against the scalar
 // reference, both footprints. Random: blocks of one motion each (sub-pixel, whole-pixel, still,
 // a zoom, per-pixel noise) over a few depth levels, so that runs land side by side and ties,
@@ -800,6 +850,7 @@ constexpr KernelEntry kEntries[] = {
     {"bicubic fetch (grid, refetch)", "bit-exact (NaN: any NaN)", true, make<BicubicCase>},
     {"stereo displacement", "bit-exact", true, make<DisplacementCase>},
     {"forward splat", "bit-exact", true, make<SplatCase>},
+    {"perceptual colour encode, decode", "bit-exact (NaN: any NaN)", true, make<PerceptualCase>},
 };
 
 }  // namespace

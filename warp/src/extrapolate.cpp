@@ -206,6 +206,7 @@ Status extrapolate_to_camera(const GBufferView& given, const glm::mat4& future_v
                                             options, out, counters, scratch.input_key[0]);
     if (!has_projection(given.camera)) {
         extrapolate_along_motion(given, s, motion_scale, options, scratch, out, counters);
+        finish_colour(out.color.view(), options);
         return {};
     }
     const GBufferView f = warp_input(given, 0, options, scratch, counters);
@@ -244,6 +245,7 @@ Status extrapolate_to_camera(const GBufferView& given, const glm::mat4& future_v
             for (int x = 0; x < w; ++x) m[x] *= to_backward;
         }
     });
+    finish_colour(out.color.view(), options);
     return {};
 }
 

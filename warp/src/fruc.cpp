@@ -312,8 +312,9 @@ Status FrameRateConverter::send_frame(const Frame& given, Frame* owned) {
     REPRISE_TRY(check_image_size(w, h, "fruc input frame"));
     // History, scratch and made frames: `reprise fruc --factor 2` peaked at 282 bytes a pixel
     // (RSS at 1920x1080 minus 960x540), 44 of them the caller's input frame.
-    // Since then the two widened inputs (FrucScratch::wide_*): 24 more, counted.
-    REPRISE_TRY(check_image_memory(w, h, 264, "fruc"));
+    // Since then the two widened inputs (FrucScratch::wide_*): 24 more, and their encoded
+    // colour (FrucScratch::encoded_color, FrucOptions::perceptual): 32, counted.
+    REPRISE_TRY(check_image_memory(w, h, 296, "fruc"));
     auto sized = [&](auto& image) {
         return image.empty() || (image.width() == w && image.height() == h);
     };

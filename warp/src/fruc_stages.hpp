@@ -31,9 +31,12 @@ struct FrucScratch {
     Image<glm::vec2> inverted;        // the later frame's moving pixels, at their earlier place
     Image<float> inverted_depth;
     Image<uint8_t> valid;
-    Image<float> wide_depth[2];  // inputs with their silhouettes widened (warp_input)
+    // Inputs as the warps take them (warp_input): silhouettes widened, colour encoded.
+    Image<float> wide_depth[2];
     Image<glm::vec2> wide_motion[2];
-    uint64_t wide_key[2] = {0, 0};  // the input each holds
+    Image<glm::vec4> encoded_color[2];
+    uint64_t prepared_key[2] = {0, 0};  // the input each holds
+    int prepared_as[2] = {0, 0};        // ... how: 1 widened, 2 encoded, 3 both
     // Set before a stage: which input is in slot 0 (a, or the one extrapolated) and slot 1 (b).
     // Equal non-zero keys mean the same frame, widened once however many frames it makes;
     // 0 = not known, widened every time. Keys are unique in the process (next_frame_key): a
@@ -55,12 +58,20 @@ std::size_t warp_into(const GBufferView& source, float factor, const FrucOptions
 // A frame key no other frame of this process has had (never 0).
 uint64_t next_frame_key();
 
-// `f` with its silhouettes widened into scratch slot `slot` (0 or 1) when options ask for it.
+// `f` as the warps take it, in scratch slot `slot` (0 or 1): silhouettes widened and colour
+// encoded (FrucOptions::perceptual) when options ask for them; for options.backend, its colour as
+// it is and not widened for a backend that widens.
 GBufferView warp_input(const GBufferView& f, int slot, const FrucOptions& options,
-                       FrucScratch& scratch, FrucCounters& counters);
-// What options.backend is handed: warp_input's, or `f` as it is for a backend that widens.
+                       FrucScratch& scratch, FrucCounters& counters, bool for_backend = false);
+// What options.backend is handed: warp_input's for it.
 GBufferView backend_input(const GBufferView& f, int slot, const FrucOptions& options,
                           FrucScratch& scratch, FrucCounters& counters);
+
+// FrucOptions::perceptual (perceptual.cpp): `color` encoded into `encoded`, and a made frame's
+// colour brought back to linear light (nothing when the option is off).
+ImageView<const glm::vec4> encode_perceptual(ImageView<const glm::vec4> color,
+                                             Image<glm::vec4>& encoded);
+void finish_colour(ImageView<glm::vec4> color, const FrucOptions& options);
 
 // Fills the holes of `color` (valid = 0; `holes` of them, counted by the caller) as options.fill
 // says, using depth for the side to prefer, after each row's border strip is continued (up to

@@ -101,33 +101,43 @@ uint64_t next_frame_key() {
 }
 
 GBufferView warp_input(const GBufferView& f, int slot, const FrucOptions& options,
-                       FrucScratch& scratch, FrucCounters& counters) {
-    if (!options.widen_silhouettes || f.depth.empty()) return f;
+                       FrucScratch& scratch, FrucCounters& counters, bool for_backend) {
+    const bool widen = options.widen_silhouettes && !f.depth.empty() &&
+                       !(for_backend && options.backend->widens_silhouettes());
+    const bool encode = options.perceptual && !for_backend && !f.color.empty();
+    if (!widen && !encode) return f;
+    auto prepared = [&](int i) {
+        GBufferView v = f;
+        if (widen) {
+            v.depth = std::as_const(scratch.wide_depth[i]).view();
+            if (!f.motion.empty()) v.motion = std::as_const(scratch.wide_motion[i]).view();
+        }
+        if (encode) v.color = std::as_const(scratch.encoded_color[i]).view();
+        return v;
+    };
     const uint64_t key = scratch.input_key[slot], other = scratch.input_key[1 - slot];
+    const int as = int(widen) | int(encode) << 1;
     int buffer = slot;
     if (key != 0) {
-        for (int i = 0; i < 2; ++i) {
-            if (scratch.wide_key[i] != key) continue;
-            GBufferView widened = f;
-            widened.depth = std::as_const(scratch.wide_depth[i]).view();
-            if (!f.motion.empty()) widened.motion = std::as_const(scratch.wide_motion[i]).view();
-            return widened;
-        }
-        if (other != 0 && scratch.wide_key[buffer] == other) buffer = 1 - buffer;
+        for (int i = 0; i < 2; ++i)
+            if (scratch.prepared_key[i] == key && scratch.prepared_as[i] == as) return prepared(i);
+        if (other != 0 && scratch.prepared_key[buffer] == other) buffer = 1 - buffer;
     }
-    std::size_t changed = 0;
-    const GBufferView widened =
+    if (widen) {
+        std::size_t changed = 0;
         widen_silhouettes(f, scratch.wide_depth[buffer], scratch.wide_motion[buffer], &changed);
-    scratch.wide_key[buffer] = key;
-    counters.silhouette_pixels += changed;
-    if (options.backend && key != 0) options.backend->silhouettes_counted(key);
-    return widened;
+        counters.silhouette_pixels += changed;
+        if (options.backend && key != 0) options.backend->silhouettes_counted(key);
+    }
+    if (encode) encode_perceptual(f.color, scratch.encoded_color[buffer]);
+    scratch.prepared_key[buffer] = key;
+    scratch.prepared_as[buffer] = as;
+    return prepared(buffer);
 }
 
 GBufferView backend_input(const GBufferView& f, int slot, const FrucOptions& options,
                           FrucScratch& scratch, FrucCounters& counters) {
-    if (options.backend->widens_silhouettes()) return f;
-    return warp_input(f, slot, options, scratch, counters);
+    return warp_input(f, slot, options, scratch, counters, true);
 }
 
 void fill_holes(ImageView<glm::vec4> color, ImageView<uint8_t> valid, ImageView<float> depth,
@@ -251,7 +261,7 @@ void interpolate_frame(const GBufferView& a_in, const GBufferView& b_in, float s
                                  std::as_const(wa.covered).view()},
                                 {std::as_const(out.color).view(), std::as_const(out.depth).view(),
                                  std::as_const(scratch.side_b.covered).view()},
-                                options.refine, counters);
+                                options.refine, options.perceptual, counters);
     std::atomic<std::size_t> holes{0};
     parallel_for(0, h, [&](int y0, int y1) {
         std::size_t local_holes = 0;
@@ -273,6 +283,7 @@ void interpolate_frame(const GBufferView& a_in, const GBufferView& b_in, float s
     fill_holes(out.color.view(), scratch.valid.view(), out.depth.view(), holes.load(), options,
                scratch, counters);
     if (refine) scratch.refiner.apply(out.color.view());
+    finish_colour(out.color.view(), options);
 }
 
 }  // namespace reprise::warp

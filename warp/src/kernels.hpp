@@ -151,4 +151,11 @@ struct PullLevelRow {
 std::size_t pull_level_row_reference(const PullLevelRow& row, int i_begin, int i_end);
 std::size_t pull_level_row(const PullLevelRow& row);
 
+// FrucOptions::perceptual: a row's colour onto the display's scale and back. Encoded, r, g and b
+// are the square root of their magnitude, sign kept; alpha is left as it is.
+void perceptual_encode_row_reference(const glm::vec4* from, glm::vec4* to, int width);
+void perceptual_encode_row(const glm::vec4* from, glm::vec4* to, int width);
+void perceptual_decode_row_reference(glm::vec4* color, int width);
+void perceptual_decode_row(glm::vec4* color, int width);
+
 }  // namespace reprise::warp

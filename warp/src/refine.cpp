@@ -21,21 +21,19 @@ constexpr int kSurveyStep = 2;      // the survey looks at every 2nd pixel of ev
 constexpr int kMinDisagreeing = 4;  // surveyed pixels a tile needs besides its share
 constexpr float kInf = std::numeric_limits<float>::infinity();
 
-// sRGB display value within about 1 % (NaN -> 0): what a viewer sees, cheaply.
-float display(float linear) {
-    const float c = linear > 0.0f ? std::min(linear, 1.0f) : 0.0f;
-    return 1.138f * std::sqrt(c) - 0.138f * c;
+glm::vec3 display(glm::vec4 c, bool perceptual) {
+    return {MotionRefiner::display(c.r, perceptual), MotionRefiner::display(c.g, perceptual),
+            MotionRefiner::display(c.b, perceptual)};
 }
 
-float largest_difference(glm::vec4 a, glm::vec4 b) {
-    return std::max({std::abs(display(a.r) - display(b.r)), std::abs(display(a.g) - display(b.g)),
-                     std::abs(display(a.b) - display(b.b))});
+float largest_difference(glm::vec4 a, glm::vec4 b, bool perceptual) {
+    const glm::vec3 d = glm::abs(display(a, perceptual) - display(b, perceptual));
+    return std::max({d.r, d.g, d.b});
 }
 
-float mean_difference(glm::vec4 a, glm::vec4 b) {
-    return (std::abs(display(a.r) - display(b.r)) + std::abs(display(a.g) - display(b.g)) +
-            std::abs(display(a.b) - display(b.b))) *
-           (1.0f / 3.0f);
+float mean_difference(glm::vec4 a, glm::vec4 b, bool perceptual) {
+    const glm::vec3 d = glm::abs(display(a, perceptual) - display(b, perceptual));
+    return (d.r + d.g + d.b) * (1.0f / 3.0f);
 }
 
 // One surface (tighter than the blend's kSameSurface: surfaces whose depth changed between the
@@ -54,14 +52,14 @@ struct Candidate {
     float error;
 };
 
-Candidate along(const GBufferView& a, const GBufferView& b, glm::vec2 q, glm::vec2 a_to_b,
-                float s) {
+Candidate along(const GBufferView& a, const GBufferView& b, glm::vec2 q, glm::vec2 a_to_b, float s,
+                bool perceptual) {
     const glm::vec2 pa = q - s * a_to_b, pb = q + (1.0f - s) * a_to_b;
     const Bilinear ta = bilinear_taps(pa.x, pa.y, a.width(), a.height());
     const Bilinear tb = bilinear_taps(pb.x, pb.y, b.width(), b.height());
     if (!ta.inside || !tb.inside) return {glm::vec4(0.0f), kInf};
     const glm::vec4 ca = bilinear_fetch(a.color, ta), cb = bilinear_fetch(b.color, tb);
-    const float e = mean_difference(ca, cb);
+    const float e = mean_difference(ca, cb, perceptual);
     if (!std::isfinite(e)) return {glm::vec4(0.0f), kInf};
     return {(1.0f - s) * ca + s * cb, e};
 }
@@ -70,6 +68,7 @@ Candidate along(const GBufferView& a, const GBufferView& b, glm::vec2 q, glm::ve
 
 struct MotionRefiner::State {
     int tile = 16, tiles_x = 0, tiles_y = 0;
+    bool perceptual = false;                 // colours on FrucOptions::perceptual's scale
     std::vector<uint8_t> flagged;            // tiles whose sides disagree
     std::vector<int> surveyed, disagreeing;  // per tile: pixels surveyed, those that disagree
     std::vector<uint8_t> wanted;             // flagged tiles and their neighbours
@@ -131,7 +130,8 @@ struct MotionRefiner::State {
                             const int tx = x / tile;
                             ++surveyed_row[tx];
                             disagreeing_row[tx] +=
-                                largest_difference(ca(x, y), cb(x, y)) > options.threshold;
+                                largest_difference(ca(x, y), cb(x, y), perceptual) >
+                                options.threshold;
                         }
                 }
             },
@@ -259,7 +259,8 @@ struct MotionRefiner::State {
         for (int y = box.y0; y < box.y1; ++y) {
             uint8_t* row = out.ptr<uint8_t>(y - box.y0);
             const glm::vec4* c = f.color.row(y);
-            for (int x = box.x0; x < box.x1; ++x) row[x - box.x0] = MotionRefiner::grey(c[x]);
+            for (int x = box.x0; x < box.x1; ++x)
+                row[x - box.x0] = MotionRefiner::grey(c[x], perceptual);
         }
     }
 
@@ -296,13 +297,13 @@ struct MotionRefiner::State {
                     const std::size_t i = row + std::size_t(x - box.x0);
                     const bool one_surface = side_a.covered(x, y) && side_b.covered(x, y) &&
                                              same_surface(side_a.depth(x, y), side_b.depth(x, y));
-                    const float e = one_surface
-                                        ? mean_difference(side_a.color(x, y), side_b.color(x, y))
-                                        : -1.0f;
+                    const float e = one_surface ? mean_difference(side_a.color(x, y),
+                                                                  side_b.color(x, y), perceptual)
+                                                : -1.0f;
                     error_rendered[i] = std::isfinite(e) ? e : -1.0f;
                     const cv::Vec2f m = f[x - box.x0];
                     const Candidate c = along(a, b, glm::vec2(float(x) + 0.5f, float(y) + 0.5f),
-                                              -glm::vec2(m[0], m[1]), s);
+                                              -glm::vec2(m[0], m[1]), s, perceptual);
                     error_flow[i] = c.error, color_flow[i] = c.color;
                 }
             }
@@ -357,8 +358,9 @@ MotionRefiner::~MotionRefiner() = default;
 
 bool MotionRefiner::prepare(const GBufferView& a, const GBufferView& b, float s,
                             const WarpedSide& side_a, const WarpedSide& side_b,
-                            const RefineOptions& options, FrucCounters& counters) {
+                            const RefineOptions& options, bool perceptual, FrucCounters& counters) {
     State& st = *state_;
+    st.perceptual = perceptual;
     const auto start = std::chrono::steady_clock::now();
     auto finish = [&](bool apply) {
         counters.refine_ms +=
@@ -408,6 +410,7 @@ void MotionRefiner::apply(ImageView<glm::vec4> color) const {
 
 bool MotionRefiner::pictures_differ(const GBufferView& a, const GBufferView& b,
                                     const RefineOptions& options) {
+    state_->perceptual = false;
     return state_->survey(a.color, a.depth, {}, b.color, b.depth, {}, options) > 0;
 }
 
@@ -428,8 +431,15 @@ RefineTiles RefineTiles::of(int width, int height, const RefineOptions& options)
     return {size, (std::max(width, 0) + size - 1) / size, (std::max(height, 0) + size - 1) / size};
 }
 
-uint8_t MotionRefiner::grey(glm::vec4 c) {
-    const float luma = display(0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b);
+float MotionRefiner::display(float value, bool perceptual) {
+    // On the perceptual scale the value is the square root of the linear light already.
+    const float c = value > 0.0f ? std::min(value, 1.0f) : 0.0f;
+    return perceptual ? 1.138f * c - 0.138f * (c * c) : 1.138f * std::sqrt(c) - 0.138f * c;
+}
+
+uint8_t MotionRefiner::grey(glm::vec4 c, bool perceptual) {
+    if (perceptual) c = glm::vec4(glm::vec3(c) * glm::abs(glm::vec3(c)), c.a);
+    const float luma = display(0.2126f * c.r + 0.7152f * c.g + 0.0722f * c.b, false);
     return uint8_t(luma * 255.0f + 0.5f);
 }
 

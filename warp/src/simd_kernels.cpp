@@ -423,6 +423,45 @@ void BicubicRowSimd(const BicubicRow& r) {
 #endif
 }
 
+// The rgb lanes of interleaved RGBA, for vectors of a multiple of four lanes.
+template <class D>
+auto ColourLanes(D d) {
+    const hn::RebindToSigned<D> di;
+    return hn::RebindMask(d, hn::And(hn::Iota(di, 0), hn::Set(di, 3)) != hn::Set(di, 3));
+}
+
+void PerceptualEncodeRowSimd(const glm::vec4* from, glm::vec4* to, int width) {
+    const hn::ScalableTag<float> df;
+    const int n = int(hn::Lanes(df));
+    int x = 0;
+    if (n % 4 == 0) {
+        const auto rgb = ColourLanes(df);
+        const float* in = &from[0].x;
+        float* out = &to[0].x;
+        for (; (x + n / 4) <= width; x += n / 4) {
+            const auto v = hn::LoadU(df, in + 4 * x);
+            const auto e = hn::CopySign(hn::Sqrt(hn::Abs(v)), v);
+            hn::StoreU(hn::IfThenElse(rgb, e, v), df, out + 4 * x);
+        }
+    }
+    perceptual_encode_row_reference(from + x, to + x, width - x);
+}
+
+void PerceptualDecodeRowSimd(glm::vec4* color, int width) {
+    const hn::ScalableTag<float> df;
+    const int n = int(hn::Lanes(df));
+    int x = 0;
+    if (n % 4 == 0) {
+        const auto rgb = ColourLanes(df);
+        float* c = &color[0].x;
+        for (; (x + n / 4) <= width; x += n / 4) {
+            const auto v = hn::LoadU(df, c + 4 * x);
+            hn::StoreU(hn::IfThenElse(rgb, hn::Mul(v, hn::Abs(v)), v), df, c + 4 * x);
+        }
+    }
+    perceptual_decode_row_reference(color + x, width - x);
+}
+
 }  // namespace reprise::warp::HWY_NAMESPACE
 HWY_AFTER_NAMESPACE();
 
@@ -436,6 +475,16 @@ HWY_EXPORT(PullLevelRowSimd);
 HWY_EXPORT(RefetchRowSimd);
 HWY_EXPORT(DisplacementRowSimd);
 HWY_EXPORT(BicubicRowSimd);
+HWY_EXPORT(PerceptualEncodeRowSimd);
+HWY_EXPORT(PerceptualDecodeRowSimd);
+
+void perceptual_encode_row(const glm::vec4* from, glm::vec4* to, int width) {
+    HWY_DYNAMIC_DISPATCH(PerceptualEncodeRowSimd)(from, to, width);
+}
+
+void perceptual_decode_row(glm::vec4* color, int width) {
+    HWY_DYNAMIC_DISPATCH(PerceptualDecodeRowSimd)(color, width);
+}
 
 void bicubic_row(const BicubicRow& row) { HWY_DYNAMIC_DISPATCH(BicubicRowSimd)(row); }
 

@@ -138,6 +138,12 @@ struct FrucOptions {
     // their blended colour travels with the silhouette instead of staying on the background as a
     // ghost contour.
     bool widen_silhouettes = true;
+    // Colour is warped, blended and filled as the square root of linear light (a scale close to
+    // the display's), then squared back: resampled and blended edges, and pixels blended from
+    // both sides, come out nearer what the display shows of the rendered truth (docs/benchmarks.md,
+    // "Blending on the display's scale"). Off: in linear light. A backend (gpu::FrucBackend) is
+    // handed linear light and works in it.
+    bool perceptual = true;
     SplatOptions splat;
     // A new frame whose camera does not say whether a cut came before it (Camera::cut Unknown) and
     // whose reverse reprojection into the previous one misses on more than this fraction of pixels,

@@ -46,8 +46,10 @@ public:
     ~MotionRefiner();
     // Surveys where the warped sides disagree at instant s between a and b and, where they do,
     // estimates flow there and keeps the better colour per pixel. False: nothing to apply.
+    // `perceptual`: the colours of a, b and the sides are on FrucOptions::perceptual's scale.
     bool prepare(const GBufferView& a, const GBufferView& b, float s, const WarpedSide& side_a,
-                 const WarpedSide& side_b, const RefineOptions& options, FrucCounters& counters);
+                 const WarpedSide& side_b, const RefineOptions& options, bool perceptual,
+                 FrucCounters& counters);
     // Writes the colours the last prepare() kept over the blended frame (nothing after plan()).
     void apply(ImageView<glm::vec4> color) const;
     // Whether the colours of a and b themselves (a still pair) disagree anywhere as prepare()
@@ -74,8 +76,11 @@ public:
     // pictures (grey(), box-sized) and `seed` (b's backward motion over the box; non-finite: 0).
     void flow(ImageView<const uint8_t> grey_b, ImageView<const uint8_t> grey_a,
               ImageView<const glm::vec2> seed, Image<glm::vec2>& flow);
-    // The grey the flow sees: display luma (about sRGB) in 0..255.
-    static uint8_t grey(glm::vec4 linear);
+    // The grey the flow sees: display luma (about sRGB) in 0..255, of linear light or of colour
+    // on FrucOptions::perceptual's scale.
+    static uint8_t grey(glm::vec4 color, bool perceptual = false);
+    // The display value (about sRGB, within 1 %; NaN: 0) the survey compares, likewise.
+    static float display(float value, bool perceptual);
 
 private:
     struct State;
