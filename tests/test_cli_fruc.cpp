@@ -163,22 +163,26 @@ TEST(CliFruc, BadRangesAreRefusedNamingTheRange) {
     fs::remove_all(dir);
 }
 
-// `--blend linear` blends in linear light: other frames; a value that is neither is refused
-// before anything is written.
+// `--blend linear` blends in linear light in both commands: other frames; a value that is
+// neither is refused before anything is written.
 TEST(CliFruc, ColourIsBlendedOnTheDisplaysScaleUnlessLinear) {
     const std::string dir = scratch("blend"), in = render_cut(dir);
-    const std::string base = "fruc --in " + q(in) + " --range 1:2 --out ";
-    const test::Outcome perceptual = test::run_reprise(base + q(dir + "/perceptual"), 60);
-    const test::Outcome linear =
-        test::run_reprise(base + q(dir + "/linear") + " --blend linear", 60);
-    ASSERT_EQ(perceptual.status, 0) << perceptual.output;
-    ASSERT_EQ(linear.status, 0) << linear.output;
-    EXPECT_NE(differences(frames(dir + "/perceptual"), frames(dir + "/linear")), "");
-    const test::Outcome bad = test::run_reprise(base + q(dir + "/bad") + " --blend gamma", 60);
-    EXPECT_NE(bad.status, 0) << bad.output;
-    EXPECT_NE(bad.output.find("--blend 'gamma': expected perceptual or linear"), std::string::npos)
-        << bad.output;
-    EXPECT_FALSE(fs::exists(dir + "/bad"));
+    for (const std::string command : {"fruc", "stereo"}) {
+        const std::string base = command + " --in " + q(in) + " --range 1:2 --out ";
+        const test::Outcome perceptual = test::run_reprise(base + q(dir + "/perceptual"), 60);
+        const test::Outcome linear =
+            test::run_reprise(base + q(dir + "/linear") + " --blend linear", 60);
+        ASSERT_EQ(perceptual.status, 0) << perceptual.output;
+        ASSERT_EQ(linear.status, 0) << linear.output;
+        EXPECT_NE(differences(frames(dir + "/perceptual"), frames(dir + "/linear")), "") << command;
+        const test::Outcome bad = test::run_reprise(base + q(dir + "/bad") + " --blend gamma", 60);
+        EXPECT_NE(bad.status, 0) << bad.output;
+        EXPECT_NE(bad.output.find("--blend"), std::string::npos) << bad.output;
+        EXPECT_NE(bad.output.find("'gamma'"), std::string::npos) << bad.output;
+        EXPECT_FALSE(fs::exists(dir + "/bad")) << command;
+        fs::remove_all(dir + "/perceptual");
+        fs::remove_all(dir + "/linear");
+    }
     fs::remove_all(dir);
 }
 

@@ -621,7 +621,8 @@ TEST(Gpu, GridWarpMatchesTheCpuOnEveryBuiltInScene) {
     EXPECT_GT(stretched, 50u);  // not vacuous: stretched triangles were drawn
 }
 
-const stereo::StereoOptions kSplatEye{.warp = stereo::StereoWarp::Splat};
+// (The GPU's eye works in linear light: StereoOptions::perceptual is the CPU's alone.)
+const stereo::StereoOptions kSplatEye{.warp = stereo::StereoWarp::Splat, .perceptual = false};
 
 TEST(Gpu, StereoEyeMatchesTheCpuOnEveryBuiltInScene) {
     std::size_t holes = 0;
@@ -666,7 +667,9 @@ TEST(Gpu, GridEyeMatchesTheCpuOnEveryBuiltInScene) {
             const Camera right =
                 stereo::eye_cameras(f.camera, {.ipd = setting.ipd}, stereo::Anchor::Left).right;
             Frame cpu, gpu;
-            const stereo::StereoStats expected = stereo::synthesize_eye(f, right, options, cpu);
+            stereo::StereoOptions on_cpu = options;
+            on_cpu.perceptual = false;  // the GPU's eye works in linear light
+            const stereo::StereoStats expected = stereo::synthesize_eye(f, right, on_cpu, cpu);
             stereo::StereoStats stats;
             const Status status = shared_gpu().stereo_eye(f, right, gpu, stats, options);
             ASSERT_TRUE(status.ok()) << status.message();
@@ -1890,8 +1893,10 @@ TEST(Gpu, StereoEyeWithHistoryMatchesTheCpuOnEveryBuiltInScene) {
             Frame cpu, gpu;
             stereo::StereoSynthesizer synthesizer;
             const GBufferView history = frames[0].view();
+            stereo::StereoOptions on_cpu = options;
+            on_cpu.perceptual = false;  // the GPU's eye works in linear light
             const stereo::StereoStats a =
-                synthesizer.synthesize(frames[1], right, cpu, options, &history);
+                synthesizer.synthesize(frames[1], right, cpu, on_cpu, &history);
             stereo::StereoStats b;
             const Status status =
                 shared_gpu().stereo_eye(frames[1], right, gpu, b, options, &history);

@@ -256,6 +256,8 @@ std::vector<OurSetting> our_settings() {
     settings.push_back(
         {other_fetch.grid.bicubic ? "grid-bicubic+pullpush" : "grid-bilinear+pullpush",
          other_fetch});
+    // The default in linear light (StereoOptions::perceptual off).
+    settings.push_back({"grid+pullpush-linear", {.perceptual = false}});
     settings.push_back({"grid+pullpush+history", {}, true});
     return settings;
 }

@@ -26,6 +26,7 @@ struct StereoJob {
     std::string in, out, rig = "parallel", eye = "left", warp = "grid", fill = "pullpush";
     std::string backend = "cpu";
     std::string silhouettes = "widen";
+    std::string blend = "perceptual";
     double ipd = 0.064;
     double convergence = 10.0;
     double fov = 0.0;  // degrees, for inputs without a camera
@@ -58,6 +59,8 @@ Status check(const StereoJob& j, stereo::StereoRig& rig, stereo::StereoOptions& 
         return Status::error("--backend: '" + j.backend + "' is not cpu or gles");
     if (j.silhouettes != "widen" && j.silhouettes != "keep")
         return Status::error("--silhouettes: '" + j.silhouettes + "' is not widen or keep");
+    if (j.blend != "perceptual" && j.blend != "linear")
+        return Status::error("--blend: '" + j.blend + "' is not perceptual or linear");
     if (j.backend == "gles" && (j.fill == "andreev" || j.fill == "patch"))
         return Status::error(
             "--backend gles: the GPU fills with --fill pullpush or none (Andreev's and the patch "
@@ -73,6 +76,7 @@ Status check(const StereoJob& j, stereo::StereoRig& rig, stereo::StereoOptions& 
     if (j.warp == "grid-bicubic" || j.warp == "grid-bilinear")
         options.grid.bicubic = j.warp == "grid-bicubic";
     options.widen_silhouettes = j.silhouettes == "widen";
+    options.perceptual = j.blend == "perceptual";
     return {};
 }
 
@@ -208,6 +212,10 @@ int command_stereo(int argc, char** argv) {
                 "the grid), with --fill pullpush or none");
     args.option("--silhouettes", &job.silhouettes,
                 "widen|keep (default widen): pixels beside a nearer surface warp with it");
+    args.option("--blend", &job.blend,
+                "perceptual|linear (default perceptual): colour warped and filled as the square "
+                "root of linear\nlight (close to the display's scale), or in linear light "
+                "(--backend gles: always linear)");
     args.flag("--temporal", &job.temporal, "fill disocclusions from the previous frame first");
     args.option("--range", &job.range,
                 "A:B: frames A..B only (--temporal reads frame A-1 first); ranges that meet "

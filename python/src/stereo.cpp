@@ -31,9 +31,10 @@ stereo::Anchor make_anchor(const std::string& anchor) {
 }
 
 stereo::StereoOptions make_options(const std::string& warp_method, const std::string& fill,
-                                   bool widen_silhouettes) {
+                                   bool widen_silhouettes, bool perceptual) {
     stereo::StereoOptions o;
     o.widen_silhouettes = widen_silhouettes;
+    o.perceptual = perceptual;
     if (warp_method == "grid")
         o.warp = stereo::StereoWarp::Grid;
     else if (warp_method == "grid-bicubic" || warp_method == "grid-bilinear")
@@ -102,10 +103,12 @@ struct Synthesizer {
             value_error("backend '" + backend + "': expected cpu or gles");
     }
     py::tuple synthesize(const Frame& rendered, const Camera& target, const std::string& warp,
-                         const std::string& fill, const Frame* history, bool widen_silhouettes) {
+                         const std::string& fill, const Frame* history, bool widen_silhouettes,
+                         bool perceptual) {
         require_color_and_depth(rendered, "rendered");
         if (history) require_color_and_depth(*history, "history");
-        const stereo::StereoOptions options = make_options(warp, fill, widen_silhouettes);
+        const stereo::StereoOptions options =
+            make_options(warp, fill, widen_silhouettes, perceptual);
         if (!gpu)
             return made_eye(rendered, [&](Frame& out) {
                 return synthesizer.synthesize(rendered, target, out, options, history);
@@ -133,9 +136,11 @@ stereo::Eye make_eye(const std::string& eye) {
 
 struct Alternation {
     py::tuple next(const Frame& rendered, const std::string& eye, const Camera& target,
-                   const std::string& warp, const std::string& fill, bool widen_silhouettes) {
+                   const std::string& warp, const std::string& fill, bool widen_silhouettes,
+                   bool perceptual) {
         require_color_and_depth(rendered, "rendered");
-        const stereo::StereoOptions options = make_options(warp, fill, widen_silhouettes);
+        const stereo::StereoOptions options =
+            make_options(warp, fill, widen_silhouettes, perceptual);
         const stereo::Eye e = make_eye(eye);
         return made_eye(rendered, [&](Frame& out) {
             return alternation.next(rendered, e, target, out, options);
@@ -167,10 +172,12 @@ void bind_stereo(py::module_& m) {
              "backend 'gles': eyes made by OpenGL ES (fill 'pullpush' or 'none')")
         .def("synthesize", &Synthesizer::synthesize, py::arg("rendered"), py::arg("target"),
              py::arg("warp") = "grid", py::arg("fill") = "pullpush", py::arg("history") = nullptr,
-             py::arg("widen_silhouettes") = true,
+             py::arg("widen_silhouettes") = true, py::arg("perceptual") = true,
              "(frame, stats): the view of camera `target` from `rendered` (colour, depth, "
              "camera); `history` (e.g. the previous frame's other eye) fills holes first; "
-             "widen_silhouettes: pixels beside a nearer surface move with it.");
+             "widen_silhouettes: pixels beside a nearer surface move with it; perceptual: colour "
+             "warped and filled as the square root of linear light (off: in linear light; the "
+             "gles backend works in linear light).");
 
     py::class_<Alternation>(m, "EyeAlternation",
                             "Temporal eye alternation (Didyk et al. 2010): each frame renders one "
@@ -186,7 +193,7 @@ void bind_stereo(py::module_& m) {
             py::arg("index"), "The eye to render at frame `index`: 'left' on even frames.")
         .def("next", &Alternation::next, py::arg("rendered"), py::arg("eye"), py::arg("target"),
              py::arg("warp") = "grid", py::arg("fill") = "pullpush",
-             py::arg("widen_silhouettes") = true,
+             py::arg("widen_silhouettes") = true, py::arg("perceptual") = true,
              "(frame, stats): the other eye, seen from camera `target`, from `rendered` (eye "
              "'left' or 'right' of this frame), with that other eye's last render as history "
              "(none across a shot change); keeps `rendered` as its eye's history.")
@@ -197,7 +204,7 @@ void bind_stereo(py::module_& m) {
         "synthesize_eye",
         [](const Frame& rendered, float ipd, float convergence, const std::string& rig,
            const std::string& rendered_eye, const std::string& warp, const std::string& fill,
-           const Frame* history, bool widen_silhouettes) {
+           const Frame* history, bool widen_silhouettes, bool perceptual) {
             if (rendered_eye != "left" && rendered_eye != "right")
                 value_error("rendered_eye must be 'left' or 'right'");
             const stereo::EyeCameras eyes = stereo::eye_cameras(
@@ -205,13 +212,13 @@ void bind_stereo(py::module_& m) {
             const Camera& target = rendered_eye == "left" ? eyes.right : eyes.left;
             Synthesizer s;
             const py::tuple made =
-                s.synthesize(rendered, target, warp, fill, history, widen_silhouettes);
+                s.synthesize(rendered, target, warp, fill, history, widen_silhouettes, perceptual);
             return py::object(made[0]);
         },
         py::arg("rendered"), py::arg("ipd") = 0.064f, py::arg("convergence") = 10.0f,
         py::arg("rig") = "parallel", py::arg("rendered_eye") = "left", py::arg("warp") = "grid",
         py::arg("fill") = "pullpush", py::arg("history") = nullptr,
-        py::arg("widen_silhouettes") = true,
+        py::arg("widen_silhouettes") = true, py::arg("perceptual") = true,
         "The other eye of a rendered eye (its camera is that eye's).");
 }
 

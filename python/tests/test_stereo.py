@@ -31,6 +31,10 @@ def test_synthesized_eye_is_close_to_the_rendered_one(renderer, pan_60):
     print(f"bilinear fetch: {psnr(truth, bilinear):.2f} dB")
     assert not np.array_equal(bilinear.color, made.color)
     assert psnr(truth, bilinear) > 28.0
+    linear, _ = reprise.StereoSynthesizer().synthesize(left, right_camera, perceptual=False)
+    print(f"in linear light: {psnr(truth, linear):.2f} dB")
+    assert not np.array_equal(linear.color, made.color)
+    assert psnr(truth, linear) > 28.0
     with pytest.raises(ValueError, match="grid-bilinear"):
         reprise.StereoSynthesizer().synthesize(left, right_camera, warp="grid-cubic")
 
@@ -44,8 +48,9 @@ def test_the_gpu_backend_makes_the_cpus_eyes(pan_60):
     # The bar for the GPU backend; on llvmpipe the eyes are bit-identical.
     assert reprise.psnr(reprise.to_display(gpu.color), reprise.to_display(cpu.color)) >= 50.0
     assert gpu_stats["holes"] == cpu_stats["holes"] and gpu_stats["holes"] > 0
-    # The default eye, the grid: its cells grown and drawn on the GPU.
-    cpu_grid, cpu_grid_stats = reprise.StereoSynthesizer().synthesize(left, right_camera)
+    # The default eye, the grid: its cells grown and drawn on the GPU (in linear light).
+    cpu_grid, cpu_grid_stats = reprise.StereoSynthesizer().synthesize(left, right_camera,
+                                                                      perceptual=False)
     gpu_grid, gpu_grid_stats = gles.synthesize(left, right_camera)
     assert reprise.psnr(reprise.to_display(gpu_grid.color),
                         reprise.to_display(cpu_grid.color)) >= 50.0
@@ -54,8 +59,8 @@ def test_the_gpu_backend_makes_the_cpus_eyes(pan_60):
     assert gpu_grid_stats["cells"] == cpu_grid_stats["cells"] > 0
     assert cpu_grid_stats["border"] > 0
     assert abs(gpu_grid_stats["border"] - cpu_grid_stats["border"]) <= allowed
-    cpu_grid, cpu_grid_stats = reprise.StereoSynthesizer().synthesize(left, right_camera,
-                                                                      history=pan_60[3])
+    cpu_grid, cpu_grid_stats = reprise.StereoSynthesizer().synthesize(
+        left, right_camera, history=pan_60[3], perceptual=False)
     gpu_grid, gpu_grid_stats = gles.synthesize(left, right_camera, history=pan_60[3])
     assert reprise.psnr(reprise.to_display(gpu_grid.color),
                         reprise.to_display(cpu_grid.color)) >= 50.0

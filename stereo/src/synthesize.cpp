@@ -7,6 +7,7 @@
 #include "reprise/core/camera_math.hpp"
 #include "reprise/core/parallel.hpp"
 #include "reprise/stereo/synthesize.hpp"
+#include "reprise/warp/perceptual.hpp"
 #include "reprise/warp/silhouettes.hpp"
 
 namespace reprise::stereo {
@@ -62,8 +63,9 @@ std::size_t StereoSynthesizer::warp_into(const GBufferView& given, const Camera&
                                          const StereoOptions& o, const warp::WarpTarget& into,
                                          std::size_t& cells, bool& maybe_nonfinite,
                                          std::size_t* moving) {
-    const GBufferView source =
+    GBufferView source =
         o.widen_silhouettes ? warp::widen_silhouettes(given, wide_depth_, wide_motion_) : given;
+    if (o.perceptual) source.color = warp::encode_perceptual(source.color, encoded_color_);
     const int w = source.width(), h = source.height();
     displacement_.resize(w, h);
     target_depth_.resize(w, h);
@@ -198,6 +200,7 @@ StereoStats StereoSynthesizer::synthesize(const GBufferView& given, const Camera
     }
     stats.filled = filled.holes - filled.unfilled;
     stats.unfilled = filled.unfilled;
+    if (o.perceptual) warp::decode_perceptual(out.color.view());
     // Non-finite colour carried from the input (the fill replaces RGB only) becomes 0; holes the
     // warp left and the fill could not fill are 0 already.
     if (!maybe_nonfinite) return stats;

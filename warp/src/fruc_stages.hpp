@@ -67,10 +67,7 @@ GBufferView warp_input(const GBufferView& f, int slot, const FrucOptions& option
 GBufferView backend_input(const GBufferView& f, int slot, const FrucOptions& options,
                           FrucScratch& scratch, FrucCounters& counters);
 
-// FrucOptions::perceptual (perceptual.cpp): `color` encoded into `encoded`, and a made frame's
-// colour brought back to linear light (nothing when the option is off).
-ImageView<const glm::vec4> encode_perceptual(ImageView<const glm::vec4> color,
-                                             Image<glm::vec4>& encoded);
+// A made frame's colour back to linear light when FrucOptions::perceptual encoded its inputs.
 void finish_colour(ImageView<glm::vec4> color, const FrucOptions& options);
 
 // Fills the holes of `color` (valid = 0; `holes` of them, counted by the caller) as options.fill

@@ -8,6 +8,7 @@
 #include "fruc_stages.hpp"
 #include "kernels.hpp"
 #include "reprise/core/parallel.hpp"
+#include "reprise/warp/perceptual.hpp"
 #include "reprise/warp/sample.hpp"
 #include "reprise/warp/silhouettes.hpp"
 

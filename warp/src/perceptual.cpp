@@ -1,5 +1,7 @@
-// FrucOptions::perceptual: colour warped, blended and filled on a scale close to the display's
-// (the square root of linear light), brought back to linear light in the made frame.
+// Colour warped, blended and filled on a scale close to the display's (the square root of linear
+// light), brought back to linear light in the made frame.
+#include "reprise/warp/perceptual.hpp"
+
 #include <cmath>
 
 #include "fruc_stages.hpp"
@@ -31,11 +33,14 @@ ImageView<const glm::vec4> encode_perceptual(ImageView<const glm::vec4> color,
     return std::as_const(encoded).view();
 }
 
-void finish_colour(ImageView<glm::vec4> color, const FrucOptions& options) {
-    if (!options.perceptual) return;
+void decode_perceptual(ImageView<glm::vec4> color) {
     parallel_for(0, color.height, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y) perceptual_decode_row(color.row(y), color.width);
     });
+}
+
+void finish_colour(ImageView<glm::vec4> color, const FrucOptions& options) {
+    if (options.perceptual) decode_perceptual(color);
 }
 
 }  // namespace reprise::warp

@@ -42,6 +42,10 @@ struct StereoOptions {
     // Edge pixels go with the nearer surface, as in frame-rate conversion
     // (warp::widen_silhouettes, warp::FrucOptions::widen_silhouettes).
     bool widen_silhouettes = true;
+    // Colour warped and filled as the square root of linear light, as in frame-rate conversion
+    // (warp/perceptual.hpp, warp::FrucOptions::perceptual). The GPU's eye (gpu::Context::
+    // stereo_eye) works in linear light.
+    bool perceptual = true;
 };
 
 struct StereoStats {
@@ -98,6 +102,7 @@ private:
     Image<float> target_depth_;      // and its depth seen from the target
     Image<float> wide_depth_;        // the source's depth and motion with its silhouettes widened
     Image<glm::vec2> wide_motion_;
+    Image<glm::vec4> encoded_color_;  // the source's colour for StereoOptions::perceptual
     Image<uint8_t> covered_;
     Image<glm::vec4> history_color_;
     Image<float> history_depth_;
