@@ -41,7 +41,7 @@ extern "C" {
  * minor be at most the library's. A struct_size of an older minor's struct is taken: the fields
  * it lacks keep their defaults. libreprise.so's SONAME carries the major. */
 #define REPRISE_ABI_VERSION_MAJOR 1
-#define REPRISE_ABI_VERSION_MINOR 2
+#define REPRISE_ABI_VERSION_MINOR 3
 #define REPRISE_ABI_VERSION \
     ((uint32_t)((REPRISE_ABI_VERSION_MAJOR << 16) | REPRISE_ABI_VERSION_MINOR))
 
@@ -165,6 +165,8 @@ typedef struct reprise_converter_options {
     float budget_db;           /* warp or fill auto: PSNR to reach, 0 = relative (default) */
     int32_t composite_ui;      /* 1: draw the UI layer into every output's colour (default 0) */
     int32_t widen_silhouettes; /* 1: edge pixels go with the nearer surface (default); minor 2 */
+    int32_t perceptual;        /* 1: colour warped and blended as the square root of linear light
+                                  (default), 0: in linear light; minor 3 */
 } reprise_converter_options;
 
 /* Sets the defaults above and struct_size. */
@@ -209,6 +211,8 @@ typedef struct reprise_stereo_options {
     reprise_fill fill;         /* pull-push (default), none, Andreev or patch (not auto) */
     int32_t temporal;          /* 1: the previous rendered frame fills holes first (default 0) */
     int32_t widen_silhouettes; /* 1: edge pixels go with the nearer surface (default); minor 2 */
+    int32_t perceptual;        /* 1: colour warped and filled as the square root of linear light
+                                  (default), 0: in linear light; minor 3 */
 } reprise_stereo_options;
 
 REPRISE_API reprise_status reprise_stereo_options_init(reprise_stereo_options* options,

@@ -47,6 +47,7 @@ reprise_status to_fruc_options(const char* function, const reprise_converter_opt
     REPRISE_CAPI_TRY(check_range(function, "options->budget_db", o.budget_db, 0.0, 100.0));
     REPRISE_CAPI_TRY(check_flag(function, "options->composite_ui", o.composite_ui));
     REPRISE_CAPI_TRY(check_flag(function, "options->widen_silhouettes", o.widen_silhouettes));
+    REPRISE_CAPI_TRY(check_flag(function, "options->perceptual", o.perceptual));
     constexpr warp::WarpMethod warps[] = {warp::WarpMethod::Grid, warp::WarpMethod::Reverse,
                                           warp::WarpMethod::Splat, warp::WarpMethod::Auto};
     constexpr warp::FillMethod fills[] = {warp::FillMethod::PullPush, warp::FillMethod::None,
@@ -60,6 +61,7 @@ reprise_status to_fruc_options(const char* function, const reprise_converter_opt
     fruc.auto_choice.budget_db = o.budget_db;
     fruc.composite_ui = o.composite_ui != 0;
     fruc.widen_silhouettes = o.widen_silhouettes != 0;
+    fruc.perceptual = o.perceptual != 0;
     return REPRISE_OK;
 }
 
@@ -78,6 +80,7 @@ reprise_converter_options default_options() {
     o.fill = REPRISE_FILL_PULLPUSH;
     o.refine = 1;
     o.widen_silhouettes = 1;
+    o.perceptual = 1;
     return o;
 }
 

@@ -301,8 +301,7 @@ reprise_status check_gbuffer_struct(const char* function, const char* name,
                                     const reprise_gbuffer* gbuffer) {
     REPRISE_CAPI_TRY(check_pointer(function, gbuffer, name));
     return check_struct_size(function, (std::string(name) + "->struct_size").c_str(),
-                             gbuffer->struct_size, sizeof(reprise_gbuffer),
-                             sizeof(reprise_gbuffer));
+                             gbuffer->struct_size, kSizes<reprise_gbuffer>);
 }
 
 }  // namespace
@@ -411,8 +410,8 @@ extern "C" reprise_status reprise_gbuffer_init(reprise_gbuffer* gbuffer, size_t 
     return guarded("reprise_gbuffer_init", [&] {
         const char* function = "reprise_gbuffer_init";
         REPRISE_CAPI_TRY(check_pointer(function, gbuffer, "gbuffer"));
-        REPRISE_CAPI_TRY(check_struct_size(function, "struct_size", struct_size,
-                                           sizeof(reprise_gbuffer), sizeof(reprise_gbuffer)));
+        REPRISE_CAPI_TRY(
+            check_struct_size(function, "struct_size", struct_size, kSizes<reprise_gbuffer>));
         *gbuffer = reprise_gbuffer{};
         gbuffer->struct_size = uint32_t(sizeof(reprise_gbuffer));
         return reprise_status(REPRISE_OK);

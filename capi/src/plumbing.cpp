@@ -42,13 +42,14 @@ reprise_status check_pointer(const char* function, const void* pointer, const ch
 }
 
 reprise_status check_struct_size(const char* function, const char* name, std::size_t given,
-                                 std::size_t oldest, std::size_t newest) {
-    if (given == oldest || given == newest) return REPRISE_OK;
-    const std::string sizes =
-        "this library's " + std::to_string(newest) +
-        (oldest == newest ? std::string() : " or an older minor's " + std::to_string(oldest));
+                                 std::span<const std::size_t> sizes) {
+    for (const std::size_t size : sizes)
+        if (given == size) return REPRISE_OK;
+    std::string taken = "this library's " + std::to_string(sizes.back());
+    for (std::size_t i = 0; i + 1 < sizes.size(); ++i)
+        taken += (i == 0 ? " or an older minor's " : ", ") + std::to_string(sizes[i]);
     return fail(REPRISE_ERROR_ABI_MISMATCH, function,
-                std::string(name) + " " + std::to_string(given) + " is not " + sizes +
+                std::string(name) + " " + std::to_string(given) + " is not " + taken +
                     " bytes: the caller was built against another reprise.h");
 }
 

@@ -2,11 +2,13 @@
 // What every C entry point shares: this thread's last error, the guard that keeps C++
 // exceptions from crossing the C boundary, and the checks of the ABI version and of the
 // caller's option structs.
+#include <array>
 #include <cstddef>
 #include <cstring>
 #include <exception>
 #include <memory>
 #include <new>
+#include <span>
 #include <string>
 
 #include "reprise.h"
@@ -49,20 +51,25 @@ reprise_status check_abi(const char* function, uint32_t abi_version);
 // memory limit.
 void name_the_memory_setter();
 reprise_status check_pointer(const char* function, const void* pointer, const char* name);
-// Checks that a struct the caller filled has a struct_size this library takes: its own, or
-// `oldest`, the struct of the minors before its last field was added.
+// Checks that a struct the caller filled has a struct_size this library takes: one of `sizes`,
+// the struct's size in each minor that changed it, oldest first (the last: this library's).
 reprise_status check_struct_size(const char* function, const char* name, std::size_t given,
-                                 std::size_t oldest, std::size_t newest);
+                                 std::span<const std::size_t> sizes);
 
-// The smallest struct_size taken for each options struct; the fields past it keep their defaults.
+// The struct_size values taken for each options struct, one per minor that changed it, oldest
+// first; the fields past an older one keep their defaults.
 template <class Options>
-inline constexpr std::size_t kOldestSize = sizeof(Options);
+inline constexpr std::array<std::size_t, 1> kSizes = {sizeof(Options)};
 template <>
-inline constexpr std::size_t kOldestSize<reprise_converter_options> =
-    offsetof(reprise_converter_options, widen_silhouettes);  // minor 2 added it
+inline constexpr std::array<std::size_t, 3> kSizes<reprise_converter_options> = {
+    offsetof(reprise_converter_options, widen_silhouettes),  // minor 1
+    offsetof(reprise_converter_options, perceptual),         // minor 2
+    sizeof(reprise_converter_options)};
 template <>
-inline constexpr std::size_t kOldestSize<reprise_stereo_options> =
-    offsetof(reprise_stereo_options, widen_silhouettes);  // minor 2 added it
+inline constexpr std::array<std::size_t, 3> kSizes<reprise_stereo_options> = {
+    offsetof(reprise_stereo_options, widen_silhouettes),  // minor 1
+    offsetof(reprise_stereo_options, perceptual),         // minor 2
+    sizeof(reprise_stereo_options)};
 
 // reprise_*_options_init: `defaults` with struct_size set, into the caller's struct.
 template <class Options>
@@ -70,8 +77,7 @@ reprise_status init_options(const char* function, Options* options, std::size_t 
                             Options defaults) {
     return guarded(function, [&] {
         REPRISE_CAPI_TRY(check_pointer(function, options, "options"));
-        REPRISE_CAPI_TRY(check_struct_size(function, "struct_size", struct_size,
-                                           kOldestSize<Options>, sizeof(Options)));
+        REPRISE_CAPI_TRY(check_struct_size(function, "struct_size", struct_size, kSizes<Options>));
         defaults.struct_size = uint32_t(struct_size);
         std::memcpy(static_cast<void*>(options), &defaults, struct_size);
         return reprise_status(REPRISE_OK);
@@ -89,7 +95,7 @@ reprise_status check_create(const char* function, uint32_t abi_version, const Op
     name_the_memory_setter();
     if (given) {
         REPRISE_CAPI_TRY(check_struct_size(function, "options->struct_size", given->struct_size,
-                                           kOldestSize<Options>, sizeof(Options)));
+                                           kSizes<Options>));
         std::memcpy(static_cast<void*>(&options), given, given->struct_size);
     }
     return REPRISE_OK;

@@ -31,6 +31,7 @@ reprise_stereo_options default_options() {
     o.warp = REPRISE_WARP_GRID;
     o.fill = REPRISE_FILL_PULLPUSH;
     o.widen_silhouettes = 1;
+    o.perceptual = 1;
     return o;
 }
 
@@ -49,6 +50,7 @@ reprise_status configure(const char* function, const reprise_stereo_options& o, 
                     "options->fill REPRISE_FILL_AUTO: the eye has no automatic fill");
     REPRISE_CAPI_TRY(check_flag(function, "options->temporal", o.temporal));
     REPRISE_CAPI_TRY(check_flag(function, "options->widen_silhouettes", o.widen_silhouettes));
+    REPRISE_CAPI_TRY(check_flag(function, "options->perceptual", o.perceptual));
     constexpr stereo::StereoFill fills[] = {stereo::StereoFill::PullPush, stereo::StereoFill::None,
                                             stereo::StereoFill::Andreev, stereo::StereoFill::None,
                                             stereo::StereoFill::Patch};
@@ -61,6 +63,7 @@ reprise_status configure(const char* function, const reprise_stereo_options& o, 
     s.options.fill = fills[o.fill];
     s.temporal = o.temporal != 0;
     s.options.widen_silhouettes = o.widen_silhouettes != 0;
+    s.options.perceptual = o.perceptual != 0;
     return REPRISE_OK;
 }
 

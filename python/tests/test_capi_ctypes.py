@@ -13,7 +13,7 @@ LIBRARY = os.environ.get("REPRISE_CAPI_LIBRARY")
 # This test is a caller built against ABI 1.1 (its ConverterOptions ends before
 # widen_silhouettes, added in 1.2): the library must keep taking it.
 ABI_VERSION = (1 << 16) | 1
-LIBRARY_ABI_VERSION = (1 << 16) | 2
+LIBRARY_ABI_VERSION = (1 << 16) | 3
 OK, NEED_MORE = 0, 1
 ERROR_INVALID_ARGUMENT, ERROR_ABI_MISMATCH, ERROR_BUFFER_TOO_SMALL = -1, -2, -3
 R32_FLOAT, RG32_FLOAT, RGB32_FLOAT, RGBA32_FLOAT = 1, 2, 3, 4
@@ -98,7 +98,7 @@ class CapiThroughCtypes(unittest.TestCase):
         self.assertIn("abi_version 2.0", self.error())
         options = ConverterOptions()
         self.assertEqual(self.lib.reprise_converter_options_init(C.byref(options), C.sizeof(options)), OK)
-        options.struct_size += 8  # a newer caller's struct
+        options.struct_size += 12  # a newer caller's struct (1.2 and 1.3 added 4 bytes each)
         status = self.lib.reprise_converter_create(ABI_VERSION, C.byref(options), C.byref(handle))
         self.assertEqual(status, ERROR_ABI_MISMATCH)
         self.assertIn("options->struct_size", self.error())

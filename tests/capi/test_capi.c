@@ -381,6 +381,13 @@ static void test_abi_mismatch(void) {
     EXPECT_STATUS(reprise_converter_create(REPRISE_ABI_VERSION, &old_converter, &taken),
                   REPRISE_OK);
     reprise_converter_destroy(taken);
+    /* A minor-2 caller's struct ends before perceptual: taken too. */
+    EXPECT_STATUS(reprise_converter_options_init(&old_converter,
+                                                 offsetof(reprise_converter_options, perceptual)),
+                  REPRISE_OK);
+    EXPECT_STATUS(reprise_converter_create(REPRISE_ABI_VERSION, &old_converter, &taken),
+                  REPRISE_OK);
+    reprise_converter_destroy(taken);
     CHECK(reprise_abi_version() == REPRISE_ABI_VERSION, "library ABI %x", reprise_abi_version());
 }
 

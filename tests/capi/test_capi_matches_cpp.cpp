@@ -169,6 +169,54 @@ TEST(CapiMatchesCpp, WidenSilhouettesIsTheSynthesizersOption) {
     }
 }
 
+// perceptual is the converter's option; a minor-2 caller's struct, which ends before it, gets the
+// default (on).
+TEST(CapiMatchesCpp, PerceptualIsTheConvertersOption) {
+    const std::vector<Frame> input = frames();
+    std::vector<Frame> want[2];
+    for (const bool perceptual : {false, true}) {
+        warp::FrameRateConverter converter;
+        ASSERT_TRUE(
+            warp::FrameRateConverter::create(2, {.perceptual = perceptual}, converter).ok());
+        for (const Frame& f : input) {
+            ASSERT_TRUE(converter.send(f).ok());
+            Frame out;
+            while (converter.receive(out)) want[perceptual].push_back(out);
+        }
+    }
+    ASSERT_EQ(want[0].size(), want[1].size());
+    ASSERT_FALSE(test::same_bits(want[0][1].color, want[1][1].color))
+        << "the option changes nothing";
+    for (const int given : {0, 1, -1}) {  // -1: a minor-2 struct, without the field
+        reprise_converter_options options;
+        const std::size_t size =
+            given < 0 ? offsetof(reprise_converter_options, perceptual) : sizeof options;
+        ASSERT_EQ(reprise_converter_options_init(&options, size), REPRISE_OK);
+        if (given >= 0) options.perceptual = given;
+        reprise_converter* c = nullptr;
+        ASSERT_EQ(reprise_converter_create(REPRISE_ABI_VERSION, &options, &c), REPRISE_OK)
+            << reprise_last_error();
+        std::size_t received = 0;
+        for (const Frame& f : input) {
+            const reprise_gbuffer g = gbuffer_of(f);
+            ASSERT_EQ(reprise_converter_send(c, &g), REPRISE_OK) << reprise_last_error();
+            for (;;) {
+                Frame got;
+                reprise_gbuffer out = output_into(got);
+                const reprise_status s = reprise_converter_receive(c, &out);
+                if (s == REPRISE_NEED_MORE) break;
+                ASSERT_EQ(s, REPRISE_OK) << reprise_last_error();
+                ASSERT_LT(received, want[0].size());
+                EXPECT_TRUE(test::same_bits(want[given != 0][received].color, got.color))
+                    << "given " << given << ", output " << received;
+                ++received;
+            }
+        }
+        EXPECT_EQ(received, want[0].size());
+        reprise_converter_destroy(c);
+    }
+}
+
 // The C encoder's packet for `frame`, received into a buffer of `capacity` bytes.
 void c_packet(reprise_encoder* ce, const Frame& frame, std::size_t capacity,
               std::vector<uint8_t>& bytes) {
