@@ -138,7 +138,9 @@ TEST(CliStereo, TheGpuBackendMakesTheCpusEyes) {
                                                 "160x90", "--out", truth}),
               0);
     const std::string cpu = (dir / "cpu").string(), gles = (dir / "gles").string();
-    ASSERT_EQ(run_command(cli::command_stereo, {"--in", truth, "--warp", "splat", "--out", cpu}),
+    // The GPU's eye works in linear light: the CPU's is made so to compare them.
+    ASSERT_EQ(run_command(cli::command_stereo,
+                          {"--in", truth, "--warp", "splat", "--blend", "linear", "--out", cpu}),
               0);
     ASSERT_EQ(run_command(cli::command_stereo,
                           {"--in", truth, "--warp", "splat", "--backend", "gles", "--out", gles}),
@@ -148,7 +150,9 @@ TEST(CliStereo, TheGpuBackendMakesTheCpusEyes) {
     // The default eye (the grid): its cells grown and drawn on the GPU.
     const std::string grid_cpu = (dir / "grid_cpu").string(),
                       grid_gles = (dir / "grid_gles").string();
-    ASSERT_EQ(run_command(cli::command_stereo, {"--in", truth, "--out", grid_cpu}), 0);
+    ASSERT_EQ(
+        run_command(cli::command_stereo, {"--in", truth, "--blend", "linear", "--out", grid_cpu}),
+        0);
     ASSERT_EQ(
         run_command(cli::command_stereo, {"--in", truth, "--backend", "gles", "--out", grid_gles}),
         0);
@@ -157,8 +161,9 @@ TEST(CliStereo, TheGpuBackendMakesTheCpusEyes) {
                   50.0);
     const std::string grid_temporal = (dir / "grid_temporal").string(),
                       grid_gles_temporal = (dir / "grid_gles_temporal").string();
-    ASSERT_EQ(
-        run_command(cli::command_stereo, {"--in", truth, "--temporal", "--out", grid_temporal}), 0);
+    ASSERT_EQ(run_command(cli::command_stereo, {"--in", truth, "--temporal", "--blend", "linear",
+                                                "--out", grid_temporal}),
+              0);
     ASSERT_EQ(run_command(cli::command_stereo, {"--in", truth, "--temporal", "--backend", "gles",
                                                 "--out", grid_gles_temporal}),
               0);
@@ -172,8 +177,8 @@ TEST(CliStereo, TheGpuBackendMakesTheCpusEyes) {
     // --temporal: the previous frame fills the holes first, on the GPU as on the CPU.
     const std::string cpu_temporal = (dir / "cpu_temporal").string(),
                       gles_temporal = (dir / "gles_temporal").string();
-    ASSERT_EQ(run_command(cli::command_stereo,
-                          {"--in", truth, "--warp", "splat", "--temporal", "--out", cpu_temporal}),
+    ASSERT_EQ(run_command(cli::command_stereo, {"--in", truth, "--warp", "splat", "--temporal",
+                                                "--blend", "linear", "--out", cpu_temporal}),
               0);
     ASSERT_EQ(run_command(cli::command_stereo, {"--in", truth, "--warp", "splat", "--temporal",
                                                 "--backend", "gles", "--out", gles_temporal}),
@@ -205,7 +210,8 @@ TEST(CliStereo, FrucOnTheGpuBackendMakesTheCpusSplatFrames) {
         args.insert(args.end(), extra.begin(), extra.end());
         return args;
     };
-    ASSERT_EQ(run_command(cli::command_fruc, with({"--out", cpu})), 0);
+    // The GPU works in linear light: the CPU's frames are made so to compare them.
+    ASSERT_EQ(run_command(cli::command_fruc, with({"--blend", "linear", "--out", cpu})), 0);
     ASSERT_EQ(run_command(cli::command_fruc, with({"--backend", "gles", "--out", gles})), 0);
     for (int i = 0; i < 5; ++i)
         EXPECT_GE(psnr_of(frame_path(cpu, i), frame_path(gles, i)), 50.0) << "frame " << i;
@@ -218,7 +224,9 @@ TEST(CliStereo, FrucOnTheGpuBackendMakesTheCpusSplatFrames) {
     // GPU, refinement's survey and choices there, its flow on the CPU.
     const std::string cpu_grid_between = (dir / "cpu_grid_between").string(),
                       gles_grid_between = (dir / "gles_grid_between").string();
-    ASSERT_EQ(run_command(cli::command_fruc, {"--in", in, "--out", cpu_grid_between}), 0);
+    ASSERT_EQ(run_command(cli::command_fruc,
+                          {"--in", in, "--blend", "linear", "--out", cpu_grid_between}),
+              0);
     ASSERT_EQ(run_command(cli::command_fruc,
                           {"--in", in, "--backend", "gles", "--out", gles_grid_between}),
               0);
@@ -230,7 +238,7 @@ TEST(CliStereo, FrucOnTheGpuBackendMakesTheCpusSplatFrames) {
                       gles_true = (dir / "gles_true").string();
     const std::vector<std::string> true_motion = {"--in", in, "--warp", "splat", "--refine", "off"};
     std::vector<std::string> run = true_motion;
-    run.insert(run.end(), {"--out", cpu_true});
+    run.insert(run.end(), {"--blend", "linear", "--out", cpu_true});
     ASSERT_EQ(run_command(cli::command_fruc, run), 0);
     run = true_motion;
     run.insert(run.end(), {"--backend", "gles", "--out", gles_true});
@@ -244,7 +252,7 @@ TEST(CliStereo, FrucOnTheGpuBackendMakesTheCpusSplatFrames) {
     const std::string cpu_ahead = (dir / "cpu_ahead").string(),
                       gles_ahead = (dir / "gles_ahead").string();
     std::vector<std::string> args = ahead;
-    args.insert(args.end(), {"--out", cpu_ahead});
+    args.insert(args.end(), {"--blend", "linear", "--out", cpu_ahead});
     ASSERT_EQ(run_command(cli::command_fruc, args), 0);
     args = ahead;
     args.insert(args.end(), {"--backend", "gles", "--out", gles_ahead});
@@ -262,7 +270,7 @@ TEST(CliStereo, FrucOnTheGpuBackendMakesTheCpusSplatFrames) {
     const std::string cpu_grid = (dir / "cpu_grid").string(),
                       gles_grid = (dir / "gles_grid").string();
     args = grid_ahead;
-    args.insert(args.end(), {"--out", cpu_grid});
+    args.insert(args.end(), {"--blend", "linear", "--out", cpu_grid});
     ASSERT_EQ(run_command(cli::command_fruc, args), 0);
     args = grid_ahead;
     args.insert(args.end(), {"--backend", "gles", "--out", gles_grid});

@@ -705,7 +705,8 @@ TEST(Gpu, GridEyeMatchesTheCpuOnEveryBuiltInScene) {
     skewed.camera.prev_projection = skewed.camera.projection;
     const Camera right = stereo::eye_cameras(skewed.camera, {}, stereo::Anchor::Left).right;
     Frame cpu, gpu;
-    const stereo::StereoStats expected = stereo::synthesize_eye(skewed, right, {}, cpu);
+    const stereo::StereoStats expected =
+        stereo::synthesize_eye(skewed, right, {.perceptual = false}, cpu);
     stereo::StereoStats stats;
     ASSERT_TRUE(shared_gpu().stereo_eye(skewed, right, gpu, stats, {}).ok());
     EXPECT_EQ(stats.cells, expected.cells);
@@ -1181,9 +1182,11 @@ TEST(Gpu, EachInputsWidenedPixelsAreCountedOnceAcrossACut) {
     std::vector<Frame> frames = test::render_scene("crossing", 5, kWidth, kHeight, 30.0, 3);
     frames[2].camera.cut = Cut::Yes;
     gpu::FrucBackend backend(shared_gpu());
-    const warp::FrucOptions cpu_options{.warp = warp::WarpMethod::Splat,
-                                        .refine = {.enabled = false}};
+    // (The converter with a backend works in linear light, the cut's frame on the CPU too.)
+    const warp::FrucOptions cpu_options{
+        .warp = warp::WarpMethod::Splat, .perceptual = false, .refine = {.enabled = false}};
     warp::FrucOptions gpu_options = cpu_options;
+    gpu_options.perceptual = true;
     gpu_options.backend = &backend;
     warp::FrucCounters cpu_counters, gpu_counters;
     const std::vector<Frame> cpu = convert(frames, 2, cpu_options, cpu_counters);

@@ -90,8 +90,10 @@ def test_gpu_backend_makes_the_cpus_splat_frames(pan_60):
     inputs = [pan_60[0].copy(), pan_60[2].copy(), pan_60[4].copy()]
     for f in inputs:
         f.fps = 30.0
+    # The GPU works in linear light: the CPU's frames are made so to compare them.
+    linear = dict(perceptual=False)
     splat = dict(factor=2, warp="splat", refine=False, true_motion=False)
-    cpu = reprise.FrameRateConverter(**splat).convert(inputs)
+    cpu = reprise.FrameRateConverter(**splat, **linear).convert(inputs)
     gpu = reprise.FrameRateConverter(**splat, backend="gles").convert(inputs)
     assert len(gpu) == len(cpu) == 5
     for k in range(5):
@@ -103,25 +105,25 @@ def test_gpu_backend_makes_the_cpus_splat_frames(pan_60):
     assert differ.mean() <= 0.001
     # Extrapolated on the GPU: the CPU's frames, motion included.
     ahead = dict(factor=2, mode="extrapolate", warp="splat")
-    cpu = reprise.FrameRateConverter(**ahead).convert(inputs)
+    cpu = reprise.FrameRateConverter(**ahead, **linear).convert(inputs)
     gpu = reprise.FrameRateConverter(**ahead, backend="gles").convert(inputs)
     assert len(gpu) == len(cpu) == 6
     for k in range(6):
         assert reprise.psnr(reprise.to_display(gpu[k].color), reprise.to_display(cpu[k].color)) >= 50.0
     assert np.array_equal(gpu[1].motion, cpu[1].motion)
     # True motion (the default) on the GPU too: the CPU's frames.
-    cpu = reprise.FrameRateConverter(factor=2, warp="splat", refine=False).convert(inputs)
+    cpu = reprise.FrameRateConverter(factor=2, warp="splat", refine=False, **linear).convert(inputs)
     gpu = reprise.FrameRateConverter(factor=2, warp="splat", refine=False,
                                      backend="gles").convert(inputs)
     for k in range(5):
         assert reprise.psnr(reprise.to_display(gpu[k].color), reprise.to_display(cpu[k].color)) >= 50.0
     # The default warp, the grid, without refinement: both sides' cells grown and drawn there.
-    cpu = reprise.FrameRateConverter(factor=2, refine=False).convert(inputs)
+    cpu = reprise.FrameRateConverter(factor=2, refine=False, **linear).convert(inputs)
     gpu = reprise.FrameRateConverter(factor=2, refine=False, backend="gles").convert(inputs)
     for k in range(5):
         assert reprise.psnr(reprise.to_display(gpu[k].color), reprise.to_display(cpu[k].color)) >= 50.0
     # The defaults, refinement on: its survey and choices on the GPU, the flow on the CPU.
-    cpu = reprise.FrameRateConverter(factor=2).convert(inputs)
+    cpu = reprise.FrameRateConverter(factor=2, **linear).convert(inputs)
     gpu = reprise.FrameRateConverter(factor=2, backend="gles").convert(inputs)
     for k in range(5):
         assert reprise.psnr(reprise.to_display(gpu[k].color), reprise.to_display(cpu[k].color)) >= 50.0

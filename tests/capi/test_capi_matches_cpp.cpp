@@ -169,6 +169,35 @@ TEST(CapiMatchesCpp, WidenSilhouettesIsTheSynthesizersOption) {
     }
 }
 
+// perceptual is the synthesizer's option too; a minor-2 struct gets the default (on).
+TEST(CapiMatchesCpp, PerceptualIsTheSynthesizersOption) {
+    const std::vector<Frame> input = frames();
+    const Frame& left = input[1];
+    const stereo::EyeCameras eyes = stereo::eye_cameras(left.camera, {}, stereo::Anchor::Left);
+    Frame want[2];
+    for (const bool perceptual : {false, true})
+        stereo::StereoSynthesizer().synthesize(left, eyes.right, want[perceptual],
+                                               {.perceptual = perceptual});
+    ASSERT_FALSE(test::same_bits(want[0].color, want[1].color)) << "the option changes nothing";
+    const reprise_gbuffer g = gbuffer_of(left);
+    for (const int given : {0, 1, -1}) {  // -1: a minor-2 struct, without the field
+        reprise_stereo_options options;
+        const std::size_t size =
+            given < 0 ? offsetof(reprise_stereo_options, perceptual) : sizeof options;
+        ASSERT_EQ(reprise_stereo_options_init(&options, size), REPRISE_OK);
+        if (given >= 0) options.perceptual = given;
+        reprise_stereo* s = nullptr;
+        ASSERT_EQ(reprise_stereo_create(REPRISE_ABI_VERSION, &options, &s), REPRISE_OK)
+            << reprise_last_error();
+        Frame got;
+        reprise_gbuffer out = output_into(got);
+        out.motion = {};
+        ASSERT_EQ(reprise_stereo_synthesize(s, &g, &out), REPRISE_OK) << reprise_last_error();
+        EXPECT_TRUE(test::same_bits(want[given != 0].color, got.color)) << "given " << given;
+        reprise_stereo_destroy(s);
+    }
+}
+
 // perceptual is the converter's option; a minor-2 caller's struct, which ends before it, gets the
 // default (on).
 TEST(CapiMatchesCpp, PerceptualIsTheConvertersOption) {

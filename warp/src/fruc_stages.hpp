@@ -59,15 +59,17 @@ std::size_t warp_into(const GBufferView& source, float factor, const FrucOptions
 uint64_t next_frame_key();
 
 // `f` as the warps take it, in scratch slot `slot` (0 or 1): silhouettes widened and colour
-// encoded (FrucOptions::perceptual) when options ask for them; for options.backend, its colour as
-// it is and not widened for a backend that widens.
+// encoded (encodes_colour) when options ask for them; for options.backend, not widened for a
+// backend that widens.
 GBufferView warp_input(const GBufferView& f, int slot, const FrucOptions& options,
                        FrucScratch& scratch, FrucCounters& counters, bool for_backend = false);
 // What options.backend is handed: warp_input's for it.
 GBufferView backend_input(const GBufferView& f, int slot, const FrucOptions& options,
                           FrucScratch& scratch, FrucCounters& counters);
 
-// A made frame's colour back to linear light when FrucOptions::perceptual encoded its inputs.
+// Whether the warps take colour encoded (FrucOptions::perceptual, without a backend), and a made
+// frame's colour back to linear light when they did.
+bool encodes_colour(const FrucOptions& options);
 void finish_colour(ImageView<glm::vec4> color, const FrucOptions& options);
 
 // Fills the holes of `color` (valid = 0; `holes` of them, counted by the caller) as options.fill

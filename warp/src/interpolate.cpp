@@ -105,7 +105,7 @@ GBufferView warp_input(const GBufferView& f, int slot, const FrucOptions& option
                        FrucScratch& scratch, FrucCounters& counters, bool for_backend) {
     const bool widen = options.widen_silhouettes && !f.depth.empty() &&
                        !(for_backend && options.backend->widens_silhouettes());
-    const bool encode = options.perceptual && !for_backend && !f.color.empty();
+    const bool encode = encodes_colour(options) && !f.color.empty();
     if (!widen && !encode) return f;
     auto prepared = [&](int i) {
         GBufferView v = f;
@@ -122,7 +122,10 @@ GBufferView warp_input(const GBufferView& f, int slot, const FrucOptions& option
     if (key != 0) {
         for (int i = 0; i < 2; ++i)
             if (scratch.prepared_key[i] == key && scratch.prepared_as[i] == as) return prepared(i);
-        if (other != 0 && scratch.prepared_key[buffer] == other) buffer = 1 - buffer;
+        // The other input's copy as this call prepares it stays: its side of the frame uses it.
+        if (other != 0 && scratch.prepared_key[buffer] == other &&
+            scratch.prepared_as[buffer] == as)
+            buffer = 1 - buffer;
     }
     if (widen) {
         std::size_t changed = 0;
@@ -262,7 +265,7 @@ void interpolate_frame(const GBufferView& a_in, const GBufferView& b_in, float s
                                  std::as_const(wa.covered).view()},
                                 {std::as_const(out.color).view(), std::as_const(out.depth).view(),
                                  std::as_const(scratch.side_b.covered).view()},
-                                options.refine, options.perceptual, counters);
+                                options.refine, encodes_colour(options), counters);
     std::atomic<std::size_t> holes{0};
     parallel_for(0, h, [&](int y0, int y1) {
         std::size_t local_holes = 0;

@@ -39,8 +39,12 @@ void decode_perceptual(ImageView<glm::vec4> color) {
     });
 }
 
+bool encodes_colour(const FrucOptions& options) {
+    return options.perceptual && options.backend == nullptr;
+}
+
 void finish_colour(ImageView<glm::vec4> color, const FrucOptions& options) {
-    if (options.perceptual) decode_perceptual(color);
+    if (encodes_colour(options)) decode_perceptual(color);
 }
 
 }  // namespace reprise::warp

@@ -30,7 +30,8 @@ public:
     // frame periods after it (periods >= 0; its motion is per period); a frame without a
     // projection goes along its motion alone. Scratch is sized once.
     // A non-zero `frame_key`, the same for the same frame, lets the work that depends on the
-    // frame alone (its widened silhouettes) be done once for all the instants made from it.
+    // frame alone (its widened silhouettes, its colour encoded for FrucOptions::perceptual) be
+    // done once for all the instants made from it.
     // With FrucOptions::backend the backend makes it; its error is returned (counters unchanged).
     Status extrapolate(const GBufferView& frame, const glm::mat4& view, const glm::mat4& projection,
                        float periods, Frame& out, uint64_t frame_key = 0);

@@ -92,7 +92,7 @@ struct FrucOptions;
 // Makes the warped frames of a FrameRateConverter or a PoseExtrapolator elsewhere than on the
 // CPU (a GPU: gpu::FrucBackend). The caller keeps the rest — order, cuts, still pairs, repair,
 // widened silhouettes (unless the backend widens them), UI — and hands the backend the inputs its
-// own warps would take. An error
+// own warps would take, in linear light (FrucOptions::perceptual is the CPU's). An error
 // from it ends send() (or extrapolate()) with that error and leaves the converter as it was
 // before that send().
 class WarpBackend {
@@ -141,8 +141,8 @@ struct FrucOptions {
     // Colour is warped, blended and filled as the square root of linear light (a scale close to
     // the display's), then squared back: resampled and blended edges, and pixels blended from
     // both sides, come out nearer what the display shows of the rendered truth (docs/benchmarks.md,
-    // "Blending on the display's scale"). Off: in linear light. A backend (gpu::FrucBackend) is
-    // handed linear light and works in it.
+    // "Blending on the display's scale"). Off: in linear light. A converter with a backend
+    // (gpu::FrucBackend) works in linear light, the frames it makes on the CPU too.
     bool perceptual = true;
     SplatOptions splat;
     // A new frame whose camera does not say whether a cut came before it (Camera::cut Unknown) and
