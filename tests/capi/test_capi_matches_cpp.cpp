@@ -136,27 +136,24 @@ TEST(CapiMatchesCpp, StereoEyeIsTheSynthesizers) {
     reprise_stereo_destroy(s);
 }
 
-// widen_silhouettes is the synthesizer's option; a minor-1 caller's struct, which ends before
-// it, gets the default (on). The frame has a near square, whose edges the option moves.
-TEST(CapiMatchesCpp, WidenSilhouettesIsTheSynthesizersOption) {
-    Frame left = frames()[1];
-    for (int y = 16; y < 32; ++y)
-        for (int x = 20; x < 40; ++x) left.depth(x, y) = 1.5f;
+// A flag of the synthesizer's options set through the C struct: off, on, and a struct of the
+// minor before the field's (ending where it starts), which gets the default (on).
+void expect_stereo_flag(const Frame& left, bool stereo::StereoOptions::*flag,
+                        int32_t reprise_stereo_options::*field, std::size_t field_offset) {
     const stereo::EyeCameras eyes = stereo::eye_cameras(left.camera, {}, stereo::Anchor::Left);
     Frame want[2];
-    for (const bool widen : {false, true}) {
+    for (const bool on : {false, true}) {
         stereo::StereoOptions o;
-        o.widen_silhouettes = widen;
-        stereo::StereoSynthesizer().synthesize(left, eyes.right, want[widen], o);
+        o.*flag = on;
+        stereo::StereoSynthesizer().synthesize(left, eyes.right, want[on], o);
     }
     ASSERT_FALSE(test::same_bits(want[0].color, want[1].color)) << "the option changes nothing";
     const reprise_gbuffer g = gbuffer_of(left);
-    for (const int given : {0, 1, -1}) {  // -1: a minor-1 struct, without the field
+    for (const int given : {0, 1, -1}) {  // -1: an older minor's struct, without the field
         reprise_stereo_options options;
-        const std::size_t size =
-            given < 0 ? offsetof(reprise_stereo_options, widen_silhouettes) : sizeof options;
+        const std::size_t size = given < 0 ? field_offset : sizeof options;
         ASSERT_EQ(reprise_stereo_options_init(&options, size), REPRISE_OK);
-        if (given >= 0) options.widen_silhouettes = given;
+        if (given >= 0) options.*field = given;
         reprise_stereo* s = nullptr;
         ASSERT_EQ(reprise_stereo_create(REPRISE_ABI_VERSION, &options, &s), REPRISE_OK)
             << reprise_last_error();
@@ -169,33 +166,22 @@ TEST(CapiMatchesCpp, WidenSilhouettesIsTheSynthesizersOption) {
     }
 }
 
-// perceptual is the synthesizer's option too; a minor-2 struct gets the default (on).
+// widen_silhouettes (minor 2) is the synthesizer's option. The frame has a near square, whose
+// edges the option moves.
+TEST(CapiMatchesCpp, WidenSilhouettesIsTheSynthesizersOption) {
+    Frame left = frames()[1];
+    for (int y = 16; y < 32; ++y)
+        for (int x = 20; x < 40; ++x) left.depth(x, y) = 1.5f;
+    expect_stereo_flag(left, &stereo::StereoOptions::widen_silhouettes,
+                       &reprise_stereo_options::widen_silhouettes,
+                       offsetof(reprise_stereo_options, widen_silhouettes));
+}
+
+// perceptual (minor 3) is the synthesizer's option too.
 TEST(CapiMatchesCpp, PerceptualIsTheSynthesizersOption) {
-    const std::vector<Frame> input = frames();
-    const Frame& left = input[1];
-    const stereo::EyeCameras eyes = stereo::eye_cameras(left.camera, {}, stereo::Anchor::Left);
-    Frame want[2];
-    for (const bool perceptual : {false, true})
-        stereo::StereoSynthesizer().synthesize(left, eyes.right, want[perceptual],
-                                               {.perceptual = perceptual});
-    ASSERT_FALSE(test::same_bits(want[0].color, want[1].color)) << "the option changes nothing";
-    const reprise_gbuffer g = gbuffer_of(left);
-    for (const int given : {0, 1, -1}) {  // -1: a minor-2 struct, without the field
-        reprise_stereo_options options;
-        const std::size_t size =
-            given < 0 ? offsetof(reprise_stereo_options, perceptual) : sizeof options;
-        ASSERT_EQ(reprise_stereo_options_init(&options, size), REPRISE_OK);
-        if (given >= 0) options.perceptual = given;
-        reprise_stereo* s = nullptr;
-        ASSERT_EQ(reprise_stereo_create(REPRISE_ABI_VERSION, &options, &s), REPRISE_OK)
-            << reprise_last_error();
-        Frame got;
-        reprise_gbuffer out = output_into(got);
-        out.motion = {};
-        ASSERT_EQ(reprise_stereo_synthesize(s, &g, &out), REPRISE_OK) << reprise_last_error();
-        EXPECT_TRUE(test::same_bits(want[given != 0].color, got.color)) << "given " << given;
-        reprise_stereo_destroy(s);
-    }
+    expect_stereo_flag(frames()[1], &stereo::StereoOptions::perceptual,
+                       &reprise_stereo_options::perceptual,
+                       offsetof(reprise_stereo_options, perceptual));
 }
 
 // perceptual is the converter's option; a minor-2 caller's struct, which ends before it, gets the
