@@ -121,8 +121,9 @@ Status run_stereo(const StereoJob& job, const stereo::StereoRig& rig,
         if (frame.depth.width() != frame.width() || frame.depth.height() != frame.height())
             return Status::error(file + ": needs a depth channel (Z) of the colour's size");
         // The synthesizer's scratch, the made eye and the history: measured 91 bytes a pixel,
-        // before the widened source (12 more, counted).
-        REPRISE_TRY(check_image_memory(frame.width(), frame.height(), 108, "stereo"));
+        // before the widened source (12 more) and its encoded colour (StereoOptions::perceptual:
+        // 16 more), counted.
+        REPRISE_TRY(check_image_memory(frame.width(), frame.height(), 124, "stereo"));
         nonfinite += repair.repair(frame);
         // Disparity needs the focal length: from the file's camera, else from --fov.
         if (!has_projection(frame.camera)) {
