@@ -224,6 +224,58 @@ TEST(CodecPieces, TransformInvertsWithinThreeLevels) {
     for (int i = 1; i < 64; ++i) EXPECT_EQ(c[i], 0);
 }
 
+TEST(CodecPieces, TheButterflyTransformGivesTheMatrixProductsIntegers) {
+    std::mt19937 rng(12);
+    for (int trial = 0; trial < 2000; ++trial) {
+        Block x, fast, reference;
+        const int range = trial % 4 == 0 ? 510 : trial % 4 == 1 ? 255 : trial % 4 == 2 ? 3 : 0;
+        for (auto& v : x) v = int32_t(rng() % (2 * range + 1)) - range;
+        if (trial % 7 == 0)  // the extremes, alternating in sign
+            for (int i = 0; i < 64; ++i) x[i] = (i + i / 8) % 2 ? 510 : -510;
+        forward_dct(x, fast);
+        forward_dct_reference(x, reference);
+        ASSERT_EQ(fast, reference) << trial;
+    }
+}
+
+TEST(CodecPieces, ABlockUnderTheQuietSadHasNoLevelAtAnyQp) {
+    // Residuals of the quiet SAD in a few random spikes, and on the four corners with the signs
+    // of T's extreme basis function (89 89 on each: the bound's worst case).
+    std::mt19937 rng(13);
+    for (int qp = 0; qp <= 51; qp += 3)
+        for (int rounding : {2, 6}) {
+            const int32_t scale = quant_scale(qp);
+            const int32_t quiet = quiet_below(scale, rounding);
+            ASSERT_GE(quiet, 0);
+            for (int trial = 0; trial < 200; ++trial) {
+                Block x{}, c, levels;
+                int left = quiet;
+                while (left > 0) {  // SAD exactly `quiet`, in a few spikes
+                    const int v = std::min<int>(left, 1 + int(rng() % 510));
+                    int& at = x[rng() % 64];
+                    if (std::abs(at) + v > 510) continue;
+                    at += at < 0 || (at == 0 && rng() % 2) ? -v : v;
+                    left -= v;
+                }
+                forward_dct(x, c);
+                ASSERT_EQ(quantize(c, scale, rounding, levels), 0) << qp << " " << trial;
+            }
+            Block corners{}, c, levels;
+            for (int k = 0; k < 4; ++k) {
+                const int v = quiet / 4 + (k < quiet % 4);
+                corners[(k / 2) * 56 + (k % 2) * 7] = k == 0 || k == 3 ? v : -v;
+            }
+            forward_dct(corners, c);
+            EXPECT_EQ(quantize(c, scale, rounding, levels), 0) << qp;
+            // The bound is near: one more unit of the same shape gives a level at most qps.
+            corners[0] += 1 + quiet / 8;
+            forward_dct(corners, c);
+            if (qp >= 12) {
+                EXPECT_GT(quantize(c, scale, rounding, levels), 0) << qp;
+            }
+        }
+}
+
 TEST(Codec, RenderedSceneDecodesBitIdenticalWithLosslessDepth) {
     const auto frames = render("crossing", 6, 160, 96);
     const Coded coded =

@@ -6,6 +6,7 @@
 #include <cstdlib>
 
 #include "internal.hpp"
+#include "kernels.hpp"
 #include "slices.hpp"
 #include "transform.hpp"
 
@@ -190,6 +191,7 @@ struct SliceJob {
     const Planes* source;     // encoder
     const Planes* predicted;  // null on key frames; else the output, predicted into
     Planes* out;
+    const InterChoice* choices;  // encoder, inter frames: per macroblock, row-major
     int qp, skip_threshold;
     int mb_y0, mb_y1;
     std::vector<uint8_t>* coded;  // per plane, per 8x8 block
@@ -286,6 +288,25 @@ int sad(const Block& a, const Block& b) {
     return s;
 }
 
+}  // namespace
+
+void block_differences_row_reference(const BlockDifferencesRow& r, int b_begin, int b_end) {
+    for (int b = b_begin; b < b_end; ++b) {
+        int32_t sum = 0, largest = 0;
+        for (int y = 0; y < 8; ++y)
+            for (int x = 0; x < 8; ++x) {
+                const std::ptrdiff_t at = std::ptrdiff_t(y) * r.stride + 8 * b + x;
+                const int32_t d = std::abs(r.source[at] - r.prediction[at]);
+                sum += d;
+                largest = std::max(largest, d);
+            }
+        r.sum[b] = sum;
+        r.largest[b] = largest;
+    }
+}
+
+namespace {
+
 // The decoded block: prediction plus the dequantised, inverse-transformed levels (none: the
 // prediction alone, which counts as skipped for inter blocks).
 void reconstruct(SliceJob& j, int k, int bx, int by, const Block& pred, const Block* levels,
@@ -333,55 +354,24 @@ bool code_slice(SliceJob& j, Coder& rc) {
             bool skip = false, intra = j.predicted == nullptr;
             // Encoder decisions: intra when its best SAD (on source neighbours) clearly beats
             // the reprojection, skip when every block stays within the threshold.
-            Block src, pred, pred2, coef, levels, residual;
+            Block src, pred, coef, levels, residual;
             Block inter_levels[12];  // encoder: an inter macroblock's blocks in coding order
             int inter_nonzero[12];
             if constexpr (Encode) {
                 if (!intra) {
-                    // Inter error first; intra is only tried where the reprojection is poor
-                    // (more than 2 levels off on average).
-                    int inter_sad = 0, samples = 0;
-                    bool all_within = true;
-                    for_each_block(j, mx, my, [&](int k, int bx, int by) {
-                        const int limit = k ? 2 * j.skip_threshold : j.skip_threshold;
-                        load(j.source->p[k], bx, by, src);
-                        load(j.predicted->p[k], bx, by, pred);
-                        inter_sad += sad(src, pred);
-                        samples += 64;
-                        for (int i = 0; i < 64 && all_within; ++i)
-                            all_within = std::abs(src[i] - pred[i]) <= limit;
-                    });
-                    skip = all_within;
-                    if (!skip && inter_sad > 2 * samples) {
-                        int intra_sad = 0;
-                        for_each_block(j, mx, my, [&](int k, int bx, int by) {
-                            const int n = j.g->blocks_per_side[k];
-                            load(j.source->p[k], bx, by, src);
-                            const IntraEdges edges =
-                                intra_edges(j.source->p[k], bx, by, j.mb_y0 * 8 * n, k ? 0 : 128);
-                            int best = 1 << 30;
-                            for (int mode = 0; mode < kModes; ++mode) {
-                                intra_predict(edges, mode, pred2);
-                                best = std::min(best, sad(src, pred2));
-                            }
-                            intra_sad += best;
-                        });
-                        intra = intra_sad + intra_penalty(j.qp) < inter_sad;
-                    }
+                    const InterChoice& choice = j.choices[std::size_t(my) * cols + mx];
+                    skip = choice.skip;
+                    intra = choice.intra;
                     // The inter blocks' levels, before the skip flag: a macroblock none of whose
                     // blocks keeps a level decodes to its prediction, so it is sent as skipped.
                     if (!skip && !intra) {
                         int b = 0;
                         bool any = false;
                         for_each_block(j, mx, my, [&](int k, int bx, int by) {
-                            const int limit = k ? 2 * j.skip_threshold : j.skip_threshold;
-                            load(j.source->p[k], bx, by, src);
-                            load(j.predicted->p[k], bx, by, pred);
                             inter_nonzero[b] = 0;
-                            bool within = true;
-                            for (int i = 0; i < 64 && within; ++i)
-                                within = std::abs(src[i] - pred[i]) <= limit;
-                            if (!within) {
+                            if (!((choice.within | choice.quiet) >> b & 1)) {
+                                load(j.source->p[k], bx, by, src);
+                                load(j.predicted->p[k], bx, by, pred);
                                 for (int i = 0; i < 64; ++i) residual[i] = src[i] - pred[i];
                                 forward_dct(residual, coef);
                                 inter_nonzero[b] =
@@ -491,12 +481,86 @@ bool code_slice(SliceJob& j, Coder& rc) {
     return true;
 }
 
+// The inter decisions of every macroblock (in parallel over macroblock rows): skipped when every
+// block stays within the skip threshold, intra when its best SAD (on source neighbours) clearly
+// beats the reprojection's; intra is only tried where the reprojection is poor (more than 2
+// levels off on average).
+void choose_inter(const Geometry& g, const Planes& source, const Planes& predicted, int qp,
+                  int skip_threshold, std::vector<InterChoice>& choices) {
+    const SequenceParams& sp = *g.sp;
+    const int cols = sp.mb_cols();
+    choices.assign(std::size_t(cols) * sp.mb_rows(), {});
+    const int32_t quiet_sad = quiet_below(quant_scale(qp), kInterRounding);
+    parallel_for(
+        0, sp.mb_rows(),
+        [&](int row0, int row1) {
+            // Per plane and 8-pixel strip of the macroblock row: each block's sum and largest.
+            std::vector<int32_t> sums[3][2], largest[3][2];
+            for (int k = 0; k < 3; ++k)
+                for (int r = 0; r < g.blocks_per_side[k]; ++r) {
+                    sums[k][r].resize(source.p[k].width() / 8);
+                    largest[k][r].resize(source.p[k].width() / 8);
+                }
+            Block src, pred;
+            for (int my = row0; my < row1; ++my) {
+                int slice = 0;
+                while (sp.slice_begin(slice + 1) <= my) ++slice;
+                for (int k = 0; k < 3; ++k) {
+                    const int n = g.blocks_per_side[k], stride = source.p[k].width();
+                    for (int r = 0; r < n; ++r) {
+                        const int y = (my * n + r) * 8;
+                        block_differences_row({&source.p[k](0, y), &predicted.p[k](0, y), stride,
+                                               stride / 8, sums[k][r].data(),
+                                               largest[k][r].data()});
+                    }
+                }
+                for (int mx = 0; mx < cols; ++mx) {
+                    InterChoice& choice = choices[std::size_t(my) * cols + mx];
+                    int inter_sad = 0, samples = 0, b = 0;
+                    for (int k = 0; k < 3; ++k) {
+                        const int n = g.blocks_per_side[k];
+                        const int limit = k ? 2 * skip_threshold : skip_threshold;
+                        for (int i = 0; i < n * n; ++i, ++b) {
+                            const int at = mx * n + i % n;
+                            const int32_t block_sad = sums[k][i / n][at];
+                            inter_sad += block_sad;
+                            samples += 64;
+                            if (largest[k][i / n][at] <= limit) choice.within |= uint16_t(1 << b);
+                            if (block_sad <= quiet_sad) choice.quiet |= uint16_t(1 << b);
+                        }
+                    }
+                    choice.skip = choice.within == (1 << b) - 1;
+                    if (choice.skip || inter_sad <= 2 * samples) continue;
+                    int intra_sad = 0;
+                    for (int k = 0; k < 3; ++k) {
+                        const int n = g.blocks_per_side[k];
+                        const int top = sp.slice_begin(slice) * 8 * n;
+                        for (int i = 0; i < n * n; ++i) {
+                            const int bx = mx * 8 * n + (i % n) * 8, by = my * 8 * n + (i / n) * 8;
+                            load(source.p[k], bx, by, src);
+                            const IntraEdges edges =
+                                intra_edges(source.p[k], bx, by, top, k ? 0 : 128);
+                            int best = 1 << 30;
+                            for (int mode = 0; mode < kModes; ++mode) {
+                                intra_predict(edges, mode, pred);
+                                best = std::min(best, sad(src, pred));
+                            }
+                            intra_sad += best;
+                        }
+                    }
+                    choice.intra = intra_sad + intra_penalty(qp) < inter_sad;
+                }
+            }
+        },
+        1);
+}
+
 std::vector<SliceJob> slice_jobs(const Geometry& g, const Planes* source, const Planes* predicted,
                                  Planes& out, int qp, int skip_threshold, Workspace& work) {
     std::vector<SliceJob> jobs;
     for (int s = 0; s < g.sp->slices; ++s)
-        jobs.push_back({&g, source, predicted, &out, qp, skip_threshold, g.sp->slice_begin(s),
-                        g.sp->slice_begin(s + 1), work.coded_blocks});
+        jobs.push_back({&g, source, predicted, &out, work.inter_choices.data(), qp, skip_threshold,
+                        g.sp->slice_begin(s), g.sp->slice_begin(s + 1), work.coded_blocks});
     return jobs;
 }
 
@@ -537,6 +601,7 @@ ColorEncodeResult encode_color(const FrameContext& fc, const Planes& source,
     ByteWriter w(bytes);
     w.u8(uint8_t(qp));
     const Geometry g = geometry(sp);
+    if (!fc.key) choose_inter(g, source, predicted, qp, skip_threshold, fc.work->inter_choices);
     std::vector<SliceJob> jobs =
         slice_jobs(g, &source, fc.key ? nullptr : &predicted, out, qp, skip_threshold, *fc.work);
     std::vector<uint8_t>& body = fc.work->section;

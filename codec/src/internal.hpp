@@ -192,6 +192,14 @@ struct MotionResidual {
 };
 
 // Per-frame scratch, sized on the first frame and reused while the size stays the same.
+// An inter macroblock's colour encoder decisions, made for the whole frame before its slices are
+// coded (color_coder.cpp: they read the source and the prediction only).
+struct InterChoice {
+    bool skip = false, intra = false;
+    uint16_t within = 0;  // bit b: block b (coding order) stays within the skip threshold
+    uint16_t quiet = 0;   // bit b: block b's residual quantises to no level (by its SAD)
+};
+
 struct Workspace {
     Image<uint32_t> depth_codes, temporal_codes, depth_residuals, depth_predictions;
     Image<float> projected_depth, view_share;
@@ -202,6 +210,7 @@ struct Workspace {
     Image<uint32_t> predicted_owner;  // empty when no pixel is predicted to move with an object
     Image<uint8_t> revealed;          // per luma pixel: the reference did not see it
     std::vector<uint8_t> coded_blocks[3];  // per 8x8 block of each plane: intra or with a residual
+    std::vector<InterChoice> inter_choices;  // colour encoder: per macroblock of an inter frame
     std::vector<std::vector<uint8_t>> slice_bytes;
     std::vector<std::vector<uint8_t>> slice_flags;  // per slice: a block row's flags
     std::vector<uint8_t> section;

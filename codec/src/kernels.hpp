@@ -38,6 +38,20 @@ const int32_t (&catmull_rom_weights())[64][4];
 inline constexpr int32_t kPackedWeightBias = 16;
 const uint32_t (&catmull_rom_packed())[64];
 
+// The encoder's skip and intra tests (color_coder.cpp): for each of `blocks` 8x8 blocks side by
+// side, from `source` and `prediction` (their top-left pixels; rows `stride` apart), the sum and
+// the largest of |source - prediction| (values within -255..255).
+struct BlockDifferencesRow {
+    const int16_t* source;
+    const int16_t* prediction;
+    int stride, blocks;
+    int32_t* sum;
+    int32_t* largest;
+};
+// The reference does blocks [b_begin, b_end).
+void block_differences_row_reference(const BlockDifferencesRow& row, int b_begin, int b_end);
+void block_differences_row(const BlockDifferencesRow& row);
+
 // Revealed luma pixels of one row (predict.cpp): a pixel whose landing floor(p + 0.5 + m) lies
 // inside the picture (never with NaN or infinite motion) and whose reference depth there is more
 // than 4 % off its own, either way (NaN compares false: not revealed).

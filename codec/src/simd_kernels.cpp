@@ -154,6 +154,33 @@ void PredictRowSimd(const PredictRow& r) {
     predict_row_reference(r, x, r.width);
 }
 
+void BlockDifferencesRowSimd(const BlockDifferencesRow& r) {
+    // One block row per vector of 8 lanes; a lane's sum over 8 rows is at most 8 * 510.
+    const hn::CappedTag<int16_t, 8> d;
+    if (hn::Lanes(d) < 8) {
+        block_differences_row_reference(r, 0, r.blocks);
+        return;
+    }
+    HWY_ALIGN int16_t sums[8], largest[8];
+    for (int b = 0; b < r.blocks; ++b) {
+        const int16_t* s = r.source + 8 * b;
+        const int16_t* p = r.prediction + 8 * b;
+        auto sum = hn::Zero(d), most = hn::Zero(d);
+        for (int y = 0; y < 8; ++y) {
+            const auto a = hn::Abs(hn::LoadU(d, s + std::ptrdiff_t(y) * r.stride) -
+                                   hn::LoadU(d, p + std::ptrdiff_t(y) * r.stride));
+            sum = sum + a;
+            most = hn::Max(most, a);
+        }
+        hn::Store(sum, d, sums);
+        hn::Store(most, d, largest);
+        int32_t total = 0, top = 0;
+        for (int i = 0; i < 8; ++i) total += sums[i], top = std::max<int32_t>(top, largest[i]);
+        r.sum[b] = total;
+        r.largest[b] = top;
+    }
+}
+
 void CameraMotionRowSimd(const CameraMotionRow& r) {
     if (!r.perspective) {
         camera_motion_row_reference(r, 0, r.width);
@@ -580,6 +607,7 @@ namespace reprise::codec {
 HWY_EXPORT(PredictRowSimd);
 
 HWY_EXPORT(CameraMotionRowSimd);
+HWY_EXPORT(BlockDifferencesRowSimd);
 HWY_EXPORT(ToPlanesRowSimd);
 HWY_EXPORT(FromPlanesRowSimd);
 HWY_EXPORT(ForwardRowSimd);
@@ -611,6 +639,10 @@ void to_planes_row(const ToPlanesRow& row) { HWY_DYNAMIC_DISPATCH(ToPlanesRowSim
 void from_planes_row(const FromPlanesRow& row) { HWY_DYNAMIC_DISPATCH(FromPlanesRowSimd)(row); }
 
 void predict_row(const PredictRow& row) { HWY_DYNAMIC_DISPATCH(PredictRowSimd)(row); }
+
+void block_differences_row(const BlockDifferencesRow& row) {
+    HWY_DYNAMIC_DISPATCH(BlockDifferencesRowSimd)(row);
+}
 
 void camera_motion_row(const CameraMotionRow& row) {
     HWY_DYNAMIC_DISPATCH(CameraMotionRowSimd)(row);

@@ -413,6 +413,58 @@ private:
 // The motion residual test, row by row. Random: the renderer's motion equal to the camera's, or
 // off by less than, about, or more than 1/16 pixel (only some rows differ); worst case: NaN/Inf
 // on either side and differences beyond the residual's range.
+// The colour encoder's per-block differences (sum and largest). Random: a source and a
+// prediction mostly within a few levels, a few blocks far off; worst case: the planes' extremes
+// (-255 against 255 and back) on whole blocks.
+class BlockDifferencesCase final : public KernelCase {
+public:
+    void generate(int w, int h, KernelInputs inputs, uint32_t seed) override {
+        std::mt19937 rng(seed);
+        blocks_ = std::max(1, w / 8), rows_ = std::max(1, h / 8);
+        stride_ = 8 * blocks_ + int(rng() % 3) * 8;  // planes wider than the blocks coded
+        const bool worst = inputs == KernelInputs::WorstCase;
+        source_.resize(std::size_t(stride_) * 8 * rows_);
+        prediction_.resize(source_.size());
+        for (std::size_t i = 0; i < source_.size(); ++i) {
+            const int s = int(rng() % 511) - 255;
+            source_[i] = int16_t(s);
+            const int off = rng() % 16 == 0 ? int(rng() % 511) - 255 : int(rng() % 7) - 3;
+            prediction_[i] = int16_t(std::clamp(s + off, -255, 255));
+            if (worst && (i / 8) % 3 == 0) {
+                source_[i] = int16_t(i % 2 ? 255 : -255);
+                prediction_[i] = int16_t(-source_[i]);
+            }
+        }
+    }
+    void run_reference() override {
+        run_into(reference_, [](const BlockDifferencesRow& r) {
+            block_differences_row_reference(r, 0, r.blocks);
+        });
+    }
+    void run() override { run_into(optimized_, block_differences_row); }
+    std::string compare() const override {
+        return compare_elements("block sum and largest difference", optimized_, reference_);
+    }
+
+private:
+    template <class Kernel>
+    void run_into(std::vector<int32_t>& out, Kernel kernel) {
+        out.assign(std::size_t(2) * blocks_ * rows_, 0);
+        parallel_for(0, rows_, [&](int r0, int r1) {
+            for (int r = r0; r < r1; ++r) {
+                const std::size_t at = std::size_t(r) * 8 * stride_;
+                int32_t* o = out.data() + std::size_t(2) * blocks_ * r;
+                kernel({source_.data() + at, prediction_.data() + at, stride_, blocks_, o,
+                        o + blocks_});
+            }
+        });
+    }
+
+    int blocks_ = 0, rows_ = 0, stride_ = 0;
+    std::vector<int16_t> source_, prediction_;
+    std::vector<int32_t> reference_, optimized_;
+};
+
 class MotionResidualCase final : public KernelCase {
 public:
     void generate(int w, int h, KernelInputs inputs, uint32_t seed) override {
@@ -701,6 +753,7 @@ constexpr KernelEntry kEntries[] = {
     {"codec depth forward projection", "bit-exact", true, make<ForwardCase>},
     {"codec depth plane fit", "bit-exact", true, make<PlaneCase>},
     {"codec motion residual test", "bit-exact", true, make<MotionResidualCase>},
+    {"codec colour block differences", "bit-exact", true, make<BlockDifferencesCase>},
     {"codec view depth keeps its prediction", "bit-exact", true, make<ViewKeepCase>},
     {"codec view depth codes and their depth", "bit-exact", true, make<ViewCodeCase>},
     {"codec colour to YCoCg-R", "bit-exact", true, make<ToPlanesCase>},
