@@ -176,6 +176,18 @@ struct MotionResidualRow {
 bool motion_residual_row_reference(const MotionResidualRow& row, int x_begin, int x_end);
 bool motion_residual_row(const MotionResidualRow& row);
 
+// Whether every pixel of a row keeps the decoded motion within `bound` px of the renderer's
+// (motion_models.cpp, motion models' test): both finite and |decoded - source|^2 <= bound^2 in
+// float, or else NaN in both x components.
+struct MotionWithinRow {
+    const glm::vec2* source;
+    const glm::vec2* decoded;
+    int width;
+    float bound;
+};
+bool motion_within_row_reference(const MotionWithinRow& row, int x_begin, int x_end);
+bool motion_within_row(const MotionWithinRow& row);
+
 // View-mode depth (depth.cpp, choose_view_code): whether each pixel keeps its temporal prediction,
 // that is, the prediction exists (not kNoPrediction), the depth to code is finite and positive,
 // and the prediction's inverse depth w_c (c step, or step / 2 for c = 0) is within the bound of

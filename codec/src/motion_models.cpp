@@ -10,6 +10,7 @@
 #include <type_traits>
 
 #include "internal.hpp"
+#include "kernels.hpp"
 #include "motion_models.hpp"
 #include "slices.hpp"
 
@@ -556,11 +557,15 @@ void add_counts(const std::vector<Job>& jobs, StreamStats& stats) {
 
 }  // namespace
 
+bool motion_within_row_reference(const MotionWithinRow& r, int x_begin, int x_end) {
+    for (int x = x_begin; x < x_end; ++x)
+        if (!within(r.source[x], r.decoded[x], r.bound)) return false;
+    return true;
+}
+
 bool motion_within_bound(ImageView<const glm::vec2> source, ImageView<const glm::vec2> base, int y,
                          float bound) {
-    for (int x = 0; x < source.width; ++x)
-        if (!within(source(x, y), base(x, y), bound)) return false;
-    return true;
+    return motion_within_row({source.row(y), base.row(y), source.width, bound});
 }
 
 void encode_motion_models(const SequenceParams& sp, ImageView<const glm::vec2> base,

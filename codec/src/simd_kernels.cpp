@@ -509,6 +509,27 @@ bool MotionResidualRowSimd(const MotionResidualRow& r) {
     return motion_residual_row_reference(r, x, r.width);
 }
 
+bool MotionWithinRowSimd(const MotionWithinRow& r) {
+    const hn::ScalableTag<float> df;
+    using VF = hn::Vec<decltype(df)>;
+    const int n = int(hn::Lanes(df));
+    const VF zero = hn::Zero(df), bound2 = hn::Set(df, r.bound * r.bound);
+    int x = 0;
+    for (; x + n <= r.width; x += n) {
+        VF sx, sy, dx, dy;
+        hn::LoadInterleaved2(df, &r.source[x].x, sx, sy);
+        hn::LoadInterleaved2(df, &r.decoded[x].x, dx, dy);
+        const auto finite = hn::And(hn::And((sx - sx) == zero, (sy - sy) == zero),
+                                    hn::And((dx - dx) == zero, (dy - dy) == zero));
+        const VF ex = dx - sx, ey = dy - sy;
+        const auto close = (ex * ex + ey * ey) <= bound2;
+        const auto both_nan = hn::And(hn::IsNaN(sx), hn::IsNaN(dx));
+        if (!hn::AllTrue(df, hn::Or(hn::And(finite, close), hn::AndNot(finite, both_nan))))
+            return false;
+    }
+    return motion_within_row_reference(r, x, r.width);
+}
+
 void ViewKeepRowSimd(const ViewKeepRow& r) {
     const hn::ScalableTag<double> dd;
     const hn::Rebind<float, decltype(dd)> df;
@@ -612,6 +633,7 @@ HWY_EXPORT(ToPlanesRowSimd);
 HWY_EXPORT(FromPlanesRowSimd);
 HWY_EXPORT(ForwardRowSimd);
 HWY_EXPORT(MotionResidualRowSimd);
+HWY_EXPORT(MotionWithinRowSimd);
 HWY_EXPORT(ViewKeepRowSimd);
 HWY_EXPORT(ViewCodeRowSimd);
 HWY_EXPORT(ViewDepthRowSimd);
@@ -626,6 +648,10 @@ void view_depth_row(const ViewDepthRow& row) { HWY_DYNAMIC_DISPATCH(ViewDepthRow
 
 bool motion_residual_row(const MotionResidualRow& row) {
     return HWY_DYNAMIC_DISPATCH(MotionResidualRowSimd)(row);
+}
+
+bool motion_within_row(const MotionWithinRow& row) {
+    return HWY_DYNAMIC_DISPATCH(MotionWithinRowSimd)(row);
 }
 
 void plane_row(const PlaneRow& row) { HWY_DYNAMIC_DISPATCH(PlaneRowSimd)(row); }

@@ -410,9 +410,6 @@ private:
     Output reference_, optimized_;
 };
 
-// The motion residual test, row by row. Random: the renderer's motion equal to the camera's, or
-// off by less than, about, or more than 1/16 pixel (only some rows differ); worst case: NaN/Inf
-// on either side and differences beyond the residual's range.
 // The colour encoder's per-block differences (sum and largest). Random: a source and a
 // prediction mostly within a few levels, a few blocks far off; worst case: the planes' extremes
 // (-255 against 255 and back) on whole blocks.
@@ -465,6 +462,11 @@ private:
     std::vector<int32_t> reference_, optimized_;
 };
 
+// The motion residual test, row by row. Random: the renderer's motion equal to the camera's, or
+// off by less than, about, or more than 1/16 pixel (only some rows differ); worst case: NaN/Inf
+// on either side and differences beyond the residual's range. Within: the motion models' test
+// (0.25 px) instead.
+template <bool Within>
 class MotionResidualCase final : public KernelCase {
 public:
     void generate(int w, int h, KernelInputs inputs, uint32_t seed) override {
@@ -490,11 +492,21 @@ public:
         }
     }
     void run_reference() override {
-        run_into(reference_, [](const MotionResidualRow& r) {
-            return motion_residual_row_reference(r, 0, r.width);
-        });
+        if constexpr (Within)
+            run_into(reference_, [](const MotionWithinRow& r) {
+                return motion_within_row_reference(r, 0, r.width);
+            });
+        else
+            run_into(reference_, [](const MotionResidualRow& r) {
+                return motion_residual_row_reference(r, 0, r.width);
+            });
     }
-    void run() override { run_into(optimized_, motion_residual_row); }
+    void run() override {
+        if constexpr (Within)
+            run_into(optimized_, motion_within_row);
+        else
+            run_into(optimized_, motion_residual_row);
+    }
     std::string compare() const override {
         return compare_elements("row needs a residual", optimized_, reference_);
     }
@@ -506,7 +518,11 @@ private:
         parallel_for(0, height_, [&](int y0, int y1) {
             for (int y = y0; y < y1; ++y) {
                 const std::size_t o = std::size_t(y) * width_;
-                out[std::size_t(y)] = kernel({source_.data() + o, base_.data() + o, width_});
+                if constexpr (Within)
+                    out[std::size_t(y)] =
+                        kernel({source_.data() + o, base_.data() + o, width_, 0.25f});
+                else
+                    out[std::size_t(y)] = kernel({source_.data() + o, base_.data() + o, width_});
             }
         });
     }
@@ -752,7 +768,8 @@ constexpr KernelEntry kEntries[] = {
     {"codec camera motion", "bit-exact", true, make<CameraMotionCase>},
     {"codec depth forward projection", "bit-exact", true, make<ForwardCase>},
     {"codec depth plane fit", "bit-exact", true, make<PlaneCase>},
-    {"codec motion residual test", "bit-exact", true, make<MotionResidualCase>},
+    {"codec motion residual test", "bit-exact", true, make<MotionResidualCase<false>>},
+    {"codec motion within the models' bound", "bit-exact", true, make<MotionResidualCase<true>>},
     {"codec colour block differences", "bit-exact", true, make<BlockDifferencesCase>},
     {"codec view depth keeps its prediction", "bit-exact", true, make<ViewKeepCase>},
     {"codec view depth codes and their depth", "bit-exact", true, make<ViewCodeCase>},
