@@ -188,6 +188,22 @@ struct MotionWithinRow {
 bool motion_within_row_reference(const MotionWithinRow& row, int x_begin, int x_end);
 bool motion_within_row(const MotionWithinRow& row);
 
+// An object's pixels in a run of one row (object_motion.cpp, fit_object_motions): how many are
+// usable (depth finite and > 0, motion finite) and how many of those the camera motion `base`
+// does not explain (|base - motion|^2 > bound^2 in float, or not finite).
+struct ObjectPixelsRow {
+    const float* depth;
+    const glm::vec2* motion;
+    const glm::vec2* base;
+    int count;
+    float bound;
+};
+struct ObjectPixels {
+    int usable = 0, unexplained = 0;
+};
+ObjectPixels object_pixels_row_reference(const ObjectPixelsRow& row, int i_begin, int i_end);
+ObjectPixels object_pixels_row(const ObjectPixelsRow& row);
+
 // View-mode depth (depth.cpp, choose_view_code): whether each pixel keeps its temporal prediction,
 // that is, the prediction exists (not kNoPrediction), the depth to code is finite and positive,
 // and the prediction's inverse depth w_c (c step, or step / 2 for c = 0) is within the bound of

@@ -14,6 +14,7 @@
 #include <glm/gtc/quaternion.hpp>
 
 #include "internal.hpp"
+#include "kernels.hpp"
 #include "least_squares.hpp"
 #include "reprise/core/parallel.hpp"
 
@@ -86,6 +87,21 @@ inline bool explains(glm::vec2 source, glm::vec2 m, float bound) {
     const glm::vec2 d = m - source;
     return finite(d) && d.x * d.x + d.y * d.y <= bound * bound;
 }
+
+}  // namespace
+
+ObjectPixels object_pixels_row_reference(const ObjectPixelsRow& r, int i_begin, int i_end) {
+    ObjectPixels total;
+    for (int i = i_begin; i < i_end; ++i) {
+        const float z = r.depth[i];
+        const bool usable = z > 0.0f && std::isfinite(z) && finite(r.motion[i]);
+        total.usable += usable;
+        total.unexplained += usable && !explains(r.motion[i], r.base[i], r.bound);
+    }
+    return total;
+}
+
+namespace {
 
 // Fits one object; false when its transform explains no more samples than the cameras.
 bool fit_one(const Camera& camera, Candidate& c, float bound, int width, int height,
@@ -206,14 +222,9 @@ std::vector<ObjectMotion> fit_object_motions(const Camera& camera, ImageView<con
                 c.pixels += end - x;
                 c.x0 = std::min(c.x0, x), c.y0 = std::min(c.y0, y);
                 c.x1 = std::max(c.x1, end), c.y1 = std::max(c.y1, y + 1);
-                int run_usable = 0, run_unexplained = 0;
-                for (int k = x; k < end; ++k) {
-                    const float z = z_row[k];
-                    const bool u = z > 0.0f && std::isfinite(z) && finite(m_row[k]);
-                    run_usable += u;
-                    run_unexplained += u && !explains(m_row[k], base_row[k], bound);
-                }
-                c.usable += run_usable, c.unexplained += run_unexplained;
+                const ObjectPixels run =
+                    object_pixels_row({z_row + x, m_row + x, base_row + x, end - x, bound});
+                c.usable += run.usable, c.unexplained += run.unexplained;
             }
         }
         const std::lock_guard lock(merging);

@@ -530,6 +530,31 @@ bool MotionWithinRowSimd(const MotionWithinRow& r) {
     return motion_within_row_reference(r, x, r.width);
 }
 
+ObjectPixels ObjectPixelsRowSimd(const ObjectPixelsRow& r) {
+    const hn::ScalableTag<float> df;
+    using VF = hn::Vec<decltype(df)>;
+    const int n = int(hn::Lanes(df));
+    const VF zero = hn::Zero(df), bound2 = hn::Set(df, r.bound * r.bound);
+    ObjectPixels total;
+    int i = 0;
+    for (; i + n <= r.count; i += n) {
+        const VF z = hn::LoadU(df, r.depth + i);
+        VF mx, my, bx, by;
+        hn::LoadInterleaved2(df, &r.motion[i].x, mx, my);
+        hn::LoadInterleaved2(df, &r.base[i].x, bx, by);
+        const auto usable = hn::And(hn::And(z > zero, (z - z) == zero),
+                                    hn::And((mx - mx) == zero, (my - my) == zero));
+        const VF dx = bx - mx, dy = by - my;
+        const auto explained =
+            hn::And(hn::And((dx - dx) == zero, (dy - dy) == zero), (dx * dx + dy * dy) <= bound2);
+        total.usable += int(hn::CountTrue(df, usable));
+        total.unexplained += int(hn::CountTrue(df, hn::AndNot(explained, usable)));
+    }
+    const ObjectPixels rest = object_pixels_row_reference(r, i, r.count);
+    total.usable += rest.usable, total.unexplained += rest.unexplained;
+    return total;
+}
+
 void ViewKeepRowSimd(const ViewKeepRow& r) {
     const hn::ScalableTag<double> dd;
     const hn::Rebind<float, decltype(dd)> df;
@@ -634,6 +659,7 @@ HWY_EXPORT(FromPlanesRowSimd);
 HWY_EXPORT(ForwardRowSimd);
 HWY_EXPORT(MotionResidualRowSimd);
 HWY_EXPORT(MotionWithinRowSimd);
+HWY_EXPORT(ObjectPixelsRowSimd);
 HWY_EXPORT(ViewKeepRowSimd);
 HWY_EXPORT(ViewCodeRowSimd);
 HWY_EXPORT(ViewDepthRowSimd);
@@ -652,6 +678,10 @@ bool motion_residual_row(const MotionResidualRow& row) {
 
 bool motion_within_row(const MotionWithinRow& row) {
     return HWY_DYNAMIC_DISPATCH(MotionWithinRowSimd)(row);
+}
+
+ObjectPixels object_pixels_row(const ObjectPixelsRow& row) {
+    return HWY_DYNAMIC_DISPATCH(ObjectPixelsRowSimd)(row);
 }
 
 void plane_row(const PlaneRow& row) { HWY_DYNAMIC_DISPATCH(PlaneRowSimd)(row); }

@@ -410,6 +410,63 @@ private:
     Output reference_, optimized_;
 };
 
+// An object's usable and unexplained pixels, run by run. Random: motion equal to the camera's or
+// off by about the 0.25 px bound, some depth behind the camera or missing; worst case: NaN/Inf
+// in depth, motion and the camera motion.
+class ObjectPixelsCase final : public KernelCase {
+public:
+    void generate(int w, int h, KernelInputs inputs, uint32_t seed) override {
+        std::mt19937 rng(seed);
+        width_ = w, height_ = h;
+        const bool worst = inputs == KernelInputs::WorstCase;
+        const std::size_t n = std::size_t(w) * h;
+        depth_.resize(n), motion_.resize(n), base_.resize(n);
+        for (std::size_t i = 0; i < n; ++i) {
+            depth_[i] = rng() % 16 == 0 ? -uniform(rng, 0, 5) : uniform(rng, 0.1f, 100);
+            base_[i] = {uniform(rng, -30, 30), uniform(rng, -30, 30)};
+            const float off = rng() % 2 ? 0.0f : uniform(rng, 0.15f, 0.35f);
+            motion_[i] = base_[i] + glm::vec2(off, rng() % 2 ? off : -off) * 0.7071f;
+            if (worst && rng() % 4 == 0) {
+                const int which = int(rng() % 3);
+                if (which == 0) depth_[i] = worst_value(rng);
+                if (which == 1) motion_[i][int(rng() % 2)] = worst_value(rng);
+                if (which == 2) base_[i][int(rng() % 2)] = worst_value(rng);
+            }
+        }
+    }
+    void run_reference() override {
+        run_into(reference_, [](const ObjectPixelsRow& r) {
+            return object_pixels_row_reference(r, 0, r.count);
+        });
+    }
+    void run() override { run_into(optimized_, object_pixels_row); }
+    std::string compare() const override {
+        return compare_elements("usable and unexplained pixels", optimized_, reference_);
+    }
+
+private:
+    template <class Kernel>
+    void run_into(std::vector<int>& out, Kernel kernel) {
+        out.assign(std::size_t(2) * height_, 0);
+        parallel_for(0, height_, [&](int y0, int y1) {
+            for (int y = y0; y < y1; ++y) {
+                const std::size_t o = std::size_t(y) * width_;
+                const int start = std::min(y % 3, width_);  // runs start anywhere in the row
+                const ObjectPixels p =
+                    kernel({depth_.data() + o + start, motion_.data() + o + start,
+                            base_.data() + o + start, width_ - start, 0.25f});
+                out[2 * std::size_t(y)] = p.usable;
+                out[2 * std::size_t(y) + 1] = p.unexplained;
+            }
+        });
+    }
+
+    int width_ = 0, height_ = 0;
+    std::vector<float> depth_;
+    std::vector<glm::vec2> motion_, base_;
+    std::vector<int> reference_, optimized_;
+};
+
 // The colour encoder's per-block differences (sum and largest). Random: a source and a
 // prediction mostly within a few levels, a few blocks far off; worst case: the planes' extremes
 // (-255 against 255 and back) on whole blocks.
@@ -771,6 +828,7 @@ constexpr KernelEntry kEntries[] = {
     {"codec motion residual test", "bit-exact", true, make<MotionResidualCase<false>>},
     {"codec motion within the models' bound", "bit-exact", true, make<MotionResidualCase<true>>},
     {"codec colour block differences", "bit-exact", true, make<BlockDifferencesCase>},
+    {"codec an object's usable and unexplained pixels", "bit-exact", true, make<ObjectPixelsCase>},
     {"codec view depth keeps its prediction", "bit-exact", true, make<ViewKeepCase>},
     {"codec view depth codes and their depth", "bit-exact", true, make<ViewCodeCase>},
     {"codec colour to YCoCg-R", "bit-exact", true, make<ToPlanesCase>},
