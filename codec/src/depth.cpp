@@ -957,14 +957,20 @@ ImageView<const float> view_share(const FrameContext& fc, const Mapping& map) {
     Image<float>& share = fc.work->view_share;
     ensure_size(share, fc.ids.width, fc.ids.height);
     parallel_for(0, fc.ids.height, [&](int y0, int y1) {
+        uint32_t last_id = 0;
+        float last_share = float(ratio);  // id 0's
         for (int y = y0; y < y1; ++y)
             for (int x = 0; x < fc.ids.width; ++x) {
                 const uint32_t id = fc.ids(x, y);
-                share(x, y) =
-                    id != 0 && std::any_of(fc.objects.begin(), fc.objects.end(),
-                                           [&](const ObjectMotion& o) { return o.id == id; })
-                        ? 1.0f
-                        : float(ratio);
+                if (id != last_id) {
+                    last_id = id;
+                    last_share =
+                        id != 0 && std::any_of(fc.objects.begin(), fc.objects.end(),
+                                               [&](const ObjectMotion& o) { return o.id == id; })
+                            ? 1.0f
+                            : float(ratio);
+                }
+                share(x, y) = last_share;
             }
     });
     return share.view();

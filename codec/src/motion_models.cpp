@@ -95,10 +95,16 @@ struct Job {
     // The object of the pixel's id (encoder), else the cameras' field when there is one, or -1.
     int object_of(int x, int y) const {
         const uint32_t id = ids(x, y);
-        for (std::size_t k = 0; k < fields.size(); ++k)
-            if (fields[k].id == id) return int(k);
-        return !fields.empty() && fields.back().id == 0 ? int(fields.size()) - 1 : -1;
+        if (id == last_id && last_object >= -1) return last_object;  // ids come in runs
+        last_id = id, last_object = -1;
+        for (std::size_t k = 0; k < fields.size() && last_object < 0; ++k)
+            if (fields[k].id == id) last_object = int(k);
+        if (last_object < 0 && !fields.empty() && fields.back().id == 0)
+            last_object = int(fields.size()) - 1;
+        return last_object;
     }
+    mutable uint32_t last_id = 0;
+    mutable int last_object = -2;  // -2: none looked up yet
     // The owners of `count` pixels from (x, y) that took model m (nullptr: their base).
     void set_owners(int x, int y, int count, const MotionModel* m) const {
         if (owner.empty()) return;
@@ -183,6 +189,17 @@ bool fit_model(const Job& j, const Node& n, const MotionModel& pred, MotionModel
 }
 
 bool model_fits(const Job& j, const Node& n, const MotionModel& m) {
+    if (m.object >= 0) {  // inside the object's field: its rows against the source's
+        const ObjectField& f = j.fields[std::size_t(m.object)];
+        const int c = n.x - f.x0, r = n.y - f.y0;
+        if (c >= 0 && r >= 0 && c + n.w <= f.motion.width() && r + n.h <= f.motion.height()) {
+            for (int y = 0; y < n.h; ++y)
+                if (!motion_within_row(
+                        {&j.source(n.x, n.y + y), &f.motion(c, r + y), n.w, j.bound}))
+                    return false;
+            return true;
+        }
+    }
     for (int y = n.y; y < n.y + n.h; ++y)
         for (int x = n.x; x < n.x + n.w; ++x)
             if (!within(j.source(x, y), j.output(m, x, y), j.bound)) return false;
@@ -191,8 +208,7 @@ bool model_fits(const Job& j, const Node& n, const MotionModel& m) {
 
 bool zero_fits(const Job& j, const Node& n) {
     for (int y = n.y; y < n.y + n.h; ++y)
-        for (int x = n.x; x < n.x + n.w; ++x)
-            if (!within(j.source(x, y), j.base(x, y), j.bound)) return false;
+        if (!motion_within_row({&j.source(n.x, y), &j.base(n.x, y), n.w, j.bound})) return false;
     return true;
 }
 
