@@ -207,6 +207,7 @@ struct Workspace {
     std::vector<MotionResidual> motion_residuals;
     MotionModelScratch motion_models;
     std::vector<ObjectField> object_fields;
+    ObjectField cameras_field;        // the memory of the cameras' field while it is not in use
     Image<uint32_t> predicted_owner;  // empty when no pixel is predicted to move with an object
     Image<uint8_t> revealed;          // per luma pixel: the reference did not see it
     std::vector<uint8_t> coded_blocks[3];  // per 8x8 block of each plane: intra or with a residual

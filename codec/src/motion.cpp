@@ -192,7 +192,7 @@ bool objects_predictable(const FrameContext& fc, const Camera& camera) {
 uint32_t predict_from_objects(const FrameContext& fc, const Camera& camera, uint32_t objects,
                               Image<glm::vec2>& base, std::vector<ObjectField>& fields,
                               Image<uint32_t>& predicted, ImageView<const glm::vec2> source = {}) {
-    predicted = {};
+    predicted.clear();  // empty, its memory kept for the next frame
     if (!objects_predictable(fc, camera)) return 0;
     const int w = base.width(), h = base.height();
     ensure_size(predicted, w, h);
@@ -219,7 +219,7 @@ uint32_t predict_from_objects(const FrameContext& fc, const Camera& camera, uint
         if (kept != objects) objects = kept, any = predict();
     }
     if (!any) {
-        predicted = {};
+        predicted.clear();
         return 0;
     }
     int x0 = w, y0 = h, x1 = 0, y1 = 0;
@@ -228,8 +228,8 @@ uint32_t predict_from_objects(const FrameContext& fc, const Camera& camera, uint
             if (predicted(x, y) != 0)
                 x0 = std::min(x0, x), y0 = std::min(y0, y), x1 = std::max(x1, x + 1),
                 y1 = std::max(y1, y + 1);
-    ObjectField cameras;
-    cameras.x0 = x0, cameras.y0 = y0;
+    ObjectField cameras = std::move(fc.work->cameras_field);
+    cameras.id = 0, cameras.x0 = x0, cameras.y0 = y0;
     ensure_size(cameras.motion, x1 - x0, y1 - y0);
     for (int y = y0; y < y1; ++y)
         for (int x = x0; x < x1; ++x) {
@@ -240,6 +240,17 @@ uint32_t predict_from_objects(const FrameContext& fc, const Camera& camera, uint
         }
     fields.push_back(std::move(cameras));
     return objects;
+}
+
+// The objects' fields of this frame (object_fields); the cameras' field the last frame added
+// (predict_from_objects) keeps its memory for this one's.
+void frame_fields(const FrameContext& fc, const Camera& camera, ImageView<const float> depth) {
+    std::vector<ObjectField>& fields = fc.work->object_fields;
+    if (!fields.empty() && fields.back().id == 0) {
+        fc.work->cameras_field = std::move(fields.back());
+        fields.pop_back();
+    }
+    object_fields(camera, depth, fc.objects, fields);
 }
 
 std::vector<SliceJob> slice_jobs(const SequenceParams& sp, const Image<glm::vec2>& base,
@@ -287,7 +298,7 @@ void encode_motion(const FrameContext& fc, const Camera& camera, ImageView<const
         std::swap(out, base);  // the camera motion is the motion (base is remade every frame)
     } else if (models) {
         const bool objects = !fc.objects.empty();
-        object_fields(camera, depth, fc.objects, fc.work->object_fields);
+        frame_fields(fc, camera, depth);
         const uint32_t all = uint32_t((uint64_t(1) << fc.objects.size()) - 1);
         const uint32_t predicting = predict_from_objects(
             fc, camera, all, base, fc.work->object_fields, fc.work->predicted_owner, source);
@@ -351,7 +362,7 @@ Status decode_motion(const FrameContext& fc, const Camera& camera, ImageView<con
         if (!read_slices(r, sp.slices, slices)) return Status::error(r.error());
         if (sp.motion_error > 0.0f) {
             const bool objects = !fc.objects.empty();
-            object_fields(camera, depth, fc.objects, fc.work->object_fields);
+            frame_fields(fc, camera, depth);
             predict_from_objects(fc, camera, predicting, base, fc.work->object_fields,
                                  fc.work->predicted_owner);
             REPRISE_TRY(decode_motion_models(sp, base.view(), fc.work->object_fields,
