@@ -313,9 +313,15 @@ void reproject_depth(const Camera& from, ImageView<const float> depth, const Cam
                            .inverse = plane_fit ? &landings.inverse(0, y) : nullptr};
             int* object = &landings.object(0, y);
             bool moved = false;
-            if (!objects.empty())
-                for (int x = 0; x < w; ++x) moved |= (object[x] = object_of(x, y)) >= 0;
-            else if (!landings.no_objects)
+            if (!objects.empty()) {
+                uint32_t last_id = 0;
+                int last_object = -1;  // of id 0
+                for (int x = 0; x < w; ++x) {
+                    if (const uint32_t id = owner(x, y); id != last_id)
+                        last_id = id, last_object = object_of(x, y);
+                    moved |= (object[x] = last_object) >= 0;
+                }
+            } else if (!landings.no_objects)
                 std::fill(object, object + w, -1);
             if (!moved) {
                 forward_row(row);
@@ -324,13 +330,17 @@ void reproject_depth(const Camera& from, ImageView<const float> depth, const Cam
                 for (int x = 0; x < w; ++x) held[x] = object[x] >= 0 ? kNan : depth(x, y);
                 row.depth = held;
                 forward_row(row);
-                for (int x = 0; x < w; ++x) {
+                for (int x = 0, end = 0; x < w; x = end) {  // each run of one object's pixels
+                    for (end = x + 1; end < w && object[end] == object[x];) ++end;
                     if (object[x] < 0) continue;
-                    ForwardRow one = row;
-                    one.to_clip = object_clip[std::size_t(object[x])];
-                    one.to_camera = object_camera[std::size_t(object[x])];
-                    one.depth = depth.row(y);
-                    forward_row_reference(one, x, x + 1);
+                    ForwardRow run = row;
+                    run.to_clip = object_clip[std::size_t(object[x])];
+                    run.to_camera = object_camera[std::size_t(object[x])];
+                    run.x0 = x, run.count = end - x;
+                    run.depth = depth.row(y) + x;
+                    run.slot += x, run.z += x, run.px += x, run.py += x;
+                    if (run.inverse) run.inverse += x;
+                    forward_row(run);
                 }
             }
             // -1 (nowhere) is the largest slot as unsigned.

@@ -183,6 +183,25 @@ bool objects_predictable(const FrameContext& fc, const Camera& camera) {
            camera.prev_view == ref->camera.view && camera.prev_projection == ref->camera.projection;
 }
 
+// The field of an object id (the last of them with it), looked up once per run of the id.
+class FieldOf {
+public:
+    explicit FieldOf(const std::vector<ObjectField>& fields) : fields_(fields) {}
+    const ObjectField* operator()(uint32_t id) {
+        if (id != id_) {
+            id_ = id, field_ = nullptr;
+            for (const ObjectField& f : fields_)
+                if (f.id == id) field_ = &f;
+        }
+        return field_;
+    }
+
+private:
+    const std::vector<ObjectField>& fields_;
+    uint32_t id_ = 0;
+    const ObjectField* field_ = nullptr;
+};
+
 // Objects whose pixels are predicted from the reference (bit k: the object list's k-th):
 // where a pixel is predicted to move with one of them (predict_owners), its base is that
 // object's motion, and the cameras' motion joins the fields (id 0) over the box of those pixels
@@ -204,15 +223,16 @@ uint32_t predict_from_objects(const FrameContext& fc, const Camera& camera, uint
     bool any = predict();
     if (any && !source.empty()) {
         std::vector<std::size_t> pixels(fields.size()), held(fields.size());
+        FieldOf field_of(fields);
         for (int y = 0; y < h; ++y)
             for (int x = 0; x < w; ++x)
                 if (const uint32_t id = predicted(x, y))
-                    for (std::size_t k = 0; k < fields.size(); ++k)
-                        if (fields[k].id == id) {
-                            ++pixels[k];
-                            const glm::vec2 d = fields[k].at(x, y) - source(x, y);
-                            held[k] += glm::dot(d, d) <= fc.sp->motion_error * fc.sp->motion_error;
-                        }
+                    if (const ObjectField* f = field_of(id)) {
+                        const std::size_t k = std::size_t(f - fields.data());
+                        ++pixels[k];
+                        const glm::vec2 d = f->at(x, y) - source(x, y);
+                        held[k] += glm::dot(d, d) <= fc.sp->motion_error * fc.sp->motion_error;
+                    }
         uint32_t kept = 0;
         for (std::size_t k = 0; k < fields.size(); ++k)
             if (pixels[k] > 0 && 4 * held[k] >= 3 * pixels[k]) kept |= 1u << k;
@@ -231,12 +251,12 @@ uint32_t predict_from_objects(const FrameContext& fc, const Camera& camera, uint
     ObjectField cameras = std::move(fc.work->cameras_field);
     cameras.id = 0, cameras.x0 = x0, cameras.y0 = y0;
     ensure_size(cameras.motion, x1 - x0, y1 - y0);
+    FieldOf field_of(fields);
     for (int y = y0; y < y1; ++y)
         for (int x = x0; x < x1; ++x) {
             cameras.motion(x - x0, y - y0) = base(x, y);
             if (const uint32_t id = predicted(x, y))
-                for (const ObjectField& f : fields)
-                    if (f.id == id) base(x, y) = f.at(x, y);
+                if (const ObjectField* f = field_of(id)) base(x, y) = f->at(x, y);
         }
     fields.push_back(std::move(cameras));
     return objects;
