@@ -352,8 +352,7 @@ bool code_slice(SliceJob& j, Coder& rc) {
             const int ctx_skip = left_skip + (my > j.mb_y0 ? above_skip[mx] : 0);
             const int ctx_intra = left_intra + (my > j.mb_y0 ? above_intra[mx] : 0);
             bool skip = false, intra = j.predicted == nullptr;
-            // Encoder decisions: intra when its best SAD (on source neighbours) clearly beats
-            // the reprojection, skip when every block stays within the threshold.
+            // Encoder: the inter decisions come from choose_inter; the levels are made here.
             Block src, pred, coef, levels, residual;
             Block inter_levels[12];  // encoder: an inter macroblock's blocks in coding order
             int inter_nonzero[12];

@@ -25,6 +25,13 @@ hn::Vec<D> counting_from(D d, hn::Vec<D> offsets, T first) {
     return offsets + hn::Set(d, hn::TFromD<D>(first));
 }
 
+// Lanes where both components of a vector (x, y) are finite: v - v is 0 only for finite v.
+template <class V>
+auto finite2(V x, V y) {
+    const V zero = hn::Zero(hn::DFromV<V>());
+    return hn::And((x - x) == zero, (y - y) == zero);
+}
+
 void PredictRowSimd(const PredictRow& r) {
     if constexpr (std::endian::native != std::endian::little) {
         predict_row_reference(r, 0, r.width);
@@ -38,7 +45,7 @@ void PredictRowSimd(const PredictRow& r) {
     const int n = int(hn::Lanes(df));
     const auto lane = hn::Iota(df, 0.0f);
     const auto lane_i = hn::Iota(di, 0);
-    const VF zero = hn::Zero(df), half = hn::Set(df, 0.5f), eighth = hn::Set(df, 0.125f);
+    const VF half = hn::Set(df, 0.5f), eighth = hn::Set(df, 0.125f);
     const VF phases = hn::Set(df, 64.0f);
     const VF x_low = hn::Set(df, -4.0f * 64), x_high = hn::Set(df, float(r.width + 4) * 64);
     // The row's vertical position is the same fixed_position for every lane but its motion.
@@ -70,7 +77,7 @@ void PredictRowSimd(const PredictRow& r) {
     };
 
     auto usable = [&](VF& mx, VF& my) {  // non-finite motion counts as 0
-        const auto finite = hn::And((mx - mx) == zero, (my - my) == zero);
+        const auto finite = finite2(mx, my);
         mx = hn::IfThenElseZero(finite, mx);
         my = hn::IfThenElseZero(finite, my);
     };
@@ -497,8 +504,8 @@ bool MotionResidualRowSimd(const MotionResidualRow& r) {
         VF sx, sy, bx, by;
         hn::LoadInterleaved2(df, &r.source[x].x, sx, sy);
         hn::LoadInterleaved2(df, &r.base[x].x, bx, by);
-        const auto source_finite = hn::And((sx - sx) == zero, (sy - sy) == zero);
-        const auto base_finite = hn::And((bx - bx) == zero, (by - by) == zero);
+        const auto source_finite = finite2(sx, sy);
+        const auto base_finite = finite2(bx, by);
         const VF dx = (sx - hn::IfThenElseZero(base_finite, bx)) * eight;
         const VF dy = (sy - hn::IfThenElseZero(base_finite, by)) * eight;
         const auto zero_residual =
@@ -513,14 +520,13 @@ bool MotionWithinRowSimd(const MotionWithinRow& r) {
     const hn::ScalableTag<float> df;
     using VF = hn::Vec<decltype(df)>;
     const int n = int(hn::Lanes(df));
-    const VF zero = hn::Zero(df), bound2 = hn::Set(df, r.bound * r.bound);
+    const VF bound2 = hn::Set(df, r.bound * r.bound);
     int x = 0;
     for (; x + n <= r.width; x += n) {
         VF sx, sy, dx, dy;
         hn::LoadInterleaved2(df, &r.source[x].x, sx, sy);
         hn::LoadInterleaved2(df, &r.decoded[x].x, dx, dy);
-        const auto finite = hn::And(hn::And((sx - sx) == zero, (sy - sy) == zero),
-                                    hn::And((dx - dx) == zero, (dy - dy) == zero));
+        const auto finite = hn::And(finite2(sx, sy), finite2(dx, dy));
         const VF ex = dx - sx, ey = dy - sy;
         const auto close = (ex * ex + ey * ey) <= bound2;
         const auto both_nan = hn::And(hn::IsNaN(sx), hn::IsNaN(dx));
@@ -542,11 +548,9 @@ ObjectPixels ObjectPixelsRowSimd(const ObjectPixelsRow& r) {
         VF mx, my, bx, by;
         hn::LoadInterleaved2(df, &r.motion[i].x, mx, my);
         hn::LoadInterleaved2(df, &r.base[i].x, bx, by);
-        const auto usable = hn::And(hn::And(z > zero, (z - z) == zero),
-                                    hn::And((mx - mx) == zero, (my - my) == zero));
+        const auto usable = hn::And(hn::And(z > zero, (z - z) == zero), finite2(mx, my));
         const VF dx = bx - mx, dy = by - my;
-        const auto explained =
-            hn::And(hn::And((dx - dx) == zero, (dy - dy) == zero), (dx * dx + dy * dy) <= bound2);
+        const auto explained = hn::And(finite2(dx, dy), (dx * dx + dy * dy) <= bound2);
         total.usable += int(hn::CountTrue(df, usable));
         total.unexplained += int(hn::CountTrue(df, hn::AndNot(explained, usable)));
     }
