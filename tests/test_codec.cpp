@@ -590,6 +590,43 @@ TEST(Codec, BoundedMotionStaysWithinItsBound) {
     }
 }
 
+// Where the depth bits go: the parts add up to the section less its headers (a few bytes a
+// frame), key-frame pixels only in the key frame, moving objects' pixels where an object is held
+// to its finer step (fast's ball), nothing but the flag byte in a frame the reference predicts
+// whole (shadows' still camera).
+TEST(Codec, TheDepthBitsAreAccountedForByWhatTheyCode) {
+    for (const char* scene : {"fast", "shadows"}) {
+        SCOPED_TRACE(scene);
+        const auto frames = render(scene, 5, 160, 96);
+        Encoder encoder;
+        ASSERT_TRUE(Encoder::create({.depth = DepthMode::View}, encoder).ok());
+        StreamStats::DepthBits inter;
+        for (std::size_t i = 0; i < frames.size(); ++i) {
+            ASSERT_TRUE(encoder.send_frame(frames[i]).ok());
+            Packet p;
+            ASSERT_EQ(encoder.receive_packet(p), Result::Ok);
+            const StreamStats& s = encoder.last_frame_stats();
+            const StreamStats::DepthBits& d = s.depth_parts;
+            const double bits = double(s.depth_bits);
+            EXPECT_LE(d.total(), bits + 32.0) << "frame " << i;  // the coder's end trims zeros
+            EXPECT_GE(d.total(), bits - 96.0) << "frame " << i;
+            if (i == 0) {
+                EXPECT_GT(d.key, 0.5 * bits);
+                EXPECT_EQ(d.objects + d.revealed + d.seen, 0.0);
+            } else {
+                EXPECT_EQ(d.key, 0.0) << "frame " << i;
+                inter += d;
+            }
+        }
+        if (std::string(scene) == "fast") {
+            EXPECT_GT(inter.objects, 0.3 * inter.total());
+            EXPECT_GT(inter.seen, 0.0);
+        } else {
+            EXPECT_EQ(inter.total(), 0.0);
+        }
+    }
+}
+
 // Above qp 34 the view and motion bounds double every 6 qp: at qp 46 (4x) the stream keeps both
 // within 1 px and spends fewer geometry bits than with the bounds as given, the colour as good.
 // Measured at 160x96, 6 frames: depth + motion 0.68x (stroll) and 0.72x (fast).

@@ -243,6 +243,7 @@ struct ViewDepthRun {
     std::size_t motion_objects = 0, motion_models = 0, motion_own_pixels = 0, frames = 0;
     std::size_t background_mismatches = 0, finite_pixels = 0, pixels_over_bound = 0;
     float step = 0.0f;
+    codec::StreamStats::DepthBits depth_parts;  // where the depth bits go (ideal lengths)
     std::vector<DepthVideoRun>
         video_peers;         // 1/z as grey video, as immersive-video systems send it
     SynthesizedViews views;  // rendered sequences only
@@ -346,6 +347,7 @@ Status run_view_depth(server::Renderer& renderer, const Sequence& seq, int qp, V
         run.pixels_over_bound += e.pixels_over_bound;
         const codec::StreamStats& bits = encoder.last_frame_stats();
         run.depth_bytes += bits.depth_bits / 8.0;
+        run.depth_parts += bits.depth_parts;
         run.camera_bytes += bits.camera_bits / 8.0;
         run.motion_bytes += bits.motion_bits / 8.0;
         run.color_bytes += bits.color_bits / 8.0;
@@ -708,6 +710,23 @@ std::string depth_text(const std::vector<DepthSummary>& depth_rows,
                      : "OUTSIDE the bound");
     depth_text += depth_video_text(view_rows, view_defaults);
     depth_text += motion_text;
+    depth_text += strf(
+        "\nwhere the depth bits go at qp %d, %% of the depth section (the range coder's ideal "
+        "lengths): block flags, plane parameters, then pixels of blocks with residuals: of the "
+        "key frame; in inter frames of moving objects held to their finer step, of pixels nothing "
+        "of the reference landed on (revealed), of the rest (the reference saw them); section "
+        "headers\n%-10s %11s %7s %7s %7s %8s %9s %7s %8s\n",
+        qp, "scene", "bits/frame", "flags", "planes", "key", "objects", "revealed", "seen",
+        "headers");
+    for (const ViewDepthRun& v : view_rows) {
+        const double all = std::max(8.0 * v.depth_bytes, 1.0);
+        const codec::StreamStats::DepthBits& d = v.depth_parts;
+        auto pct = [&](double bits) { return 100.0 * bits / all; };
+        depth_text += strf("%-10s %11.0f %6.1f%% %6.1f%% %6.1f%% %7.1f%% %8.1f%% %6.1f%% %7.1f%%\n",
+                           v.scene.c_str(), all / double(std::max<std::size_t>(1, v.frames)),
+                           pct(d.flags), pct(d.planes), pct(d.key), pct(d.objects), pct(d.revealed),
+                           pct(d.seen), pct(std::max(0.0, all - d.total())));
+    }
     depth_text += synthesized_views_text(view_rows);
     depth_ratio = depth_ratio_n ? depth_ratio_sum / depth_ratio_n : NAN;
     return depth_text;

@@ -96,6 +96,16 @@ void print_stats(const codec::StreamStats& s, double fps) {
         100.0 * double(s.blocks_skipped) / double(std::max<std::size_t>(1, s.blocks)),
         s.depth_zero_blocks, s.depth_plane_blocks, s.motion_residual_pixels, s.motion_objects,
         s.motion_models, s.motion_own_pixels);
+    if (const codec::StreamStats::DepthBits& d = s.depth_parts; d.total() > 0.0) {
+        const double all = double(std::max<std::size_t>(1, s.depth_bits));
+        auto share = [&](double bits) { return 100.0 * bits / all; };
+        std::printf(
+            "  depth bits: block flags %.1f %%, plane parameters %.1f %%, pixels of key frames "
+            "%.1f %%, of moving objects at their finer step %.1f %%, revealed %.1f %%, the "
+            "reference saw %.1f %%, section headers %.1f %%\n",
+            share(d.flags), share(d.planes), share(d.key), share(d.objects), share(d.revealed),
+            share(d.seen), share(std::max(0.0, all - d.total())));
+    }
     std::printf(
         "  %zu frames: %zu key, %zu predicted from an older reference, %zu intra macroblocks, "
         "%zu pixels the reference did not see predicted from the surface beside them\n",

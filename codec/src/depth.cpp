@@ -165,7 +165,8 @@ struct SliceJob {
     ImageView<const float> share;     // encoder, view mode: each pixel's multiple of the bound
     std::size_t zero_blocks = 0;
     std::size_t plane_blocks = 0;
-    Plane plane;  // the plane of the block being predicted
+    StreamStats::DepthBits bits;  // encoder: where the slice's bits go
+    Plane plane;                  // the plane of the block being predicted
     int plane_x = 0, plane_y = 0;
 };
 
@@ -675,14 +676,18 @@ void encode_slice(SliceJob& j, std::vector<uint8_t>& bytes, std::vector<uint8_t>
             if (j.map->view && mode != last)
                 block_cost(j, bx, by, bw, bh, mode);  // the chosen prediction's codes again
             const int shows = reprojection_class(j, bx, by, bw, bh);
+            rc.tally_into(&j.bits.flags);
             if (inter)
                 rc.bit(m.temporal[shows][temporal_context(block_flags, above, b)],
                        mode == kTemporalMode);
             if (j.map->view && mode != kTemporalMode) {
                 rc.bit(m.plane[shows][plane_context(block_flags, above, b)], mode == kPlaneMode);
-                if (mode == kPlaneMode)
+                if (mode == kPlaneMode) {
+                    rc.tally_into(&j.bits.planes);
                     encode_plane(rc, m, fitted, predicted,
                                  plane_context(block_flags, above, b) > 0);
+                    rc.tally_into(&j.bits.flags);
+                }
             }
             planes[std::size_t(b)] = mode == kPlaneMode ? fitted : Plane{};
             j.plane_blocks += mode == kPlaneMode;
@@ -706,6 +711,10 @@ void encode_slice(SliceJob& j, std::vector<uint8_t>& bytes, std::vector<uint8_t>
                 for (int x = b * kBlock; x < std::min(j.width, (b + 1) * kBlock); ++x) {
                     const uint32_t p = j.predictions(x, y), c = j.codes(x, y);
                     const bool background = c == j.map->empty();
+                    rc.tally_into(!inter                                      ? &j.bits.key
+                                  : !j.share.empty() && j.share(x, y) == 1.0f ? &j.bits.objects
+                                  : j.temporal(x, y) == kNoPrediction         ? &j.bits.revealed
+                                                                              : &j.bits.seen);
                     rc.bit(m.background[background_context(j, x, y, p)], background);
                     j.residuals(x, y) = 0;
                     if (background) continue;
@@ -1032,6 +1041,7 @@ void encode_depth(const FrameContext& fc, const Camera& camera, ImageView<const 
         for (const SliceJob& j : jobs) {
             stats.depth_zero_blocks += j.zero_blocks;
             stats.depth_plane_blocks += j.plane_blocks;
+            stats.depth_parts += j.bits;
         }
     }
     stats.depth_bits += 8 * (bytes.size() - start);

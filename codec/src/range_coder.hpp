@@ -5,6 +5,8 @@
 // it sees zero bytes and counts them (an honest slice: at most 4), so a truncated or hostile
 // slice decodes to garbage values that the caller bounds, never to undefined behaviour.
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -34,11 +36,23 @@ struct BitModel {
     }
 };
 
+// -log2 of a probability of p / 4096: the ideal length of a coded bit.
+inline const std::array<float, 4097> kBitLength = [] {
+    std::array<float, 4097> t{};
+    for (int p = 1; p <= 4096; ++p) t[std::size_t(p)] = float(-std::log2(double(p) / 4096.0));
+    t[0] = t[1];
+    return t;
+}();
+
 class RangeEncoder {
 public:
     explicit RangeEncoder(std::vector<uint8_t>& out) : out_(out), start_(out.size()) {}
 
+    // From here on, the ideal length of each bit coded (bits) is added to *t (null: none).
+    void tally_into(double* t) { tally_ = t; }
+
     void bit(BitModel& m, int b) {
+        if (tally_) *tally_ += kBitLength[b ? 4096 - m.p() : m.p()];
         const uint32_t bound = (range_ >> kProbBits) * m.p();
         if (!b) {
             range_ = bound;
@@ -50,6 +64,7 @@ public:
         normalize();
     }
     void bypass(int b) {
+        if (tally_) *tally_ += 1.0;
         range_ >>= 1;
         if (b) low_ += range_;
         normalize();
@@ -103,6 +118,7 @@ private:
     uint32_t range_ = 0xFFFFFFFFu;
     uint8_t cache_ = 0;
     uint64_t cache_size_ = 1;
+    double* tally_ = nullptr;
 };
 
 class RangeDecoder {

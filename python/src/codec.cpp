@@ -70,6 +70,14 @@ py::dict stats_dict(const codec::StreamStats& s) {
     d["intra_blocks"] = s.intra_blocks;
     d["depth_zero_blocks"] = s.depth_zero_blocks;
     d["depth_plane_blocks"] = s.depth_plane_blocks;
+    py::dict parts;  // encoder: the depth section's bits by what they code
+    parts["flags"] = s.depth_parts.flags;
+    parts["planes"] = s.depth_parts.planes;
+    parts["key"] = s.depth_parts.key;
+    parts["objects"] = s.depth_parts.objects;
+    parts["revealed"] = s.depth_parts.revealed;
+    parts["seen"] = s.depth_parts.seen;
+    d["depth_parts"] = parts;
     d["revealed_pixels"] = s.revealed_pixels;
     d["motion_residual_pixels"] = s.motion_residual_pixels;
     d["motion_objects"] = s.motion_objects;

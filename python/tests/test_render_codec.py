@@ -68,6 +68,10 @@ def test_codec_round_trip(pan_60):
         assert np.array_equal(exact.decode(lossless.encode(frame)).depth, frame.depth)
     assert encoder.stats["frames"] == 3 and encoder.stats["key_frames"] == 1
     assert encoder.stats["depth_bits"] < 0.25 * lossless.stats["depth_bits"]
+    # Where the depth bits go: the parts add up to the section less its few header bytes.
+    parts = encoder.stats["depth_parts"]
+    assert parts["key"] > 0 and decoder.stats["depth_parts"]["key"] == 0
+    assert 0.9 * encoder.stats["depth_bits"] < sum(parts.values()) <= encoder.stats["depth_bits"] + 32
     # Milliseconds by stage: the inter frames' shared stages ran on both sides.
     for stats in (encoder.stats, decoder.stats):
         assert stats["ms"]["reproject"] > 0 and stats["ms"]["predict"] > 0, stats["ms"]

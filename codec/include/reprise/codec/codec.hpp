@@ -90,6 +90,19 @@ struct StreamStats {
     std::size_t motion_objects = 0;          // rigid object motions sent
     std::size_t depth_zero_blocks = 0;       // depth blocks predicted exactly
     std::size_t depth_plane_blocks = 0;      // depth blocks predicted by a plane they send
+    // Encoder: where the depth section's bits go (the coder's ideal lengths, bits): each block's
+    // flags (temporal, plane, no residual), plane parameters, then the pixels of blocks with
+    // residuals: of key frames, and in inter frames of moving objects held to their finer step,
+    // of pixels nothing of the reference landed on (revealed), of the rest (the reference saw).
+    struct DepthBits {
+        double flags = 0.0, planes = 0.0, key = 0.0, objects = 0.0, revealed = 0.0, seen = 0.0;
+        double total() const { return flags + planes + key + objects + revealed + seen; }
+        DepthBits& operator+=(const DepthBits& o) {
+            flags += o.flags, planes += o.planes, key += o.key, objects += o.objects;
+            revealed += o.revealed, seen += o.seen;
+            return *this;
+        }
+    } depth_parts;
     std::size_t revealed_pixels =
         0;                           // colour predicted from beside: the reference did not see them
     std::size_t cameras_fitted = 0;  // encoder: frames without a camera coded with a fitted one
