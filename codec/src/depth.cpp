@@ -163,6 +163,7 @@ struct SliceJob {
     ImageView<uint32_t> predictions;  // encoder: the block's prediction of each pixel
     ImageView<const float> source;    // encoder, view mode: the depth to code
     ImageView<const float> share;     // encoder, view mode: each pixel's multiple of the bound
+    ImageView<const uint8_t> shows;   // inter frames: each block's reprojection_class (block_shows)
     std::size_t zero_blocks = 0;
     std::size_t plane_blocks = 0;
     StreamStats::DepthBits bits;  // encoder: where the slice's bits go
@@ -380,9 +381,10 @@ inline int zero_context(const std::vector<uint8_t>& row, const std::vector<uint8
 
 // What the temporal prediction shows of a block, known to both sides before its flags: 0 no
 // step between neighbouring codes, 1 a step (a silhouette, where residuals gather), 2 a pixel
-// nothing landed on. Key frames (version 17): what the row above the block shows, 0 one
-// surface, 1 an edge or background beside a surface, 2 background only (or no row above).
-inline int reprojection_class(const SliceJob& j, int bx, int by, int bw, int bh) {
+// nothing landed on (block_shows, for the whole frame before the slices). Key frames (version
+// 17): what the row above the block shows, 0 one surface, 1 an edge or background beside a
+// surface, 2 background only (or no row above).
+inline int reprojection_class(const SliceJob& j, int bx, int by, int bw) {
     if (j.temporal.empty()) {
         if (by == j.y0) return 2;
         bool surface = false, background = false, step = false;
@@ -399,15 +401,7 @@ inline int reprojection_class(const SliceJob& j, int bx, int by, int bw, int bh)
         }
         return !surface ? 2 : (background || step) ? 1 : 0;
     }
-    int step = 0;
-    for (int y = by; y < by + bh; ++y)
-        for (int x = bx; x < bx + bw; ++x) {
-            const uint32_t t = j.temporal(x, y);
-            if (t == kNoPrediction) return 2;
-            step |= (x > bx && step_between(*j.map, t, j.temporal(x - 1, y))) ||
-                    (y > by && step_between(*j.map, t, j.temporal(x, y - 1)));
-        }
-    return step;
+    return j.shows(bx / kBlock, by / kBlock);
 }
 
 // Cost estimate of coding a block's residuals.
@@ -452,6 +446,19 @@ void view_depth_row_reference(const ViewDepthRow& r, int i_begin, int i_end) {
         r.out[i] = c <= kMaxViewCode ? z
                    : c == kInfCode   ? std::numeric_limits<float>::infinity()
                                      : std::numeric_limits<float>::quiet_NaN();
+    }
+}
+
+void shows_row_reference(const ShowsRow& r, int i_begin, int i_end) {
+    auto apart = [&](uint32_t a, uint32_t b) { return std::max(a, b) - std::min(a, b) > r.step; };
+    for (int i = i_begin; i < i_end; ++i) {
+        const uint32_t t = r.temporal[i];
+        const uint8_t shows =
+            t == kNoPrediction ? 2
+            : (i % kBlock != 0 && apart(t, r.temporal[i - 1])) || (r.above && apart(t, r.above[i]))
+                ? 1
+                : 0;
+        r.out[i] = std::max(r.out[i], shows);
     }
 }
 
@@ -675,7 +682,7 @@ void encode_slice(SliceJob& j, std::vector<uint8_t>& bytes, std::vector<uint8_t>
             }
             if (j.map->view && mode != last)
                 block_cost(j, bx, by, bw, bh, mode);  // the chosen prediction's codes again
-            const int shows = reprojection_class(j, bx, by, bw, bh);
+            const int shows = reprojection_class(j, bx, by, bw);
             rc.tally_into(&j.bits.flags);
             if (inter)
                 rc.bit(m.temporal[shows][temporal_context(block_flags, above, b)],
@@ -788,7 +795,7 @@ bool decode_slice(SliceJob& j, std::span<const uint8_t> bytes) {
         }
         for (int b = 0; b < blocks; ++b) {
             const int shows =
-                reprojection_class(j, b * kBlock, by, std::min(kBlock, j.width - b * kBlock), bh);
+                reprojection_class(j, b * kBlock, by, std::min(kBlock, j.width - b * kBlock));
             const bool temporal =
                 inter && rc.bit(m.temporal[shows][temporal_context(flags, above, b)]);
             const int context = plane_context(flags, above, b);
@@ -908,16 +915,41 @@ void temporal_codes(const FrameContext& fc, const Camera& camera, const Mapping&
     });
 }
 
+// Inter frames: what the temporal prediction shows of each block (reprojection_class), for the
+// whole frame before the slices, a block row per task.
+void block_shows(const Image<uint32_t>& temporal, uint32_t step, Image<uint8_t>& out) {
+    const int w = temporal.width(), h = temporal.height();
+    const int columns = (w + kBlock - 1) / kBlock, rows = (h + kBlock - 1) / kBlock;
+    ensure_size(out, columns, rows);
+    parallel_for(0, rows, [&](int r0, int r1) {
+        std::vector<uint8_t> pixels(static_cast<std::size_t>(w));
+        for (int r = r0; r < r1; ++r) {
+            std::fill(pixels.begin(), pixels.end(), uint8_t(0));
+            for (int y = r * kBlock; y < std::min(h, (r + 1) * kBlock); ++y)
+                shows_row({.temporal = &temporal(0, y),
+                           .above = y > r * kBlock ? &temporal(0, y - 1) : nullptr,
+                           .count = w,
+                           .step = step,
+                           .out = pixels.data()});
+            for (int b = 0; b < columns; ++b)
+                out(b, r) = *std::max_element(pixels.begin() + b * kBlock,
+                                              pixels.begin() + std::min(w, (b + 1) * kBlock));
+        }
+    });
+}
+
 std::vector<SliceJob> slice_jobs(const SequenceParams& sp, const Mapping& map,
                                  Image<uint32_t>& codes, const Image<uint32_t>& temporal,
-                                 Image<uint32_t>& residuals,
+                                 Image<uint32_t>& residuals, Image<uint8_t>& shows,
                                  Image<uint32_t>* predictions = nullptr) {
+    if (!temporal.empty()) block_shows(temporal, map.residual_step, shows);
     std::vector<SliceJob> jobs;
     for (int s = 0; s < sp.slices; ++s) {
         const int y0 = std::min(sp.height, sp.slice_begin(s) * kMb);
         const int y1 = std::min(sp.height, sp.slice_begin(s + 1) * kMb);
         jobs.push_back({&map, sp.width, y0, y1, codes.view(), temporal.view(), residuals.view(),
                         predictions ? predictions->view() : ImageView<uint32_t>{}});
+        jobs.back().shows = shows.view();
     }
     return jobs;
 }
@@ -1021,7 +1053,8 @@ void encode_depth(const FrameContext& fc, const Camera& camera, ImageView<const 
     const std::size_t slices_start = bytes.size();
     Image<uint32_t>& predictions = fc.work->depth_predictions;
     ensure_size(predictions, w, h);
-    std::vector<SliceJob> jobs = slice_jobs(sp, map, codes, temporal, residuals, &predictions);
+    std::vector<SliceJob> jobs =
+        slice_jobs(sp, map, codes, temporal, residuals, fc.work->depth_shows, &predictions);
     const ImageView<const float> share = view_share(fc, map);
     for (SliceJob& j : jobs) j.source = source, j.share = share;
     std::vector<std::vector<uint8_t>>& flags = fc.work->slice_flags;
@@ -1095,7 +1128,8 @@ Status decode_depth(const FrameContext& fc, const Camera& camera, std::span<cons
     } else {
         std::vector<std::span<const uint8_t>> slices;
         if (!read_slices(r, sp.slices, slices)) return Status::error(r.error());
-        std::vector<SliceJob> jobs = slice_jobs(sp, map, codes, temporal, residuals);
+        std::vector<SliceJob> jobs =
+            slice_jobs(sp, map, codes, temporal, residuals, fc.work->depth_shows);
         REPRISE_TRY(decode_slices(
             slices, "depth section",
             [&](int s, std::span<const uint8_t> bytes) { return decode_slice(jobs[s], bytes); }));

@@ -202,6 +202,7 @@ struct InterChoice {
 
 struct Workspace {
     Image<uint32_t> depth_codes, temporal_codes, depth_residuals, depth_predictions;
+    Image<uint8_t> depth_shows;  // inter frames: per depth block, what the reprojection shows
     Image<float> projected_depth, view_share;
     Image<glm::vec2> base_motion, to_reference;
     std::vector<MotionResidual> motion_residuals;

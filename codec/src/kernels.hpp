@@ -226,6 +226,21 @@ inline constexpr uint32_t kMaxViewCode = 1u << 30;        // view codes of surfa
 inline constexpr uint32_t kInfCode = (1u << 30) + 1;      // background (+inf)
 inline constexpr uint32_t kInvalidCode = (1u << 30) + 2;  // NaN, zero or negative depth
 
+// Inter-frame depth (depth.cpp, reprojection_class): what the temporal prediction shows at each
+// pixel of a row of a block row, raised into `out` (each byte the larger of the two): 2 where
+// nothing landed (kNoPrediction), else 1 where the code differs by more than `step` from the one
+// to its left (not at a block's first column, x % 8 == 0) or from the one above (`above`, null on
+// the block row's first row), else 0.
+struct ShowsRow {
+    const uint32_t* temporal;
+    const uint32_t* above;
+    int count;
+    uint32_t step;
+    uint8_t* out;
+};
+void shows_row_reference(const ShowsRow& row, int i_begin, int i_end);
+void shows_row(const ShowsRow& row);
+
 // View-mode codes of one row of the reprojected reference's depth (depth.cpp, temporal_codes):
 // NaN (nothing landed) kNoPrediction, +inf kInfCode, other depth that is not finite and
 // positive kInvalidCode, else min(k, 2^30) with k = 1 / z / step rounded half to even, in

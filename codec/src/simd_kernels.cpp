@@ -559,6 +559,32 @@ ObjectPixels ObjectPixelsRowSimd(const ObjectPixelsRow& r) {
     return total;
 }
 
+void ShowsRowSimd(const ShowsRow& r) {
+    const hn::ScalableTag<uint32_t> du;
+    const hn::RebindToSigned<decltype(du)> di;
+    const hn::Rebind<uint8_t, decltype(du)> d8;
+    using VU = hn::Vec<decltype(du)>;
+    const int n = int(hn::Lanes(du));
+    const VU none = hn::Set(du, kNoPrediction), step = hn::Set(du, r.step);
+    const VU one = hn::Set(du, 1), two = hn::Set(du, 2), seven = hn::Set(du, 7);
+    const auto lane = hn::Iota(du, 0);
+    auto apart = [&](VU a, VU b) { return hn::Max(a, b) - hn::Min(a, b) > step; };
+    // The first block's pixels by the reference: no vector reads left of the row.
+    int i = std::min(r.count, 8);
+    shows_row_reference(r, 0, i);
+    for (; i + n <= r.count; i += n) {
+        const VU t = hn::LoadU(du, r.temporal + i);
+        const auto first_column =
+            hn::And(hn::Add(lane, hn::Set(du, uint32_t(i))), seven) == hn::Zero(du);
+        auto stepped = hn::AndNot(first_column, apart(t, hn::LoadU(du, r.temporal + i - 1)));
+        if (r.above) stepped = hn::Or(stepped, apart(t, hn::LoadU(du, r.above + i)));
+        const VU shows = hn::IfThenElse(t == none, two, hn::IfThenElseZero(stepped, one));
+        const VU held = hn::PromoteTo(du, hn::LoadU(d8, r.out + i));
+        hn::StoreU(hn::DemoteTo(d8, hn::BitCast(di, hn::Max(held, shows))), d8, r.out + i);
+    }
+    shows_row_reference(r, i, r.count);
+}
+
 void ViewKeepRowSimd(const ViewKeepRow& r) {
     const hn::ScalableTag<double> dd;
     const hn::Rebind<float, decltype(dd)> df;
@@ -664,11 +690,14 @@ HWY_EXPORT(ForwardRowSimd);
 HWY_EXPORT(MotionResidualRowSimd);
 HWY_EXPORT(MotionWithinRowSimd);
 HWY_EXPORT(ObjectPixelsRowSimd);
+HWY_EXPORT(ShowsRowSimd);
 HWY_EXPORT(ViewKeepRowSimd);
 HWY_EXPORT(ViewCodeRowSimd);
 HWY_EXPORT(ViewDepthRowSimd);
 HWY_EXPORT(PlaneRowSimd);
 HWY_EXPORT(RevealRowSimd);
+
+void shows_row(const ShowsRow& row) { HWY_DYNAMIC_DISPATCH(ShowsRowSimd)(row); }
 
 void view_keep_row(const ViewKeepRow& row) { HWY_DYNAMIC_DISPATCH(ViewKeepRowSimd)(row); }
 

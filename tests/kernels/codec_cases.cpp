@@ -670,6 +670,65 @@ private:
     std::vector<uint8_t> reference_, optimized_;
 };
 
+// What inter-frame depth's temporal prediction shows at each pixel (reprojection_class), in the
+// rows of 8-row block rows. Random: a surface's codes stepping by up to twice the step, a second
+// surface far off, nothing landed one time in twenty, held bytes 0..2; worst case: codes at
+// 0, 2^32 - 2 and around 2^30 (lossless depth's codes span all 32 bits), steps of exactly the
+// step and one more, a step of 0 and of 2^32 - 1.
+class ShowsCase final : public KernelCase {
+public:
+    void generate(int w, int h, KernelInputs inputs, uint32_t seed) override {
+        std::mt19937 rng(seed);
+        width_ = w, height_ = h;
+        const bool worst = inputs == KernelInputs::WorstCase;
+        step_ = worst && seed % 3 == 0 ? (seed % 2 ? 0u : 0xFFFFFFFFu) : 1 + rng() % 64;
+        temporal_.resize(std::size_t(w) * h);
+        held_.resize(temporal_.size());
+        uint32_t surface = 1u << 20;
+        for (std::size_t i = 0; i < temporal_.size(); ++i) {
+            surface += uint32_t(rng() % (4 * std::min(step_, 64u) + 1)) - 2 * std::min(step_, 64u);
+            uint32_t t = rng() % 8 == 0 ? surface + (1u << 24) : surface;
+            if (rng() % 20 == 0) t = kNoPrediction;
+            if (worst && rng() % 4 == 0) {
+                const uint32_t extremes[] = {
+                    0u,           0xFFFFFFFEu,     kMaxViewCode,        kInfCode,
+                    kInvalidCode, surface + step_, surface + step_ + 1, surface - step_};
+                t = extremes[rng() % std::size(extremes)];
+            }
+            temporal_[i] = t;
+            held_[i] = uint8_t(rng() % 3);
+        }
+    }
+    void run_reference() override {
+        run_into(reference_, [](const ShowsRow& r) { shows_row_reference(r, 0, r.count); });
+    }
+    void run() override { run_into(optimized_, shows_row); }
+    std::string compare() const override {
+        return compare_elements("what the prediction shows", optimized_, reference_);
+    }
+
+private:
+    template <class Kernel>
+    void run_into(std::vector<uint8_t>& out, Kernel kernel) {
+        out = held_;
+        parallel_for(0, height_, [&](int y0, int y1) {
+            for (int y = y0; y < y1; ++y) {
+                const std::size_t o = std::size_t(y) * width_;
+                kernel({.temporal = temporal_.data() + o,
+                        .above = y % 8 ? temporal_.data() + o - width_ : nullptr,
+                        .count = width_,
+                        .step = step_,
+                        .out = out.data() + o});
+            }
+        });
+    }
+
+    int width_ = 0, height_ = 0;
+    uint32_t step_ = 33;
+    std::vector<uint32_t> temporal_;
+    std::vector<uint8_t> held_, reference_, optimized_;
+};
+
 // View-mode codes of reprojected depth and the depth of codes. Random: depth of a scene (and
 // nothing landed one time in eight); codes near a depth's own and the background's; worst case:
 // NaN/Inf/zero/negative/denormal depths, codes around 2^30 and above 2^31, halfway quotients
@@ -830,6 +889,7 @@ constexpr KernelEntry kEntries[] = {
     {"codec colour block differences", "bit-exact", true, make<BlockDifferencesCase>},
     {"codec an object's usable and unexplained pixels", "bit-exact", true, make<ObjectPixelsCase>},
     {"codec view depth keeps its prediction", "bit-exact", true, make<ViewKeepCase>},
+    {"codec what depth's temporal prediction shows", "bit-exact", true, make<ShowsCase>},
     {"codec view depth codes and their depth", "bit-exact", true, make<ViewCodeCase>},
     {"codec colour to YCoCg-R", "bit-exact", true, make<ToPlanesCase>},
     {"codec YCoCg-R to colour", "bit-exact", true, make<FromPlanesCase>},
