@@ -146,10 +146,10 @@ struct Models {
     BitModel plane[3][3];  // [what the block shows][neighbours]
     BitModel zero_block[3][3][3];
     BitModel background[32];  // version 17 (4 before)
-    IntModel<24> residual[2][16];
-    BitModel other[2];
+    IntModel<24> residual[2][48];
+    BitModel other[2][3];
     IntModel<24> other_residual[2];  // version 17: a residual from the other prediction
-    BitModel across[2];              // version 14
+    BitModel across[2][3];           // version 14
     IntModel<24> plane_offset[2], plane_slope[2][2];
 };
 
@@ -355,16 +355,53 @@ inline int background_context(const SliceJob& j, int x, int y, uint32_t p) {
            (top && x + 1 < j.width && j.codes(x + 1, y - 1) == empty);
 }
 
-// A residual's class: at an edge (p no surface, or a step from the left or above code) or not,
-// beside a step in the temporal prediction (a third prediction exists, version 14) or not, and
-// the magnitude of the residuals to the left and above.
-inline int residual_context(const SliceJob& j, int x, int y, uint32_t p) {
+// Inter frames in view mode (version 18), for the contexts: what the staircase of the decoded rows
+// above says of a pixel beside a step of the temporal prediction along its row (a silhouette's
+// side): 0 nothing (no step, or no staircase), 1 the line through where the step lies in the
+// kStairRows rows above, continued to this row, puts the pixel on the side the prediction does,
+// 2 on the other (there a silhouette comes a pixel off about half the time).
+constexpr int kStairRows = 6;
+inline int staircase(const SliceJob& j, int x, int y) {
+    if (j.temporal.empty() || !j.map->view || y - kStairRows < j.y0 || x < 4 || x + 4 > j.width)
+        return 0;
+    const int64_t far = 4 * int64_t(j.map->residual_step);
+    auto apart = [&](uint32_t a, uint32_t b) {
+        return a <= kMaxViewCode && b <= kMaxViewCode && std::abs(int64_t(a) - int64_t(b)) > far;
+    };
+    int edge = -1;  // the step lies between edge - 1 and edge
+    if (apart(j.temporal(x - 1, y), j.temporal(x, y)))
+        edge = x;
+    else if (apart(j.temporal(x, y), j.temporal(x + 1, y)))
+        edge = x + 1;
+    if (edge < 0) return 0;
+    const int64_t a = j.temporal(edge - 1, y), b = j.temporal(edge, y);
+    auto b_side = [&](uint32_t c) { return std::abs(int64_t(c) - b) < std::abs(int64_t(c) - a); };
+    int64_t sum = 0, weighted = 0;
+    for (int k = 1, near = edge; k <= kStairRows; ++k) {
+        int found = -1;
+        for (int c = std::max(1, near - 3); c <= std::min(j.width - 1, near + 3) && found < 0; ++c)
+            if (!b_side(j.codes(c - 1, y - k)) && b_side(j.codes(c, y - k))) found = c;
+        if (found < 0) return 0;
+        sum += found, weighted += int64_t(k) * found, near = found;
+    }
+    // The least-squares line through (k, column) for k = 1..K, at k = 0.
+    const int64_t n = kStairRows, sk = n * (n + 1) / 2, skk = n * (n + 1) * (2 * n + 1) / 6;
+    const int64_t numerator = sum * skk - weighted * sk, denominator = n * skk - sk * sk;
+    const int64_t predicted = (2 * numerator + denominator) / (2 * denominator);
+    return (x >= edge) != (x >= predicted) ? 2 : 1;
+}
+
+// A residual's class: what the staircase above says (`stair`, version 18), at an edge (p no
+// surface, or a step from the left or above code) or not, beside a step in the temporal
+// prediction (a third prediction exists, version 14) or not, and the magnitude of the residuals
+// to the left and above.
+inline int residual_context(const SliceJob& j, int x, int y, uint32_t p, int stair) {
     const bool edge = !j.map->surface(p) || (x > 0 && step_between(*j.map, j.codes(x - 1, y), p)) ||
                       (y > j.y0 && step_between(*j.map, j.codes(x, y - 1), p));
     const bool across = j.temporal.empty() ? y > j.y0 && x + 1 < j.width &&
                                                  step_between(*j.map, j.codes(x + 1, y - 1), p)
                                            : across_prediction(j, x, y, p) != p;
-    return 4 * (edge + 2 * across) +
+    return 16 * stair + 4 * (edge + 2 * across) +
            magnitude_class(x > 0 ? j.residuals(x - 1, y) : 0, y > j.y0 ? j.residuals(x, y - 1) : 0);
 }
 
@@ -726,13 +763,15 @@ void encode_slice(SliceJob& j, std::vector<uint8_t>& bytes, std::vector<uint8_t>
                     j.residuals(x, y) = 0;
                     if (background) continue;
                     const uint32_t base = surface_prediction(j, x, y, p);
-                    IntModel<24>& model = m.residual[flags & 1][residual_context(j, x, y, p)];
+                    const int stair = staircase(j, x, y);
+                    IntModel<24>& model =
+                        m.residual[flags & 1][residual_context(j, x, y, p, stair)];
                     rc.bit(model.zero, c != base);
                     if (c == base) continue;
                     const uint32_t other = other_prediction(j, x, y, flags & 1, p);
                     if (other != p) {
                         const bool use = from_other(c, base, other, j.map->residual_step);
-                        rc.bit(m.other[flags & 1], use);
+                        rc.bit(m.other[flags & 1][stair], use);
                         if (use) {
                             const int32_t r = int32_t(c - other) / int32_t(j.map->residual_step);
                             encode_int(rc, m.other_residual[flags & 1], r);
@@ -743,7 +782,7 @@ void encode_slice(SliceJob& j, std::vector<uint8_t>& bytes, std::vector<uint8_t>
                     }
                     const uint32_t across = across_prediction(j, x, y, p);
                     if (across != p && across != other) {
-                        rc.bit(m.across[flags & 1], c == across);
+                        rc.bit(m.across[flags & 1][stair], c == across);
                         if (c == across) {
                             j.residuals(x, y) = 1;
                             continue;
@@ -844,13 +883,14 @@ bool decode_slice(SliceJob& j, std::span<const uint8_t> bytes) {
                     j.codes(x, y) = j.map->empty();
                     continue;
                 }
-                IntModel<24>& model = m.residual[temporal][residual_context(j, x, y, p)];
+                const int stair = staircase(j, x, y);
+                IntModel<24>& model = m.residual[temporal][residual_context(j, x, y, p, stair)];
                 const uint32_t base = surface_prediction(j, x, y, p);
                 j.residuals(x, y) = 0;
                 j.codes(x, y) = base;
                 if (!rc.bit(model.zero)) continue;
                 const uint32_t other = other_prediction(j, x, y, temporal, p);
-                if (other != p && rc.bit(m.other[temporal])) {
+                if (other != p && rc.bit(m.other[temporal][stair])) {
                     int64_t r = 0;
                     if (!decode_int(rc, m.other_residual[temporal], r)) return false;
                     j.residuals(x, y) = r == 0 ? 1u : uint32_t(r);
@@ -858,7 +898,7 @@ bool decode_slice(SliceJob& j, std::span<const uint8_t> bytes) {
                     continue;
                 }
                 const uint32_t across = across_prediction(j, x, y, p);
-                if (across != p && across != other && rc.bit(m.across[temporal])) {
+                if (across != p && across != other && rc.bit(m.across[temporal][stair])) {
                     j.residuals(x, y) = 1;
                     j.codes(x, y) = across;
                     continue;
