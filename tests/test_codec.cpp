@@ -768,6 +768,27 @@ TEST(Codec, ASmoothSurfaceCostsItsPlanesNotTheMediansDrift) {
     EXPECT_EQ(decoder.stats().depth_plane_blocks, coded.stats.depth_plane_blocks);
 }
 
+// `frames` of `scene` at 320x180 in view depth at qp 34, and its first frame alone: the decoder
+// makes the encoder's pictures, the views stay within the bound.
+struct KeyAndAll {
+    Coded key, all;
+};
+KeyAndAll code_within_the_bound(const char* scene, int frames_count) {
+    const EncoderOptions options{.qp = 34, .depth = DepthMode::View};
+    const auto frames = render(scene, frames_count, 320, 180);
+    KeyAndAll c{encode_all({frames.front()}, options), encode_all(frames, options)};
+    const std::vector<Frame> decoded = decode_all(c.all.packets);
+    EXPECT_EQ(decoded.size(), frames.size());
+    for (std::size_t i = 0; i < std::min(frames.size(), decoded.size()); ++i) {
+        EXPECT_TRUE(same_frame(decoded[i], c.all.reconstructions[i])) << "frame " << i;
+        EXPECT_LE(measure_view_depth_error(frames[i].camera, frames[i].depth.view(),
+                                           decoded[i].depth.view(), options.view_displacement)
+                      .max_px,
+                  options.view_error_px);
+    }
+    return c;
+}
+
 // Version 17: key-frame depth reads more of what is above a pixel or block. Block flags take
 // their contexts from the row above the block (one surface, an edge, nothing); background flags
 // from the above-left and above-right codes too; a silhouette coming down from the right gives the
@@ -780,19 +801,7 @@ TEST(Codec, KeyFrameDepthReadsTheRowsAbove) {
     for (auto [scene, most_bits] :
          {std::pair{"shadows", 2700}, std::pair{"stroll", 3950}, std::pair{"courtyard", 2750}}) {
         SCOPED_TRACE(scene);
-        const EncoderOptions options{.qp = 34, .depth = DepthMode::View};
-        const auto frames = render(scene, 2, 320, 180);
-        const Coded coded = encode_all(frames, options);
-        const Coded key = encode_all({frames.front()}, options);
-        const std::vector<Frame> decoded = decode_all(coded.packets);
-        ASSERT_EQ(decoded.size(), frames.size());
-        for (std::size_t i = 0; i < frames.size(); ++i) {
-            EXPECT_TRUE(same_frame(decoded[i], coded.reconstructions[i])) << "frame " << i;
-            EXPECT_LE(measure_view_depth_error(frames[i].camera, frames[i].depth.view(),
-                                               decoded[i].depth.view(), options.view_displacement)
-                          .max_px,
-                      options.view_error_px);
-        }
+        const Coded key = code_within_the_bound(scene, 2).key;
         std::printf("%s: key-frame depth %zu bits\n", scene, key.stats.depth_bits);
         EXPECT_LE(key.stats.depth_bits, std::size_t(most_bits));
     }
@@ -808,20 +817,8 @@ TEST(Codec, SilhouettesAreCodedByTheStaircaseAbove) {
     for (auto [scene, most_bits] :
          {std::pair{"fence", 12400}, std::pair{"stroll", 7980}, std::pair{"mirror", 7320}}) {
         SCOPED_TRACE(scene);
-        const EncoderOptions options{.qp = 34, .depth = DepthMode::View};
-        const auto frames = render(scene, 6, 320, 180);
-        const Coded coded = encode_all(frames, options);
-        const Coded key = encode_all({frames.front()}, options);
-        const std::vector<Frame> decoded = decode_all(coded.packets);
-        ASSERT_EQ(decoded.size(), frames.size());
-        for (std::size_t i = 0; i < frames.size(); ++i) {
-            EXPECT_TRUE(same_frame(decoded[i], coded.reconstructions[i])) << "frame " << i;
-            EXPECT_LE(measure_view_depth_error(frames[i].camera, frames[i].depth.view(),
-                                               decoded[i].depth.view(), options.view_displacement)
-                          .max_px,
-                      options.view_error_px);
-        }
-        const std::size_t inter = coded.stats.depth_bits - key.stats.depth_bits;
+        const KeyAndAll c = code_within_the_bound(scene, 6);
+        const std::size_t inter = c.all.stats.depth_bits - c.key.stats.depth_bits;
         std::printf("%s: inter-frame depth %zu bits\n", scene, inter);
         EXPECT_LE(inter, std::size_t(most_bits));
     }
