@@ -810,8 +810,9 @@ TEST(Codec, KeyFrameDepthReadsTheRowsAbove) {
 // Version 18: a silhouette's pixel is coded in the context of what the staircase of the rows
 // above says (the line through where its step lies there, continued to the pixel's row): on the
 // wrong side about half the time where it disagrees with the temporal prediction, seldom where it
-// agrees. Inter-frame depth at 320x180, qp 34, 6 frames (version 17 / 18): fence 12,544 / 12,248
-// bits, stroll 8,080 / 7,880, mirror 7,440 / 7,184. The decoder makes the encoder's pictures and
+// agrees; a block's zero flag, whether it disagrees in the block's first row. Inter-frame depth
+// at 320x180, qp 34, 6 frames (version 17 / 18): fence 12,544 / 12,256 bits, stroll 8,080 / 7,880,
+// mirror 7,440 / 7,160. The decoder makes the encoder's pictures and
 // the views stay within the bound.
 TEST(Codec, SilhouettesAreCodedByTheStaircaseAbove) {
     for (auto [scene, most_bits] :

@@ -144,7 +144,7 @@ inline uint32_t plane_code(const Plane& q, int dx, int dy) {
 struct Models {
     BitModel temporal[3][3];
     BitModel plane[3][3];  // [what the block shows][neighbours]
-    BitModel zero_block[3][3][3];
+    BitModel zero_block[3][3][3][2];
     BitModel background[32];  // version 17 (4 before)
     IntModel<24> residual[2][48];
     BitModel other[2][3];
@@ -389,6 +389,14 @@ inline int staircase(const SliceJob& j, int x, int y) {
     const int64_t numerator = sum * skk - weighted * sk, denominator = n * skk - sk * sk;
     const int64_t predicted = (2 * numerator + denominator) / (2 * denominator);
     return (x >= edge) != (x >= predicted) ? 2 : 1;
+}
+
+// Whether the staircase above puts a pixel of a block's first row on the other side of the
+// temporal prediction's step (version 18): such a block seldom goes without residuals.
+inline int stairs_in_row(const SliceJob& j, int bx, int by, int bw) {
+    for (int x = bx; x < bx + bw; ++x)
+        if (staircase(j, x, by) == 2) return 1;
+    return 0;
 }
 
 // A residual's class: what the staircase above says (`stair`, version 18), at an edge (p no
@@ -735,7 +743,9 @@ void encode_slice(SliceJob& j, std::vector<uint8_t>& bytes, std::vector<uint8_t>
             }
             planes[std::size_t(b)] = mode == kPlaneMode ? fitted : Plane{};
             j.plane_blocks += mode == kPlaneMode;
-            rc.bit(m.zero_block[mode][shows][zero_context(block_flags, above, b)], cost == 0);
+            rc.bit(m.zero_block[mode][shows][zero_context(block_flags, above, b)]
+                               [stairs_in_row(j, bx, by, bw)],
+                   cost == 0);
             j.zero_blocks += cost == 0;
             block_flags[b] = (mode == kTemporalMode ? kTemporalBlock : 0) |
                              (mode == kPlaneMode ? kPlaneBlock : 0) | (cost == 0 ? kZeroBlock : 0);
@@ -833,8 +843,8 @@ bool decode_slice(SliceJob& j, std::span<const uint8_t> bytes) {
             above_planes = planes;
         }
         for (int b = 0; b < blocks; ++b) {
-            const int shows =
-                reprojection_class(j, b * kBlock, by, std::min(kBlock, j.width - b * kBlock));
+            const int bw = std::min(kBlock, j.width - b * kBlock);
+            const int shows = reprojection_class(j, b * kBlock, by, bw);
             const bool temporal =
                 inter && rc.bit(m.temporal[shows][temporal_context(flags, above, b)]);
             const int context = plane_context(flags, above, b);
@@ -845,7 +855,8 @@ bool decode_slice(SliceJob& j, std::span<const uint8_t> bytes) {
                               context > 0, planes[std::size_t(b)]))
                 return false;
             const int mode = temporal ? kTemporalMode : plane ? kPlaneMode : kSpatialMode;
-            const bool zero = rc.bit(m.zero_block[mode][shows][zero_context(flags, above, b)]);
+            const bool zero = rc.bit(m.zero_block[mode][shows][zero_context(flags, above, b)]
+                                                 [stairs_in_row(j, b * kBlock, by, bw)]);
             flags[b] = (temporal ? kTemporalBlock : 0) | (plane ? kPlaneBlock : 0) |
                        (zero ? kZeroBlock : 0);
             copied[std::size_t(b)] = temporal && zero && shows != 2;
