@@ -574,6 +574,7 @@ void ShowsRowSimd(const ShowsRow& r) {
     shows_row_reference(r, 0, i);
     for (; i + n <= r.count; i += n) {
         const VU t = hn::LoadU(du, r.temporal + i);
+        // A depth block's first column (x % 8 == 0: the row starts at x = 0) has no left code.
         const auto first_column =
             hn::And(hn::Add(lane, hn::Set(du, uint32_t(i))), seven) == hn::Zero(du);
         auto stepped = hn::AndNot(first_column, apart(t, hn::LoadU(du, r.temporal + i - 1)));
