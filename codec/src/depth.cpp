@@ -163,6 +163,7 @@ struct SliceJob {
     ImageView<uint32_t> predictions;  // encoder: the block's prediction of each pixel
     ImageView<const float> source;    // encoder, view mode: the depth to code
     ImageView<const float> share;     // encoder, view mode: each pixel's multiple of the bound
+    float uniform_share = 1.0f;       // encoder, view mode: every pixel's, where `share` is empty
     ImageView<const uint8_t> shows;   // inter frames: each block's reprojection_class (block_shows)
     std::size_t zero_blocks = 0;
     std::size_t plane_blocks = 0;
@@ -524,19 +525,18 @@ namespace {
 // when it is such a code, else the surface prediction, or the other prediction where that takes
 // fewer steps, plus the residual steps that come nearest the truth (within q / 2). The allowance
 // shrinks by (1 - B/z)^2 for points near the camera (docs/bitstream.md). A key frame keeps p only
-// within 4/5 of the allowance: every later frame transports its depth, and values left at the edge
-// of the bound would leave it at the first noise of that transport, a residual each. The other
-// prediction, then the third (inter frames), when it is close enough, costs less than a residual. A
-// pixel may be allowed a multiple of the bound (`SliceJob::share`); its residual still takes it
-// nearest the truth (the smallest residual within the wider bound left the next frames' predictions
-// farther off: key depth +4 %).
+// within 4/5 of the allowance (view_share): later frames transport its depth, and values left at
+// the edge of the bound would leave it at the first noise of that transport, a residual each. The
+// other prediction, then the third (inter frames), when it is close enough, costs less than a
+// residual. A pixel may be allowed a multiple of the bound (`SliceJob::share`, view_share); its
+// residual still takes it nearest the truth (the smallest residual within the wider bound left the
+// next frames' predictions farther off: key depth +4 %).
 uint32_t choose_view_code(const SliceJob& j, int x, int y, bool temporal, uint32_t p) {
     const Mapping& map = *j.map;
     const float z = j.source.empty() ? INFINITY : j.source(x, y);
     const uint32_t k = map.code(z);
     if (k > kMaxViewCode && k != kInvalidCode) return k;  // background: a flag
-    const double share =
-        (j.temporal.empty() ? 0.8 : 1.0) * (j.share.empty() ? 1.0 : double(j.share(x, y)));
+    const double share = j.share.empty() ? j.uniform_share : double(j.share(x, y));
     if (k != kInvalidCode && p <= kMaxViewCode &&
         view_code_within(1.0 / double(z), p, map.step, map.displacement, share))
         return p;
@@ -1040,17 +1040,27 @@ double SequenceParams::depth_step() const {
 
 namespace {
 
-// View mode: the multiple of the frame's bound each pixel may use, or empty (1 everywhere). Where
-// an object's travel made the frame's step finer than the cameras' (frame_view_step), only the
-// objects' pixels need it; the others keep the cameras' bound, as many times coarser.
-ImageView<const float> view_share(const FrameContext& fc, const Mapping& map) {
+// View mode: the multiple of the frame's bound each pixel may use, or empty (`uniform` everywhere).
+// Where an object's travel made the frame's step finer than the cameras' (frame_view_step), only
+// the objects' pixels need it; the others keep the cameras' bound, as many times coarser. A key
+// frame keeps kKeyShare of that (choose_view_code), but where its camera stands still and no object
+// moves the pixel: the next frames take that depth where it lies (shadows' key depth -7 %).
+constexpr float kKeyShare = 0.8f;
+ImageView<const float> view_share(const FrameContext& fc, const Mapping& map, const Camera& camera,
+                                  float& uniform) {
+    const bool still =
+        fc.key && camera.prev_view == camera.view && camera.prev_projection == camera.projection;
+    uniform = fc.key && !still ? kKeyShare : 1.0f;
     const double ratio = double(fc.camera_step) / (map.step * kViewCodesPerStep);
-    if (!map.view || fc.ids.empty() || fc.objects.empty() || !(ratio > 1.0)) return {};
+    const bool finer = ratio > 1.0;
+    if (!map.view || fc.ids.empty() || fc.objects.empty() || !(finer || still)) return {};
+    const float moving_share = fc.key ? kKeyShare : 1.0f;
+    const float other_share = (finer ? float(ratio) : 1.0f) * uniform;
     Image<float>& share = fc.work->view_share;
     ensure_size(share, fc.ids.width, fc.ids.height);
     parallel_for(0, fc.ids.height, [&](int y0, int y1) {
         uint32_t last_id = 0;
-        float last_share = float(ratio);  // id 0's
+        float last_share = other_share;  // id 0's
         for (int y = y0; y < y1; ++y)
             for (int x = 0; x < fc.ids.width; ++x) {
                 const uint32_t id = fc.ids(x, y);
@@ -1059,8 +1069,8 @@ ImageView<const float> view_share(const FrameContext& fc, const Mapping& map) {
                     last_share =
                         id != 0 && std::any_of(fc.objects.begin(), fc.objects.end(),
                                                [&](const ObjectMotion& o) { return o.id == id; })
-                            ? 1.0f
-                            : float(ratio);
+                            ? moving_share
+                            : other_share;
                 }
                 share(x, y) = last_share;
             }
@@ -1106,8 +1116,9 @@ void encode_depth(const FrameContext& fc, const Camera& camera, ImageView<const 
     ensure_size(predictions, w, h);
     std::vector<SliceJob> jobs =
         slice_jobs(sp, map, codes, temporal, residuals, fc.work->depth_shows, &predictions);
-    const ImageView<const float> share = view_share(fc, map);
-    for (SliceJob& j : jobs) j.source = source, j.share = share;
+    float uniform_share = 1.0f;
+    const ImageView<const float> share = view_share(fc, map, camera, uniform_share);
+    for (SliceJob& j : jobs) j.source = source, j.share = share, j.uniform_share = uniform_share;
     std::vector<std::vector<uint8_t>>& flags = fc.work->slice_flags;
     flags.resize(std::size_t(sp.slices));
     encode_slices(sp.slices, fc.work->slice_bytes, bytes,
