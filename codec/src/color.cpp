@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <type_traits>
 
 #include "internal.hpp"
 #include "kernels.hpp"
@@ -57,8 +58,13 @@ inline int srgb_code(const SrgbTables& t, float v) {
 void to_planes_row_reference(const ToPlanesRow& r, int x_begin, int x_end) {
     const SrgbTables& t = srgb_tables();
     for (int x = x_begin; x < x_end; ++x) {
-        const glm::vec4& c = r.color[x];
-        const int R = srgb_code(t, c.r), G = srgb_code(t, c.g), B = srgb_code(t, c.b);
+        int R, G, B;
+        if (r.display) {
+            R = r.display[x].r, G = r.display[x].g, B = r.display[x].b;
+        } else {
+            const glm::vec4& c = r.color[x];
+            R = srgb_code(t, c.r), G = srgb_code(t, c.g), B = srgb_code(t, c.b);
+        }
         const int co = R - B;
         const int tt = B + (co >> 1);
         const int cg = G - tt;
@@ -76,14 +82,26 @@ void from_planes_row_reference(const FromPlanesRow& r, int x_begin, int x_end) {
         const int G = std::clamp(cg + tt, 0, 255);
         const int B = std::clamp(tt - (co >> 1), 0, 255);
         const int R = std::clamp(tt - (co >> 1) + co, 0, 255);
-        const float a = !r.depth || std::isfinite(r.depth[x]) ? 1.0f : 0.0f;
-        r.out[x] = {t.to_linear[R], t.to_linear[G], t.to_linear[B], a};
+        const bool covered = !r.depth || std::isfinite(r.depth[x]);
+        if (r.display)
+            r.display[x] = {R, G, B, covered ? 255 : 0};
+        else
+            r.out[x] = {t.to_linear[R], t.to_linear[G], t.to_linear[B], covered ? 1.0f : 0.0f};
     }
 }
 
-void planes_from_linear(ImageView<const glm::vec4> color, const SequenceParams& sp, Planes& out) {
+namespace {
+
+// The source colour: linear light or display codes (one of the two).
+struct SourceColor {
+    ImageView<const glm::vec4> linear;
+    ImageView<const glm::u8vec4> display;
+};
+
+void to_planes(const SourceColor& color, const SequenceParams& sp, Planes& out) {
     const int w = sp.width, h = sp.height, cw = sp.chroma_width(), ch = sp.chroma_height();
-    REPRISE_ASSERT(color.width == w && color.height == h);
+    REPRISE_ASSERT(color.linear.empty() ? color.display.width == w && color.display.height == h
+                                        : color.linear.width == w && color.linear.height == h);
     for (int k = 0; k < 3; ++k) ensure_size(out.p[k], sp.plane_width(k), sp.plane_height(k));
     const bool sub = sp.chroma == Chroma::C420;
     const int pw = out.p[0].width(), cpw = out.p[1].width();
@@ -99,8 +117,9 @@ void planes_from_linear(ImageView<const glm::vec4> color, const SequenceParams& 
                     const int y = std::min(h - 1, 2 * r + i);
                     int16_t* py = out.p[0].data() + std::size_t(y) * pw + x0;
                     to_planes_row(
-                        {.color = color.row(y) + x0,
+                        {.color = color.linear.empty() ? nullptr : color.linear.row(y) + x0,
                          .width = n,
+                         .display = color.display.empty() ? nullptr : color.display.row(y) + x0,
                          .y = py,
                          .co = sub ? co_rows[i] : out.p[1].data() + std::size_t(y) * cpw + x0,
                          .cg = sub ? cg_rows[i] : out.p[2].data() + std::size_t(y) * cpw + x0});
@@ -131,8 +150,22 @@ void planes_from_linear(ImageView<const glm::vec4> color, const SequenceParams& 
     }
 }
 
-void linear_from_planes(const Planes& planes, const SequenceParams& sp,
-                        ImageView<const float> depth, Image<glm::vec4>& out) {
+}  // namespace
+
+void planes_from_linear(ImageView<const glm::vec4> color, const SequenceParams& sp, Planes& out) {
+    to_planes({.linear = color}, sp, out);
+}
+
+void planes_from_display(ImageView<const glm::u8vec4> color, const SequenceParams& sp,
+                         Planes& out) {
+    to_planes({.display = color}, sp, out);
+}
+
+namespace {
+
+template <class Pixel>
+void from_planes(const Planes& planes, const SequenceParams& sp, ImageView<const float> depth,
+                 Image<Pixel>& out) {
     const int w = sp.width, h = sp.height, cw = sp.chroma_width(), ch = sp.chroma_height();
     ensure_size(out, w, h);
     const bool sub = sp.chroma == Chroma::C420;
@@ -179,15 +212,32 @@ void linear_from_planes(const Planes& planes, const SequenceParams& sp,
                     }
                     pco = co, pcg = cg;
                 }
-                from_planes_row({.y = py + x0,
-                                 .co = pco,
-                                 .cg = pcg,
-                                 .depth = depth.empty() ? nullptr : depth.row(y) + x0,
-                                 .width = n,
-                                 .out = out.data() + std::size_t(y) * w + x0});
+                FromPlanesRow row{.y = py + x0,
+                                  .co = pco,
+                                  .cg = pcg,
+                                  .depth = depth.empty() ? nullptr : depth.row(y) + x0,
+                                  .width = n,
+                                  .out = nullptr};
+                if constexpr (std::is_same_v<Pixel, glm::vec4>)
+                    row.out = out.data() + std::size_t(y) * w + x0;
+                else
+                    row.display = out.data() + std::size_t(y) * w + x0;
+                from_planes_row(row);
             }
         }
     });
+}
+
+}  // namespace
+
+void linear_from_planes(const Planes& planes, const SequenceParams& sp,
+                        ImageView<const float> depth, Image<glm::vec4>& out) {
+    from_planes(planes, sp, depth, out);
+}
+
+void display_from_planes(const Planes& planes, const SequenceParams& sp,
+                         ImageView<const float> depth, Image<glm::u8vec4>& out) {
+    from_planes(planes, sp, depth, out);
 }
 
 }  // namespace reprise::codec

@@ -13,6 +13,25 @@ namespace {
 
 constexpr std::size_t kMaxQueuedFrames = 16;
 
+template <class T>
+Image<T> take_spare(std::vector<Image<T>>& spare) {
+    if (spare.empty()) return {};
+    Image<T> buffer = std::move(spare.back());
+    spare.pop_back();
+    return buffer;
+}
+
+// The caller's buffer comes back for a later frame (no allocation per frame); one the caller
+// moved from keeps its size but not its pixels, and is not reused.
+template <class T>
+void hand_out(Image<T>& made, Image<T>& callers, std::vector<Image<T>>& spare,
+              const SequenceParams& sp) {
+    std::swap(callers, made);
+    if (made.width() == sp.width && made.height() == sp.height &&
+        made.pixel_count() == std::size_t(sp.width) * std::size_t(sp.height) && spare.size() < 2)
+        spare.push_back(std::move(made));
+}
+
 }  // namespace
 
 Decoder::Decoder() : state_(std::make_unique<State>()) {}
@@ -117,16 +136,16 @@ Status Decoder::send_packet(std::span<const uint8_t> packet) {
     s.newest = h.frame;
 
     State::Output out{.picture = s.refs[slot], .fps = s.sp.fps};
-    if (!s.spare.empty()) {
-        out.color = std::move(s.spare.back());
-        s.spare.pop_back();
-    }
     {
         const StageTimer timer(fs.ms.convert);
-        if (s.options.color)
-            linear_from_planes(out.picture->planes, s.sp, out.picture->depth.view(), out.color);
-        else
-            out.color.clear();
+        const ImageView<const float> depth = out.picture->depth.view();
+        if (s.options.color && s.options.display) {
+            out.display = take_spare(s.spare_display);
+            display_from_planes(out.picture->planes, s.sp, depth, out.display);
+        } else if (s.options.color) {
+            out.color = take_spare(s.spare);
+            linear_from_planes(out.picture->planes, s.sp, depth, out.color);
+        }
     }
     s.queue.push_back(std::move(out));
     add_stats(s.stats, fs);
@@ -147,14 +166,8 @@ Result Decoder::receive_frame(DecodedFrame& frame) {
     State& s = *state_;
     if (s.queue.empty()) return Result::NeedMoreData;
     State::Output& out = s.queue.front();
-    // The caller's colour buffer comes back for a later frame (no allocation per frame); one
-    // the caller moved from keeps its size but not its pixels, and is not reused.
-    std::swap(frame.color, out.color);
-    const Image<glm::vec4>& old = out.color;
-    if (old.width() == s.sp.width && old.height() == s.sp.height &&
-        old.pixel_count() == std::size_t(s.sp.width) * std::size_t(s.sp.height) &&
-        s.spare.size() < 2)
-        s.spare.push_back(std::move(out.color));
+    hand_out(out.color, frame.color, s.spare, s.sp);
+    hand_out(out.display, frame.display, s.spare_display, s.sp);
     const Picture& pic = *out.picture;
     frame.camera = pic.camera;
     frame.fps = out.fps;

@@ -21,10 +21,13 @@ struct Decoder::State {
     struct Output {
         std::shared_ptr<const Picture> picture;
         Image<glm::vec4> color;
+        Image<glm::u8vec4> display;
         double fps = 0.0;
     };
     std::deque<Output> queue;
-    std::vector<Image<glm::vec4>> spare;  // colour buffers handed back, reused for output
+    // Colour buffers handed back, reused for output.
+    std::vector<Image<glm::vec4>> spare;
+    std::vector<Image<glm::u8vec4>> spare_display;
     StreamStats stats;
     NonfiniteRepair repair;
     std::shared_ptr<Picture> scratch;

@@ -143,7 +143,7 @@ struct Encoder::State {
         if (!options.fit_cameras || !carries_no_camera(frame.camera) || frame.depth.empty() ||
             frame.motion.empty() || options.depth == DepthMode::None)
             return frame.camera;
-        const int w = frame.width(), h = frame.height();
+        const int w = frame.depth.width, h = frame.depth.height;
         CameraFit fit;
         if (chain.lens[2][3] == 0.0f) {
             // The focal length shows in how rotation bends the motion: kept once a fit rotates
@@ -282,9 +282,13 @@ int Encoder::bitrate() const { return state_->options.bitrate_kbps; }
 Encoder::Encoder(Encoder&&) noexcept = default;
 Encoder& Encoder::operator=(Encoder&&) noexcept = default;
 
-Status Encoder::send_frame(const GBufferView& given) {
+Status Encoder::send_frame(const GBufferView& given) { return send_frame(given, {}); }
+
+Status Encoder::send_frame(const GBufferView& given, ImageView<const glm::u8vec4> display) {
     State& s = *state_;
-    const int w = given.color.width, h = given.color.height;
+    const bool linear = display.empty();
+    const int w = linear ? given.color.width : display.width;
+    const int h = linear ? given.color.height : display.height;
     REPRISE_TRY(check_image_size(w, h, "encoder input frame " + std::to_string(s.next_frame)));
     // References, predictions, residuals and the stages' scratch: the encoder's own peak RSS was
     // 113 bytes a pixel at 1920x1080 and 119 for 1920x1080 minus 960x540 (8 frames of pan, the
@@ -300,9 +304,11 @@ Status Encoder::send_frame(const GBufferView& given) {
         return Status::error("encoder: " + std::to_string(s.queue.size()) +
                              " packets not taken by receive_packet");
 
-    // The codec codes no normals: they are neither scanned nor repaired.
+    // The codec codes no normals: they are neither scanned nor repaired; nor linear colour when
+    // the display values come instead.
     GBufferView coded = given;
     coded.normal = {};
+    if (!linear) coded.color = {};
     StreamStats::Milliseconds ms;
     NonfiniteCounts nonfinite;
     State::Chain next_chain;
@@ -342,7 +348,10 @@ Status Encoder::send_frame(const GBufferView& given) {
     s.sp = sp;
 
     timer.emplace(ms.convert);
-    planes_from_linear(frame.color, sp, s.source_planes);
+    if (linear)
+        planes_from_linear(frame.color, sp, s.source_planes);
+    else
+        planes_from_display(display, sp, s.source_planes);
     timer.reset();
     // A cut the frame's camera reports starts a key frame; one it does not say is detected below.
     int ref = frame.camera.cut == Cut::Yes ? -1 : s.choose_reference();

@@ -137,11 +137,16 @@ int held_slot(const Held (&refs)[kReferences], uint32_t frame) {
 }
 
 // --- color.cpp
-// Linear colour -> 8-bit sRGB -> YCoCg-R, chroma averaged 2x2 for 4:2:0.
+// Linear colour -> 8-bit sRGB -> YCoCg-R, chroma averaged 2x2 for 4:2:0; or from the 8-bit sRGB
+// display values themselves (RGBA8, alpha not read).
 void planes_from_linear(ImageView<const glm::vec4> color, const SequenceParams& sp, Planes& out);
-// YCoCg-R planes -> linear RGB (A = alpha_one ? 1 : coverage from depth).
+void planes_from_display(ImageView<const glm::u8vec4> color, const SequenceParams& sp, Planes& out);
+// YCoCg-R planes -> linear RGB, or 8-bit sRGB display values (A: coverage from depth, 1 without
+// depth).
 void linear_from_planes(const Planes& planes, const SequenceParams& sp,
                         ImageView<const float> depth, Image<glm::vec4>& out);
+void display_from_planes(const Planes& planes, const SequenceParams& sp,
+                         ImageView<const float> depth, Image<glm::u8vec4>& out);
 
 // --- geometry.cpp
 // Backward motion that the cameras alone explain: pixel p of a frame seen by `from` with depth z

@@ -5,6 +5,7 @@
 #include <cstddef>
 #include <cstdint>
 
+#include <glm/ext/vector_uint4_sized.hpp>
 #include <glm/mat4x4.hpp>
 #include <glm/vec2.hpp>
 #include <glm/vec4.hpp>
@@ -85,10 +86,12 @@ void camera_motion_row_reference(const CameraMotionRow& row, int x_begin, int x_
 void camera_motion_row(const CameraMotionRow& row);
 
 // Colour conversion of one row into YCoCg-R: linear RGB -> 8-bit sRGB codes (color.cpp's
-// table and thresholds) -> y, co, cg.
+// table and thresholds) -> y, co, cg; or the codes themselves, given as `display` (RGBA8, alpha
+// not read) instead of `color`.
 struct ToPlanesRow {
     const glm::vec4* color;
     int width;
+    const glm::u8vec4* display = nullptr;
     int16_t* y;
     int16_t* co;
     int16_t* cg;
@@ -109,7 +112,8 @@ struct SrgbTables {
 const SrgbTables& srgb_tables();
 
 // One row of YCoCg-R (chroma at full resolution) -> linear RGB; alpha 0 where the depth is
-// not finite (no depth: 1).
+// not finite (no depth: 1). Or the 8-bit sRGB codes, to `display` (RGBA8, alpha 0 or 255) instead
+// of `out`.
 struct FromPlanesRow {
     const int16_t* y;
     const int16_t* co;
@@ -117,6 +121,7 @@ struct FromPlanesRow {
     const float* depth;  // null without depth
     int width;
     glm::vec4* out;
+    glm::u8vec4* display = nullptr;
 };
 void from_planes_row_reference(const FromPlanesRow& row, int x_begin, int x_end);
 void from_planes_row(const FromPlanesRow& row);

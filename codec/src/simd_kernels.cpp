@@ -267,11 +267,19 @@ void ToPlanesRowSimd(const ToPlanesRow& r) {
         return hn::IfThenElse(hn::RebindMask(di, saturated), top,
                               hn::IfThenElse(hn::RebindMask(di, positive), c, zero_i));
     };
+    const hn::Rebind<uint8_t, decltype(di)> d8;
     int x = 0;
     for (; x + n <= r.width; x += n) {
-        VF red, green, blue, alpha;
-        hn::LoadInterleaved4(df, &r.color[x].x, red, green, blue, alpha);
-        const VI R = code(red), G = code(green), B = code(blue);
+        VI R, G, B;
+        if (r.display) {
+            hn::Vec<decltype(d8)> red, green, blue, alpha;
+            hn::LoadInterleaved4(d8, &r.display[x].x, red, green, blue, alpha);
+            R = hn::PromoteTo(di, red), G = hn::PromoteTo(di, green), B = hn::PromoteTo(di, blue);
+        } else {
+            VF red, green, blue, alpha;
+            hn::LoadInterleaved4(df, &r.color[x].x, red, green, blue, alpha);
+            R = code(red), G = code(green), B = code(blue);
+        }
         const VI co = R - B;
         const VI tt = B + hn::ShiftRight<1>(co);
         const VI cg = G - tt;
@@ -293,6 +301,7 @@ void FromPlanesRowSimd(const FromPlanesRow& r) {
     const VI zero_i = hn::Zero(di), top = hn::Set(di, 255);
     const VF zero = hn::Zero(df), one = hn::Set(df, 1.0f);
     auto clamp = [&](VI v) { return hn::Min(hn::Max(v, zero_i), top); };
+    const hn::Rebind<uint8_t, decltype(di)> d8;
     int x = 0;
     for (; x + n <= r.width; x += n) {
         const VI y = hn::PromoteTo(di, hn::LoadU(d16, r.y + x));
@@ -306,6 +315,12 @@ void FromPlanesRowSimd(const FromPlanesRow& r) {
         if (r.depth) {
             const VF d = hn::LoadU(df, r.depth + x);
             alpha = hn::IfThenElseZero((d - d) == zero, one);
+        }
+        if (r.display) {
+            hn::StoreInterleaved4(hn::DemoteTo(d8, R), hn::DemoteTo(d8, G), hn::DemoteTo(d8, B),
+                                  hn::DemoteTo(d8, hn::ConvertTo(di, alpha) * top), d8,
+                                  &r.display[x].x);
+            continue;
         }
         hn::StoreInterleaved4(hn::GatherIndex(df, lut, R), hn::GatherIndex(df, lut, G),
                               hn::GatherIndex(df, lut, B), alpha, df, &r.out[x].x);

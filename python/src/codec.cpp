@@ -1,6 +1,7 @@
 // The scene-aware codec: frames to packets (bytes) and back.
 #include <pybind11/stl.h>
 
+#include <cstring>
 #include <span>
 
 #include "common.hpp"
@@ -103,12 +104,24 @@ struct PyEncoder {
             value_error(made.message());
     }
 
-    py::bytes encode(const Frame& frame) {
+    py::bytes encode(const Frame& frame, const py::object& display) {
         Status status;
         codec::Packet packet;
+        py::array_t<uint8_t, py::array::c_style> rgba;
+        ImageView<const glm::u8vec4> display_view;
+        if (!display.is_none()) {
+            rgba = py::array_t<uint8_t, py::array::c_style>::ensure(display);
+            if (!rgba || py::array(display).dtype().kind() != 'u' ||
+                py::array(display).dtype().itemsize() != 1 || rgba.ndim() != 3 ||
+                rgba.shape(2) != 4)
+                value_error("display: expected a uint8 array of shape (height, width, 4)");
+            display_view = {reinterpret_cast<const glm::u8vec4*>(rgba.data()), int(rgba.shape(1)),
+                            int(rgba.shape(0)), std::size_t(rgba.shape(1))};
+        }
         {
             py::gil_scoped_release release;
-            status = encoder.send_frame(frame);
+            status = display_view.empty() ? encoder.send_frame(frame)
+                                          : encoder.send_frame(frame, display_view);
             if (status.ok() && encoder.receive_packet(packet) != Result::Ok)
                 status = Status::error("encoder: no packet for the frame");
         }
@@ -119,25 +132,48 @@ struct PyEncoder {
 };
 
 struct PyDecoder {
-    explicit PyDecoder(int64_t max_pixels) {
-        if (const Status made = codec::Decoder::create({.max_pixels = max_pixels}, decoder); !made)
+    PyDecoder(int64_t max_pixels, bool display) {
+        if (const Status made =
+                codec::Decoder::create({.max_pixels = max_pixels, .display = display}, decoder);
+            !made)
             value_error(made.message());
     }
-
-    std::optional<Frame> decode(const py::buffer& packet) {
+    // One packet in, the frame it completes out (false: none yet), the GIL released meanwhile.
+    template <class Out>
+    bool next(const py::buffer& packet, Out& out) {
         py::buffer_info info;
         const std::span<const uint8_t> bytes = byte_span(packet, info);
         Status status;
-        Frame frame;
         bool made = false;
         {
             py::gil_scoped_release release;
             status = decoder.send_packet(bytes);
-            if (status.ok()) made = decoder.receive_frame(frame) == Result::Ok;
+            if (status.ok()) made = decoder.receive_frame(out) == Result::Ok;
         }
         check(status);
-        if (!made) return std::nullopt;
+        return made;
+    }
+    std::optional<Frame> decode(const py::buffer& packet) {
+        Frame frame;
+        if (!next(packet, frame)) return std::nullopt;
         return frame;
+    }
+    // With display: the frame (no colour) and its 8-bit sRGB display values, (height, width, 4).
+    std::optional<std::pair<Frame, py::array_t<uint8_t>>> decode_display(const py::buffer& packet) {
+        codec::DecodedFrame decoded;
+        if (!next(packet, decoded)) return std::nullopt;
+        if (decoded.display.empty())
+            value_error("decode_display: the decoder was made without display=True");
+        Frame frame;
+        frame.depth.assign(decoded.depth());
+        frame.motion.assign(decoded.motion());
+        frame.camera = decoded.camera;
+        frame.fps = decoded.fps;
+        const Image<glm::u8vec4>& d = decoded.display;
+        py::array_t<uint8_t> rgba(
+            {py::ssize_t(d.height()), py::ssize_t(d.width()), py::ssize_t(4)});
+        std::memcpy(rgba.mutable_data(), d.data(), d.pixel_count() * sizeof(glm::u8vec4));
+        return std::pair{std::move(frame), std::move(rgba)};
     }
     codec::Decoder decoder;
 };
@@ -165,7 +201,10 @@ void bind_codec(py::module_& m) {
              py::arg("motion_error_px") = 0.25f, py::arg("skip_threshold") = 2,
              py::arg("detect_cuts") = true, py::arg("bounds_follow_qp") = true,
              py::arg("slices") = 0)
-        .def("encode", &PyEncoder::encode, py::arg("frame"), "The packet of the next frame.")
+        .def("encode", &PyEncoder::encode, py::arg("frame"), py::arg("display") = py::none(),
+             "The packet of the next frame; `display` (uint8, (height, width, 4), alpha not "
+             "read): its colour as 8-bit sRGB display values, coded as they are instead of "
+             "frame.color.")
         .def("request_key_frame", [](PyEncoder& e) { e.encoder.request_key_frame(); })
         .def_property_readonly(
             "reconstruction", [](const PyEncoder& e) { return e.encoder.reconstruction(); },
@@ -177,9 +216,14 @@ void bind_codec(py::module_& m) {
     py::class_<PyDecoder>(m, "Decoder",
                           "Decodes packets; a bad packet raises reprise.Error and the decoder "
                           "stays usable.")
-        .def(py::init<int64_t>(), py::arg("max_pixels") = int64_t(8192) * 4320)
+        .def(py::init<int64_t, bool>(), py::arg("max_pixels") = int64_t(8192) * 4320,
+             py::arg("display") = false)
         .def("decode", &PyDecoder::decode, py::arg("packet"),
-             "The frame of one packet (bytes-like), or None when it needs more.")
+             "The frame of one packet (bytes-like), or None when it needs more (made with "
+             "display=True: no colour).")
+        .def("decode_display", &PyDecoder::decode_display, py::arg("packet"),
+             "Made with display=True: (frame without colour, its 8-bit sRGB display values as "
+             "uint8 (height, width, 4), alpha 0 on background), or None when it needs more.")
         .def_property_readonly("stats",
                                [](const PyDecoder& d) { return stats_dict(d.decoder.stats()); });
 
@@ -218,7 +262,7 @@ void bind_codec(py::module_& m) {
             check(codec::write_stream_header(file, frames[0]->width(), frames[0]->height(),
                                              stream_fps));
             for (const Frame* f : frames) {
-                const std::string packet = encoder->encode(*f);
+                const std::string packet = encoder->encode(*f, py::none());
                 file.insert(file.end(), packet.begin(), packet.end());
             }
             return py::bytes(reinterpret_cast<const char*>(file.data()), file.size());

@@ -78,6 +78,30 @@ def test_codec_round_trip(pan_60):
     assert decoder.stats["ms"]["objects"] == 0
 
 
+def test_codec_8bit_srgb_in_and_out(pan_60):
+    """Colour as 8-bit sRGB display values both ways: the same codes as linear light."""
+    encoder, linear, display = reprise.Encoder(qp=24), reprise.Decoder(), reprise.Decoder(display=True)
+    again_linear, again_display = reprise.Encoder(qp=24), reprise.Encoder(qp=24)
+    for frame in pan_60[:3]:
+        packet = encoder.encode(frame)
+        decoded = linear.decode(packet)
+        shown_frame, rgba = display.decode_display(packet)
+        assert rgba.dtype == np.uint8 and rgba.shape == decoded.color.shape
+        assert shown_frame.color is None and np.array_equal(shown_frame.depth, decoded.depth)
+        c = decoded.color[..., :3]
+        srgb = np.where(c <= 0.0031308, 12.92 * c, 1.055 * np.power(c, 1 / 2.4) - 0.055)
+        assert np.array_equal(rgba[..., :3], np.rint(255 * srgb).astype(np.uint8))
+        assert np.array_equal(rgba[..., 3], (255 * decoded.color[..., 3]).astype(np.uint8))
+        # The decoded picture coded again: as display values, the bytes of linear light.
+        again = reprise.Frame(decoded.color, frame.depth, frame.motion, camera=frame.camera,
+                              fps=frame.fps)
+        assert again_display.encode(again, display=rgba) == again_linear.encode(again)
+    with pytest.raises(ValueError, match="uint8"):
+        again_display.encode(pan_60[0], display=np.zeros((4, 4, 4), np.float32))
+    with pytest.raises(ValueError, match="display=True"):
+        linear.decode_display(reprise.Encoder().encode(pan_60[0]))
+
+
 def test_codec_streams_and_bad_packets(pan_60):
     stream = reprise.encode_stream(pan_60[:2], qp=30)
     frames = reprise.decode_stream(stream)

@@ -226,9 +226,16 @@ private:
 // included); worst case: NaN, Inf, negative, denormal and values just around the thresholds.
 class ToPlanesCase final : public KernelCase {
 public:
+    explicit ToPlanesCase(bool display) : display_(display) {}
     void generate(int w, int h, KernelInputs inputs, uint32_t seed) override {
         std::mt19937 rng(seed);
         width_ = w, height_ = h;
+        if (display_) {  // every byte value in every channel
+            display_color_.resize(std::size_t(w) * h);
+            for (glm::u8vec4& c : display_color_)
+                for (int k = 0; k < 4; ++k) c[k] = uint8_t(rng());
+            return;
+        }
         color_.resize(std::size_t(w) * h);
         const float* thresholds = srgb_tables().thresholds;
         for (glm::vec4& c : color_)
@@ -256,13 +263,14 @@ public:
 private:
     template <class Kernel>
     void run_into(std::vector<int16_t>& out, Kernel kernel) {
-        const std::size_t n = color_.size();
+        const std::size_t n = std::size_t(width_) * height_;
         out.assign(3 * n, 0);
         parallel_for(0, height_, [&](int y0, int y1) {
             for (int y = y0; y < y1; ++y) {
                 const std::size_t o = std::size_t(y) * width_;
-                kernel({.color = color_.data() + o,
+                kernel({.color = display_ ? nullptr : color_.data() + o,
                         .width = width_,
+                        .display = display_ ? display_color_.data() + o : nullptr,
                         .y = out.data() + o,
                         .co = out.data() + n + o,
                         .cg = out.data() + 2 * n + o});
@@ -270,8 +278,10 @@ private:
         });
     }
 
+    bool display_;
     int width_ = 0, height_ = 0;
     std::vector<glm::vec4> color_;
+    std::vector<glm::u8vec4> display_color_;
     std::vector<int16_t> reference_, optimized_;
 };
 
@@ -279,6 +289,7 @@ private:
 // them (every clamp) and NaN/Inf depths.
 class FromPlanesCase final : public KernelCase {
 public:
+    explicit FromPlanesCase(bool display) : display_(display) {}
     void generate(int w, int h, KernelInputs inputs, uint32_t seed) override {
         std::mt19937 rng(seed);
         width_ = w, height_ = h;
@@ -305,10 +316,12 @@ public:
     }
 
 private:
+    // The display values are compared as floats, one per channel.
     template <class Kernel>
     void run_into(std::vector<glm::vec4>& out, Kernel kernel) {
         const std::size_t n = depth_.size();
         out.assign(n, glm::vec4(0.0f));
+        std::vector<glm::u8vec4> display(display_ ? n : 0);
         parallel_for(0, height_, [&](int y0, int y1) {
             for (int y = y0; y < y1; ++y) {
                 const std::size_t o = std::size_t(y) * width_;
@@ -317,11 +330,14 @@ private:
                         .cg = planes_.data() + 2 * n + o,
                         .depth = y % 2 ? depth_.data() + o : nullptr,
                         .width = width_,
-                        .out = out.data() + o});
+                        .out = display_ ? nullptr : out.data() + o,
+                        .display = display_ ? display.data() + o : nullptr});
             }
         });
+        for (std::size_t i = 0; i < display.size(); ++i) out[i] = glm::vec4(display[i]);
     }
 
+    bool display_;
     int width_ = 0, height_ = 0;
     std::vector<int16_t> planes_;
     std::vector<float> depth_;
@@ -891,8 +907,10 @@ constexpr KernelEntry kEntries[] = {
     {"codec view depth keeps its prediction", "bit-exact", true, make<ViewKeepCase>},
     {"codec what depth's temporal prediction shows", "bit-exact", true, make<ShowsCase>},
     {"codec view depth codes and their depth", "bit-exact", true, make<ViewCodeCase>},
-    {"codec colour to YCoCg-R", "bit-exact", true, make<ToPlanesCase>},
-    {"codec YCoCg-R to colour", "bit-exact", true, make<FromPlanesCase>},
+    {"codec colour to YCoCg-R", "bit-exact", true, make<ToPlanesCase, false>},
+    {"codec display colour to YCoCg-R", "bit-exact", true, make<ToPlanesCase, true>},
+    {"codec YCoCg-R to colour", "bit-exact", true, make<FromPlanesCase, false>},
+    {"codec YCoCg-R to display colour", "bit-exact", true, make<FromPlanesCase, true>},
 };
 
 }  // namespace

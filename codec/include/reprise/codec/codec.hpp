@@ -11,6 +11,8 @@
 #include <string>
 #include <vector>
 
+#include <glm/ext/vector_uint4_sized.hpp>
+
 #include "reprise/core/frame.hpp"
 #include "reprise/core/nonfinite.hpp"
 
@@ -155,6 +157,10 @@ public:
     // A Frame converts to it. The packet then comes out of receive_packet(). An error for a frame
     // it cannot code (sizes, memory, more than 16 packets not taken); the encoder stays usable.
     Status send_frame(const GBufferView& frame);
+    // The same with the colour as 8-bit sRGB display values (RGBA8, alpha not read; an engine's
+    // swapchain image, say), coded as they are: frame.color is not read (it may be empty), and
+    // the display values set the size.
+    Status send_frame(const GBufferView& frame, ImageView<const glm::u8vec4> display);
     // Ok with the next packet in `packet`, or NeedMoreData: send the next frame first.
     Result receive_packet(Packet& packet);
     void flush();  // no delayed frames: kept for the state-machine shape
@@ -199,6 +205,10 @@ struct DecoderOptions {
     // geometry stream whose colour the caller does not use (lowres streaming). The colour planes
     // are still decoded: the next frames predict from them.
     bool color = true;
+    // On (with `color`): the colour comes as the 8-bit sRGB display values the stream codes
+    // (DecodedFrame::display, RGBA8, A 255 where depth is finite or absent, else 0) instead of
+    // linear light, for a client that shows them: a quarter of the bytes and no conversion.
+    bool display = false;
 };
 
 // A decoded frame that shares the decoder's picture, as dav1d hands out its pictures: depth and
@@ -207,7 +217,8 @@ struct DecoderOptions {
 // or motion (a lossless stream can spell NaN) comes repaired, in a copy of the channel.
 class DecodedFrame {
 public:
-    Image<glm::vec4> color;  // linear light; empty with DecoderOptions::color = false
+    Image<glm::vec4> color;  // linear light; empty with DecoderOptions::color = false or display
+    Image<glm::u8vec4> display;  // with DecoderOptions::display: 8-bit sRGB display values
     Camera camera;
     double fps = 0.0;
 
