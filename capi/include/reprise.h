@@ -41,7 +41,7 @@ extern "C" {
  * minor be at most the library's. A struct_size of an older minor's struct is taken: the fields
  * it lacks keep their defaults. libreprise.so's SONAME carries the major. */
 #define REPRISE_ABI_VERSION_MAJOR 1
-#define REPRISE_ABI_VERSION_MINOR 3
+#define REPRISE_ABI_VERSION_MINOR 4
 #define REPRISE_ABI_VERSION \
     ((uint32_t)((REPRISE_ABI_VERSION_MAJOR << 16) | REPRISE_ABI_VERSION_MINOR))
 
@@ -71,7 +71,10 @@ REPRISE_API const char* reprise_last_error(void);
 REPRISE_API reprise_status reprise_set_max_memory(uint64_t bytes);
 REPRISE_API uint64_t reprise_max_memory(void);
 
-/* Pixel formats: components of 32-bit float, 16-bit float (IEEE half) or 32-bit unsigned. */
+/* Pixel formats: components of 32-bit float, 16-bit float (IEEE half) or 32-bit unsigned; and
+ * (ABI 1.4) 8-bit sRGB display values, RGBA, for the codec's colour only: an engine's swapchain
+ * image into the encoder (alpha not read), a client's texture out of a decoder made with
+ * options.display (alpha 255 on surfaces, 0 on background). */
 typedef int32_t reprise_format;
 enum {
     REPRISE_FORMAT_NONE = 0,
@@ -83,7 +86,8 @@ enum {
     REPRISE_FORMAT_RG16_FLOAT = 6,
     REPRISE_FORMAT_RGB16_FLOAT = 7,
     REPRISE_FORMAT_RGBA16_FLOAT = 8,
-    REPRISE_FORMAT_R32_UINT = 9
+    REPRISE_FORMAT_R32_UINT = 9,
+    REPRISE_FORMAT_RGBA8_SRGB = 10
 };
 
 /* One channel: a non-owning view. data NULL = the channel is absent. Rows run top to bottom,
@@ -265,8 +269,9 @@ REPRISE_API reprise_status reprise_encoder_create(uint32_t abi_version,
                                                   const reprise_encoder_options* options,
                                                   reprise_encoder** encoder);
 REPRISE_API void reprise_encoder_destroy(reprise_encoder* encoder);
-/* Encodes one frame: colour required; depth, motion and the camera enable prediction; reset
- * forces a key frame. Its packet then comes out of receive_packet. */
+/* Encodes one frame: colour required (linear float, or REPRISE_FORMAT_RGBA8_SRGB display values,
+ * coded as they are); depth, motion and the camera enable prediction; reset forces a key frame.
+ * Its packet then comes out of receive_packet. */
 REPRISE_API reprise_status reprise_encoder_send_frame(reprise_encoder* encoder,
                                                       const reprise_gbuffer* frame);
 /* Copies the next packet into data[0..capacity) and sets *size to its length. NEED_MORE when
@@ -277,7 +282,9 @@ REPRISE_API reprise_status reprise_encoder_flush(reprise_encoder* encoder);
 
 typedef struct reprise_decoder_options {
     uint32_t struct_size; /* sizeof(reprise_decoder_options) */
-    int32_t reserved;     /* 0 */
+    int32_t display;      /* 1: colour comes out as REPRISE_FORMAT_RGBA8_SRGB display values (the
+                             stream's own, no conversion); 0 (default): linear float. ABI 1.4,
+                             was `reserved`, 0 */
     int64_t max_pixels;   /* larger key frames are refused (default 8192 x 4320) */
 } reprise_decoder_options;
 
@@ -295,8 +302,9 @@ REPRISE_API reprise_status reprise_decoder_flush(reprise_decoder* decoder);
 /* As the converter's: the next frame's size, or NEED_MORE. */
 REPRISE_API reprise_status reprise_decoder_output_size(reprise_decoder* decoder, int32_t* width,
                                                        int32_t* height);
-/* Writes the next decoded frame: colour required, depth and motion where data is set; normal,
- * id and ui must be absent. Sets camera and fps. */
+/* Writes the next decoded frame: colour required (a float format, or REPRISE_FORMAT_RGBA8_SRGB
+ * from a decoder made with options.display), depth and motion where data is set; normal, id and
+ * ui must be absent. Sets camera and fps. */
 REPRISE_API reprise_status reprise_decoder_receive_frame(reprise_decoder* decoder,
                                                          reprise_gbuffer* out);
 

@@ -11,10 +11,25 @@ using namespace reprise::capi;
 
 struct reprise_decoder {
     std::unique_ptr<codec::Decoder> decoder;
+    bool display = false;  // colour out as RGBA8_SRGB
     HeldFrame next;
+    codec::DecodedFrame decoded;
 
     void pull() {
-        if (!next.held) next.held = decoder->receive_frame(next.frame) == Result::Ok;
+        if (next.held) return;
+        if (!display) {
+            next.held = decoder->receive_frame(next.frame) == Result::Ok;
+            return;
+        }
+        next.held = decoder->receive_frame(decoded) == Result::Ok;
+        if (!next.held) return;
+        std::swap(next.display, decoded.display);  // buffers go back and forth, not reallocated
+        next.frame.color.clear();
+        next.frame.depth.assign(decoded.depth());
+        next.frame.motion.assign(decoded.motion());
+        next.frame.camera = decoded.camera;
+        next.frame.fps = decoded.fps;
+        decoded.release();
     }
 };
 
@@ -42,9 +57,11 @@ reprise_status reprise_decoder_create(uint32_t abi_version, const reprise_decode
         [&](const reprise_decoder_options& o, reprise_decoder& made) {
             REPRISE_CAPI_TRY(check_range(function, "options->max_pixels", double(o.max_pixels), 1.0,
                                          double(kMaxImageSide) * kMaxImageSide));
+            REPRISE_CAPI_TRY(check_flag(function, "options->display", o.display));
+            made.display = o.display != 0;
             made.decoder = std::make_unique<codec::Decoder>();
-            const Status status =
-                codec::Decoder::create({.max_pixels = o.max_pixels}, *made.decoder);
+            const Status status = codec::Decoder::create(
+                {.max_pixels = o.max_pixels, .display = made.display}, *made.decoder);
             if (!status) return fail(REPRISE_ERROR_INVALID_ARGUMENT, function, status.message());
             return reprise_status(REPRISE_OK);
         });

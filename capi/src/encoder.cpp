@@ -12,6 +12,7 @@ using namespace reprise::capi;
 struct reprise_encoder {
     std::unique_ptr<codec::Encoder> encoder;
     Frame input;
+    Image<glm::u8vec4> display;  // the colour given as RGBA8_SRGB
     codec::Packet packet;
     bool held = false;  // `packet` was pulled (its size told) and not yet copied out
 };
@@ -104,8 +105,9 @@ reprise_status reprise_encoder_send_frame(reprise_encoder* encoder, const repris
     const char* function = "reprise_encoder_send_frame";
     return with_handle(function, encoder, "encoder", [&](reprise_encoder& e) {
         REPRISE_CAPI_TRY(
-            read_gbuffer(function, "frame", frame, kColor | kDepth | kMotion, e.input));
-        const Status status = e.encoder->send_frame(e.input);
+            read_gbuffer(function, "frame", frame, kColor | kDepth | kMotion, e.input, &e.display));
+        const Status status = e.display.empty() ? e.encoder->send_frame(e.input)
+                                                : e.encoder->send_frame(e.input, e.display.view());
         if (!status) return fail(REPRISE_ERROR_INVALID_ARGUMENT, function, status.message());
         return reprise_status(REPRISE_OK);
     });

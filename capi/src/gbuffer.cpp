@@ -14,13 +14,13 @@
 namespace reprise::capi {
 namespace {
 
-enum class Kind { Float32, Float16, Uint32 };
+enum class Kind { Float32, Float16, Uint32, Srgb8 };
 
 struct Format {
     int components = 0;  // 0: not a format
     Kind kind = Kind::Float32;
     const char* name = "unknown";
-    int component_bytes() const { return kind == Kind::Float16 ? 2 : 4; }
+    int component_bytes() const { return kind == Kind::Srgb8 ? 1 : kind == Kind::Float16 ? 2 : 4; }
     int pixel_bytes() const { return components * component_bytes(); }
 };
 
@@ -44,6 +44,8 @@ Format describe(reprise_format format) {
             return {4, Kind::Float16, "RGBA16_FLOAT"};
         case REPRISE_FORMAT_R32_UINT:
             return {1, Kind::Uint32, "R32_UINT"};
+        case REPRISE_FORMAT_RGBA8_SRGB:
+            return {4, Kind::Srgb8, "RGBA8_SRGB"};
         default:
             return {};
     }
@@ -56,9 +58,11 @@ struct Spec {
     int min_components, components;
     bool integer;
     const char* accepted;  // for messages
+    bool srgb8 = false;    // 8-bit sRGB display values (the codec's colour) instead
 };
 constexpr Spec kColorSpec{"color", 3, 4, false,
                           "RGB32_FLOAT, RGBA32_FLOAT, RGB16_FLOAT, RGBA16_FLOAT"};
+constexpr Spec kDisplaySpec{"color", 4, 4, false, "RGBA8_SRGB", true};
 constexpr Spec kDepthSpec{"depth", 1, 1, false, "R32_FLOAT, R16_FLOAT"};
 constexpr Spec kMotionSpec{"motion", 2, 2, false, "RG32_FLOAT, RG16_FLOAT"};
 constexpr Spec kNormalSpec{"normal", 3, 3, false, "RGB32_FLOAT, RGB16_FLOAT"};
@@ -78,9 +82,9 @@ reprise_status check_image(const char* function, const std::string& name, const 
                            const reprise_image& image, int width, int height) {
     const std::string field = name + "->" + spec.field;
     const Format format = describe(image.format);
-    const bool fits = format.components >= spec.min_components &&
-                      format.components <= spec.components &&
-                      (format.kind == Kind::Uint32) == spec.integer;
+    const bool fits =
+        format.components >= spec.min_components && format.components <= spec.components &&
+        (format.kind == Kind::Uint32) == spec.integer && (format.kind == Kind::Srgb8) == spec.srgb8;
     if (!fits)
         return fail(REPRISE_ERROR_INVALID_ARGUMENT, function,
                     field + ".format " + std::to_string(image.format) + " (" + format.name +
@@ -171,8 +175,11 @@ void read_pixels(const reprise_image& image, Image<T>& out) {
     parallel_for(0, image.height, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y) {
             const unsigned char* row = base + int64_t(y) * image.stride;
-            for (int x = 0; x < image.width; ++x)
-                out(x, y) = load_pixel<T>(row + int64_t(x) * f.pixel_bytes(), f);
+            if constexpr (std::is_same_v<T, glm::u8vec4>)  // RGBA8_SRGB: the bytes as they are
+                std::memcpy(&out(0, y), row, std::size_t(image.width) * sizeof(T));
+            else
+                for (int x = 0; x < image.width; ++x)
+                    out(x, y) = load_pixel<T>(row + int64_t(x) * f.pixel_bytes(), f);
         }
     });
 }
@@ -184,8 +191,11 @@ void write_pixels(const Image<T>& in, const reprise_image& image) {
     parallel_for(0, image.height, [&](int y0, int y1) {
         for (int y = y0; y < y1; ++y) {
             unsigned char* row = base + int64_t(y) * image.stride;
-            for (int x = 0; x < image.width; ++x)
-                store_pixel(row + int64_t(x) * f.pixel_bytes(), f, in(x, y));
+            if constexpr (std::is_same_v<T, glm::u8vec4>)
+                std::memcpy(row, &in(0, y), std::size_t(image.width) * sizeof(T));
+            else
+                for (int x = 0; x < image.width; ++x)
+                    store_pixel(row + int64_t(x) * f.pixel_bytes(), f, in(x, y));
         }
     });
 }
@@ -307,7 +317,7 @@ reprise_status check_gbuffer_struct(const char* function, const char* name,
 }  // namespace
 
 reprise_status read_gbuffer(const char* function, const char* name, const reprise_gbuffer* given,
-                            unsigned read, Frame& frame) {
+                            unsigned read, Frame& frame, Image<glm::u8vec4>* display) {
     REPRISE_CAPI_TRY(check_gbuffer_struct(function, name, given));
     const std::string prefix = std::string(name) + "->";
     if (given->reset < REPRISE_RESET_UNKNOWN || given->reset > REPRISE_RESET_NO)
@@ -318,9 +328,17 @@ reprise_status read_gbuffer(const char* function, const char* name, const repris
         return fail(REPRISE_ERROR_INVALID_ARGUMENT, function,
                     prefix + "color.data is NULL: colour is required");
     const std::string n = name;
-    REPRISE_CAPI_TRY(check_image(function, n, kColorSpec, given->color, 0, 0));
+    const bool srgb8 = display && given->color.format == REPRISE_FORMAT_RGBA8_SRGB;
+    REPRISE_CAPI_TRY(
+        check_image(function, n, srgb8 ? kDisplaySpec : kColorSpec, given->color, 0, 0));
     const int w = given->color.width, h = given->color.height;
-    read_pixels(given->color, frame.color);
+    if (display) display->clear();
+    if (srgb8) {
+        read_pixels(given->color, *display);
+        frame.color.clear();
+    } else {
+        read_pixels(given->color, frame.color);
+    }
     REPRISE_CAPI_TRY(
         read_channel(function, n, kDepthSpec, given->depth, read & kDepth, w, h, frame.depth));
     REPRISE_CAPI_TRY(
@@ -341,7 +359,7 @@ reprise_status read_gbuffer(const char* function, const char* name, const repris
 }
 
 reprise_status check_output(const char* function, const reprise_gbuffer* out, int width, int height,
-                            unsigned written) {
+                            unsigned written, bool srgb8) {
     REPRISE_CAPI_TRY(check_gbuffer_struct(function, "out", out));
     for (const OutputChannel& channel : kChannels) {
         const reprise_image& image = out->*channel.image;
@@ -355,18 +373,24 @@ reprise_status check_output(const char* function, const reprise_gbuffer* out, in
             return fail(REPRISE_ERROR_INVALID_ARGUMENT, function,
                         std::string("out->") + channel.spec.field + ": this call writes no " +
                             channel.spec.field + " (leave its data NULL)");
-        REPRISE_CAPI_TRY(check_image(function, "out", channel.spec, image, width, height));
+        const Spec& spec = channel.bit == kColor && srgb8 ? kDisplaySpec : channel.spec;
+        REPRISE_CAPI_TRY(check_image(function, "out", spec, image, width, height));
     }
     return REPRISE_OK;
 }
 
-reprise_status write_gbuffer(const char* function, const Frame& frame, reprise_gbuffer* out) {
+reprise_status write_gbuffer(const char* function, const Frame& frame, reprise_gbuffer* out,
+                             const Image<glm::u8vec4>* display) {
     for (const OutputChannel& channel : kChannels)
-        if ((out->*channel.image).data && !frame_has(frame, channel.bit))
+        if ((out->*channel.image).data && !frame_has(frame, channel.bit) &&
+            !(channel.bit == kColor && display && !display->empty()))
             return fail(REPRISE_ERROR_INVALID_ARGUMENT, function,
                         std::string("out->") + channel.spec.field + ": this frame has no " +
                             channel.spec.field + " (its input had none; leave data NULL)");
-    write_pixels(frame.color, out->color);
+    if (display && !display->empty())
+        write_pixels(*display, out->color);
+    else
+        write_pixels(frame.color, out->color);
     if (out->depth.data) write_pixels(frame.depth, out->depth);
     if (out->motion.data) write_pixels(frame.motion, out->motion);
     if (out->normal.data) write_pixels(frame.normal, out->normal);
@@ -386,8 +410,8 @@ reprise_status held_size(const char* function, const HeldFrame& next, int32_t* w
     REPRISE_CAPI_TRY(check_pointer(function, height, "height"));
     *width = *height = 0;
     if (!next.held) return REPRISE_NEED_MORE;
-    *width = next.frame.width();
-    *height = next.frame.height();
+    *width = next.width();
+    *height = next.height();
     return REPRISE_OK;
 }
 
@@ -397,8 +421,9 @@ reprise_status receive_held(const char* function, HeldFrame& next, unsigned writ
         REPRISE_CAPI_TRY(check_gbuffer_struct(function, "out", out));
         return REPRISE_NEED_MORE;
     }
-    REPRISE_CAPI_TRY(check_output(function, out, next.frame.width(), next.frame.height(), written));
-    REPRISE_CAPI_TRY(write_gbuffer(function, next.frame, out));
+    REPRISE_CAPI_TRY(
+        check_output(function, out, next.width(), next.height(), written, !next.display.empty()));
+    REPRISE_CAPI_TRY(write_gbuffer(function, next.frame, out, &next.display));
     next.held = false;
     return REPRISE_OK;
 }

@@ -13,7 +13,7 @@ LIBRARY = os.environ.get("REPRISE_CAPI_LIBRARY")
 # This test is a caller built against ABI 1.1 (its ConverterOptions ends before
 # widen_silhouettes, added in 1.2): the library must keep taking it.
 ABI_VERSION = (1 << 16) | 1
-LIBRARY_ABI_VERSION = (1 << 16) | 3
+LIBRARY_ABI_VERSION = (1 << 16) | 4
 OK, NEED_MORE = 0, 1
 ERROR_INVALID_ARGUMENT, ERROR_ABI_MISMATCH, ERROR_BUFFER_TOO_SMALL = -1, -2, -3
 R32_FLOAT, RG32_FLOAT, RGB32_FLOAT, RGBA32_FLOAT = 1, 2, 3, 4

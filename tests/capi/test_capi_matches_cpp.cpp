@@ -316,5 +316,72 @@ TEST(CapiMatchesCpp, FixedBoundsAreTheCodecsOption) {
         << reprise_last_error();
 }
 
+// Colour as 8-bit sRGB display values (ABI 1.4): RGBA8_SRGB into the encoder gives the C++
+// encoder's packets from those values, and a decoder made with `display` writes the C++
+// decoder's display values; the other calls and a linear decoder refuse the format.
+TEST(CapiMatchesCpp, CodecColourAsEightBitSrgbIsTheCodecs) {
+    const std::vector<Frame> input = frames();
+    codec::Encoder encoder;
+    codec::Decoder decoder;
+    ASSERT_TRUE(codec::Decoder::create({.display = true}, decoder).ok());
+    reprise_encoder* ce = nullptr;
+    reprise_decoder* cd = nullptr;
+    reprise_decoder_options options;
+    ASSERT_EQ(reprise_decoder_options_init(&options, sizeof options), REPRISE_OK);
+    EXPECT_EQ(options.display, 0);
+    options.display = 1;
+    ASSERT_EQ(reprise_encoder_create(REPRISE_ABI_VERSION, nullptr, &ce), REPRISE_OK);
+    ASSERT_EQ(reprise_decoder_create(REPRISE_ABI_VERSION, &options, &cd), REPRISE_OK);
+    for (std::size_t k = 0; k < input.size(); ++k) {
+        Image<glm::u8vec4> shown(kW, kH);
+        for (std::size_t p = 0; p < shown.pixel_count(); ++p)
+            shown.data()[p] = glm::u8vec4(uint8_t(7 * p + k), uint8_t(p / 3), uint8_t(200 - p), 9);
+        ASSERT_TRUE(encoder.send_frame(input[k], shown.view()).ok());
+        codec::Packet packet;
+        ASSERT_EQ(encoder.receive_packet(packet), Result::Ok);
+        reprise_gbuffer g = gbuffer_of(input[k]);
+        g.color = image_of(shown, REPRISE_FORMAT_RGBA8_SRGB);
+        ASSERT_EQ(reprise_encoder_send_frame(ce, &g), REPRISE_OK) << reprise_last_error();
+        std::vector<uint8_t> bytes(packet.data.size());
+        std::size_t size = 0;
+        ASSERT_EQ(reprise_encoder_receive_packet(ce, bytes.data(), bytes.size(), &size),
+                  REPRISE_OK);
+        EXPECT_EQ(bytes, packet.data) << "packet " << k;
+
+        ASSERT_TRUE(decoder.send_packet(packet.data).ok());
+        codec::DecodedFrame want;
+        ASSERT_EQ(decoder.receive_frame(want), Result::Ok);
+        ASSERT_EQ(reprise_decoder_send_packet(cd, bytes.data(), bytes.size()), REPRISE_OK);
+        Frame got;
+        reprise_gbuffer out = output_into(got);
+        Image<glm::u8vec4> display(kW, kH);
+        if (k == 0) {  // a float colour from a display decoder: refused, the frame kept
+            ASSERT_EQ(reprise_decoder_receive_frame(cd, &out), REPRISE_ERROR_INVALID_ARGUMENT);
+            EXPECT_NE(std::string(reprise_last_error()).find("RGBA8_SRGB"), std::string::npos)
+                << reprise_last_error();
+        }
+        out.color = image_of(display, REPRISE_FORMAT_RGBA8_SRGB);
+        ASSERT_EQ(reprise_decoder_receive_frame(cd, &out), REPRISE_OK) << reprise_last_error();
+        EXPECT_EQ(0, std::memcmp(display.data(), want.display.data(),
+                                 display.pixel_count() * sizeof(glm::u8vec4)))
+            << "frame " << k;
+        Image<float> want_depth;
+        want_depth.assign(want.depth());
+        EXPECT_TRUE(test::same_bits(want_depth, got.depth)) << "frame " << k;
+    }
+    reprise_encoder_destroy(ce);
+    reprise_decoder_destroy(cd);
+    // The converter takes linear colour only.
+    reprise_converter* c = nullptr;
+    ASSERT_EQ(reprise_converter_create(REPRISE_ABI_VERSION, nullptr, &c), REPRISE_OK);
+    Image<glm::u8vec4> shown(kW, kH);
+    reprise_gbuffer g = gbuffer_of(input[0]);
+    g.color = image_of(shown, REPRISE_FORMAT_RGBA8_SRGB);
+    EXPECT_EQ(reprise_converter_send(c, &g), REPRISE_ERROR_INVALID_ARGUMENT);
+    EXPECT_NE(std::string(reprise_last_error()).find("RGBA8_SRGB"), std::string::npos)
+        << reprise_last_error();
+    reprise_converter_destroy(c);
+}
+
 }  // namespace
 }  // namespace reprise
