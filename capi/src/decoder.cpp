@@ -57,8 +57,10 @@ reprise_status reprise_decoder_create(uint32_t abi_version, const reprise_decode
         [&](const reprise_decoder_options& o, reprise_decoder& made) {
             REPRISE_CAPI_TRY(check_range(function, "options->max_pixels", double(o.max_pixels), 1.0,
                                          double(kMaxImageSide) * kMaxImageSide));
-            REPRISE_CAPI_TRY(check_flag(function, "options->display", o.display));
-            made.display = o.display != 0;
+            // A caller of an older minor had `reserved` there, never read: not read now either.
+            const bool has_display = (abi_version & 0xFFFFu) >= 4;
+            if (has_display) REPRISE_CAPI_TRY(check_flag(function, "options->display", o.display));
+            made.display = has_display && o.display != 0;
             made.decoder = std::make_unique<codec::Decoder>();
             const Status status = codec::Decoder::create(
                 {.max_pixels = o.max_pixels, .display = made.display}, *made.decoder);

@@ -332,11 +332,11 @@ reprise_status read_gbuffer(const char* function, const char* name, const repris
     REPRISE_CAPI_TRY(
         check_image(function, n, srgb8 ? kDisplaySpec : kColorSpec, given->color, 0, 0));
     const int w = given->color.width, h = given->color.height;
-    if (display) display->clear();
     if (srgb8) {
         read_pixels(given->color, *display);
         frame.color.clear();
     } else {
+        if (display) display->clear();
         read_pixels(given->color, frame.color);
     }
     REPRISE_CAPI_TRY(

@@ -115,8 +115,11 @@ struct PyEncoder {
                 py::array(display).dtype().itemsize() != 1 || rgba.ndim() != 3 ||
                 rgba.shape(2) != 4)
                 value_error("display: expected a uint8 array of shape (height, width, 4)");
+            if (rgba.shape(0) < 1 || rgba.shape(1) < 1 || rgba.shape(0) > kMaxImageSide ||
+                rgba.shape(1) > kMaxImageSide)
+                value_error("display: size outside 1.." + std::to_string(kMaxImageSide));
             display_view = {reinterpret_cast<const glm::u8vec4*>(rgba.data()), int(rgba.shape(1)),
-                            int(rgba.shape(0)), std::size_t(rgba.shape(1))};
+                            int(rgba.shape(0)), std::ptrdiff_t(rgba.shape(1))};
         }
         {
             py::gil_scoped_release release;
@@ -132,7 +135,7 @@ struct PyEncoder {
 };
 
 struct PyDecoder {
-    PyDecoder(int64_t max_pixels, bool display) {
+    PyDecoder(int64_t max_pixels, bool display_values) : display(display_values) {
         if (const Status made =
                 codec::Decoder::create({.max_pixels = max_pixels, .display = display}, decoder);
             !made)
@@ -160,10 +163,9 @@ struct PyDecoder {
     }
     // With display: the frame (no colour) and its 8-bit sRGB display values, (height, width, 4).
     std::optional<std::pair<Frame, py::array_t<uint8_t>>> decode_display(const py::buffer& packet) {
+        if (!display) value_error("decode_display: the decoder was made without display=True");
         codec::DecodedFrame decoded;
         if (!next(packet, decoded)) return std::nullopt;
-        if (decoded.display.empty())
-            value_error("decode_display: the decoder was made without display=True");
         Frame frame;
         frame.depth.assign(decoded.depth());
         frame.motion.assign(decoded.motion());
@@ -175,6 +177,7 @@ struct PyDecoder {
         std::memcpy(rgba.mutable_data(), d.data(), d.pixel_count() * sizeof(glm::u8vec4));
         return std::pair{std::move(frame), std::move(rgba)};
     }
+    bool display;
     codec::Decoder decoder;
 };
 

@@ -98,6 +98,8 @@ def test_codec_8bit_srgb_in_and_out(pan_60):
         assert again_display.encode(again, display=rgba) == again_linear.encode(again)
     with pytest.raises(ValueError, match="uint8"):
         again_display.encode(pan_60[0], display=np.zeros((4, 4, 4), np.float32))
+    with pytest.raises(ValueError, match="size"):
+        again_display.encode(pan_60[0], display=np.zeros((0, 4, 4), np.uint8))
     with pytest.raises(ValueError, match="display=True"):
         linear.decode_display(reprise.Encoder().encode(pan_60[0]))
 
