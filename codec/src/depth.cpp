@@ -568,11 +568,13 @@ uint32_t choose_view_code(const SliceJob& j, int x, int y, bool temporal, uint32
 }
 
 // The estimated cost of a block predicted temporally or spatially; in view mode, its codes are
-// chosen for that prediction on the way.
-uint64_t block_cost(SliceJob& j, int bx, int by, int bw, int bh, int mode) {
+// chosen for that prediction on the way. A mode whose cost reaches `enough` cannot be chosen: its
+// pixels are left at the first row that reaches it (the chosen mode's codes are made again).
+uint64_t block_cost(SliceJob& j, int bx, int by, int bw, int bh, int mode,
+                    uint64_t enough = UINT64_MAX) {
     const bool temporal = mode == kTemporalMode;
     uint64_t cost = 0;
-    for (int y = by; y < by + bh; ++y)
+    for (int y = by; y < by + bh && cost < enough; ++y)
         for (int x = bx; x < bx + bw; ++x) {
             const uint32_t p = block_prediction(j, x, y, mode);
             if (j.map->view) {
@@ -697,7 +699,8 @@ void encode_slice(SliceJob& j, std::vector<uint8_t>& bytes, std::vector<uint8_t>
                 if (!exact) cost = block_cost(j, bx, by, bw, bh, kTemporalMode);
             }
             if (!inter || cost > 0) {
-                const uint64_t spatial_cost = block_cost(j, bx, by, bw, bh, kSpatialMode);
+                const uint64_t spatial_cost =
+                    block_cost(j, bx, by, bw, bh, kSpatialMode, inter ? cost : UINT64_MAX);
                 last = kSpatialMode;
                 if (!inter || spatial_cost < cost) {
                     mode = kSpatialMode;
@@ -715,7 +718,9 @@ void encode_slice(SliceJob& j, std::vector<uint8_t>& bytes, std::vector<uint8_t>
                 j.plane = fitted;
                 j.plane_x = bx;
                 j.plane_y = by;
-                const uint64_t pixels = block_cost(j, bx, by, bw, bh, kPlaneMode);
+                // Beyond cost + kZeroFlags a plane's pixels alone cost more than the block.
+                const uint64_t pixels =
+                    block_cost(j, bx, by, bw, bh, kPlaneMode, cost + kZeroFlags);
                 last = kPlaneMode;
                 // The estimates leave out the zero flags of a block with residuals (one per
                 // pixel, kZeroFlags bits in all); a plane that leaves none saves them.
