@@ -534,25 +534,27 @@ namespace {
 uint32_t choose_view_code(const SliceJob& j, int x, int y, bool temporal, uint32_t p) {
     const Mapping& map = *j.map;
     const float z = j.source.empty() ? INFINITY : j.source(x, y);
-    const uint32_t k = map.code(z);
-    if (k > kMaxViewCode && k != kInvalidCode) return k;  // background: a flag
+    if (z == INFINITY) return kInfCode;  // background: a flag
+    // map.code(z), a rounding, is needed only for a residual: the tests first.
+    const bool valid = z > 0.0f && std::isfinite(z);
+    const double w = valid ? 1.0 / double(z) : 0.0;
     const double share = j.share.empty() ? j.uniform_share : double(j.share(x, y));
-    if (k != kInvalidCode && p <= kMaxViewCode &&
-        view_code_within(1.0 / double(z), p, map.step, map.displacement, share))
+    if (valid && p <= kMaxViewCode && view_code_within(w, p, map.step, map.displacement, share))
         return p;
     const uint32_t other = other_prediction(j, x, y, temporal, p);
-    if (k != kInvalidCode) {
+    if (valid) {
         if (other != p && other <= kMaxViewCode &&
-            view_code_within(1.0 / double(z), other, map.step, map.displacement, share))
+            view_code_within(w, other, map.step, map.displacement, share))
             return other;
         const uint32_t across = across_prediction(j, x, y, p);
         if (across != p && across != other && across <= kMaxViewCode &&
-            view_code_within(1.0 / double(z), across, map.step, map.displacement, share))
+            view_code_within(w, across, map.step, map.displacement, share))
             return across;
     }
     const int64_t base = surface_prediction(j, x, y, p), s = kViewResidualStep;
-    if (k == kInvalidCode)  // NaN: any code above 2^30 + 1
+    if (!valid)  // NaN: any code above 2^30 + 1
         return uint32_t(base + std::max<int64_t>(0, (kInvalidCode - base + s - 1) / s) * s);
+    const uint32_t k = map.code(z);
     auto nearest = [&](int64_t from) {  // whole steps from `from`, nearest the truth
         int64_t c = from + (int64_t(k) - from + (k >= from ? s / 2 : -(s / 2))) / s * s;
         if (c < 0) c += s;  // the nearest code of 0..2^30 instead
