@@ -256,7 +256,8 @@ public:
     // The frame's colour buffer goes back to the decoder for a later frame (no allocation per
     // frame); its picture is let go.
     Result receive_frame(DecodedFrame& frame);
-    // The same into a Frame that owns its channels: depth and motion are copied.
+    // The same into a Frame that owns its channels: depth and motion are copied (with
+    // DecoderOptions::display the Frame gets no colour: take the DecodedFrame's `display`).
     Result receive_frame(Frame& frame);
     void flush();
 
