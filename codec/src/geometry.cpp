@@ -210,6 +210,29 @@ inline int next_without_landing(const float* row, int x, int end) {
     return x;
 }
 
+// The first pixel of row[x, end) with a landing, or end (a run of background, say, can be long).
+inline int next_with_landing(const float* row, int x, int end) {
+    for (; x + 16 <= end; x += 16) {
+        bool all = true;
+        for (int k = 0; k < 16; ++k) all &= std::isnan(row[x + k]);
+        if (!all) break;
+    }
+    while (x < end && std::isnan(row[x])) ++x;
+    return x;
+}
+
+// Whether a pixel of up[x, end) or down[x, end) has a landing in front of the background.
+inline bool any_surface(const float* up, const float* down, int x, int end) {
+    for (; x + 16 <= end; x += 16) {
+        bool any = false;
+        for (int k = 0; k < 16; ++k) any |= (up[x + k] < kInf) | (down[x + k] < kInf);
+        if (any) return true;
+    }
+    for (; x < end; ++x)
+        if (up[x] < kInf || down[x] < kInf) return true;
+    return false;
+}
+
 // A pixel no landing reached between two on one surface, across, down or diagonally (a crack
 // where the reference was stretched, or where two cracks cross), takes their mean inverse depth:
 // exact on a plane, as both are values at pixel centres. Then the gaps left in each row are
@@ -239,14 +262,14 @@ void fill_cracks_and_gaps(ImageView<float> depth, Image<float>& scratch, float s
             float* crack = &scratch(0, y);
             for (int x = next_without_landing(row, 1, w - 1); x + 1 < w;
                  x = next_without_landing(row, x + 1, w - 1)) {
-                int end = x + 1;  // the run of pixels without a landing, within the interior
-                while (end + 1 < w && std::isnan(row[end])) ++end;
+                // The run of pixels without a landing, within the interior.
+                const int end = next_with_landing(row, x + 1, w - 1);
                 // A run of two or more (background, say) with no landing above or below it has
                 // no pair of landings across any of its pixels.
-                bool beside = end - x < 2;
-                for (int k = x - 1; k <= end && !beside; ++k)
-                    beside = up[k] < kInf || down[k] < kInf;
-                for (int c = x; c < end; ++c) crack[c] = beside ? across(up, row, down, c) : kNan;
+                if (end - x < 2 || any_surface(up, down, x - 1, end + 1))
+                    for (int c = x; c < end; ++c) crack[c] = across(up, row, down, c);
+                else
+                    std::fill(crack + x, crack + end, kNan);
                 x = end - 1;
             }
         }
@@ -261,8 +284,7 @@ void fill_cracks_and_gaps(ImageView<float> depth, Image<float>& scratch, float s
             const float* crack = cracks ? &scratch(0, y) : nullptr;
             for (int x = next_without_landing(row, 1, w); x < w;
                  x = next_without_landing(row, x + 1, w)) {
-                int end = x + 1;  // the run without a landing
-                while (end < w && std::isnan(row[end])) ++end;
+                const int end = next_with_landing(row, x + 1, w);  // the run without a landing
                 if (cracks)
                     for (int c = x; c < std::min(end, w - 1); ++c) row[c] = crack[c];
                 for (int a = x; a < end; ++a) {  // what the cracks left

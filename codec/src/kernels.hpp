@@ -38,6 +38,9 @@ const int32_t (&catmull_rom_weights())[64][4];
 // -9..128), so that one gather fetches a lane's four taps.
 inline constexpr int32_t kPackedWeightBias = 16;
 const uint32_t (&catmull_rom_packed())[64];
+// The same as pairs of 16-bit weights, taps 0 and 1 (low, high) and taps 2 and 3, for a pairwise
+// multiply-add.
+const uint32_t (&catmull_rom_pairs())[2][64];
 
 // The encoder's skip and intra tests (color_coder.cpp): for each of `blocks` 8x8 blocks side by
 // side, from `source` and `prediction` (their top-left pixels; rows `stride` apart), the sum and

@@ -101,6 +101,20 @@ const uint32_t (&catmull_rom_packed())[64] {
     return table.words;
 }
 
+const uint32_t (&catmull_rom_pairs())[2][64] {
+    struct Pairs {
+        uint32_t words[2][kPhases] = {};
+        Pairs() {
+            for (int p = 0; p < kPhases; ++p)
+                for (int k = 0; k < 2; ++k)
+                    words[k][p] = uint32_t(uint16_t(catmull_rom_weights()[p][2 * k])) |
+                                  uint32_t(uint16_t(catmull_rom_weights()[p][2 * k + 1])) << 16;
+        }
+    };
+    static const Pairs table;
+    return table.words;
+}
+
 void predict_row_reference(const PredictRow& r, int x_begin, int x_end) {
     const int last = r.motion_width - 1;
     const float cy = float(r.y) + 0.5f;

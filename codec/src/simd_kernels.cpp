@@ -64,6 +64,7 @@ void PredictRowSimd(const PredictRow& r) {
     if (permute)
         for (int k = 0; k < 4; ++k) table[k] = hn::LoadU(di, weights + 16 * k);
     const VI fifteen = hn::Set(di, 15), sixteen = hn::Set(di, 16), thirty_two = hn::Set(di, 32);
+    const VI byte = hn::Set(di, 255), bias = hn::Set(di, kPackedWeightBias);
     auto packed_weights = [&](VI phase) {
         if (!permute) return hn::GatherIndex(di, weights, phase);
         const auto index = hn::IndicesFromVec(di, hn::And(phase, fifteen));
@@ -87,6 +88,69 @@ void PredictRowSimd(const PredictRow& r) {
         return t - hn::IfThenElseZero(hn::RebindMask(di, q < hn::ConvertTo(df, t)), one);
     };
 
+    // The 16 lanes' windows (taps clamped to the plane) within 32 samples of a row and within two
+    // adjacent rows' reach: each row's samples are one load, each lane's tap pairs are permuted out
+    // of it (AVX-512BW) and multiplied pairwise; false where they spread wider.
+#if HWY_ARCH_X86 && HWY_TARGET <= HWY_AVX3
+    const bool span_path = n == 16 && r.width >= 32;
+    // 64 words as four vectors, looked up by phase: two two-table permutes and a blend.
+    struct Table64 {
+        __m512i t[4];
+        explicit Table64(const uint32_t* words) {
+            for (int k = 0; k < 4; ++k) t[k] = _mm512_loadu_si512(words + 16 * k);
+        }
+        VI operator()(VI phase) const {
+            const __mmask16 upper = _mm512_test_epi32_mask(phase.raw, _mm512_set1_epi32(32));
+            return VI{_mm512_mask_blend_epi32(upper,
+                                              _mm512_permutex2var_epi32(t[0], phase.raw, t[1]),
+                                              _mm512_permutex2var_epi32(t[2], phase.raw, t[3]))};
+        }
+    };
+    const Table64 pairs01(catmull_rom_pairs()[0]), pairs23(catmull_rom_pairs()[1]);
+    const Table64 packed(catmull_rom_packed());
+    const VI last_x = hn::Set(di, r.width - 1), minus_one = hn::Set(di, -1);
+    auto span_sum = [&](VI ix, VI iy, VI px, VI py, VI& sum) {
+        if (!span_path) return false;
+        auto column = [&](VI c) { return hn::Min(hn::Max(c, zero_i), last_x); };
+        const VI c0 = column(ix - one), c3 = column(ix + two);
+        // Lanes go left to right: the first's or the last's window is the leftmost.
+        const int start =
+            std::clamp(std::min(hn::GetLane(c0), hn::ExtractLane(c0, n - 1)), 0, r.width - 32);
+        const int top = std::min(hn::GetLane(iy), hn::ExtractLane(iy, n - 1));
+        const VI first = hn::Set(di, start), row_offset = iy - hn::Set(di, top);
+        const VI c0_in = c0 - first, c3_in = c3 - first;
+        if (!hn::AllTrue(di, hn::And(hn::And(c0_in > minus_one, c3_in < thirty_two),
+                                     hn::And(row_offset > minus_one, row_offset < two))))
+            return false;
+        const bool spread = !hn::AllTrue(di, row_offset == zero_i);
+        auto pair = [&](VI a, VI b) {
+            return hn::Or(hn::And(a, hn::Set(di, 0xffff)), hn::ShiftLeft<16>(b));
+        };
+        const VI taps01 = pair(c0_in, column(ix) - first);
+        const VI taps23 = pair(column(ix + one) - first, c3_in);
+        const VI weights01 = pairs01(px), weights23 = pairs23(px);
+        auto line = [&](int y) {
+            y = std::clamp(y, 0, r.height - 1);
+            const __m512i s = _mm512_loadu_si512(r.reference + std::size_t(y) * r.width + start);
+            return VI{_mm512_add_epi32(
+                _mm512_madd_epi16(_mm512_permutexvar_epi16(taps01.raw, s), weights01.raw),
+                _mm512_madd_epi16(_mm512_permutexvar_epi16(taps23.raw, s), weights23.raw))};
+        };
+        const VI packed_y = packed(py);
+        const auto lower = row_offset != zero_i;
+        VI above = line(top - 1);
+        for (int j = 0; j < 4; ++j) {
+            const VI wy = hn::And(hn::ShiftRightSame(packed_y, 8 * j), byte) - bias;
+            const VI below = spread ? line(top + j) : above;
+            sum = sum + wy * (spread ? hn::IfThenElse(lower, below, above) : above);
+            if (j < 3) above = spread ? below : line(top + j);
+        }
+        return true;
+    };
+#else
+    auto span_sum = [](VI, VI, VI, VI, VI&) { return false; };
+#endif
+
     const int vector_end = std::min(r.width, r.subsampled ? r.motion_width / 2 : r.motion_width);
     int x = 0;
     for (; x + n <= vector_end; x += n) {
@@ -108,48 +172,48 @@ void PredictRowSimd(const PredictRow& r) {
         const VI ix = hn::ShiftRight<6>(qx), iy = hn::ShiftRight<6>(qy);
         const auto inside =
             hn::And(hn::And(ix > zero_i, iy > zero_i), hn::And(ix < w_minus2, iy < h_minus2));
-        if (!hn::AllTrue(di, inside)) {  // a window over the edge: the reference clamps
-            predict_row_reference(r, x, x + n);
-            continue;
-        }
         const VI px = hn::And(qx, mask63), py = hn::And(qy, mask63);
-        // One lookup per axis fetches a lane's four taps, a biased byte each.
-        const VI packed_x = packed_weights(px), packed_y = packed_weights(py);
-        const VI byte = hn::Set(di, 255), bias = hn::Set(di, kPackedWeightBias);
-        const VI wx[4] = {hn::And(packed_x, byte) - bias,
-                          hn::And(hn::ShiftRight<8>(packed_x), byte) - bias,
-                          hn::And(hn::ShiftRight<16>(packed_x), byte) - bias,
-                          hn::And(hn::ShiftRight<24>(packed_x), byte) - bias};
-        const VI wy[4] = {hn::And(packed_y, byte) - bias,
-                          hn::And(hn::ShiftRight<8>(packed_y), byte) - bias,
-                          hn::And(hn::ShiftRight<16>(packed_y), byte) - bias,
-                          hn::And(hn::ShiftRight<24>(packed_y), byte) - bias};
         VI sum = zero_i;
-        const int ix0 = hn::GetLane(ix), iy0 = hn::GetLane(iy);
-        if (hn::AllTrue(di,
-                        hn::And(ix == counting_from(di, lane_i, ix0), iy == hn::Set(di, iy0)))) {
-            // Adjacent windows (the usual case: motion changes slowly along a row): each tap's
-            // samples are one contiguous load.
-            const int16_t* row = r.reference + std::size_t(iy0 - 1) * r.width + (ix0 - 1);
-            for (int j = 0; j < 4; ++j, row += r.width) {
-                const VI line = wx[0] * hn::PromoteTo(di, hn::LoadU(d16, row)) +
-                                wx[1] * hn::PromoteTo(di, hn::LoadU(d16, row + 1)) +
-                                wx[2] * hn::PromoteTo(di, hn::LoadU(d16, row + 2)) +
-                                wx[3] * hn::PromoteTo(di, hn::LoadU(d16, row + 3));
-                sum = sum + wy[j] * line;
+        if (!span_sum(ix, iy, px, py, sum)) {
+            if (!hn::AllTrue(di, inside)) {  // a window over the edge: the reference clamps
+                predict_row_reference(r, x, x + n);
+                continue;
             }
-        } else {
-            // Byte offsets of each window's top-left sample; a 32-bit gather takes two samples.
-            VI offset = hn::ShiftLeft<1>((iy - one) * stride + (ix - one));
-            const VI row_bytes = hn::Set(di, 2 * r.width);
-            for (int j = 0; j < 4; ++j, offset = offset + row_bytes) {
-                const VI a = hn::GatherOffset(di, base, offset);
-                const VI b = hn::GatherOffset(di, base, offset + two + two);
-                const VI line = wx[0] * hn::ShiftRight<16>(hn::ShiftLeft<16>(a)) +
-                                wx[1] * hn::ShiftRight<16>(a) +
-                                wx[2] * hn::ShiftRight<16>(hn::ShiftLeft<16>(b)) +
-                                wx[3] * hn::ShiftRight<16>(b);
-                sum = sum + wy[j] * line;
+            // One lookup per axis fetches a lane's four taps, a biased byte each.
+            const VI packed_x = packed_weights(px), packed_y = packed_weights(py);
+            const VI wx[4] = {hn::And(packed_x, byte) - bias,
+                              hn::And(hn::ShiftRight<8>(packed_x), byte) - bias,
+                              hn::And(hn::ShiftRight<16>(packed_x), byte) - bias,
+                              hn::And(hn::ShiftRight<24>(packed_x), byte) - bias};
+            const VI wy[4] = {hn::And(packed_y, byte) - bias,
+                              hn::And(hn::ShiftRight<8>(packed_y), byte) - bias,
+                              hn::And(hn::ShiftRight<16>(packed_y), byte) - bias,
+                              hn::And(hn::ShiftRight<24>(packed_y), byte) - bias};
+            const int ix0 = hn::GetLane(ix), iy0 = hn::GetLane(iy);
+            if (hn::AllTrue(
+                    di, hn::And(ix == counting_from(di, lane_i, ix0), iy == hn::Set(di, iy0)))) {
+                // Adjacent windows: each tap's samples are one contiguous load.
+                const int16_t* row = r.reference + std::size_t(iy0 - 1) * r.width + (ix0 - 1);
+                for (int j = 0; j < 4; ++j, row += r.width) {
+                    const VI line = wx[0] * hn::PromoteTo(di, hn::LoadU(d16, row)) +
+                                    wx[1] * hn::PromoteTo(di, hn::LoadU(d16, row + 1)) +
+                                    wx[2] * hn::PromoteTo(di, hn::LoadU(d16, row + 2)) +
+                                    wx[3] * hn::PromoteTo(di, hn::LoadU(d16, row + 3));
+                    sum = sum + wy[j] * line;
+                }
+            } else {
+                // Byte offsets of each window's top-left sample; a 32-bit gather takes two.
+                VI offset = hn::ShiftLeft<1>((iy - one) * stride + (ix - one));
+                const VI row_bytes = hn::Set(di, 2 * r.width);
+                for (int j = 0; j < 4; ++j, offset = offset + row_bytes) {
+                    const VI a = hn::GatherOffset(di, base, offset);
+                    const VI b = hn::GatherOffset(di, base, offset + two + two);
+                    const VI line = wx[0] * hn::ShiftRight<16>(hn::ShiftLeft<16>(a)) +
+                                    wx[1] * hn::ShiftRight<16>(a) +
+                                    wx[2] * hn::ShiftRight<16>(hn::ShiftLeft<16>(b)) +
+                                    wx[3] * hn::ShiftRight<16>(b);
+                    sum = sum + wy[j] * line;
+                }
             }
         }
         const VI value = hn::ShiftRight<14>(sum + round);

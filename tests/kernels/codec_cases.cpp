@@ -37,7 +37,9 @@ public:
         const glm::vec2 pan{uniform(rng, -9, 9), uniform(rng, -5, 5)};
         for (int y = 0; y < motion_height_; ++y)
             for (int x = 0; x < motion_width_; ++x) {
-                glm::vec2 m = pan + glm::vec2(0.01f * float(x), -0.005f * float(y));
+                // The vertical motion changes along a row too: a vector's windows span two rows.
+                glm::vec2 m =
+                    pan + glm::vec2(0.01f * float(x), 0.04f * float(x) - 0.005f * float(y));
                 if (x > motion_width_ / 2) m *= 1.5f;                    // a depth edge
                 if (y % 4 == 1) m = {std::round(m.x), std::round(m.y)};  // whole pixels
                 if (worst && rng() % 3 == 0) m[int(rng() % 2)] = worst_value(rng);
