@@ -179,12 +179,12 @@ struct Landings {
     Image<int> object;     // index into the objects, -1: none
     // Per reference row, the smallest and largest slot its landings reach (first > last: none).
     std::vector<int32_t> first_slot, last_slot;
-    // The plane's span in pixels (plane_row): 6 at a height of 360, the best of 3 to 18 there, as
-    // 12 was at 720.
+    // The plane's span in pixels (plane_row): 2 up to a height of 540, 3 at 1080 (version 19; the
+    // best of 2 to 6 on 20 frames of ten scenes at 360 and 720, of 2 to 18 at 1080).
     int span = 1;
     bool no_objects = false;  // every pixel of `object` is -1
     void resize(int w, int h) {
-        span = std::max(2, int(std::lround(double(h) / 60.0)));
+        span = std::max(2, int(std::lround(double(h) / 360.0)));
         for (Image<float>* i : {&z, &px, &py, &held, &inverse}) ensure_size(*i, w, h);
         ensure_size(slot, w, h);
         first_slot.resize(std::size_t(h));
