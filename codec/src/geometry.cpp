@@ -179,7 +179,7 @@ struct Landings {
     Image<int> object;     // index into the objects, -1: none
     // Per reference row, the smallest and largest slot its landings reach (first > last: none).
     std::vector<int32_t> first_slot, last_slot;
-    // The plane's span in pixels (plane_row): 2 up to a height of 540, 3 at 1080 (version 19; the
+    // The plane's span in pixels (plane_row): 2 below a height of 900, 3 at 1080 (version 19; the
     // best of 2 to 6 on 20 frames of ten scenes at 360 and 720, of 2 to 18 at 1080).
     int span = 1;
     bool no_objects = false;  // every pixel of `object` is -1
