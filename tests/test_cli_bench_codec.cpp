@@ -334,6 +334,37 @@ TEST(CliBenchCodec, TinySceneWritesRowsForEveryPeer) {
     fs::remove_all(dir);
 }
 
+// The speed run alternates the codecs over --repeat rounds and keeps each one's fastest: every
+// round runs, every row of speed.csv has its figures.
+TEST(CliBenchCodec, TheSpeedRunKeepsEachCodecsFastestRound) {
+    namespace fs = std::filesystem;
+    const fs::path dir =
+        fs::temp_directory_path() / ("reprise-cli-bench-codec-speed-" + std::to_string(getpid()));
+    fs::remove_all(dir);
+    const test::Outcome result = test::run_reprise(
+        "bench codec --scenes pan --size 64x48 --frames 2 --qps 28,34 --speed-size 64x48 "
+        "--speed-frames 6 --repeat 2 --out " +
+            dir.string(),
+        300);
+    ASSERT_EQ(result.status, 0) << result.output;
+    for (const char* text : {"round 1/2", "round 2/2", "the fastest of 2 alternating rounds",
+                             "encode at least as fast as x264 veryfast"})
+        EXPECT_NE(result.output.find(text), std::string::npos) << text << "\n" << result.output;
+    std::ifstream csv(dir / "speed.csv");
+    std::string line;
+    std::getline(csv, line);
+    EXPECT_EQ(line, "size,frames,codec,setting,encode_ms,decode_ms,encode_ms_warm,decode_ms_warm");
+    int rows = 0;
+    while (std::getline(csv, line)) {
+        ++rows;
+        EXPECT_EQ(line.rfind("64x48,6,", 0), 0u) << line;
+        const std::size_t after_setting = line.find(',', line.find(',', 8) + 1);
+        EXPECT_GT(std::stod(line.substr(after_setting + 1)), 0.0) << line;  // encode ms
+    }
+    EXPECT_EQ(rows, 5);  // x264 veryfast, ultrafast, the default stream twice, lossless depth
+    fs::remove_all(dir);
+}
+
 // The client's views (1-3 display periods ahead, the other eye) from the default stream's decoded
 // depth stay within 0.2 dB of the same views from rendered depth; with depth coded 32 times
 // coarser (E = 8 px, motion per pixel so that its bound does not refine the depth) they do not.

@@ -516,7 +516,7 @@ std::string verdict(bool known, bool met) { return !known ? "n/a" : met ? "met" 
 
 struct SpeedResult {
     bool measured = false;
-    int w = 0, h = 0, frames = 0;
+    int w = 0, h = 0, frames = 0, rounds = 0;
     double ours_encode = NAN, ours_decode = NAN;          // mean ms per frame, the default stream
     double lossless_encode = NAN, lossless_decode = NAN;  // lossless depth, per-pixel motion
     double x264_veryfast_encode = NAN, x264_veryfast_decode = NAN;
@@ -535,6 +535,14 @@ struct SpeedResult {
     codec::StreamStats encoder_stats, decoder_stats;
 };
 
+// `slot` keeps the smallest of the values given it (NaN: none yet).
+void keep_fastest(double& slot, double value) {
+    if (std::isnan(slot) || value < slot) slot = value;
+}
+
+// The speed run: each codec timed in `rounds` rounds that alternate between them, so that a
+// machine whose load changes during the run slows them alike; each figure is its fastest round's
+// (the stages' milliseconds those of the default stream's fastest encode). Lossless depth once.
 Status measure_speed(server::Renderer& renderer, const BenchOptions& job, int threads, int mid_qp,
                      SpeedResult& speed) {
     REPRISE_TRY(parse_size(job.speed_size, speed.w, speed.h));
@@ -543,46 +551,54 @@ Status measure_speed(server::Renderer& renderer, const BenchOptions& job, int th
         render_sequence(renderer, job.speed_scene, job.speed_frames, speed.w, speed.h, seq));
     seq.name = "speed-" + seq.name;
     speed.frames = int(seq.frames.size());
-    RunResult run;
-    std::fprintf(stderr, "[codec] speed: x264 veryfast at %dx%d\n", speed.w, speed.h);
-    double convert_ms[2] = {NAN, NAN};
-    REPRISE_TRY(
-        run_peer(seq, {.kind = PeerKind::X264, .preset = "veryfast", .crf = 26, .threads = threads},
-                 run, convert_ms));
-    speed.rgb_to_yuv = convert_ms[0];
-    speed.yuv_to_rgb = convert_ms[1];
+    speed.rounds = std::max(1, job.repeat);
     const std::size_t warm = SpeedResult::kWarmFrom;
-    speed.x264_veryfast_encode = run.mean(&Sample::encode_ms);
-    speed.x264_veryfast_decode = run.mean(&Sample::decode_ms);
-    speed.x264_veryfast_encode_warm = run.mean(&Sample::encode_ms, warm);
-    speed.x264_veryfast_decode_warm = run.mean(&Sample::decode_ms, warm);
-    std::fprintf(stderr, "[codec] speed: x264 ultrafast\n");
-    REPRISE_TRY(run_peer(
-        seq, {.kind = PeerKind::X264, .preset = "ultrafast", .crf = 26, .threads = threads}, run));
-    speed.x264_ultrafast_encode = run.mean(&Sample::encode_ms);
-    speed.x264_ultrafast_encode_warm = run.mean(&Sample::encode_ms, warm);
-    std::fprintf(stderr, "[codec] speed: reprise qp %d\n", mid_qp);
-    RunResult color;
+    RunResult run, color;
+    std::fprintf(stderr, "[codec] speed: reprise qp %d, lossless depth and per-pixel motion\n",
+                 mid_qp);
     REPRISE_TRY(run_ours(seq, mid_qp, false, run, color, nullptr));
     speed.lossless_encode = run.mean(&Sample::encode_ms);
     speed.lossless_decode = run.mean(&Sample::decode_ms);
-    REPRISE_TRY(run_ours(seq, mid_qp, true, run, color, nullptr, &speed.encoder_stats,
-                         &speed.decoder_stats));
-    speed.ours_encode = run.mean(&Sample::encode_ms);
-    speed.ours_decode = run.mean(&Sample::decode_ms);
-    speed.ours_encode_warm = run.mean(&Sample::encode_ms, warm);
-    speed.ours_decode_warm = run.mean(&Sample::decode_ms, warm);
-    const double linear_bits = run.mean(&Sample::bits);
-    std::fprintf(stderr, "[codec] speed: reprise qp %d from and to 8-bit sRGB\n", mid_qp);
-    REPRISE_TRY(run_ours_display(seq, mid_qp, run));
-    if (run.mean(&Sample::bits) != linear_bits)  // visualize_color's rounding is not the codec's
-        std::fprintf(stderr,
-                     "[codec] note: from 8-bit sRGB %.0f bits/frame, from linear light %.0f\n",
-                     run.mean(&Sample::bits), linear_bits);
-    speed.display_encode = run.mean(&Sample::encode_ms);
-    speed.display_decode = run.mean(&Sample::decode_ms);
-    speed.display_encode_warm = run.mean(&Sample::encode_ms, warm);
-    speed.display_decode_warm = run.mean(&Sample::decode_ms, warm);
+    for (int round = 1; round <= speed.rounds; ++round) {
+        std::fprintf(stderr, "[codec] speed: round %d/%d, x264 veryfast and ultrafast at %dx%d\n",
+                     round, speed.rounds, speed.w, speed.h);
+        double convert_ms[2] = {NAN, NAN};
+        REPRISE_TRY(run_peer(
+            seq, {.kind = PeerKind::X264, .preset = "veryfast", .crf = 26, .threads = threads}, run,
+            convert_ms));
+        keep_fastest(speed.rgb_to_yuv, convert_ms[0]);
+        keep_fastest(speed.yuv_to_rgb, convert_ms[1]);
+        keep_fastest(speed.x264_veryfast_encode, run.mean(&Sample::encode_ms));
+        keep_fastest(speed.x264_veryfast_decode, run.mean(&Sample::decode_ms));
+        keep_fastest(speed.x264_veryfast_encode_warm, run.mean(&Sample::encode_ms, warm));
+        keep_fastest(speed.x264_veryfast_decode_warm, run.mean(&Sample::decode_ms, warm));
+        REPRISE_TRY(run_peer(
+            seq, {.kind = PeerKind::X264, .preset = "ultrafast", .crf = 26, .threads = threads},
+            run));
+        keep_fastest(speed.x264_ultrafast_encode, run.mean(&Sample::encode_ms));
+        keep_fastest(speed.x264_ultrafast_encode_warm, run.mean(&Sample::encode_ms, warm));
+        std::fprintf(stderr, "[codec] speed: round %d/%d, reprise qp %d\n", round, speed.rounds,
+                     mid_qp);
+        codec::StreamStats encoder_stats, decoder_stats;
+        REPRISE_TRY(
+            run_ours(seq, mid_qp, true, run, color, nullptr, &encoder_stats, &decoder_stats));
+        if (!(speed.ours_encode <= run.mean(&Sample::encode_ms)))
+            speed.encoder_stats = encoder_stats, speed.decoder_stats = decoder_stats;
+        keep_fastest(speed.ours_encode, run.mean(&Sample::encode_ms));
+        keep_fastest(speed.ours_decode, run.mean(&Sample::decode_ms));
+        keep_fastest(speed.ours_encode_warm, run.mean(&Sample::encode_ms, warm));
+        keep_fastest(speed.ours_decode_warm, run.mean(&Sample::decode_ms, warm));
+        const double linear_bits = run.mean(&Sample::bits);
+        REPRISE_TRY(run_ours_display(seq, mid_qp, run));
+        if (round == 1 && run.mean(&Sample::bits) != linear_bits)  // visualize_color's rounding
+            std::fprintf(stderr,
+                         "[codec] note: from 8-bit sRGB %.0f bits/frame, from linear light %.0f\n",
+                         run.mean(&Sample::bits), linear_bits);
+        keep_fastest(speed.display_encode, run.mean(&Sample::encode_ms));
+        keep_fastest(speed.display_decode, run.mean(&Sample::decode_ms));
+        keep_fastest(speed.display_encode_warm, run.mean(&Sample::encode_ms, warm));
+        keep_fastest(speed.display_decode_warm, run.mean(&Sample::decode_ms, warm));
+    }
     speed.measured = true;
     return {};
 }
@@ -920,12 +936,12 @@ Status speed_run(server::Renderer& renderer, const BenchOptions& job, int qp, Cs
     if (speed.measured) {
         speed_text = strf(
             "speed at %dx%d, %d frames, %d threads per codec (reprise: %d pool threads), mean ms "
-            "per frame\n  x264 veryfast zerolatency: encode %8.2f  decode %8.2f  (of which "
-            "swscale RGB->YUV %.2f, YUV->RGB %.2f)\n"
+            "per frame, the fastest of %d alternating rounds\n  x264 veryfast zerolatency: "
+            "encode %8.2f  decode %8.2f  (of which swscale RGB->YUV %.2f, YUV->RGB %.2f)\n"
             "  x264 ultrafast zerolatency: encode %7.2f\n",
-            speed.w, speed.h, speed.frames, job.threads, thread_count(), speed.x264_veryfast_encode,
-            speed.x264_veryfast_decode, speed.rgb_to_yuv, speed.yuv_to_rgb,
-            speed.x264_ultrafast_encode);
+            speed.w, speed.h, speed.frames, job.threads, thread_count(), speed.rounds,
+            speed.x264_veryfast_encode, speed.x264_veryfast_decode, speed.rgb_to_yuv,
+            speed.yuv_to_rgb, speed.x264_ultrafast_encode);
         speed_text += strf(
             "  reprise qp %d, the default stream: encode %8.2f  decode %8.2f  (lossless depth "
             "and per-pixel motion: encode %.2f  decode %.2f)\n"

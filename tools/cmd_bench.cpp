@@ -182,7 +182,8 @@ int command_bench(int argc, char** argv) {
                 "also times 1); stream: the server's and the video peers' sources' (default 1, "
                 "the truth has 4)");
     args.option("--repeat", &job.repeat,
-                "fruc, stereo, upsample: timed runs, each frame's fastest counts (default 3)");
+                "fruc, stereo, upsample: timed runs, each frame's fastest counts; codec: "
+                "alternating rounds of the speed run, each codec's fastest counts (default 3)");
     args.option(
         "--in", &job.in,
         "codec: also a sequence folder (EXR frames, up to --frames); fruc: comma-separated "
