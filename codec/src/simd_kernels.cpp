@@ -55,27 +55,45 @@ void PredictRowSimd(const PredictRow& r) {
     const VI w_minus2 = hn::Set(di, r.width - 2), h_minus2 = hn::Set(di, r.height - 2);
     const VI stride = hn::Set(di, r.width), round = hn::Set(di, 1 << 13);
     const VI lo = hn::Set(di, r.lo), hi = hn::Set(di, r.hi), zero_i = hn::Zero(di);
-    const int32_t* weights = reinterpret_cast<const int32_t*>(&catmull_rom_packed()[0]);
     const int32_t* base = reinterpret_cast<const int32_t*>(r.reference);
+    const VI byte = hn::Set(di, 255), bias = hn::Set(di, kPackedWeightBias);
+#if HWY_ARCH_X86 && HWY_TARGET <= HWY_AVX3
+    // 64 words as four vectors, looked up by phase: two two-table permutes and a blend.
+    struct Table64 {
+        __m512i t[4];
+        explicit Table64(const uint32_t* words) {
+            for (int k = 0; k < 4; ++k) t[k] = _mm512_loadu_si512(words + 16 * k);
+        }
+        VI operator()(VI phase) const {
+            const __mmask16 upper = _mm512_test_epi32_mask(phase.raw, _mm512_set1_epi32(32));
+            return VI{_mm512_mask_blend_epi32(upper,
+                                              _mm512_permutex2var_epi32(t[0], phase.raw, t[1]),
+                                              _mm512_permutex2var_epi32(t[2], phase.raw, t[3]))};
+        }
+    };
+    const Table64 packed(catmull_rom_packed());
+    auto packed_weights = [&](VI phase) { return packed(phase); };
+#else
     // With 16 lanes the 64 packed weights are four vectors, looked up by permutes (a gather
     // each otherwise).
+    const int32_t* weights = reinterpret_cast<const int32_t*>(&catmull_rom_packed()[0]);
     const bool permute = n == 16;
     VI table[4] = {zero_i, zero_i, zero_i, zero_i};
     if (permute)
         for (int k = 0; k < 4; ++k) table[k] = hn::LoadU(di, weights + 16 * k);
-    const VI fifteen = hn::Set(di, 15), sixteen = hn::Set(di, 16), thirty_two = hn::Set(di, 32);
-    const VI byte = hn::Set(di, 255), bias = hn::Set(di, kPackedWeightBias);
+    const VI fifteen = hn::Set(di, 15), sixteen = hn::Set(di, 16);
     auto packed_weights = [&](VI phase) {
         if (!permute) return hn::GatherIndex(di, weights, phase);
         const auto index = hn::IndicesFromVec(di, hn::And(phase, fifteen));
         const auto odd_table = hn::RebindMask(di, hn::And(phase, sixteen) != zero_i);
-        const auto upper_tables = hn::RebindMask(di, hn::And(phase, thirty_two) != zero_i);
+        const auto upper_tables = hn::RebindMask(di, hn::And(phase, hn::Set(di, 32)) != zero_i);
         const VI low = hn::IfThenElse(odd_table, hn::TableLookupLanes(table[1], index),
                                       hn::TableLookupLanes(table[0], index));
         const VI high = hn::IfThenElse(odd_table, hn::TableLookupLanes(table[3], index),
                                        hn::TableLookupLanes(table[2], index));
         return hn::IfThenElse(upper_tables, high, low);
     };
+#endif
 
     auto usable = [&](VF& mx, VF& my) {  // non-finite motion counts as 0
         const auto finite = finite2(mx, my);
@@ -93,22 +111,9 @@ void PredictRowSimd(const PredictRow& r) {
     // of it (AVX-512BW) and multiplied pairwise; false where they spread wider.
 #if HWY_ARCH_X86 && HWY_TARGET <= HWY_AVX3
     const bool span_path = n == 16 && r.width >= 32;
-    // 64 words as four vectors, looked up by phase: two two-table permutes and a blend.
-    struct Table64 {
-        __m512i t[4];
-        explicit Table64(const uint32_t* words) {
-            for (int k = 0; k < 4; ++k) t[k] = _mm512_loadu_si512(words + 16 * k);
-        }
-        VI operator()(VI phase) const {
-            const __mmask16 upper = _mm512_test_epi32_mask(phase.raw, _mm512_set1_epi32(32));
-            return VI{_mm512_mask_blend_epi32(upper,
-                                              _mm512_permutex2var_epi32(t[0], phase.raw, t[1]),
-                                              _mm512_permutex2var_epi32(t[2], phase.raw, t[3]))};
-        }
-    };
     const Table64 pairs01(catmull_rom_pairs()[0]), pairs23(catmull_rom_pairs()[1]);
-    const Table64 packed(catmull_rom_packed());
     const VI last_x = hn::Set(di, r.width - 1), minus_one = hn::Set(di, -1);
+    const VI thirty_two = hn::Set(di, 32);
     auto span_sum = [&](VI ix, VI iy, VI px, VI py, VI& sum) {
         if (!span_path) return false;
         auto column = [&](VI c) { return hn::Min(hn::Max(c, zero_i), last_x); };
@@ -136,7 +141,7 @@ void PredictRowSimd(const PredictRow& r) {
                 _mm512_madd_epi16(_mm512_permutexvar_epi16(taps01.raw, s), weights01.raw),
                 _mm512_madd_epi16(_mm512_permutexvar_epi16(taps23.raw, s), weights23.raw))};
         };
-        const VI packed_y = packed(py);
+        const VI packed_y = packed_weights(py);
         const auto lower = row_offset != zero_i;
         VI above = line(top - 1);
         for (int j = 0; j < 4; ++j) {
