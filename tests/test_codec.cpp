@@ -627,6 +627,29 @@ TEST(Codec, TheDepthBitsAreAccountedForByWhatTheyCode) {
     }
 }
 
+// The motion bits by what they code add up to all of them less the section's header bytes (the
+// flags byte, the predicting objects, the slice sizes): crossing's objects' lists, and what they
+// leave at their silhouettes to the tree and the 4x4 cells.
+TEST(Codec, TheMotionBitsAreAccountedForByWhatTheyCode) {
+    const auto frames = render("crossing", 5, 160, 96);
+    Encoder encoder;
+    ASSERT_TRUE(Encoder::create({.depth = DepthMode::View}, encoder).ok());
+    StreamStats::MotionBits all;
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+        ASSERT_TRUE(encoder.send_frame(frames[i]).ok());
+        Packet p;
+        ASSERT_EQ(encoder.receive_packet(p), Result::Ok);
+        const StreamStats& s = encoder.last_frame_stats();
+        const StreamStats::MotionBits& m = s.motion_parts;
+        EXPECT_LE(m.total(), double(s.motion_bits) + 32.0) << "frame " << i;
+        EXPECT_GE(m.total(), double(s.motion_bits) - 64.0) << "frame " << i;
+        all += m;
+    }
+    EXPECT_GT(all.objects, 0.0);
+    EXPECT_GT(all.tree, 0.0);
+    EXPECT_GT(all.pixels + all.models, 0.0);
+}
+
 // Above qp 34 the view and motion bounds double every 6 qp: at qp 46 (4x) the stream keeps both
 // within 1 px and spends fewer geometry bits than with the bounds as given, the colour as good.
 // Measured at 160x96, 6 frames: depth + motion 0.68x (stroll) and 0.72x (fast).

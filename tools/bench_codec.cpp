@@ -286,6 +286,7 @@ struct ViewDepthRun {
     std::size_t background_mismatches = 0, finite_pixels = 0, pixels_over_bound = 0;
     float step = 0.0f;
     codec::StreamStats::DepthBits depth_parts;  // where the depth bits go (ideal lengths)
+    codec::StreamStats::MotionBits motion_parts;
     std::vector<DepthVideoRun>
         video_peers;         // 1/z as grey video, as immersive-video systems send it
     SynthesizedViews views;  // rendered sequences only
@@ -390,6 +391,7 @@ Status run_view_depth(server::Renderer& renderer, const Sequence& seq, int qp, V
         const codec::StreamStats& bits = encoder.last_frame_stats();
         run.depth_bytes += bits.depth_bits / 8.0;
         run.depth_parts += bits.depth_parts;
+        run.motion_parts += bits.motion_parts;
         run.camera_bytes += bits.camera_bits / 8.0;
         run.motion_bytes += bits.motion_bits / 8.0;
         run.color_bytes += bits.color_bits / 8.0;
@@ -798,6 +800,20 @@ std::string depth_text(const std::vector<DepthSummary>& depth_rows,
                            v.scene.c_str(), all / double(std::max<std::size_t>(1, v.frames)),
                            pct(d.flags), pct(d.planes), pct(d.key), pct(d.objects), pct(d.revealed),
                            pct(d.seen), pct(std::max(0.0, all - d.total())));
+    }
+    depth_text += strf(
+        "\nwhere the motion bits go at qp %d, %% of the motion bits: the quadtree's flags, new "
+        "affine models, 4x4 cells pixel by pixel, the rigid objects' list; section headers\n"
+        "%-10s %11s %7s %7s %7s %8s %8s\n",
+        qp, "scene", "bits/frame", "tree", "models", "pixels", "objects", "headers");
+    for (const ViewDepthRun& v : view_rows) {
+        const double all = std::max(8.0 * v.motion_bytes, 1.0);
+        const codec::StreamStats::MotionBits& m = v.motion_parts;
+        auto pct = [&](double bits) { return 100.0 * bits / all; };
+        depth_text +=
+            strf("%-10s %11.0f %6.1f%% %6.1f%% %6.1f%% %7.1f%% %7.1f%%\n", v.scene.c_str(),
+                 all / double(std::max<std::size_t>(1, v.frames)), pct(m.tree), pct(m.models),
+                 pct(m.pixels), pct(m.objects), pct(std::max(0.0, all - m.total())));
     }
     depth_text += synthesized_views_text(view_rows);
     depth_ratio = depth_ratio_n ? depth_ratio_sum / depth_ratio_n : NAN;

@@ -106,6 +106,14 @@ void print_stats(const codec::StreamStats& s, double fps) {
             share(d.flags), share(d.planes), share(d.key), share(d.objects), share(d.revealed),
             share(d.seen), share(std::max(0.0, all - d.total())));
     }
+    if (const codec::StreamStats::MotionBits& m = s.motion_parts; m.total() > 0.0) {
+        const double all = double(std::max<std::size_t>(1, s.motion_bits));
+        std::printf(
+            "  motion bits: quadtree flags %.1f %%, affine models %.1f %%, 4x4 cells pixel by "
+            "pixel %.1f %%, rigid objects' list %.1f %%, section headers %.1f %%\n",
+            100.0 * m.tree / all, 100.0 * m.models / all, 100.0 * m.pixels / all,
+            100.0 * m.objects / all, 100.0 * std::max(0.0, all - m.total()) / all);
+    }
     std::printf(
         "  %zu frames: %zu key, %zu predicted from an older reference, %zu intra macroblocks, "
         "%zu pixels the reference did not see predicted from the surface beside them\n",

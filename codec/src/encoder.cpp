@@ -206,6 +206,7 @@ struct Encoder::State {
                 encode_camera(camera, camera.time, ref, objects, section);
             fs.camera_bits += 8 * (section.size() - object_bytes);
             fs.motion_bits += 8 * object_bytes;
+            fs.motion_parts.objects += 8.0 * double(object_bytes);
             fs.motion_objects = objects.size();
             append_section(payload, section);
             append_section(payload, depth_section);

@@ -324,7 +324,7 @@ void encode_motion(const FrameContext& fc, const Camera& camera, ImageView<const
             fc, camera, all, base, fc.work->object_fields, fc.work->predicted_owner, source);
         wr.u8(predicting ? kPredictedObjects : 0);
         if (predicting) wr.varint(predicting);
-        encode_motion_models(sp, base.view(), source, ids, fc.work->object_fields,
+        encode_motion_models(sp, depth, base.view(), source, ids, fc.work->object_fields,
                              fc.work->predicted_owner.view(), out.view(),
                              objects ? owner.view() : ImageView<uint32_t>{}, fc.work->motion_models,
                              fc.work->slice_bytes, bytes, stats);
@@ -385,7 +385,7 @@ Status decode_motion(const FrameContext& fc, const Camera& camera, ImageView<con
             frame_fields(fc, camera, depth);
             predict_from_objects(fc, camera, predicting, base, fc.work->object_fields,
                                  fc.work->predicted_owner);
-            REPRISE_TRY(decode_motion_models(sp, base.view(), fc.work->object_fields,
+            REPRISE_TRY(decode_motion_models(sp, depth, base.view(), fc.work->object_fields,
                                              fc.work->predicted_owner.view(), slices, out.view(),
                                              objects ? owner.view() : ImageView<uint32_t>{},
                                              fc.work->motion_models, stats));

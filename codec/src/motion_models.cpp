@@ -49,12 +49,12 @@ inline int64_t clamped_round(double v, int64_t limit) {
 }
 
 struct Models {
-    BitModel zero[kLevels][3];
+    BitModel zero[kLevels][3][3];  // [level][left and above cells not zero][edge_class]
     BitModel merge[kLevels];
     BitModel which;
     BitModel split[kLevels - 1];
     BitModel own_cell;
-    BitModel pixel_zero[3], pixel_model[3], pixel_which[2], invalid;
+    BitModel pixel_zero[16], pixel_model[16], pixel_which[2], invalid;  // [pixel_context]
     BitModel object[kLevels], leaf_object, object_index[2 * kMaxObjects];
     IntModel<20> offset[2], gradient[4], pixel[2];
 };
@@ -63,7 +63,8 @@ struct Job {
     const SequenceParams* sp;
     int y0, y1;
     float bound;
-    int64_t step;                             // of a pixel's own value
+    int64_t step;  // of a pixel's own value
+    ImageView<const float> depth;
     ImageView<const glm::vec2> base, source;  // source: encoder only
     ImageView<const uint32_t> ids;            // encoder only
     std::span<const ObjectField> fields;
@@ -72,6 +73,7 @@ struct Job {
     ImageView<uint32_t> owner;  // may be empty
     MotionModelScratch* scratch;
     std::size_t pixels = 0, models = 0, own_pixels = 0, object_nodes = 0;
+    StreamStats::MotionBits bits;  // encoder
 
     int width() const { return sp->width; }
     MotionCell* cell(int x, int y) const {
@@ -247,10 +249,60 @@ void apply_model(Job& j, const Node& n, const MotionModel& m) {
     set_cells(j, n, &m, false);
 }
 
+// Two decoded depths on different surfaces: a relative step over 1/64, or one is no surface.
+inline bool is_surface(float z) { return z > 0.0f && z < std::numeric_limits<float>::infinity(); }
+inline bool depth_step(float a, float b) {
+    if (!is_surface(a) || !is_surface(b)) return is_surface(a) != is_surface(b);
+    return std::abs(a - b) > (1.0f / 64.0f) * std::min(a, b);
+}
+
+// A pixel's context: for the left and the above neighbour, whether it took the camera's motion,
+// and whether a step in depth or between predicted owners lies between them (version 20).
 inline int pixel_context(const Job& j, int x, int y) {
-    const int left = x > 0 ? int(j.kind(x - 1, y)) : int(kZeroPixel);
-    const int top = y > j.y0 ? int(j.kind(x, y - 1)) : int(kZeroPixel);
-    return std::min(2, (left != kZeroPixel) + (top != kZeroPixel));
+    auto state = [&](int nx, int ny) {
+        return (j.kind(nx, ny) != kZeroPixel) +
+               2 * ((!j.depth.empty() && depth_step(j.depth(nx, ny), j.depth(x, y))) ||
+                    (!j.predicted.empty() && j.predicted(nx, ny) != j.predicted(x, y)));
+    };
+    return (x > 0 ? state(x - 1, y) : 0) + 4 * (y > j.y0 ? state(x, y - 1) : 0);
+}
+
+// Version 20: per 4x4 cell, whether a pixel of it and its right or lower neighbour lie on two
+// surfaces (bit 0), or on one surface that the reference says two owners share (bit 1: where an
+// object touches what it stands on, the motions differ without a step in depth).
+constexpr uint8_t kDepthEdge = 1, kOwnerEdge = 2;
+void find_edges(const SequenceParams& sp, ImageView<const float> depth,
+                ImageView<const uint32_t> predicted, MotionModelScratch& scratch) {
+    const int rows = (sp.height + 3) / 4;
+    scratch.edges.assign(std::size_t(scratch.cell_columns) * rows, 0);
+    if (depth.empty()) return;
+    parallel_for(0, rows, [&](int r0, int r1) {
+        for (int y = 4 * r0; y < std::min(sp.height, 4 * r1); ++y) {
+            const float* z = depth.row(y);
+            const float* below = y + 1 < sp.height ? depth.row(y + 1) : nullptr;
+            const uint32_t* o = predicted.empty() ? nullptr : predicted.row(y);
+            const uint32_t* o_below = o && below ? predicted.row(y + 1) : nullptr;
+            uint8_t* cells = &scratch.edges[std::size_t(y / 4) * scratch.cell_columns];
+            auto edge = [](bool step, bool owners) {
+                return step ? kDepthEdge : owners ? kOwnerEdge : uint8_t(0);
+            };
+            for (int x = 0; x < sp.width; ++x) {
+                if (x + 1 < sp.width)
+                    cells[x / 4] |= edge(depth_step(z[x], z[x + 1]), o && o[x] != o[x + 1]);
+                if (below)
+                    cells[x / 4] |= edge(depth_step(z[x], below[x]), o_below && o[x] != o_below[x]);
+            }
+        }
+    });
+}
+
+// A node's class for its zero flag: no edge, steps in depth only, an edge between owners.
+int edge_class(const Job& j, const Node& n) {
+    uint8_t e = 0;
+    for (int cy = n.y / 4; cy < (n.y + n.h + 3) / 4; ++cy)
+        for (int cx = n.x / 4; cx < (n.x + n.w + 3) / 4; ++cx)
+            e |= j.scratch->edges[std::size_t(cy) * j.scratch->cell_columns + cx];
+    return e & kOwnerEdge ? 2 : e;
 }
 
 // A 4x4 cell pixel by pixel: the camera's motion, one of the node's candidate models, or its own
@@ -437,12 +489,14 @@ bool code_node(Job& j, Models& m, Node n, int level, Coder& rc) {
     if (n.w <= 0 || n.h <= 0) return true;
     const MotionCell *left = j.cell(n.x - 1, n.y), *top = j.cell(n.x, n.y - 1);
     const int zero_ctx = (left && !left->zero) + (top && !top->zero);
+    const int edge = edge_class(j, n);
     bool zero = false;
     if constexpr (Encode) {
+        rc.tally_into(&j.bits.tree);
         zero = zero_fits(j, n);
-        rc.bit(m.zero[level][zero_ctx], zero);
+        rc.bit(m.zero[level][zero_ctx][edge], zero);
     } else {
-        zero = rc.bit(m.zero[level][zero_ctx]);
+        zero = rc.bit(m.zero[level][zero_ctx][edge]);
     }
     if (zero) {
         apply_zero(j, n);
@@ -522,9 +576,11 @@ bool code_node(Job& j, Models& m, Node n, int level, Coder& rc) {
                 }
                 if (object.object >= 0) cands[cands[0] ? 1 : 0] = &object;
             }
+            if constexpr (Encode) rc.tally_into(&j.bits.pixels);
             return code_pixels<Encode>(j, m, n, cands, rc);
         }
     }
+    if constexpr (Encode) rc.tally_into(&j.bits.models);
     if (!code_new_model<Encode>(j, m, n, pred, model, rc)) return false;
     apply_model(j, n, model);
     return true;
@@ -543,9 +599,9 @@ bool code_slice(Job& j, Coder& rc) {
     return true;
 }
 
-std::vector<Job> slice_jobs(const SequenceParams& sp, ImageView<const glm::vec2> base,
-                            ImageView<const glm::vec2> source, ImageView<const uint32_t> ids,
-                            std::span<const ObjectField> fields,
+std::vector<Job> slice_jobs(const SequenceParams& sp, ImageView<const float> depth,
+                            ImageView<const glm::vec2> base, ImageView<const glm::vec2> source,
+                            ImageView<const uint32_t> ids, std::span<const ObjectField> fields,
                             ImageView<const uint32_t> predicted, ImageView<glm::vec2> out,
                             ImageView<uint32_t> owner, MotionModelScratch& scratch) {
     scratch.cell_columns = (sp.width + 3) / 4;
@@ -553,12 +609,13 @@ std::vector<Job> slice_jobs(const SequenceParams& sp, ImageView<const glm::vec2>
     scratch.kinds.resize(std::size_t(sp.width) * sp.height);
     scratch.values.resize(std::size_t(sp.width) * sp.height);
     scratch.which.resize(std::size_t(sp.width) * sp.height);
+    find_edges(sp, depth, predicted, scratch);
     std::vector<Job> jobs;
     for (int s = 0; s < sp.slices; ++s) {
         const int y0 = std::min(sp.height, sp.slice_begin(s) * kMb);
         const int y1 = std::min(sp.height, sp.slice_begin(s + 1) * kMb);
-        jobs.push_back({&sp, y0, y1, sp.motion_error, own_step(sp.motion_error), base, source, ids,
-                        fields, predicted, out, owner, &scratch});
+        jobs.push_back({&sp, y0, y1, sp.motion_error, own_step(sp.motion_error), depth, base,
+                        source, ids, fields, predicted, out, owner, &scratch});
     }
     return jobs;
 }
@@ -568,6 +625,7 @@ void add_counts(const std::vector<Job>& jobs, StreamStats& stats) {
         stats.motion_residual_pixels += j.pixels;
         stats.motion_models += j.models;
         stats.motion_own_pixels += j.own_pixels;
+        stats.motion_parts += j.bits;
     }
 }
 
@@ -584,15 +642,15 @@ bool motion_within_bound(ImageView<const glm::vec2> source, ImageView<const glm:
     return motion_within_row({source.row(y), base.row(y), source.width, bound});
 }
 
-void encode_motion_models(const SequenceParams& sp, ImageView<const glm::vec2> base,
-                          ImageView<const glm::vec2> source, ImageView<const uint32_t> ids,
-                          std::span<const ObjectField> fields, ImageView<const uint32_t> predicted,
-                          ImageView<glm::vec2> out, ImageView<uint32_t> owner,
-                          MotionModelScratch& scratch,
+void encode_motion_models(const SequenceParams& sp, ImageView<const float> depth,
+                          ImageView<const glm::vec2> base, ImageView<const glm::vec2> source,
+                          ImageView<const uint32_t> ids, std::span<const ObjectField> fields,
+                          ImageView<const uint32_t> predicted, ImageView<glm::vec2> out,
+                          ImageView<uint32_t> owner, MotionModelScratch& scratch,
                           std::vector<std::vector<uint8_t>>& slice_bytes,
                           std::vector<uint8_t>& bytes, StreamStats& stats) {
     std::vector<Job> jobs =
-        slice_jobs(sp, base, source, ids, fields, predicted, out, owner, scratch);
+        slice_jobs(sp, depth, base, source, ids, fields, predicted, out, owner, scratch);
     encode_slices(sp.slices, slice_bytes, bytes, [&](int s, std::vector<uint8_t>& b) {
         RangeEncoder rc(b);
         code_slice<true>(jobs[s], rc);
@@ -601,13 +659,14 @@ void encode_motion_models(const SequenceParams& sp, ImageView<const glm::vec2> b
     add_counts(jobs, stats);
 }
 
-Status decode_motion_models(const SequenceParams& sp, ImageView<const glm::vec2> base,
-                            std::span<const ObjectField> fields,
+Status decode_motion_models(const SequenceParams& sp, ImageView<const float> depth,
+                            ImageView<const glm::vec2> base, std::span<const ObjectField> fields,
                             ImageView<const uint32_t> predicted,
                             const std::vector<std::span<const uint8_t>>& slices,
                             ImageView<glm::vec2> out, ImageView<uint32_t> owner,
                             MotionModelScratch& scratch, StreamStats& stats) {
-    std::vector<Job> jobs = slice_jobs(sp, base, {}, {}, fields, predicted, out, owner, scratch);
+    std::vector<Job> jobs =
+        slice_jobs(sp, depth, base, {}, {}, fields, predicted, out, owner, scratch);
     REPRISE_TRY(decode_slices(slices, "motion section", [&](int s, std::span<const uint8_t> b) {
         RangeDecoder rc(b);
         return code_slice<false>(jobs[s], rc);

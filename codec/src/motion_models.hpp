@@ -37,6 +37,7 @@ struct MotionModelScratch {
     std::vector<uint8_t> kinds;      // per pixel: camera motion, a model, its own value
     std::vector<uint8_t> which;      // per pixel of a 4x4 cell coded pixel by pixel: its model
     std::vector<glm::ivec2> values;  // per pixel: the decoded residual, 1/512 px (clamped)
+    std::vector<uint8_t> edges;      // per 4x4 cell: a step in decoded depth within it
 };
 
 // Whether every pixel of row y is within `bound` px of the camera motion (NaN both ways counts).
@@ -48,15 +49,15 @@ bool motion_within_bound(ImageView<const glm::vec2> source, ImageView<const glm:
 // ids that are no field's). `predicted` (may be empty): the object a pixel's base moves with.
 // `owner` (when not empty) gets each pixel's object id where an object model or the base gave
 // its motion, else 0.
-void encode_motion_models(const SequenceParams& sp, ImageView<const glm::vec2> base,
-                          ImageView<const glm::vec2> source, ImageView<const uint32_t> ids,
-                          std::span<const ObjectField> fields, ImageView<const uint32_t> predicted,
-                          ImageView<glm::vec2> out, ImageView<uint32_t> owner,
-                          MotionModelScratch& scratch,
+void encode_motion_models(const SequenceParams& sp, ImageView<const float> depth,
+                          ImageView<const glm::vec2> base, ImageView<const glm::vec2> source,
+                          ImageView<const uint32_t> ids, std::span<const ObjectField> fields,
+                          ImageView<const uint32_t> predicted, ImageView<glm::vec2> out,
+                          ImageView<uint32_t> owner, MotionModelScratch& scratch,
                           std::vector<std::vector<uint8_t>>& slice_bytes,
                           std::vector<uint8_t>& bytes, StreamStats& stats);
-Status decode_motion_models(const SequenceParams& sp, ImageView<const glm::vec2> base,
-                            std::span<const ObjectField> fields,
+Status decode_motion_models(const SequenceParams& sp, ImageView<const float> depth,
+                            ImageView<const glm::vec2> base, std::span<const ObjectField> fields,
                             ImageView<const uint32_t> predicted,
                             const std::vector<std::span<const uint8_t>>& slices,
                             ImageView<glm::vec2> out, ImageView<uint32_t> owner,

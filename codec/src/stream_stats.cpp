@@ -23,6 +23,7 @@ void add_stats(StreamStats& total, const StreamStats& f) {
     total.depth_zero_blocks += f.depth_zero_blocks;
     total.depth_plane_blocks += f.depth_plane_blocks;
     total.depth_parts += f.depth_parts;
+    total.motion_parts += f.motion_parts;
     total.revealed_pixels += f.revealed_pixels;
     total.cameras_fitted += f.cameras_fitted;
     total.ms.input += f.ms.input;

@@ -79,6 +79,12 @@ py::dict stats_dict(const codec::StreamStats& s) {
     parts["revealed"] = s.depth_parts.revealed;
     parts["seen"] = s.depth_parts.seen;
     d["depth_parts"] = parts;
+    py::dict motion_parts;  // encoder: the motion section's bits by what they code
+    motion_parts["tree"] = s.motion_parts.tree;
+    motion_parts["models"] = s.motion_parts.models;
+    motion_parts["pixels"] = s.motion_parts.pixels;
+    motion_parts["objects"] = s.motion_parts.objects;
+    d["motion_parts"] = motion_parts;
     d["revealed_pixels"] = s.revealed_pixels;
     d["motion_residual_pixels"] = s.motion_residual_pixels;
     d["motion_objects"] = s.motion_objects;

@@ -105,6 +105,17 @@ struct StreamStats {
             return *this;
         }
     } depth_parts;
+    // Encoder: where the motion bits go (bits; ideal lengths but for `objects`): the quadtree's
+    // flags (zero, merge, object, split), new affine models' parameters, 4x4 cells coded pixel by
+    // pixel, and the rigid objects' list (in the camera section, counted as motion).
+    struct MotionBits {
+        double tree = 0.0, models = 0.0, pixels = 0.0, objects = 0.0;
+        double total() const { return tree + models + pixels + objects; }
+        MotionBits& operator+=(const MotionBits& o) {
+            tree += o.tree, models += o.models, pixels += o.pixels, objects += o.objects;
+            return *this;
+        }
+    } motion_parts;
     std::size_t revealed_pixels =
         0;                           // colour predicted from beside: the reference did not see them
     std::size_t cameras_fitted = 0;  // encoder: frames without a camera coded with a fitted one
