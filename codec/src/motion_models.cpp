@@ -50,12 +50,12 @@ inline int64_t clamped_round(double v, int64_t limit) {
 
 struct Models {
     BitModel zero[kLevels][3][3];  // [level][left and above cells not zero][edge_class]
-    BitModel merge[kLevels];
+    BitModel merge[kLevels][3];    // [level][edge_class], as split and object
     BitModel which;
-    BitModel split[kLevels - 1];
+    BitModel split[kLevels - 1][3];
     BitModel own_cell;
     BitModel pixel_zero[16], pixel_model[16], pixel_which[2], invalid;  // [pixel_context]
-    BitModel object[kLevels], leaf_object, object_index[2 * kMaxObjects];
+    BitModel object[kLevels][3], leaf_object, object_index[2 * kMaxObjects];
     IntModel<20> offset[2], gradient[4], pixel[2];
 };
 
@@ -296,7 +296,7 @@ void find_edges(const SequenceParams& sp, ImageView<const float> depth,
     });
 }
 
-// A node's class for its zero flag: no edge, steps in depth only, an edge between owners.
+// A node's class for its flags: no edge, steps in depth only, an edge between owners.
 int edge_class(const Job& j, const Node& n) {
     uint8_t e = 0;
     for (int cy = n.y / 4; cy < (n.y + n.h + 3) / 4; ++cy)
@@ -510,9 +510,9 @@ bool code_node(Job& j, Models& m, Node n, int level, Coder& rc) {
         if constexpr (Encode) {
             for (int k = 0; k < 2 && chosen < 0; ++k)
                 if (cands[k] && model_fits(j, n, *cands[k])) chosen = k;
-            rc.bit(m.merge[level], chosen >= 0);
+            rc.bit(m.merge[level][edge], chosen >= 0);
             if (chosen >= 0 && cands[1]) rc.bit(m.which, chosen);
-        } else if (rc.bit(m.merge[level])) {
+        } else if (rc.bit(m.merge[level][edge])) {
             chosen = cands[1] ? rc.bit(m.which) : 0;
         }
         if (chosen >= 0) {
@@ -525,9 +525,9 @@ bool code_node(Job& j, Models& m, Node n, int level, Coder& rc) {
         MotionModel object;
         if constexpr (Encode) {
             object.object = fitting_object(j, n);
-            rc.bit(m.object[level], object.object >= 0);
+            rc.bit(m.object[level][edge], object.object >= 0);
             if (object.object >= 0) code_object_index(m, int(j.fields.size()), object.object, rc);
-        } else if (rc.bit(m.object[level]) &&
+        } else if (rc.bit(m.object[level][edge]) &&
                    !code_object_index(m, int(j.fields.size()), object.object, rc)) {
             return false;
         }
@@ -544,9 +544,9 @@ bool code_node(Job& j, Models& m, Node n, int level, Coder& rc) {
     if constexpr (Encode) fits = fit_model(j, n, pred, model) && model_fits(j, n, model);
     if (level < kLevels - 1) {
         if constexpr (Encode)
-            rc.bit(m.split[level], !fits);
+            rc.bit(m.split[level][edge], !fits);
         else
-            fits = !rc.bit(m.split[level]);
+            fits = !rc.bit(m.split[level][edge]);
         if (!fits) {
             const int half = (kMb >> level) / 2;
             for (int k = 0; k < 4; ++k)
