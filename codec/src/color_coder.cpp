@@ -195,6 +195,8 @@ struct SliceJob {
     int qp, skip_threshold;
     int mb_y0, mb_y1;
     std::vector<uint8_t>* coded;  // per plane, per 8x8 block
+    const ModelCarry* carry;
+    int slice;
     std::size_t blocks = 0, skipped = 0, intra = 0, macroblocks = 0;
 
     void mark(int k, int bx, int by, bool is_coded) const {
@@ -337,6 +339,7 @@ bool code_slice(SliceJob& j, Coder& rc) {
     const SequenceParams& sp = *j.g->sp;
     const int32_t scale = quant_scale(j.qp);
     Models m;
+    j.carry->load(j.slice, m);
     const int cols = sp.mb_cols();
     std::vector<uint8_t> above_skip(cols, 0), above_intra(cols, 0);
     // Per 8x8 block of each plane: it has levels (the coded-block flag's context).
@@ -477,6 +480,7 @@ bool code_slice(SliceJob& j, Coder& rc) {
             if (rc.overrun() > 8) return false;
         }
     }
+    j.carry->save(j.slice, m);
     return true;
 }
 
@@ -555,11 +559,13 @@ void choose_inter(const Geometry& g, const Planes& source, const Planes& predict
 }
 
 std::vector<SliceJob> slice_jobs(const Geometry& g, const Planes* source, const Planes* predicted,
-                                 Planes& out, int qp, int skip_threshold, Workspace& work) {
+                                 Planes& out, int qp, int skip_threshold, Workspace& work,
+                                 const ModelCarry& carry) {
     std::vector<SliceJob> jobs;
     for (int s = 0; s < g.sp->slices; ++s)
         jobs.push_back({&g, source, predicted, &out, work.inter_choices.data(), qp, skip_threshold,
-                        g.sp->slice_begin(s), g.sp->slice_begin(s + 1), work.coded_blocks});
+                        g.sp->slice_begin(s), g.sp->slice_begin(s + 1), work.coded_blocks, &carry,
+                        s});
     return jobs;
 }
 
@@ -601,8 +607,9 @@ ColorEncodeResult encode_color(const FrameContext& fc, const Planes& source,
     w.u8(uint8_t(qp));
     const Geometry g = geometry(sp);
     if (!fc.key) choose_inter(g, source, predicted, qp, skip_threshold, fc.work->inter_choices);
-    std::vector<SliceJob> jobs =
-        slice_jobs(g, &source, fc.key ? nullptr : &predicted, out, qp, skip_threshold, *fc.work);
+    const ModelCarry carry = fc.carry(&Picture::Models::colour);
+    std::vector<SliceJob> jobs = slice_jobs(g, &source, fc.key ? nullptr : &predicted, out, qp,
+                                            skip_threshold, *fc.work, carry);
     std::vector<uint8_t>& body = fc.work->section;
     body.clear();
     encode_slices(sp.slices, fc.work->slice_bytes, body, [&](int s, std::vector<uint8_t>& b) {
@@ -620,6 +627,7 @@ ColorEncodeResult encode_color(const FrameContext& fc, const Planes& source,
     }
     const bool all_skipped = !fc.key && skipped == blocks;
     w.u8(all_skipped ? kAllSkipped : 0);
+    if (all_skipped) carry.pass_on(sp.slices);  // no slice is coded
     if (!all_skipped) {
         w.bytes(body);
         deblock(out, fc.work->coded_blocks, qp);
@@ -650,6 +658,7 @@ Status decode_color(const FrameContext& fc, ImageView<const float> depth,
     Planes& predicted = out;
     if (!fc.key) predict(fc, depth, motion, predicted, stats);
     const StageTimer timer(stats.ms.color);
+    const ModelCarry carry = fc.carry(&Picture::Models::colour);
     const std::size_t blocks =
         std::size_t(sp.mb_cols()) * sp.mb_rows() * (4 + 2 * (sp.chroma == Chroma::C420 ? 1 : 4));
     if (flags & kAllSkipped) {
@@ -661,7 +670,7 @@ Status decode_color(const FrameContext& fc, ImageView<const float> depth,
         if (!read_slices(r, sp.slices, slices)) return Status::error(r.error());
         const Geometry g = geometry(sp);
         std::vector<SliceJob> jobs =
-            slice_jobs(g, nullptr, fc.key ? nullptr : &predicted, out, qp, 0, *fc.work);
+            slice_jobs(g, nullptr, fc.key ? nullptr : &predicted, out, qp, 0, *fc.work, carry);
         REPRISE_TRY(
             decode_slices(slices, "colour section", [&](int s, std::span<const uint8_t> bytes) {
                 RangeDecoder rc(bytes);

@@ -89,8 +89,9 @@ Status Decoder::send_packet(std::span<const uint8_t> packet) {
         return Status::error(where + ": " + std::to_string(r.remaining()) +
                              " bytes after the last section");
 
-    FrameContext fc{&sp, ref, key, &s.work};
     Picture& pic = *s.scratch;
+    FrameContext fc{&sp, ref, key, &s.work};
+    fc.models = &pic.models;
     StreamStats fs;
     Camera camera;
     double time = 0.0;

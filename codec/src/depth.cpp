@@ -653,9 +653,11 @@ bool decode_plane(RangeDecoder& rc, Models& m, const Plane& predicted, bool from
 // plane fitted to the block where neither is. Residuals of
 // the whole block row are stored before they are coded; the contexts read the same values the
 // decoder has at that point.
-void encode_slice(SliceJob& j, std::vector<uint8_t>& bytes, std::vector<uint8_t>& block_flags) {
+void encode_slice(SliceJob& j, const ModelCarry& carry, int slice, std::vector<uint8_t>& bytes,
+                  std::vector<uint8_t>& block_flags) {
     RangeEncoder rc(bytes);
     Models m;
+    carry.load(slice, m);
     const bool inter = !j.temporal.empty();
     const int blocks = (j.width + kBlock - 1) / kBlock;
     block_flags.assign(std::size_t(blocks), 0);
@@ -812,6 +814,7 @@ void encode_slice(SliceJob& j, std::vector<uint8_t>& bytes, std::vector<uint8_t>
             }
     }
     rc.finish();
+    carry.save(slice, m);
 }
 
 // Codes x0..x1 - 1 of row y are their predictions (a block without residuals, not a plane): as
@@ -834,9 +837,10 @@ void predict_run(SliceJob& j, int x0, int x1, int y, bool temporal) {
     }
 }
 
-bool decode_slice(SliceJob& j, std::span<const uint8_t> bytes) {
+bool decode_slice(SliceJob& j, const ModelCarry& carry, int slice, std::span<const uint8_t> bytes) {
     RangeDecoder rc(bytes);
     Models m;
+    carry.load(slice, m);
     const bool inter = !j.temporal.empty();
     const int blocks = (j.width + kBlock - 1) / kBlock;
     std::vector<uint8_t> flags(std::size_t(blocks), 0), above;
@@ -928,7 +932,9 @@ bool decode_slice(SliceJob& j, std::span<const uint8_t> bytes) {
             }
         if (rc.overrun() > 8) return false;
     }
-    return rc.overrun() <= 8;
+    if (rc.overrun() > 8) return false;
+    carry.save(slice, m);
+    return true;
 }
 
 // Two landings d pixels apart whose 1/z differ by at most d of this are one surface in the plane
@@ -1093,6 +1099,7 @@ ImageView<const float> view_share(const FrameContext& fc, const Mapping& map, co
 void encode_depth(const FrameContext& fc, const Camera& camera, ImageView<const float> source,
                   Image<float>& out, std::vector<uint8_t>& bytes, StreamStats& stats) {
     const SequenceParams& sp = *fc.sp;
+    const ModelCarry carry = fc.carry(&Picture::Models::depth);
     if (sp.depth == DepthMode::None) {
         out.clear();
         return;
@@ -1131,13 +1138,15 @@ void encode_depth(const FrameContext& fc, const Camera& camera, ImageView<const 
     for (SliceJob& j : jobs) j.source = source, j.share = share, j.uniform_share = uniform_share;
     std::vector<std::vector<uint8_t>>& flags = fc.work->slice_flags;
     flags.resize(std::size_t(sp.slices));
-    encode_slices(sp.slices, fc.work->slice_bytes, bytes,
-                  [&](int s, std::vector<uint8_t>& b) { encode_slice(jobs[s], b, flags[s]); });
+    encode_slices(sp.slices, fc.work->slice_bytes, bytes, [&](int s, std::vector<uint8_t>& b) {
+        encode_slice(jobs[s], carry, s, b, flags[s]);
+    });
     // A frame whose every code is its temporal prediction needs only the flag.
     bool all_predicted = !temporal.empty();
     for (std::size_t i = 0; all_predicted && i < codes.pixel_count(); ++i)
         all_predicted = codes.data()[i] == temporal.data()[i];
     if (all_predicted) {
+        carry.pass_on(sp.slices);  // no slice is coded
         bytes.resize(slices_start);
         bytes[start] |= kAllPredicted;
         stats.depth_zero_blocks +=
@@ -1156,6 +1165,7 @@ void encode_depth(const FrameContext& fc, const Camera& camera, ImageView<const 
 Status decode_depth(const FrameContext& fc, const Camera& camera, std::span<const uint8_t> in,
                     Image<float>& out, StreamStats& stats) {
     const SequenceParams& sp = *fc.sp;
+    const ModelCarry carry = fc.carry(&Picture::Models::depth);
     if (sp.depth == DepthMode::None) {
         if (!in.empty()) return Status::error("depth section: present in a stream without depth");
         out.clear();
@@ -1202,9 +1212,10 @@ Status decode_depth(const FrameContext& fc, const Camera& camera, std::span<cons
         if (!read_slices(r, sp.slices, slices)) return Status::error(r.error());
         std::vector<SliceJob> jobs =
             slice_jobs(sp, map, codes, temporal, residuals, fc.work->depth_shows);
-        REPRISE_TRY(decode_slices(
-            slices, "depth section",
-            [&](int s, std::span<const uint8_t> bytes) { return decode_slice(jobs[s], bytes); }));
+        REPRISE_TRY(
+            decode_slices(slices, "depth section", [&](int s, std::span<const uint8_t> bytes) {
+                return decode_slice(jobs[s], carry, s, bytes);
+            }));
         for (const SliceJob& j : jobs) {
             stats.depth_zero_blocks += j.zero_blocks;
             stats.depth_plane_blocks += j.plane_blocks;

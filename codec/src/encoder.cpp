@@ -179,6 +179,7 @@ struct Encoder::State {
         const bool key = ref_slot < 0;
         const Picture* ref = key ? nullptr : &refs[ref_slot];
         FrameContext fc{&sp, ref, key, &work};
+        fc.models = &pic.models;
         payload.clear();
         if (key) write_params(sp, payload);
 

@@ -9,6 +9,7 @@
 #include "range_coder.hpp"
 #include "reprise/codec/codec.hpp"
 #include "reprise/core/byte_io.hpp"
+#include "slices.hpp"
 
 namespace reprise::codec {
 
@@ -74,6 +75,10 @@ struct Picture {
     std::vector<ObjectMotion> objects;  // the rigid object motions its packet sent
     Camera camera;
     double time = 0.0;
+    // Each section's adaptive models at the end of its slices (version 20, ModelCarry).
+    struct Models {
+        SliceModels depth, motion, colour;
+    } models;
 };
 
 // --- packet.cpp: the packet header and CRC (docs/bitstream.md) and the key frame's parameters.
@@ -242,6 +247,15 @@ struct FrameContext {
     // finer step for a fast object is the object's need: the other pixels keep the cameras' bound.
     float camera_step = 0.0f;
     ImageView<const uint32_t> ids;
+    Picture::Models* models = nullptr;  // the picture being made: its sections' models
+
+    // Where a section's slices take their models from and leave them (its reference's passed on).
+    ModelCarry carry(SliceModels Picture::Models::*section) const {
+        const ModelCarry c{key || !reference ? nullptr : &(reference->models.*section),
+                           models ? &(models->*section) : nullptr};
+        c.pass_on(sp->slices);
+        return c;
+    }
 };
 
 // The camera and the objects' rigid motions (their bytes returned; counted as motion).

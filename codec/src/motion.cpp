@@ -62,6 +62,8 @@ struct SliceJob {
     ImageView<const glm::vec2> source;  // encoder only: the renderer's motion
     ImageView<glm::vec2> out;
     Residual* residuals;  // per pixel of the frame, for contexts and prediction
+    const ModelCarry* carry;
+    int slice;
     std::size_t pixels = 0;
 
     const Residual* at(int x, int y) const {
@@ -96,6 +98,7 @@ namespace {
 template <bool Encode, class Coder>
 bool code_slice(SliceJob& j, Coder& rc) {
     Models m;
+    j.carry->load(j.slice, m);
     std::vector<uint8_t> block_nonzero;
     int previous_block = 0;
     for (int by = j.y0; by < j.y1; by += kBlock) {
@@ -154,6 +157,7 @@ bool code_slice(SliceJob& j, Coder& rc) {
             if (rc.overrun() > 8) return false;
         }
     }
+    j.carry->save(j.slice, m);
     return true;
 }
 
@@ -275,12 +279,13 @@ void frame_fields(const FrameContext& fc, const Camera& camera, ImageView<const 
 
 std::vector<SliceJob> slice_jobs(const SequenceParams& sp, const Image<glm::vec2>& base,
                                  ImageView<const glm::vec2> source, Image<glm::vec2>& out,
-                                 std::vector<Residual>& residuals) {
+                                 std::vector<Residual>& residuals, const ModelCarry& carry) {
     std::vector<SliceJob> jobs;
     for (int s = 0; s < sp.slices; ++s) {
         const int y0 = std::min(sp.height, sp.slice_begin(s) * kMb);
         const int y1 = std::min(sp.height, sp.slice_begin(s + 1) * kMb);
-        jobs.push_back({sp.width, y0, y1, base.view(), source, out.view(), residuals.data()});
+        jobs.push_back(
+            {sp.width, y0, y1, base.view(), source, out.view(), residuals.data(), &carry, s});
     }
     return jobs;
 }
@@ -293,6 +298,7 @@ void encode_motion(const FrameContext& fc, const Camera& camera, ImageView<const
                    StreamStats& stats) {
     const SequenceParams& sp = *fc.sp;
     const int w = sp.width, h = sp.height;
+    const ModelCarry carry = fc.carry(&Picture::Models::motion);
     Image<glm::vec2>& base = fc.work->base_motion;
     base_motion(camera, depth, w, h, base);
     ensure_size(out, w, h);
@@ -327,12 +333,12 @@ void encode_motion(const FrameContext& fc, const Camera& camera, ImageView<const
         encode_motion_models(sp, depth, base.view(), source, ids, fc.work->object_fields,
                              fc.work->predicted_owner.view(), out.view(),
                              objects ? owner.view() : ImageView<uint32_t>{}, fc.work->motion_models,
-                             fc.work->slice_bytes, bytes, stats);
+                             carry, fc.work->slice_bytes, bytes, stats);
     } else {
         wr.u8(0);
         std::vector<Residual>& residuals = fc.work->motion_residuals;
         residuals.resize(std::size_t(w) * h);
-        std::vector<SliceJob> jobs = slice_jobs(sp, base, source, out, residuals);
+        std::vector<SliceJob> jobs = slice_jobs(sp, base, source, out, residuals, carry);
         encode_slices(sp.slices, fc.work->slice_bytes, bytes, [&](int s, std::vector<uint8_t>& b) {
             RangeEncoder rc(b);
             code_slice<true>(jobs[s], rc);
@@ -348,6 +354,7 @@ Status decode_motion(const FrameContext& fc, const Camera& camera, ImageView<con
                      StreamStats& stats) {
     const SequenceParams& sp = *fc.sp;
     const int w = sp.width, h = sp.height;
+    const ModelCarry carry = fc.carry(&Picture::Models::motion);
     Image<glm::vec2>& base = fc.work->base_motion;
     base_motion(camera, depth, w, h, base);
     ensure_size(out, w, h);
@@ -388,13 +395,13 @@ Status decode_motion(const FrameContext& fc, const Camera& camera, ImageView<con
             REPRISE_TRY(decode_motion_models(sp, depth, base.view(), fc.work->object_fields,
                                              fc.work->predicted_owner.view(), slices, out.view(),
                                              objects ? owner.view() : ImageView<uint32_t>{},
-                                             fc.work->motion_models, stats));
+                                             fc.work->motion_models, carry, stats));
             stats.motion_bits += 8 * in.size();
             return {};
         }
         std::vector<Residual>& residuals = fc.work->motion_residuals;
         residuals.resize(std::size_t(w) * h);
-        std::vector<SliceJob> jobs = slice_jobs(sp, base, {}, out, residuals);
+        std::vector<SliceJob> jobs = slice_jobs(sp, base, {}, out, residuals, carry);
         REPRISE_TRY(
             decode_slices(slices, "motion section", [&](int s, std::span<const uint8_t> bytes) {
                 RangeDecoder rc(bytes);

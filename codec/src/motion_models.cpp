@@ -72,6 +72,8 @@ struct Job {
     ImageView<glm::vec2> out;
     ImageView<uint32_t> owner;  // may be empty
     MotionModelScratch* scratch;
+    const ModelCarry* carry;
+    int slice;
     std::size_t pixels = 0, models = 0, own_pixels = 0, object_nodes = 0;
     StreamStats::MotionBits bits;  // encoder
 
@@ -589,6 +591,7 @@ bool code_node(Job& j, Models& m, Node n, int level, Coder& rc) {
 template <bool Encode, class Coder>
 bool code_slice(Job& j, Coder& rc) {
     Models m;
+    j.carry->load(j.slice, m);
     for (int y = j.y0; y < j.y1; y += kMb) {
         for (int x = 0; x < j.width(); x += kMb)
             if (!code_node<Encode>(j, m, {x, y, kMb, kMb}, 0, rc)) return false;
@@ -596,6 +599,7 @@ bool code_slice(Job& j, Coder& rc) {
             if (rc.overrun() > 8) return false;
         }
     }
+    j.carry->save(j.slice, m);
     return true;
 }
 
@@ -603,7 +607,8 @@ std::vector<Job> slice_jobs(const SequenceParams& sp, ImageView<const float> dep
                             ImageView<const glm::vec2> base, ImageView<const glm::vec2> source,
                             ImageView<const uint32_t> ids, std::span<const ObjectField> fields,
                             ImageView<const uint32_t> predicted, ImageView<glm::vec2> out,
-                            ImageView<uint32_t> owner, MotionModelScratch& scratch) {
+                            ImageView<uint32_t> owner, MotionModelScratch& scratch,
+                            const ModelCarry& carry) {
     scratch.cell_columns = (sp.width + 3) / 4;
     scratch.cells.assign(std::size_t(scratch.cell_columns) * ((sp.height + 3) / 4), {});
     scratch.kinds.resize(std::size_t(sp.width) * sp.height);
@@ -615,7 +620,7 @@ std::vector<Job> slice_jobs(const SequenceParams& sp, ImageView<const float> dep
         const int y0 = std::min(sp.height, sp.slice_begin(s) * kMb);
         const int y1 = std::min(sp.height, sp.slice_begin(s + 1) * kMb);
         jobs.push_back({&sp, y0, y1, sp.motion_error, own_step(sp.motion_error), depth, base,
-                        source, ids, fields, predicted, out, owner, &scratch});
+                        source, ids, fields, predicted, out, owner, &scratch, &carry, s});
     }
     return jobs;
 }
@@ -647,10 +652,10 @@ void encode_motion_models(const SequenceParams& sp, ImageView<const float> depth
                           ImageView<const uint32_t> ids, std::span<const ObjectField> fields,
                           ImageView<const uint32_t> predicted, ImageView<glm::vec2> out,
                           ImageView<uint32_t> owner, MotionModelScratch& scratch,
-                          std::vector<std::vector<uint8_t>>& slice_bytes,
+                          const ModelCarry& carry, std::vector<std::vector<uint8_t>>& slice_bytes,
                           std::vector<uint8_t>& bytes, StreamStats& stats) {
     std::vector<Job> jobs =
-        slice_jobs(sp, depth, base, source, ids, fields, predicted, out, owner, scratch);
+        slice_jobs(sp, depth, base, source, ids, fields, predicted, out, owner, scratch, carry);
     encode_slices(sp.slices, slice_bytes, bytes, [&](int s, std::vector<uint8_t>& b) {
         RangeEncoder rc(b);
         code_slice<true>(jobs[s], rc);
@@ -664,9 +669,10 @@ Status decode_motion_models(const SequenceParams& sp, ImageView<const float> dep
                             ImageView<const uint32_t> predicted,
                             const std::vector<std::span<const uint8_t>>& slices,
                             ImageView<glm::vec2> out, ImageView<uint32_t> owner,
-                            MotionModelScratch& scratch, StreamStats& stats) {
+                            MotionModelScratch& scratch, const ModelCarry& carry,
+                            StreamStats& stats) {
     std::vector<Job> jobs =
-        slice_jobs(sp, depth, base, {}, {}, fields, predicted, out, owner, scratch);
+        slice_jobs(sp, depth, base, {}, {}, fields, predicted, out, owner, scratch, carry);
     REPRISE_TRY(decode_slices(slices, "motion section", [&](int s, std::span<const uint8_t> b) {
         RangeDecoder rc(b);
         return code_slice<false>(jobs[s], rc);

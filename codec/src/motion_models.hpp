@@ -8,6 +8,7 @@
 #include "object_motion.hpp"
 #include "reprise/core/image.hpp"
 #include "reprise/core/status.hpp"
+#include "slices.hpp"
 
 namespace reprise::codec {
 
@@ -48,19 +49,20 @@ bool motion_within_bound(ImageView<const glm::vec2> source, ImageView<const glm:
 // encoder's object ids) chooses which one to try (a field with id 0, the cameras' motion, for
 // ids that are no field's). `predicted` (may be empty): the object a pixel's base moves with.
 // `owner` (when not empty) gets each pixel's object id where an object model or the base gave
-// its motion, else 0.
+// its motion, else 0. `carry`: the slices' models (version 20).
 void encode_motion_models(const SequenceParams& sp, ImageView<const float> depth,
                           ImageView<const glm::vec2> base, ImageView<const glm::vec2> source,
                           ImageView<const uint32_t> ids, std::span<const ObjectField> fields,
                           ImageView<const uint32_t> predicted, ImageView<glm::vec2> out,
                           ImageView<uint32_t> owner, MotionModelScratch& scratch,
-                          std::vector<std::vector<uint8_t>>& slice_bytes,
+                          const ModelCarry& carry, std::vector<std::vector<uint8_t>>& slice_bytes,
                           std::vector<uint8_t>& bytes, StreamStats& stats);
 Status decode_motion_models(const SequenceParams& sp, ImageView<const float> depth,
                             ImageView<const glm::vec2> base, std::span<const ObjectField> fields,
                             ImageView<const uint32_t> predicted,
                             const std::vector<std::span<const uint8_t>>& slices,
                             ImageView<glm::vec2> out, ImageView<uint32_t> owner,
-                            MotionModelScratch& scratch, StreamStats& stats);
+                            MotionModelScratch& scratch, const ModelCarry& carry,
+                            StreamStats& stats);
 
 }  // namespace reprise::codec

@@ -2,14 +2,49 @@
 // A section split into independently coded slices (bands of macroblock rows): each slice is
 // preceded by its byte length, so slices are coded and decoded in parallel and the result does
 // not depend on the thread count.
+#include <cstring>
 #include <span>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "reprise/core/byte_io.hpp"
 #include "reprise/core/parallel.hpp"
 
 namespace reprise::codec {
+
+using SliceModels = std::vector<std::vector<uint8_t>>;  // per slice: its adaptive models' bytes
+
+// Version 20: the slices of an inter frame's section start from the adaptive models that the same
+// slices of its reference picture's section ended with (`from`); a key frame's start fresh. The
+// picture being made (`to`) keeps each slice's models at its end, and the reference's where the
+// section codes no slices.
+struct ModelCarry {
+    const SliceModels* from = nullptr;
+    SliceModels* to = nullptr;
+
+    // `to` as the reference's models, for `slices` slices.
+    void pass_on(int slices) const {
+        if (!to) return;
+        *to = from ? *from : SliceModels{};
+        to->resize(std::size_t(slices));
+    }
+    template <class Models>
+    void load(int slice, Models& m) const {
+        static_assert(std::is_trivially_copyable_v<Models>);
+        if (from && std::size_t(slice) < from->size() && (*from)[slice].size() == sizeof(Models))
+            std::memcpy(&m, (*from)[slice].data(), sizeof(Models));
+        else
+            m = Models{};
+    }
+    // After pass_on: each slice writes its own entry, so slices in parallel may save.
+    template <class Models>
+    void save(int slice, const Models& m) const {
+        if (!to || std::size_t(slice) >= to->size()) return;
+        (*to)[slice].resize(sizeof(Models));
+        std::memcpy((*to)[slice].data(), &m, sizeof(Models));
+    }
+};
 
 template <class CodeSlice>  // void(int slice, std::vector<uint8_t>& bytes)
 void encode_slices(int count, std::vector<std::vector<uint8_t>>& scratch, std::vector<uint8_t>& out,
