@@ -16,16 +16,17 @@ namespace reprise::codec {
 
 inline constexpr int kProbBits = 12;
 
-// The probability of a 0 as the mean of two estimates in 1/32768, one moving 1/8 and one 1/32 of
-// the way to each bit seen; a model's first bits move them further (1/2, 1/4, ...), as a model
-// starts at 1/2 in every slice of every frame and most see only a few hundred bits.
+// The probability of a 0 as the mean of two estimates in 1/32768, one moving 1/8 and one 1/64
+// (version 20; 1/32 before) of the way to each bit seen; a model's first bits move them further
+// (1/2, 1/4, ...), as a model starts at 1/2 in every slice of a key frame (an inter frame's carry
+// on from its reference's, slices.hpp) and many see only a few hundred bits.
 struct BitModel {
     uint16_t fast = 1 << 14, slow = 1 << 14;
-    uint8_t seen = 0;                                            // bits seen, up to 4
-    uint32_t p() const { return (uint32_t(fast) + slow) >> 4; }  // in 1/4096, 2..4093
+    uint8_t seen = 0;                                            // bits seen, up to 5
+    uint32_t p() const { return (uint32_t(fast) + slow) >> 4; }  // in 1/4096, 4..4091
     void update(int b) {
-        const int f = std::min(int(seen) + 1, 3), s = std::min(int(seen) + 1, 5);
-        if (seen < 4) ++seen;
+        const int f = std::min(int(seen) + 1, 3), s = std::min(int(seen) + 1, 6);
+        if (seen < 5) ++seen;
         if (!b) {
             fast += ((1 << 15) - fast) >> f;
             slow += ((1 << 15) - slow) >> s;
