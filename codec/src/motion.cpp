@@ -65,6 +65,7 @@ struct SliceJob {
     const ModelCarry* carry;
     int slice;
     std::size_t pixels = 0;
+    StreamStats::MotionBits bits;  // encoder
 
     const Residual* at(int x, int y) const {
         return x >= 0 && y >= y0 ? &residuals[std::size_t(y) * width + x] : nullptr;
@@ -107,6 +108,7 @@ bool code_slice(SliceJob& j, Coder& rc) {
         block_nonzero.assign(blocks, 0);
         for (int b = 0; b < blocks; ++b) {
             if constexpr (Encode) {
+                rc.tally_into(&j.bits.tree);
                 for (int y = by; y < by + bh && !block_nonzero[b]; ++y)
                     for (int x = b * kBlock; x < std::min(j.width, (b + 1) * kBlock); ++x)
                         if (!residual_of(j.source(x, y), j.base(x, y)).zero()) block_nonzero[b] = 1;
@@ -123,6 +125,7 @@ bool code_slice(SliceJob& j, Coder& rc) {
                     BitModel& nz = m.nonzero[nonzero_context(j, x, y)];
                     if constexpr (Encode) {
                         r = residual_of(j.source(x, y), j.base(x, y));
+                        rc.tally_into(&j.bits.pixels);
                         rc.bit(nz, !r.zero());
                         if (!r.zero()) {
                             rc.bit(m.invalid, r.invalid);
@@ -344,7 +347,10 @@ void encode_motion(const FrameContext& fc, const Camera& camera, ImageView<const
             code_slice<true>(jobs[s], rc);
             rc.finish();
         });
-        for (const SliceJob& j : jobs) stats.motion_residual_pixels += j.pixels;
+        for (const SliceJob& j : jobs) {
+            stats.motion_residual_pixels += j.pixels;
+            stats.motion_parts += j.bits;
+        }
     }
     stats.motion_bits += 8 * (bytes.size() - start);
 }

@@ -106,8 +106,9 @@ struct StreamStats {
         }
     } depth_parts;
     // Encoder: where the motion bits go (bits; ideal lengths but for `objects`): the quadtree's
-    // flags (zero, merge, object, split), new affine models' parameters, 4x4 cells coded pixel by
-    // pixel, and the rigid objects' list (in the camera section, counted as motion).
+    // flags (zero, merge, object, split; a 4x4 cell's pixel-by-pixel and object flags), new affine
+    // models' parameters, the cells coded pixel by pixel (per-pixel motion, M = 0: its block flags
+    // as tree, its pixels as pixels), and the rigid objects' list (in the camera section).
     struct MotionBits {
         double tree = 0.0, models = 0.0, pixels = 0.0, objects = 0.0;
         double total() const { return tree + models + pixels + objects; }
